@@ -1,0 +1,114 @@
+#pragma once
+/// @file
+/// Artifact: anything placed in a scene. Physic and render node trees, at most one driver, any
+/// number of sensors.
+
+#include <ssx/descriptor.hpp>
+#include <ssx/export.hpp>
+#include <ssx/physic_engine.hpp>
+#include <ssx/physic_node.hpp>
+#include <ssx/plugin.hpp>
+#include <ssx/render.hpp>
+
+#include <cstddef>
+#include <memory>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace ssx {
+
+class Environment;
+
+/// An artifact. Created by `Environment::addArtifact`; owned by the environment.
+/// Node trees, drivers and sensors are added before the environment starts.
+class SSX_EXPORT Artifact {
+ public:
+  Artifact(const Artifact&) = delete;
+  Artifact& operator=(const Artifact&) = delete;
+  ~Artifact();
+
+  const std::string& name() const noexcept { return name_; }
+  /// Position in the environment's artifact list; streams and orders derive from it.
+  std::size_t index() const noexcept { return index_; }
+  Environment& environment() const noexcept { return *env_; }
+  /// The pose the artifact was placed at; root nodes are posed relative to it.
+  const Pose& placement() const noexcept { return placement_; }
+
+  // --- setup (before the environment starts) ---------------------------------------------
+
+  /// Adds a physic node tree (checked with validatePhysicTree) and returns its root node.
+  PhysicNode& addPhysicRoot(PhysicNodeSpec spec);
+  /// Adds a render node tree.
+  void addRenderRoot(RenderNodeSpec spec);
+  /// Sets the driver. `class_name` names it in messages; `period_steps` >= 1.
+  Driver& setDriver(std::unique_ptr<Driver> driver, Descriptor params = {}, std::int64_t period_steps = 1,
+                    std::string class_name = {});
+  /// Adds a sensor; returns it. Sensor i has plugin index i + 1 (the driver has 0).
+  Sensor& addSensor(std::unique_ptr<Sensor> sensor, Descriptor params = {}, std::int64_t period_steps = 1,
+                    std::string class_name = {});
+
+  // --- access -------------------------------------------------------------------------------
+
+  Driver* driver() const noexcept { return driver_.get(); }
+  std::size_t sensorCount() const noexcept { return sensors_.size(); }
+  Sensor& sensor(std::size_t i) const { return *sensors_.at(i).sensor; }
+  /// The first sensor of type T, or nullptr.
+  template <class T>
+  T* findSensor() const {
+    for (const auto& s : sensors_)
+      if (auto* t = dynamic_cast<T*>(s.sensor.get())) return t;
+    return nullptr;
+  }
+
+  std::size_t rootCount() const noexcept { return roots_.size(); }
+  PhysicNode& root(std::size_t i = 0) const { return *roots_.at(i); }
+  /// Node by name, searching every tree; nullptr if none.
+  PhysicNode* node(std::string_view name) const;
+  const std::vector<std::unique_ptr<PhysicNode>>& nodes() const noexcept { return nodes_; }
+  const std::vector<RenderNodeSpec>& renderRoots() const noexcept { return render_roots_; }
+
+  /// State of the first root node (world frame). Requires a physic root.
+  BodyState state() const { return root().state(); }
+  Pose pose() const { return root().pose(); }
+
+ private:
+  friend class Environment;
+  friend class PhysicNode;
+  Artifact(Environment& env, std::string name, std::size_t index, const Pose& placement);
+
+  struct SensorSlot {
+    std::unique_ptr<Sensor> sensor;
+    Descriptor params;
+    bool fresh = false;  // wrote a measurement in this step
+  };
+  struct Subscription {
+    const Artifact* source;
+    std::size_t sensor_index;
+    std::uint64_t sequence;
+    std::function<void(const Measurement&)> callback;
+  };
+
+  void buildNodes(PhysicNode* parent, const PhysicNodeSpec& spec);
+  void checkWritable() const;
+  Wrench& wrench(int body);
+  void requireSetup(const char* what) const;
+
+  Environment* env_;
+  std::string name_;
+  std::size_t index_;
+  Pose placement_;
+  std::vector<std::unique_ptr<PhysicNodeSpec>> root_specs_;
+  std::vector<std::unique_ptr<PhysicNode>> nodes_;  // every node, trees in order
+  std::vector<PhysicNode*> roots_;
+  std::vector<RenderNodeSpec> render_roots_;
+  std::unique_ptr<Driver> driver_;
+  Descriptor driver_params_;
+  std::vector<SensorSlot> sensors_;
+  std::vector<Subscription> inbox_;  // sorted (source index, sensor index, sequence) at start
+  // bodies of this artifact: [body_begin_, body_end_) in the environment's body arrays
+  int body_begin_ = 0;
+  int body_end_ = 0;
+};
+
+}  // namespace ssx

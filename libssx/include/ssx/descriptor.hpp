@@ -1,0 +1,100 @@
+#pragma once
+/// @file
+/// Descriptor: one node of configuration (an XML element, or built in code) with typed getters.
+
+#include <ssx/error.hpp>
+#include <ssx/export.hpp>
+#include <ssx/types.hpp>
+
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace ssx {
+
+/// A node of configuration: a name, string attributes and child nodes, each with the file and
+/// line it came from. Typed getters parse on demand and throw `ConfigError` naming the file,
+/// line, element and attribute. Every attribute remembers whether it was read, so that unread
+/// (unknown) attributes can be reported as warnings.
+///
+/// Supported value types: `std::string`, `bool` (true/false/1/0), `int`, `std::int64_t`,
+/// `double`, `Vec3` ("x y z").
+class SSX_EXPORT Descriptor {
+ public:
+  struct Attribute {
+    std::string key;
+    std::string value;
+    SourceLocation where;
+    mutable bool used = false;
+  };
+
+  Descriptor() = default;
+  explicit Descriptor(std::string name, SourceLocation where = {});
+
+  const std::string& name() const noexcept { return name_; }
+  const SourceLocation& where() const noexcept { return where_; }
+
+  /// Sets (or replaces) an attribute; returns *this for chaining.
+  Descriptor& set(std::string key, std::string value, SourceLocation where = {});
+  Descriptor& set(std::string key, double value);
+  Descriptor& set(std::string key, std::int64_t value);
+  Descriptor& set(std::string key, int value) { return set(std::move(key), std::int64_t{value}); }
+  Descriptor& set(std::string key, bool value);
+  Descriptor& set(std::string key, const char* value) { return set(std::move(key), std::string(value)); }
+  Descriptor& set(std::string key, const Vec3& value);
+
+  /// Appends a child node and returns it.
+  Descriptor& addChild(Descriptor child);
+
+  bool has(std::string_view key) const;
+  /// The raw text of an attribute, or nullptr. Marks it read.
+  const Attribute* find(std::string_view key) const;
+
+  /// The attribute parsed as T; throws ConfigError if missing or malformed.
+  template <class T>
+  T get(std::string_view key) const;
+  /// The attribute parsed as T, or `fallback` if absent; throws ConfigError if malformed.
+  template <class T>
+  T get(std::string_view key, const T& fallback) const;
+  /// Like get, and also checks `value > 0` (throws ConfigError naming the attribute).
+  double getPositive(std::string_view key, double fallback) const;
+
+  const std::vector<Attribute>& attributes() const noexcept { return attributes_; }
+  const std::vector<Descriptor>& children() const noexcept { return children_; }
+  /// The first child with this element name, or nullptr.
+  const Descriptor* child(std::string_view name) const;
+  /// Every child with this element name, in document order.
+  std::vector<const Descriptor*> childrenNamed(std::string_view name) const;
+
+  /// Attributes never read, as "file:line: warning: unknown attribute 'k' of <name>" lines
+  /// (this node only; callers recurse where the children are theirs).
+  std::vector<std::string> unusedAttributeWarnings() const;
+
+  /// Builds the ConfigError for this element: "file:line: error: <name>: message".
+  ConfigError error(const std::string& message) const;
+  /// Builds the ConfigError for one attribute of this element.
+  ConfigError error(const Attribute& attribute, const std::string& message) const;
+
+ private:
+  std::string name_;
+  SourceLocation where_;
+  std::vector<Attribute> attributes_;
+  std::vector<Descriptor> children_;
+};
+
+// explicit instantiations live in descriptor.cpp
+extern template SSX_EXPORT std::string Descriptor::get<std::string>(std::string_view) const;
+extern template SSX_EXPORT bool Descriptor::get<bool>(std::string_view) const;
+extern template SSX_EXPORT int Descriptor::get<int>(std::string_view) const;
+extern template SSX_EXPORT std::int64_t Descriptor::get<std::int64_t>(std::string_view) const;
+extern template SSX_EXPORT double Descriptor::get<double>(std::string_view) const;
+extern template SSX_EXPORT Vec3 Descriptor::get<Vec3>(std::string_view) const;
+extern template SSX_EXPORT std::string Descriptor::get<std::string>(std::string_view, const std::string&) const;
+extern template SSX_EXPORT bool Descriptor::get<bool>(std::string_view, const bool&) const;
+extern template SSX_EXPORT int Descriptor::get<int>(std::string_view, const int&) const;
+extern template SSX_EXPORT std::int64_t Descriptor::get<std::int64_t>(std::string_view, const std::int64_t&) const;
+extern template SSX_EXPORT double Descriptor::get<double>(std::string_view, const double&) const;
+extern template SSX_EXPORT Vec3 Descriptor::get<Vec3>(std::string_view, const Vec3&) const;
+
+}  // namespace ssx

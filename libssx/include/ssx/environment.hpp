@@ -1,0 +1,209 @@
+#pragma once
+/// @file
+/// Environment: owns the engines, the artifacts and the extensions; steps and paces them.
+///
+/// One step (`step()`), advancing simulated time by one timestep:
+///   1. extensions' beforeStep (calling thread)
+///   2. physics: the engine integrates the timestep (in `substeps` parts) with the forces the
+///      drivers wrote before; no plugin code runs
+///   3. snapshot: every body's new pose, velocities and accelerations are published read-only and
+///      checked for NaN / infinity
+///   4. sensors, in parallel over artifacts: each due sensor reads the snapshot and writes its
+///      own measurement
+///   5. drivers, in parallel over artifacts: each artifact's subscribed callbacks get the fresh
+///      measurements (ordered by source artifact, sensor, subscription), then its driver runs
+///      if due and writes its own command buffer
+///   6. render, when due: render items are posed from the snapshot and a frame is drawn
+///   7. extensions' afterStep (calling thread)
+/// A plugin that throws, or a non-finite state, abandons the step with a StepError; the
+/// environment is then failed and refuses further steps. `step()` never sleeps: pacing is in
+/// `run()`.
+
+#include <ssx/artifact.hpp>
+#include <ssx/descriptor.hpp>
+#include <ssx/export.hpp>
+#include <ssx/physic_engine.hpp>
+#include <ssx/plugin.hpp>
+#include <ssx/render.hpp>
+#include <ssx/timing.hpp>
+#include <ssx/types.hpp>
+
+#include <atomic>
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace ssx {
+
+namespace detail {
+class WorkerPool;
+}
+
+/// Everything that defines an environment before it is populated.
+struct EnvironmentSettings {
+  Nanoseconds timestep = 1'000'000;  ///< tau, ns (default 1 ms)
+  std::uint64_t seed = 0;            ///< root of every random stream
+  int threads = 0;                   ///< worker threads for the parallel phases; 0: one per core; 1: inline
+  PhysicsSettings physics;
+  RenderSettings render;
+};
+
+/// How a run is paced.
+struct RunOptions {
+  enum class Mode : std::uint8_t {
+    RealTime,  ///< one timestep per timestep/realtime_factor of wall-clock time
+    Fast,      ///< as fast as possible
+  };
+  enum class Overrun : std::uint8_t {
+    CatchUp,  ///< deadlines stay on the original grid; late steps run back to back until caught up (the paper's)
+    Resync,   ///< after a late step the grid restarts from now: lateness never accumulates
+  };
+  Mode mode = Mode::RealTime;
+  double realtime_factor = 1.0;  ///< > 1 runs faster than the wall clock
+  std::int64_t steps = -1;       ///< stop after this many steps; -1: until `stop` is set
+  Overrun overrun = Overrun::CatchUp;
+  Nanoseconds spin = 0;          ///< busy-wait this long before each deadline, for precision
+  Nanoseconds warn_interval = 1'000'000'000;  ///< at most one overrun warning per this wall time
+  const std::atomic<bool>* stop = nullptr;    ///< set to true (from anywhere) to end the run
+  std::function<void(const Environment&)> on_step;  ///< after every step, calling thread
+};
+
+enum class LogLevel : std::uint8_t { Info, Warning, Error };
+using LogSink = std::function<void(LogLevel, std::string_view)>;
+
+/// A simulated world. Not copyable. All calls come from one thread (the one that steps);
+/// plugin callbacks run on worker threads only inside the parallel phases.
+class SSX_EXPORT Environment {
+ public:
+  enum class State : std::uint8_t { Setup, Running, Stopped, Failed };
+
+  explicit Environment(EnvironmentSettings settings = {});
+  Environment(const Environment&) = delete;
+  Environment& operator=(const Environment&) = delete;
+  /// Stops (if running) and destroys everything: plugins, engines, then extensions.
+  ~Environment();
+
+  // --- setup -------------------------------------------------------------------------------
+
+  /// Adds an artifact placed at `placement`. Names are unique (ConfigError otherwise).
+  Artifact& addArtifact(std::string name, const Pose& placement = {});
+  /// Adds a static ground plane at height `z` (an artifact named "ground").
+  Artifact& addGround(double z = 0.0);
+  /// Adds an extension under a unique name.
+  SimulationExtension& addExtension(std::string name, std::unique_ptr<SimulationExtension> extension,
+                                    Descriptor params = {});
+  /// Delivers `sensor`'s measurements to `callback`, in the drivers phase on `subscriber`'s
+  /// thread. Allowed before start and from `configure`.
+  void subscribe(const Sensor& sensor, Artifact& subscriber, std::function<void(const Measurement&)> callback);
+  /// Typed form: the sensor's measurement must be an M (checked now).
+  template <class M>
+  void subscribe(const Sensor& sensor, Artifact& subscriber, std::function<void(const M&)> callback);
+  /// Where messages go (default: stderr, "ssx: warning: ...").
+  void setLogSink(LogSink sink);
+  void log(LogLevel level, std::string_view message) const;
+
+  // --- lifecycle -----------------------------------------------------------------------------
+
+  /// Inits extensions, configures the engines, publishes the first snapshot, configures drivers
+  /// and sensors, starts the worker pool. Called by the first step() if not called before.
+  void start();
+  /// Advances one timestep (see the file comment). Throws StepError if a plugin fails.
+  void step();
+  /// Steps `n` times.
+  void step(std::int64_t n);
+  /// Runs and paces steps; returns the timing summary of this run. Throws StepError.
+  TimingSummary run(const RunOptions& options);
+  /// Destroys drivers and sensors, stops the engines, shuts extensions down (reverse order).
+  void stop();
+  State state() const noexcept { return state_; }
+
+  // --- queries -------------------------------------------------------------------------------
+
+  const EnvironmentSettings& settings() const noexcept { return settings_; }
+  Nanoseconds timestep() const noexcept { return settings_.timestep; }
+  /// Simulated time: steps taken times the timestep.
+  Nanoseconds time() const noexcept { return steps_ * settings_.timestep; }
+  std::int64_t stepCount() const noexcept { return steps_; }
+  /// Worker threads used by the parallel phases (1: inline).
+  unsigned threadCount() const noexcept;
+
+  std::size_t artifactCount() const noexcept { return artifacts_.size(); }
+  Artifact& artifact(std::size_t index) const { return *artifacts_.at(index); }
+  /// Artifact by name, or nullptr.
+  Artifact* findArtifact(std::string_view name) const;
+  /// Extension by name, or nullptr.
+  SimulationExtension* extension(std::string_view name) const;
+  template <class T>
+  T* extension(std::string_view name) const { return dynamic_cast<T*>(extension(name)); }
+
+  /// The published state of body `i` (see PhysicNode::bodyIndex).
+  const BodyState& bodyState(int i) const { return states_.at(static_cast<std::size_t>(i)); }
+  std::size_t bodyCount() const noexcept { return states_.size(); }
+  /// A 64-bit hash (FNV-1a) of every body's pose and velocities, bit for bit, and the time.
+  std::uint64_t stateHash() const;
+
+  PhysicEngine& physics() const;
+  RenderEngine& renderer() const;
+  /// Per-step timing of every step taken so far.
+  TimingRecorder& timing() noexcept { return timing_; }
+  const TimingRecorder& timing() const noexcept { return timing_; }
+
+ private:
+  friend class Artifact;
+  friend class PhysicNode;
+
+  void requireSetup(const char* what) const;
+  void buildBodies();
+  void publishSnapshot(bool first);
+  void runSensors(std::size_t begin, std::size_t end);
+  void runDrivers(std::size_t begin, std::size_t end);
+  void raiseFirstError(const char* phase);
+  void drawFrame();
+  void fail();
+
+  struct ExtensionSlot {
+    std::string name;
+    std::unique_ptr<SimulationExtension> extension;
+    Descriptor params;
+    bool initialised = false;
+  };
+  struct PendingError {
+    std::string plugin;
+    std::string message;
+  };
+
+  EnvironmentSettings settings_;
+  State state_ = State::Setup;
+  std::int64_t steps_ = 0;
+  std::vector<std::unique_ptr<Artifact>> artifacts_;
+  std::vector<ExtensionSlot> extensions_;
+  std::unique_ptr<PhysicEngine> physics_;
+  std::unique_ptr<RenderEngine> renderer_;
+  std::unique_ptr<detail::WorkerPool> pool_;
+  std::vector<BodyState> states_;        // the snapshot, one per body
+  std::vector<Vec3> previous_linear_;    // velocities before the step, for accelerations
+  std::vector<Vec3> previous_angular_;
+  std::vector<Wrench> wrenches_;         // command buffers, one per body, owned by artifacts
+  std::vector<Artifact*> body_owner_;
+  std::vector<PendingError> errors_;     // one per artifact, filled by the parallel phases
+  std::vector<RenderItem> render_items_;
+  std::uint64_t subscription_sequence_ = 0;
+  TimingRecorder timing_;
+  LogSink log_;
+  std::int64_t current_step_ = 0;
+  bool configuring_ = false;
+};
+
+template <class M>
+void Environment::subscribe(const Sensor& sensor, Artifact& subscriber, std::function<void(const M&)> callback) {
+  if (dynamic_cast<const M*>(&sensor.latest()) == nullptr)
+    throw ConfigError({}, "sensor '" + sensor.className() + "' of artifact '" + sensor.artifact().name() +
+                              "' does not produce the measurement type the subscriber asked for");
+  subscribe(sensor, subscriber,
+            [cb = std::move(callback)](const Measurement& m) { cb(static_cast<const M&>(m)); });
+}
+
+}  // namespace ssx

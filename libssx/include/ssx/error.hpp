@@ -1,0 +1,59 @@
+#pragma once
+/// @file
+/// The errors ssx reports. Every message is complete and says what to do.
+
+#include <ssx/export.hpp>
+
+#include <stdexcept>
+#include <string>
+
+namespace ssx {
+
+/// Where a piece of configuration came from: a file and a 1-based line, or code.
+struct SourceLocation {
+  std::string file;  ///< empty when built in code
+  int line = 0;      ///< 1-based; 0 when unknown
+
+  /// "file:line", "file", or "<code>".
+  SSX_EXPORT std::string str() const;
+};
+
+/// Base of every ssx exception.
+class SSX_EXPORT Error : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+/// Bad configuration: a scene, an artifact, a parameter. The message reads
+/// `file:line: error: ...` when the location is known.
+class SSX_EXPORT ConfigError : public Error {
+ public:
+  ConfigError(SourceLocation where, const std::string& message);
+  const SourceLocation& where() const noexcept { return where_; }
+  /// The message without the location prefix.
+  const std::string& detail() const noexcept { return detail_; }
+
+ private:
+  SourceLocation where_;
+  std::string detail_;
+};
+
+/// A step was abandoned: a plugin threw, or the physics produced a NaN or infinite state.
+/// The environment is left in the failed state: it refuses further steps.
+class SSX_EXPORT StepError : public Error {
+ public:
+  StepError(std::string artifact, std::string plugin, std::int64_t step, const std::string& what);
+  /// Name of the artifact whose plugin or state failed.
+  const std::string& artifact() const noexcept { return artifact_; }
+  /// Which plugin failed: "driver <class>", "sensor <index> <class>", or "physics".
+  const std::string& plugin() const noexcept { return plugin_; }
+  /// Index of the step that was abandoned.
+  std::int64_t step() const noexcept { return step_; }
+
+ private:
+  std::string artifact_;
+  std::string plugin_;
+  std::int64_t step_;
+};
+
+}  // namespace ssx

@@ -1,0 +1,83 @@
+#pragma once
+/// @file
+/// The abstract physics engine. Nothing of a backend's library appears here, so another backend
+/// can be added without touching clients.
+
+#include <ssx/export.hpp>
+#include <ssx/physic_node.hpp>
+#include <ssx/types.hpp>
+
+#include <limits>
+#include <memory>
+#include <span>
+#include <string>
+#include <vector>
+
+namespace ssx {
+
+/// Settings of the physics engine.
+struct PhysicsSettings {
+  enum class Solver : std::uint8_t {
+    QuickStep,  ///< iterative (ODE's dWorldQuickStep): O(n) in constraints; the default
+    Exact,      ///< direct LCP (ODE's dWorldStep): accurate, O(n^3) per island
+  };
+  enum class Broadphase : std::uint8_t {
+    SweepAndPrune,  ///< sorts bounds along the axes; scales to tens of thousands of bodies
+    QuadTree,       ///< fixed region, see quadtree_center / quadtree_extents
+  };
+  std::string engine = "ode";
+  Vec3 gravity{0.0, 0.0, -9.81};  ///< m/s^2, world frame
+  Solver solver = Solver::QuickStep;
+  int iterations = 20;            ///< QuickStep iterations
+  double sor = 1.3;               ///< QuickStep over-relaxation
+  int substeps = 1;               ///< equal physics steps per environment timestep
+  double erp = 0.2;               ///< error reduction parameter
+  double cfm = 1e-9;              ///< constraint force mixing
+  Broadphase broadphase = Broadphase::SweepAndPrune;
+  Vec3 quadtree_center = Vec3::Zero();
+  Vec3 quadtree_extents{1000.0, 1000.0, 200.0};
+  int quadtree_depth = 6;
+  // contacts
+  double friction = 1.0;          ///< Coulomb coefficient (pyramid approximation)
+  double restitution = 0.0;       ///< bounce, 0..1
+  double contact_soft_cfm = 1e-6;
+  double contact_soft_erp = 0.2;
+  double contact_surface_layer = 1e-3;  ///< m of allowed penetration, for resting stability
+  int max_contacts = 8;           ///< per pair of geoms
+};
+
+/// Force and torque on a body, world frame, torque about the centre of mass.
+struct Wrench {
+  Vec3 force = Vec3::Zero();
+  Vec3 torque = Vec3::Zero();
+};
+
+/// An abstract rigid-body engine. Bodies are created with their centre of mass at the body
+/// origin; the Environment flattens node trees into bodies. Called from one thread at a time
+/// (the thread calling Environment::step), never from the parallel phases.
+class SSX_EXPORT PhysicEngine {
+ public:
+  virtual ~PhysicEngine();
+  virtual std::string name() const = 0;
+
+  /// Adds a dynamic body; `state.pose` is the pose of its centre-of-mass frame. Returns its index.
+  virtual int addBody(const MassProperties& mass, const std::vector<Shape>& shapes, const BodyState& state) = 0;
+  /// Adds shapes fixed in the world at `pose`.
+  virtual void addStatic(const std::vector<Shape>& shapes, const Pose& pose) = 0;
+  /// Integrates one timestep (in the configured substeps), with `wrenches[i]` applied to body i
+  /// throughout.
+  virtual void step(Nanoseconds dt, std::span<const Wrench> wrenches) = 0;
+  /// Writes every body's pose and velocities into `out` (size bodyCount()); accelerations are
+  /// left as they are.
+  virtual void readStates(std::span<BodyState> out) const = 0;
+  /// Overwrites one body's pose and velocities.
+  virtual void setState(int body, const BodyState& state) = 0;
+  virtual std::size_t bodyCount() const = 0;
+  /// Contacts generated in the last step.
+  virtual std::size_t contactCount() const = 0;
+};
+
+/// Creates a physics engine by name ("ode"); throws ConfigError for an unknown name.
+SSX_EXPORT std::unique_ptr<PhysicEngine> createPhysicEngine(const PhysicsSettings& settings);
+
+}  // namespace ssx

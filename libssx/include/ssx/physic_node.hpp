@@ -1,0 +1,129 @@
+#pragma once
+/// @file
+/// Physic node trees: what a body is made of (shapes, mass, inertia), and the live nodes that
+/// read the simulated state and take forces.
+
+#include <ssx/error.hpp>
+#include <ssx/export.hpp>
+#include <ssx/types.hpp>
+
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace ssx {
+
+class Artifact;
+
+/// A collision and mass shape, posed relative to the node that holds it. Cylinders and capsules
+/// lie along their local z axis. A plane is the half-space below its local xy-plane (normal +z)
+/// and is allowed only on static nodes.
+struct SSX_EXPORT Shape {
+  enum class Kind : std::uint8_t { Box, Sphere, Cylinder, Capsule, Plane };
+  Kind kind = Kind::Box;
+  Vec3 size = Vec3::Ones();  ///< box: full edge lengths, m
+  double radius = 0.5;       ///< sphere, cylinder, capsule: m
+  double length = 1.0;       ///< cylinder: full height; capsule: length of the cylindrical part, m
+  Pose pose;                 ///< relative to the node
+  double density = 1000.0;   ///< kg/m^3; used when the node's mass comes from its shapes
+
+  static Shape box(const Vec3& size, const Pose& pose = {});
+  static Shape sphere(double radius, const Pose& pose = {});
+  static Shape cylinder(double radius, double length, const Pose& pose = {});
+  static Shape capsule(double radius, double length, const Pose& pose = {});
+  static Shape plane(const Pose& pose = {});
+
+  /// Volume in m^3 (0 for a plane).
+  double volume() const;
+  /// Inertia about the shape's own centre, in its own axes, for a given mass.
+  Mat3 unitInertia(double mass) const;
+};
+
+/// One node of a physic node tree, as described in a file or in code (the constant model).
+/// Children are rigidly attached to their parent (joints come later), posed relative to it.
+///
+/// Mass, in order of precedence: `mass` and `inertia` given: used as they are (inertia about
+/// `center_of_mass`, node axes); `mass` only: shapes' inertia scaled to that mass; neither:
+/// shapes' volume times density. A node without shapes and mass is a massless frame (a sensor
+/// mount, say).
+struct SSX_EXPORT PhysicNodeSpec {
+  std::string name;
+  Pose pose;  ///< relative to the parent node; for a root, relative to the artifact's pose
+  std::vector<Shape> shapes;
+  std::optional<double> mass;   ///< kg
+  std::optional<Mat3> inertia;  ///< kg m^2, about the centre of mass, node axes; needs `mass`
+  Vec3 center_of_mass = Vec3::Zero();  ///< node frame; used with an explicit `mass`
+  bool is_static = false;              ///< root only: fixed in the world, never moves
+  SourceLocation where;                ///< where it was described, for messages
+  std::vector<PhysicNodeSpec> children;
+
+  /// Appends a child and returns it.
+  PhysicNodeSpec& addChild(PhysicNodeSpec child);
+};
+
+/// Mass properties of a rigid body: total mass, centre of mass and inertia about it.
+struct MassProperties {
+  double mass = 0.0;
+  Vec3 center_of_mass = Vec3::Zero();  ///< in the frame the properties were computed in
+  Mat3 inertia = Mat3::Zero();         ///< about the centre of mass, axes of that frame
+};
+
+/// Checks a node tree: positive mass, positive definite inertia, positive shape sizes, planes
+/// only on static roots, unique names. Throws ConfigError naming the node.
+SSX_EXPORT void validatePhysicTree(const PhysicNodeSpec& root);
+
+/// Combined mass properties of a whole tree (children rigidly attached), in the root node's frame.
+SSX_EXPORT MassProperties combinedMass(const PhysicNodeSpec& root);
+
+/// A live node of an artifact's physic tree: reads its state from the environment's current
+/// snapshot and takes forces and torques for its rigid body.
+///
+/// Reads are safe from any phase and thread (they read the read-only snapshot). Writes
+/// (`addForce`, `addTorque`) go into the owning artifact's command buffer: during a step only
+/// that artifact's own driver may write; outside a step, the embedding program may.
+class SSX_EXPORT PhysicNode {
+ public:
+  const std::string& name() const noexcept { return spec_->name; }
+  const PhysicNodeSpec& spec() const noexcept { return *spec_; }
+  Artifact& artifact() const noexcept { return *artifact_; }
+  /// The parent node, or nullptr for a root.
+  PhysicNode* parent() const noexcept { return parent_; }
+  /// Fixed in the world (its root is static).
+  bool isStatic() const noexcept { return static_; }
+  /// Index of the rigid body this node belongs to (children share their root's body), or -1.
+  int bodyIndex() const noexcept { return body_; }
+  /// This node's frame relative to its body's centre-of-mass frame.
+  const Pose& poseInBody() const noexcept { return pose_in_body_; }
+
+  /// Pose, velocities and accelerations of this node's frame origin, world frame.
+  BodyState state() const;
+  Pose pose() const;
+
+  /// Adds a force at a point. `force` is in `force_frame`; `point` in `point_frame` (Local:
+  /// this node's frame; the default, the node's origin). Held until the driver next runs.
+  void addForce(const Vec3& force, Frame force_frame = Frame::World, const Vec3& point = Vec3::Zero(),
+                Frame point_frame = Frame::Local);
+  /// Adds a torque, in `frame`.
+  void addTorque(const Vec3& torque, Frame frame = Frame::World);
+  /// Sets the linear and angular velocity (world frame) of the node's body, the node's origin
+  /// moving at `linear`. Before start: the initial state. Between steps: applied at once.
+  void setVelocity(const Vec3& linear, const Vec3& angular);
+
+ private:
+  friend class Artifact;
+  friend class Environment;
+  PhysicNode(Artifact& artifact, const PhysicNodeSpec& spec, PhysicNode* parent)
+      : artifact_(&artifact), spec_(&spec), parent_(parent) {}
+
+  Artifact* artifact_;
+  const PhysicNodeSpec* spec_;
+  PhysicNode* parent_;
+  int body_ = -1;           // -1: static, or not started
+  bool static_ = false;
+  Pose pose_in_body_;       // node frame in body (centre-of-mass) frame
+  Pose setup_pose_;         // world pose as placed (static nodes keep it)
+  Vec3 initial_linear_ = Vec3::Zero();   // of this node's origin, set before start
+  Vec3 initial_angular_ = Vec3::Zero();
+};
+
+}  // namespace ssx

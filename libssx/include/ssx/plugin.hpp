@@ -1,0 +1,135 @@
+#pragma once
+/// @file
+/// What users write: drivers (behaviour), sensors (measurements) and simulation extensions
+/// (bridges to the outside). Instances are created by the embedding program or, later, loaded
+/// from plugin libraries; the code is the same.
+
+#include <ssx/descriptor.hpp>
+#include <ssx/export.hpp>
+#include <ssx/random.hpp>
+#include <ssx/types.hpp>
+
+#include <cstdint>
+#include <functional>
+#include <string>
+
+namespace ssx {
+
+class Artifact;
+class Environment;
+
+/// What a driver or sensor is told about the step it runs in.
+struct StepInfo {
+  std::int64_t step = 0;  ///< index of the current step, from 0
+  Nanoseconds time = 0;   ///< simulated time after this step's physics
+  Nanoseconds period = 0; ///< time between two runs of this plugin (period_steps * timestep)
+  double periodSeconds() const { return toSeconds(period); }
+};
+
+/// Common base of drivers and sensors: the artifact it belongs to, its random stream and period.
+class SSX_EXPORT Plugin {
+ public:
+  Plugin() = default;
+  Plugin(const Plugin&) = delete;
+  Plugin& operator=(const Plugin&) = delete;
+  virtual ~Plugin();
+
+  /// Called once when the environment starts, after the engines are configured and the first
+  /// snapshot is published, on the thread that starts the environment. `params` are this
+  /// instance's parameters (from the artifact file, or given in code). Subscriptions to sensors
+  /// are made here. Throw ConfigError (use `params.error(...)`) for bad parameters.
+  virtual void configure(const Descriptor& params);
+  /// Called once when the environment stops, before the engines stop.
+  virtual void destroy();
+
+  /// The artifact this plugin belongs to.
+  Artifact& artifact() const noexcept { return *artifact_; }
+  /// The environment of that artifact.
+  Environment& environment() const noexcept;
+  /// This instance's random stream, seeded from (scene seed, artifact index, plugin index):
+  /// the same numbers whatever the number of threads. Use it only inside this plugin's calls.
+  Random& random() noexcept { return random_; }
+  /// Runs every this many steps.
+  std::int64_t periodSteps() const noexcept { return period_steps_; }
+  /// A name for messages: the class name given when attached.
+  const std::string& className() const noexcept { return class_name_; }
+
+ private:
+  friend class Artifact;
+  friend class Environment;
+  Artifact* artifact_ = nullptr;
+  Random random_;
+  std::int64_t period_steps_ = 1;
+  std::string class_name_;
+  std::uint32_t plugin_index_ = 0;  // 0 driver, 1.. sensors
+};
+
+/// The behaviour of an artifact: a flight controller, a door. At most one per artifact.
+///
+/// `step` runs in the drivers phase (after physics and sensors, in parallel over artifacts), on
+/// any worker thread. It may read any artifact's state (the snapshot) and this artifact's
+/// sensors; it writes only its own artifact (forces and torques through its PhysicNodes).
+/// Its command buffer is cleared right before `step`, and what it writes is applied in every
+/// physics step until its next run (zero-order hold).
+class SSX_EXPORT Driver : public Plugin {
+ public:
+  virtual void step(const StepInfo& info) = 0;
+};
+
+/// Base of every measurement a sensor delivers; `stamp` is the simulated time it was taken.
+struct SSX_EXPORT Measurement {
+  Nanoseconds stamp = 0;
+  virtual ~Measurement();
+};
+
+/// Produces measurements from the simulated world.
+///
+/// `sense` runs in the sensors phase (after physics, before drivers, in parallel over
+/// artifacts), on any worker thread. It reads the snapshot and writes only its own measurement
+/// buffer. Subscribed callbacks then receive the measurement in the drivers phase, on the
+/// subscriber artifact's thread, in a fixed order.
+class SSX_EXPORT Sensor : public Plugin {
+ public:
+  virtual void sense(const StepInfo& info) = 0;
+  /// The last measurement written by `sense` (never null).
+  virtual const Measurement& latest() const = 0;
+};
+
+/// A sensor whose measurements are of type M (derived from Measurement).
+template <class M>
+class SensorOf : public Sensor {
+ public:
+  using MeasurementType = M;
+  const M& value() const noexcept { return measurement_; }
+  const Measurement& latest() const override { return measurement_; }
+
+ protected:
+  /// The buffer `sense` writes.
+  M& output() noexcept { return measurement_; }
+
+ private:
+  M measurement_{};
+};
+
+/// A bridge to the outside world (ROS, a logger, a network link). Runs on the thread that calls
+/// Environment::start/step/stop.
+///
+/// Order: every extension's `init` runs before the engines are configured and started, in the
+/// order they were added; `shutdown` runs after the engines stopped, in reverse order (first in,
+/// last out). Drivers and sensors can look an extension up by name.
+class SSX_EXPORT SimulationExtension {
+ public:
+  SimulationExtension() = default;
+  SimulationExtension(const SimulationExtension&) = delete;
+  SimulationExtension& operator=(const SimulationExtension&) = delete;
+  virtual ~SimulationExtension();
+
+  virtual void init(Environment& env, const Descriptor& params);
+  /// Before each step's physics.
+  virtual void beforeStep(Environment& env);
+  /// After each step (drivers done, frame drawn if due).
+  virtual void afterStep(Environment& env);
+  virtual void shutdown(Environment& env);
+};
+
+}  // namespace ssx

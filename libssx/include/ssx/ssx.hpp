@@ -1,0 +1,17 @@
+#pragma once
+/// @file
+/// The whole public API of libssx.
+
+#include <ssx/artifact.hpp>
+#include <ssx/descriptor.hpp>
+#include <ssx/environment.hpp>
+#include <ssx/error.hpp>
+#include <ssx/export.hpp>
+#include <ssx/physic_engine.hpp>
+#include <ssx/physic_node.hpp>
+#include <ssx/plugin.hpp>
+#include <ssx/random.hpp>
+#include <ssx/render.hpp>
+#include <ssx/timing.hpp>
+#include <ssx/types.hpp>
+#include <ssx/version.hpp>

@@ -1,0 +1,200 @@
+#include <ssx/descriptor.hpp>
+
+#include <cerrno>
+#include <charconv>
+#include <cmath>
+#include <cstdlib>
+#include <sstream>
+
+namespace ssx {
+
+namespace {
+
+// parse helpers: each returns false when the text is not a complete value of the type
+bool parseValue(const std::string& text, std::string& out) {
+  out = text;
+  return true;
+}
+
+bool parseValue(const std::string& text, bool& out) {
+  if (text == "true" || text == "1") {
+    out = true;
+    return true;
+  }
+  if (text == "false" || text == "0") {
+    out = false;
+    return true;
+  }
+  return false;
+}
+
+template <class Int>
+bool parseInt(const std::string& text, Int& out) {
+  const char* begin = text.data();
+  const char* end = begin + text.size();
+  while (begin < end && *begin == ' ') ++begin;
+  while (end > begin && end[-1] == ' ') --end;
+  if (begin < end && *begin == '+') ++begin;
+  auto [ptr, ec] = std::from_chars(begin, end, out);
+  return ec == std::errc() && ptr == end && begin != end;
+}
+
+bool parseValue(const std::string& text, int& out) { return parseInt(text, out); }
+bool parseValue(const std::string& text, std::int64_t& out) { return parseInt(text, out); }
+
+bool parseValue(const std::string& text, double& out) {
+  // strtod accepts what users write (1e-3, .5, inf is rejected below)
+  const char* begin = text.c_str();
+  char* end = nullptr;
+  errno = 0;
+  out = std::strtod(begin, &end);
+  if (end == begin || errno == ERANGE) return false;
+  while (*end == ' ') ++end;
+  return *end == '\0' && std::isfinite(out);
+}
+
+bool parseValue(const std::string& text, Vec3& out) {
+  std::istringstream in(text);
+  std::string a, b, c, extra;
+  if (!(in >> a >> b >> c) || (in >> extra)) return false;
+  return parseValue(a, out.x()) && parseValue(b, out.y()) && parseValue(c, out.z());
+}
+
+template <class T>
+const char* typeName();
+template <>
+const char* typeName<std::string>() { return "a string"; }
+template <>
+const char* typeName<bool>() { return "a boolean (true or false)"; }
+template <>
+const char* typeName<int>() { return "an integer"; }
+template <>
+const char* typeName<std::int64_t>() { return "an integer"; }
+template <>
+const char* typeName<double>() { return "a finite number"; }
+template <>
+const char* typeName<Vec3>() { return "three numbers \"x y z\""; }
+
+std::string formatNumber(double v) {
+  std::ostringstream out;
+  out.precision(17);
+  out << v;
+  return out.str();
+}
+
+}  // namespace
+
+Descriptor::Descriptor(std::string name, SourceLocation where) : name_(std::move(name)), where_(std::move(where)) {}
+
+Descriptor& Descriptor::set(std::string key, std::string value, SourceLocation where) {
+  if (where.file.empty()) where = where_;
+  for (auto& a : attributes_) {
+    if (a.key == key) {
+      a.value = std::move(value);
+      a.where = std::move(where);
+      a.used = false;
+      return *this;
+    }
+  }
+  attributes_.push_back({std::move(key), std::move(value), std::move(where), false});
+  return *this;
+}
+
+Descriptor& Descriptor::set(std::string key, double value) { return set(std::move(key), formatNumber(value)); }
+Descriptor& Descriptor::set(std::string key, std::int64_t value) {
+  return set(std::move(key), std::to_string(value));
+}
+Descriptor& Descriptor::set(std::string key, bool value) {
+  return set(std::move(key), std::string(value ? "true" : "false"));
+}
+Descriptor& Descriptor::set(std::string key, const Vec3& v) {
+  return set(std::move(key), formatNumber(v.x()) + " " + formatNumber(v.y()) + " " + formatNumber(v.z()));
+}
+
+Descriptor& Descriptor::addChild(Descriptor child) {
+  children_.push_back(std::move(child));
+  return children_.back();
+}
+
+bool Descriptor::has(std::string_view key) const {
+  for (const auto& a : attributes_)
+    if (a.key == key) return true;
+  return false;
+}
+
+const Descriptor::Attribute* Descriptor::find(std::string_view key) const {
+  for (const auto& a : attributes_) {
+    if (a.key == key) {
+      a.used = true;
+      return &a;
+    }
+  }
+  return nullptr;
+}
+
+template <class T>
+T Descriptor::get(std::string_view key) const {
+  const Attribute* a = find(key);
+  if (a == nullptr) throw error("missing attribute '" + std::string(key) + "'");
+  T value{};
+  if (!parseValue(a->value, value))
+    throw error(*a, "attribute '" + a->key + "' must be " + typeName<T>() + ", got '" + a->value + "'");
+  return value;
+}
+
+template <class T>
+T Descriptor::get(std::string_view key, const T& fallback) const {
+  if (find(key) == nullptr) return fallback;
+  return get<T>(key);
+}
+
+double Descriptor::getPositive(std::string_view key, double fallback) const {
+  const double v = get<double>(key, fallback);
+  if (!(v > 0.0)) {
+    const Attribute* a = find(key);
+    const std::string message = "attribute '" + std::string(key) + "' must be positive, got " + formatNumber(v);
+    throw a != nullptr ? error(*a, message) : error(message);
+  }
+  return v;
+}
+
+const Descriptor* Descriptor::child(std::string_view name) const {
+  for (const auto& c : children_)
+    if (c.name_ == name) return &c;
+  return nullptr;
+}
+
+std::vector<const Descriptor*> Descriptor::childrenNamed(std::string_view name) const {
+  std::vector<const Descriptor*> out;
+  for (const auto& c : children_)
+    if (c.name_ == name) out.push_back(&c);
+  return out;
+}
+
+std::vector<std::string> Descriptor::unusedAttributeWarnings() const {
+  std::vector<std::string> out;
+  for (const auto& a : attributes_)
+    if (!a.used) out.push_back(a.where.str() + ": warning: unknown attribute '" + a.key + "' of <" + name_ + ">");
+  return out;
+}
+
+ConfigError Descriptor::error(const std::string& message) const {
+  return ConfigError(where_, "<" + name_ + ">: " + message);
+}
+
+ConfigError Descriptor::error(const Attribute& attribute, const std::string& message) const {
+  return ConfigError(attribute.where, "<" + name_ + ">: " + message);
+}
+
+#define SSX_INSTANTIATE_GET(T)                                         \
+  template SSX_EXPORT T Descriptor::get<T>(std::string_view) const; \
+  template SSX_EXPORT T Descriptor::get<T>(std::string_view, const T&) const;
+SSX_INSTANTIATE_GET(std::string)
+SSX_INSTANTIATE_GET(bool)
+SSX_INSTANTIATE_GET(int)
+SSX_INSTANTIATE_GET(std::int64_t)
+SSX_INSTANTIATE_GET(double)
+SSX_INSTANTIATE_GET(Vec3)
+#undef SSX_INSTANTIATE_GET
+
+}  // namespace ssx

@@ -1,0 +1,484 @@
+#include "phase_guard.hpp"
+#include "worker_pool.hpp"
+
+#include <ssx/environment.hpp>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstring>
+#include <iostream>
+
+namespace ssx {
+
+namespace detail {
+thread_local bool PhaseGuard::in_phase = false;
+thread_local const Artifact* PhaseGuard::writer = nullptr;
+thread_local const char* PhaseGuard::role = "";
+}  // namespace detail
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+Nanoseconds since(Clock::time_point t0) {
+  return std::chrono::duration_cast<std::chrono::nanoseconds>(Clock::now() - t0).count();
+}
+
+bool finite(const BodyState& s) {
+  return s.pose.position.allFinite() && s.pose.orientation.coeffs().allFinite() && s.linear_velocity.allFinite() &&
+         s.angular_velocity.allFinite();
+}
+
+bool finite(const Wrench& w) { return w.force.allFinite() && w.torque.allFinite(); }
+
+std::string describe(const std::exception_ptr& e) {
+  try {
+    std::rethrow_exception(e);
+  } catch (const std::exception& ex) {
+    return ex.what();
+  } catch (...) {
+    return "unknown exception";
+  }
+}
+
+void checkSettings(const EnvironmentSettings& s) {
+  auto bad = [](const std::string& what) { throw ConfigError({}, what); };
+  if (s.timestep <= 0) bad("timestep must be positive");
+  if (s.threads < 0) bad("threads must be 0 (one per core), 1 (inline) or more");
+  if (s.physics.substeps < 1) bad("physics substeps must be at least 1");
+  if (s.physics.iterations < 1) bad("physics iterations must be at least 1");
+  if (s.physics.max_contacts < 1) bad("physics max_contacts must be at least 1");
+  if (!s.physics.gravity.allFinite()) bad("gravity must be finite");
+  if (s.render.period_steps < 0) bad("render period must be 0 (never) or positive");
+}
+
+}  // namespace
+
+Environment::Environment(EnvironmentSettings settings) : settings_(std::move(settings)) { checkSettings(settings_); }
+
+Environment::~Environment() {
+  try {
+    stop();
+  } catch (const std::exception& e) {
+    log(LogLevel::Error, std::string("while stopping: ") + e.what());
+  }
+}
+
+void Environment::requireSetup(const char* what) const {
+  if (state_ != State::Setup) throw Error(std::string(what) + " only before the environment starts");
+}
+
+Artifact& Environment::addArtifact(std::string name, const Pose& placement) {
+  requireSetup("artifacts can be added");
+  if (name.empty()) throw ConfigError({}, "an artifact needs a name");
+  if (findArtifact(name) != nullptr) throw ConfigError({}, "duplicate artifact name '" + name + "'");
+  artifacts_.push_back(std::unique_ptr<Artifact>(new Artifact(*this, std::move(name), artifacts_.size(), placement)));
+  return *artifacts_.back();
+}
+
+Artifact& Environment::addGround(double z) {
+  Artifact& ground = addArtifact("ground", Pose{Vec3(0, 0, z), Quat::Identity()});
+  PhysicNodeSpec plane;
+  plane.name = "ground";
+  plane.is_static = true;
+  plane.shapes.push_back(Shape::plane());
+  ground.addPhysicRoot(std::move(plane));
+  return ground;
+}
+
+SimulationExtension& Environment::addExtension(std::string name, std::unique_ptr<SimulationExtension> extension,
+                                               Descriptor params) {
+  requireSetup("extensions can be added");
+  if (!extension) throw Error("addExtension given a null extension");
+  if (this->extension(name) != nullptr) throw ConfigError(params.where(), "duplicate extension name '" + name + "'");
+  extensions_.push_back({std::move(name), std::move(extension), std::move(params), false});
+  return *extensions_.back().extension;
+}
+
+void Environment::subscribe(const Sensor& sensor, Artifact& subscriber,
+                            std::function<void(const Measurement&)> callback) {
+  if (state_ != State::Setup && !configuring_)
+    throw Error("subscriptions are made before the environment starts or from configure");
+  if (&subscriber.environment() != this || sensor.artifact_ == nullptr || &sensor.artifact().environment() != this)
+    throw Error("subscribe: sensor and subscriber must belong to this environment");
+  const Artifact& source = sensor.artifact();
+  subscriber.inbox_.push_back({&source, sensor.plugin_index_ - 1u, subscription_sequence_++, std::move(callback)});
+}
+
+void Environment::setLogSink(LogSink sink) { log_ = std::move(sink); }
+
+void Environment::log(LogLevel level, std::string_view message) const {
+  if (log_) {
+    log_(level, message);
+    return;
+  }
+  const char* tag = level == LogLevel::Error ? "error" : level == LogLevel::Warning ? "warning" : "info";
+  std::cerr << "ssx: " << tag << ": " << message << '\n';
+}
+
+unsigned Environment::threadCount() const noexcept {
+  if (pool_) return pool_->size();
+  if (settings_.threads > 0) return static_cast<unsigned>(settings_.threads);
+  return std::max(1u, std::thread::hardware_concurrency());
+}
+
+Artifact* Environment::findArtifact(std::string_view name) const {
+  for (const auto& a : artifacts_)
+    if (a->name() == name) return a.get();
+  return nullptr;
+}
+
+SimulationExtension* Environment::extension(std::string_view name) const {
+  for (const auto& e : extensions_)
+    if (e.name == name) return e.extension.get();
+  return nullptr;
+}
+
+PhysicEngine& Environment::physics() const {
+  if (!physics_) throw Error("the physics engine exists only while the environment runs");
+  return *physics_;
+}
+
+RenderEngine& Environment::renderer() const {
+  if (!renderer_) throw Error("the render engine exists only while the environment runs");
+  return *renderer_;
+}
+
+// --- lifecycle ---------------------------------------------------------------------------------
+
+void Environment::buildBodies() {
+  // flatten each node tree into one rigid body whose frame is the tree's centre-of-mass frame
+  for (auto& artifact : artifacts_) {
+    artifact->body_begin_ = static_cast<int>(physics_->bodyCount());
+    for (PhysicNode* root : artifact->roots_) {
+      const PhysicNodeSpec& spec = root->spec();
+      std::vector<Shape> shapes;
+      std::vector<PhysicNode*> tree;  // the root and its descendants, in order
+      for (auto& n : artifact->nodes_) {
+        const PhysicNode* r = n.get();
+        while (r->parent_ != nullptr) r = r->parent_;
+        if (r == root) tree.push_back(n.get());
+      }
+      if (spec.is_static) {
+        for (PhysicNode* n : tree) {
+          n->pose_in_body_ = root->setup_pose_.inverse() * n->setup_pose_;
+          for (Shape s : n->spec().shapes) {
+            s.pose = n->pose_in_body_ * s.pose;
+            shapes.push_back(s);
+          }
+        }
+        physics_->addStatic(shapes, root->setup_pose_);
+        continue;
+      }
+      const MassProperties mass = combinedMass(spec);
+      const Pose root_in_body{-mass.center_of_mass, Quat::Identity()};
+      for (PhysicNode* n : tree) {
+        n->pose_in_body_ = root_in_body * (root->setup_pose_.inverse() * n->setup_pose_);
+        for (Shape s : n->spec().shapes) {
+          s.pose = n->pose_in_body_ * s.pose;
+          shapes.push_back(s);
+        }
+      }
+      BodyState initial;
+      initial.pose = root->setup_pose_ * root_in_body.inverse();
+      initial.angular_velocity = root->initial_angular_;
+      initial.linear_velocity =
+          root->initial_linear_ + root->initial_angular_.cross(initial.pose.position - root->setup_pose_.position);
+      const int body = physics_->addBody(mass, shapes, initial);
+      for (PhysicNode* n : tree) n->body_ = body;
+      body_owner_.push_back(artifact.get());
+    }
+    artifact->body_end_ = static_cast<int>(physics_->bodyCount());
+  }
+  states_.assign(physics_->bodyCount(), BodyState{});
+  previous_linear_.assign(states_.size(), Vec3::Zero());
+  previous_angular_.assign(states_.size(), Vec3::Zero());
+  wrenches_.assign(states_.size(), Wrench{});
+}
+
+void Environment::start() {
+  if (state_ == State::Running) return;
+  requireSetup("start() is allowed");
+  try {
+    // extensions first, in the order they were added
+    for (auto& e : extensions_) {
+      e.extension->init(*this, e.params);
+      e.initialised = true;
+    }
+    physics_ = createPhysicEngine(settings_.physics);
+    renderer_ = createRenderEngine(settings_.render);
+    buildBodies();
+    publishSnapshot(true);
+    const unsigned threads = settings_.threads > 0 ? static_cast<unsigned>(settings_.threads)
+                                                   : std::max(1u, std::thread::hardware_concurrency());
+    pool_ = std::make_unique<detail::WorkerPool>(threads);
+    errors_.assign(artifacts_.size(), PendingError{});
+    state_ = State::Running;  // configure may subscribe and read the snapshot
+    configuring_ = true;
+    for (auto& a : artifacts_) {
+      if (a->driver_) a->driver_->configure(a->driver_params_);
+      for (auto& s : a->sensors_) s.sensor->configure(s.params);
+    }
+    configuring_ = false;
+    // callbacks are delivered by source artifact, then sensor, then subscription order
+    for (auto& a : artifacts_) {
+      std::sort(a->inbox_.begin(), a->inbox_.end(), [](const auto& x, const auto& y) {
+        if (x.source->index() != y.source->index()) return x.source->index() < y.source->index();
+        if (x.sensor_index != y.sensor_index) return x.sensor_index < y.sensor_index;
+        return x.sequence < y.sequence;
+      });
+    }
+  } catch (...) {
+    configuring_ = false;
+    state_ = State::Failed;
+    stop();
+    throw;
+  }
+}
+
+void Environment::stop() {
+  if (state_ == State::Stopped) return;
+  const bool started = state_ != State::Setup;
+  state_ = State::Stopped;
+  if (started) {
+    // plugins first, then engines, then extensions in reverse order
+    for (auto& a : artifacts_) {
+      auto destroy = [&](Plugin& p, const std::string& what) {
+        try {
+          p.destroy();
+        } catch (const std::exception& e) {
+          log(LogLevel::Error, "artifact '" + a->name() + "', " + what + ": destroy threw: " + e.what());
+        }
+      };
+      if (a->driver_) destroy(*a->driver_, "driver '" + a->driver_->className() + "'");
+      for (auto& s : a->sensors_) destroy(*s.sensor, "sensor '" + s.sensor->className() + "'");
+    }
+    pool_.reset();
+    renderer_.reset();
+    physics_.reset();
+  }
+  for (auto it = extensions_.rbegin(); it != extensions_.rend(); ++it) {
+    if (!it->initialised) continue;
+    it->initialised = false;
+    try {
+      it->extension->shutdown(*this);
+    } catch (const std::exception& e) {
+      log(LogLevel::Error, "extension '" + it->name + "': shutdown threw: " + e.what());
+    }
+  }
+}
+
+void Environment::fail() { state_ = State::Failed; }
+
+// --- one step ----------------------------------------------------------------------------------
+
+void Environment::publishSnapshot(bool first) {
+  if (!first) {
+    for (std::size_t i = 0; i < states_.size(); ++i) {
+      previous_linear_[i] = states_[i].linear_velocity;
+      previous_angular_[i] = states_[i].angular_velocity;
+    }
+  }
+  physics_->readStates(states_);
+  const double inv_dt = 1.0 / toSeconds(settings_.timestep);
+  for (std::size_t i = 0; i < states_.size(); ++i) {
+    BodyState& s = states_[i];
+    if (!finite(s)) {
+      fail();
+      throw StepError(body_owner_[i]->name(), "physics", steps_ - 1,
+                      "the state became NaN or infinite after the physics step (a non-finite force, an "
+                      "extreme velocity, or a timestep too large for the contacts)");
+    }
+    if (first) continue;
+    s.linear_acceleration = (s.linear_velocity - previous_linear_[i]) * inv_dt;
+    s.angular_acceleration = (s.angular_velocity - previous_angular_[i]) * inv_dt;
+  }
+}
+
+void Environment::runSensors(std::size_t begin, std::size_t end) {
+  const StepInfo base{current_step_, time(), 0};
+  for (std::size_t i = begin; i < end; ++i) {
+    Artifact& a = *artifacts_[i];
+    for (std::size_t k = 0; k < a.sensors_.size(); ++k) {
+      auto& slot = a.sensors_[k];
+      slot.fresh = false;
+      Sensor& sensor = *slot.sensor;
+      if (current_step_ % sensor.period_steps_ != 0) continue;
+      StepInfo info = base;
+      info.period = sensor.period_steps_ * settings_.timestep;
+      try {
+        detail::PhaseGuard guard(nullptr, "sensor");
+        sensor.sense(info);
+        slot.fresh = true;
+      } catch (...) {
+        errors_[i] = {"sensor " + std::to_string(k) + " '" + sensor.className() + "'", describe(std::current_exception())};
+        break;
+      }
+    }
+  }
+}
+
+void Environment::runDrivers(std::size_t begin, std::size_t end) {
+  const StepInfo base{current_step_, time(), 0};
+  for (std::size_t i = begin; i < end; ++i) {
+    Artifact& a = *artifacts_[i];
+    if (!errors_[i].plugin.empty()) continue;
+    // deliver fresh measurements, in the order fixed at start
+    const Artifact::Subscription* current = nullptr;
+    try {
+      detail::PhaseGuard guard(nullptr, "callback");
+      for (const auto& sub : a.inbox_) {
+        const auto& slot = sub.source->sensors_[sub.sensor_index];
+        if (!slot.fresh) continue;
+        current = &sub;
+        sub.callback(slot.sensor->latest());
+      }
+    } catch (...) {
+      errors_[i] = {"callback subscribed to sensor '" + current->source->sensors_[current->sensor_index].sensor->className() +
+                        "' of artifact '" + current->source->name() + "'",
+                    describe(std::current_exception())};
+      continue;
+    }
+    Driver* driver = a.driver_.get();
+    if (driver == nullptr || current_step_ % driver->period_steps_ != 0) continue;
+    StepInfo info = base;
+    info.period = driver->period_steps_ * settings_.timestep;
+    for (int b = a.body_begin_; b < a.body_end_; ++b) wrenches_[static_cast<std::size_t>(b)] = Wrench{};
+    try {
+      detail::PhaseGuard guard(&a, "driver");
+      driver->step(info);
+    } catch (...) {
+      errors_[i] = {"driver '" + driver->className() + "'", describe(std::current_exception())};
+      continue;
+    }
+    for (int b = a.body_begin_; b < a.body_end_; ++b) {
+      if (!finite(wrenches_[static_cast<std::size_t>(b)])) {
+        errors_[i] = {"driver '" + driver->className() + "'", "applied a NaN or infinite force or torque"};
+        break;
+      }
+    }
+  }
+}
+
+void Environment::raiseFirstError(const char* phase) {
+  // the lowest artifact index wins, so the report does not depend on the thread count
+  for (std::size_t i = 0; i < errors_.size(); ++i) {
+    if (errors_[i].plugin.empty()) continue;
+    fail();
+    throw StepError(artifacts_[i]->name(), errors_[i].plugin, current_step_,
+                    std::string(errors_[i].message) + " (in the " + phase + " phase)");
+  }
+}
+
+void Environment::drawFrame() {
+  render_items_.clear();
+  auto add = [&](auto& self, const RenderNodeSpec& spec, const Pose& parent) -> void {
+    const Pose world = parent * spec.pose;
+    render_items_.push_back({&spec, world});
+    for (const auto& c : spec.children) self(self, c, world);
+  };
+  for (const auto& a : artifacts_) {
+    for (const auto& r : a->render_roots_) {
+      const PhysicNode* follow = r.follow.empty() ? nullptr : a->node(r.follow);
+      add(add, r, follow != nullptr ? follow->pose() : a->placement());
+    }
+  }
+  renderer_->draw(time(), render_items_);
+}
+
+void Environment::step() {
+  if (state_ == State::Setup) start();
+  if (state_ != State::Running)
+    throw Error(state_ == State::Failed ? "the environment failed in an earlier step; it cannot step again"
+                                        : "the environment is stopped");
+  const auto t_step = Clock::now();
+  StepTiming timing;
+  current_step_ = steps_;
+  timing.step = current_step_;
+
+  for (auto& e : extensions_) {
+    try {
+      e.extension->beforeStep(*this);
+    } catch (const std::exception& ex) {
+      fail();
+      throw StepError("", "extension '" + e.name + "'", current_step_, std::string("beforeStep: ") + ex.what());
+    }
+  }
+
+  // physics, with the actuation written before
+  auto t = Clock::now();
+  physics_->step(settings_.timestep, wrenches_);
+  timing.physics = since(t);
+  t = Clock::now();
+  for (const auto& a : artifacts_)
+    if (!a->driver_)
+      for (int b = a->body_begin_; b < a->body_end_; ++b) wrenches_[static_cast<std::size_t>(b)] = Wrench{};
+  ++steps_;
+  publishSnapshot(false);
+  timing.snapshot = since(t);
+
+  const std::size_t n = artifacts_.size();
+  const std::size_t chunk = std::max<std::size_t>(1, n / (pool_->size() * 8));
+  // sensors, in parallel
+  t = Clock::now();
+  auto sensors = [this](std::size_t b, std::size_t e) { runSensors(b, e); };
+  pool_->parallelFor(n, chunk, sensors);
+  timing.sensors = since(t);
+  raiseFirstError("sensors");
+
+  // callbacks and drivers, in parallel
+  t = Clock::now();
+  auto drivers = [this](std::size_t b, std::size_t e) { runDrivers(b, e); };
+  pool_->parallelFor(n, chunk, drivers);
+  timing.drivers = since(t);
+  raiseFirstError("drivers");
+
+  // render, when due
+  if (settings_.render.period_steps > 0 && current_step_ % settings_.render.period_steps == 0) {
+    t = Clock::now();
+    drawFrame();
+    timing.render = since(t);
+  }
+
+  for (auto& e : extensions_) {
+    try {
+      e.extension->afterStep(*this);
+    } catch (const std::exception& ex) {
+      fail();
+      throw StepError("", "extension '" + e.name + "'", current_step_, std::string("afterStep: ") + ex.what());
+    }
+  }
+  timing.total = since(t_step);
+  timing_.add(timing);
+}
+
+void Environment::step(std::int64_t n) {
+  for (std::int64_t i = 0; i < n; ++i) step();
+}
+
+std::uint64_t Environment::stateHash() const {
+  // FNV-1a over the raw bits of every pose and velocity, then the step count
+  std::uint64_t h = 0xcbf29ce484222325ULL;
+  auto mix = [&h](const double* p, std::size_t count) {
+    for (std::size_t i = 0; i < count; ++i) {
+      std::uint64_t bits;
+      std::memcpy(&bits, p + i, sizeof bits);
+      for (int k = 0; k < 8; ++k) {
+        h ^= (bits >> (8 * k)) & 0xffU;
+        h *= 0x100000001b3ULL;
+      }
+    }
+  };
+  for (const auto& s : states_) {
+    mix(s.pose.position.data(), 3);
+    mix(s.pose.orientation.coeffs().data(), 4);
+    mix(s.linear_velocity.data(), 3);
+    mix(s.angular_velocity.data(), 3);
+  }
+  const double steps = static_cast<double>(steps_);
+  mix(&steps, 1);
+  return h;
+}
+
+}  // namespace ssx

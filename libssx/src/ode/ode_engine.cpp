@@ -1,0 +1,215 @@
+#include "ode/ode_engine.hpp"
+
+#include <ssx/error.hpp>
+
+#include <mutex>
+
+namespace ssx::detail {
+
+namespace {
+
+// ODE's process-wide initialisation, reference-counted across engines; `generation` changes on
+// every fresh init so that threads know to allocate their per-thread data again
+std::mutex g_ode_mutex;
+int g_ode_users = 0;
+unsigned g_ode_generation = 0;
+
+// ODE keeps the seed that QuickStep uses to reorder constraints in one global; each world keeps
+// its own copy and swaps it in around its step under this lock, so worlds never disturb each other
+std::mutex g_ode_step_mutex;
+
+void acquireOde() {
+  std::lock_guard lock(g_ode_mutex);
+  if (g_ode_users++ == 0) {
+    dInitODE2(0);
+    ++g_ode_generation;
+  }
+}
+
+void releaseOde() {
+  std::lock_guard lock(g_ode_mutex);
+  if (--g_ode_users == 0) dCloseODE();
+}
+
+// every thread that calls into ODE needs its own collision data
+void ensureThreadData() {
+  thread_local unsigned seen_generation = 0;
+  const unsigned generation = g_ode_generation;
+  if (seen_generation != generation) {
+    if (!dAllocateODEDataForThread(dAllocateMaskAll))
+      throw Error("ode: could not allocate per-thread data (out of memory?)");
+    seen_generation = generation;
+  }
+}
+
+void toOde(const Quat& q, dQuaternion out) {
+  out[0] = q.w();
+  out[1] = q.x();
+  out[2] = q.y();
+  out[3] = q.z();
+}
+
+}  // namespace
+
+OdeEngine::OdeEngine(const PhysicsSettings& settings) : settings_(settings) {
+  acquireOde();
+  ensureThreadData();
+  world_ = dWorldCreate();
+  const Vec3& g = settings_.gravity;
+  dWorldSetGravity(world_, g.x(), g.y(), g.z());
+  dWorldSetERP(world_, settings_.erp);
+  dWorldSetCFM(world_, settings_.cfm);
+  dWorldSetQuickStepNumIterations(world_, settings_.iterations);
+  dWorldSetQuickStepW(world_, settings_.sor);
+  dWorldSetContactSurfaceLayer(world_, settings_.contact_surface_layer);
+  dWorldSetAutoDisableFlag(world_, 0);
+
+  if (settings_.broadphase == PhysicsSettings::Broadphase::QuadTree) {
+    dVector3 c{settings_.quadtree_center.x(), settings_.quadtree_center.y(), settings_.quadtree_center.z(), 0};
+    dVector3 e{settings_.quadtree_extents.x(), settings_.quadtree_extents.y(), settings_.quadtree_extents.z(), 0};
+    space_ = dQuadTreeSpaceCreate(nullptr, c, e, settings_.quadtree_depth);
+  } else {
+    space_ = dSweepAndPruneSpaceCreate(nullptr, dSAP_AXES_XYZ);
+  }
+  dSpaceSetCleanup(space_, 1);
+  contact_group_ = dJointGroupCreate(0);
+  contact_scratch_.resize(static_cast<std::size_t>(std::max(1, settings_.max_contacts)));
+}
+
+OdeEngine::~OdeEngine() {
+  ensureThreadData();
+  dJointGroupDestroy(contact_group_);
+  dSpaceDestroy(space_);  // destroys its geoms (cleanup mode)
+  dWorldDestroy(world_);  // destroys its bodies
+  releaseOde();
+}
+
+dGeomID OdeEngine::createGeom(const Shape& s) {
+  switch (s.kind) {
+    case Shape::Kind::Box: return dCreateBox(space_, s.size.x(), s.size.y(), s.size.z());
+    case Shape::Kind::Sphere: return dCreateSphere(space_, s.radius);
+    case Shape::Kind::Cylinder: return dCreateCylinder(space_, s.radius, s.length);
+    case Shape::Kind::Capsule: return dCreateCapsule(space_, s.radius, s.length);
+    case Shape::Kind::Plane: break;
+  }
+  return nullptr;
+}
+
+int OdeEngine::addBody(const MassProperties& mass, const std::vector<Shape>& shapes, const BodyState& state) {
+  ensureThreadData();
+  dBodyID body = dBodyCreate(world_);
+  dMass m;
+  const Mat3& j = mass.inertia;
+  // the body frame is the centre-of-mass frame: ODE requires the centre at the origin
+  dMassSetParameters(&m, mass.mass, 0, 0, 0, j(0, 0), j(1, 1), j(2, 2), j(0, 1), j(0, 2), j(1, 2));
+  dBodySetMass(body, &m);
+  for (const auto& s : shapes) {
+    if (s.kind == Shape::Kind::Plane) throw Error("ode: a plane cannot belong to a dynamic body");
+    dGeomID g = createGeom(s);
+    dGeomSetBody(g, body);
+    dQuaternion q;
+    toOde(s.pose.orientation, q);
+    dGeomSetOffsetPosition(g, s.pose.position.x(), s.pose.position.y(), s.pose.position.z());
+    dGeomSetOffsetQuaternion(g, q);
+  }
+  bodies_.push_back(body);
+  setState(static_cast<int>(bodies_.size() - 1), state);
+  return static_cast<int>(bodies_.size() - 1);
+}
+
+void OdeEngine::addStatic(const std::vector<Shape>& shapes, const Pose& pose) {
+  ensureThreadData();
+  for (const auto& s : shapes) {
+    const Pose world = pose * s.pose;
+    if (s.kind == Shape::Kind::Plane) {
+      const Vec3 n = world.orientation * Vec3::UnitZ();
+      dCreatePlane(space_, n.x(), n.y(), n.z(), n.dot(world.position));
+      continue;
+    }
+    dGeomID g = createGeom(s);
+    dQuaternion q;
+    toOde(world.orientation, q);
+    dGeomSetPosition(g, world.position.x(), world.position.y(), world.position.z());
+    dGeomSetQuaternion(g, q);
+  }
+}
+
+void OdeEngine::nearCallback(void* data, dGeomID a, dGeomID b) {
+  auto* self = static_cast<OdeEngine*>(data);
+  dBodyID ba = dGeomGetBody(a);
+  dBodyID bb = dGeomGetBody(b);
+  if (ba == nullptr && bb == nullptr) return;  // two static geoms
+  if (ba != nullptr && bb != nullptr && dAreConnectedExcluding(ba, bb, dJointTypeContact)) return;
+  const int n = dCollide(a, b, static_cast<int>(self->contact_scratch_.size()), &self->contact_scratch_[0].geom,
+                         sizeof(dContact));
+  const PhysicsSettings& s = self->settings_;
+  for (int i = 0; i < n; ++i) {
+    dContact& c = self->contact_scratch_[static_cast<std::size_t>(i)];
+    c.surface.mode = dContactApprox1 | dContactSoftCFM | dContactSoftERP;
+    c.surface.mu = s.friction;
+    c.surface.soft_cfm = s.contact_soft_cfm;
+    c.surface.soft_erp = s.contact_soft_erp;
+    if (s.restitution > 0) {
+      c.surface.mode |= dContactBounce;
+      c.surface.bounce = s.restitution;
+      c.surface.bounce_vel = 0.01;
+    }
+    dJointID j = dJointCreateContact(self->world_, self->contact_group_, &c);
+    dJointAttach(j, ba, bb);
+  }
+  self->contact_count_ += static_cast<std::size_t>(n);
+}
+
+void OdeEngine::step(Nanoseconds dt, std::span<const Wrench> wrenches) {
+  ensureThreadData();
+  const int substeps = std::max(1, settings_.substeps);
+  const double h = toSeconds(dt) / substeps;
+  contact_count_ = 0;
+  std::lock_guard lock(g_ode_step_mutex);
+  const unsigned long outer_seed = dRandGetSeed();
+  dRandSetSeed(rand_seed_);
+  for (int k = 0; k < substeps; ++k) {
+    // ODE clears force accumulators after each step: apply the held wrenches every substep
+    for (std::size_t i = 0; i < bodies_.size(); ++i) {
+      const Wrench& w = wrenches[i];
+      dBodyAddForce(bodies_[i], w.force.x(), w.force.y(), w.force.z());
+      dBodyAddTorque(bodies_[i], w.torque.x(), w.torque.y(), w.torque.z());
+    }
+    dSpaceCollide(space_, this, &OdeEngine::nearCallback);
+    if (settings_.solver == PhysicsSettings::Solver::Exact)
+      dWorldStep(world_, h);
+    else
+      dWorldQuickStep(world_, h);
+    dJointGroupEmpty(contact_group_);
+  }
+  rand_seed_ = dRandGetSeed();
+  dRandSetSeed(outer_seed);
+}
+
+void OdeEngine::readStates(std::span<BodyState> out) const {
+  for (std::size_t i = 0; i < bodies_.size(); ++i) {
+    dBodyID b = bodies_[i];
+    const dReal* p = dBodyGetPosition(b);
+    const dReal* q = dBodyGetQuaternion(b);
+    const dReal* v = dBodyGetLinearVel(b);
+    const dReal* w = dBodyGetAngularVel(b);
+    BodyState& s = out[i];
+    s.pose.position = Vec3(p[0], p[1], p[2]);
+    s.pose.orientation = Quat(q[0], q[1], q[2], q[3]);
+    s.linear_velocity = Vec3(v[0], v[1], v[2]);
+    s.angular_velocity = Vec3(w[0], w[1], w[2]);
+  }
+}
+
+void OdeEngine::setState(int body, const BodyState& s) {
+  ensureThreadData();
+  dBodyID b = bodies_.at(static_cast<std::size_t>(body));
+  dQuaternion q;
+  toOde(s.pose.orientation.normalized(), q);
+  dBodySetPosition(b, s.pose.position.x(), s.pose.position.y(), s.pose.position.z());
+  dBodySetQuaternion(b, q);
+  dBodySetLinearVel(b, s.linear_velocity.x(), s.linear_velocity.y(), s.linear_velocity.z());
+  dBodySetAngularVel(b, s.angular_velocity.x(), s.angular_velocity.y(), s.angular_velocity.z());
+}
+
+}  // namespace ssx::detail

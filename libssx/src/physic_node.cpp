@@ -1,0 +1,214 @@
+#include <ssx/physic_node.hpp>
+
+#include <Eigen/Eigenvalues>
+
+#include <cmath>
+#include <numbers>
+#include <set>
+
+namespace ssx {
+
+namespace {
+
+constexpr double kPi = std::numbers::pi;
+
+// mass properties of one node alone, in its own frame
+MassProperties nodeMass(const PhysicNodeSpec& node) {
+  MassProperties shapes;
+  for (const auto& s : node.shapes) {
+    if (s.kind == Shape::Kind::Plane) continue;
+    const double m = s.volume() * s.density;
+    const Mat3 r = s.pose.orientation.toRotationMatrix();
+    const Vec3 c = s.pose.position;
+    // shift the running centre and inertia to include this shape
+    const double total = shapes.mass + m;
+    const Vec3 com = total > 0 ? Vec3((shapes.mass * shapes.center_of_mass + m * c) / total) : Vec3::Zero();
+    auto shifted = [&](const Mat3& inertia, double mass, const Vec3& from) {
+      const Vec3 d = from - com;
+      return Mat3(inertia + mass * (d.squaredNorm() * Mat3::Identity() - d * d.transpose()));
+    };
+    const Mat3 own = r * s.unitInertia(m) * r.transpose();
+    shapes.inertia = shifted(shapes.inertia, shapes.mass, shapes.center_of_mass) + shifted(own, m, c);
+    shapes.mass = total;
+    shapes.center_of_mass = com;
+  }
+  if (!node.mass) return shapes;
+  if (node.inertia) return {*node.mass, node.center_of_mass, *node.inertia};
+  // mass given, inertia from the shapes scaled to it
+  MassProperties scaled = shapes;
+  if (shapes.mass > 0) scaled.inertia *= *node.mass / shapes.mass;
+  scaled.mass = *node.mass;
+  return scaled;
+}
+
+void accumulate(const PhysicNodeSpec& node, const Pose& in_root, MassProperties& total) {
+  const MassProperties own = nodeMass(node);
+  if (own.mass > 0) {
+    const Mat3 r = in_root.orientation.toRotationMatrix();
+    const Vec3 c = in_root.transformPoint(own.center_of_mass);
+    const double m = total.mass + own.mass;
+    const Vec3 com = (total.mass * total.center_of_mass + own.mass * c) / m;
+    auto shifted = [&](const Mat3& inertia, double mass, const Vec3& from) {
+      const Vec3 d = from - com;
+      return Mat3(inertia + mass * (d.squaredNorm() * Mat3::Identity() - d * d.transpose()));
+    };
+    total.inertia = shifted(total.inertia, total.mass, total.center_of_mass) +
+                    shifted(r * own.inertia * r.transpose(), own.mass, c);
+    total.mass = m;
+    total.center_of_mass = com;
+  }
+  for (const auto& child : node.children) accumulate(child, in_root * child.pose, total);
+}
+
+std::string nodeLabel(const PhysicNodeSpec& node) {
+  return node.name.empty() ? std::string("physic node") : "physic node '" + node.name + "'";
+}
+
+void validateNode(const PhysicNodeSpec& node, bool is_root, bool root_static, std::set<std::string>& names) {
+  auto fail = [&](const std::string& what) { throw ConfigError(node.where, nodeLabel(node) + ": " + what); };
+  if (!node.name.empty() && !names.insert(node.name).second) fail("duplicate node name in this tree");
+  if (node.is_static && !is_root) fail("only a root node can be static");
+  if (node.mass && !(std::isfinite(*node.mass) && *node.mass > 0))
+    fail("mass must be positive, got " + std::to_string(*node.mass) + " kg");
+  if (node.inertia) {
+    if (!node.mass) fail("an inertia needs a mass");
+    const Mat3& j = *node.inertia;
+    if (!j.allFinite() || (j - j.transpose()).cwiseAbs().maxCoeff() > 1e-12 * j.cwiseAbs().maxCoeff())
+      fail("inertia must be a finite symmetric matrix");
+    const Vec3 eig = Eigen::SelfAdjointEigenSolver<Mat3>(j).eigenvalues();
+    if (!(eig.minCoeff() > 0)) fail("inertia must be positive definite (principal moments > 0)");
+    if (eig[0] + eig[1] < eig[2] * (1 - 1e-9))
+      fail("inertia violates the triangle inequality (no rigid body has these principal moments)");
+  }
+  for (const auto& s : node.shapes) {
+    bool ok = true;
+    switch (s.kind) {
+      case Shape::Kind::Box: ok = (s.size.array() > 0).all() && s.size.allFinite(); break;
+      case Shape::Kind::Sphere: ok = s.radius > 0 && std::isfinite(s.radius); break;
+      case Shape::Kind::Cylinder:
+      case Shape::Kind::Capsule:
+        ok = s.radius > 0 && s.length >= 0 && std::isfinite(s.radius) && std::isfinite(s.length);
+        if (s.kind == Shape::Kind::Cylinder) ok = ok && s.length > 0;
+        break;
+      case Shape::Kind::Plane:
+        if (!(is_root && root_static)) fail("a plane shape is allowed only on a static root node");
+        break;
+    }
+    if (!ok) fail("shape sizes must be positive and finite");
+    if (!(s.density > 0 && std::isfinite(s.density))) fail("shape density must be positive");
+  }
+  for (const auto& c : node.children) validateNode(c, false, root_static, names);
+}
+
+}  // namespace
+
+Shape Shape::box(const Vec3& size, const Pose& pose) {
+  Shape s;
+  s.kind = Kind::Box;
+  s.size = size;
+  s.pose = pose;
+  return s;
+}
+Shape Shape::sphere(double radius, const Pose& pose) {
+  Shape s;
+  s.kind = Kind::Sphere;
+  s.radius = radius;
+  s.pose = pose;
+  return s;
+}
+Shape Shape::cylinder(double radius, double length, const Pose& pose) {
+  Shape s;
+  s.kind = Kind::Cylinder;
+  s.radius = radius;
+  s.length = length;
+  s.pose = pose;
+  return s;
+}
+Shape Shape::capsule(double radius, double length, const Pose& pose) {
+  Shape s = cylinder(radius, length, pose);
+  s.kind = Kind::Capsule;
+  return s;
+}
+Shape Shape::plane(const Pose& pose) {
+  Shape s;
+  s.kind = Kind::Plane;
+  s.pose = pose;
+  return s;
+}
+
+double Shape::volume() const {
+  switch (kind) {
+    case Kind::Box: return size.prod();
+    case Kind::Sphere: return 4.0 / 3.0 * kPi * radius * radius * radius;
+    case Kind::Cylinder: return kPi * radius * radius * length;
+    case Kind::Capsule: return kPi * radius * radius * (length + 4.0 / 3.0 * radius);
+    case Kind::Plane: return 0.0;
+  }
+  return 0.0;
+}
+
+Mat3 Shape::unitInertia(double m) const {
+  const double r2 = radius * radius;
+  switch (kind) {
+    case Kind::Box: {
+      const Vec3 s2 = size.cwiseProduct(size);
+      return (m / 12.0 * Vec3(s2.y() + s2.z(), s2.x() + s2.z(), s2.x() + s2.y())).asDiagonal();
+    }
+    case Kind::Sphere: return Mat3::Identity() * (0.4 * m * r2);
+    case Kind::Cylinder: {
+      const double t = m * (3 * r2 + length * length) / 12.0;
+      return Vec3(t, t, 0.5 * m * r2).asDiagonal();
+    }
+    case Kind::Capsule: {
+      // cylinder plus two hemispheres, mass split by volume
+      const double vc = length;
+      const double vs = 4.0 / 3.0 * radius;
+      const double mc = m * vc / (vc + vs);
+      const double ms = m - mc;
+      const double h = length;
+      const double t = mc * (h * h / 12.0 + r2 / 4.0) + ms * (0.4 * r2 + h * h / 4.0 + 3.0 * h * radius / 8.0);
+      return Vec3(t, t, 0.5 * mc * r2 + 0.4 * ms * r2).asDiagonal();
+    }
+    case Kind::Plane: return Mat3::Zero();
+  }
+  return Mat3::Zero();
+}
+
+PhysicNodeSpec& PhysicNodeSpec::addChild(PhysicNodeSpec child) {
+  children.push_back(std::move(child));
+  return children.back();
+}
+
+void validatePhysicTree(const PhysicNodeSpec& root) {
+  std::set<std::string> names;
+  validateNode(root, true, root.is_static, names);
+  if (!root.is_static) {
+    const MassProperties m = combinedMass(root);
+    if (!(m.mass > 0))
+      throw ConfigError(root.where, nodeLabel(root) + ": a dynamic body needs mass: give a mass or shapes with volume");
+    const Vec3 eig = Eigen::SelfAdjointEigenSolver<Mat3>(m.inertia).eigenvalues();
+    if (!(eig.minCoeff() > 0))
+      throw ConfigError(root.where, nodeLabel(root) +
+                                        ": the body's combined inertia is singular: give an inertia or shapes with volume");
+  }
+}
+
+MassProperties combinedMass(const PhysicNodeSpec& root) {
+  MassProperties total;
+  accumulate(root, Pose::identity(), total);
+  return total;
+}
+
+BodyState BodyState::attached(const Pose& relative) const {
+  BodyState out;
+  out.pose = pose * relative;
+  const Vec3 r = out.pose.position - pose.position;
+  out.angular_velocity = angular_velocity;
+  out.angular_acceleration = angular_acceleration;
+  out.linear_velocity = linear_velocity + angular_velocity.cross(r);
+  out.linear_acceleration =
+      linear_acceleration + angular_acceleration.cross(r) + angular_velocity.cross(angular_velocity.cross(r));
+  return out;
+}
+
+}  // namespace ssx

@@ -1,0 +1,19 @@
+#include <ssx/artifact.hpp>
+#include <ssx/plugin.hpp>
+
+namespace ssx {
+
+Plugin::~Plugin() = default;
+void Plugin::configure(const Descriptor&) {}
+void Plugin::destroy() {}
+Environment& Plugin::environment() const noexcept { return artifact_->environment(); }
+
+Measurement::~Measurement() = default;
+
+SimulationExtension::~SimulationExtension() = default;
+void SimulationExtension::init(Environment&, const Descriptor&) {}
+void SimulationExtension::beforeStep(Environment&) {}
+void SimulationExtension::afterStep(Environment&) {}
+void SimulationExtension::shutdown(Environment&) {}
+
+}  // namespace ssx

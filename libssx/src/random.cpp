@@ -1,0 +1,71 @@
+#include <ssx/random.hpp>
+
+#include <cmath>
+
+namespace ssx {
+
+namespace {
+
+std::uint64_t splitmix64(std::uint64_t& state) {
+  std::uint64_t z = (state += 0x9e3779b97f4a7c15ULL);
+  z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
+  z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
+  return z ^ (z >> 31);
+}
+
+std::uint64_t rotl(std::uint64_t x, int k) { return (x << k) | (x >> (64 - k)); }
+
+}  // namespace
+
+std::uint64_t deriveSeed(std::uint64_t seed, std::uint64_t a, std::uint64_t b) {
+  // chain the three values through SplitMix64 so that nearby indices give unrelated seeds
+  std::uint64_t state = seed;
+  std::uint64_t h = splitmix64(state);
+  state = h ^ (a * 0xd1342543de82ef95ULL);
+  h = splitmix64(state);
+  state = h ^ (b * 0xaf251af3b0f025b5ULL);
+  return splitmix64(state);
+}
+
+void Random::reseed(std::uint64_t seed) {
+  std::uint64_t state = seed;
+  for (auto& s : s_) s = splitmix64(state);
+  has_spare_ = false;
+}
+
+Random::result_type Random::operator()() {
+  // xoshiro256++ (Blackman and Vigna)
+  const std::uint64_t result = rotl(s_[0] + s_[3], 23) + s_[0];
+  const std::uint64_t t = s_[1] << 17;
+  s_[2] ^= s_[0];
+  s_[3] ^= s_[1];
+  s_[1] ^= s_[2];
+  s_[0] ^= s_[3];
+  s_[2] ^= t;
+  s_[3] = rotl(s_[3], 45);
+  return result;
+}
+
+double Random::uniform() {
+  // 53 random bits into [0, 1)
+  return static_cast<double>((*this)() >> 11) * 0x1.0p-53;
+}
+
+double Random::normal() {
+  if (has_spare_) {
+    has_spare_ = false;
+    return spare_;
+  }
+  double u, v, s;
+  do {
+    u = 2.0 * uniform() - 1.0;
+    v = 2.0 * uniform() - 1.0;
+    s = u * u + v * v;
+  } while (s >= 1.0 || s == 0.0);
+  const double f = std::sqrt(-2.0 * std::log(s) / s);
+  spare_ = v * f;
+  has_spare_ = true;
+  return u * f;
+}
+
+}  // namespace ssx

@@ -1,0 +1,90 @@
+// Environment::run: pacing steps against the monotonic clock.
+#include <ssx/environment.hpp>
+
+#include <sys/prctl.h>
+#include <time.h>
+
+#include <cerrno>
+#include <cmath>
+#include <cstdio>
+
+namespace ssx {
+
+namespace {
+
+Nanoseconds monotonicNow() {
+  timespec ts{};
+  clock_gettime(CLOCK_MONOTONIC, &ts);
+  return static_cast<Nanoseconds>(ts.tv_sec) * 1'000'000'000 + ts.tv_nsec;
+}
+
+// sleeps until an absolute monotonic time, then spins for the last `spin` nanoseconds
+void waitUntil(Nanoseconds deadline, Nanoseconds spin) {
+  const Nanoseconds wake = deadline - spin;
+  if (monotonicNow() < wake) {
+    timespec ts{static_cast<time_t>(wake / 1'000'000'000), static_cast<long>(wake % 1'000'000'000)};
+    while (clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &ts, nullptr) == EINTR) {
+    }
+  }
+  while (monotonicNow() < deadline) {
+  }
+}
+
+}  // namespace
+
+TimingSummary Environment::run(const RunOptions& options) {
+  if (options.mode == RunOptions::Mode::RealTime && !(options.realtime_factor > 0 && std::isfinite(options.realtime_factor)))
+    throw ConfigError({}, "real-time factor must be a positive number");
+  if (state_ == State::Setup) start();
+  const bool realtime = options.mode == RunOptions::Mode::RealTime;
+  if (realtime) prctl(PR_SET_TIMERSLACK, 1UL, 0, 0, 0);  // wake within 1 ns of the deadline, not 50 us
+
+  const double period = static_cast<double>(settings_.timestep) / (realtime ? options.realtime_factor : 1.0);
+  const std::size_t first_sample = timing_.samples().size();
+  const Nanoseconds sim_start = time();
+  const Nanoseconds wall_start = monotonicNow();
+  Nanoseconds grid_start = wall_start;  // deadlines are grid_start + k * period
+  std::int64_t grid_k = 0;
+  std::int64_t done = 0;
+  std::int64_t overruns = 0, unreported = 0;
+  Nanoseconds last_warning = wall_start - options.warn_interval;
+  Nanoseconds worst_unreported = 0;
+
+  while ((options.steps < 0 || done < options.steps) && !(options.stop != nullptr && options.stop->load())) {
+    step();
+    ++done;
+    ++grid_k;
+    if (realtime) {
+      const Nanoseconds deadline = grid_start + static_cast<Nanoseconds>(std::llround(static_cast<double>(grid_k) * period));
+      const Nanoseconds now = monotonicNow();
+      if (now > deadline) {
+        // overrun: record it, warn at most once per interval, and go on at once
+        const Nanoseconds late = now - deadline;
+        if (StepTiming* last = timing_.last()) last->lateness = late;
+        ++overruns;
+        ++unreported;
+        worst_unreported = std::max(worst_unreported, late);
+        if (now - last_warning >= options.warn_interval) {
+          char msg[200];
+          std::snprintf(msg, sizeof msg, "real time missed: %lld step(s) late since the last report, worst by %.3f ms (%lld overruns in all)",
+                        static_cast<long long>(unreported), static_cast<double>(worst_unreported) * 1e-6,
+                        static_cast<long long>(overruns));
+          log(LogLevel::Warning, msg);
+          last_warning = now;
+          unreported = 0;
+          worst_unreported = 0;
+        }
+        if (options.overrun == RunOptions::Overrun::Resync) {
+          grid_start = now;
+          grid_k = 0;
+        }
+      } else {
+        waitUntil(deadline, options.spin);
+      }
+    }
+    if (options.on_step) options.on_step(*this);
+  }
+  return timing_.summary(monotonicNow() - wall_start, time() - sim_start, first_sample);
+}
+
+}  // namespace ssx

@@ -1,0 +1,105 @@
+#include <ssx/error.hpp>
+#include <ssx/timing.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <ostream>
+
+namespace ssx {
+
+namespace {
+
+// nearest-rank percentile of sorted values, in milliseconds
+double percentileMs(const std::vector<Nanoseconds>& sorted, double p) {
+  if (sorted.empty()) return 0.0;
+  const auto rank = static_cast<std::size_t>(std::ceil(p / 100.0 * static_cast<double>(sorted.size())));
+  const std::size_t i = std::min(sorted.size() - 1, rank == 0 ? 0 : rank - 1);
+  return static_cast<double>(sorted[i]) * 1e-6;
+}
+
+double medianMs(std::vector<Nanoseconds> values) {
+  std::sort(values.begin(), values.end());
+  return percentileMs(values, 50.0);
+}
+
+}  // namespace
+
+TimingRecorder::TimingRecorder(std::size_t max_samples) : max_samples_(std::max<std::size_t>(2, max_samples)) {}
+
+void TimingRecorder::add(const StepTiming& sample) {
+  // beyond the cap, drop the older half at once (amortised O(1))
+  if (samples_.size() >= max_samples_)
+    samples_.erase(samples_.begin(), samples_.begin() + static_cast<std::ptrdiff_t>(max_samples_ / 2));
+  samples_.push_back(sample);
+}
+
+void TimingRecorder::clear() { samples_.clear(); }
+
+TimingSummary TimingRecorder::summary(Nanoseconds wall, Nanoseconds simulated, std::size_t first) const {
+  TimingSummary s;
+  if (first > samples_.size()) first = samples_.size();
+  const auto begin = samples_.begin() + static_cast<std::ptrdiff_t>(first);
+  const std::size_t n = samples_.size() - first;
+  s.steps = static_cast<std::int64_t>(n);
+  s.wall_s = toSeconds(wall);
+  s.simulated_s = toSeconds(simulated);
+  s.realtime_factor = wall > 0 ? s.simulated_s / s.wall_s : 0.0;
+  if (n == 0) return s;
+  std::vector<Nanoseconds> total, physics, sensors, drivers, render;
+  total.reserve(n);
+  double sum = 0;
+  Nanoseconds max_late = 0;
+  for (auto it = begin; it != samples_.end(); ++it) {
+    total.push_back(it->total);
+    physics.push_back(it->physics);
+    sensors.push_back(it->sensors);
+    drivers.push_back(it->drivers);
+    render.push_back(it->render);
+    sum += static_cast<double>(it->total);
+    if (it->lateness > 0) ++s.overruns;
+    max_late = std::max(max_late, it->lateness);
+  }
+  std::sort(total.begin(), total.end());
+  s.median_ms = percentileMs(total, 50);
+  s.p95_ms = percentileMs(total, 95);
+  s.p99_ms = percentileMs(total, 99);
+  s.max_ms = static_cast<double>(total.back()) * 1e-6;
+  s.mean_ms = sum / static_cast<double>(n) * 1e-6;
+  s.physics_median_ms = medianMs(std::move(physics));
+  s.sensors_median_ms = medianMs(std::move(sensors));
+  s.drivers_median_ms = medianMs(std::move(drivers));
+  s.render_median_ms = medianMs(std::move(render));
+  s.max_lateness_ms = static_cast<double>(max_late) * 1e-6;
+  return s;
+}
+
+std::string TimingSummary::str() const {
+  char buf[768];
+  std::snprintf(buf, sizeof buf,
+                "steps %lld, simulated %.3f s in %.3f s wall (real-time factor %.3f)\n"
+                "step time ms: median %.4f  p95 %.4f  p99 %.4f  max %.4f  mean %.4f\n"
+                "phase medians ms: physics %.4f  sensors %.4f  drivers %.4f  render %.4f\n"
+                "overruns %lld (max lateness %.3f ms)",
+                static_cast<long long>(steps), simulated_s, wall_s, realtime_factor, median_ms, p95_ms, p99_ms, max_ms,
+                mean_ms, physics_median_ms, sensors_median_ms, drivers_median_ms, render_median_ms,
+                static_cast<long long>(overruns), max_lateness_ms);
+  return buf;
+}
+
+void TimingRecorder::writeCsv(std::ostream& out) const {
+  out << "step,physics_ns,snapshot_ns,sensors_ns,drivers_ns,render_ns,total_ns,lateness_ns\n";
+  for (const auto& s : samples_)
+    out << s.step << ',' << s.physics << ',' << s.snapshot << ',' << s.sensors << ',' << s.drivers << ','
+        << s.render << ',' << s.total << ',' << s.lateness << '\n';
+}
+
+void TimingRecorder::writeCsv(const std::string& path) const {
+  std::ofstream out(path);
+  if (!out) throw Error("cannot write timing CSV '" + path + "': check the directory exists and is writable");
+  writeCsv(out);
+  if (!out.flush()) throw Error("error while writing timing CSV '" + path + "'");
+}
+
+}  // namespace ssx

@@ -1,0 +1,51 @@
+#pragma once
+// A fixed pool of worker threads for the parallel phases. The calling thread takes part; all
+// threads meet at the end of each job (a barrier). Work is handed out in chunks of indices from
+// a shared counter, so a slow artifact does not hold up a whole thread's share.
+
+#include <atomic>
+#include <cstddef>
+#include <cstdint>
+#include <exception>
+#include <thread>
+#include <vector>
+
+namespace ssx::detail {
+
+class WorkerPool {
+ public:
+  /// `threads` in total, the caller included (>= 1); threads - 1 are started.
+  explicit WorkerPool(unsigned threads);
+  ~WorkerPool();
+  WorkerPool(const WorkerPool&) = delete;
+  WorkerPool& operator=(const WorkerPool&) = delete;
+
+  unsigned size() const noexcept { return static_cast<unsigned>(workers_.size()) + 1; }
+
+  /// Calls fn(begin, end) over [0, n) in chunks of `chunk`, on every thread; returns when all
+  /// are done. If fn throws, the first exception caught is rethrown here after the barrier.
+  template <class F>
+  void parallelFor(std::size_t n, std::size_t chunk, F& fn) {
+    run(n, chunk, [](void* ctx, std::size_t b, std::size_t e) { (*static_cast<F*>(ctx))(b, e); }, &fn);
+  }
+
+ private:
+  using Invoke = void (*)(void*, std::size_t, std::size_t);
+  void run(std::size_t n, std::size_t chunk, Invoke invoke, void* ctx);
+  void work();
+  void workerLoop();
+
+  std::vector<std::thread> workers_;
+  std::atomic<std::uint64_t> generation_{0};
+  std::atomic<unsigned> busy_{0};
+  std::atomic<std::size_t> next_{0};
+  std::atomic<bool> stop_{false};
+  std::size_t n_ = 0;
+  std::size_t chunk_ = 1;
+  Invoke invoke_ = nullptr;
+  void* ctx_ = nullptr;
+  std::atomic<bool> has_error_{false};
+  std::exception_ptr error_;
+};
+
+}  // namespace ssx::detail
