@@ -118,6 +118,8 @@ void PhysicNode::addForce(const Vec3& force, Frame force_frame, const Vec3& poin
   if (body_ < 0 || artifact_->environment().states_.empty())
     throw Error("artifact '" + artifact_->name() + "', node '" + name() +
                 "': forces apply to dynamic nodes once the environment has started");
+  if (!force.allFinite() || !point.allFinite())
+    throw Error("artifact '" + artifact_->name() + "', node '" + name() + "': force or point is NaN or infinite");
   const BodyState& b = artifact_->environment().states_[static_cast<std::size_t>(body_)];
   const Pose node = b.pose * pose_in_body_;
   const Vec3 f = force_frame == Frame::World ? force : Vec3(node.orientation * force);
@@ -132,6 +134,8 @@ void PhysicNode::addTorque(const Vec3& torque, Frame frame) {
   if (body_ < 0 || artifact_->environment().states_.empty())
     throw Error("artifact '" + artifact_->name() + "', node '" + name() +
                 "': torques apply to dynamic nodes once the environment has started");
+  if (!torque.allFinite())
+    throw Error("artifact '" + artifact_->name() + "', node '" + name() + "': torque is NaN or infinite");
   const Pose node = pose();
   artifact_->wrench(body_).torque += frame == Frame::World ? torque : Vec3(node.orientation * torque);
 }
@@ -139,6 +143,11 @@ void PhysicNode::addTorque(const Vec3& torque, Frame frame) {
 void PhysicNode::setVelocity(const Vec3& linear, const Vec3& angular) {
   Environment& env = artifact_->environment();
   if (detail::PhaseGuard::in_phase) throw Error("setVelocity is not allowed during a step");
+  const PhysicsSettings& ps = env.settings().physics;
+  if (!linear.allFinite() || !angular.allFinite() || linear.norm() > ps.max_linear_speed ||
+      angular.norm() > ps.max_angular_speed)
+    throw Error("artifact '" + artifact_->name() + "', node '" + name() +
+                "': velocity must be finite and within max_linear_speed / max_angular_speed");
   if (env.state() == Environment::State::Setup) {
     initial_linear_ = linear;
     initial_angular_ = angular;

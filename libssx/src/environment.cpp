@@ -282,13 +282,15 @@ void Environment::publishSnapshot(bool first) {
   }
   physics_->readStates(states_);
   const double inv_dt = 1.0 / toSeconds(settings_.timestep);
+  const double max_v2 = settings_.physics.max_linear_speed * settings_.physics.max_linear_speed;
+  const double max_w2 = settings_.physics.max_angular_speed * settings_.physics.max_angular_speed;
   for (std::size_t i = 0; i < states_.size(); ++i) {
     BodyState& s = states_[i];
-    if (!finite(s)) {
+    if (!finite(s) || s.linear_velocity.squaredNorm() > max_v2 || s.angular_velocity.squaredNorm() > max_w2) {
       fail();
       throw StepError(body_owner_[i]->name(), "physics", steps_ - 1,
-                      "the state became NaN or infinite after the physics step (a non-finite force, an "
-                      "extreme velocity, or a timestep too large for the contacts)");
+                      "the simulation diverged: the state is NaN, infinite or faster than max_linear_speed / "
+                      "max_angular_speed (an absurd force, or a timestep too large for the contacts)");
     }
     if (first) continue;
     s.linear_acceleration = (s.linear_velocity - previous_linear_[i]) * inv_dt;
@@ -408,7 +410,21 @@ void Environment::step() {
 
   // physics, with the actuation written before
   auto t = Clock::now();
-  physics_->step(settings_.timestep, wrenches_);
+  try {
+    physics_->step(settings_.timestep, wrenches_);
+  } catch (const std::exception& e) {
+    // the engine gave up (ODE reports a NaN it met as an internal error): name the first
+    // artifact whose state is no longer finite, if the engine can still tell
+    fail();
+    std::string who;
+    try {
+      physics_->readStates(states_);
+      for (std::size_t i = 0; i < states_.size() && who.empty(); ++i)
+        if (!finite(states_[i])) who = body_owner_[i]->name();
+    } catch (...) {
+    }
+    throw StepError(who, "physics", current_step_, e.what());
+  }
   timing.physics = since(t);
   t = Clock::now();
   for (const auto& a : artifacts_)

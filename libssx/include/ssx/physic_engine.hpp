@@ -44,6 +44,10 @@ struct PhysicsSettings {
   double contact_soft_erp = 0.2;
   double contact_surface_layer = 1e-3;  ///< m of allowed penetration, for resting stability
   int max_contacts = 8;           ///< per pair of geoms
+  // divergence guards: a body past these speeds stops the run (StepError) before the engine
+  // meets a NaN; far beyond anything a robot does, far below where the arithmetic breaks
+  double max_linear_speed = 1e5;   ///< m/s
+  double max_angular_speed = 1e6;  ///< rad/s
 };
 
 /// Force and torque on a body, world frame, torque about the centre of mass.

@@ -2,6 +2,9 @@
 
 #include <ssx/error.hpp>
 
+#include <atomic>
+#include <cstdarg>
+#include <cstdio>
 #include <mutex>
 
 namespace ssx::detail {
@@ -18,17 +21,32 @@ unsigned g_ode_generation = 0;
 // its own copy and swaps it in around its step under this lock, so worlds never disturb each other
 std::mutex g_ode_step_mutex;
 
+// set once ODE reported an internal error: its state (worlds, the threading job list) can no
+// longer be torn down safely, so nothing of it is freed from then on
+std::atomic<bool> g_ode_poisoned{false};
+
+// ODE reports internal errors (a NaN quaternion, say) through handlers that abort by default;
+// ours throw instead, so the Environment can stop the run with a StepError and clean up
+[[noreturn]] void throwOdeError(int code, const char* format, va_list args) {
+  g_ode_poisoned = true;
+  char text[512];
+  std::vsnprintf(text, sizeof text, format, args);
+  throw Error("ode internal error " + std::to_string(code) + ": " + text);
+}
+
 void acquireOde() {
   std::lock_guard lock(g_ode_mutex);
   if (g_ode_users++ == 0) {
     dInitODE2(0);
+    dSetErrorHandler(&throwOdeError);
+    dSetDebugHandler(&throwOdeError);
     ++g_ode_generation;
   }
 }
 
 void releaseOde() {
   std::lock_guard lock(g_ode_mutex);
-  if (--g_ode_users == 0) dCloseODE();
+  if (--g_ode_users == 0 && !g_ode_poisoned) dCloseODE();
 }
 
 // every thread that calls into ODE needs its own collision data
@@ -77,6 +95,10 @@ OdeEngine::OdeEngine(const PhysicsSettings& settings) : settings_(settings) {
 }
 
 OdeEngine::~OdeEngine() {
+  if (g_ode_poisoned) {
+    releaseOde();  // the world is leaked on purpose: ODE cannot tear it down after an internal error
+    return;
+  }
   ensureThreadData();
   dJointGroupDestroy(contact_group_);
   dSpaceDestroy(space_);  // destroys its geoms (cleanup mode)
@@ -168,6 +190,14 @@ void OdeEngine::step(Nanoseconds dt, std::span<const Wrench> wrenches) {
   std::lock_guard lock(g_ode_step_mutex);
   const unsigned long outer_seed = dRandGetSeed();
   dRandSetSeed(rand_seed_);
+  struct RestoreSeed {
+    unsigned long& mine;
+    unsigned long outer;
+    ~RestoreSeed() {
+      mine = dRandGetSeed();
+      dRandSetSeed(outer);
+    }
+  } restore{rand_seed_, outer_seed};
   for (int k = 0; k < substeps; ++k) {
     // ODE clears force accumulators after each step: apply the held wrenches every substep
     for (std::size_t i = 0; i < bodies_.size(); ++i) {
@@ -182,8 +212,6 @@ void OdeEngine::step(Nanoseconds dt, std::span<const Wrench> wrenches) {
       dWorldQuickStep(world_, h);
     dJointGroupEmpty(contact_group_);
   }
-  rand_seed_ = dRandGetSeed();
-  dRandSetSeed(outer_seed);
 }
 
 void OdeEngine::readStates(std::span<BodyState> out) const {

@@ -1,0 +1,329 @@
+#include "test_util.hpp"
+
+#include <catch2/catch.hpp>
+
+#include <limits>
+#include <string>
+#include <vector>
+
+using namespace ssx;
+using ssx::test::at;
+using ssx::test::LambdaDriver;
+
+namespace {
+
+struct Counter : Measurement {
+  int value = 0;
+};
+
+// a sensor that counts its own runs
+class CountingSensor final : public SensorOf<Counter> {
+ public:
+  void sense(const StepInfo& info) override {
+    output().value += 1;
+    output().stamp = info.time;
+  }
+};
+
+class ThrowingSensor final : public SensorOf<Counter> {
+ public:
+  void sense(const StepInfo& info) override {
+    if (info.step == 2) throw std::runtime_error("lidar unplugged");
+  }
+};
+
+// records init and shutdown calls into a shared journal
+class JournalExtension final : public SimulationExtension {
+ public:
+  JournalExtension(std::string name, std::vector<std::string>& journal) : name_(std::move(name)), journal_(journal) {}
+  void init(Environment& env, const Descriptor&) override {
+    // engines are not configured yet
+    journal_.push_back("init " + name_ + (env.state() == Environment::State::Setup ? " (setup)" : " (running?)"));
+  }
+  void shutdown(Environment& env) override {
+    bool engines_gone = false;
+    try {
+      (void)env.physics();
+    } catch (const Error&) {
+      engines_gone = true;
+    }
+    journal_.push_back("shutdown " + name_ + (engines_gone ? " (engines stopped)" : " (engines alive!)"));
+  }
+
+ private:
+  std::string name_;
+  std::vector<std::string>& journal_;
+};
+
+Artifact& addBall(Environment& env, const std::string& name, double x = 0) {
+  Artifact& a = env.addArtifact(name, at(x, 0, 1));
+  a.addPhysicRoot(test::boxBody(Vec3(0.1, 0.1, 0.1), 1.0));
+  return a;
+}
+
+}  // namespace
+
+TEST_CASE("extensions init before the engines and shut down after them, first in last out", "[environment]") {
+  std::vector<std::string> journal;
+  {
+    Environment env;
+    env.addExtension("a", std::make_unique<JournalExtension>("a", journal));
+    env.addExtension("b", std::make_unique<JournalExtension>("b", journal));
+    addBall(env, "ball");
+    env.step();
+    CHECK(journal == std::vector<std::string>{"init a (setup)", "init b (setup)"});
+  }
+  CHECK(journal == std::vector<std::string>{"init a (setup)", "init b (setup)", "shutdown b (engines stopped)",
+                                            "shutdown a (engines stopped)"});
+}
+
+TEST_CASE("an extension that fails to init unwinds the ones before it", "[environment]") {
+  struct Failing : SimulationExtension {
+    void init(Environment&, const Descriptor&) override { throw Error("no ROS master"); }
+  };
+  std::vector<std::string> journal;
+  Environment env;
+  env.addExtension("a", std::make_unique<JournalExtension>("a", journal));
+  env.addExtension("bad", std::make_unique<Failing>());
+  CHECK_THROWS_WITH(env.start(), "no ROS master");
+  CHECK(journal == std::vector<std::string>{"init a (setup)", "shutdown a (engines stopped)"});
+  CHECK_THROWS(env.step());
+}
+
+TEST_CASE("drivers and sensors find extensions by name", "[environment]") {
+  struct Bridge : SimulationExtension {
+    int calls = 0;
+  };
+  Environment env;
+  env.addExtension("bridge", std::make_unique<Bridge>());
+  Artifact& a = addBall(env, "ball");
+  Bridge* seen = nullptr;
+  a.setDriver(std::make_unique<LambdaDriver>([&](Driver& d, const StepInfo&) {
+    seen = d.environment().extension<Bridge>("bridge");
+    seen->calls++;
+  }));
+  env.step(3);
+  REQUIRE(seen != nullptr);
+  CHECK(seen->calls == 3);
+  CHECK(env.extension("nope") == nullptr);
+}
+
+TEST_CASE("callbacks are delivered by source artifact, sensor and subscription, on every thread count", "[environment]") {
+  for (int threads : {1, 2, 4}) {
+    EnvironmentSettings s;
+    s.threads = threads;
+    Environment env(s);
+    // three artifacts with two sensors each; artifact "sink" subscribes in a scrambled order
+    std::vector<Artifact*> sources;
+    for (int i = 0; i < 3; ++i) {
+      Artifact& a = addBall(env, "src" + std::to_string(i), i);
+      a.addSensor(std::make_unique<CountingSensor>(), {}, 1, "s0");
+      a.addSensor(std::make_unique<CountingSensor>(), {}, 1, "s1");
+      sources.push_back(&a);
+    }
+    Artifact& sink = addBall(env, "sink", 5);
+    std::vector<std::string> order;
+    auto record = [&order](std::string tag) { return [&order, tag](const Counter&) { order.push_back(tag); }; };
+    env.subscribe<Counter>(sources[2]->sensor(1), sink, record("2.1"));
+    env.subscribe<Counter>(sources[0]->sensor(1), sink, record("0.1a"));
+    env.subscribe<Counter>(sources[1]->sensor(0), sink, record("1.0"));
+    env.subscribe<Counter>(sources[0]->sensor(0), sink, record("0.0"));
+    env.subscribe<Counter>(sources[0]->sensor(1), sink, record("0.1b"));
+    env.step();
+    CHECK(order == std::vector<std::string>{"0.0", "0.1a", "0.1b", "1.0", "2.1"});
+  }
+}
+
+TEST_CASE("callbacks see this step's measurement and only from due sensors", "[environment]") {
+  Environment env;
+  Artifact& src = addBall(env, "src");
+  auto& sensor = static_cast<CountingSensor&>(src.addSensor(std::make_unique<CountingSensor>(), {}, 3));
+  Artifact& sink = addBall(env, "sink", 2);
+  std::vector<std::pair<std::int64_t, int>> got;
+  env.subscribe<Counter>(sensor, sink, [&](const Counter& c) { got.emplace_back(c.stamp, c.value); });
+  env.step(7);
+  // due at steps 0, 3, 6; stamps are the time after each of those steps' physics
+  const Nanoseconds tau = env.timestep();
+  CHECK(got == std::vector<std::pair<std::int64_t, int>>{{tau, 1}, {4 * tau, 2}, {7 * tau, 3}});
+}
+
+TEST_CASE("subscribing with the wrong measurement type is refused", "[environment]") {
+  struct Other : Measurement {};
+  Environment env;
+  Artifact& a = addBall(env, "a");
+  Sensor& s = a.addSensor(std::make_unique<CountingSensor>());
+  CHECK_THROWS_AS(env.subscribe<Other>(s, a, [](const Other&) {}), ConfigError);
+}
+
+TEST_CASE("a throwing driver abandons the step with a StepError naming artifact and plugin", "[environment]") {
+  for (int threads : {1, 2}) {
+    EnvironmentSettings s;
+    s.threads = threads;
+    Environment env(s);
+    for (int i = 0; i < 20; ++i) {
+      Artifact& a = addBall(env, "robot" + std::to_string(i), i);
+      a.setDriver(std::make_unique<LambdaDriver>([i](Driver&, const StepInfo& info) {
+        if (info.step == 4 && (i == 7 || i == 13)) throw std::runtime_error("controller diverged");
+      }), {}, 1, "my_controller");
+    }
+    env.step(4);
+    try {
+      env.step();
+      FAIL("no StepError");
+    } catch (const StepError& e) {
+      // the lowest failing artifact is reported, whatever the threads
+      CHECK(e.artifact() == "robot7");
+      CHECK(e.plugin() == "driver 'my_controller'");
+      CHECK(e.step() == 4);
+      CHECK_THAT(e.what(), Catch::Contains("controller diverged"));
+    }
+    CHECK(env.state() == Environment::State::Failed);
+    CHECK_THROWS_WITH(env.step(), Catch::Contains("failed in an earlier step"));
+  }
+}
+
+TEST_CASE("a throwing sensor is named with its index and class", "[environment]") {
+  Environment env;
+  Artifact& a = addBall(env, "scout");
+  a.addSensor(std::make_unique<CountingSensor>(), {}, 1, "clock");
+  a.addSensor(std::make_unique<ThrowingSensor>(), {}, 1, "lidar");
+  env.step(2);
+  try {
+    env.step();
+    FAIL("no StepError");
+  } catch (const StepError& e) {
+    CHECK(e.artifact() == "scout");
+    CHECK(e.plugin() == "sensor 1 'lidar'");
+    CHECK_THAT(e.what(), Catch::Contains("lidar unplugged") && Catch::Contains("sensors phase"));
+  }
+}
+
+TEST_CASE("a driver producing a NaN force is stopped by name", "[environment]") {
+  Environment env;
+  Artifact& a = addBall(env, "quad3");
+  a.setDriver(std::make_unique<LambdaDriver>([](Driver& d, const StepInfo& info) {
+    const double bad = info.step == 10 ? std::numeric_limits<double>::quiet_NaN() : 0.0;
+    d.artifact().root().addForce(Vec3(0, 0, bad));
+  }), {}, 1, "broken_pid");
+  env.step(10);
+  try {
+    env.step();
+    FAIL("no StepError");
+  } catch (const StepError& e) {
+    CHECK(e.artifact() == "quad3");
+    CHECK(e.plugin() == "driver 'broken_pid'");
+    CHECK_THAT(e.what(), Catch::Contains("NaN"));
+  }
+}
+
+TEST_CASE("a diverging state after physics is reported naming the artifact", "[environment]") {
+  Environment env;
+  addBall(env, "calm");
+  Artifact& wild = addBall(env, "wild", 3);
+  env.step();
+  // non-finite or absurd inputs are refused where they are given
+  CHECK_THROWS_WITH(wild.root().addForce(Vec3(std::numeric_limits<double>::infinity(), 0, 0)),
+                    Catch::Contains("NaN or infinite"));
+  CHECK_THROWS_WITH(wild.root().setVelocity(Vec3::Zero(), Vec3(1e200, 0, 0)), Catch::Contains("max_angular_speed"));
+  // a finite but absurd force makes the body diverge in the physics step
+  wild.root().addForce(Vec3(1e300, 0, 0));
+  try {
+    env.step();
+    FAIL("no StepError");
+  } catch (const StepError& e) {
+    CHECK(e.artifact() == "wild");
+    CHECK(e.plugin() == "physics");
+    CHECK_THAT(e.what(), Catch::Contains("diverged"));
+  }
+  CHECK(env.state() == Environment::State::Failed);
+}
+
+TEST_CASE("a driver writing to another artifact is an error", "[environment]") {
+  Environment env;
+  Artifact& victim = addBall(env, "victim");
+  Artifact& bully = addBall(env, "bully", 2);
+  bully.setDriver(std::make_unique<LambdaDriver>([&victim](Driver&, const StepInfo&) {
+    victim.root().addForce(Vec3(1, 0, 0));
+  }), {}, 1, "pusher");
+  try {
+    env.step();
+    FAIL("no StepError");
+  } catch (const StepError& e) {
+    CHECK(e.artifact() == "bully");
+    CHECK_THAT(e.what(), Catch::Contains("tried to write to artifact 'victim'"));
+  }
+}
+
+TEST_CASE("drivers run at their period and hold their command in between", "[environment]") {
+  EnvironmentSettings s;
+  s.physics.gravity = Vec3::Zero();
+  Environment env(s);
+  Artifact& a = addBall(env, "slow");
+  int runs = 0;
+  a.setDriver(std::make_unique<LambdaDriver>([&runs](Driver& d, const StepInfo& info) {
+    ++runs;
+    CHECK(info.period == 5 * d.environment().timestep());
+    d.artifact().root().addForce(Vec3(1, 0, 0));  // 1 N on 1 kg
+  }), {}, 5);
+  env.step(11);  // runs at steps 0, 5, 10
+  CHECK(runs == 3);
+  // the force written at step 0 acts in steps 1..10: 10 ms of 1 m/s^2
+  CHECK(a.state().linear_velocity.x() == Approx(0.010).margin(1e-12));
+}
+
+TEST_CASE("setup calls are refused once running, and names are unique", "[environment]") {
+  Environment env;
+  addBall(env, "a");
+  CHECK_THROWS_AS(env.addArtifact("a"), ConfigError);
+  env.step();
+  CHECK_THROWS_WITH(env.addArtifact("b"), Catch::Contains("only before the environment starts"));
+  CHECK_THROWS(env.artifact(0).addSensor(std::make_unique<CountingSensor>()));
+}
+
+TEST_CASE("bad settings are refused at construction", "[environment]") {
+  EnvironmentSettings s;
+  s.timestep = 0;
+  CHECK_THROWS_WITH(Environment(s), Catch::Contains("timestep must be positive"));
+  s = {};
+  s.physics.substeps = 0;
+  CHECK_THROWS_AS(Environment(s), ConfigError);
+  s = {};
+  s.physics.engine = "physx";
+  Environment env(s);
+  CHECK_THROWS_WITH(env.start(), Catch::Contains("unknown physics engine 'physx'"));
+}
+
+TEST_CASE("time is an integer number of timesteps", "[environment]") {
+  EnvironmentSettings s;
+  s.timestep = 1'000'000 / 3;  // a timestep that is no round number of seconds
+  Environment env(s);
+  addBall(env, "a");
+  env.step(3000);
+  CHECK(env.time() == 3000 * s.timestep);
+  CHECK(env.stepCount() == 3000);
+}
+
+TEST_CASE("substeps split the timestep", "[environment]") {
+  // free fall with 4 substeps of h/4 equals 4x as many plain steps of h/4
+  auto fall = [](int substeps, double dt, int steps) {
+    EnvironmentSettings s;
+    s.timestep = toNanoseconds(dt);
+    s.physics.substeps = substeps;
+    Environment env(s);
+    Artifact& a = addBall(env, "a");
+    env.step(steps);
+    return a.pose().position.z();
+  };
+  CHECK(fall(4, 0.004, 100) == Approx(fall(1, 0.001, 400)).margin(1e-12));
+  CHECK(fall(4, 0.004, 100) != Approx(fall(1, 0.004, 100)).margin(1e-9));
+}
+
+TEST_CASE("sensors cannot write forces", "[environment]") {
+  struct Pushy : SensorOf<Counter> {
+    void sense(const StepInfo&) override { artifact().root().addForce(Vec3(1, 0, 0)); }
+  };
+  Environment env;
+  Artifact& a = addBall(env, "a");
+  a.addSensor(std::make_unique<Pushy>(), {}, 1, "pushy");
+  CHECK_THROWS_WITH(env.step(), Catch::Contains("a sensor tried to write to artifact 'a'"));
+}

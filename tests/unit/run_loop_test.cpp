@@ -1,0 +1,133 @@
+#include "test_util.hpp"
+
+#include <catch2/catch.hpp>
+
+#include <chrono>
+
+using namespace ssx;
+
+namespace {
+
+double secondsOf(const std::function<void()>& fn) {
+  const auto t0 = std::chrono::steady_clock::now();
+  fn();
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+Environment& withBall(Environment& env) {
+  env.addArtifact("ball", test::at(0, 0, 1)).addPhysicRoot(test::boxBody(Vec3(0.1, 0.1, 0.1), 1.0));
+  return env;
+}
+
+// busy-waits (no sleeping): the work a slow controller would do
+void burn(std::chrono::microseconds d) {
+  const auto until = std::chrono::steady_clock::now() + d;
+  while (std::chrono::steady_clock::now() < until) {
+  }
+}
+
+}  // namespace
+
+TEST_CASE("real time paces 50 steps of 10 ms to at least 0.5 s; fast mode does not wait", "[run]") {
+  EnvironmentSettings s;
+  s.timestep = toNanoseconds(0.010);
+  Environment rt(s);
+  withBall(rt);
+  RunOptions o;
+  o.steps = 50;
+  TimingSummary summary;
+  const double wall = secondsOf([&] { summary = rt.run(o); });
+  CHECK(wall >= 0.5);
+  CHECK(wall < 5.0);  // generous: a loaded CI machine
+  CHECK(summary.steps == 50);
+  CHECK(summary.simulated_s == Approx(0.5));
+  CHECK(rt.stepCount() == 50);
+
+  Environment fast(s);
+  withBall(fast);
+  o.mode = RunOptions::Mode::Fast;
+  const double fast_wall = secondsOf([&] { fast.run(o); });
+  CHECK(fast_wall < 0.5);
+  CHECK(fast.stepCount() == 50);
+}
+
+TEST_CASE("a real-time factor scales the pacing", "[run]") {
+  EnvironmentSettings s;
+  s.timestep = toNanoseconds(0.010);
+  Environment env(s);
+  withBall(env);
+  RunOptions o;
+  o.steps = 40;
+  o.realtime_factor = 4.0;  // 0.4 s simulated in 0.1 s
+  const double wall = secondsOf([&] { env.run(o); });
+  CHECK(wall >= 0.1);
+  CHECK(wall < 0.4);
+}
+
+TEST_CASE("overruns are counted and reported", "[run]") {
+  EnvironmentSettings s;
+  s.timestep = toNanoseconds(0.001);
+  s.threads = 1;
+  Environment env(s);
+  withBall(env);
+  // every 5th step takes 3 ms of a 1 ms budget
+  env.artifact(0).setDriver(std::make_unique<test::LambdaDriver>([](Driver&, const StepInfo& info) {
+    if (info.step % 5 == 0) burn(std::chrono::microseconds(3000));
+  }));
+  std::vector<std::string> warnings;
+  env.setLogSink([&](LogLevel level, std::string_view m) {
+    if (level == LogLevel::Warning) warnings.emplace_back(m);
+  });
+  RunOptions o;
+  o.steps = 20;
+  o.warn_interval = 1'000'000'000;
+  const TimingSummary summary = env.run(o);
+  CHECK(summary.overruns >= 4);
+  CHECK(summary.max_lateness_ms >= 1.5);
+  // rate-limited: one warning in well under a second of run
+  REQUIRE(warnings.size() == 1);
+  CHECK_THAT(warnings[0], Catch::Contains("real time missed"));
+}
+
+TEST_CASE("catch-up keeps the original grid, resync restarts it", "[run]") {
+  // one 30 ms step at the start of 20 steps of 2 ms: catch-up runs the next steps back to back
+  // (40 ms in all), resync moves the grid and takes about 30 + 19 * 2 ms
+  auto wallFor = [](RunOptions::Overrun policy, std::int64_t& overruns) {
+    EnvironmentSettings s;
+    s.timestep = toNanoseconds(0.002);
+    s.threads = 1;
+    Environment env(s);
+    withBall(env);
+    env.artifact(0).setDriver(std::make_unique<test::LambdaDriver>([](Driver&, const StepInfo& info) {
+      if (info.step == 0) burn(std::chrono::microseconds(30000));
+    }));
+    env.setLogSink([](LogLevel, std::string_view) {});
+    RunOptions o;
+    o.steps = 20;
+    o.overrun = policy;
+    double wall = 0;
+    wall = secondsOf([&] { overruns = env.run(o).overruns; });
+    return wall;
+  };
+  std::int64_t catchup_overruns = 0, resync_overruns = 0;
+  const double catchup = wallFor(RunOptions::Overrun::CatchUp, catchup_overruns);
+  const double resync = wallFor(RunOptions::Overrun::Resync, resync_overruns);
+  CHECK(catchup >= 0.040);
+  CHECK(resync >= 0.030 + 19 * 0.002);
+  CHECK(catchup_overruns > resync_overruns);  // catch-up steps are late until the grid is reached
+  CHECK(resync_overruns >= 1);
+}
+
+TEST_CASE("a stop flag ends the run", "[run]") {
+  Environment env;
+  withBall(env);
+  std::atomic<bool> stop{false};
+  RunOptions o;
+  o.mode = RunOptions::Mode::Fast;
+  o.stop = &stop;
+  o.on_step = [&stop](const Environment& e) {
+    if (e.stepCount() == 123) stop = true;
+  };
+  env.run(o);
+  CHECK(env.stepCount() == 123);
+}

@@ -1,0 +1,49 @@
+#include <ssx/error.hpp>
+#include <ssx/timing.hpp>
+
+#include <catch2/catch.hpp>
+
+#include <sstream>
+
+using namespace ssx;
+
+TEST_CASE("timing summary percentiles use nearest rank", "[timing]") {
+  TimingRecorder r;
+  for (int i = 1; i <= 100; ++i) {
+    StepTiming t;
+    t.step = i - 1;
+    t.total = i * 1'000'000;  // 1..100 ms
+    t.physics = 500'000;
+    t.lateness = i > 97 ? 1'000 : 0;
+    r.add(t);
+  }
+  const TimingSummary s = r.summary(toNanoseconds(2.0), toNanoseconds(1.0));
+  CHECK(s.steps == 100);
+  CHECK(s.median_ms == Approx(50));
+  CHECK(s.p95_ms == Approx(95));
+  CHECK(s.p99_ms == Approx(99));
+  CHECK(s.max_ms == Approx(100));
+  CHECK(s.mean_ms == Approx(50.5));
+  CHECK(s.physics_median_ms == Approx(0.5));
+  CHECK(s.overruns == 3);
+  CHECK(s.realtime_factor == Approx(0.5));
+  CHECK(r.summary(0, 0, 90).steps == 10);
+  CHECK(r.summary(0, 0, 90).median_ms == Approx(95));
+}
+
+TEST_CASE("timing samples are written as CSV", "[timing]") {
+  TimingRecorder r;
+  r.add({3, 10, 20, 30, 40, 0, 100, 5});
+  std::ostringstream out;
+  r.writeCsv(out);
+  CHECK(out.str() == "step,physics_ns,snapshot_ns,sensors_ns,drivers_ns,render_ns,total_ns,lateness_ns\n"
+                     "3,10,20,30,40,0,100,5\n");
+  CHECK_THROWS_WITH(r.writeCsv("/nonexistent-dir/t.csv"), Catch::Contains("cannot write timing CSV"));
+}
+
+TEST_CASE("the recorder keeps a bounded number of samples", "[timing]") {
+  TimingRecorder r(10);
+  for (int i = 0; i < 25; ++i) r.add({i, 0, 0, 0, 0, 0, i, 0});
+  CHECK(r.samples().size() <= 10);
+  CHECK(r.samples().back().step == 24);
+}

@@ -1,0 +1,44 @@
+#include "worker_pool.hpp"
+
+#include <catch2/catch.hpp>
+
+#include <atomic>
+#include <stdexcept>
+#include <vector>
+
+using ssx::detail::WorkerPool;
+
+TEST_CASE("the worker pool covers every index exactly once", "[pool]") {
+  for (unsigned threads : {1u, 2u, 4u}) {
+    WorkerPool pool(threads);
+    CHECK(pool.size() == threads);
+    for (std::size_t n : {std::size_t{0}, std::size_t{1}, std::size_t{7}, std::size_t{1000}}) {
+      for (int round = 0; round < 50; ++round) {
+        std::vector<std::atomic<int>> hits(n);
+        auto fn = [&](std::size_t b, std::size_t e) {
+          for (std::size_t i = b; i < e; ++i) hits[i].fetch_add(1);
+        };
+        pool.parallelFor(n, 3, fn);
+        for (std::size_t i = 0; i < n; ++i) REQUIRE(hits[i].load() == 1);
+      }
+    }
+  }
+}
+
+TEST_CASE("the worker pool rethrows a task's exception after the barrier", "[pool]") {
+  WorkerPool pool(3);
+  std::atomic<int> done{0};
+  auto fn = [&](std::size_t b, std::size_t e) {
+    for (std::size_t i = b; i < e; ++i) {
+      if (i == 17) throw std::runtime_error("task 17");
+      done.fetch_add(1);
+    }
+  };
+  CHECK_THROWS_WITH(pool.parallelFor(100, 1, fn), "task 17");
+  CHECK(done.load() == 99);  // every other chunk still ran
+  // the pool is usable afterwards
+  std::atomic<int> again{0};
+  auto count = [&](std::size_t b, std::size_t e) { again.fetch_add(static_cast<int>(e - b)); };
+  pool.parallelFor(100, 8, count);
+  CHECK(again.load() == 100);
+}
