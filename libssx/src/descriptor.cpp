@@ -63,17 +63,29 @@ bool parseValue(const std::string& text, Vec3& out) {
 template <class T>
 const char* typeName();
 template <>
-const char* typeName<std::string>() { return "a string"; }
+const char* typeName<std::string>() {
+  return "a string";
+}
 template <>
-const char* typeName<bool>() { return "a boolean (true or false)"; }
+const char* typeName<bool>() {
+  return "a boolean (true or false)";
+}
 template <>
-const char* typeName<int>() { return "an integer"; }
+const char* typeName<int>() {
+  return "an integer";
+}
 template <>
-const char* typeName<std::int64_t>() { return "an integer"; }
+const char* typeName<std::int64_t>() {
+  return "an integer";
+}
 template <>
-const char* typeName<double>() { return "a finite number"; }
+const char* typeName<double>() {
+  return "a finite number";
+}
 template <>
-const char* typeName<Vec3>() { return "three numbers \"x y z\""; }
+const char* typeName<Vec3>() {
+  return "three numbers \"x y z\"";
+}
 
 std::string formatNumber(double v) {
   std::ostringstream out;
@@ -101,9 +113,7 @@ Descriptor& Descriptor::set(std::string key, std::string value, SourceLocation w
 }
 
 Descriptor& Descriptor::set(std::string key, double value) { return set(std::move(key), formatNumber(value)); }
-Descriptor& Descriptor::set(std::string key, std::int64_t value) {
-  return set(std::move(key), std::to_string(value));
-}
+Descriptor& Descriptor::set(std::string key, std::int64_t value) { return set(std::move(key), std::to_string(value)); }
 Descriptor& Descriptor::set(std::string key, bool value) {
   return set(std::move(key), std::string(value ? "true" : "false"));
 }
@@ -186,7 +196,7 @@ ConfigError Descriptor::error(const Attribute& attribute, const std::string& mes
   return ConfigError(attribute.where, "<" + name_ + ">: " + message);
 }
 
-#define SSX_INSTANTIATE_GET(T)                                         \
+#define SSX_INSTANTIATE_GET(T)                                      \
   template SSX_EXPORT T Descriptor::get<T>(std::string_view) const; \
   template SSX_EXPORT T Descriptor::get<T>(std::string_view, const T&) const;
 SSX_INSTANTIATE_GET(std::string)

@@ -314,7 +314,8 @@ void Environment::runSensors(std::size_t begin, std::size_t end) {
         sensor.sense(info);
         slot.fresh = true;
       } catch (...) {
-        errors_[i] = {"sensor " + std::to_string(k) + " '" + sensor.className() + "'", describe(std::current_exception())};
+        errors_[i] = {"sensor " + std::to_string(k) + " '" + sensor.className() + "'",
+                      describe(std::current_exception())};
         break;
       }
     }
@@ -337,8 +338,9 @@ void Environment::runDrivers(std::size_t begin, std::size_t end) {
         sub.callback(slot.sensor->latest());
       }
     } catch (...) {
-      errors_[i] = {"callback subscribed to sensor '" + current->source->sensors_[current->sensor_index].sensor->className() +
-                        "' of artifact '" + current->source->name() + "'",
+      errors_[i] = {"callback subscribed to sensor '" +
+                        current->source->sensors_[current->sensor_index].sensor->className() + "' of artifact '" +
+                        current->source->name() + "'",
                     describe(std::current_exception())};
       continue;
     }

@@ -9,9 +9,9 @@ class Artifact;
 namespace ssx::detail {
 
 struct PhaseGuard {
-  static thread_local bool in_phase;               // inside a parallel phase
-  static thread_local const Artifact* writer;      // the artifact whose driver runs, or nullptr
-  static thread_local const char* role;            // "driver", "sensor", "callback" for messages
+  static thread_local bool in_phase;           // inside a parallel phase
+  static thread_local const Artifact* writer;  // the artifact whose driver runs, or nullptr
+  static thread_local const char* role;        // "driver", "sensor", "callback" for messages
 
   PhaseGuard(const Artifact* w, const char* r) : saved_in_(in_phase), saved_writer_(writer), saved_role_(role) {
     in_phase = true;

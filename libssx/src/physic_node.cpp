@@ -83,8 +83,12 @@ void validateNode(const PhysicNodeSpec& node, bool is_root, bool root_static, st
   for (const auto& s : node.shapes) {
     bool ok = true;
     switch (s.kind) {
-      case Shape::Kind::Box: ok = (s.size.array() > 0).all() && s.size.allFinite(); break;
-      case Shape::Kind::Sphere: ok = s.radius > 0 && std::isfinite(s.radius); break;
+      case Shape::Kind::Box:
+        ok = (s.size.array() > 0).all() && s.size.allFinite();
+        break;
+      case Shape::Kind::Sphere:
+        ok = s.radius > 0 && std::isfinite(s.radius);
+        break;
       case Shape::Kind::Cylinder:
       case Shape::Kind::Capsule:
         ok = s.radius > 0 && s.length >= 0 && std::isfinite(s.radius) && std::isfinite(s.length);
@@ -138,11 +142,16 @@ Shape Shape::plane(const Pose& pose) {
 
 double Shape::volume() const {
   switch (kind) {
-    case Kind::Box: return size.prod();
-    case Kind::Sphere: return 4.0 / 3.0 * kPi * radius * radius * radius;
-    case Kind::Cylinder: return kPi * radius * radius * length;
-    case Kind::Capsule: return kPi * radius * radius * (length + 4.0 / 3.0 * radius);
-    case Kind::Plane: return 0.0;
+    case Kind::Box:
+      return size.prod();
+    case Kind::Sphere:
+      return 4.0 / 3.0 * kPi * radius * radius * radius;
+    case Kind::Cylinder:
+      return kPi * radius * radius * length;
+    case Kind::Capsule:
+      return kPi * radius * radius * (length + 4.0 / 3.0 * radius);
+    case Kind::Plane:
+      return 0.0;
   }
   return 0.0;
 }
@@ -154,7 +163,8 @@ Mat3 Shape::unitInertia(double m) const {
       const Vec3 s2 = size.cwiseProduct(size);
       return (m / 12.0 * Vec3(s2.y() + s2.z(), s2.x() + s2.z(), s2.x() + s2.y())).asDiagonal();
     }
-    case Kind::Sphere: return Mat3::Identity() * (0.4 * m * r2);
+    case Kind::Sphere:
+      return Mat3::Identity() * (0.4 * m * r2);
     case Kind::Cylinder: {
       const double t = m * (3 * r2 + length * length) / 12.0;
       return Vec3(t, t, 0.5 * m * r2).asDiagonal();
@@ -169,7 +179,8 @@ Mat3 Shape::unitInertia(double m) const {
       const double t = mc * (h * h / 12.0 + r2 / 4.0) + ms * (0.4 * r2 + h * h / 4.0 + 3.0 * h * radius / 8.0);
       return Vec3(t, t, 0.5 * mc * r2 + 0.4 * ms * r2).asDiagonal();
     }
-    case Kind::Plane: return Mat3::Zero();
+    case Kind::Plane:
+      return Mat3::Zero();
   }
   return Mat3::Zero();
 }
@@ -188,8 +199,9 @@ void validatePhysicTree(const PhysicNodeSpec& root) {
       throw ConfigError(root.where, nodeLabel(root) + ": a dynamic body needs mass: give a mass or shapes with volume");
     const Vec3 eig = Eigen::SelfAdjointEigenSolver<Mat3>(m.inertia).eigenvalues();
     if (!(eig.minCoeff() > 0))
-      throw ConfigError(root.where, nodeLabel(root) +
-                                        ": the body's combined inertia is singular: give an inertia or shapes with volume");
+      throw ConfigError(
+          root.where,
+          nodeLabel(root) + ": the body's combined inertia is singular: give an inertia or shapes with volume");
   }
 }
 

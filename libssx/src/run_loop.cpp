@@ -33,7 +33,8 @@ void waitUntil(Nanoseconds deadline, Nanoseconds spin) {
 }  // namespace
 
 TimingSummary Environment::run(const RunOptions& options) {
-  if (options.mode == RunOptions::Mode::RealTime && !(options.realtime_factor > 0 && std::isfinite(options.realtime_factor)))
+  if (options.mode == RunOptions::Mode::RealTime &&
+      !(options.realtime_factor > 0 && std::isfinite(options.realtime_factor)))
     throw ConfigError({}, "real-time factor must be a positive number");
   if (state_ == State::Setup) start();
   const bool realtime = options.mode == RunOptions::Mode::RealTime;
@@ -55,7 +56,8 @@ TimingSummary Environment::run(const RunOptions& options) {
     ++done;
     ++grid_k;
     if (realtime) {
-      const Nanoseconds deadline = grid_start + static_cast<Nanoseconds>(std::llround(static_cast<double>(grid_k) * period));
+      const Nanoseconds deadline =
+          grid_start + static_cast<Nanoseconds>(std::llround(static_cast<double>(grid_k) * period));
       const Nanoseconds now = monotonicNow();
       if (now > deadline) {
         // overrun: record it, warn at most once per interval, and go on at once
@@ -66,9 +68,11 @@ TimingSummary Environment::run(const RunOptions& options) {
         worst_unreported = std::max(worst_unreported, late);
         if (now - last_warning >= options.warn_interval) {
           char msg[200];
-          std::snprintf(msg, sizeof msg, "real time missed: %lld step(s) late since the last report, worst by %.3f ms (%lld overruns in all)",
-                        static_cast<long long>(unreported), static_cast<double>(worst_unreported) * 1e-6,
-                        static_cast<long long>(overruns));
+          std::snprintf(
+              msg, sizeof msg,
+              "real time missed: %lld step(s) late since the last report, worst by %.3f ms (%lld overruns in all)",
+              static_cast<long long>(unreported), static_cast<double>(worst_unreported) * 1e-6,
+              static_cast<long long>(overruns));
           log(LogLevel::Warning, msg);
           last_warning = now;
           unreported = 0;

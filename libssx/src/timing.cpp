@@ -91,8 +91,8 @@ std::string TimingSummary::str() const {
 void TimingRecorder::writeCsv(std::ostream& out) const {
   out << "step,physics_ns,snapshot_ns,sensors_ns,drivers_ns,render_ns,total_ns,lateness_ns\n";
   for (const auto& s : samples_)
-    out << s.step << ',' << s.physics << ',' << s.snapshot << ',' << s.sensors << ',' << s.drivers << ','
-        << s.render << ',' << s.total << ',' << s.lateness << '\n';
+    out << s.step << ',' << s.physics << ',' << s.snapshot << ',' << s.sensors << ',' << s.drivers << ',' << s.render
+        << ',' << s.total << ',' << s.lateness << '\n';
 }
 
 void TimingRecorder::writeCsv(const std::string& path) const {

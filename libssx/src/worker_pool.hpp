@@ -26,7 +26,8 @@ class WorkerPool {
   /// are done. If fn throws, the first exception caught is rethrown here after the barrier.
   template <class F>
   void parallelFor(std::size_t n, std::size_t chunk, F& fn) {
-    run(n, chunk, [](void* ctx, std::size_t b, std::size_t e) { (*static_cast<F*>(ctx))(b, e); }, &fn);
+    run(
+        n, chunk, [](void* ctx, std::size_t b, std::size_t e) { (*static_cast<F*>(ctx))(b, e); }, &fn);
   }
 
  private:

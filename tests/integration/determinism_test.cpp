@@ -18,7 +18,8 @@ class NoisyPoseSensor final : public SensorOf<NoisyPose> {
  public:
   void sense(const StepInfo& info) override {
     output().stamp = info.time;
-    output().position = artifact().pose().position + Vec3(random().normal(), random().normal(), random().normal()) * 0.01;
+    output().position =
+        artifact().pose().position + Vec3(random().normal(), random().normal(), random().normal()) * 0.01;
   }
 };
 

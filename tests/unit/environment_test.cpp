@@ -108,7 +108,8 @@ TEST_CASE("drivers and sensors find extensions by name", "[environment]") {
   CHECK(env.extension("nope") == nullptr);
 }
 
-TEST_CASE("callbacks are delivered by source artifact, sensor and subscription, on every thread count", "[environment]") {
+TEST_CASE("callbacks are delivered by source artifact, sensor and subscription, on every thread count",
+          "[environment]") {
   for (int threads : {1, 2, 4}) {
     EnvironmentSettings s;
     s.threads = threads;
@@ -163,8 +164,9 @@ TEST_CASE("a throwing driver abandons the step with a StepError naming artifact 
     for (int i = 0; i < 20; ++i) {
       Artifact& a = addBall(env, "robot" + std::to_string(i), i);
       a.setDriver(std::make_unique<LambdaDriver>([i](Driver&, const StepInfo& info) {
-        if (info.step == 4 && (i == 7 || i == 13)) throw std::runtime_error("controller diverged");
-      }), {}, 1, "my_controller");
+                    if (info.step == 4 && (i == 7 || i == 13)) throw std::runtime_error("controller diverged");
+                  }),
+                  {}, 1, "my_controller");
     }
     env.step(4);
     try {
@@ -202,9 +204,10 @@ TEST_CASE("a driver producing a NaN force is stopped by name", "[environment]") 
   Environment env;
   Artifact& a = addBall(env, "quad3");
   a.setDriver(std::make_unique<LambdaDriver>([](Driver& d, const StepInfo& info) {
-    const double bad = info.step == 10 ? std::numeric_limits<double>::quiet_NaN() : 0.0;
-    d.artifact().root().addForce(Vec3(0, 0, bad));
-  }), {}, 1, "broken_pid");
+                const double bad = info.step == 10 ? std::numeric_limits<double>::quiet_NaN() : 0.0;
+                d.artifact().root().addForce(Vec3(0, 0, bad));
+              }),
+              {}, 1, "broken_pid");
   env.step(10);
   try {
     env.step();
@@ -242,9 +245,9 @@ TEST_CASE("a driver writing to another artifact is an error", "[environment]") {
   Environment env;
   Artifact& victim = addBall(env, "victim");
   Artifact& bully = addBall(env, "bully", 2);
-  bully.setDriver(std::make_unique<LambdaDriver>([&victim](Driver&, const StepInfo&) {
-    victim.root().addForce(Vec3(1, 0, 0));
-  }), {}, 1, "pusher");
+  bully.setDriver(
+      std::make_unique<LambdaDriver>([&victim](Driver&, const StepInfo&) { victim.root().addForce(Vec3(1, 0, 0)); }),
+      {}, 1, "pusher");
   try {
     env.step();
     FAIL("no StepError");
@@ -261,10 +264,11 @@ TEST_CASE("drivers run at their period and hold their command in between", "[env
   Artifact& a = addBall(env, "slow");
   int runs = 0;
   a.setDriver(std::make_unique<LambdaDriver>([&runs](Driver& d, const StepInfo& info) {
-    ++runs;
-    CHECK(info.period == 5 * d.environment().timestep());
-    d.artifact().root().addForce(Vec3(1, 0, 0));  // 1 N on 1 kg
-  }), {}, 5);
+                ++runs;
+                CHECK(info.period == 5 * d.environment().timestep());
+                d.artifact().root().addForce(Vec3(1, 0, 0));  // 1 N on 1 kg
+              }),
+              {}, 5);
   env.step(11);  // runs at steps 0, 5, 10
   CHECK(runs == 3);
   // the force written at step 0 acts in steps 1..10: 10 ms of 1 m/s^2

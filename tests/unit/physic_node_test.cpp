@@ -78,7 +78,8 @@ TEST_CASE("invalid node trees are rejected with the node named", "[physic_node]"
   n.name = "frame";
   n.where = {"quad.xml", 9};
   n.mass = -1.0;
-  CHECK_THROWS_WITH(validatePhysicTree(n), "quad.xml:9: error: physic node 'frame': mass must be positive, got -1.000000 kg");
+  CHECK_THROWS_WITH(validatePhysicTree(n),
+                    "quad.xml:9: error: physic node 'frame': mass must be positive, got -1.000000 kg");
 
   n.mass = 1.0;
   n.inertia = Vec3(1, 1, -1).asDiagonal();

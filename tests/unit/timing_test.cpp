@@ -36,8 +36,9 @@ TEST_CASE("timing samples are written as CSV", "[timing]") {
   r.add({3, 10, 20, 30, 40, 0, 100, 5});
   std::ostringstream out;
   r.writeCsv(out);
-  CHECK(out.str() == "step,physics_ns,snapshot_ns,sensors_ns,drivers_ns,render_ns,total_ns,lateness_ns\n"
-                     "3,10,20,30,40,0,100,5\n");
+  CHECK(out.str() ==
+        "step,physics_ns,snapshot_ns,sensors_ns,drivers_ns,render_ns,total_ns,lateness_ns\n"
+        "3,10,20,30,40,0,100,5\n");
   CHECK_THROWS_WITH(r.writeCsv("/nonexistent-dir/t.csv"), Catch::Contains("cannot write timing CSV"));
 }
 

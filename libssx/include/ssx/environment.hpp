@@ -65,9 +65,9 @@ struct RunOptions {
   double realtime_factor = 1.0;  ///< > 1 runs faster than the wall clock
   std::int64_t steps = -1;       ///< stop after this many steps; -1: until `stop` is set
   Overrun overrun = Overrun::CatchUp;
-  Nanoseconds spin = 0;          ///< busy-wait this long before each deadline, for precision
-  Nanoseconds warn_interval = 1'000'000'000;  ///< at most one overrun warning per this wall time
-  const std::atomic<bool>* stop = nullptr;    ///< set to true (from anywhere) to end the run
+  Nanoseconds spin = 0;                             ///< busy-wait this long before each deadline, for precision
+  Nanoseconds warn_interval = 1'000'000'000;        ///< at most one overrun warning per this wall time
+  const std::atomic<bool>* stop = nullptr;          ///< set to true (from anywhere) to end the run
   std::function<void(const Environment&)> on_step;  ///< after every step, calling thread
 };
 
@@ -137,7 +137,9 @@ class SSX_EXPORT Environment {
   /// Extension by name, or nullptr.
   SimulationExtension* extension(std::string_view name) const;
   template <class T>
-  T* extension(std::string_view name) const { return dynamic_cast<T*>(extension(name)); }
+  T* extension(std::string_view name) const {
+    return dynamic_cast<T*>(extension(name));
+  }
 
   /// The published state of body `i` (see PhysicNode::bodyIndex).
   const BodyState& bodyState(int i) const { return states_.at(static_cast<std::size_t>(i)); }
@@ -183,12 +185,12 @@ class SSX_EXPORT Environment {
   std::unique_ptr<PhysicEngine> physics_;
   std::unique_ptr<RenderEngine> renderer_;
   std::unique_ptr<detail::WorkerPool> pool_;
-  std::vector<BodyState> states_;        // the snapshot, one per body
-  std::vector<Vec3> previous_linear_;    // velocities before the step, for accelerations
+  std::vector<BodyState> states_;      // the snapshot, one per body
+  std::vector<Vec3> previous_linear_;  // velocities before the step, for accelerations
   std::vector<Vec3> previous_angular_;
-  std::vector<Wrench> wrenches_;         // command buffers, one per body, owned by artifacts
+  std::vector<Wrench> wrenches_;  // command buffers, one per body, owned by artifacts
   std::vector<Artifact*> body_owner_;
-  std::vector<PendingError> errors_;     // one per artifact, filled by the parallel phases
+  std::vector<PendingError> errors_;  // one per artifact, filled by the parallel phases
   std::vector<RenderItem> render_items_;
   std::uint64_t subscription_sequence_ = 0;
   TimingRecorder timing_;
@@ -202,8 +204,7 @@ void Environment::subscribe(const Sensor& sensor, Artifact& subscriber, std::fun
   if (dynamic_cast<const M*>(&sensor.latest()) == nullptr)
     throw ConfigError({}, "sensor '" + sensor.className() + "' of artifact '" + sensor.artifact().name() +
                               "' does not produce the measurement type the subscriber asked for");
-  subscribe(sensor, subscriber,
-            [cb = std::move(callback)](const Measurement& m) { cb(static_cast<const M&>(m)); });
+  subscribe(sensor, subscriber, [cb = std::move(callback)](const Measurement& m) { cb(static_cast<const M&>(m)); });
 }
 
 }  // namespace ssx

@@ -28,22 +28,22 @@ struct PhysicsSettings {
   std::string engine = "ode";
   Vec3 gravity{0.0, 0.0, -9.81};  ///< m/s^2, world frame
   Solver solver = Solver::QuickStep;
-  int iterations = 20;            ///< QuickStep iterations
-  double sor = 1.3;               ///< QuickStep over-relaxation
-  int substeps = 1;               ///< equal physics steps per environment timestep
-  double erp = 0.2;               ///< error reduction parameter
-  double cfm = 1e-9;              ///< constraint force mixing
+  int iterations = 20;  ///< QuickStep iterations
+  double sor = 1.3;     ///< QuickStep over-relaxation
+  int substeps = 1;     ///< equal physics steps per environment timestep
+  double erp = 0.2;     ///< error reduction parameter
+  double cfm = 1e-9;    ///< constraint force mixing
   Broadphase broadphase = Broadphase::SweepAndPrune;
   Vec3 quadtree_center = Vec3::Zero();
   Vec3 quadtree_extents{1000.0, 1000.0, 200.0};
   int quadtree_depth = 6;
   // contacts
-  double friction = 1.0;          ///< Coulomb coefficient (pyramid approximation)
-  double restitution = 0.0;       ///< bounce, 0..1
+  double friction = 1.0;     ///< Coulomb coefficient (pyramid approximation)
+  double restitution = 0.0;  ///< bounce, 0..1
   double contact_soft_cfm = 1e-6;
   double contact_soft_erp = 0.2;
   double contact_surface_layer = 1e-3;  ///< m of allowed penetration, for resting stability
-  int max_contacts = 8;           ///< per pair of geoms
+  int max_contacts = 8;                 ///< per pair of geoms
   // divergence guards: a body past these speeds stops the run (StepError) before the engine
   // meets a NaN; far beyond anything a robot does, far below where the arithmetic breaks
   double max_linear_speed = 1e5;   ///< m/s

@@ -50,8 +50,8 @@ struct SSX_EXPORT PhysicNodeSpec {
   std::string name;
   Pose pose;  ///< relative to the parent node; for a root, relative to the artifact's pose
   std::vector<Shape> shapes;
-  std::optional<double> mass;   ///< kg
-  std::optional<Mat3> inertia;  ///< kg m^2, about the centre of mass, node axes; needs `mass`
+  std::optional<double> mass;          ///< kg
+  std::optional<Mat3> inertia;         ///< kg m^2, about the centre of mass, node axes; needs `mass`
   Vec3 center_of_mass = Vec3::Zero();  ///< node frame; used with an explicit `mass`
   bool is_static = false;              ///< root only: fixed in the world, never moves
   SourceLocation where;                ///< where it was described, for messages
@@ -118,11 +118,11 @@ class SSX_EXPORT PhysicNode {
   Artifact* artifact_;
   const PhysicNodeSpec* spec_;
   PhysicNode* parent_;
-  int body_ = -1;           // -1: static, or not started
+  int body_ = -1;  // -1: static, or not started
   bool static_ = false;
-  Pose pose_in_body_;       // node frame in body (centre-of-mass) frame
-  Pose setup_pose_;         // world pose as placed (static nodes keep it)
-  Vec3 initial_linear_ = Vec3::Zero();   // of this node's origin, set before start
+  Pose pose_in_body_;                   // node frame in body (centre-of-mass) frame
+  Pose setup_pose_;                     // world pose as placed (static nodes keep it)
+  Vec3 initial_linear_ = Vec3::Zero();  // of this node's origin, set before start
   Vec3 initial_angular_ = Vec3::Zero();
 };
 

@@ -20,9 +20,9 @@ class Environment;
 
 /// What a driver or sensor is told about the step it runs in.
 struct StepInfo {
-  std::int64_t step = 0;  ///< index of the current step, from 0
-  Nanoseconds time = 0;   ///< simulated time after this step's physics
-  Nanoseconds period = 0; ///< time between two runs of this plugin (period_steps * timestep)
+  std::int64_t step = 0;   ///< index of the current step, from 0
+  Nanoseconds time = 0;    ///< simulated time after this step's physics
+  Nanoseconds period = 0;  ///< time between two runs of this plugin (period_steps * timestep)
   double periodSeconds() const { return toSeconds(period); }
 };
 

@@ -29,11 +29,11 @@ struct SSX_EXPORT TimingSummary {
   std::int64_t steps = 0;
   double median_ms = 0, p95_ms = 0, p99_ms = 0, max_ms = 0, mean_ms = 0;  ///< step compute time
   double physics_median_ms = 0, sensors_median_ms = 0, drivers_median_ms = 0, render_median_ms = 0;
-  std::int64_t overruns = 0;      ///< steps that ended after their deadline (real-time runs)
+  std::int64_t overruns = 0;  ///< steps that ended after their deadline (real-time runs)
   double max_lateness_ms = 0;
-  double wall_s = 0;              ///< wall-clock time of the run
-  double simulated_s = 0;         ///< simulated time covered
-  double realtime_factor = 0;     ///< simulated_s / wall_s
+  double wall_s = 0;           ///< wall-clock time of the run
+  double simulated_s = 0;      ///< simulated time covered
+  double realtime_factor = 0;  ///< simulated_s / wall_s
 
   /// A human-readable block of lines.
   std::string str() const;

@@ -50,8 +50,8 @@ struct Pose {
 /// Velocities and accelerations are those of the frame's origin.
 struct SSX_EXPORT BodyState {
   Pose pose;
-  Vec3 linear_velocity = Vec3::Zero();    ///< m/s, world frame
-  Vec3 angular_velocity = Vec3::Zero();   ///< rad/s, world frame
+  Vec3 linear_velocity = Vec3::Zero();       ///< m/s, world frame
+  Vec3 angular_velocity = Vec3::Zero();      ///< rad/s, world frame
   Vec3 linear_acceleration = Vec3::Zero();   ///< m/s^2, world frame, gravity included
   Vec3 angular_acceleration = Vec3::Zero();  ///< rad/s^2, world frame
 

@@ -108,11 +108,16 @@ OdeEngine::~OdeEngine() {
 
 dGeomID OdeEngine::createGeom(const Shape& s) {
   switch (s.kind) {
-    case Shape::Kind::Box: return dCreateBox(space_, s.size.x(), s.size.y(), s.size.z());
-    case Shape::Kind::Sphere: return dCreateSphere(space_, s.radius);
-    case Shape::Kind::Cylinder: return dCreateCylinder(space_, s.radius, s.length);
-    case Shape::Kind::Capsule: return dCreateCapsule(space_, s.radius, s.length);
-    case Shape::Kind::Plane: break;
+    case Shape::Kind::Box:
+      return dCreateBox(space_, s.size.x(), s.size.y(), s.size.z());
+    case Shape::Kind::Sphere:
+      return dCreateSphere(space_, s.radius);
+    case Shape::Kind::Cylinder:
+      return dCreateCylinder(space_, s.radius, s.length);
+    case Shape::Kind::Capsule:
+      return dCreateCapsule(space_, s.radius, s.length);
+    case Shape::Kind::Plane:
+      break;
   }
   return nullptr;
 }
