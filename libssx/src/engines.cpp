@@ -13,7 +13,7 @@ namespace {
 class NullRenderEngine final : public RenderEngine {
  public:
   std::string name() const override { return "null"; }
-  void draw(Nanoseconds, const std::vector<RenderItem>&) override { ++frames_; }
+  void draw(Nanoseconds, const std::vector<RenderNode>&) override { ++frames_; }
   std::int64_t frameCount() const override { return frames_; }
 
  private:

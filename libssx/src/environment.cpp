@@ -377,12 +377,14 @@ void Environment::raiseFirstError(const char* phase) {
 
 void Environment::drawFrame() {
   render_items_.clear();
+  const Artifact* owner = nullptr;
   auto add = [&](auto& self, const RenderNodeSpec& spec, const Pose& parent) -> void {
     const Pose world = parent * spec.pose;
-    render_items_.push_back({&spec, world});
+    render_items_.push_back({&spec, owner, world});
     for (const auto& c : spec.children) self(self, c, world);
   };
   for (const auto& a : artifacts_) {
+    owner = a.get();
     for (const auto& r : a->render_roots_) {
       const PhysicNode* follow = r.follow.empty() ? nullptr : a->node(r.follow);
       add(add, r, follow != nullptr ? follow->pose() : a->placement());

@@ -331,3 +331,38 @@ TEST_CASE("sensors cannot write forces", "[environment]") {
   a.addSensor(std::make_unique<Pushy>(), {}, 1, "pushy");
   CHECK_THROWS_WITH(env.step(), Catch::Contains("a sensor tried to write to artifact 'a'"));
 }
+
+TEST_CASE("frames are drawn when due, with render nodes following their physic nodes", "[environment][render]") {
+  EnvironmentSettings s;
+  s.render.period_steps = 5;
+  Environment env(s);
+  Artifact& a = addBall(env, "ball");
+  RenderNodeSpec body;
+  body.name = "shell";
+  body.primitive = RenderNodeSpec::Primitive::Sphere;
+  body.follow = "body";
+  RenderNodeSpec mast;
+  mast.name = "mast";
+  mast.primitive = RenderNodeSpec::Primitive::Cylinder;
+  mast.pose.position = Vec3(0, 0, 0.5);
+  body.children.push_back(mast);
+  a.addRenderRoot(body);
+  RenderNodeSpec bad;
+  bad.follow = "no_such_node";
+  CHECK_THROWS_WITH(a.addRenderRoot(bad), Catch::Contains("follows unknown physic node 'no_such_node'"));
+
+  env.step(12);  // due at steps 0, 5, 10
+  CHECK(env.renderer().frameCount() == 3);
+  CHECK(env.renderer().name() == "null");
+  const auto& nodes = env.renderNodes();
+  REQUIRE(nodes.size() == 2);
+  CHECK(nodes[1].spec->name == "mast");
+  CHECK(nodes[1].artifact == &a);
+  // drawn at step 10: the mast sits 0.5 m above the falling body as it was then
+  const double z_then = 1.0 - 9.81 * 0.001 * 0.001 * 11 * 12 / 2.0;
+  CHECK(nodes[0].world.position.z() == Approx(z_then).margin(1e-9));
+  CHECK(nodes[1].world.position.z() == Approx(z_then + 0.5).margin(1e-9));
+  std::int64_t drawn = 0;
+  for (const auto& t : env.timing().samples()) drawn += t.render > 0 ? 1 : 0;
+  CHECK(drawn == 3);
+}

@@ -147,6 +147,9 @@ class SSX_EXPORT Environment {
   /// A 64-bit hash (FNV-1a) of every body's pose and velocities, bit for bit, and the time.
   std::uint64_t stateHash() const;
 
+  /// The render nodes of the last frame drawn, posed in the world.
+  const std::vector<RenderNode>& renderNodes() const noexcept { return render_items_; }
+
   PhysicEngine& physics() const;
   RenderEngine& renderer() const;
   /// Per-step timing of every step taken so far.
@@ -191,7 +194,7 @@ class SSX_EXPORT Environment {
   std::vector<Wrench> wrenches_;  // command buffers, one per body, owned by artifacts
   std::vector<Artifact*> body_owner_;
   std::vector<PendingError> errors_;  // one per artifact, filled by the parallel phases
-  std::vector<RenderItem> render_items_;
+  std::vector<RenderNode> render_items_;
   std::uint64_t subscription_sequence_ = 0;
   TimingRecorder timing_;
   LogSink log_;

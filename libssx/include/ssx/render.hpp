@@ -14,6 +14,8 @@
 
 namespace ssx {
 
+class Artifact;
+
 /// One node of what the user sees, posed relative to its parent. A root follows the physic node
 /// named in `follow` (its pose is then relative to that node), or stays where it was placed.
 struct RenderNodeSpec {
@@ -35,20 +37,22 @@ struct RenderSettings {
   std::int64_t period_steps = 0;  ///< draw every this many steps; 0: never
 };
 
-/// A node instance to draw: its world pose is computed by the Environment before `draw`.
-struct RenderItem {
+/// A live render node: one node of an artifact's render tree, posed in the world from the
+/// snapshot by the Environment right before `draw`.
+struct RenderNode {
   const RenderNodeSpec* spec = nullptr;
+  const Artifact* artifact = nullptr;
   Pose world;
 };
 
 /// An abstract renderer. Called only from the thread calling Environment::step, in the render
-/// phase, after drivers; it reads the snapshot through the items the Environment hands it.
+/// phase, after drivers; it reads the snapshot through the nodes the Environment hands it.
 class SSX_EXPORT RenderEngine {
  public:
   virtual ~RenderEngine();
   virtual std::string name() const = 0;
-  /// Draws one frame of the given items at simulated time `time`.
-  virtual void draw(Nanoseconds time, const std::vector<RenderItem>& items) = 0;
+  /// Draws one frame of the given nodes at simulated time `time`.
+  virtual void draw(Nanoseconds time, const std::vector<RenderNode>& nodes) = 0;
   /// Frames drawn so far.
   virtual std::int64_t frameCount() const = 0;
 };
