@@ -47,33 +47,45 @@ void Artifact::addRenderRoot(RenderNodeSpec spec) {
 
 Driver& Artifact::setDriver(std::unique_ptr<Driver> driver, Descriptor params, std::int64_t period_steps,
                             std::string class_name) {
-  requireSetup("a driver can be set");
   if (!driver) throw Error("artifact '" + name_ + "': setDriver given a null driver");
-  if (driver_) throw ConfigError(params.where(), "artifact '" + name_ + "' already has a driver");
+  Driver& d = setDriver(*driver, std::move(params), period_steps, std::move(class_name));
+  owned_driver_ = std::move(driver);
+  return d;
+}
+
+Driver& Artifact::setDriver(Driver& driver, Descriptor params, std::int64_t period_steps, std::string class_name) {
+  requireSetup("a driver can be set");
+  if (driver_ != nullptr) throw ConfigError(params.where(), "artifact '" + name_ + "' already has a driver");
   if (period_steps < 1) throw ConfigError(params.where(), "driver period must be at least 1 step");
-  driver->artifact_ = this;
-  driver->period_steps_ = period_steps;
-  driver->plugin_index_ = 0;
-  driver->class_name_ = class_name.empty() ? std::string("driver") : std::move(class_name);
-  driver->random_.reseed(deriveSeed(env_->settings().seed, index_, 0));
-  driver_ = std::move(driver);
+  driver.artifact_ = this;
+  driver.period_steps_ = period_steps;
+  driver.plugin_index_ = 0;
+  driver.class_name_ = class_name.empty() ? std::string("driver") : std::move(class_name);
+  driver.random_.reseed(deriveSeed(env_->settings().seed, index_, 0));
+  driver_ = &driver;
   driver_params_ = std::move(params);
-  return *driver_;
+  return driver;
 }
 
 Sensor& Artifact::addSensor(std::unique_ptr<Sensor> sensor, Descriptor params, std::int64_t period_steps,
                             std::string class_name) {
-  requireSetup("sensors can be added");
   if (!sensor) throw Error("artifact '" + name_ + "': addSensor given a null sensor");
+  Sensor& s = addSensor(*sensor, std::move(params), period_steps, std::move(class_name));
+  sensors_.back().owned = std::move(sensor);
+  return s;
+}
+
+Sensor& Artifact::addSensor(Sensor& sensor, Descriptor params, std::int64_t period_steps, std::string class_name) {
+  requireSetup("sensors can be added");
   if (period_steps < 1) throw ConfigError(params.where(), "sensor period must be at least 1 step");
   const auto plugin_index = static_cast<std::uint32_t>(sensors_.size() + 1);
-  sensor->artifact_ = this;
-  sensor->period_steps_ = period_steps;
-  sensor->plugin_index_ = plugin_index;
-  sensor->class_name_ = class_name.empty() ? "sensor" + std::to_string(plugin_index - 1) : std::move(class_name);
-  sensor->random_.reseed(deriveSeed(env_->settings().seed, index_, plugin_index));
-  sensors_.push_back({std::move(sensor), std::move(params), false});
-  return *sensors_.back().sensor;
+  sensor.artifact_ = this;
+  sensor.period_steps_ = period_steps;
+  sensor.plugin_index_ = plugin_index;
+  sensor.class_name_ = class_name.empty() ? "sensor" + std::to_string(plugin_index - 1) : std::move(class_name);
+  sensor.random_.reseed(deriveSeed(env_->settings().seed, index_, plugin_index));
+  sensors_.push_back({&sensor, nullptr, std::move(params), false});
+  return sensor;
 }
 
 PhysicNode* Artifact::node(std::string_view name) const {

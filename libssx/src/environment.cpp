@@ -8,6 +8,7 @@
 #include <cmath>
 #include <cstring>
 #include <iostream>
+#include <set>
 
 namespace ssx {
 
@@ -55,7 +56,10 @@ void checkSettings(const EnvironmentSettings& s) {
 
 }  // namespace
 
-Environment::Environment(EnvironmentSettings settings) : settings_(std::move(settings)) { checkSettings(settings_); }
+Environment::Environment(EnvironmentSettings settings)
+    : settings_(std::move(settings)), loader_(std::make_unique<ClassLoader>()) {
+  checkSettings(settings_);
+}
 
 Environment::~Environment() {
   try {
@@ -63,6 +67,8 @@ Environment::~Environment() {
   } catch (const std::exception& e) {
     log(LogLevel::Error, std::string("while stopping: ") + e.what());
   }
+  // plugin instances go before the artifacts and extension slots that point at them
+  loader_->destroyInstances();
 }
 
 void Environment::requireSetup(const char* what) const {
@@ -89,11 +95,18 @@ Artifact& Environment::addGround(double z) {
 
 SimulationExtension& Environment::addExtension(std::string name, std::unique_ptr<SimulationExtension> extension,
                                                Descriptor params) {
-  requireSetup("extensions can be added");
   if (!extension) throw Error("addExtension given a null extension");
+  SimulationExtension& e = addExtension(std::move(name), *extension, std::move(params));
+  extensions_.back().owned = std::move(extension);
+  return e;
+}
+
+SimulationExtension& Environment::addExtension(std::string name, SimulationExtension& extension, Descriptor params) {
+  requireSetup("extensions can be added");
+  if (name.empty()) throw ConfigError(params.where(), "an extension needs a name");
   if (this->extension(name) != nullptr) throw ConfigError(params.where(), "duplicate extension name '" + name + "'");
-  extensions_.push_back({std::move(name), std::move(extension), std::move(params), false});
-  return *extensions_.back().extension;
+  extensions_.push_back({std::move(name), &extension, nullptr, std::move(params), false});
+  return extension;
 }
 
 void Environment::subscribe(const Sensor& sensor, Artifact& subscriber,
@@ -111,6 +124,11 @@ void Environment::setLogSink(LogSink sink) { log_ = std::move(sink); }
 void Environment::log(LogLevel level, std::string_view message) const {
   if (log_) {
     log_(level, message);
+    return;
+  }
+  // diagnostics that already carry "file:line: warning:" are printed as they are
+  if (message.find(": warning: ") != std::string_view::npos || message.find(": error: ") != std::string_view::npos) {
+    std::cerr << message << '\n';
     return;
   }
   const char* tag = level == LogLevel::Error ? "error" : level == LogLevel::Warning ? "warning" : "info";
@@ -131,7 +149,7 @@ Artifact* Environment::findArtifact(std::string_view name) const {
 
 SimulationExtension* Environment::extension(std::string_view name) const {
   for (const auto& e : extensions_)
-    if (e.name == name) return e.extension.get();
+    if (e.name == name) return e.extension;
   return nullptr;
 }
 
@@ -221,6 +239,7 @@ void Environment::start() {
       for (auto& s : a->sensors_) s.sensor->configure(s.params);
     }
     configuring_ = false;
+    warnUnusedParameters();
     // callbacks are delivered by source artifact, then sensor, then subscription order
     for (auto& a : artifacts_) {
       std::sort(a->inbox_.begin(), a->inbox_.end(), [](const auto& x, const auto& y) {
@@ -270,6 +289,20 @@ void Environment::stop() {
 }
 
 void Environment::fail() { state_ = State::Failed; }
+
+void Environment::warnUnusedParameters() const {
+  // parameters no plugin read are typos or leftovers: say so once per place they were written
+  std::set<std::string> seen;
+  auto report = [&](const Descriptor& d) {
+    for (auto& w : d.unusedAttributeWarnings())
+      if (seen.insert(w).second) log(LogLevel::Warning, w);
+  };
+  for (const auto& e : extensions_) report(e.params);
+  for (const auto& a : artifacts_) {
+    if (a->driver_ != nullptr) report(a->driver_params_);
+    for (const auto& s : a->sensors_) report(s.params);
+  }
+}
 
 // --- one step ----------------------------------------------------------------------------------
 
@@ -344,7 +377,7 @@ void Environment::runDrivers(std::size_t begin, std::size_t end) {
                     describe(std::current_exception())};
       continue;
     }
-    Driver* driver = a.driver_.get();
+    Driver* driver = a.driver_;
     if (driver == nullptr || current_step_ % driver->period_steps_ != 0) continue;
     StepInfo info = base;
     info.period = driver->period_steps_ * settings_.timestep;

@@ -47,17 +47,21 @@ class SSX_EXPORT Artifact {
   /// Adds a sensor; returns it. Sensor i has plugin index i + 1 (the driver has 0).
   Sensor& addSensor(std::unique_ptr<Sensor> sensor, Descriptor params = {}, std::int64_t period_steps = 1,
                     std::string class_name = {});
+  /// Same, for instances owned elsewhere (by the environment's ClassLoader); they must outlive
+  /// the environment's run.
+  Driver& setDriver(Driver& driver, Descriptor params, std::int64_t period_steps, std::string class_name);
+  Sensor& addSensor(Sensor& sensor, Descriptor params, std::int64_t period_steps, std::string class_name);
 
   // --- access -------------------------------------------------------------------------------
 
-  Driver* driver() const noexcept { return driver_.get(); }
+  Driver* driver() const noexcept { return driver_; }
   std::size_t sensorCount() const noexcept { return sensors_.size(); }
   Sensor& sensor(std::size_t i) const { return *sensors_.at(i).sensor; }
   /// The first sensor of type T, or nullptr.
   template <class T>
   T* findSensor() const {
     for (const auto& s : sensors_)
-      if (auto* t = dynamic_cast<T*>(s.sensor.get())) return t;
+      if (auto* t = dynamic_cast<T*>(s.sensor)) return t;
     return nullptr;
   }
 
@@ -78,7 +82,8 @@ class SSX_EXPORT Artifact {
   Artifact(Environment& env, std::string name, std::size_t index, const Pose& placement);
 
   struct SensorSlot {
-    std::unique_ptr<Sensor> sensor;
+    Sensor* sensor;
+    std::unique_ptr<Sensor> owned;  // null when a ClassLoader owns it
     Descriptor params;
     bool fresh = false;  // wrote a measurement in this step
   };
@@ -102,7 +107,8 @@ class SSX_EXPORT Artifact {
   std::vector<std::unique_ptr<PhysicNode>> nodes_;  // every node, trees in order
   std::vector<PhysicNode*> roots_;
   std::vector<RenderNodeSpec> render_roots_;
-  std::unique_ptr<Driver> driver_;
+  Driver* driver_ = nullptr;
+  std::unique_ptr<Driver> owned_driver_;  // null when a ClassLoader owns it
   Descriptor driver_params_;
   std::vector<SensorSlot> sensors_;
   std::vector<Subscription> inbox_;  // sorted (source index, sensor index, sequence) at start

@@ -20,6 +20,7 @@
 /// `run()`.
 
 #include <ssx/artifact.hpp>
+#include <ssx/class_loader.hpp>
 #include <ssx/descriptor.hpp>
 #include <ssx/export.hpp>
 #include <ssx/physic_engine.hpp>
@@ -95,6 +96,11 @@ class SSX_EXPORT Environment {
   /// Adds an extension under a unique name.
   SimulationExtension& addExtension(std::string name, std::unique_ptr<SimulationExtension> extension,
                                     Descriptor params = {});
+  /// Same, for an extension owned elsewhere (by classLoader()).
+  SimulationExtension& addExtension(std::string name, SimulationExtension& extension, Descriptor params);
+  /// The loader for plugin libraries; it owns what it creates, and the environment destroys
+  /// those instances right after its plugins' destroy() and before anything else.
+  ClassLoader& classLoader() noexcept { return *loader_; }
   /// Delivers `sensor`'s measurements to `callback`, in the drivers phase on `subscriber`'s
   /// thread. Allowed before start and from `configure`.
   void subscribe(const Sensor& sensor, Artifact& subscriber, std::function<void(const Measurement&)> callback);
@@ -168,10 +174,12 @@ class SSX_EXPORT Environment {
   void raiseFirstError(const char* phase);
   void drawFrame();
   void fail();
+  void warnUnusedParameters() const;
 
   struct ExtensionSlot {
     std::string name;
-    std::unique_ptr<SimulationExtension> extension;
+    SimulationExtension* extension;
+    std::unique_ptr<SimulationExtension> owned;  // null when the ClassLoader owns it
     Descriptor params;
     bool initialised = false;
   };
@@ -181,6 +189,7 @@ class SSX_EXPORT Environment {
   };
 
   EnvironmentSettings settings_;
+  std::unique_ptr<ClassLoader> loader_;  // declared first: destroyed last
   State state_ = State::Setup;
   std::int64_t steps_ = 0;
   std::vector<std::unique_ptr<Artifact>> artifacts_;

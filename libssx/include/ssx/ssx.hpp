@@ -3,12 +3,14 @@
 /// The whole public API of libssx.
 
 #include <ssx/artifact.hpp>
+#include <ssx/class_loader.hpp>
 #include <ssx/descriptor.hpp>
 #include <ssx/environment.hpp>
 #include <ssx/error.hpp>
 #include <ssx/export.hpp>
 #include <ssx/physic_engine.hpp>
 #include <ssx/physic_node.hpp>
+#include <ssx/plugin_abi.hpp>
 #include <ssx/plugin.hpp>
 #include <ssx/random.hpp>
 #include <ssx/render.hpp>

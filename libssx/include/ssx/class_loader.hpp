@@ -1,0 +1,96 @@
+#pragma once
+/// @file
+/// ClassLoader: finds plugin libraries on a search path, checks them, creates and owns instances.
+
+#include <ssx/error.hpp>
+#include <ssx/export.hpp>
+#include <ssx/plugin.hpp>
+
+#include <filesystem>
+#include <memory>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace ssx {
+
+enum class PluginKind : std::uint8_t { Driver, Sensor, Extension };
+/// "driver", "sensor" or "extension".
+SSX_EXPORT const char* toString(PluginKind kind);
+
+/// A plugin could not be found, loaded, checked or instantiated. The message names the plugin,
+/// every path tried and why each failed.
+class SSX_EXPORT PluginError : public Error {
+ public:
+  using Error::Error;
+};
+
+/// What a plugin library holds, as read from its manifest.
+struct PluginLibraryInfo {
+  std::filesystem::path path;
+  bool ok = false;        ///< passes every check
+  std::string problem;    ///< why not, when !ok
+  std::string build_tag;  ///< as the library reports it
+  struct Class {
+    PluginKind kind;
+    std::string name;
+  };
+  std::vector<Class> classes;
+};
+
+/// Loads plugin libraries with dlopen(RTLD_NOW | RTLD_LOCAL) and checks their manifest (ABI
+/// version, record sizes, build tag, classes) before calling any of their functions.
+///
+/// Ownership: the loader owns every instance it creates and destroys all of them (newest first)
+/// in `destroyInstances()` or its destructor. It never unloads a library: callbacks, type
+/// information and strings made by plugin code may outlive the instances (in other artifacts'
+/// subscriptions, in exception messages), and unloading would buy nothing in a simulator process.
+///
+/// A plugin name ("hover") is looked up in each search directory, in order, as
+/// `libssx_<name>.so`, `lib<name>.so` and `<name>.so`; a name with a '/' or ending in ".so" is a
+/// file path, used as it is (the scene loader makes paths in scene files absolute first).
+class SSX_EXPORT ClassLoader {
+ public:
+  ClassLoader();
+  ~ClassLoader();
+  ClassLoader(const ClassLoader&) = delete;
+  ClassLoader& operator=(const ClassLoader&) = delete;
+
+  /// Appends a directory to the search path (searched in the order added).
+  void addSearchDirectory(std::filesystem::path dir);
+  const std::vector<std::filesystem::path>& searchPath() const noexcept { return search_path_; }
+  /// The plugin directory of this libssx installation (`<libdir>/ssx/plugins`, found beside the
+  /// loaded libssx itself, so it works in a build tree and after install).
+  static std::filesystem::path installedPluginDirectory();
+
+  /// Finds, opens and checks a plugin library; returns its path. Loading the same library again
+  /// is free. Throws PluginError.
+  std::filesystem::path load(std::string_view plugin);
+  /// Creates an instance of `class_name` from `plugin`, of the given kind. The loader owns it.
+  /// Throws PluginError (unknown class, class of another kind, constructor threw or returned null).
+  Driver& createDriver(std::string_view plugin, std::string_view class_name);
+  Sensor& createSensor(std::string_view plugin, std::string_view class_name);
+  SimulationExtension& createExtension(std::string_view plugin, std::string_view class_name);
+
+  /// Every library on the search path (files ending in .so), checked but not instantiated.
+  std::vector<PluginLibraryInfo> scan() const;
+  /// Checks one library file without keeping it loaded (if it fails) and without creating anything.
+  static PluginLibraryInfo inspect(const std::filesystem::path& file);
+
+  /// Destroys every instance created so far, newest first.
+  void destroyInstances() noexcept;
+
+ private:
+  struct Library;
+  void* create(std::string_view plugin, std::string_view class_name, PluginKind kind);
+
+  std::vector<std::filesystem::path> search_path_;
+  std::vector<std::unique_ptr<Library>> libraries_;
+  struct Instance {
+    void* object;
+    void (*destroy)(void*) noexcept;
+  };
+  std::vector<Instance> instances_;
+};
+
+}  // namespace ssx

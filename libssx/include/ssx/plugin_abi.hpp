@@ -1,0 +1,135 @@
+#pragma once
+/// @file
+/// The binary interface between libssx and plugin libraries, and the macro that writes it.
+///
+/// A plugin library exports one C data symbol, `ssx_plugin_manifest_v1`, of type
+/// `ssx_plugin_manifest`: plain constant data (no code runs to produce it) giving the ABI version,
+/// the record sizes, a build tag, and for every class its kind, name and `noexcept` create /
+/// destroy functions. The ClassLoader reads and checks all of it before calling any plugin code.
+///
+/// A plugin author writes, in one .cpp of the library:
+///
+///     SSX_PLUGIN(SSX_DRIVER(HoverDriver, "hover"),
+///                SSX_SENSOR(PoseSensor, "pose"))
+///
+/// Types must be default-constructible and derive from ssx::Driver, ssx::Sensor or
+/// ssx::SimulationExtension respectively.
+
+#include <ssx/plugin.hpp>
+#include <ssx/version.hpp>
+
+#include <cstddef>
+#include <cstdint>
+#include <cstring>
+#include <exception>
+#include <new>
+#include <type_traits>
+
+/// Incremented whenever the manifest layout or the meaning of its fields changes.
+#define SSX_PLUGIN_ABI_VERSION 1u
+
+#define SSX_PLUGIN_STRINGIFY2(x) #x
+#define SSX_PLUGIN_STRINGIFY(x) SSX_PLUGIN_STRINGIFY2(x)
+#if defined(__clang__)
+#define SSX_PLUGIN_COMPILER "clang " SSX_PLUGIN_STRINGIFY(__clang_major__)
+#elif defined(__GNUC__)
+#define SSX_PLUGIN_COMPILER "gcc " SSX_PLUGIN_STRINGIFY(__GNUC__)
+#else
+#define SSX_PLUGIN_COMPILER "unknown"
+#endif
+#if defined(_GLIBCXX_USE_CXX11_ABI)
+#define SSX_PLUGIN_STDLIB "libstdc++ abi" SSX_PLUGIN_STRINGIFY(_GLIBCXX_USE_CXX11_ABI)
+#elif defined(_LIBCPP_VERSION)
+#define SSX_PLUGIN_STDLIB "libc++"
+#else
+#define SSX_PLUGIN_STDLIB "unknown"
+#endif
+/// What a plugin must have been built against to be loaded: the ssx major.minor version and the
+/// C++ ABI (a class layout or standard-library mismatch would crash at run time instead).
+#define SSX_PLUGIN_BUILD_TAG                                                                                 \
+  "ssx " SSX_PLUGIN_STRINGIFY(SSX_VERSION_MAJOR) "." SSX_PLUGIN_STRINGIFY(SSX_VERSION_MINOR) "; " SSX_PLUGIN_STDLIB
+
+extern "C" {
+
+/// What a class in a plugin is.
+enum ssx_plugin_kind : std::uint32_t {
+  SSX_PLUGIN_DRIVER = 1,
+  SSX_PLUGIN_SENSOR = 2,
+  SSX_PLUGIN_EXTENSION = 3,
+};
+
+/// One class. `create` returns a new instance (as ssx::Driver*, ssx::Sensor* or
+/// ssx::SimulationExtension*, by kind) or null, writing the reason into `error` (NUL-terminated,
+/// at most `error_size` bytes); it never throws. `destroy` deletes an instance `create` returned.
+struct ssx_plugin_class {
+  std::uint32_t kind;
+  const char* name;
+  void* (*create)(char* error, std::size_t error_size) noexcept;
+  void (*destroy)(void* instance) noexcept;
+};
+
+/// The manifest. `record_size` is sizeof(ssx_plugin_manifest) and `class_size` is
+/// sizeof(ssx_plugin_class) as the plugin saw them.
+struct ssx_plugin_manifest {
+  std::uint32_t abi_version;
+  std::uint32_t record_size;
+  std::uint32_t class_size;
+  std::uint32_t class_count;
+  const char* build_tag;
+  const ssx_plugin_class* classes;
+};
+
+}  // extern "C"
+
+namespace ssx::detail {
+
+template <class T, class Base>
+void* pluginCreate(char* error, std::size_t error_size) noexcept {
+  auto report = [&](const char* what) {
+    if (error != nullptr && error_size > 0) {
+      std::strncpy(error, what, error_size - 1);
+      error[error_size - 1] = '\0';
+    }
+  };
+  try {
+    return static_cast<void*>(static_cast<Base*>(new T()));
+  } catch (const std::exception& e) {
+    report(e.what());
+  } catch (...) {
+    report("unknown exception");
+  }
+  return nullptr;
+}
+
+template <class Base>
+void pluginDestroy(void* instance) noexcept {
+  delete static_cast<Base*>(instance);
+}
+
+template <class T, class Base>
+constexpr ssx_plugin_class pluginClass(std::uint32_t kind, const char* name) {
+  static_assert(std::is_base_of_v<Base, T>, "SSX_DRIVER / SSX_SENSOR / SSX_EXTENSION: wrong base class");
+  return {kind, name, &pluginCreate<T, Base>, &pluginDestroy<Base>};
+}
+
+}  // namespace ssx::detail
+
+#define SSX_DRIVER(Type, name) ::ssx::detail::pluginClass<Type, ::ssx::Driver>(SSX_PLUGIN_DRIVER, name)
+#define SSX_SENSOR(Type, name) ::ssx::detail::pluginClass<Type, ::ssx::Sensor>(SSX_PLUGIN_SENSOR, name)
+#define SSX_EXTENSION(Type, name) \
+  ::ssx::detail::pluginClass<Type, ::ssx::SimulationExtension>(SSX_PLUGIN_EXTENSION, name)
+
+/// Writes the manifest of this plugin library from a list of SSX_DRIVER / SSX_SENSOR /
+/// SSX_EXTENSION entries. Use once per library, at namespace scope.
+#define SSX_PLUGIN(...)                                                                                        \
+  namespace {                                                                                                  \
+  constexpr ssx_plugin_class ssx_plugin_classes_[] = {__VA_ARGS__};                                            \
+  }                                                                                                            \
+  extern "C" __attribute__((visibility("default"))) const ssx_plugin_manifest ssx_plugin_manifest_v1;          \
+  extern "C" __attribute__((visibility("default"))) const ssx_plugin_manifest ssx_plugin_manifest_v1 = {      \
+      SSX_PLUGIN_ABI_VERSION,                                                                                  \
+      static_cast<std::uint32_t>(sizeof(ssx_plugin_manifest)),                                                 \
+      static_cast<std::uint32_t>(sizeof(ssx_plugin_class)),                                                    \
+      static_cast<std::uint32_t>(sizeof(ssx_plugin_classes_) / sizeof(ssx_plugin_classes_[0])),               \
+      SSX_PLUGIN_BUILD_TAG,                                                                                    \
+      ssx_plugin_classes_}

@@ -1,0 +1,221 @@
+#include <ssx/class_loader.hpp>
+#include <ssx/plugin_abi.hpp>
+
+#include <cxxabi.h>
+#include <dlfcn.h>
+
+#include <algorithm>
+#include <cstdlib>
+#include <cstring>
+#include <system_error>
+
+namespace ssx {
+
+namespace fs = std::filesystem;
+
+const char* toString(PluginKind kind) {
+  switch (kind) {
+    case PluginKind::Driver: return "driver";
+    case PluginKind::Sensor: return "sensor";
+    case PluginKind::Extension: return "extension";
+  }
+  return "?";
+}
+
+namespace {
+
+constexpr const char* kManifestSymbol = "ssx_plugin_manifest_v1";
+constexpr std::uint32_t kMaxClasses = 4096;
+
+// dlerror text, with any undefined C++ symbol demangled so the user sees what is missing
+std::string explainDlerror(const char* text) {
+  std::string out = text != nullptr ? text : "unknown dlopen error";
+  const std::string marker = "undefined symbol: ";
+  const auto at = out.find(marker);
+  if (at == std::string::npos) return out;
+  const auto begin = at + marker.size();
+  auto end = out.find_first_of(" ,\t\n", begin);
+  if (end == std::string::npos) end = out.size();
+  const std::string mangled = out.substr(begin, end - begin);
+  int status = 0;
+  char* demangled = abi::__cxa_demangle(mangled.c_str(), nullptr, nullptr, &status);
+  if (status == 0 && demangled != nullptr) out += " (" + std::string(demangled) + ")";
+  std::free(demangled);
+  return out;
+}
+
+bool validKind(std::uint32_t k) { return k >= SSX_PLUGIN_DRIVER && k <= SSX_PLUGIN_EXTENSION; }
+
+PluginKind toKind(std::uint32_t k) {
+  return k == SSX_PLUGIN_DRIVER ? PluginKind::Driver : k == SSX_PLUGIN_SENSOR ? PluginKind::Sensor : PluginKind::Extension;
+}
+
+// reads and checks a manifest; returns "" when it is good
+std::string checkManifest(const ssx_plugin_manifest* m, PluginLibraryInfo& info) {
+  if (m == nullptr) return "not an ssx plugin: it has no '" + std::string(kManifestSymbol) + "' symbol (use SSX_PLUGIN)";
+  if (m->abi_version != SSX_PLUGIN_ABI_VERSION)
+    return "plugin ABI version " + std::to_string(m->abi_version) + ", this ssx loads version " +
+           std::to_string(SSX_PLUGIN_ABI_VERSION) + ": rebuild the plugin against this ssx";
+  if (m->record_size != sizeof(ssx_plugin_manifest) || m->class_size != sizeof(ssx_plugin_class))
+    return "manifest record sizes differ from this ssx's (" + std::to_string(m->record_size) + "/" +
+           std::to_string(m->class_size) + " vs " + std::to_string(sizeof(ssx_plugin_manifest)) + "/" +
+           std::to_string(sizeof(ssx_plugin_class)) + "): rebuild the plugin against this ssx";
+  info.build_tag = m->build_tag != nullptr ? m->build_tag : "";
+  if (info.build_tag != SSX_PLUGIN_BUILD_TAG)
+    return "built for '" + info.build_tag + "', this ssx is '" + SSX_PLUGIN_BUILD_TAG +
+           "': rebuild the plugin against this ssx";
+  if (m->class_count > kMaxClasses || (m->class_count > 0 && m->classes == nullptr))
+    return "manifest lists an invalid class table";
+  for (std::uint32_t i = 0; i < m->class_count; ++i) {
+    const ssx_plugin_class& c = m->classes[i];
+    if (c.name == nullptr || c.create == nullptr || c.destroy == nullptr || !validKind(c.kind))
+      return "manifest entry " + std::to_string(i) + " is incomplete (kind, name, create and destroy are required)";
+    info.classes.push_back({toKind(c.kind), c.name});
+  }
+  return {};
+}
+
+}  // namespace
+
+struct ClassLoader::Library {
+  fs::path path;
+  void* handle = nullptr;
+  const ssx_plugin_manifest* manifest = nullptr;
+  PluginLibraryInfo info;
+};
+
+ClassLoader::ClassLoader() = default;
+
+ClassLoader::~ClassLoader() { destroyInstances(); }
+
+void ClassLoader::destroyInstances() noexcept {
+  for (auto it = instances_.rbegin(); it != instances_.rend(); ++it) it->destroy(it->object);
+  instances_.clear();
+}
+
+void ClassLoader::addSearchDirectory(fs::path dir) {
+  if (std::find(search_path_.begin(), search_path_.end(), dir) == search_path_.end())
+    search_path_.push_back(std::move(dir));
+}
+
+fs::path ClassLoader::installedPluginDirectory() {
+  // the directory of the libssx that holds this very function, plus ssx/plugins
+  Dl_info info{};
+  if (dladdr(reinterpret_cast<void*>(&ClassLoader::installedPluginDirectory), &info) == 0 || info.dli_fname == nullptr)
+    return {};
+  std::error_code ec;
+  const fs::path lib = fs::weakly_canonical(fs::path(info.dli_fname), ec);
+  return lib.parent_path() / "ssx" / "plugins";
+}
+
+PluginLibraryInfo ClassLoader::inspect(const fs::path& file) {
+  PluginLibraryInfo info;
+  info.path = file;
+  void* handle = dlopen(file.c_str(), RTLD_NOW | RTLD_LOCAL);
+  if (handle == nullptr) {
+    info.problem = explainDlerror(dlerror());
+    return info;
+  }
+  const auto* m = static_cast<const ssx_plugin_manifest*>(dlsym(handle, kManifestSymbol));
+  info.problem = checkManifest(m, info);
+  info.ok = info.problem.empty();
+  // never unloaded: see the class comment
+  return info;
+}
+
+fs::path ClassLoader::load(std::string_view plugin) {
+  const std::string name(plugin);
+  // candidates in search order
+  std::vector<fs::path> candidates;
+  const bool is_path = name.find('/') != std::string::npos || (name.size() > 3 && name.ends_with(".so"));
+  if (is_path) {
+    candidates.emplace_back(name);
+  } else {
+    for (const auto& dir : search_path_)
+      for (const std::string& file : {"libssx_" + name + ".so", "lib" + name + ".so", name + ".so"})
+        candidates.push_back(dir / file);
+  }
+  std::string tried;
+  for (const auto& candidate : candidates) {
+    std::error_code ec;
+    if (!fs::is_regular_file(candidate, ec)) {
+      tried += "\n  " + candidate.string() + ": not found";
+      continue;
+    }
+    const fs::path canonical = fs::weakly_canonical(candidate, ec);
+    for (const auto& lib : libraries_)
+      if (lib->path == canonical) return canonical;
+    auto lib = std::make_unique<Library>();
+    lib->path = canonical;
+    lib->info.path = canonical;
+    lib->handle = dlopen(canonical.c_str(), RTLD_NOW | RTLD_LOCAL);
+    if (lib->handle == nullptr) {
+      tried += "\n  " + candidate.string() + ": " + explainDlerror(dlerror());
+      continue;
+    }
+    lib->manifest = static_cast<const ssx_plugin_manifest*>(dlsym(lib->handle, kManifestSymbol));
+    const std::string problem = checkManifest(lib->manifest, lib->info);
+    if (!problem.empty()) {
+      tried += "\n  " + candidate.string() + ": " + problem;
+      continue;
+    }
+    lib->info.ok = true;
+    libraries_.push_back(std::move(lib));
+    return canonical;
+  }
+  if (candidates.empty()) tried = "\n  (the search path is empty: add a plugin directory)";
+  throw PluginError("plugin '" + name + "' could not be loaded; tried:" + tried);
+}
+
+void* ClassLoader::create(std::string_view plugin, std::string_view class_name, PluginKind kind) {
+  const fs::path path = load(plugin);
+  const Library* lib = nullptr;
+  for (const auto& l : libraries_)
+    if (l->path == path) lib = l.get();
+  const std::string where = "plugin '" + std::string(plugin) + "' (" + path.string() + ")";
+  const ssx_plugin_class* found = nullptr;
+  std::string available;
+  for (std::uint32_t i = 0; i < lib->manifest->class_count; ++i) {
+    const ssx_plugin_class& c = lib->manifest->classes[i];
+    available += std::string(available.empty() ? "" : ", ") + c.name + " (" + toString(toKind(c.kind)) + ")";
+    if (class_name == c.name) found = &c;
+  }
+  if (found == nullptr)
+    throw PluginError(where + " has no class '" + std::string(class_name) + "'; it has: " +
+                      (available.empty() ? std::string("none") : available));
+  if (toKind(found->kind) != kind)
+    throw PluginError(where + ": class '" + std::string(class_name) + "' is a " + toString(toKind(found->kind)) +
+                      ", not a " + toString(kind));
+  char error[512] = {0};
+  void* object = found->create(error, sizeof error);
+  if (object == nullptr)
+    throw PluginError(where + ": creating '" + std::string(class_name) + "' failed: " +
+                      (error[0] != '\0' ? std::string(error) : std::string("the constructor returned null")));
+  instances_.push_back({object, found->destroy});
+  return object;
+}
+
+Driver& ClassLoader::createDriver(std::string_view plugin, std::string_view class_name) {
+  return *static_cast<Driver*>(create(plugin, class_name, PluginKind::Driver));
+}
+Sensor& ClassLoader::createSensor(std::string_view plugin, std::string_view class_name) {
+  return *static_cast<Sensor*>(create(plugin, class_name, PluginKind::Sensor));
+}
+SimulationExtension& ClassLoader::createExtension(std::string_view plugin, std::string_view class_name) {
+  return *static_cast<SimulationExtension*>(create(plugin, class_name, PluginKind::Extension));
+}
+
+std::vector<PluginLibraryInfo> ClassLoader::scan() const {
+  std::vector<PluginLibraryInfo> out;
+  for (const auto& dir : search_path_) {
+    std::error_code ec;
+    std::vector<fs::path> files;
+    for (const auto& e : fs::directory_iterator(dir, ec))
+      if (e.path().extension() == ".so") files.push_back(e.path());
+    std::sort(files.begin(), files.end());
+    for (const auto& f : files) out.push_back(inspect(f));
+  }
+  return out;
+}
+
+}  // namespace ssx
