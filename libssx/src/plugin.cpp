@@ -17,3 +17,10 @@ void SimulationExtension::afterStep(Environment&) {}
 void SimulationExtension::shutdown(Environment&) {}
 
 }  // namespace ssx
+
+#include <ssx/measurements.hpp>
+
+namespace ssx {
+ClockMeasurement::~ClockMeasurement() = default;
+PoseMeasurement::~PoseMeasurement() = default;
+}  // namespace ssx

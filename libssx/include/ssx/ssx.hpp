@@ -7,6 +7,7 @@
 #include <ssx/descriptor.hpp>
 #include <ssx/environment.hpp>
 #include <ssx/error.hpp>
+#include <ssx/measurements.hpp>
 #include <ssx/export.hpp>
 #include <ssx/physic_engine.hpp>
 #include <ssx/physic_node.hpp>
@@ -14,6 +15,7 @@
 #include <ssx/plugin.hpp>
 #include <ssx/random.hpp>
 #include <ssx/render.hpp>
+#include <ssx/scene.hpp>
 #include <ssx/timing.hpp>
 #include <ssx/types.hpp>
 #include <ssx/version.hpp>

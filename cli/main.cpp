@@ -1,0 +1,235 @@
+// ssx: the command-line client. run, validate, plugins.
+//
+// Exit status: 0 success, 2 bad input (scene, arguments, plugins), 1 failure while running.
+#include <ssx/ssx.hpp>
+
+#include <CLI/CLI.hpp>
+
+#include <unistd.h>
+
+#include <atomic>
+#include <chrono>
+#include <csignal>
+#include <cstdio>
+#include <cstdlib>
+#include <iostream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+namespace {
+
+namespace fs = std::filesystem;
+
+constexpr int kExitRunFailure = 1;
+constexpr int kExitBadInput = 2;
+
+std::atomic<bool> g_stop{false};
+
+void onSignal(int) { g_stop = true; }
+
+// --plugin-path first, then SSX_PLUGIN_PATH (colon-separated), read here and nowhere else
+std::vector<fs::path> pluginPath(const std::vector<std::string>& from_args) {
+  std::vector<fs::path> out(from_args.begin(), from_args.end());
+  if (const char* env = std::getenv("SSX_PLUGIN_PATH")) {
+    std::stringstream in(env);
+    std::string dir;
+    while (std::getline(in, dir, ':'))
+      if (!dir.empty()) out.emplace_back(dir);
+  }
+  return out;
+}
+
+void printWarnings(const ssx::Scene& scene) {
+  for (const auto& w : scene.warnings) std::cerr << w.str() << '\n';
+}
+
+// a one-line progress display on stderr, redrawn at most ten times a second
+class Progress {
+ public:
+  Progress(bool enabled, std::int64_t total_steps) : enabled_(enabled), total_(total_steps) {}
+  void update(const ssx::Environment& env) {
+    if (!enabled_) return;
+    const auto now = std::chrono::steady_clock::now();
+    if (now - last_ < std::chrono::milliseconds(100)) return;
+    last_ = now;
+    const double t = ssx::toSeconds(env.time());
+    if (total_ > 0) {
+      const double f = static_cast<double>(env.stepCount()) / static_cast<double>(total_);
+      const int width = 30;
+      const int filled = static_cast<int>(f * width);
+      std::fprintf(stderr, "\r[%.*s%*s] %5.1f%%  t = %.2f s ", filled, "##############################",
+                   width - filled, "", 100.0 * f, t);
+    } else {
+      std::fprintf(stderr, "\rt = %.2f s (Ctrl-C to stop) ", t);
+    }
+    std::fflush(stderr);
+  }
+  void finish() {
+    if (enabled_) std::fprintf(stderr, "\r%60s\r", "");
+  }
+
+ private:
+  bool enabled_;
+  std::int64_t total_;
+  std::chrono::steady_clock::time_point last_{};
+};
+
+struct RunArgs {
+  std::string scene;
+  double duration = 0;
+  std::int64_t steps = -1;
+  double realtime = 1.0;
+  bool fast = false;
+  int threads = -1;
+  std::int64_t seed = -1;
+  std::vector<std::string> plugin_path;
+  std::string stats_csv;
+  bool quiet = false;
+};
+
+int commandRun(const RunArgs& args, bool realtime_given) {
+  ssx::SceneOptions options;
+  options.plugin_path = pluginPath(args.plugin_path);
+  if (args.threads >= 0) options.threads = args.threads;
+  if (args.seed >= 0) options.seed = static_cast<std::uint64_t>(args.seed);
+  ssx::Scene scene;
+  try {
+    scene = ssx::loadScene(args.scene, options);
+  } catch (const ssx::SceneError& e) {
+    std::cerr << e.what() << '\n';
+    return kExitBadInput;
+  }
+  printWarnings(scene);
+  ssx::Environment& env = *scene.environment;
+
+  ssx::RunOptions run = scene.run;
+  run.mode = args.fast ? ssx::RunOptions::Mode::Fast : ssx::RunOptions::Mode::RealTime;
+  if (realtime_given) run.realtime_factor = args.realtime;
+  if (args.steps >= 0) {
+    run.steps = args.steps;
+  } else {
+    const ssx::Nanoseconds duration = args.duration > 0 ? ssx::toNanoseconds(args.duration) : scene.duration.value_or(-1);
+    if (duration > 0) run.steps = (duration + env.timestep() - 1) / env.timestep();
+  }
+  run.stop = &g_stop;
+  Progress progress(!args.quiet && isatty(STDERR_FILENO) == 1, run.steps);
+  run.on_step = [&progress](const ssx::Environment& e) { progress.update(e); };
+
+  std::signal(SIGINT, onSignal);
+  std::signal(SIGTERM, onSignal);
+  int status = 0;
+  ssx::TimingSummary summary;
+  try {
+    env.start();
+    if (!args.quiet)
+      std::cerr << "ssx: " << scene.file.string() << ": " << env.artifactCount() << " artifacts, " << env.threadCount()
+                << " thread(s), timestep " << ssx::toSeconds(env.timestep()) * 1e3 << " ms, "
+                << (args.fast ? std::string("as fast as possible")
+                              : "real time x" + std::to_string(run.realtime_factor))
+                << '\n';
+    summary = env.run(run);
+  } catch (const ssx::ConfigError& e) {
+    progress.finish();
+    std::cerr << e.what() << '\n';
+    return kExitBadInput;
+  } catch (const std::exception& e) {
+    progress.finish();
+    std::cerr << "ssx: error: " << e.what() << '\n';
+    status = kExitRunFailure;
+  }
+  progress.finish();
+  if (g_stop) std::cerr << "ssx: interrupted at t = " << ssx::toSeconds(env.time()) << " s\n";
+  // stop cleanly: plugins destroyed, engines stopped, extensions shut down (files closed)
+  try {
+    env.stop();
+  } catch (const std::exception& e) {
+    std::cerr << "ssx: error while stopping: " << e.what() << '\n';
+    status = kExitRunFailure;
+  }
+  if (status == 0) {
+    if (!args.quiet) std::cout << summary.str() << '\n';
+  }
+  if (!args.stats_csv.empty()) {
+    try {
+      env.timing().writeCsv(args.stats_csv);
+    } catch (const std::exception& e) {
+      std::cerr << "ssx: error: " << e.what() << '\n';
+      status = kExitRunFailure;
+    }
+  }
+  return status;
+}
+
+int commandValidate(const std::string& file, const std::vector<std::string>& plugin_path) {
+  ssx::SceneOptions options;
+  options.plugin_path = pluginPath(plugin_path);
+  try {
+    const ssx::Scene scene = ssx::loadScene(file, options);
+    printWarnings(scene);
+    std::cout << file << ": ok: " << scene.environment->artifactCount() << " artifacts, "
+              << scene.warnings.size() << " warning(s)\n";
+    return 0;
+  } catch (const ssx::SceneError& e) {
+    std::cerr << e.what() << '\n';
+    return kExitBadInput;
+  }
+}
+
+int commandPlugins(const std::vector<std::string>& plugin_path) {
+  ssx::ClassLoader loader;
+  for (const auto& dir : pluginPath(plugin_path)) loader.addSearchDirectory(dir);
+  loader.addSearchDirectory(ssx::ClassLoader::installedPluginDirectory());
+  int bad = 0;
+  for (const auto& dir : loader.searchPath()) std::cout << "search: " << dir.string() << '\n';
+  for (const auto& lib : loader.scan()) {
+    std::cout << lib.path.string() << ": " << (lib.ok ? "ok" : "FAILS: " + lib.problem) << '\n';
+    for (const auto& c : lib.classes) std::cout << "  " << ssx::toString(c.kind) << ' ' << c.name << '\n';
+    bad += lib.ok ? 0 : 1;
+  }
+  return bad == 0 ? 0 : kExitBadInput;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"ssx: real-time simulation of robot swarms"};
+  app.set_version_flag("--version", std::string("ssx ") + SSX_VERSION_STRING);
+  app.require_subcommand(1);
+
+  RunArgs run;
+  CLI::App* run_cmd = app.add_subcommand("run", "run a scene");
+  run_cmd->add_option("scene", run.scene, "scene file")->required()->check(CLI::ExistingFile);
+  auto* duration = run_cmd->add_option("--duration", run.duration, "simulated seconds to run")->check(CLI::PositiveNumber);
+  run_cmd->add_option("--steps", run.steps, "steps to run")->check(CLI::NonNegativeNumber)->excludes(duration);
+  auto* realtime = run_cmd->add_option("--realtime", run.realtime, "pace against the wall clock, optionally FACTOR times faster")
+                       ->expected(0, 1)
+                       ->check(CLI::PositiveNumber);
+  run_cmd->add_flag("--fast", run.fast, "run as fast as possible")->excludes(realtime);
+  run_cmd->add_option("--threads", run.threads, "worker threads (0: one per core)")->check(CLI::NonNegativeNumber);
+  run_cmd->add_option("--seed", run.seed, "scene seed")->check(CLI::NonNegativeNumber);
+  run_cmd->add_option("--plugin-path", run.plugin_path, "plugin directory (repeatable)");
+  run_cmd->add_option("--stats-csv", run.stats_csv, "write per-step timing samples to FILE");
+  run_cmd->add_flag("--quiet", run.quiet, "no progress, no summary");
+
+  std::string validate_file;
+  std::vector<std::string> validate_path;
+  CLI::App* validate_cmd = app.add_subcommand("validate", "check a scene and its plugins; run nothing");
+  validate_cmd->add_option("scene", validate_file, "scene file")->required()->check(CLI::ExistingFile);
+  validate_cmd->add_option("--plugin-path", validate_path, "plugin directory (repeatable)");
+
+  std::vector<std::string> plugins_path;
+  CLI::App* plugins_cmd = app.add_subcommand("plugins", "list plugin libraries, their classes, and ABI checks");
+  plugins_cmd->add_option("--plugin-path", plugins_path, "plugin directory (repeatable)");
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    const int code = app.exit(e);
+    return code == 0 ? 0 : kExitBadInput;
+  }
+  if (*run_cmd) return commandRun(run, realtime->count() > 0);
+  if (*validate_cmd) return commandValidate(validate_file, validate_path);
+  if (*plugins_cmd) return commandPlugins(plugins_path);
+  return kExitBadInput;
+}

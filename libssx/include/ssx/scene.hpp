@@ -1,0 +1,68 @@
+#pragma once
+/// @file
+/// Scenes and artifacts from XML files. The formats are described in docs/scene-format.md.
+
+#include <ssx/environment.hpp>
+#include <ssx/error.hpp>
+#include <ssx/export.hpp>
+
+#include <cstdint>
+#include <filesystem>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace ssx {
+
+/// One problem found in a scene or artifact file.
+struct SSX_EXPORT Diagnostic {
+  enum class Severity : std::uint8_t { Warning, Error };
+  Severity severity = Severity::Error;
+  SourceLocation where;
+  std::string message;
+  /// "file:line: error: message" (or warning).
+  std::string str() const;
+};
+
+/// A scene could not be loaded. `what()` lists every error (and the warnings) found, one per
+/// line; nothing was started.
+class SSX_EXPORT SceneError : public Error {
+ public:
+  explicit SceneError(std::vector<Diagnostic> diagnostics);
+  const std::vector<Diagnostic>& diagnostics() const noexcept { return diagnostics_; }
+
+ private:
+  std::vector<Diagnostic> diagnostics_;
+};
+
+/// How to load a scene, beyond what the file says.
+struct SceneOptions {
+  /// Plugin directories searched after the scene's own <plugin_path>s and before the installed
+  /// plugin directory (the CLI puts --plugin-path, then SSX_PLUGIN_PATH, here).
+  std::vector<std::filesystem::path> plugin_path;
+  std::optional<std::uint64_t> seed;  ///< overrides <environment seed>
+  std::optional<int> threads;         ///< overrides <environment threads>
+  std::optional<std::string> render_engine;  ///< overrides <render engine>
+  bool search_installed_plugins = true;      ///< append ClassLoader::installedPluginDirectory()
+};
+
+/// A loaded scene: an environment ready to start, and how the file asks to run it.
+struct Scene {
+  std::filesystem::path file;
+  std::unique_ptr<Environment> environment;
+  RunOptions run;                        ///< real-time factor and overrun policy from the file
+  std::optional<Nanoseconds> duration;   ///< <environment duration>, if given
+  std::vector<Diagnostic> warnings;      ///< unknown elements and attributes, and the like
+};
+
+/// Parses a scene file and every file it includes, loads every plugin it names and creates every
+/// artifact. All problems are collected; if any is an error, throws SceneError before anything
+/// is started.
+SSX_EXPORT Scene loadScene(const std::filesystem::path& file, const SceneOptions& options = {});
+
+/// Same, from text in memory; relative paths resolve against `base_dir`, messages say `label`.
+SSX_EXPORT Scene loadSceneFromString(std::string_view xml, const std::string& label,
+                                     const std::filesystem::path& base_dir, const SceneOptions& options = {});
+
+}  // namespace ssx

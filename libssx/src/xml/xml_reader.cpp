@@ -1,0 +1,80 @@
+#include "xml/xml_reader.hpp"
+
+#include <pugixml.hpp>
+
+#include <algorithm>
+#include <cctype>
+#include <fstream>
+#include <sstream>
+#include <vector>
+
+namespace ssx::detail {
+
+namespace {
+
+// maps byte offsets to 1-based line numbers
+class LineIndex {
+ public:
+  explicit LineIndex(std::string_view text) {
+    for (std::size_t i = 0; i < text.size(); ++i)
+      if (text[i] == '\n') newlines_.push_back(i);
+  }
+  int line(std::ptrdiff_t offset) const {
+    if (offset < 0) return 0;
+    const auto it = std::lower_bound(newlines_.begin(), newlines_.end(), static_cast<std::size_t>(offset));
+    return static_cast<int>(it - newlines_.begin()) + 1;
+  }
+
+ private:
+  std::vector<std::size_t> newlines_;
+};
+
+// offset of `name=` inside the start tag that begins at `tag`, or the tag's offset
+std::ptrdiff_t attributeOffset(std::string_view text, std::ptrdiff_t tag, std::string_view name) {
+  if (tag < 0 || static_cast<std::size_t>(tag) >= text.size()) return tag;
+  const std::size_t end = text.find('>', static_cast<std::size_t>(tag));
+  std::size_t pos = static_cast<std::size_t>(tag);
+  while ((pos = text.find(name, pos + 1)) != std::string_view::npos && pos < end) {
+    const bool space_before = std::isspace(static_cast<unsigned char>(text[pos - 1])) != 0;
+    std::size_t after = pos + name.size();
+    while (after < text.size() && std::isspace(static_cast<unsigned char>(text[after])) != 0) ++after;
+    if (space_before && after < text.size() && text[after] == '=') return static_cast<std::ptrdiff_t>(pos);
+  }
+  return tag;
+}
+
+Descriptor convert(const pugi::xml_node& node, std::string_view text, const LineIndex& lines, const std::string& file) {
+  const std::ptrdiff_t offset = node.offset_debug();
+  Descriptor d(node.name(), {file, lines.line(offset)});
+  for (const auto& a : node.attributes())
+    d.set(a.name(), a.value(), {file, lines.line(attributeOffset(text, offset, a.name()))});
+  for (const auto& child : node.children())
+    if (child.type() == pugi::node_element) d.addChild(convert(child, text, lines, file));
+  return d;
+}
+
+}  // namespace
+
+Descriptor parseXml(std::string_view text, const std::string& file) {
+  pugi::xml_document doc;
+  const pugi::xml_parse_result result =
+      doc.load_buffer(text.data(), text.size(), pugi::parse_default | pugi::parse_declaration);
+  const LineIndex lines(text);
+  if (!result)
+    throw ConfigError({file, lines.line(result.offset)}, std::string("XML syntax: ") + result.description());
+  const pugi::xml_node root = doc.document_element();
+  if (!root) throw ConfigError({file, 1}, "the file has no XML element");
+  return convert(root, text, lines, file);
+}
+
+Descriptor readXmlFile(const std::filesystem::path& file) {
+  std::ifstream in(file, std::ios::binary);
+  std::error_code ec;
+  if (!in || std::filesystem::is_directory(file, ec))
+    throw ConfigError({file.string(), 0}, "cannot read file (missing, a directory, or no permission)");
+  std::ostringstream buffer;
+  buffer << in.rdbuf();
+  return parseXml(buffer.str(), file.string());
+}
+
+}  // namespace ssx::detail
