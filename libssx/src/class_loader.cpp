@@ -15,9 +15,12 @@ namespace fs = std::filesystem;
 
 const char* toString(PluginKind kind) {
   switch (kind) {
-    case PluginKind::Driver: return "driver";
-    case PluginKind::Sensor: return "sensor";
-    case PluginKind::Extension: return "extension";
+    case PluginKind::Driver:
+      return "driver";
+    case PluginKind::Sensor:
+      return "sensor";
+    case PluginKind::Extension:
+      return "extension";
   }
   return "?";
 }
@@ -44,15 +47,22 @@ std::string explainDlerror(const char* text) {
   return out;
 }
 
+std::string withArticle(PluginKind kind) {
+  return std::string(kind == PluginKind::Extension ? "an " : "a ") + toString(kind);
+}
+
 bool validKind(std::uint32_t k) { return k >= SSX_PLUGIN_DRIVER && k <= SSX_PLUGIN_EXTENSION; }
 
 PluginKind toKind(std::uint32_t k) {
-  return k == SSX_PLUGIN_DRIVER ? PluginKind::Driver : k == SSX_PLUGIN_SENSOR ? PluginKind::Sensor : PluginKind::Extension;
+  return k == SSX_PLUGIN_DRIVER   ? PluginKind::Driver
+         : k == SSX_PLUGIN_SENSOR ? PluginKind::Sensor
+                                  : PluginKind::Extension;
 }
 
 // reads and checks a manifest; returns "" when it is good
 std::string checkManifest(const ssx_plugin_manifest* m, PluginLibraryInfo& info) {
-  if (m == nullptr) return "not an ssx plugin: it has no '" + std::string(kManifestSymbol) + "' symbol (use SSX_PLUGIN)";
+  if (m == nullptr)
+    return "not an ssx plugin: it has no '" + std::string(kManifestSymbol) + "' symbol (use SSX_PLUGIN)";
   if (m->abi_version != SSX_PLUGIN_ABI_VERSION)
     return "plugin ABI version " + std::to_string(m->abi_version) + ", this ssx loads version " +
            std::to_string(SSX_PLUGIN_ABI_VERSION) + ": rebuild the plugin against this ssx";
@@ -181,11 +191,11 @@ void* ClassLoader::create(std::string_view plugin, std::string_view class_name, 
     if (class_name == c.name) found = &c;
   }
   if (found == nullptr)
-    throw PluginError(where + " has no class '" + std::string(class_name) + "'; it has: " +
-                      (available.empty() ? std::string("none") : available));
+    throw PluginError(where + " has no class '" + std::string(class_name) +
+                      "'; it has: " + (available.empty() ? std::string("none") : available));
   if (toKind(found->kind) != kind)
-    throw PluginError(where + ": class '" + std::string(class_name) + "' is a " + toString(toKind(found->kind)) +
-                      ", not a " + toString(kind));
+    throw PluginError(where + ": class '" + std::string(class_name) + "' is " + withArticle(toKind(found->kind)) +
+                      ", not " + withArticle(kind));
   char error[512] = {0};
   void* object = found->create(error, sizeof error);
   if (object == nullptr)

@@ -29,10 +29,10 @@ class CsvLogger final : public SimulationExtension {
     const double rate = params.get<double>("rate_hz", 0.0);
     if (rate < 0) throw params.error(*params.find("rate_hz"), "rate_hz must not be negative");
     period_ = rate > 0 ? toNanoseconds(1.0 / rate) : env.timestep();
+    next_ = period_;  // rows at period, 2 period, ... of simulated time
     resolve(env, params);
     file_ = std::fopen(path_.c_str(), "w");
-    if (file_ == nullptr)
-      throw params.error("cannot open '" + path_ + "' for writing: " + std::strerror(errno));
+    if (file_ == nullptr) throw params.error("cannot open '" + path_ + "' for writing: " + std::strerror(errno));
     std::fputs("time_s,artifact,x,y,z,qw,qx,qy,qz,vx,vy,vz,wx,wy,wz\n", file_);
   }
 
@@ -48,8 +48,8 @@ class CsvLogger final : public SimulationExtension {
       const Vec3& v = s.linear_velocity;
       const Vec3& w = s.angular_velocity;
       std::fprintf(file_, "%.9g,%s,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g\n", t,
-                   a->name().c_str(), p.x(), p.y(), p.z(), q.w(), q.x(), q.y(), q.z(), v.x(), v.y(), v.z(), w.x(), w.y(),
-                   w.z());
+                   a->name().c_str(), p.x(), p.y(), p.z(), q.w(), q.x(), q.y(), q.z(), v.x(), v.y(), v.z(), w.x(),
+                   w.y(), w.z());
     }
   }
 

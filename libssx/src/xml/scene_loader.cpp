@@ -164,7 +164,8 @@ class SceneLoader {
     const bool ok = in.eof() && (v.size() == 3 || v.size() == 4) &&
                     std::all_of(v.begin(), v.end(), [](double c) { return c >= 0 && c <= 1; });
     if (!ok) {
-      record(d.error(*a, "attribute 'color' must be \"r g b\" or \"r g b a\" with each in 0..1, got '" + a->value + "'"));
+      record(
+          d.error(*a, "attribute 'color' must be \"r g b\" or \"r g b a\" with each in 0..1, got '" + a->value + "'"));
       return fallback;
     }
     return {static_cast<float>(v[0]), static_cast<float>(v[1]), static_cast<float>(v[2]),
@@ -175,7 +176,8 @@ class SceneLoader {
     for (const auto& a : d.attributes())
       if (!a.used) warning(a.where, "unknown attribute '" + a.key + "' of <" + d.name() + "> (ignored)");
     for (const auto& c : d.children())
-      if (!children.contains(c.name())) warning(c.where(), "unknown element <" + c.name() + "> in <" + d.name() + "> (ignored)");
+      if (!children.contains(c.name()))
+        warning(c.where(), "unknown element <" + c.name() + "> in <" + d.name() + "> (ignored)");
   }
   fs::path resolve(const fs::path& dir, const std::string& file) const {
     const fs::path p(file);
@@ -193,7 +195,7 @@ class SceneLoader {
   const ArtifactType* artifactType(const std::string& name, const SourceLocation& where);
   ArtifactType parseArtifact(const Descriptor& root);
   Shape readShape(const Descriptor& d);
-  PhysicNodeSpec readPhysicNode(const Descriptor& d, bool is_root);
+  PhysicNodeSpec readPhysicNode(const Descriptor& d);
   RenderNodeSpec readRenderNode(const Descriptor& d, bool is_root);
   std::optional<PluginDecl> readPluginDecl(const Descriptor& d);
 
@@ -223,8 +225,8 @@ class SceneLoader {
     SourceLocation where;
   };
   std::map<std::string, TypeDecl> type_decls_;
-  std::map<std::string, ArtifactType> types_;             // by type name, parsed on first use
-  std::map<std::string, std::string> failed_plugins_;     // "plugin/class" -> already reported
+  std::map<std::string, ArtifactType> types_;          // by type name, parsed on first use
+  std::map<std::string, std::string> failed_plugins_;  // "plugin/class" -> already reported
 };
 
 bool SceneLoader::once(const Descriptor& d, const Descriptor*& slot) {
@@ -241,8 +243,6 @@ void SceneLoader::collect(const Descriptor& scene, const fs::path& dir, std::vec
     error(scene.where(), "the root element of a scene file must be <scene>, got <" + scene.name() + ">");
     return;
   }
-  checkUnknown(scene, {"environment", "physics", "render", "plugin_path", "extension", "type", "artifact", "swarm",
-                       "ground", "obstacle", "include"});
   for (const Descriptor& d : scene.children()) {
     const std::string& n = d.name();
     if (n == "environment") {
@@ -263,7 +263,9 @@ void SceneLoader::collect(const Descriptor& scene, const fs::path& dir, std::vec
       checkUnknown(d);
       if (name.empty() || file.empty()) continue;
       const auto [it, fresh] = type_decls_.try_emplace(name, TypeDecl{resolve(dir, file), d.where()});
-      if (!fresh) error(d.where(), "<type>: artifact type '" + name + "' declared twice (first at " + it->second.where.str() + ")");
+      if (!fresh)
+        error(d.where(),
+              "<type>: artifact type '" + name + "' declared twice (first at " + it->second.where.str() + ")");
     } else if (n == "artifact" || n == "swarm" || n == "ground" || n == "obstacle") {
       entities_.push_back({&d, dir});
     } else if (n == "include") {
@@ -291,6 +293,8 @@ void SceneLoader::collect(const Descriptor& scene, const fs::path& dir, std::vec
       stack.pop_back();
     }
   }
+  checkUnknown(scene, {"environment", "physics", "render", "plugin_path", "extension", "type", "artifact", "swarm",
+                       "ground", "obstacle", "include"});
 }
 
 void SceneLoader::readEnvironment(const Descriptor& d) {
@@ -299,7 +303,19 @@ void SceneLoader::readEnvironment(const Descriptor& d) {
   const std::int64_t seed = readCount(d, "seed", 0, 0);
   settings_.seed = static_cast<std::uint64_t>(seed);
   const std::string threads = read<std::string>(d, "threads", "auto");
-  if (threads != "auto") settings_.threads = static_cast<int>(readCount(d, "threads", 0, 1));
+  if (threads != "auto") {
+    std::int64_t n = 0;
+    try {
+      n = d.get<std::int64_t>("threads");
+    } catch (const ConfigError&) {
+      n = 0;  // reported below, with the accepted forms
+    }
+    if (n < 1 || n > 1024)
+      record(d.error(*d.find("threads"),
+                     "attribute 'threads' must be 'auto' or a whole number from 1 to 1024, got '" + threads + "'"));
+    else
+      settings_.threads = static_cast<int>(n);
+  }
   run_.realtime_factor = readPositive(d, "realtime_factor", 1.0);
   run_.overrun = readChoice(d, "overrun", "catchup", {"catchup", "resync"}) == "resync" ? RunOptions::Overrun::Resync
                                                                                         : RunOptions::Overrun::CatchUp;
@@ -309,9 +325,10 @@ void SceneLoader::readEnvironment(const Descriptor& d) {
 
 void SceneLoader::readPhysics(const Descriptor& d) {
   PhysicsSettings& p = settings_.physics;
-  p.engine = read<std::string>(d, "engine", p.engine);
-  p.solver = readChoice(d, "solver", "quickstep", {"quickstep", "exact"}) == "exact" ? PhysicsSettings::Solver::Exact
-                                                                                     : PhysicsSettings::Solver::QuickStep;
+  p.engine = readChoice(d, "engine", p.engine, {"ode"});
+  p.solver = readChoice(d, "solver", "quickstep", {"quickstep", "exact"}) == "exact"
+                 ? PhysicsSettings::Solver::Exact
+                 : PhysicsSettings::Solver::QuickStep;
   p.iterations = static_cast<int>(readCount(d, "iterations", p.iterations, 1));
   p.sor = readPositive(d, "sor", p.sor);
   p.substeps = static_cast<int>(readCount(d, "substeps", p.substeps, 1));
@@ -336,7 +353,7 @@ void SceneLoader::readPhysics(const Descriptor& d) {
 }
 
 void SceneLoader::readRender(const Descriptor& d) {
-  settings_.render.engine = read<std::string>(d, "engine", settings_.render.engine);
+  settings_.render.engine = readChoice(d, "engine", settings_.render.engine, {"null"});
   settings_.render.period_steps = readCount(d, "period", 0, 0);
   checkUnknown(d);
 }
@@ -364,7 +381,7 @@ Shape SceneLoader::readShape(const Descriptor& d) {
   return s;
 }
 
-PhysicNodeSpec SceneLoader::readPhysicNode(const Descriptor& d, bool is_root) {
+PhysicNodeSpec SceneLoader::readPhysicNode(const Descriptor& d) {
   PhysicNodeSpec n;
   n.where = d.where();
   n.name = read<std::string>(d, "name", "");
@@ -379,15 +396,12 @@ PhysicNodeSpec SceneLoader::readPhysicNode(const Descriptor& d, bool is_root) {
     n.inertia = j;
   }
   n.center_of_mass = read<Vec3>(d, "com", Vec3::Zero());
-  if (d.has("static")) {
-    n.is_static = read<bool>(d, "static", false);
-    if (!is_root) error(d.where(), "<physic>: only a root node can be static");
-  }
+  n.is_static = read<bool>(d, "static", false);  // validatePhysicTree refuses it below the root
   for (const Descriptor& c : d.children()) {
     if (kShapeElements.contains(c.name()))
       n.shapes.push_back(readShape(c));
     else if (c.name() == "physic")
-      n.children.push_back(readPhysicNode(c, false));
+      n.children.push_back(readPhysicNode(c));
   }
   std::set<std::string> allowed = kShapeElements;
   allowed.insert("physic");
@@ -432,7 +446,8 @@ std::optional<PluginDecl> SceneLoader::readPluginDecl(const Descriptor& d) {
   decl.period = readCount(d, "period", 1, 1);
   decl.params = d;  // the element is the parameter set; plugin, class, period are marked read
   // a plugin's own parameters are checked when it is configured; element children are not allowed
-  for (const auto& c : d.children()) warning(c.where(), "unknown element <" + c.name() + "> in <" + d.name() + "> (ignored)");
+  for (const auto& c : d.children())
+    warning(c.where(), "unknown element <" + c.name() + "> in <" + d.name() + "> (ignored)");
   if (decl.plugin.empty()) return std::nullopt;
   return decl;
 }
@@ -447,7 +462,7 @@ ArtifactType SceneLoader::parseArtifact(const Descriptor& root) {
   const std::size_t errors_before = diagnostics_.size();
   for (const Descriptor& c : root.children()) {
     if (c.name() == "physic") {
-      PhysicNodeSpec spec = readPhysicNode(c, true);
+      PhysicNodeSpec spec = readPhysicNode(c);
       try {
         validatePhysicTree(spec);
         for (const auto& other : t.physic)
@@ -496,7 +511,8 @@ const ArtifactType* SceneLoader::artifactType(const std::string& name, const Sou
   if (decl == type_decls_.end()) {
     std::string known;
     for (const auto& [k, v] : type_decls_) known += (known.empty() ? "" : ", ") + k;
-    error(where, "unknown artifact type '" + name + "' (declared with <type>: " + (known.empty() ? "none" : known) + ")");
+    error(where,
+          "unknown artifact type '" + name + "' (declared with <type>: " + (known.empty() ? "none" : known) + ")");
     types_[name].ok = false;
     return nullptr;
   }
@@ -602,10 +618,12 @@ void SceneLoader::buildSwarm(Environment& env, const Descriptor& d, std::size_t 
   if (layout == "grid") {
     // rows along x, then y, then layers along z
     const double spacing = readPositive(d, "spacing", 1.0);
-    const auto columns = readCount(d, "columns", static_cast<std::int64_t>(std::ceil(std::sqrt(static_cast<double>(count)))), 1);
+    const auto columns =
+        readCount(d, "columns", static_cast<std::int64_t>(std::ceil(std::sqrt(static_cast<double>(count)))), 1);
     const auto rows = readCount(d, "rows", (count + columns - 1) / columns, 1);
     for (std::int64_t i = 0; i < count; ++i)
-      positions.emplace_back(spacing * static_cast<double>(i % columns), spacing * static_cast<double>((i / columns) % rows),
+      positions.emplace_back(spacing * static_cast<double>(i % columns),
+                             spacing * static_cast<double>((i / columns) % rows),
                              spacing * static_cast<double>(i / (columns * rows)));
   } else if (layout == "random") {
     const Vec3 lo = read<Vec3>(d, "min", Vec3(-1, -1, 0));
@@ -652,7 +670,8 @@ void SceneLoader::build(Scene& scene) {
   } catch (const ConfigError& e) {
     error(environment_element_ != nullptr ? environment_element_->where() : SourceLocation{scene.file.string(), 0},
           e.detail());
-    return;
+    // go on with defaults, so that the artifacts are checked too
+    scene.environment = std::make_unique<Environment>(EnvironmentSettings{});
   }
   Environment& env = *scene.environment;
   // search order: the scene's directories, the caller's, then the installation's
@@ -706,7 +725,8 @@ Scene SceneLoader::load(Descriptor root, const fs::path& file, const fs::path& d
   std::error_code ec;
   std::vector<fs::path> stack{fs::weakly_canonical(file, ec)};
   collect(documents_.front(), dir, stack);
-  if (!hasErrors()) build(scene);
+  // build even after errors, to report the problems of artifacts and plugins in the same go
+  build(scene);
   if (hasErrors()) throw SceneError(std::move(diagnostics_));
   scene.run.realtime_factor = run_.realtime_factor;
   scene.run.overrun = run_.overrun;

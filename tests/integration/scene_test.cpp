@@ -1,0 +1,185 @@
+// Scene files: every broken file gives its exact first diagnostic and runs nothing; valid files
+// load, warn about what they do not understand, and run reproducibly.
+#include <ssx/ssx.hpp>
+
+#include <catch2/catch.hpp>
+
+#include <filesystem>
+#include <fstream>
+#include <regex>
+
+using namespace ssx;
+namespace fs = std::filesystem;
+
+namespace {
+
+const fs::path kData = SSX_TEST_DATA_DIR;
+
+SceneOptions testOptions() {
+  SceneOptions o;
+  o.plugin_path.emplace_back(SSX_TEST_PLUGIN_DIR);
+  return o;
+}
+
+// the expectation written on the first line of each broken file: <!-- expect: ... -->
+std::string expectation(const fs::path& file) {
+  std::ifstream in(file);
+  std::string line;
+  std::getline(in, line);
+  const auto begin = line.find("expect: ");
+  const auto end = line.rfind(" -->");
+  REQUIRE(begin != std::string::npos);
+  return line.substr(begin + 8, end - begin - 8);
+}
+
+// the first error line, with the data directory and absolute plugin paths taken out
+std::string firstError(const SceneError& e, const fs::path& dir) {
+  for (const auto& d : e.diagnostics()) {
+    if (d.severity != Diagnostic::Severity::Error) continue;
+    std::string s = d.str();
+    const std::string prefix = dir.string() + "/";
+    for (auto at = s.find(prefix); at != std::string::npos; at = s.find(prefix)) s.erase(at, prefix.size());
+    return std::regex_replace(s, std::regex(" \\(/[^)]*\\)"), "");
+  }
+  return "(no error)";
+}
+
+}  // namespace
+
+TEST_CASE("every broken scene reports its exact file:line: error: and runs nothing", "[scene]") {
+  const fs::path dir = kData / "invalid";
+  fs::remove("marker_ran.txt");
+  int files = 0;
+  for (const auto& entry : fs::directory_iterator(dir)) {
+    if (entry.path().extension() != ".xml") continue;
+    ++files;
+    const std::string expected = expectation(entry.path());
+    INFO(entry.path().filename().string());
+    try {
+      (void)loadScene(entry.path(), testOptions());
+      FAIL("loaded without error");
+    } catch (const SceneError& e) {
+      const std::string got = firstError(e, dir);
+      CHECK(got.substr(0, expected.size()) == expected);
+      CHECK_THAT(e.what(), Catch::EndsWith("nothing was run"));
+    }
+  }
+  CHECK(files >= 25);
+  // the scenes' marker extension writes this file if any of them was ever initialised
+  CHECK_FALSE(fs::exists("marker_ran.txt"));
+}
+
+TEST_CASE("all problems of a scene are reported together, in document order", "[scene]") {
+  try {
+    (void)loadScene(kData / "valid" / "three_errors.xml", testOptions());
+    FAIL("loaded without error");
+  } catch (const SceneError& e) {
+    std::vector<std::string> errors;
+    for (const auto& d : e.diagnostics())
+      if (d.severity == Diagnostic::Severity::Error) errors.push_back(std::to_string(d.where.line) + " " + d.message);
+    REQUIRE(errors.size() == 3);
+    CHECK_THAT(errors[0], Catch::StartsWith("2 <environment>: attribute 'timestep' must be positive"));
+    CHECK_THAT(errors[1], Catch::StartsWith("2 <environment>: attribute 'seed' must be an integer"));
+    CHECK_THAT(errors[2], Catch::StartsWith("5 <swarm>: attribute 'layout' must be one of"));
+  }
+}
+
+TEST_CASE("unknown elements, attributes and plugin parameters are warnings with their lines", "[scene]") {
+  Scene scene = loadScene(kData / "valid" / "warnings.xml", testOptions());
+  std::vector<std::string> warnings;
+  for (const auto& w : scene.warnings) warnings.push_back(w.str().substr(w.str().rfind('/') + 1));
+  CHECK(warnings ==
+        std::vector<std::string>{"warnings.xml:2: warning: unknown attribute 'colour' of <environment> (ignored)",
+                                 "warnings.xml:5: warning: unknown element <lights> in <scene> (ignored)"});
+  // the plugin's own parameters are known once it is configured
+  std::vector<std::string> logged;
+  scene.environment->setLogSink([&](LogLevel, std::string_view m) { logged.emplace_back(m.substr(m.rfind('/') + 1)); });
+  scene.environment->start();
+  CHECK(logged == std::vector<std::string>{"spinner.xml:5: warning: unknown attribute 'torqeu' of <driver>"});
+  scene.environment->step(11);
+  // and the one it knows took effect: 0.5 N m on Izz = 1/600 for 10 steps of 10 ms
+  CHECK(scene.environment->findArtifact("s")->state().angular_velocity.z() == Approx(0.5 * 600 * 0.1).epsilon(1e-9));
+}
+
+TEST_CASE("swarm layouts place artifacts on a grid, on a Fibonacci sphere and at seeded random", "[scene]") {
+  Scene scene = loadScene(kData / "valid" / "layouts.xml", testOptions());
+  Environment& env = *scene.environment;
+  CHECK(env.artifactCount() == 70 + 12 + 50 + 1);
+  // sphere: every robot 4 m from the centre; neighbours 1.48 to 1.65 m apart for N = 70
+  double nearest_min = 1e9, nearest_max = 0;
+  for (int i = 0; i < 70; ++i) {
+    const Vec3 p = env.findArtifact("s" + std::to_string(i))->pose().position;
+    CHECK((p - Vec3(0, 0, 5)).norm() == Approx(4.0).epsilon(1e-9));
+    double nearest = 1e9;
+    for (int j = 0; j < 70; ++j)
+      if (j != i) nearest = std::min(nearest, (p - env.findArtifact("s" + std::to_string(j))->pose().position).norm());
+    nearest_min = std::min(nearest_min, nearest);
+    nearest_max = std::max(nearest_max, nearest);
+  }
+  CHECK(nearest_min > 1.3);
+  CHECK(nearest_max < 1.8);
+  // grid: 4 columns along x, spacing 2
+  CHECK(env.findArtifact("g5")->pose().position.isApprox(Vec3(12, 2, 0)));
+  // random: inside the box, and the same for the same seed
+  for (int i = 0; i < 50; ++i) {
+    const Vec3 p = env.findArtifact("r" + std::to_string(i))->pose().position;
+    CHECK(p.x() >= -20);
+    CHECK(p.x() <= -10);
+    CHECK(p.y() <= -15);
+    CHECK(p.z() >= 1);
+  }
+  Scene again = loadScene(kData / "valid" / "layouts.xml", testOptions());
+  CHECK(again.environment->findArtifact("r7")->pose().position == env.findArtifact("r7")->pose().position);
+  SceneOptions other = testOptions();
+  other.seed = 6;
+  Scene reseeded = loadScene(kData / "valid" / "layouts.xml", other);
+  CHECK(reseeded.environment->findArtifact("r7")->pose().position != env.findArtifact("r7")->pose().position);
+  // the included fragment's obstacle
+  CHECK(env.findArtifact("pillar") != nullptr);
+  CHECK(env.findArtifact("pillar")->root().isStatic());
+}
+
+TEST_CASE("a scene with plugins runs bitwise identically on 1 and 2 threads", "[scene][determinism]") {
+  auto hashAfter = [](int threads) {
+    SceneOptions o = testOptions();
+    o.threads = threads;
+    Scene scene = loadScene(kData / "valid" / "layouts.xml", o);
+    scene.environment->step(200);
+    return scene.environment->stateHash();
+  };
+  CHECK(hashAfter(1) == hashAfter(2));
+}
+
+TEST_CASE("the example scene loads, flies and logs", "[scene]") {
+  fs::remove("hover_swarm_poses.csv");
+  Scene scene = loadScene(fs::path(SSX_EXAMPLES_DIR) / "scenes" / "hover_swarm.xml");
+  CHECK(scene.warnings.empty());
+  CHECK(scene.duration == toNanoseconds(10.0));
+  Environment& env = *scene.environment;
+  CHECK(env.artifactCount() == 25 + 4 + 2 + 1);
+  env.step(2500);  // 5 s
+  // every robot holds 1 m above where it started (pose noise 2 mm)
+  for (int i = 0; i < 25; ++i)
+    CHECK(env.findArtifact("robot" + std::to_string(i))->pose().position.z() == Approx(1.05).margin(0.02));
+  env.stop();
+  std::ifstream csv("hover_swarm_poses.csv");
+  std::string header;
+  std::getline(csv, header);
+  CHECK(header == "time_s,artifact,x,y,z,qw,qx,qy,qz,vx,vy,vz,wx,wy,wz");
+  int rows = 0;
+  for (std::string line; std::getline(csv, line);) ++rows;
+  CHECK(rows == 3 * 250);  // three robots at 50 Hz for 5 s
+}
+
+TEST_CASE("scenes load from memory with paths relative to a base directory", "[scene]") {
+  const std::string xml = R"(<scene>
+    <type name="box" file="parts/box.xml"/>
+    <artifact name="b" type="box" xyz="1 2 3" rpy="0 0 1.5707963267948966"/>
+  </scene>)";
+  Scene scene = loadSceneFromString(xml, "memory.xml", kData / "invalid", testOptions());
+  const Pose p = scene.environment->findArtifact("b")->pose();
+  CHECK(p.position.isApprox(Vec3(1, 2, 3)));
+  CHECK((p.orientation * Vec3::UnitX()).isApprox(Vec3::UnitY(), 1e-12));
+  CHECK_THROWS_WITH(loadSceneFromString("<scene><artifact/>", "memory.xml", ".", testOptions()),
+                    Catch::StartsWith("memory.xml:1: error: XML syntax"));
+}

@@ -1,0 +1,132 @@
+#include <ssx/ssx.hpp>
+
+#include <catch2/catch.hpp>
+
+#include <string>
+
+using namespace ssx;
+using Catch::Contains;
+
+namespace {
+
+const std::string kDir = SSX_TEST_PLUGIN_DIR;
+
+std::string loadError(ClassLoader& loader, const std::string& plugin) {
+  try {
+    loader.load(plugin);
+  } catch (const PluginError& e) {
+    return e.what();
+  }
+  return "(no error)";
+}
+
+}  // namespace
+
+TEST_CASE("a good plugin library loads and creates classes of each kind", "[plugins]") {
+  ClassLoader loader;
+  loader.addSearchDirectory(kDir);
+  const auto path = loader.load("test_good");
+  CHECK(path.filename() == "libssx_test_good.so");
+  Driver& d = loader.createDriver("test_good", "spinner");
+  Sensor& s = loader.createSensor("test_good", "counter");
+  SimulationExtension& e = loader.createExtension("test_good", "marker");
+  CHECK(dynamic_cast<const ClockMeasurement*>(&s.latest()) != nullptr);  // type info shared across libraries
+  (void)d;
+  (void)e;
+  // two classes of the same library, one load
+  CHECK(loader.load("test_good") == path);
+}
+
+TEST_CASE("plugin instances drive an environment built in code", "[plugins]") {
+  Environment env;
+  env.classLoader().addSearchDirectory(kDir);
+  PhysicNodeSpec body;
+  body.name = "body";
+  body.mass = 1.0;
+  body.shapes.push_back(Shape::box(Vec3(0.1, 0.1, 0.1)));
+  Artifact& a = env.addArtifact("top", {Vec3(0, 0, 10), Quat::Identity()});
+  a.addPhysicRoot(body);
+  Descriptor params("driver");
+  params.set("torque", 0.5);
+  a.setDriver(env.classLoader().createDriver("test_good", "spinner"), params, 1, "spinner");
+  env.step(11);
+  // 10 steps of 0.5 N m on Izz = 1/600 kg m^2 (the first step's torque acts from step 1 on)
+  CHECK(a.state().angular_velocity.z() == Approx(10 * 0.001 * 0.5 * 600).epsilon(1e-9));
+}
+
+TEST_CASE("plugin load failures name the plugin, every path tried and the reason", "[plugins]") {
+  ClassLoader loader;
+  loader.addSearchDirectory("/nonexistent/plugins");
+  loader.addSearchDirectory(kDir);
+
+  SECTION("not found anywhere") {
+    const std::string e = loadError(loader, "teleporter");
+    CHECK_THAT(e, Contains("plugin 'teleporter' could not be loaded; tried:"));
+    CHECK_THAT(e, Contains("/nonexistent/plugins/libssx_teleporter.so: not found"));
+    CHECK_THAT(e, Contains(kDir + "/libssx_teleporter.so: not found"));
+    CHECK_THAT(e, Contains(kDir + "/libteleporter.so: not found"));
+    CHECK_THAT(e, Contains(kDir + "/teleporter.so: not found"));
+  }
+  SECTION("wrong ABI version") {
+    CHECK_THAT(loadError(loader, "test_wrong_abi"),
+               Contains("libssx_test_wrong_abi.so: plugin ABI version 999, this ssx loads version 1"));
+  }
+  SECTION("build tag mismatch") {
+    CHECK_THAT(loadError(loader, "test_wrong_tag"), Contains("built for 'ssx 0.0; libc++', this ssx is 'ssx 0.1;"));
+  }
+  SECTION("no manifest symbol") {
+    CHECK_THAT(loadError(loader, "test_no_manifest"),
+               Contains("not an ssx plugin: it has no 'ssx_plugin_manifest_v1' symbol"));
+  }
+  SECTION("undefined symbol, demangled") {
+    const std::string e = loadError(loader, "test_undefined_symbol");
+    CHECK_THAT(e, Contains("undefined symbol: _ZN7missing12solveRiccatiEi"));
+    CHECK_THAT(e, Contains("(missing::solveRiccati(int))"));
+  }
+  SECTION("not a library") { CHECK_THAT(loadError(loader, "test_garbage"), Contains("libssx_test_garbage.so: ")); }
+}
+
+TEST_CASE("class lookup failures say what the library has", "[plugins]") {
+  ClassLoader loader;
+  loader.addSearchDirectory(kDir);
+  CHECK_THROWS_WITH(loader.createDriver("test_good", "rocket"),
+                    Contains("has no class 'rocket'; it has: spinner (driver), counter (sensor), marker (extension)"));
+  CHECK_THROWS_WITH(loader.createDriver("test_good", "counter"), Contains("class 'counter' is a sensor, not a driver"));
+  CHECK_THROWS_WITH(loader.createExtension("test_good", "spinner"),
+                    Contains("class 'spinner' is a driver, not an extension"));
+}
+
+TEST_CASE("a throwing or null-returning constructor is reported", "[plugins]") {
+  ClassLoader loader;
+  loader.addSearchDirectory(kDir);
+  CHECK_THROWS_WITH(loader.createDriver("test_throwing", "fragile"),
+                    Contains("creating 'fragile' failed: calibration file not found"));
+  CHECK_THROWS_WITH(loader.createSensor("test_null_create", "ghost"),
+                    Contains("creating 'ghost' failed: the constructor returned null"));
+}
+
+TEST_CASE("scanning lists every library with its classes and check result", "[plugins]") {
+  ClassLoader loader;
+  loader.addSearchDirectory(kDir);
+  const auto libs = loader.scan();
+  int ok = 0, bad = 0;
+  bool saw_good = false;
+  for (const auto& lib : libs) {
+    (lib.ok ? ok : bad) += 1;
+    if (lib.path.filename() == "libssx_test_good.so") {
+      saw_good = true;
+      REQUIRE(lib.classes.size() == 3);
+      CHECK(lib.classes[1].kind == PluginKind::Sensor);
+      CHECK(lib.classes[1].name == "counter");
+    }
+  }
+  CHECK(saw_good);
+  CHECK(ok == 3);   // good, throwing, null_create pass the manifest checks
+  CHECK(bad == 5);  // wrong_abi, wrong_tag, no_manifest, undefined_symbol, garbage
+}
+
+TEST_CASE("the installed plugin directory is found beside libssx", "[plugins]") {
+  const auto dir = ClassLoader::installedPluginDirectory();
+  CHECK(dir.filename() == "plugins");
+  CHECK(std::filesystem::exists(dir / "libssx_hover.so"));
+}
