@@ -4,6 +4,7 @@
 #include <ssx/plugin_abi.hpp>
 
 #include <fstream>
+#include <stdexcept>
 
 namespace {
 
@@ -25,6 +26,22 @@ class Counter final : public ssx::SensorOf<ssx::ClockMeasurement> {
   }
 };
 
+// throws at step `at_step` in the artifact named `only`
+class Bomb final : public ssx::Driver {
+ public:
+  void configure(const ssx::Descriptor& params) override {
+    at_step_ = params.get<std::int64_t>("at_step", 0);
+    armed_ = params.get<std::string>("only", artifact().name()) == artifact().name();
+  }
+  void step(const ssx::StepInfo& info) override {
+    if (armed_ && info.step == at_step_) throw std::runtime_error("exploded as asked");
+  }
+
+ private:
+  std::int64_t at_step_ = 0;
+  bool armed_ = false;
+};
+
 // writes the file named by `file` (relative: to the working directory) when initialised, so a
 // test can tell whether a scene ever started
 class Marker final : public ssx::SimulationExtension {
@@ -36,4 +53,5 @@ class Marker final : public ssx::SimulationExtension {
 
 }  // namespace
 
-SSX_PLUGIN(SSX_DRIVER(Spinner, "spinner"), SSX_SENSOR(Counter, "counter"), SSX_EXTENSION(Marker, "marker"));
+SSX_PLUGIN(SSX_DRIVER(Spinner, "spinner"), SSX_SENSOR(Counter, "counter"), SSX_EXTENSION(Marker, "marker"),
+           SSX_DRIVER(Bomb, "bomb"));

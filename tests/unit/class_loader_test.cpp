@@ -90,7 +90,7 @@ TEST_CASE("class lookup failures say what the library has", "[plugins]") {
   ClassLoader loader;
   loader.addSearchDirectory(kDir);
   CHECK_THROWS_WITH(loader.createDriver("test_good", "rocket"),
-                    Contains("has no class 'rocket'; it has: spinner (driver), counter (sensor), marker (extension)"));
+                    Contains("has no class 'rocket'; it has: spinner (driver), counter (sensor), marker (extension), bomb (driver)"));
   CHECK_THROWS_WITH(loader.createDriver("test_good", "counter"), Contains("class 'counter' is a sensor, not a driver"));
   CHECK_THROWS_WITH(loader.createExtension("test_good", "spinner"),
                     Contains("class 'spinner' is a driver, not an extension"));
@@ -115,7 +115,7 @@ TEST_CASE("scanning lists every library with its classes and check result", "[pl
     (lib.ok ? ok : bad) += 1;
     if (lib.path.filename() == "libssx_test_good.so") {
       saw_good = true;
-      REQUIRE(lib.classes.size() == 3);
+      REQUIRE(lib.classes.size() == 4);
       CHECK(lib.classes[1].kind == PluginKind::Sensor);
       CHECK(lib.classes[1].name == "counter");
     }

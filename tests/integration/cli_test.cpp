@@ -1,0 +1,175 @@
+// The `ssx` command, run as a child process: exit codes, messages, files, Ctrl-C.
+#include <ssx/ssx.hpp>
+
+#include <catch2/catch.hpp>
+
+#include <fcntl.h>
+#include <poll.h>
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <string>
+#include <vector>
+
+namespace fs = std::filesystem;
+using Catch::Contains;
+
+extern char** environ;
+
+namespace {
+
+const std::string kCli = SSX_CLI_PATH;
+const fs::path kData = SSX_TEST_DATA_DIR;
+const fs::path kExamples = SSX_EXAMPLES_DIR;
+
+struct Result {
+  int status = -1;
+  std::string out, err;
+};
+
+// runs ssx with `args`; `extra_env` entries are added to the child's environment only;
+// `on_err` sees stderr as it grows and may signal the child
+Result run(std::vector<std::string> args, std::vector<std::string> extra_env = {},
+           const std::function<void(pid_t, const std::string&)>& on_err = {}) {
+  int out_pipe[2], err_pipe[2];
+  REQUIRE(pipe(out_pipe) == 0);
+  REQUIRE(pipe(err_pipe) == 0);
+  std::vector<std::string> env_strings;
+  for (char** e = environ; *e != nullptr; ++e) {
+    const std::string s(*e);
+    if (s.rfind("SSX_PLUGIN_PATH=", 0) != 0) env_strings.push_back(s);
+  }
+  for (auto& e : extra_env) env_strings.push_back(e);
+  args.insert(args.begin(), kCli);
+  std::vector<char*> argv, envp;
+  for (auto& a : args) argv.push_back(a.data());
+  argv.push_back(nullptr);
+  for (auto& e : env_strings) envp.push_back(e.data());
+  envp.push_back(nullptr);
+
+  const pid_t pid = fork();
+  REQUIRE(pid >= 0);
+  if (pid == 0) {
+    dup2(out_pipe[1], 1);
+    dup2(err_pipe[1], 2);
+    close(out_pipe[0]);
+    close(err_pipe[0]);
+    execve(kCli.c_str(), argv.data(), envp.data());
+    _exit(127);
+  }
+  close(out_pipe[1]);
+  close(err_pipe[1]);
+  Result r;
+  pollfd fds[2] = {{out_pipe[0], POLLIN, 0}, {err_pipe[0], POLLIN, 0}};
+  int open_fds = 2;
+  while (open_fds > 0) {
+    if (poll(fds, 2, -1) < 0) continue;
+    for (int i = 0; i < 2; ++i) {
+      if (fds[i].fd < 0 || (fds[i].revents & (POLLIN | POLLHUP)) == 0) continue;
+      char buf[4096];
+      const ssize_t n = read(fds[i].fd, buf, sizeof buf);
+      if (n <= 0) {
+        close(fds[i].fd);
+        fds[i].fd = -1;
+        --open_fds;
+        continue;
+      }
+      (i == 0 ? r.out : r.err).append(buf, static_cast<std::size_t>(n));
+      if (i == 1 && on_err) on_err(pid, r.err);
+    }
+  }
+  int status = 0;
+  waitpid(pid, &status, 0);
+  r.status = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+  return r;
+}
+
+}  // namespace
+
+TEST_CASE("ssx --version and --help", "[cli]") {
+  const Result v = run({"--version"});
+  CHECK(v.status == 0);
+  CHECK_THAT(v.out, Contains(std::string("ssx ") + SSX_VERSION_STRING));
+  const Result h = run({"run", "--help"});
+  CHECK(h.status == 0);
+  CHECK_THAT(h.out, Contains("--realtime") && Contains("--plugin-path") && Contains("--stats-csv"));
+}
+
+TEST_CASE("ssx validate: 0 for a good scene, 2 with the diagnostics for a broken one", "[cli]") {
+  const Result good = run({"validate", (kExamples / "scenes" / "hover_swarm.xml").string()});
+  CHECK(good.status == 0);
+  CHECK_THAT(good.out, Contains("ok: 32 artifacts"));
+  const Result bad =
+      run({"validate", (kData / "invalid" / "negative_mass.xml").string(), "--plugin-path", SSX_TEST_PLUGIN_DIR});
+  CHECK(bad.status == 2);
+  CHECK_THAT(bad.err, Contains("parts/negative_mass.xml:3: error: physic node 'body': mass must be positive"));
+}
+
+TEST_CASE("bad arguments exit with 2", "[cli]") {
+  CHECK(run({"run", "/no/such/scene.xml"}).status == 2);
+  CHECK(run({"run", (kExamples / "scenes" / "hover_swarm.xml").string(), "--fast", "--realtime"}).status == 2);
+  CHECK(run({"fly"}).status == 2);
+  CHECK(run({}).status == 2);
+}
+
+TEST_CASE("ssx run --fast --steps writes the timing CSV and the summary", "[cli]") {
+  fs::remove("cli_stats.csv");
+  const Result r = run({"run", (kExamples / "scenes" / "hover_swarm.xml").string(), "--fast", "--steps", "100",
+                        "--stats-csv", "cli_stats.csv", "--threads", "2", "--seed", "3"});
+  CHECK(r.status == 0);
+  CHECK_THAT(r.out, Contains("steps 100, simulated 0.200 s"));
+  std::ifstream csv("cli_stats.csv");
+  int lines = 0;
+  for (std::string line; std::getline(csv, line);) ++lines;
+  CHECK(lines == 101);
+}
+
+TEST_CASE("a plugin failing while running exits with 1 naming artifact and plugin", "[cli]") {
+  const Result r =
+      run({"run", (kData / "valid" / "bomb.xml").string(), "--fast", "--plugin-path", SSX_TEST_PLUGIN_DIR});
+  CHECK(r.status == 1);
+  CHECK_THAT(r.err, Contains("step 5: artifact 'victim', driver 'bomb': exploded as asked"));
+}
+
+TEST_CASE("SSX_PLUGIN_PATH is read by the command", "[cli]") {
+  const std::string scene = (kData / "valid" / "warnings.xml").string();
+  CHECK(run({"validate", scene}).status == 2);  // test_good is not on any default path
+  CHECK(run({"validate", scene}, {std::string("SSX_PLUGIN_PATH=/nowhere:") + SSX_TEST_PLUGIN_DIR}).status == 0);
+}
+
+TEST_CASE("ssx plugins lists libraries, classes and failing checks", "[cli]") {
+  const Result builtin = run({"plugins"});
+  CHECK(builtin.status == 0);
+  CHECK_THAT(builtin.out,
+             Contains("libssx_hover.so: ok") && Contains("  driver hover") && Contains("  extension csv_logger"));
+  const Result tests = run({"plugins", "--plugin-path", SSX_TEST_PLUGIN_DIR});
+  CHECK(tests.status == 2);
+  CHECK_THAT(tests.out, Contains("libssx_test_wrong_abi.so: FAILS: plugin ABI version 999"));
+  CHECK_THAT(tests.out, Contains("  sensor counter"));
+}
+
+TEST_CASE("Ctrl-C stops a real-time run cleanly: summary printed, files closed", "[cli]") {
+  fs::remove("hover_swarm_poses.csv");
+  bool sent = false;
+  const Result r = run({"run", (kExamples / "scenes" / "hover_swarm.xml").string(), "--duration", "1000"}, {},
+                       [&sent](pid_t pid, const std::string& err) {
+                         // interrupt once the run has started
+                         if (!sent && err.find("artifacts,") != std::string::npos) {
+                           kill(pid, SIGINT);
+                           sent = true;
+                         }
+                       });
+  REQUIRE(sent);
+  CHECK(r.status == 0);
+  CHECK_THAT(r.err, Contains("ssx: interrupted at t = "));
+  CHECK_THAT(r.out, Contains("step time ms"));
+  // the logger's file was flushed and closed by its shutdown: complete lines only
+  std::ifstream csv("hover_swarm_poses.csv");
+  std::string content((std::istreambuf_iterator<char>(csv)), std::istreambuf_iterator<char>());
+  REQUIRE_FALSE(content.empty());
+  CHECK(content.back() == '\n');
+}
