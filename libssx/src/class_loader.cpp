@@ -135,6 +135,7 @@ PluginLibraryInfo ClassLoader::inspect(const fs::path& file) {
 
 fs::path ClassLoader::load(std::string_view plugin) {
   const std::string name(plugin);
+  if (const auto it = by_name_.find(name); it != by_name_.end()) return it->second->path;
   // candidates in search order
   std::vector<fs::path> candidates;
   const bool is_path = name.find('/') != std::string::npos || (name.size() > 3 && name.ends_with(".so"));
@@ -153,8 +154,11 @@ fs::path ClassLoader::load(std::string_view plugin) {
       continue;
     }
     const fs::path canonical = fs::weakly_canonical(candidate, ec);
-    for (const auto& lib : libraries_)
-      if (lib->path == canonical) return canonical;
+    for (const auto& lib : libraries_) {
+      if (lib->path != canonical) continue;
+      by_name_.emplace(name, lib.get());
+      return canonical;
+    }
     auto lib = std::make_unique<Library>();
     lib->path = canonical;
     lib->info.path = canonical;
@@ -170,6 +174,7 @@ fs::path ClassLoader::load(std::string_view plugin) {
       continue;
     }
     lib->info.ok = true;
+    by_name_.emplace(name, lib.get());
     libraries_.push_back(std::move(lib));
     return canonical;
   }
@@ -179,9 +184,7 @@ fs::path ClassLoader::load(std::string_view plugin) {
 
 void* ClassLoader::create(std::string_view plugin, std::string_view class_name, PluginKind kind) {
   const fs::path path = load(plugin);
-  const Library* lib = nullptr;
-  for (const auto& l : libraries_)
-    if (l->path == path) lib = l.get();
+  const Library* lib = by_name_.at(std::string(plugin));
   const std::string where = "plugin '" + std::string(plugin) + "' (" + path.string() + ")";
   const ssx_plugin_class* found = nullptr;
   std::string available;

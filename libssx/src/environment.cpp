@@ -80,6 +80,7 @@ Artifact& Environment::addArtifact(std::string name, const Pose& placement) {
   if (name.empty()) throw ConfigError({}, "an artifact needs a name");
   if (findArtifact(name) != nullptr) throw ConfigError({}, "duplicate artifact name '" + name + "'");
   artifacts_.push_back(std::unique_ptr<Artifact>(new Artifact(*this, std::move(name), artifacts_.size(), placement)));
+  artifact_names_.emplace(artifacts_.back()->name(), artifacts_.back().get());
   return *artifacts_.back();
 }
 
@@ -142,9 +143,8 @@ unsigned Environment::threadCount() const noexcept {
 }
 
 Artifact* Environment::findArtifact(std::string_view name) const {
-  for (const auto& a : artifacts_)
-    if (a->name() == name) return a.get();
-  return nullptr;
+  const auto it = artifact_names_.find(std::string(name));
+  return it == artifact_names_.end() ? nullptr : it->second;
 }
 
 SimulationExtension* Environment::extension(std::string_view name) const {

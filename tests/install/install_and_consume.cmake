@@ -1,20 +1,45 @@
-# Installs the ssx build into a temporary prefix, then configures, builds and runs the consumer
-# project against it with find_package(ssx). Run with cmake -P (see tests/CMakeLists.txt).
+# Installs the ssx build into a temporary prefix, then, against that installation only:
+#  - configures, builds and runs a consumer program (find_package(ssx), ssx::ssx);
+#  - builds the out-of-tree plugin in examples/custom_plugin with ssx_add_plugin, and runs a
+#    scene that loads it with the installed `ssx run`.
+# Run with cmake -P (see tests/CMakeLists.txt).
 file(REMOVE_RECURSE ${WORK_DIR})
+file(MAKE_DIRECTORY ${WORK_DIR})
 set(prefix ${WORK_DIR}/prefix)
 
 function(run)
-  execute_process(COMMAND ${ARGN} RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
-  message(STATUS "${out}")
+  execute_process(COMMAND ${ARGN} RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err
+                  WORKING_DIRECTORY ${WORK_DIR})
+  message(STATUS "${out}${err}")
   if(NOT rc EQUAL 0)
     message(FATAL_ERROR "failed (${rc}): ${ARGN}\n${out}\n${err}")
   endif()
+  set(last_output "${out}${err}" PARENT_SCOPE)
 endfunction()
 
 run(${CMAKE_COMMAND} --install ${SSX_BUILD_DIR} --prefix ${prefix})
-run(${CMAKE_COMMAND} -S ${CONSUMER_SOURCE_DIR} -B ${WORK_DIR}/build -G ${GENERATOR}
+
+# a program linking libssx
+run(${CMAKE_COMMAND} -S ${CONSUMER_SOURCE_DIR} -B ${WORK_DIR}/consumer -G ${GENERATOR}
     -DCMAKE_PREFIX_PATH=${prefix} -DCMAKE_BUILD_TYPE=Release)
-run(${CMAKE_COMMAND} --build ${WORK_DIR}/build)
-# the consumer finds libssx through the install's RPATH-free layout: point the loader at it
-set(ENV{LD_LIBRARY_PATH} "${prefix}/lib:${prefix}/lib64:${prefix}/lib/x86_64-linux-gnu")
-run(${WORK_DIR}/build/consumer)
+run(${CMAKE_COMMAND} --build ${WORK_DIR}/consumer)
+run(${WORK_DIR}/consumer/consumer)
+
+# an out-of-tree plugin, run by the installed command
+run(${CMAKE_COMMAND} -S ${PLUGIN_SOURCE_DIR} -B ${WORK_DIR}/plugin -G ${GENERATOR}
+    -DCMAKE_PREFIX_PATH=${prefix} -DCMAKE_BUILD_TYPE=Release)
+run(${CMAKE_COMMAND} --build ${WORK_DIR}/plugin)
+run(${prefix}/bin/ssx plugins --plugin-path ${WORK_DIR}/plugin)
+if(NOT last_output MATCHES "libssx_orbit.so: ok" OR NOT last_output MATCHES "driver orbit")
+  message(FATAL_ERROR "the installed ssx does not list the orbit plugin")
+endif()
+run(${prefix}/bin/ssx run ${PLUGIN_SOURCE_DIR}/orbit_scene.xml --fast --plugin-path ${WORK_DIR}/plugin)
+if(NOT last_output MATCHES "steps 2400, simulated 12.000 s")
+  message(FATAL_ERROR "the orbit scene did not run its 12 s")
+endif()
+# the logger wrote 20 rows a second for each of the three orbiters, and closed the file
+file(STRINGS ${WORK_DIR}/orbit_poses.csv rows)
+list(LENGTH rows n)
+if(NOT n EQUAL 721)
+  message(FATAL_ERROR "orbit_poses.csv has ${n} lines, expected 1 + 3 * 20 * 12 = 721")
+endif()

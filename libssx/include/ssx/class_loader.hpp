@@ -10,6 +10,7 @@
 #include <memory>
 #include <string>
 #include <string_view>
+#include <unordered_map>
 #include <vector>
 
 namespace ssx {
@@ -86,6 +87,7 @@ class SSX_EXPORT ClassLoader {
 
   std::vector<std::filesystem::path> search_path_;
   std::vector<std::unique_ptr<Library>> libraries_;
+  std::unordered_map<std::string, const Library*> by_name_;  // plugin names already resolved
   struct Instance {
     void* object;
     void (*destroy)(void*) noexcept;

@@ -35,6 +35,7 @@
 #include <memory>
 #include <string>
 #include <string_view>
+#include <unordered_map>
 #include <vector>
 
 namespace ssx {
@@ -193,6 +194,7 @@ class SSX_EXPORT Environment {
   State state_ = State::Setup;
   std::int64_t steps_ = 0;
   std::vector<std::unique_ptr<Artifact>> artifacts_;
+  std::unordered_map<std::string, Artifact*> artifact_names_;
   std::vector<ExtensionSlot> extensions_;
   std::unique_ptr<PhysicEngine> physics_;
   std::unique_ptr<RenderEngine> renderer_;

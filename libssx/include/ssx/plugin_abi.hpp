@@ -46,7 +46,7 @@
 #endif
 /// What a plugin must have been built against to be loaded: the ssx major.minor version and the
 /// C++ ABI (a class layout or standard-library mismatch would crash at run time instead).
-#define SSX_PLUGIN_BUILD_TAG                                                                                 \
+#define SSX_PLUGIN_BUILD_TAG \
   "ssx " SSX_PLUGIN_STRINGIFY(SSX_VERSION_MAJOR) "." SSX_PLUGIN_STRINGIFY(SSX_VERSION_MINOR) "; " SSX_PLUGIN_STDLIB
 
 extern "C" {
@@ -121,15 +121,15 @@ constexpr ssx_plugin_class pluginClass(std::uint32_t kind, const char* name) {
 
 /// Writes the manifest of this plugin library from a list of SSX_DRIVER / SSX_SENSOR /
 /// SSX_EXTENSION entries. Use once per library, at namespace scope.
-#define SSX_PLUGIN(...)                                                                                        \
-  namespace {                                                                                                  \
-  constexpr ssx_plugin_class ssx_plugin_classes_[] = {__VA_ARGS__};                                            \
-  }                                                                                                            \
-  extern "C" __attribute__((visibility("default"))) const ssx_plugin_manifest ssx_plugin_manifest_v1;          \
-  extern "C" __attribute__((visibility("default"))) const ssx_plugin_manifest ssx_plugin_manifest_v1 = {      \
-      SSX_PLUGIN_ABI_VERSION,                                                                                  \
-      static_cast<std::uint32_t>(sizeof(ssx_plugin_manifest)),                                                 \
-      static_cast<std::uint32_t>(sizeof(ssx_plugin_class)),                                                    \
-      static_cast<std::uint32_t>(sizeof(ssx_plugin_classes_) / sizeof(ssx_plugin_classes_[0])),               \
-      SSX_PLUGIN_BUILD_TAG,                                                                                    \
+#define SSX_PLUGIN(...)                                                                                  \
+  namespace {                                                                                            \
+  constexpr ssx_plugin_class ssx_plugin_classes_[] = {__VA_ARGS__};                                      \
+  }                                                                                                      \
+  extern "C" __attribute__((visibility("default"))) const ssx_plugin_manifest ssx_plugin_manifest_v1;    \
+  extern "C" __attribute__((visibility("default"))) const ssx_plugin_manifest ssx_plugin_manifest_v1 = { \
+      SSX_PLUGIN_ABI_VERSION,                                                                            \
+      static_cast<std::uint32_t>(sizeof(ssx_plugin_manifest)),                                           \
+      static_cast<std::uint32_t>(sizeof(ssx_plugin_class)),                                              \
+      static_cast<std::uint32_t>(sizeof(ssx_plugin_classes_) / sizeof(ssx_plugin_classes_[0])),          \
+      SSX_PLUGIN_BUILD_TAG,                                                                              \
       ssx_plugin_classes_}

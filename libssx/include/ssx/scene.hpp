@@ -41,8 +41,8 @@ struct SceneOptions {
   /// Plugin directories searched after the scene's own <plugin_path>s and before the installed
   /// plugin directory (the CLI puts --plugin-path, then SSX_PLUGIN_PATH, here).
   std::vector<std::filesystem::path> plugin_path;
-  std::optional<std::uint64_t> seed;  ///< overrides <environment seed>
-  std::optional<int> threads;         ///< overrides <environment threads>
+  std::optional<std::uint64_t> seed;         ///< overrides <environment seed>
+  std::optional<int> threads;                ///< overrides <environment threads>
   std::optional<std::string> render_engine;  ///< overrides <render engine>
   bool search_installed_plugins = true;      ///< append ClassLoader::installedPluginDirectory()
 };
@@ -51,9 +51,9 @@ struct SceneOptions {
 struct Scene {
   std::filesystem::path file;
   std::unique_ptr<Environment> environment;
-  RunOptions run;                        ///< real-time factor and overrun policy from the file
-  std::optional<Nanoseconds> duration;   ///< <environment duration>, if given
-  std::vector<Diagnostic> warnings;      ///< unknown elements and attributes, and the like
+  RunOptions run;                       ///< real-time factor and overrun policy from the file
+  std::optional<Nanoseconds> duration;  ///< <environment duration>, if given
+  std::vector<Diagnostic> warnings;     ///< unknown elements and attributes, and the like
 };
 
 /// Parses a scene file and every file it includes, loads every plugin it names and creates every

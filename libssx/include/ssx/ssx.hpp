@@ -7,12 +7,12 @@
 #include <ssx/descriptor.hpp>
 #include <ssx/environment.hpp>
 #include <ssx/error.hpp>
-#include <ssx/measurements.hpp>
 #include <ssx/export.hpp>
+#include <ssx/measurements.hpp>
 #include <ssx/physic_engine.hpp>
 #include <ssx/physic_node.hpp>
-#include <ssx/plugin_abi.hpp>
 #include <ssx/plugin.hpp>
+#include <ssx/plugin_abi.hpp>
 #include <ssx/random.hpp>
 #include <ssx/render.hpp>
 #include <ssx/scene.hpp>

@@ -61,6 +61,9 @@ struct Entity {
   fs::path dir;  // of the file it came from
 };
 
+// the most artifacts one swarm may make, and the bound on other counts
+constexpr std::int64_t kMaxCount = 10'000'000;
+
 // the names a file may use for primitive shapes
 const std::set<std::string> kShapeElements{"box", "sphere", "cylinder", "capsule"};
 
@@ -121,13 +124,16 @@ class SceneLoader {
       return fallback;
     }
   }
-  std::int64_t readCount(const Descriptor& d, std::string_view key, std::int64_t fallback, std::int64_t min) {
+  // a whole number in [min, max]; the upper bounds keep absurd input from allocating the machine away
+  std::int64_t readCount(const Descriptor& d, std::string_view key, std::int64_t fallback, std::int64_t min,
+                         std::int64_t max = kMaxCount) {
     const std::int64_t v = read<std::int64_t>(d, key, fallback);
-    if (v < min) {
+    if (v < min || v > max) {
       const auto* a = d.find(key);
-      record(a != nullptr ? d.error(*a, "attribute '" + std::string(key) + "' must be at least " + std::to_string(min) +
-                                            ", got " + std::to_string(v))
-                          : d.error("attribute '" + std::string(key) + "' must be at least " + std::to_string(min)));
+      const std::string message = "attribute '" + std::string(key) + "' must be " +
+                                  (v < min ? "at least " + std::to_string(min) : "at most " + std::to_string(max)) +
+                                  ", got " + std::to_string(v);
+      record(a != nullptr ? d.error(*a, message) : d.error(message));
       return fallback;
     }
     return v;
@@ -329,9 +335,9 @@ void SceneLoader::readPhysics(const Descriptor& d) {
   p.solver = readChoice(d, "solver", "quickstep", {"quickstep", "exact"}) == "exact"
                  ? PhysicsSettings::Solver::Exact
                  : PhysicsSettings::Solver::QuickStep;
-  p.iterations = static_cast<int>(readCount(d, "iterations", p.iterations, 1));
+  p.iterations = static_cast<int>(readCount(d, "iterations", p.iterations, 1, 100'000));
   p.sor = readPositive(d, "sor", p.sor);
-  p.substeps = static_cast<int>(readCount(d, "substeps", p.substeps, 1));
+  p.substeps = static_cast<int>(readCount(d, "substeps", p.substeps, 1, 10'000));
   p.gravity = read<Vec3>(d, "gravity", p.gravity);
   p.erp = readPositive(d, "erp", p.erp);
   p.cfm = readPositive(d, "cfm", p.cfm);
@@ -340,12 +346,12 @@ void SceneLoader::readPhysics(const Descriptor& d) {
                      : PhysicsSettings::Broadphase::SweepAndPrune;
   p.quadtree_center = read<Vec3>(d, "quadtree_center", p.quadtree_center);
   p.quadtree_extents = read<Vec3>(d, "quadtree_extents", p.quadtree_extents);
-  p.quadtree_depth = static_cast<int>(readCount(d, "quadtree_depth", p.quadtree_depth, 1));
+  p.quadtree_depth = static_cast<int>(readCount(d, "quadtree_depth", p.quadtree_depth, 1, 12));
   p.friction = read<double>(d, "friction", p.friction);
   if (p.friction < 0) error(d.where(), "<physics>: friction must not be negative");
   p.restitution = read<double>(d, "restitution", p.restitution);
   if (p.restitution < 0 || p.restitution > 1) error(d.where(), "<physics>: restitution must be in 0..1");
-  p.max_contacts = static_cast<int>(readCount(d, "max_contacts", p.max_contacts, 1));
+  p.max_contacts = static_cast<int>(readCount(d, "max_contacts", p.max_contacts, 1, 1024));
   p.contact_surface_layer = read<double>(d, "contact_surface_layer", p.contact_surface_layer);
   p.max_linear_speed = readPositive(d, "max_linear_speed", p.max_linear_speed);
   p.max_angular_speed = readPositive(d, "max_angular_speed", p.max_angular_speed);

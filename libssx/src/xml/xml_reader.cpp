@@ -60,8 +60,7 @@ Descriptor parseXml(std::string_view text, const std::string& file) {
   const pugi::xml_parse_result result =
       doc.load_buffer(text.data(), text.size(), pugi::parse_default | pugi::parse_declaration);
   const LineIndex lines(text);
-  if (!result)
-    throw ConfigError({file, lines.line(result.offset)}, std::string("XML syntax: ") + result.description());
+  if (!result) throw ConfigError({file, lines.line(result.offset)}, std::string("XML syntax: ") + result.description());
   const pugi::xml_node root = doc.document_element();
   if (!root) throw ConfigError({file, 1}, "the file has no XML element");
   return convert(root, text, lines, file);
