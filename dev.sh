@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Builds ssx from a fresh Debian 12 machine and runs it. Installs what the build needs first.
 #
-#   ./dev.sh demo   build, then run the default scenario
+#   ./dev.sh demo   build, then run the default swarm scenario in real time
 #   ./dev.sh test   build, then run every test (ctest)
 #   ./dev.sh build  build only
 #
@@ -40,7 +40,7 @@ build() {
 case "${1:-}" in
   demo)
     build
-    "$build_dir/bin/ssx_embed_minimal"
+    "$build_dir/bin/ssx" run examples/scenes/hover_swarm.xml --realtime
     ;;
   test)
     build
