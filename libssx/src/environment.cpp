@@ -436,14 +436,7 @@ void Environment::step() {
   current_step_ = steps_;
   timing.step = current_step_;
 
-  for (auto& e : extensions_) {
-    try {
-      e.extension->beforeStep(*this);
-    } catch (const std::exception& ex) {
-      fail();
-      throw StepError("", "extension '" + e.name + "'", current_step_, std::string("beforeStep: ") + ex.what());
-    }
-  }
+  runExtensionHook(&SimulationExtension::beforeStep, "beforeStep");
 
   // physics, with the actuation written before
   auto t = Clock::now();
@@ -494,16 +487,20 @@ void Environment::step() {
     timing.render = since(t);
   }
 
-  for (auto& e : extensions_) {
-    try {
-      e.extension->afterStep(*this);
-    } catch (const std::exception& ex) {
-      fail();
-      throw StepError("", "extension '" + e.name + "'", current_step_, std::string("afterStep: ") + ex.what());
-    }
-  }
+  runExtensionHook(&SimulationExtension::afterStep, "afterStep");
   timing.total = since(t_step);
   timing_.add(timing);
+}
+
+void Environment::runExtensionHook(void (SimulationExtension::*hook)(Environment&), const char* what) {
+  for (auto& e : extensions_) {
+    try {
+      (e.extension->*hook)(*this);
+    } catch (const std::exception& ex) {
+      fail();
+      throw StepError("", "extension '" + e.name + "'", current_step_, std::string(what) + ": " + ex.what());
+    }
+  }
 }
 
 void Environment::step(std::int64_t n) {

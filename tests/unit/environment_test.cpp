@@ -366,3 +366,24 @@ TEST_CASE("frames are drawn when due, with render nodes following their physic n
   for (const auto& t : env.timing().samples()) drawn += t.render > 0 ? 1 : 0;
   CHECK(drawn == 3);
 }
+
+TEST_CASE("an extension that throws in a step hook stops the run naming it", "[environment]") {
+  struct Flaky : SimulationExtension {
+    void afterStep(Environment& env) override {
+      if (env.stepCount() == 3) throw Error("bridge lost its peer");
+    }
+  };
+  Environment env;
+  addBall(env, "a");
+  env.addExtension("bridge", std::make_unique<Flaky>());
+  env.step(2);
+  try {
+    env.step();
+    FAIL("no StepError");
+  } catch (const StepError& e) {
+    CHECK(e.plugin() == "extension 'bridge'");
+    CHECK(e.step() == 2);
+    CHECK_THAT(e.what(), Catch::Contains("afterStep: bridge lost its peer"));
+  }
+  CHECK(env.state() == Environment::State::Failed);
+}

@@ -176,6 +176,7 @@ class SSX_EXPORT Environment {
   void drawFrame();
   void fail();
   void warnUnusedParameters() const;
+  void runExtensionHook(void (SimulationExtension::*hook)(Environment&), const char* what);
 
   struct ExtensionSlot {
     std::string name;

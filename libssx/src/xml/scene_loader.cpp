@@ -211,8 +211,8 @@ class SceneLoader {
   void buildSwarm(Environment& env, const Descriptor& d, std::size_t swarm_index);
   void place(Environment& env, const std::string& name, const std::string& type, const Pose& pose,
              const SourceLocation& where);
-  Driver* createDriver(Environment& env, const PluginDecl& decl);
-  Sensor* createSensor(Environment& env, const PluginDecl& decl);
+  template <class T, class Create>
+  T* createPlugin(const PluginDecl& decl, Create create);
 
   const SceneOptions& options_;
   std::vector<Diagnostic> diagnostics_;
@@ -539,25 +539,15 @@ const ArtifactType* SceneLoader::artifactType(const std::string& name, const Sou
 
 // --- pass 2 --------------------------------------------------------------------------------------
 
-Driver* SceneLoader::createDriver(Environment& env, const PluginDecl& decl) {
+template <class T, class Create>
+T* SceneLoader::createPlugin(const PluginDecl& decl, Create create) {
+  // a plugin that failed once is reported once, not for every artifact of a swarm
   const std::string key = decl.plugin + "/" + decl.class_name;
   if (failed_plugins_.contains(key)) return nullptr;
   try {
-    return &env.classLoader().createDriver(decl.plugin, decl.class_name);
+    return &create(decl.plugin, decl.class_name);
   } catch (const PluginError& e) {
-    error(decl.params.where(), "<driver>: " + std::string(e.what()));
-    failed_plugins_[key] = e.what();
-    return nullptr;
-  }
-}
-
-Sensor* SceneLoader::createSensor(Environment& env, const PluginDecl& decl) {
-  const std::string key = decl.plugin + "/" + decl.class_name;
-  if (failed_plugins_.contains(key)) return nullptr;
-  try {
-    return &env.classLoader().createSensor(decl.plugin, decl.class_name);
-  } catch (const PluginError& e) {
-    error(decl.params.where(), "<sensor>: " + std::string(e.what()));
+    error(decl.params.where(), "<" + decl.params.name() + ">: " + std::string(e.what()));
     failed_plugins_[key] = e.what();
     return nullptr;
   }
@@ -574,11 +564,16 @@ void SceneLoader::place(Environment& env, const std::string& name, const std::st
   Artifact& a = env.addArtifact(name, pose);
   for (const auto& p : type->physic) a.addPhysicRoot(p);
   for (const auto& r : type->render) a.addRenderRoot(r);
-  if (type->driver)
-    if (Driver* d = createDriver(env, *type->driver))
-      a.setDriver(*d, type->driver->params, type->driver->period, type->driver->class_name);
-  for (const auto& s : type->sensors)
-    if (Sensor* sensor = createSensor(env, s)) a.addSensor(*sensor, s.params, s.period, s.class_name);
+  ClassLoader& loader = env.classLoader();
+  if (type->driver) {
+    const PluginDecl& decl = *type->driver;
+    auto create = [&](std::string_view p, std::string_view c) -> Driver& { return loader.createDriver(p, c); };
+    if (Driver* d = createPlugin<Driver>(decl, create)) a.setDriver(*d, decl.params, decl.period, decl.class_name);
+  }
+  for (const auto& decl : type->sensors) {
+    auto create = [&](std::string_view p, std::string_view c) -> Sensor& { return loader.createSensor(p, c); };
+    if (Sensor* s = createPlugin<Sensor>(decl, create)) a.addSensor(*s, decl.params, decl.period, decl.class_name);
+  }
 }
 
 void SceneLoader::buildObstacle(Environment& env, const Descriptor& d) {
