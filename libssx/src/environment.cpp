@@ -235,8 +235,9 @@ void Environment::start() {
     state_ = State::Running;  // configure may subscribe and read the snapshot
     configuring_ = true;
     for (auto& a : artifacts_) {
-      if (a->driver_) a->driver_->configure(a->driver_params_);
+      // sensors first: a driver may read their configuration (rates, resolutions)
       for (auto& s : a->sensors_) s.sensor->configure(s.params);
+      if (a->driver_) a->driver_->configure(a->driver_params_);
     }
     configuring_ = false;
     warnUnusedParameters();

@@ -24,3 +24,13 @@ namespace ssx {
 ClockMeasurement::~ClockMeasurement() = default;
 PoseMeasurement::~PoseMeasurement() = default;
 }  // namespace ssx
+
+namespace ssx {
+ImuMeasurement::~ImuMeasurement() = default;
+}  // namespace ssx
+
+#include <ssx/setpoint.hpp>
+
+namespace ssx {
+SetpointInterface::~SetpointInterface() = default;
+}  // namespace ssx

@@ -47,7 +47,12 @@ class PoseSensor final : public SensorOf<PoseMeasurement> {
     if (v < 0) throw params.error(*params.find(key), std::string(key) + " must not be negative");
     return v;
   }
-  Vec3 noise(double sigma) { return Vec3(random().normal(), random().normal(), random().normal()) * sigma; }
+  // three draws in a fixed order (the order of function arguments is unspecified in C++)
+  Vec3 noise(double sigma) {
+    Vec3 n;
+    for (int i = 0; i < 3; ++i) n[i] = random().normal() * sigma;
+    return n;
+  }
 
   const PhysicNode* node_ = nullptr;
   double position_noise_ = 0, orientation_noise_ = 0, velocity_noise_ = 0, angular_velocity_noise_ = 0;

@@ -7,6 +7,7 @@
 #include <ssx/plugin.hpp>
 #include <ssx/types.hpp>
 
+#include <array>
 #include <cstdint>
 
 namespace ssx {
@@ -24,6 +25,18 @@ struct SSX_EXPORT PoseMeasurement : Measurement {
   Vec3 linear_velocity = Vec3::Zero();   ///< m/s, world frame
   Vec3 angular_velocity = Vec3::Zero();  ///< rad/s, world frame
   ~PoseMeasurement() override;
+};
+
+/// An inertial measurement: specific force and angular rate in the IMU's frame, after bias, noise,
+/// scale, quantisation and saturation; also as the raw integer counts a microcontroller reads.
+struct SSX_EXPORT ImuMeasurement : Measurement {
+  Vec3 accelerometer = Vec3::Zero();  ///< specific force, m/s^2, IMU frame (reads +g upwards at rest)
+  Vec3 gyroscope = Vec3::Zero();      ///< angular rate, rad/s, IMU frame
+  std::array<std::int32_t, 3> accelerometer_counts{};  ///< accelerometer / accelerometer_lsb
+  std::array<std::int32_t, 3> gyroscope_counts{};      ///< gyroscope / gyroscope_lsb
+  double accelerometer_lsb = 0.0;  ///< m/s^2 per count
+  double gyroscope_lsb = 0.0;      ///< rad/s per count
+  ~ImuMeasurement() override;
 };
 
 }  // namespace ssx

@@ -35,7 +35,8 @@ class SSX_EXPORT Plugin {
   virtual ~Plugin();
 
   /// Called once when the environment starts, after the engines are configured and the first
-  /// snapshot is published, on the thread that starts the environment. `params` are this
+  /// snapshot is published, on the thread that starts the environment; artifact by artifact,
+  /// each artifact's sensors before its driver. `params` are this
   /// instance's parameters (from the artifact file, or given in code). Subscriptions to sensors
   /// are made here. Throw ConfigError (use `params.error(...)`) for bad parameters.
   virtual void configure(const Descriptor& params);

@@ -16,6 +16,7 @@
 #include <ssx/random.hpp>
 #include <ssx/render.hpp>
 #include <ssx/scene.hpp>
+#include <ssx/setpoint.hpp>
 #include <ssx/timing.hpp>
 #include <ssx/types.hpp>
 #include <ssx/version.hpp>

@@ -210,7 +210,8 @@ class SceneLoader {
   void buildObstacle(Environment& env, const Descriptor& d);
   void buildSwarm(Environment& env, const Descriptor& d, std::size_t swarm_index);
   void place(Environment& env, const std::string& name, const std::string& type, const Pose& pose,
-             const SourceLocation& where);
+             const Descriptor& element);
+  Descriptor withOverrides(const PluginDecl& decl, const Descriptor* overrides);
   template <class T, class Create>
   T* createPlugin(const PluginDecl& decl, Create create);
 
@@ -553,14 +554,41 @@ T* SceneLoader::createPlugin(const PluginDecl& decl, Create create) {
   }
 }
 
+// the type's plugin parameters, with those given on the scene's <artifact> or <swarm> on top
+Descriptor SceneLoader::withOverrides(const PluginDecl& decl, const Descriptor* overrides) {
+  if (overrides == nullptr) return decl.params;
+  Descriptor params = decl.params;
+  for (const auto& a : overrides->attributes()) {
+    if (a.key == "index") continue;
+    params.set(a.key, a.value, a.where);
+  }
+  return params;
+}
+
 void SceneLoader::place(Environment& env, const std::string& name, const std::string& type_name, const Pose& pose,
-                        const SourceLocation& where) {
+                        const Descriptor& element) {
+  const SourceLocation& where = element.where();
   const ArtifactType* type = artifactType(type_name, where);
   if (env.findArtifact(name) != nullptr) {
     error(where, "duplicate artifact name '" + name + "'");
     return;
   }
   if (type == nullptr) return;
+  // parameter overrides: <driver .../> and <sensor index="i" .../> inside the placing element
+  const Descriptor* driver_override = element.child("driver");
+  std::vector<const Descriptor*> sensor_overrides(type->sensors.size(), nullptr);
+  for (const Descriptor* o : element.childrenNamed("sensor")) {
+    const std::int64_t i = read<std::int64_t>(*o, "index", 0);
+    if (i < 0 || i >= static_cast<std::int64_t>(type->sensors.size())) {
+      error(o->where(), "<sensor>: index " + std::to_string(i) + " does not name a sensor of type '" + type_name +
+                            "' (it has " + std::to_string(type->sensors.size()) + ")");
+      continue;
+    }
+    sensor_overrides[static_cast<std::size_t>(i)] = o;
+  }
+  if (driver_override != nullptr && !type->driver)
+    error(driver_override->where(), "<driver>: artifact type '" + type_name + "' has no driver to set parameters of");
+
   Artifact& a = env.addArtifact(name, pose);
   for (const auto& p : type->physic) a.addPhysicRoot(p);
   for (const auto& r : type->render) a.addRenderRoot(r);
@@ -568,11 +596,14 @@ void SceneLoader::place(Environment& env, const std::string& name, const std::st
   if (type->driver) {
     const PluginDecl& decl = *type->driver;
     auto create = [&](std::string_view p, std::string_view c) -> Driver& { return loader.createDriver(p, c); };
-    if (Driver* d = createPlugin<Driver>(decl, create)) a.setDriver(*d, decl.params, decl.period, decl.class_name);
+    if (Driver* d = createPlugin<Driver>(decl, create))
+      a.setDriver(*d, withOverrides(decl, driver_override), decl.period, decl.class_name);
   }
-  for (const auto& decl : type->sensors) {
+  for (std::size_t i = 0; i < type->sensors.size(); ++i) {
+    const PluginDecl& decl = type->sensors[i];
     auto create = [&](std::string_view p, std::string_view c) -> Sensor& { return loader.createSensor(p, c); };
-    if (Sensor* s = createPlugin<Sensor>(decl, create)) a.addSensor(*s, decl.params, decl.period, decl.class_name);
+    if (Sensor* s = createPlugin<Sensor>(decl, create))
+      a.addSensor(*s, withOverrides(decl, sensor_overrides[i]), decl.period, decl.class_name);
   }
 }
 
@@ -645,7 +676,7 @@ void SceneLoader::buildSwarm(Environment& env, const Descriptor& d, std::size_t 
       positions.emplace_back(radius * r * std::cos(theta), radius * r * std::sin(theta), radius * z);
     }
   }
-  checkUnknown(d);
+  checkUnknown(d, {"driver", "sensor"});
   if (count > 1 && pattern.find("{i}") == std::string::npos)
     error(d.where(), "<swarm>: the name pattern '" + pattern + "' needs {i} to give " + std::to_string(count) +
                          " artifacts different names");
@@ -657,7 +688,7 @@ void SceneLoader::buildSwarm(Environment& env, const Descriptor& d, std::size_t 
       name.replace(at, 3, index);
     Pose pose = origin;
     pose.position = origin.transformPoint(positions[static_cast<std::size_t>(i)]);
-    place(env, name, type, pose, d.where());
+    place(env, name, type, pose, d);
     if (errorCount() != errors_before) return;  // one report per swarm, not one per robot
   }
 }
@@ -702,8 +733,8 @@ void SceneLoader::build(Scene& scene) {
       const std::string name = require(d, "name");
       const std::string type = require(d, "type");
       const Pose pose = readPose(d);
-      checkUnknown(d);
-      if (!name.empty() && !type.empty()) place(env, name, type, pose, d.where());
+      checkUnknown(d, {"driver", "sensor"});
+      if (!name.empty() && !type.empty()) place(env, name, type, pose, d);
     } else if (d.name() == "swarm") {
       buildSwarm(env, d, swarm_index++);
     } else if (d.name() == "ground") {

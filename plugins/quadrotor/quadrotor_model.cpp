@@ -1,0 +1,287 @@
+#include "quadrotor_model.hpp"
+
+#include "fixed_point.hpp"
+
+#include <Eigen/QR>
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+
+namespace ssx::quadrotor {
+
+namespace fx = fixed;
+
+std::optional<RotorParams> preset(const std::string& name) {
+  RotorParams p;  // the defaults are mk_quad
+  if (name == "mk_quad") return p;
+  if (name == "hummingbird") {
+    p.thrust_coefficient = 8.54858e-6;
+    p.moment_constant = 0.016;
+    p.max_rotor_speed = 838.0;
+    return p;
+  }
+  if (name == "crazyflie") {
+    p.thrust_coefficient = 1.28192e-8;
+    p.moment_constant = 5.964552e-3;
+    p.max_rotor_speed = 3052.0;
+    p.rotor_drag_coefficient = 0.0;  // no published figure
+    p.rolling_moment_coefficient = 0.0;
+    return p;
+  }
+  return std::nullopt;
+}
+
+// --- allocation and rotors -------------------------------------------------------------------------
+
+Allocation::Allocation(const std::vector<Rotor>& rotors, const RotorParams& p) {
+  const auto n = static_cast<Eigen::Index>(rotors.size());
+  a_.resize(4, n);
+  for (Eigen::Index i = 0; i < n; ++i) {
+    const Rotor& r = rotors[static_cast<std::size_t>(i)];
+    a_(0, i) = r.position.y() * p.thrust_coefficient;
+    a_(1, i) = -r.position.x() * p.thrust_coefficient;
+    a_(2, i) = -r.direction * p.thrust_coefficient * p.moment_constant;
+    a_(3, i) = p.thrust_coefficient;
+  }
+  a_inv_ = a_.completeOrthogonalDecomposition().pseudoInverse();
+}
+
+RotorModel::RotorModel(std::vector<Rotor> rotors, const RotorParams& params)
+    : rotors_(std::move(rotors)), params_(params), speeds_(rotors_.size(), 0.0) {}
+
+void RotorModel::step(double dt, const std::vector<double>& commanded) {
+  for (std::size_t i = 0; i < speeds_.size(); ++i) {
+    const double target = std::clamp(commanded[i], params_.min_rotor_speed, params_.max_rotor_speed);
+    const double tau = target > speeds_[i] ? params_.time_constant_up : params_.time_constant_down;
+    const double alpha = std::exp(-dt / tau);
+    speeds_[i] = alpha * speeds_[i] + (1.0 - alpha) * target;
+  }
+}
+
+void RotorModel::wrench(const Vec3& v_body, const Vec3& w_body, Vec3& force, Vec3& torque) const {
+  force.setZero();
+  torque.setZero();
+  double spin = 0.0;  // sum of s_i w_i, for the rotors' angular momentum
+  const Vec3 z = Vec3::UnitZ();
+  for (std::size_t i = 0; i < rotors_.size(); ++i) {
+    const Rotor& r = rotors_[i];
+    const double w = speeds_[i];
+    const double thrust = params_.thrust_coefficient * w * w;
+    // thrust and reaction torque
+    const Vec3 f = thrust * z;
+    torque += r.position.cross(f) + Vec3(0, 0, -r.direction * params_.moment_constant * thrust);
+    force += f;
+    // rotor drag and rolling moment from the air-relative velocity in the rotor plane
+    const Vec3 v = v_body + w_body.cross(r.position);
+    const Vec3 v_perp = v - v.dot(z) * z;
+    const Vec3 drag = -std::abs(w) * params_.rotor_drag_coefficient * v_perp;
+    force += drag;
+    torque += r.position.cross(drag) - std::abs(w) * params_.rolling_moment_coefficient * v_perp;
+    spin += r.direction * w;
+  }
+  // turning spinning rotors takes a torque: the body feels -w x h, h = J_r sum(s_i w_i) z
+  if (params_.rotor_inertia > 0) torque += -w_body.cross(params_.rotor_inertia * spin * z);
+}
+
+// --- inner loop, fixed point --------------------------------------------------------------------
+
+namespace {
+
+constexpr double kQ12 = 4096.0;
+constexpr double kQ16 = 65536.0;
+constexpr double kQ20 = 1048576.0;
+constexpr double kQ30 = 1073741824.0;
+constexpr double kMaxPitch = 80.0 * std::numbers::pi / 180.0;
+
+std::int64_t toFixed(double v, double scale) { return std::llround(v * scale); }
+
+}  // namespace
+
+InnerLoopFixed::InnerLoopFixed(const InnerLoopParams& p) : params_(p) {
+  gyro_to_q12_q16 = toFixed(p.gyro_lsb * kQ12, kQ16);
+  dt_q24 = toFixed(p.dt, 16777216.0);
+  kp_q8 = toFixed(p.attitude_kp, 256.0);
+  kd_q8 = toFixed(p.attitude_kd, 256.0);
+  kyaw_q8 = toFixed(p.yaw_rate_kp, 256.0);
+  max_alpha_q12 = toFixed(p.max_angular_acceleration, kQ12);
+  gyro_weight_q15 = toFixed(p.filter_gyro_weight, 32768.0);
+  const double g_counts = p.gravity / p.accel_lsb;
+  accel_gate_low2 = toFixed(0.25 * g_counts * g_counts, 1.0);
+  accel_gate_high2 = toFixed(2.25 * g_counts * g_counts, 1.0);
+  for (Eigen::Index i = 0; i < p.mixer.rows(); ++i) {
+    std::array<std::int64_t, 4> row{};
+    for (int j = 0; j < 4; ++j) row[static_cast<std::size_t>(j)] = toFixed(p.mixer(i, j), kQ20);
+    mixer_q20.push_back(row);
+  }
+  min_speed_q4 = toFixed(p.min_rotor_speed, 16.0);
+  max_speed_q4 = toFixed(p.max_rotor_speed, 16.0);
+}
+
+double InnerLoopFixed::commandToSpeed(std::uint8_t command) const {
+  return params_.min_rotor_speed + (params_.max_rotor_speed - params_.min_rotor_speed) * command / 255.0;
+}
+
+InnerOutput InnerLoopFixed::step(const std::array<std::int32_t, 3>& gyro, const std::array<std::int32_t, 3>& accel,
+                                 const InnerCommand& command) {
+  InnerOutput out = evaluate(estimate_, gyro, accel, command);
+  estimate_ = out.estimate;
+  return out;
+}
+
+InnerOutput InnerLoopFixed::evaluate(const AttitudeEstimate& prior, const std::array<std::int32_t, 3>& gyro,
+                                     const std::array<std::int32_t, 3>& accel, const InnerCommand& command) const {
+  InnerOutput out;
+  // body rates, Q12 rad/s
+  std::int64_t rate[3];
+  for (int i = 0; i < 3; ++i) rate[i] = fx::roundShift(gyro[static_cast<std::size_t>(i)] * gyro_to_q12_q16, 16);
+
+  // Euler angle rates from body rates: roll' = p + tan(pitch) (q sin roll + r cos roll),
+  // pitch' = q cos roll - r sin roll (Q30 trigonometry, Q12 results)
+  std::int64_t sr, cr, sp, cp;
+  fx::sinCosQ30(std::int64_t{prior.roll_q20} << 10, sr, cr);
+  fx::sinCosQ30(std::int64_t{prior.pitch_q20} << 10, sp, cp);
+  const std::int64_t u = fx::roundShift(rate[1] * sr + rate[2] * cr, 30);       // Q12
+  const std::int64_t tan_u = (u * sp + (u * sp >= 0 ? cp / 2 : -cp / 2)) / cp;  // Q12, cp > 0 (|pitch| < 80 deg)
+  const std::int64_t roll_rate = rate[0] + tan_u;
+  const std::int64_t pitch_rate = fx::roundShift(rate[1] * cr - rate[2] * sr, 30);
+
+  // predict with the gyro, Q12 * Q24 >> 16 = Q20
+  std::int64_t roll = prior.roll_q20 + fx::roundShift(roll_rate * dt_q24, 16);
+  std::int64_t pitch = prior.pitch_q20 + fx::roundShift(pitch_rate * dt_q24, 16);
+
+  // correct towards the accelerometer's gravity direction when it reads about 1 g
+  const std::int64_t ax = accel[0], ay = accel[1], az = accel[2];
+  const std::int64_t norm2 = ax * ax + ay * ay + az * az;
+  if (norm2 >= accel_gate_low2 && norm2 <= accel_gate_high2) {
+    const std::int64_t roll_acc = fx::roundShift(fx::atan2Q30(ay, az), 10);
+    const std::int64_t pitch_acc = fx::roundShift(
+        fx::atan2Q30(-ax, static_cast<std::int64_t>(fx::isqrtRound(static_cast<std::uint64_t>(ay * ay + az * az)))),
+        10);
+    roll = fx::roundShift(gyro_weight_q15 * roll + (32768 - gyro_weight_q15) * roll_acc, 15);
+    pitch = fx::roundShift(gyro_weight_q15 * pitch + (32768 - gyro_weight_q15) * pitch_acc, 15);
+  }
+  // keep roll in (-pi, pi], pitch within +-80 deg
+  const std::int64_t pi_q20 = fx::roundShift(fx::kPiQ30, 10);
+  if (roll > pi_q20) roll -= 2 * pi_q20;
+  if (roll < -pi_q20) roll += 2 * pi_q20;
+  const std::int64_t max_pitch = toFixed(kMaxPitch, kQ20);
+  pitch = fx::clamp(pitch, -max_pitch, max_pitch);
+  out.estimate = {static_cast<std::int32_t>(roll), static_cast<std::int32_t>(pitch)};
+
+  // attitude control: angular accelerations, Q12 rad/s^2, saturated
+  const std::int64_t e_roll = command.roll_q12 - fx::roundShift(roll, 8);
+  const std::int64_t e_pitch = command.pitch_q12 - fx::roundShift(pitch, 8);
+  const std::int64_t alpha[3] = {
+      fx::clamp(fx::roundShift(kp_q8 * e_roll, 8) - fx::roundShift(kd_q8 * rate[0], 8), -max_alpha_q12, max_alpha_q12),
+      fx::clamp(fx::roundShift(kp_q8 * e_pitch, 8) - fx::roundShift(kd_q8 * rate[1], 8), -max_alpha_q12, max_alpha_q12),
+      fx::clamp(fx::roundShift(kyaw_q8 * (command.yaw_rate_q12 - rate[2]), 8), -max_alpha_q12, max_alpha_q12)};
+  for (int i = 0; i < 3; ++i)
+    out.angular_acceleration_q12[static_cast<std::size_t>(i)] = static_cast<std::int32_t>(alpha[i]);
+
+  // mixer: rotor speed squared in Q8, then speed in Q4, then an 8-bit command
+  const std::int64_t min2 = min_speed_q4 * min_speed_q4, max2 = max_speed_q4 * max_speed_q4;
+  const std::int64_t range = max_speed_q4 - min_speed_q4;
+  for (const auto& m : mixer_q20) {
+    std::int64_t w2 = fx::roundShift(m[0] * alpha[0], 24) + fx::roundShift(m[1] * alpha[1], 24) +
+                      fx::roundShift(m[2] * alpha[2], 24) + fx::roundShift(m[3] * command.thrust_q16, 28);
+    w2 = fx::clamp(w2, min2, max2);
+    const auto w = static_cast<std::int64_t>(fx::isqrtRound(static_cast<std::uint64_t>(w2)));
+    const std::int64_t cmd = range > 0 ? ((w - min_speed_q4) * 255 * 2 + range) / (2 * range) : 0;
+    out.motor_commands.push_back(static_cast<std::uint8_t>(fx::clamp(cmd, 0, 255)));
+  }
+  return out;
+}
+
+// --- inner loop, floating-point reference --------------------------------------------------------
+
+InnerOutput innerLoopFloat(const InnerLoopParams& p, const AttitudeEstimate& prior,
+                           const std::array<std::int32_t, 3>& gyro, const std::array<std::int32_t, 3>& accel,
+                           const InnerCommand& command) {
+  InnerOutput out;
+  const Vec3 rate = Vec3(gyro[0], gyro[1], gyro[2]) * p.gyro_lsb;
+  const double roll0 = prior.roll_q20 / kQ20, pitch0 = prior.pitch_q20 / kQ20;
+  const double roll_rate = rate.x() + std::tan(pitch0) * (rate.y() * std::sin(roll0) + rate.z() * std::cos(roll0));
+  const double pitch_rate = rate.y() * std::cos(roll0) - rate.z() * std::sin(roll0);
+  double roll = roll0 + roll_rate * p.dt;
+  double pitch = pitch0 + pitch_rate * p.dt;
+  const double ax = accel[0], ay = accel[1], az = accel[2];
+  const double g_counts = p.gravity / p.accel_lsb;
+  const double norm2 = ax * ax + ay * ay + az * az;
+  if (norm2 >= std::llround(0.25 * g_counts * g_counts) && norm2 <= std::llround(2.25 * g_counts * g_counts)) {
+    const double w = p.filter_gyro_weight;
+    roll = w * roll + (1 - w) * std::atan2(ay, az);
+    pitch = w * pitch + (1 - w) * std::atan2(-ax, std::sqrt(ay * ay + az * az));
+  }
+  if (roll > std::numbers::pi) roll -= 2 * std::numbers::pi;
+  if (roll < -std::numbers::pi) roll += 2 * std::numbers::pi;
+  pitch = std::clamp(pitch, -kMaxPitch, kMaxPitch);
+  out.estimate = {static_cast<std::int32_t>(std::llround(roll * kQ20)),
+                  static_cast<std::int32_t>(std::llround(pitch * kQ20))};
+
+  const double e_roll = command.roll_q12 / kQ12 - roll;
+  const double e_pitch = command.pitch_q12 / kQ12 - pitch;
+  const double amax = p.max_angular_acceleration;
+  const Vec3 alpha(std::clamp(p.attitude_kp * e_roll - p.attitude_kd * rate.x(), -amax, amax),
+                   std::clamp(p.attitude_kp * e_pitch - p.attitude_kd * rate.y(), -amax, amax),
+                   std::clamp(p.yaw_rate_kp * (command.yaw_rate_q12 / kQ12 - rate.z()), -amax, amax));
+  for (int i = 0; i < 3; ++i)
+    out.angular_acceleration_q12[static_cast<std::size_t>(i)] =
+        static_cast<std::int32_t>(std::llround(alpha[i] * kQ12));
+  const Eigen::Vector4d x(alpha.x(), alpha.y(), alpha.z(), command.thrust_q16 / kQ16);
+  for (Eigen::Index i = 0; i < p.mixer.rows(); ++i) {
+    const double w2 =
+        std::clamp(p.mixer.row(i).dot(x), p.min_rotor_speed * p.min_rotor_speed, p.max_rotor_speed * p.max_rotor_speed);
+    const double range = p.max_rotor_speed - p.min_rotor_speed;
+    const double cmd = range > 0 ? std::round(255.0 * (std::sqrt(w2) - p.min_rotor_speed) / range) : 0.0;
+    out.motor_commands.push_back(static_cast<std::uint8_t>(std::clamp(cmd, 0.0, 255.0)));
+  }
+  return out;
+}
+
+// --- outer loop --------------------------------------------------------------------------------
+
+AttitudeCommand PositionController::update(double dt, const Setpoint& ref, const Vec3& position, const Vec3& velocity,
+                                           double roll, double pitch, double yaw) {
+  const PositionParams& p = params_;
+  const Vec3 error = ref.position - position;
+  // integral of the position error, clamped per axis
+  for (int i = 0; i < 3; ++i)
+    if (p.ki[i] > 0) integral_[i] = std::clamp(integral_[i] + error[i] * dt, -p.integral_limit, p.integral_limit);
+  const Vec3 a = ref.acceleration + p.kd.cwiseProduct(ref.velocity - velocity) + p.kp.cwiseProduct(error) +
+                 p.ki.cwiseProduct(integral_);
+  AttitudeCommand c;
+  const double tilt = std::max(0.2, std::cos(roll) * std::cos(pitch));
+  c.thrust = std::clamp(p.mass * (a.z() + p.gravity) / tilt, p.min_thrust, p.max_thrust);
+  const double max_sin = std::sin(p.max_tilt);
+  const double sin_roll =
+      std::clamp(p.mass / c.thrust * (std::sin(yaw) * a.x() - std::cos(yaw) * a.y()), -max_sin, max_sin);
+  c.roll = std::asin(sin_roll);
+  const double sin_pitch = std::clamp(
+      p.mass / (c.thrust * std::cos(c.roll)) * (std::cos(yaw) * a.x() + std::sin(yaw) * a.y()), -max_sin, max_sin);
+  c.pitch = std::asin(sin_pitch);
+  c.yaw_rate = ref.yaw_rate;  // rate mode: the feed-forward passes through
+  return c;
+}
+
+// --- references --------------------------------------------------------------------------------
+
+Setpoint FigureEight::at(double t) const {
+  const double w = 2.0 * std::numbers::pi / period;
+  const double s = w * t;
+  const double a = amplitude;
+  // the first axis is x; the second is y (horizontal) or z (vertical)
+  const Vec3 along(a * std::sin(s), 0.5 * a * std::sin(2 * s), 0);
+  const Vec3 speed(a * w * std::cos(s), a * w * std::cos(2 * s), 0);
+  const Vec3 accel(-a * w * w * std::sin(s), -2 * a * w * w * std::sin(2 * s), 0);
+  auto place = [this](const Vec3& v) { return vertical ? Vec3(v.x(), 0, v.y()) : v; };
+  Setpoint sp;
+  sp.position = center + place(along);
+  sp.velocity = place(speed);
+  sp.acceleration = place(accel);
+  sp.yaw = yaw_rate * t;
+  sp.yaw_rate = yaw_rate;
+  return sp;
+}
+
+}  // namespace ssx::quadrotor

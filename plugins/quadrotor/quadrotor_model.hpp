@@ -1,0 +1,193 @@
+#pragma once
+// The quadrotor model and flight controller, free of the plugin glue so that tests and programs
+// can use each part alone. Reference numbers: shared/specs/quadrotor.md.
+//
+//   RotorModel      first-order motors, thrust kF w^2, reaction torque, rotor drag, rolling moment
+//   Allocation      maps rotor speeds squared to body torques and thrust, and back
+//   InnerLoopFixed  integer attitude estimate (complementary filter) + attitude control + 8-bit mixer
+//   innerLoopFloat  the same law in double precision: the reference the fixed-point code must match
+//   PositionController  the outer loop in floating point (TeleKyb form)
+//   FigureEight     reference trajectories of the fidelity study
+
+#include <ssx/setpoint.hpp>
+#include <ssx/types.hpp>
+
+#include <array>
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace ssx::quadrotor {
+
+/// Rotor and motor constants of a vehicle (SI units).
+struct RotorParams {
+  double thrust_coefficient = 1.0e-5;          ///< kF, N/(rad/s)^2
+  double moment_constant = 0.016;              ///< kM, m: reaction torque = kM * thrust
+  double time_constant_up = 0.0125;            ///< s
+  double time_constant_down = 0.025;           ///< s
+  double max_rotor_speed = 940.0;              ///< rad/s
+  double min_rotor_speed = 0.0;                ///< rad/s (idle)
+  double rotor_drag_coefficient = 8.06428e-5;  ///< lambda1, N/(m/s)/(rad/s)
+  double rolling_moment_coefficient = 1e-6;    ///< mu1, N m/(m/s)/(rad/s)
+  double rotor_inertia = 0.0;                  ///< kg m^2; > 0 adds the rotors' gyroscopic torque
+};
+
+/// The named presets: "mk_quad" (default), "hummingbird", "crazyflie". Empty if unknown.
+std::optional<RotorParams> preset(const std::string& name);
+
+/// One rotor: position in the body (centre-of-mass) frame, spin direction (+1 CCW seen from above).
+struct Rotor {
+  Vec3 position = Vec3::Zero();
+  int direction = 1;
+};
+
+/// Maps rotor speeds squared to (tau_x, tau_y, tau_z, thrust), body frame, and back.
+class Allocation {
+ public:
+  Allocation(const std::vector<Rotor>& rotors, const RotorParams& params);
+  /// 4 x n matrix: column i is [r_y kF, -r_x kF, -s_i kF kM, kF].
+  const Eigen::MatrixXd& matrix() const { return a_; }
+  /// n x 4 Moore-Penrose pseudo-inverse.
+  const Eigen::MatrixXd& inverse() const { return a_inv_; }
+
+ private:
+  Eigen::MatrixXd a_, a_inv_;
+};
+
+/// First-order motors and the aerodynamic forces of the rotors.
+class RotorModel {
+ public:
+  RotorModel(std::vector<Rotor> rotors, const RotorParams& params);
+  /// Advances the motor speeds by dt towards the commanded speeds (clamped to the limits).
+  void step(double dt, const std::vector<double>& commanded);
+  const std::vector<double>& speeds() const { return speeds_; }
+  void setSpeeds(const std::vector<double>& w) { speeds_ = w; }
+  /// Force and torque on the body about its centre of mass, body frame, given the body's
+  /// velocity and angular velocity in the body frame (air at rest).
+  void wrench(const Vec3& velocity_body, const Vec3& angular_velocity_body, Vec3& force, Vec3& torque) const;
+  const std::vector<Rotor>& rotors() const { return rotors_; }
+  const RotorParams& params() const { return params_; }
+
+ private:
+  std::vector<Rotor> rotors_;
+  RotorParams params_;
+  std::vector<double> speeds_;
+};
+
+/// Gains and conversions of the inner loop, in engineering units; InnerLoopFixed converts them to
+/// integers once.
+struct InnerLoopParams {
+  double dt = 0.002;                        ///< s, inner loop period (500 Hz)
+  double attitude_kp = 200.0;               ///< 1/s^2
+  double attitude_kd = 25.0;                ///< 1/s
+  double yaw_rate_kp = 8.0;                 ///< 1/s
+  double max_angular_acceleration = 400.0;  ///< rad/s^2, per axis
+  double filter_gyro_weight = 0.998;        ///< complementary filter: weight of the gyro path per step
+  double gyro_lsb = 6.98131700797732e-4;    ///< rad/s per count
+  double accel_lsb = 8.16893945e-3;         ///< m/s^2 per count
+  double gravity = 9.81;                    ///< m/s^2, for the accelerometer gate
+  Mat3 inertia = Vec3(0.009, 0.009, 0.018).asDiagonal().toDenseMatrix();
+  double min_rotor_speed = 0.0, max_rotor_speed = 940.0;
+  Eigen::MatrixXd mixer;  ///< n x 4: w^2 from (alpha_x, alpha_y, alpha_z, thrust) = A^+ diag(J, 1)
+};
+
+/// What the outer loop hands the inner loop, as integers (as over a serial link).
+struct InnerCommand {
+  std::int32_t roll_q12 = 0, pitch_q12 = 0;  ///< rad, Q12
+  std::int32_t yaw_rate_q12 = 0;             ///< rad/s, Q12
+  std::int32_t thrust_q16 = 0;               ///< N, Q16
+};
+
+/// The integer attitude estimate the inner loop keeps.
+struct AttitudeEstimate {
+  std::int32_t roll_q20 = 0, pitch_q20 = 0;  ///< rad, Q20
+};
+
+/// Result of one inner-loop step.
+struct InnerOutput {
+  AttitudeEstimate estimate;
+  std::array<std::int32_t, 3> angular_acceleration_q12{};  ///< rad/s^2, Q12, after saturation
+  std::vector<std::uint8_t> motor_commands;                ///< 0..255 per rotor
+};
+
+/// The inner loop as it would run on an 8/32-bit microcontroller: integers only, every product in
+/// int64 followed by a rounding shift, every stage saturated.
+class InnerLoopFixed {
+ public:
+  explicit InnerLoopFixed(const InnerLoopParams& params);
+  /// One step from raw IMU counts; updates and returns the estimate.
+  InnerOutput step(const std::array<std::int32_t, 3>& gyro_counts, const std::array<std::int32_t, 3>& accel_counts,
+                   const InnerCommand& command);
+  /// The same step from a given estimate, without touching the loop's own state.
+  InnerOutput evaluate(const AttitudeEstimate& prior, const std::array<std::int32_t, 3>& gyro_counts,
+                       const std::array<std::int32_t, 3>& accel_counts, const InnerCommand& command) const;
+  const AttitudeEstimate& estimate() const { return estimate_; }
+  void reset(const AttitudeEstimate& e) { estimate_ = e; }
+  /// Motor command to commanded rotor speed (linear between the speed limits).
+  double commandToSpeed(std::uint8_t command) const;
+
+  // integer parameters, public for the tests that check their range
+  std::int64_t gyro_to_q12_q16 = 0;  ///< counts -> rad/s Q12, as a Q16 multiplier
+  std::int64_t dt_q24 = 0;
+  std::int64_t kp_q8 = 0, kd_q8 = 0, kyaw_q8 = 0;
+  std::int64_t max_alpha_q12 = 0;
+  std::int64_t gyro_weight_q15 = 0;
+  std::int64_t accel_gate_low2 = 0, accel_gate_high2 = 0;  ///< counts^2
+  std::vector<std::array<std::int64_t, 4>> mixer_q20;
+  std::int64_t min_speed_q4 = 0, max_speed_q4 = 0;
+
+ private:
+  InnerLoopParams params_;
+  AttitudeEstimate estimate_;
+};
+
+/// The reference: the same step in double precision, rounded only where the fixed-point code hands
+/// a value on (the estimate to Q20, the motor commands to integers).
+InnerOutput innerLoopFloat(const InnerLoopParams& params, const AttitudeEstimate& prior,
+                           const std::array<std::int32_t, 3>& gyro_counts,
+                           const std::array<std::int32_t, 3>& accel_counts, const InnerCommand& command);
+
+/// Outer loop gains and limits.
+struct PositionParams {
+  double mass = 0.82;  ///< kg, as the controller believes it
+  double gravity = 9.81;
+  Vec3 kp{9.0, 9.0, 9.0};                      ///< 1/s^2
+  Vec3 kd{7.5, 7.5, 7.5};                      ///< 1/s
+  Vec3 ki{4.5, 4.5, 0.0};                      ///< 1/s^3
+  double integral_limit = 2.0;                 ///< m s, per axis
+  double max_tilt = 0.5235987755982988;        ///< rad (30 deg)
+  double min_thrust = 0.5, max_thrust = 30.0;  ///< N
+};
+
+/// Attitude and thrust set-points for the inner loop.
+struct AttitudeCommand {
+  double roll = 0, pitch = 0, yaw_rate = 0, thrust = 0;
+};
+
+/// The outer loop: position and velocity errors to thrust and attitude (ENU, z up).
+class PositionController {
+ public:
+  explicit PositionController(const PositionParams& params) : params_(params) {}
+  /// `yaw`, `roll`, `pitch`: the current attitude (roll and pitch from the inner loop's estimate).
+  AttitudeCommand update(double dt, const Setpoint& ref, const Vec3& position, const Vec3& velocity, double roll,
+                         double pitch, double yaw);
+  void reset() { integral_.setZero(); }
+
+ private:
+  PositionParams params_;
+  Vec3 integral_ = Vec3::Zero();
+};
+
+/// The fidelity study's figure eight: s = w t; horizontal c + (A sin s, A/2 sin 2s, 0), vertical the
+/// same curve in the x-z plane; constant yaw rate.
+struct FigureEight {
+  Vec3 center{0, 0, 1.5};
+  double amplitude = 1.0;  ///< A, m
+  double period = 12.0;    ///< T, s
+  double yaw_rate = 0.2;   ///< rad/s
+  bool vertical = false;
+  Setpoint at(double t) const;
+};
+
+}  // namespace ssx::quadrotor
