@@ -94,11 +94,19 @@ void QuadrotorDriver::configure(const Descriptor& params) {
   // inner loop
   InnerLoopParams ip;
   ip.dt = inner_steps_ * tau;
-  ip.attitude_kp = positive(params, "attitude_kp", ip.attitude_kp);
-  ip.attitude_kd = positive(params, "attitude_kd", ip.attitude_kd);
-  ip.yaw_rate_kp = positive(params, "yaw_rate_kp", ip.yaw_rate_kp);
-  ip.max_angular_acceleration = positive(params, "max_angular_acceleration", ip.max_angular_acceleration);
+  auto bounded = [&](const char* key, double fallback, double max) {
+    const double v = positive(params, key, fallback);
+    if (v > max) throw params.error(*params.find(key), std::string(key) + " must be at most " + std::to_string(max));
+    return v;
+  };
+  ip.attitude_kp = bounded("attitude_kp", ip.attitude_kp, InnerLoopLimits::attitude_kp);
+  ip.attitude_kd = bounded("attitude_kd", ip.attitude_kd, InnerLoopLimits::attitude_kd);
+  ip.yaw_rate_kp = bounded("yaw_rate_kp", ip.yaw_rate_kp, InnerLoopLimits::yaw_rate_kp);
+  ip.max_angular_acceleration =
+      bounded("max_angular_acceleration", ip.max_angular_acceleration, InnerLoopLimits::max_angular_acceleration);
   ip.filter_gyro_weight = positive(params, "filter_gyro_weight", ip.filter_gyro_weight);
+  if (ip.filter_gyro_weight > 1)
+    throw params.error(*params.find("filter_gyro_weight"), "filter_gyro_weight must be at most 1");
   ip.gravity = -env.settings().physics.gravity.z();
   ip.inertia = mass.inertia;
   ip.min_rotor_speed = rp.min_rotor_speed;
@@ -106,6 +114,7 @@ void QuadrotorDriver::configure(const Descriptor& params) {
   Eigen::Matrix4d scale = Eigen::Matrix4d::Identity();
   scale.topLeftCorner<3, 3>() = mass.inertia;
   ip.mixer = allocation.inverse() * scale;
+  ip.max_thrust = allocation.matrix().row(3).sum() * rp.max_rotor_speed * rp.max_rotor_speed;
   // the IMU's LSBs are known once it has been configured (it comes first in the artifact)
   ip.gyro_lsb = imu_->gyroscope_lsb > 0 ? imu_->gyroscope_lsb : ip.gyro_lsb;
   ip.accel_lsb = imu_->accelerometer_lsb > 0 ? imu_->accelerometer_lsb : ip.accel_lsb;
@@ -120,8 +129,7 @@ void QuadrotorDriver::configure(const Descriptor& params) {
   pp.ki = params.get<Vec3>("position_ki", pp.ki);
   pp.integral_limit = positive(params, "integral_limit", pp.integral_limit);
   pp.max_tilt = positive(params, "max_tilt_deg", 30.0) * std::numbers::pi / 180.0;
-  const double max_thrust = allocation.matrix().row(3).sum() * rp.max_rotor_speed * rp.max_rotor_speed;
-  pp.max_thrust = positive(params, "max_thrust", 0.95 * max_thrust);
+  pp.max_thrust = positive(params, "max_thrust", 0.95 * ip.max_thrust);
   pp.min_thrust = 0.05 * pp.max_thrust;
   outer_ = std::make_unique<PositionController>(pp);
 

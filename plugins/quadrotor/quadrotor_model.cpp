@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cmath>
 #include <numbers>
+#include <stdexcept>
 
 namespace ssx::quadrotor {
 
@@ -99,7 +100,7 @@ std::int64_t toFixed(double v, double scale) { return std::llround(v * scale); }
 }  // namespace
 
 InnerLoopFixed::InnerLoopFixed(const InnerLoopParams& p) : params_(p) {
-  gyro_to_q12_q16 = toFixed(p.gyro_lsb * kQ12, kQ16);
+  gyro_to_q16_q16 = toFixed(p.gyro_lsb * kQ16, kQ16);
   dt_q24 = toFixed(p.dt, 16777216.0);
   kp_q8 = toFixed(p.attitude_kp, 256.0);
   kd_q8 = toFixed(p.attitude_kd, 256.0);
@@ -109,11 +110,23 @@ InnerLoopFixed::InnerLoopFixed(const InnerLoopParams& p) : params_(p) {
   const double g_counts = p.gravity / p.accel_lsb;
   accel_gate_low2 = toFixed(0.25 * g_counts * g_counts, 1.0);
   accel_gate_high2 = toFixed(2.25 * g_counts * g_counts, 1.0);
+  // mixer coefficients: Q12 for the angular-acceleration columns, Q20 for the thrust column; with
+  // alpha in Q12 and thrust in Q16 every product and the sum of four stay below 2^62
+  double worst = 0;
   for (Eigen::Index i = 0; i < p.mixer.rows(); ++i) {
     std::array<std::int64_t, 4> row{};
-    for (int j = 0; j < 4; ++j) row[static_cast<std::size_t>(j)] = toFixed(p.mixer(i, j), kQ20);
+    double sum = 0;
+    for (int j = 0; j < 4; ++j) {
+      row[static_cast<std::size_t>(j)] = toFixed(p.mixer(i, j), j < 3 ? kQ12 : kQ20);
+      sum += std::abs(static_cast<double>(row[static_cast<std::size_t>(j)])) *
+             (j < 3 ? p.max_angular_acceleration * kQ12 : p.max_thrust * kQ16);
+    }
+    worst = std::max(worst, sum);
     mixer_q20.push_back(row);
   }
+  if (worst >= 4.6e18)
+    throw std::invalid_argument("inner loop: the mixer would overflow 64 bits: lower max_angular_acceleration");
+  max_thrust_q16 = toFixed(p.max_thrust, kQ16);
   min_speed_q4 = toFixed(p.min_rotor_speed, 16.0);
   max_speed_q4 = toFixed(p.max_rotor_speed, 16.0);
 }
@@ -132,23 +145,23 @@ InnerOutput InnerLoopFixed::step(const std::array<std::int32_t, 3>& gyro, const 
 InnerOutput InnerLoopFixed::evaluate(const AttitudeEstimate& prior, const std::array<std::int32_t, 3>& gyro,
                                      const std::array<std::int32_t, 3>& accel, const InnerCommand& command) const {
   InnerOutput out;
-  // body rates, Q12 rad/s
+  // body rates, Q16 rad/s
   std::int64_t rate[3];
-  for (int i = 0; i < 3; ++i) rate[i] = fx::roundShift(gyro[static_cast<std::size_t>(i)] * gyro_to_q12_q16, 16);
+  for (int i = 0; i < 3; ++i) rate[i] = fx::roundShift(gyro[static_cast<std::size_t>(i)] * gyro_to_q16_q16, 16);
 
   // Euler angle rates from body rates: roll' = p + tan(pitch) (q sin roll + r cos roll),
-  // pitch' = q cos roll - r sin roll (Q30 trigonometry, Q12 results)
+  // pitch' = q cos roll - r sin roll (Q30 trigonometry, Q16 results)
   std::int64_t sr, cr, sp, cp;
   fx::sinCosQ30(std::int64_t{prior.roll_q20} << 10, sr, cr);
   fx::sinCosQ30(std::int64_t{prior.pitch_q20} << 10, sp, cp);
-  const std::int64_t u = fx::roundShift(rate[1] * sr + rate[2] * cr, 30);       // Q12
-  const std::int64_t tan_u = (u * sp + (u * sp >= 0 ? cp / 2 : -cp / 2)) / cp;  // Q12, cp > 0 (|pitch| < 80 deg)
+  const std::int64_t u = fx::roundShift(rate[1] * sr + rate[2] * cr, 30);       // Q16
+  const std::int64_t tan_u = (u * sp + (u * sp >= 0 ? cp / 2 : -cp / 2)) / cp;  // Q16, cp > 0 (|pitch| < 80 deg)
   const std::int64_t roll_rate = rate[0] + tan_u;
   const std::int64_t pitch_rate = fx::roundShift(rate[1] * cr - rate[2] * sr, 30);
 
-  // predict with the gyro, Q12 * Q24 >> 16 = Q20
-  std::int64_t roll = prior.roll_q20 + fx::roundShift(roll_rate * dt_q24, 16);
-  std::int64_t pitch = prior.pitch_q20 + fx::roundShift(pitch_rate * dt_q24, 16);
+  // predict with the gyro, Q16 * Q24 >> 20 = Q20
+  std::int64_t roll = prior.roll_q20 + fx::roundShift(roll_rate * dt_q24, 20);
+  std::int64_t pitch = prior.pitch_q20 + fx::roundShift(pitch_rate * dt_q24, 20);
 
   // correct towards the accelerometer's gravity direction when it reads about 1 g
   const std::int64_t ax = accel[0], ay = accel[1], az = accel[2];
@@ -173,18 +186,21 @@ InnerOutput InnerLoopFixed::evaluate(const AttitudeEstimate& prior, const std::a
   const std::int64_t e_roll = command.roll_q12 - fx::roundShift(roll, 8);
   const std::int64_t e_pitch = command.pitch_q12 - fx::roundShift(pitch, 8);
   const std::int64_t alpha[3] = {
-      fx::clamp(fx::roundShift(kp_q8 * e_roll, 8) - fx::roundShift(kd_q8 * rate[0], 8), -max_alpha_q12, max_alpha_q12),
-      fx::clamp(fx::roundShift(kp_q8 * e_pitch, 8) - fx::roundShift(kd_q8 * rate[1], 8), -max_alpha_q12, max_alpha_q12),
-      fx::clamp(fx::roundShift(kyaw_q8 * (command.yaw_rate_q12 - rate[2]), 8), -max_alpha_q12, max_alpha_q12)};
+      fx::clamp(fx::roundShift(kp_q8 * e_roll, 8) - fx::roundShift(kd_q8 * rate[0], 12), -max_alpha_q12, max_alpha_q12),
+      fx::clamp(fx::roundShift(kp_q8 * e_pitch, 8) - fx::roundShift(kd_q8 * rate[1], 12), -max_alpha_q12,
+                max_alpha_q12),
+      fx::clamp(fx::roundShift(kyaw_q8 * ((std::int64_t{command.yaw_rate_q12} << 4) - rate[2]), 12), -max_alpha_q12,
+                max_alpha_q12)};
   for (int i = 0; i < 3; ++i)
     out.angular_acceleration_q12[static_cast<std::size_t>(i)] = static_cast<std::int32_t>(alpha[i]);
 
   // mixer: rotor speed squared in Q8, then speed in Q4, then an 8-bit command
   const std::int64_t min2 = min_speed_q4 * min_speed_q4, max2 = max_speed_q4 * max_speed_q4;
   const std::int64_t range = max_speed_q4 - min_speed_q4;
+  const std::int64_t thrust = fx::clamp(command.thrust_q16, 0, max_thrust_q16);
   for (const auto& m : mixer_q20) {
-    std::int64_t w2 = fx::roundShift(m[0] * alpha[0], 24) + fx::roundShift(m[1] * alpha[1], 24) +
-                      fx::roundShift(m[2] * alpha[2], 24) + fx::roundShift(m[3] * command.thrust_q16, 28);
+    std::int64_t w2 = fx::roundShift(m[0] * alpha[0], 16) + fx::roundShift(m[1] * alpha[1], 16) +
+                      fx::roundShift(m[2] * alpha[2], 16) + fx::roundShift(m[3] * thrust, 28);
     w2 = fx::clamp(w2, min2, max2);
     const auto w = static_cast<std::int64_t>(fx::isqrtRound(static_cast<std::uint64_t>(w2)));
     const std::int64_t cmd = range > 0 ? ((w - min_speed_q4) * 255 * 2 + range) / (2 * range) : 0;
@@ -219,8 +235,11 @@ InnerOutput innerLoopFloat(const InnerLoopParams& p, const AttitudeEstimate& pri
   out.estimate = {static_cast<std::int32_t>(std::llround(roll * kQ20)),
                   static_cast<std::int32_t>(std::llround(pitch * kQ20))};
 
-  const double e_roll = command.roll_q12 / kQ12 - roll;
-  const double e_pitch = command.pitch_q12 / kQ12 - pitch;
+  // the estimate reaches the control law as a Q12 angle, in both implementations
+  const double roll_q12 = static_cast<double>(fx::roundShift(out.estimate.roll_q20, 8)) / kQ12;
+  const double pitch_q12 = static_cast<double>(fx::roundShift(out.estimate.pitch_q20, 8)) / kQ12;
+  const double e_roll = command.roll_q12 / kQ12 - roll_q12;
+  const double e_pitch = command.pitch_q12 / kQ12 - pitch_q12;
   const double amax = p.max_angular_acceleration;
   const Vec3 alpha(std::clamp(p.attitude_kp * e_roll - p.attitude_kd * rate.x(), -amax, amax),
                    std::clamp(p.attitude_kp * e_pitch - p.attitude_kd * rate.y(), -amax, amax),
@@ -228,7 +247,8 @@ InnerOutput innerLoopFloat(const InnerLoopParams& p, const AttitudeEstimate& pri
   for (int i = 0; i < 3; ++i)
     out.angular_acceleration_q12[static_cast<std::size_t>(i)] =
         static_cast<std::int32_t>(std::llround(alpha[i] * kQ12));
-  const Eigen::Vector4d x(alpha.x(), alpha.y(), alpha.z(), command.thrust_q16 / kQ16);
+  const double thrust = std::clamp(command.thrust_q16 / kQ16, 0.0, std::llround(p.max_thrust * kQ16) / kQ16);
+  const Eigen::Vector4d x(alpha.x(), alpha.y(), alpha.z(), thrust);
   for (Eigen::Index i = 0; i < p.mixer.rows(); ++i) {
     const double w2 =
         std::clamp(p.mixer.row(i).dot(x), p.min_rotor_speed * p.min_rotor_speed, p.max_rotor_speed * p.max_rotor_speed);

@@ -75,6 +75,13 @@ class RotorModel {
   std::vector<double> speeds_;
 };
 
+/// The largest inner-loop gains the driver accepts; the integer code is tested to agree with its
+/// float reference and not to overflow up to these.
+struct InnerLoopLimits {
+  static constexpr double attitude_kp = 5000.0, attitude_kd = 500.0, yaw_rate_kp = 500.0;
+  static constexpr double max_angular_acceleration = 5000.0;
+};
+
 /// Gains and conversions of the inner loop, in engineering units; InnerLoopFixed converts them to
 /// integers once.
 struct InnerLoopParams {
@@ -89,7 +96,8 @@ struct InnerLoopParams {
   double gravity = 9.81;                    ///< m/s^2, for the accelerometer gate
   Mat3 inertia = Vec3(0.009, 0.009, 0.018).asDiagonal().toDenseMatrix();
   double min_rotor_speed = 0.0, max_rotor_speed = 940.0;
-  Eigen::MatrixXd mixer;  ///< n x 4: w^2 from (alpha_x, alpha_y, alpha_z, thrust) = A^+ diag(J, 1)
+  double max_thrust = 35.0;  ///< N; the thrust command is saturated here (the rotors' total at full speed)
+  Eigen::MatrixXd mixer;     ///< n x 4: w^2 from (alpha_x, alpha_y, alpha_z, thrust) = A^+ diag(J, 1)
 };
 
 /// What the outer loop hands the inner loop, as integers (as over a serial link).
@@ -111,8 +119,10 @@ struct InnerOutput {
   std::vector<std::uint8_t> motor_commands;                ///< 0..255 per rotor
 };
 
-/// The inner loop as it would run on an 8/32-bit microcontroller: integers only, every product in
-/// int64 followed by a rounding shift, every stage saturated.
+/// The inner loop as it would run on a 32-bit microcontroller: integers only, every product in
+/// int64 followed by a rounding shift, every stage saturated. Formats: angles Q20 in the filter
+/// state and Q12 at the control law, body rates Q16, gains Q8, angular accelerations Q12, thrust
+/// Q16, rotor speed squared Q8, rotor speed Q4, motor commands 8 bits.
 class InnerLoopFixed {
  public:
   explicit InnerLoopFixed(const InnerLoopParams& params);
@@ -128,14 +138,15 @@ class InnerLoopFixed {
   double commandToSpeed(std::uint8_t command) const;
 
   // integer parameters, public for the tests that check their range
-  std::int64_t gyro_to_q12_q16 = 0;  ///< counts -> rad/s Q12, as a Q16 multiplier
+  std::int64_t gyro_to_q16_q16 = 0;  ///< counts -> rad/s Q16, as a Q16 multiplier
   std::int64_t dt_q24 = 0;
   std::int64_t kp_q8 = 0, kd_q8 = 0, kyaw_q8 = 0;
   std::int64_t max_alpha_q12 = 0;
   std::int64_t gyro_weight_q15 = 0;
   std::int64_t accel_gate_low2 = 0, accel_gate_high2 = 0;  ///< counts^2
-  std::vector<std::array<std::int64_t, 4>> mixer_q20;
+  std::vector<std::array<std::int64_t, 4>> mixer_q20;      ///< alpha columns Q12, thrust column Q20
   std::int64_t min_speed_q4 = 0, max_speed_q4 = 0;
+  std::int64_t max_thrust_q16 = 0;
 
  private:
   InnerLoopParams params_;
