@@ -50,7 +50,9 @@ inline constexpr std::int64_t kAtanTable[30] = {
     1048576,   524288,    262144,    131072,    65536,    32768,    16384,    8192,    4096,    2048,
     1024,      512,       256,       128,       64,       32,       16,       8,       4,       2};
 inline constexpr std::int64_t kPiQ30 = 3373259426;         // pi * 2^30
-inline constexpr std::int64_t kCordicGainQ30 = 652032874;  // prod 1/sqrt(1 + 2^-2i) * 2^30
+inline constexpr std::int64_t kCordicGainQ30 = 652032874;  // prod 1/sqrt(1 + 2^-2i) * 2^30 (i < 24: same to 2^-30)
+// 24 rotations leave an angle error below 2^-23 rad, far under the Q20 filter state's resolution
+inline constexpr int kCordicIterations = 24;
 
 /// atan2(y, x) in Q30 radians, (-pi, pi]; inputs of any common scale up to 2^40.
 constexpr std::int64_t atan2Q30(std::int64_t y, std::int64_t x) {
@@ -72,7 +74,7 @@ constexpr std::int64_t atan2Q30(std::int64_t y, std::int64_t x) {
   // scale up for precision (keeps |x|, |y| < 2^60 for inputs < 2^40)
   x <<= 16;
   y <<= 16;
-  for (int i = 0; i < 30; ++i) {
+  for (int i = 0; i < kCordicIterations; ++i) {
     const std::int64_t xs = x >> i, ys = y >> i;
     if (y > 0) {
       x += ys;
@@ -99,7 +101,7 @@ constexpr void sinCosQ30(std::int64_t angle, std::int64_t& s, std::int64_t& c) {
     flip = true;
   }
   std::int64_t x = kCordicGainQ30, y = 0, z = angle;
-  for (int i = 0; i < 30; ++i) {
+  for (int i = 0; i < kCordicIterations; ++i) {
     const std::int64_t xs = x >> i, ys = y >> i;
     if (z >= 0) {
       x -= ys;

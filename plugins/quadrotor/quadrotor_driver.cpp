@@ -217,8 +217,7 @@ void QuadrotorDriver::step(const StepInfo& info) {
   if (info.step % inner_steps_ == 0 && imu_fresh_) {
     imu_fresh_ = false;
     const InnerOutput out = inner_->step(imu_->gyroscope_counts, imu_->accelerometer_counts, command_);
-    for (std::size_t i = 0; i < out.motor_commands.size(); ++i)
-      commanded_speeds_[i] = inner_->commandToSpeed(out.motor_commands[i]);
+    for (std::size_t i = 0; i < out.motors; ++i) commanded_speeds_[i] = inner_->commandToSpeed(out.motor_commands[i]);
   }
   // motors and aerodynamics, applied at the centre of mass in body axes
   rotors_->step(tau, commanded_speeds_);

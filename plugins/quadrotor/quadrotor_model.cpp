@@ -52,10 +52,14 @@ RotorModel::RotorModel(std::vector<Rotor> rotors, const RotorParams& params)
     : rotors_(std::move(rotors)), params_(params), speeds_(rotors_.size(), 0.0) {}
 
 void RotorModel::step(double dt, const std::vector<double>& commanded) {
+  if (dt != alpha_dt_) {  // the filter factors depend only on dt: compute them once
+    alpha_dt_ = dt;
+    alpha_up_ = std::exp(-dt / params_.time_constant_up);
+    alpha_down_ = std::exp(-dt / params_.time_constant_down);
+  }
   for (std::size_t i = 0; i < speeds_.size(); ++i) {
     const double target = std::clamp(commanded[i], params_.min_rotor_speed, params_.max_rotor_speed);
-    const double tau = target > speeds_[i] ? params_.time_constant_up : params_.time_constant_down;
-    const double alpha = std::exp(-dt / tau);
+    const double alpha = target > speeds_[i] ? alpha_up_ : alpha_down_;
     speeds_[i] = alpha * speeds_[i] + (1.0 - alpha) * target;
   }
 }
@@ -100,6 +104,8 @@ std::int64_t toFixed(double v, double scale) { return std::llround(v * scale); }
 }  // namespace
 
 InnerLoopFixed::InnerLoopFixed(const InnerLoopParams& p) : params_(p) {
+  if (static_cast<std::size_t>(p.mixer.rows()) > kMaxRotors)
+    throw std::invalid_argument("inner loop: at most " + std::to_string(kMaxRotors) + " rotors");
   gyro_to_q16_q16 = toFixed(p.gyro_lsb * kQ16, kQ16);
   dt_q24 = toFixed(p.dt, 16777216.0);
   kp_q8 = toFixed(p.attitude_kp, 256.0);
@@ -204,7 +210,7 @@ InnerOutput InnerLoopFixed::evaluate(const AttitudeEstimate& prior, const std::a
     w2 = fx::clamp(w2, min2, max2);
     const auto w = static_cast<std::int64_t>(fx::isqrtRound(static_cast<std::uint64_t>(w2)));
     const std::int64_t cmd = range > 0 ? ((w - min_speed_q4) * 255 * 2 + range) / (2 * range) : 0;
-    out.motor_commands.push_back(static_cast<std::uint8_t>(fx::clamp(cmd, 0, 255)));
+    out.motor_commands[out.motors++] = static_cast<std::uint8_t>(fx::clamp(cmd, 0, 255));
   }
   return out;
 }
@@ -254,7 +260,7 @@ InnerOutput innerLoopFloat(const InnerLoopParams& p, const AttitudeEstimate& pri
         std::clamp(p.mixer.row(i).dot(x), p.min_rotor_speed * p.min_rotor_speed, p.max_rotor_speed * p.max_rotor_speed);
     const double range = p.max_rotor_speed - p.min_rotor_speed;
     const double cmd = range > 0 ? std::round(255.0 * (std::sqrt(w2) - p.min_rotor_speed) / range) : 0.0;
-    out.motor_commands.push_back(static_cast<std::uint8_t>(std::clamp(cmd, 0.0, 255.0)));
+    out.motor_commands[out.motors++] = static_cast<std::uint8_t>(std::clamp(cmd, 0.0, 255.0));
   }
   return out;
 }

@@ -36,6 +36,9 @@ struct RotorParams {
 /// The named presets: "mk_quad" (default), "hummingbird", "crazyflie". Empty if unknown.
 std::optional<RotorParams> preset(const std::string& name);
 
+/// The most rotors the inner loop's mixer drives.
+inline constexpr std::size_t kMaxRotors = 8;
+
 /// One rotor: position in the body (centre-of-mass) frame, spin direction (+1 CCW seen from above).
 struct Rotor {
   Vec3 position = Vec3::Zero();
@@ -73,6 +76,7 @@ class RotorModel {
   std::vector<Rotor> rotors_;
   RotorParams params_;
   std::vector<double> speeds_;
+  double alpha_dt_ = -1, alpha_up_ = 0, alpha_down_ = 0;  // exp(-dt/tau) for the last dt
 };
 
 /// The largest inner-loop gains the driver accepts; the integer code is tested to agree with its
@@ -116,7 +120,8 @@ struct AttitudeEstimate {
 struct InnerOutput {
   AttitudeEstimate estimate;
   std::array<std::int32_t, 3> angular_acceleration_q12{};  ///< rad/s^2, Q12, after saturation
-  std::vector<std::uint8_t> motor_commands;                ///< 0..255 per rotor
+  std::array<std::uint8_t, 8> motor_commands{};            ///< 0..255 per rotor (the first `motors`)
+  std::size_t motors = 0;
 };
 
 /// The inner loop as it would run on a 32-bit microcontroller: integers only, every product in
