@@ -137,7 +137,7 @@ void QuadrotorDriver::configure(const Descriptor& params) {
   const Vec3 start = a.placement().position;
   const std::string source = params.get<std::string>("reference", "hover");
   hover_.position = params.get<Vec3>("target", Vec3(start + params.get<Vec3>("offset", Vec3::Zero())));
-  eight_.center = params.get<Vec3>("center", start);
+  eight_.center = params.get<Vec3>("center", Vec3(start + params.get<Vec3>("center_offset", Vec3::Zero())));
   eight_.amplitude = positive(params, "amplitude", eight_.amplitude);
   eight_.period = positive(params, "period", eight_.period);
   eight_.yaw_rate = params.get<double>("yaw_rate", eight_.yaw_rate);

@@ -15,7 +15,8 @@
 //   controller_mass    the mass the controller assumes (default: the model's)
 //   reference          hover (default), eight_horizontal, eight_vertical, external
 //   target / offset    hover point, or the start plus offset (default 0 0 0)
-//   center, amplitude, period, yaw_rate, start_time   figure eight (center default: the start)
+//   center, amplitude, period, yaw_rate, start_time   figure eight (center default: the start
+//                      plus center_offset; before start_time the vehicle holds the centre)
 //
 // Needs a sensor producing ssx::ImuMeasurement on the artifact (the `imu` plugin). Uses the first
 // sensor producing ssx::PoseMeasurement (a motion-capture stand-in) for position and velocity,

@@ -218,3 +218,10 @@ TEST_CASE("counts have upper bounds", "[scene]") {
     CHECK_THAT(e.what(), Catch::Contains("m.xml:4: error: <swarm>: attribute 'count' must be at most 10000000"));
   }
 }
+
+TEST_CASE("the default demo scene loads without warnings", "[scene]") {
+  Scene scene = loadScene(fs::path(SSX_EXAMPLES_DIR) / "scenes" / "quad_swarm.xml");
+  CHECK(scene.warnings.empty());
+  CHECK(scene.environment->artifactCount() == 27);
+  CHECK(scene.duration == toNanoseconds(20.0));
+}

@@ -176,3 +176,14 @@ TEST_CASE("the accelerometer reads +1 g upwards at rest and the gyroscope the bo
   CHECK(std::abs(imu.accelerometer.x()) < 0.02);
   CHECK(imu.accelerometer_counts[2] == std::llround(imu.accelerometer.z() / imu.accelerometer_lsb));
 }
+
+TEST_CASE("quadrotors with noisy IMUs fly bitwise identically on 1 and 2 threads", "[quadrotor][determinism]") {
+  auto hashAfter = [](int threads) {
+    SceneOptions o;
+    o.threads = threads;
+    Scene s = loadScene(kScenes / "quad_hover.xml", o);
+    s.environment->step(1500);
+    return s.environment->stateHash();
+  };
+  CHECK(hashAfter(1) == hashAfter(2));
+}
