@@ -332,6 +332,34 @@ void Environment::publishSnapshot(bool first) {
   }
 }
 
+void Environment::enableNeighborQueries(double cell_size) {
+  if (!(cell_size > 0)) throw Error("enableNeighborQueries: cell size must be positive");
+  if (!neighbors_enabled_ || cell_size < neighbor_index_.cellSize()) neighbor_index_ = SpatialIndex(cell_size);
+  neighbors_enabled_ = true;
+  if (state_ == State::Running) rebuildNeighborIndex();
+}
+
+void Environment::neighbors(const Vec3& point, double radius, std::vector<std::size_t>& out) const {
+  if (!neighbors_enabled_) throw Error("neighbour queries are off: call enableNeighborQueries from configure");
+  neighbor_index_.query(point, radius, out);
+}
+
+void Environment::rebuildNeighborIndex() {
+  // one point per artifact with a dynamic root: its first root's position
+  neighbor_points_.clear();
+  neighbor_ids_.clear();
+  for (const auto& a : artifacts_) {
+    if (a->body_begin_ == a->body_end_) continue;
+    for (const PhysicNode* root : a->roots_) {
+      if (root->isStatic()) continue;
+      neighbor_points_.push_back(root->pose().position);
+      neighbor_ids_.push_back(a->index());
+      break;
+    }
+  }
+  neighbor_index_.rebuild(neighbor_points_, neighbor_ids_);
+}
+
 void Environment::runSensors(std::size_t begin, std::size_t end) {
   const StepInfo base{current_step_, time(), 0};
   for (std::size_t i = begin; i < end; ++i) {
@@ -463,6 +491,7 @@ void Environment::step() {
       for (int b = a->body_begin_; b < a->body_end_; ++b) wrenches_[static_cast<std::size_t>(b)] = Wrench{};
   ++steps_;
   publishSnapshot(false);
+  if (neighbors_enabled_) rebuildNeighborIndex();
   timing.snapshot = since(t);
 
   const std::size_t n = artifacts_.size();

@@ -34,3 +34,7 @@ ImuMeasurement::~ImuMeasurement() = default;
 namespace ssx {
 SetpointInterface::~SetpointInterface() = default;
 }  // namespace ssx
+
+namespace ssx {
+RangeMeasurement::~RangeMeasurement() = default;
+}  // namespace ssx

@@ -26,6 +26,7 @@
 #include <ssx/physic_engine.hpp>
 #include <ssx/plugin.hpp>
 #include <ssx/render.hpp>
+#include <ssx/spatial_index.hpp>
 #include <ssx/timing.hpp>
 #include <ssx/types.hpp>
 
@@ -154,6 +155,16 @@ class SSX_EXPORT Environment {
   /// A 64-bit hash (FNV-1a) of every body's pose and velocities, bit for bit, and the time.
   std::uint64_t stateHash() const;
 
+  /// Neighbour queries. A plugin that wants them calls enableNeighborQueries from configure; from
+  /// then on the index of every artifact's first dynamic root position is rebuilt once per step,
+  /// in the snapshot phase (the smallest cell size asked for wins).
+  void enableNeighborQueries(double cell_size);
+  bool neighborQueriesEnabled() const noexcept { return neighbors_enabled_; }
+  /// Appends to `out` the indices of the artifacts (with a dynamic root) whose first root is
+  /// within `radius` of `point`, in ascending order; reads the snapshot's index, so it is safe in
+  /// the parallel phases. Throws if queries were not enabled.
+  void neighbors(const Vec3& point, double radius, std::vector<std::size_t>& out) const;
+
   /// The render nodes of the last frame drawn, posed in the world.
   const std::vector<RenderNode>& renderNodes() const noexcept { return render_items_; }
 
@@ -207,6 +218,11 @@ class SSX_EXPORT Environment {
   std::vector<Artifact*> body_owner_;
   std::vector<PendingError> errors_;  // one per artifact, filled by the parallel phases
   std::vector<RenderNode> render_items_;
+  bool neighbors_enabled_ = false;
+  SpatialIndex neighbor_index_;
+  std::vector<Vec3> neighbor_points_;
+  std::vector<std::size_t> neighbor_ids_;
+  void rebuildNeighborIndex();
   std::uint64_t subscription_sequence_ = 0;
   TimingRecorder timing_;
   LogSink log_;

@@ -8,7 +8,9 @@
 #include <ssx/types.hpp>
 
 #include <array>
+#include <cstddef>
 #include <cstdint>
+#include <vector>
 
 namespace ssx {
 
@@ -30,13 +32,26 @@ struct SSX_EXPORT PoseMeasurement : Measurement {
 /// An inertial measurement: specific force and angular rate in the IMU's frame, after bias, noise,
 /// scale, quantisation and saturation; also as the raw integer counts a microcontroller reads.
 struct SSX_EXPORT ImuMeasurement : Measurement {
-  Vec3 accelerometer = Vec3::Zero();  ///< specific force, m/s^2, IMU frame (reads +g upwards at rest)
-  Vec3 gyroscope = Vec3::Zero();      ///< angular rate, rad/s, IMU frame
+  Vec3 accelerometer = Vec3::Zero();                   ///< specific force, m/s^2, IMU frame (reads +g upwards at rest)
+  Vec3 gyroscope = Vec3::Zero();                       ///< angular rate, rad/s, IMU frame
   std::array<std::int32_t, 3> accelerometer_counts{};  ///< accelerometer / accelerometer_lsb
   std::array<std::int32_t, 3> gyroscope_counts{};      ///< gyroscope / gyroscope_lsb
-  double accelerometer_lsb = 0.0;  ///< m/s^2 per count
-  double gyroscope_lsb = 0.0;      ///< rad/s per count
+  double accelerometer_lsb = 0.0;                      ///< m/s^2 per count
+  double gyroscope_lsb = 0.0;                          ///< rad/s per count
   ~ImuMeasurement() override;
+};
+
+/// What a range sensor sees: other robots and obstacles within its range, nearest first.
+struct SSX_EXPORT RangeMeasurement : Measurement {
+  struct Detection {
+    Vec3 relative = Vec3::Zero();  ///< from the sensor to the robot (or the obstacle's nearest surface point), m
+    double distance = 0.0;         ///< |relative| before noise, m
+    std::size_t artifact = 0;      ///< index of the artifact seen
+    bool obstacle = false;         ///< a static obstacle rather than a robot
+  };
+  bool body_frame = false;  ///< `relative` in the sensor's body frame, else the world frame
+  std::vector<Detection> detections;
+  ~RangeMeasurement() override;
 };
 
 }  // namespace ssx

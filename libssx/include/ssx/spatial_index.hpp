@@ -1,0 +1,42 @@
+#pragma once
+/// @file
+/// A uniform-grid index of points for neighbour queries: rebuilt from scratch each time (cells
+/// sorted by key), queried for everything within a radius. Building is O(n log n) in the points,
+/// a query O(cells probed + points found).
+
+#include <ssx/export.hpp>
+#include <ssx/types.hpp>
+
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+namespace ssx {
+
+class SSX_EXPORT SpatialIndex {
+ public:
+  /// `cell_size` in m; queries are cheapest when it is about the typical query radius.
+  explicit SpatialIndex(double cell_size = 2.0);
+
+  double cellSize() const noexcept { return cell_size_; }
+  /// Replaces the contents: point i gets the id ids[i] (ids.size() == points.size()).
+  void rebuild(const std::vector<Vec3>& points, const std::vector<std::size_t>& ids);
+  /// Appends to `out` the ids of the points within `radius` of `center` (distance <= radius),
+  /// in ascending id order. Safe to call from many threads at once.
+  void query(const Vec3& center, double radius, std::vector<std::size_t>& out) const;
+  std::size_t size() const noexcept { return entries_.size(); }
+
+ private:
+  struct Entry {
+    std::uint64_t key;
+    std::size_t id;
+    Vec3 point;
+  };
+  std::uint64_t key(std::int64_t x, std::int64_t y, std::int64_t z) const;
+  std::int64_t cell(double v) const;
+
+  double cell_size_;
+  std::vector<Entry> entries_;  // sorted by (key, id)
+};
+
+}  // namespace ssx

@@ -1,0 +1,144 @@
+// range: the robots and obstacles around an artifact (ssx::RangeMeasurement), nearest first.
+//
+// Robots come from the environment's neighbour index (its first dynamic root's position);
+// obstacles are the shapes of static artifacts (boxes, spheres, cylinders, capsules; not planes),
+// seen at their nearest surface point.
+//
+// Parameters:
+//   range           m (default 2.5)
+//   frame           world (default) or body: the frame of the relative positions
+//   position_noise  standard deviation per axis of Gaussian noise on each relative position, m (0)
+//   fov_deg         full cone angle around the body x axis; 360 (default) sees all around
+//   max_count       keep at most this many detections, nearest first; 0 (default) keeps all
+//   obstacles       false ignores static obstacles (default true)
+#include <ssx/artifact.hpp>
+#include <ssx/environment.hpp>
+#include <ssx/measurements.hpp>
+#include <ssx/plugin_abi.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+
+namespace ssx::plugins {
+
+namespace {
+
+// a static shape in the world, for nearest-point queries
+struct ObstacleShape {
+  Shape shape;
+  Pose world;  // the shape's frame
+  std::size_t artifact;
+};
+
+// nearest point of a shape's surface (or the point itself when inside) to p
+Vec3 nearestPoint(const ObstacleShape& o, const Vec3& p) {
+  const Vec3 q = o.world.inverse().transformPoint(p);
+  Vec3 n = q;
+  const Shape& s = o.shape;
+  switch (s.kind) {
+    case Shape::Kind::Sphere:
+      if (q.norm() > s.radius) n = q.normalized() * s.radius;
+      break;
+    case Shape::Kind::Box:
+      n = q.cwiseMax(-s.size / 2).cwiseMin(s.size / 2);
+      break;
+    case Shape::Kind::Cylinder: {
+      n.z() = std::clamp(q.z(), -s.length / 2, s.length / 2);
+      const double r = std::hypot(q.x(), q.y());
+      if (r > s.radius) n.head<2>() = q.head<2>() * (s.radius / r);
+      break;
+    }
+    case Shape::Kind::Capsule: {
+      const Vec3 axis(0, 0, std::clamp(q.z(), -s.length / 2, s.length / 2));
+      const Vec3 d = q - axis;
+      if (d.norm() > s.radius) n = axis + d.normalized() * s.radius;
+      break;
+    }
+    case Shape::Kind::Plane:
+      break;
+  }
+  return o.world.transformPoint(n);
+}
+
+}  // namespace
+
+class RangeSensor final : public SensorOf<RangeMeasurement> {
+ public:
+  void configure(const Descriptor& params) override {
+    range_ = params.getPositive("range", 2.5);
+    const std::string frame = params.get<std::string>("frame", "world");
+    if (frame != "world" && frame != "body") throw params.error(*params.find("frame"), "frame must be world or body");
+    output().body_frame = frame == "body";
+    noise_ = params.get<double>("position_noise", 0.0);
+    if (noise_ < 0) throw params.error(*params.find("position_noise"), "position_noise must not be negative");
+    const double fov = params.get<double>("fov_deg", 360.0);
+    if (!(fov > 0 && fov <= 360)) throw params.error(*params.find("fov_deg"), "fov_deg must be in (0, 360]");
+    cos_half_fov_ = fov >= 360 ? -2.0 : std::cos(fov / 2 * std::numbers::pi / 180.0);
+    const auto max_count = params.get<std::int64_t>("max_count", 0);
+    if (max_count < 0) throw params.error(*params.find("max_count"), "max_count must not be negative");
+    max_count_ = static_cast<std::size_t>(max_count);
+    if (artifact().rootCount() == 0 || artifact().root().isStatic())
+      throw params.error("a range sensor needs a dynamic root");
+
+    Environment& env = environment();
+    env.enableNeighborQueries(range_);
+    if (params.get<bool>("obstacles", true)) {
+      for (std::size_t i = 0; i < env.artifactCount(); ++i) {
+        const Artifact& a = env.artifact(i);
+        for (const auto& node : a.nodes()) {
+          if (!node->isStatic()) continue;
+          for (const Shape& s : node->spec().shapes)
+            if (s.kind != Shape::Kind::Plane) obstacles_.push_back({s, node->pose() * s.pose, i});
+        }
+      }
+    }
+  }
+
+  void sense(const StepInfo& info) override {
+    RangeMeasurement& m = output();
+    m.stamp = info.time;
+    m.detections.clear();
+    const Pose self = artifact().root().pose();
+    const Quat to_body = self.orientation.conjugate();
+    auto visible = [&](const Vec3& rel) {
+      if (cos_half_fov_ < -1.0) return true;
+      const double d = rel.norm();
+      return d > 0 && (to_body * rel).x() / d >= cos_half_fov_;
+    };
+    // robots
+    found_.clear();
+    environment().neighbors(self.position, range_, found_);
+    for (std::size_t j : found_) {
+      if (j == artifact().index()) continue;
+      const Vec3 rel = environment().artifact(j).root().pose().position - self.position;
+      if (visible(rel)) m.detections.push_back({rel, rel.norm(), j, false});
+    }
+    // obstacles, at their nearest point
+    for (const auto& o : obstacles_) {
+      const Vec3 rel = nearestPoint(o, self.position) - self.position;
+      const double d = rel.norm();
+      if (d <= range_ && visible(rel)) m.detections.push_back({rel, d, o.artifact, true});
+    }
+    std::sort(m.detections.begin(), m.detections.end(), [](const auto& a, const auto& b) {
+      return a.distance != b.distance ? a.distance < b.distance : a.artifact < b.artifact;
+    });
+    if (max_count_ > 0 && m.detections.size() > max_count_) m.detections.resize(max_count_);
+    // frame and noise, drawn in a fixed order
+    for (auto& d : m.detections) {
+      if (noise_ > 0)
+        for (int k = 0; k < 3; ++k) d.relative[k] += noise_ * random().normal();
+      if (m.body_frame) d.relative = to_body * d.relative;
+    }
+  }
+
+ private:
+  double range_ = 2.5, noise_ = 0, cos_half_fov_ = -2;
+  std::size_t max_count_ = 0;
+  std::vector<ObstacleShape> obstacles_;
+  std::vector<std::size_t> found_;
+};
+
+}  // namespace ssx::plugins
+
+SSX_PLUGIN(SSX_SENSOR(ssx::plugins::RangeSensor, "range"));

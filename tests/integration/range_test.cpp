@@ -1,0 +1,98 @@
+// The range sensor in a scene: robots from the environment's neighbour index, obstacles at their
+// nearest surface point, field of view, count limit, frames.
+#include <ssx/ssx.hpp>
+
+#include <catch2/catch.hpp>
+
+#include <algorithm>
+#include <filesystem>
+
+using namespace ssx;
+
+namespace {
+
+Scene rangeScene(const std::string& sensor_attributes, std::uint64_t seed = 1) {
+  const std::string xml = R"(<scene><environment timestep="0.01" seed=")" + std::to_string(seed) + R"("/>
+    <physics gravity="0 0 0"/>
+    <type name="dot" file="dot.xml"/>
+    <obstacle name="pillar" xyz="0 3 0"><cylinder radius="0.5" length="4"/></obstacle>
+    <artifact name="me" type="dot" rpy="0 0 1.5707963267948966"><sensor index="0" )" +
+                          sensor_attributes + R"(/></artifact>
+    <artifact name="east" type="dot" xyz="2 0 0"/>
+    <artifact name="west" type="dot" xyz="-1 0 0"/>
+    <artifact name="north" type="dot" xyz="0 1.5 0"/>
+    <artifact name="far" type="dot" xyz="10 0 0"/>
+  </scene>)";
+  return loadSceneFromString(xml, "range.xml", std::filesystem::path(SSX_TEST_DATA_DIR) / "valid");
+}
+
+const RangeMeasurement& seen(Environment& env) {
+  return dynamic_cast<const RangeMeasurement&>(env.findArtifact("me")->sensor(0).latest());
+}
+
+std::vector<std::string> names(Environment& env) {
+  std::vector<std::string> out;
+  for (const auto& d : seen(env).detections) out.push_back(env.artifact(d.artifact).name() + (d.obstacle ? "*" : ""));
+  return out;
+}
+
+}  // namespace
+
+TEST_CASE("the range sensor sees robots and obstacles within range, nearest first", "[range]") {
+  Scene s = rangeScene(R"(range="2.6")");
+  Environment& env = *s.environment;
+  env.step();
+  // west 1 m, north 1.5 m, east 2 m, the pillar's surface 2.5 m away; far and itself are not seen
+  CHECK(names(env) == std::vector<std::string>{"west", "north", "east", "pillar*"});
+  const auto& d = seen(env).detections;
+  CHECK(d[3].relative.isApprox(Vec3(0, 2.5, 0)));
+  CHECK(d[3].distance == Approx(2.5));
+  CHECK(d[0].relative.isApprox(Vec3(-1, 0, 0)));
+}
+
+TEST_CASE("field of view, count limit and body frame", "[range]") {
+  // "me" faces +y (yaw 90 deg): a 90 degree cone sees north and the pillar only
+  Scene cone = rangeScene(R"(range="2.6" fov_deg="90" frame="body")");
+  cone.environment->step();
+  CHECK(names(*cone.environment) == std::vector<std::string>{"north", "pillar*"});
+  // in the body frame, straight ahead is +x
+  CHECK(seen(*cone.environment).detections[0].relative.isApprox(Vec3(1.5, 0, 0), 1e-9));
+
+  Scene nearest = rangeScene(R"(range="5" max_count="2" obstacles="false")");
+  nearest.environment->step();
+  CHECK(names(*nearest.environment) == std::vector<std::string>{"west", "north"});
+}
+
+TEST_CASE("range noise repeats with the seed", "[range]") {
+  auto first = [](std::uint64_t seed) {
+    Scene s = rangeScene(R"(range="3" position_noise="0.05")", seed);
+    s.environment->step();
+    return seen(*s.environment).detections[0].relative;
+  };
+  CHECK(first(3) == first(3));
+  CHECK(first(3) != first(4));
+  CHECK((first(3) - Vec3(-1, 0, 0)).norm() < 0.3);
+}
+
+TEST_CASE("neighbour queries need to be enabled and follow the robots", "[range]") {
+  Environment env;
+  PhysicNodeSpec body;
+  body.name = "body";
+  body.mass = 1;
+  body.shapes.push_back(Shape::sphere(0.1));
+  env.addArtifact("a", {Vec3(0, 0, 10), Quat::Identity()}).addPhysicRoot(body);
+  env.addArtifact("b", {Vec3(1, 0, 10), Quat::Identity()}).addPhysicRoot(body);
+  env.start();
+  std::vector<std::size_t> out;
+  CHECK_THROWS_WITH(env.neighbors(Vec3::Zero(), 1.0, out), Catch::Contains("enableNeighborQueries"));
+  env.enableNeighborQueries(1.0);
+  env.neighbors(Vec3(0, 0, 10), 1.5, out);
+  CHECK(out == std::vector<std::size_t>{0, 1});
+  env.step(1000);  // both fall 4.9 m in 1 s: the index moves with them
+  out.clear();
+  env.neighbors(Vec3(0, 0, 10), 0.3, out);
+  CHECK(out.empty());
+  out.clear();
+  env.neighbors(env.findArtifact("a")->pose().position, 0.3, out);
+  CHECK(out == std::vector<std::size_t>{0});
+}

@@ -1,0 +1,44 @@
+#include <ssx/random.hpp>
+#include <ssx/spatial_index.hpp>
+
+#include <catch2/catch.hpp>
+
+#include <vector>
+
+using namespace ssx;
+
+TEST_CASE("neighbour queries return exactly what a brute-force search returns", "[spatial]") {
+  Random r(17);
+  for (double cell : {0.5, 2.0, 7.0}) {
+    for (int n : {0, 1, 50, 3000}) {
+      std::vector<Vec3> points;
+      std::vector<std::size_t> ids;
+      for (int i = 0; i < n; ++i) {
+        // a cloud around the origin, with a dense clump and some duplicates
+        Vec3 p(r.uniform(-30, 30), r.uniform(-30, 30), r.uniform(-5, 10));
+        if (i % 7 == 0) p = Vec3(r.uniform(-1, 1), r.uniform(-1, 1), r.uniform(-1, 1));
+        if (i % 13 == 0 && i > 0) p = points.back();
+        points.push_back(p);
+        ids.push_back(static_cast<std::size_t>(i) * 3 + 1);  // ids need not be positions
+      }
+      SpatialIndex index(cell);
+      index.rebuild(points, ids);
+      CHECK(index.size() == points.size());
+      for (int q = 0; q < 200; ++q) {
+        const Vec3 c(r.uniform(-35, 35), r.uniform(-35, 35), r.uniform(-8, 12));
+        const double radius = q % 10 == 0 ? 0.0 : r.uniform(0.1, 12.0);
+        std::vector<std::size_t> got{999999};  // the index appends
+        index.query(c, radius, got);
+        std::vector<std::size_t> expected{999999};
+        for (std::size_t i = 0; i < points.size(); ++i)
+          if ((points[i] - c).squaredNorm() <= radius * radius) expected.push_back(ids[i]);
+        REQUIRE(got == expected);
+      }
+    }
+  }
+}
+
+TEST_CASE("the spatial index refuses a non-positive cell size", "[spatial]") {
+  CHECK_THROWS(SpatialIndex(0.0));
+  CHECK_THROWS(SpatialIndex(-1.0));
+}
