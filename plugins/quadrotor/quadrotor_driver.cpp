@@ -147,12 +147,39 @@ void QuadrotorDriver::configure(const Descriptor& params) {
   } else if (source == "eight_horizontal" || source == "eight_vertical") {
     source_ = Source::Eight;
     eight_.vertical = source == "eight_vertical";
+  } else if (source == "formation") {
+    source_ = Source::Formation;
+    formation_.size =
+        static_cast<std::size_t>(std::max<std::int64_t>(1, params.get<std::int64_t>("formation_size", 70)));
+    const auto index = params.get<std::int64_t>("formation_index", 0);
+    if (index < 0 || static_cast<std::size_t>(index) >= formation_.size || static_cast<std::size_t>(index) > a.index())
+      throw params.error("formation_index must be in [0, formation_size) and the members one swarm");
+    formation_index_ = static_cast<std::size_t>(index);
+    formation_base_ = a.index() - formation_index_;
+    formation_.radius = positive(params, "formation_radius", formation_.radius);
+    formation_.center = params.get<Vec3>("formation_center", formation_.center);
+    formation_.gain = positive(params, "formation_gain", formation_.gain);
+    formation_.max_speed = positive(params, "formation_max_speed", formation_.max_speed);
+    formation_.anchor_gain = nonNegative(params, "formation_anchor_gain", formation_.anchor_gain);
+    formation_.obstacle_distance = positive(params, "obstacle_distance", formation_.obstacle_distance);
+    formation_.obstacle_saturation = positive(params, "obstacle_saturation", formation_.obstacle_saturation);
+    bool have_range = false;
+    for (std::size_t i = 0; i < a.sensorCount(); ++i) {
+      const Sensor& s = a.sensor(i);
+      if (dynamic_cast<const RangeMeasurement*>(&s.latest()) == nullptr) continue;
+      env.subscribe<RangeMeasurement>(s, a, [this](const RangeMeasurement& m) { seen_ = m.detections; });
+      have_range = true;
+      break;
+    }
+    if (!have_range) throw params.error("reference=\"formation\" needs a range sensor on the artifact");
+    virtual_point_ = start + params.get<Vec3>("offset", Vec3::Zero());
   } else if (source == "external") {
     source_ = Source::External;
     external_ = hover_;
   } else {
-    throw params.error(*params.find("reference"),
-                       "unknown reference '" + source + "' (hover, eight_horizontal, eight_vertical, external)");
+    throw params.error(
+        *params.find("reference"),
+        "unknown reference '" + source + "' (hover, eight_horizontal, eight_vertical, external, formation)");
   }
   current_ = reference(0.0);
 
@@ -172,6 +199,12 @@ Setpoint QuadrotorDriver::reference(double t) const {
       return hover_;
     case Source::External:
       return external_;
+    case Source::Formation: {
+      Setpoint s;
+      s.position = virtual_point_;
+      s.velocity = virtual_velocity_;
+      return s;
+    }
     case Source::Eight: {
       // hold the curve's start until start_time, then fly it
       if (t < start_time_) {
@@ -197,6 +230,8 @@ void QuadrotorDriver::step(const StepInfo& info) {
   PhysicNode& body = artifact().root();
   // outer loop: position (motion capture or ground truth) to attitude and thrust
   if (info.step % outer_steps_ == 0) {
+    // the formation starts after start_time; until then the vehicle climbs to its start + offset
+    if (source_ == Source::Formation && toSeconds(info.time) >= start_time_) formationStep(outer_dt_);
     current_ = reference(toSeconds(info.time));
     BodyState truth;
     if (!have_pose_) truth = artifact().state();
@@ -228,6 +263,52 @@ void QuadrotorDriver::step(const StepInfo& info) {
   rotors_->wrench(to_body * v_com, to_body * s.angular_velocity, force, torque);
   body.addForce(force, Frame::Local, com_in_root_, Frame::Local);
   body.addTorque(torque, Frame::Local);
+}
+
+// the formation's virtual point: v = gain sum_j g(d_ij, d*_ij) u_ij + repulsion from whatever is too
+// close + a pull towards the own target, then no approach towards anything inside its safety
+// distance, saturated; integrated at the position loop's rate
+void QuadrotorDriver::formationStep(double dt) {
+  const Formation& f = formation_;
+  Vec3 v = Vec3::Zero();
+  const Vec3 own_target = f.target(formation_index_);
+  for (const auto& d : seen_) {
+    if (d.distance <= 1e-9) continue;
+    const Vec3 away = -d.relative / d.relative.norm();  // u_ij, from the neighbour to this robot
+    if (d.obstacle) {
+      v += 2.0 * f.max_speed * f.obstacleGradient(d.distance) * away;
+      continue;
+    }
+    // every robot close by is kept clear of; members are also held at their desired distance
+    v += f.max_speed * f.clearanceGradient(d.relative.norm()) * away;
+    if (d.artifact < formation_base_ || d.artifact >= formation_base_ + f.size) continue;
+    const double d_star = (own_target - f.target(d.artifact - formation_base_)).norm();
+    v += f.gain * f.pairGradient(d.relative.norm(), d_star) * away;
+  }
+  // v_cmd: each member knows its own place on the sphere, capped at half the top speed
+  const BodyState s = artifact().state();
+  Vec3 anchor = f.anchor_gain * (own_target - s.pose.position);
+  if (anchor.norm() > 0.5 * f.max_speed) anchor *= 0.5 * f.max_speed / anchor.norm();
+  v += anchor;
+  // never approach an obstacle or robot inside its safety distance (fully inside the saturation
+  // distance, partly on the way there)
+  for (const auto& d : seen_) {
+    const double dist = d.relative.norm();
+    if (dist <= 1e-9) continue;
+    const double outer = d.obstacle ? f.obstacle_distance : f.clearance;
+    const double inner = d.obstacle ? f.obstacle_saturation : 0.6 * f.clearance;
+    if (dist >= outer) continue;
+    const Vec3 toward = d.relative / dist;
+    const double approach = v.dot(toward);
+    if (approach <= 0) continue;
+    const double weight = std::clamp((outer - dist) / (outer - inner), 0.0, 1.0);
+    v -= weight * approach * toward;
+  }
+  if (v.norm() > f.max_speed) v *= f.max_speed / v.norm();
+  // the virtual point stays close to the vehicle (a short leash: the velocity feed-forward does the
+  // driving, so a stop in v is a stop of the vehicle)
+  virtual_velocity_ = v;
+  virtual_point_ = s.pose.position + (virtual_point_ - s.pose.position).cwiseMin(0.15).cwiseMax(-0.15) + v * dt;
 }
 
 }  // namespace ssx::quadrotor

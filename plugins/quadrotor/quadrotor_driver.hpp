@@ -13,10 +13,14 @@
 //   attitude_kp, attitude_kd, yaw_rate_kp, max_angular_acceleration, filter_gyro_weight
 //   position_kp, position_kd, position_ki ("x y z"), integral_limit, max_tilt_deg, max_thrust
 //   controller_mass    the mass the controller assumes (default: the model's)
-//   reference          hover (default), eight_horizontal, eight_vertical, external
+//   reference          hover (default), eight_horizontal, eight_vertical, external, formation
 //   target / offset    hover point, or the start plus offset (default 0 0 0)
 //   center, amplitude, period, yaw_rate, start_time   figure eight (center default: the start
 //                      plus center_offset; before start_time the vehicle holds the centre)
+//   formation_index, formation_size, formation_radius, formation_center, formation_gain,
+//   formation_max_speed, formation_anchor_gain, obstacle_distance, obstacle_saturation
+//                      formation on a sphere; needs a `range` sensor; the members must be one
+//                      swarm (consecutive artifacts), member i at artifact index (own - own i + i)
 //
 // Needs a sensor producing ssx::ImuMeasurement on the artifact (the `imu` plugin). Uses the first
 // sensor producing ssx::PoseMeasurement (a motion-capture stand-in) for position and velocity,
@@ -52,7 +56,13 @@ class QuadrotorDriver final : public Driver, public SetpointInterface {
   std::vector<double> commanded_speeds_;
   std::int64_t inner_steps_ = 1, outer_steps_ = 10;
   double outer_dt_ = 0.02;
-  enum class Source { Hover, Eight, External } source_ = Source::Hover;
+  enum class Source { Hover, Eight, External, Formation } source_ = Source::Hover;
+  void formationStep(double dt);
+  Formation formation_;
+  std::size_t formation_index_ = 0, formation_base_ = 0;
+  Vec3 virtual_point_ = Vec3::Zero();
+  Vec3 virtual_velocity_ = Vec3::Zero();
+  std::vector<RangeMeasurement::Detection> seen_;
   Setpoint hover_;
   Setpoint external_;
   FigureEight eight_;

@@ -310,4 +310,42 @@ Setpoint FigureEight::at(double t) const {
   return sp;
 }
 
+// --- formation -----------------------------------------------------------------------------------
+
+namespace {
+// cot(pi/2 x) for x in (0, 1], saturated near 0
+double cotHalfPi(double x) {
+  const double a = std::numbers::pi / 2 * std::max(x, 1e-3);
+  return std::cos(a) / std::sin(a);
+}
+}  // namespace
+
+Vec3 Formation::target(std::size_t i) const {
+  const double n = static_cast<double>(size);
+  const double z = 1.0 - 2.0 * (static_cast<double>(i) + 0.5) / n;
+  const double r = std::sqrt(std::max(0.0, 1.0 - z * z));
+  const double theta = static_cast<double>(i) * std::numbers::pi * (3.0 - std::sqrt(5.0));
+  return center + radius * Vec3(r * std::cos(theta), r * std::sin(theta), z);
+}
+
+double Formation::clearanceGradient(double d) const {
+  return d < clearance ? std::min(cotHalfPi(d / clearance), 1.0) : 0.0;
+}
+
+double Formation::pairGradient(double d, double d_star) const {
+  double g = 0;
+  if (d < d_star) {
+    g = cotHalfPi(d / d_star);  // 0 at d*, growing without bound towards contact
+  } else if (d_star < sensing_range && d < sensing_range) {
+    g = -cotHalfPi(1.0 - (d - d_star) / (sensing_range - d_star));  // 0 at d*, growing towards R_s
+  }
+  return std::clamp(g, -1.0, 1.0);
+}
+
+double Formation::obstacleGradient(double d) const {
+  if (d >= obstacle_distance) return 0.0;
+  const double x = (d - obstacle_saturation) / (obstacle_distance - obstacle_saturation);
+  return std::min(cotHalfPi(x), 1.0);
+}
+
 }  // namespace ssx::quadrotor

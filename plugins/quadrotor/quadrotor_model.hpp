@@ -206,4 +206,30 @@ struct FigureEight {
   Setpoint at(double t) const;
 };
 
+/// Formation control on a sphere (spec section 6): Fibonacci-sphere targets, and a velocity
+/// reference from C1 cotangent-shaped potentials over the neighbours a range sensor reports.
+struct Formation {
+  std::size_t size = 70;             ///< N
+  double radius = 4.0;               ///< R, m
+  Vec3 center{0, 0, 5};              ///< m
+  double sensing_range = 2.5;        ///< R_s, m: neighbours beyond it are not attracted
+  double clearance = 1.4;            ///< m: any two robots closer than this repel (below the sphere's 1.48 m spacing)
+  double gain = 0.2;                 ///< m/s per unit of the shape potentials' gradient
+  double max_speed = 1.0;            ///< m/s, of the virtual point
+  double anchor_gain = 0.5;          ///< 1/s, pull towards the robot's own target (v_cmd)
+  double obstacle_distance = 0.5;    ///< m: obstacles repel inside it
+  double obstacle_saturation = 0.2;  ///< m: the repulsion is saturated inside it
+
+  /// Target of member i: z_i = 1 - 2 (i + 0.5) / N, r_i = sqrt(1 - z_i^2), theta_i = i pi (3 - sqrt 5).
+  Vec3 target(std::size_t i) const;
+  /// Gradient between two members at distance d whose desired distance is d_star, in [-1, 1]:
+  /// > 0 pushes apart (d < d*), < 0 pulls together (d* < d < R_s), 0 at d = d*, C1 there.
+  double pairGradient(double d, double d_star) const;
+  /// Repulsion between any two robots at distance d, in [0, 1]: 0 beyond `clearance`.
+  double clearanceGradient(double d) const;
+  /// Repulsion from an obstacle at distance d, in [0, 1]: 0 beyond obstacle_distance, 1 inside
+  /// obstacle_saturation.
+  double obstacleGradient(double d) const;
+};
+
 }  // namespace ssx::quadrotor

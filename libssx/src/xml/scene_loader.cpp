@@ -210,8 +210,8 @@ class SceneLoader {
   void buildObstacle(Environment& env, const Descriptor& d);
   void buildSwarm(Environment& env, const Descriptor& d, std::size_t swarm_index);
   void place(Environment& env, const std::string& name, const std::string& type, const Pose& pose,
-             const Descriptor& element);
-  Descriptor withOverrides(const PluginDecl& decl, const Descriptor* overrides);
+             const Descriptor& element, const std::string& index = {});
+  Descriptor withOverrides(const PluginDecl& decl, const Descriptor* overrides, const std::string& index);
   template <class T, class Create>
   T* createPlugin(const PluginDecl& decl, Create create);
 
@@ -555,18 +555,23 @@ T* SceneLoader::createPlugin(const PluginDecl& decl, Create create) {
 }
 
 // the type's plugin parameters, with those given on the scene's <artifact> or <swarm> on top
-Descriptor SceneLoader::withOverrides(const PluginDecl& decl, const Descriptor* overrides) {
+Descriptor SceneLoader::withOverrides(const PluginDecl& decl, const Descriptor* overrides, const std::string& index) {
   if (overrides == nullptr) return decl.params;
   Descriptor params = decl.params;
   for (const auto& a : overrides->attributes()) {
     if (a.key == "index") continue;
-    params.set(a.key, a.value, a.where);
+    // in a swarm, {i} in a value is the member's index
+    std::string value = a.value;
+    if (!index.empty())
+      for (auto at = value.find("{i}"); at != std::string::npos; at = value.find("{i}", at + index.size()))
+        value.replace(at, 3, index);
+    params.set(a.key, value, a.where);
   }
   return params;
 }
 
 void SceneLoader::place(Environment& env, const std::string& name, const std::string& type_name, const Pose& pose,
-                        const Descriptor& element) {
+                        const Descriptor& element, const std::string& index) {
   const SourceLocation& where = element.where();
   const ArtifactType* type = artifactType(type_name, where);
   if (env.findArtifact(name) != nullptr) {
@@ -597,13 +602,13 @@ void SceneLoader::place(Environment& env, const std::string& name, const std::st
     const PluginDecl& decl = *type->driver;
     auto create = [&](std::string_view p, std::string_view c) -> Driver& { return loader.createDriver(p, c); };
     if (Driver* d = createPlugin<Driver>(decl, create))
-      a.setDriver(*d, withOverrides(decl, driver_override), decl.period, decl.class_name);
+      a.setDriver(*d, withOverrides(decl, driver_override, index), decl.period, decl.class_name);
   }
   for (std::size_t i = 0; i < type->sensors.size(); ++i) {
     const PluginDecl& decl = type->sensors[i];
     auto create = [&](std::string_view p, std::string_view c) -> Sensor& { return loader.createSensor(p, c); };
     if (Sensor* s = createPlugin<Sensor>(decl, create))
-      a.addSensor(*s, withOverrides(decl, sensor_overrides[i]), decl.period, decl.class_name);
+      a.addSensor(*s, withOverrides(decl, sensor_overrides[i], index), decl.period, decl.class_name);
   }
 }
 
@@ -662,9 +667,23 @@ void SceneLoader::buildSwarm(Environment& env, const Descriptor& d, std::size_t 
     const Vec3 hi = read<Vec3>(d, "max", Vec3(1, 1, 1));
     if (!(lo.array() <= hi.array()).all()) error(d.where(), "<swarm>: every component of 'min' must be <= 'max'");
     // a stream of its own, from the scene seed and the swarm's position among the swarms
+    const double min_distance = read<double>(d, "min_distance", 0.0);
     Random rng(deriveSeed(settings_.seed, 0xa11ce5ULL, swarm_index));
-    for (std::int64_t i = 0; i < count; ++i)
-      positions.emplace_back(rng.uniform(lo.x(), hi.x()), rng.uniform(lo.y(), hi.y()), rng.uniform(lo.z(), hi.z()));
+    // rejection sampling keeps members at least min_distance apart; give up after many misses
+    const std::int64_t max_tries = 1000 * count;
+    std::int64_t tries = 0;
+    while (static_cast<std::int64_t>(positions.size()) < count && tries++ < max_tries) {
+      const double x = rng.uniform(lo.x(), hi.x()), y = rng.uniform(lo.y(), hi.y()), z = rng.uniform(lo.z(), hi.z());
+      const Vec3 p(x, y, z);
+      bool ok = true;
+      for (const Vec3& q : positions) ok = ok && (p - q).norm() >= min_distance;
+      if (ok) positions.push_back(p);
+    }
+    if (static_cast<std::int64_t>(positions.size()) < count) {
+      error(d.where(), "<swarm>: could not place " + std::to_string(count) + " members " +
+                           std::to_string(min_distance) + " m apart in the box: enlarge it or lower min_distance");
+      positions.resize(static_cast<std::size_t>(count), Vec3::Zero());
+    }
   } else {
     // Fibonacci sphere: z_i = 1 - 2 (i + 0.5) / N, theta_i = i pi (3 - sqrt 5)
     const double radius = readPositive(d, "radius", 1.0);
@@ -688,7 +707,7 @@ void SceneLoader::buildSwarm(Environment& env, const Descriptor& d, std::size_t 
       name.replace(at, 3, index);
     Pose pose = origin;
     pose.position = origin.transformPoint(positions[static_cast<std::size_t>(i)]);
-    place(env, name, type, pose, d);
+    place(env, name, type, pose, d, index);
     if (errorCount() != errors_before) return;  // one report per swarm, not one per robot
   }
 }
