@@ -12,6 +12,7 @@
 #include <numbers>
 #include <set>
 #include <sstream>
+#include <unordered_map>
 
 namespace ssx {
 
@@ -669,15 +670,30 @@ void SceneLoader::buildSwarm(Environment& env, const Descriptor& d, std::size_t 
     // a stream of its own, from the scene seed and the swarm's position among the swarms
     const double min_distance = read<double>(d, "min_distance", 0.0);
     Random rng(deriveSeed(settings_.seed, 0xa11ce5ULL, swarm_index));
-    // rejection sampling keeps members at least min_distance apart; give up after many misses
+    // rejection sampling keeps members at least min_distance apart (a grid of that cell size finds
+    // the candidates' neighbours); give up after many misses
     const std::int64_t max_tries = 1000 * count;
     std::int64_t tries = 0;
+    const double cell = min_distance > 0 ? min_distance : 1.0;
+    std::unordered_map<std::int64_t, std::vector<std::size_t>> grid;
+    auto cellKey = [&](std::int64_t x, std::int64_t y, std::int64_t z) {
+      return (x * 73856093) ^ (y * 19349663) ^ (z * 83492791);
+    };
     while (static_cast<std::int64_t>(positions.size()) < count && tries++ < max_tries) {
       const double x = rng.uniform(lo.x(), hi.x()), y = rng.uniform(lo.y(), hi.y()), z = rng.uniform(lo.z(), hi.z());
       const Vec3 p(x, y, z);
+      const auto cx = static_cast<std::int64_t>(std::floor(x / cell)),
+                 cy = static_cast<std::int64_t>(std::floor(y / cell)),
+                 cz = static_cast<std::int64_t>(std::floor(z / cell));
       bool ok = true;
-      for (const Vec3& q : positions) ok = ok && (p - q).norm() >= min_distance;
-      if (ok) positions.push_back(p);
+      for (std::int64_t dx = -1; dx <= 1 && ok && min_distance > 0; ++dx)
+        for (std::int64_t dy = -1; dy <= 1 && ok; ++dy)
+          for (std::int64_t dz = -1; dz <= 1 && ok; ++dz)
+            if (const auto it = grid.find(cellKey(cx + dx, cy + dy, cz + dz)); it != grid.end())
+              for (std::size_t q : it->second) ok = ok && (p - positions[q]).norm() >= min_distance;
+      if (!ok) continue;
+      grid[cellKey(cx, cy, cz)].push_back(positions.size());
+      positions.push_back(p);
     }
     if (static_cast<std::int64_t>(positions.size()) < count) {
       error(d.where(), "<swarm>: could not place " + std::to_string(count) + " members " +

@@ -1,0 +1,149 @@
+// ssx_rt_study: the paper's real-time study (section 3.2, Fig. 5).
+//
+// For each N, a scene of N quadrotors with the full stack per robot (quadrotor driver with motor
+// model and both control loops, IMU, pose and range sensors, formation with obstacle avoidance)
+// runs in real time at tau = 0.02 s and records the compute time of every step. The formation's
+// radius grows with sqrt(N) so that the spacing stays about 1.5 m. Prints, last for each N:
+//   n=1000 samples=5000 median_ms=1.23 p95_ms=1.50 p99_ms=1.80 max_ms=4.00 overruns=0
+//
+// usage: ssx_rt_study [--n N]... [--samples K] [--threads T] [--physics-hz H] [--tau S] [--csv FILE]
+//                     [--fast]
+//   --physics-hz  physics rate (default 1/tau: one physics step per tau, as the paper). When it is
+//                 faster than 1/tau the environment steps at it, the inner loop runs at
+//                 min(500 Hz, H), and one sample is the compute time of the steps of one tau
+//   --fast        do not pace against the wall clock (for tests; overruns are then not measured)
+#include <ssx/ssx.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <fstream>
+#include <string>
+#include <vector>
+
+namespace {
+
+struct Options {
+  std::vector<int> sizes;
+  int samples = 5000;
+  int threads = 0;
+  double tau = 0.02;
+  double physics_hz = 0;  // 0: 1/tau
+  std::string csv;
+  bool fast = false;
+};
+
+// the scene for N robots: the environment steps at the physics rate when it is faster than 1/tau
+std::string sceneFor(int n, const Options& o) {
+  const double physics_hz = o.physics_hz > 0 ? o.physics_hz : 1.0 / o.tau;
+  const double step = std::min(o.tau, 1.0 / physics_hz);
+  const double inner_hz = std::min(500.0, 1.0 / step);
+  const double radius = std::max(1.5, 4.0 * std::sqrt(n / 70.0));
+  const double half = std::max(3.0, 1.6 * radius);
+  char xml[2048];
+  std::snprintf(
+      xml, sizeof xml,
+      "<scene><environment timestep=\"%.6f\" seed=\"5\" threads=\"%s\"/>"
+      "<type name=\"q\" file=\"mk_quad_formation.xml\"/><ground/>"
+      "<obstacle name=\"pillar\" xyz=\"%.3f 0 3\"><cylinder radius=\"0.25\" length=\"6\"/></obstacle>"
+      "<swarm type=\"q\" count=\"%d\" name=\"quad{i}\" layout=\"random\" min=\"%.3f %.3f 0.05\" max=\"%.3f %.3f 0.05\" "
+      "min_distance=\"1.0\"><driver formation_index=\"{i}\" formation_size=\"%d\" formation_radius=\"%.3f\" "
+      "formation_center=\"0 0 %.3f\" inner_rate_hz=\"%.3f\" outer_rate_hz=\"%.3f\" offset=\"0 0 1.5\" "
+      "start_time=\"2\"/><sensor index=\"2\" period=\"%d\"/></swarm></scene>",
+      step, o.threads > 0 ? std::to_string(o.threads).c_str() : "auto", half + 1.5, n, -half, -half, half, half, n,
+      radius, radius + 1.5, inner_hz, std::min(50.0, 1.0 / step),
+      std::max(1, static_cast<int>(std::lround(0.02 / step))));
+  return xml;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  Options o;
+  for (int i = 1; i < argc; ++i) {
+    const std::string a = argv[i];
+    auto value = [&]() -> std::string {
+      if (i + 1 >= argc) throw std::runtime_error(a + " needs a value");
+      return argv[++i];
+    };
+    try {
+      if (a == "--n")
+        o.sizes.push_back(std::stoi(value()));
+      else if (a == "--samples")
+        o.samples = std::stoi(value());
+      else if (a == "--threads")
+        o.threads = std::stoi(value());
+      else if (a == "--physics-hz")
+        o.physics_hz = std::stod(value());
+      else if (a == "--tau")
+        o.tau = std::stod(value());
+      else if (a == "--csv")
+        o.csv = value();
+      else if (a == "--fast")
+        o.fast = true;
+      else
+        throw std::runtime_error("unknown option " + a);
+    } catch (const std::exception& e) {
+      std::fprintf(stderr,
+                   "ssx_rt_study: %s\nusage: ssx_rt_study [--n N]... [--samples K] [--threads T] "
+                   "[--physics-hz H] [--tau S] [--csv FILE] [--fast]\n",
+                   e.what());
+      return 2;
+    }
+  }
+  if (o.sizes.empty()) o.sizes = {1, 10, 20, 30, 40, 50, 60, 70, 80, 90, 100};
+  std::ofstream csv;
+  if (!o.csv.empty()) {
+    csv.open(o.csv);
+    csv << "n,step,total_ns,physics_ns,sensors_ns,drivers_ns,lateness_ns\n";
+  }
+  for (int n : o.sizes) {
+    try {
+      ssx::Scene scene =
+          ssx::loadSceneFromString(sceneFor(n, o), "rt_study.xml", std::string(SSX_EXAMPLES_DIR) + "/artifacts");
+      ssx::Environment& env = *scene.environment;
+      env.setLogSink([](ssx::LogLevel, std::string_view) {});  // overruns are counted, not printed
+      ssx::RunOptions run;
+      run.mode = o.fast ? ssx::RunOptions::Mode::Fast : ssx::RunOptions::Mode::RealTime;
+      // the step at the physics rate; a sample is the compute time of one tau of simulated time
+      const int per_tau = std::max(1, static_cast<int>(std::lround(o.tau / ssx::toSeconds(env.timestep()))));
+      run.steps = static_cast<std::int64_t>(o.samples) * per_tau;
+      env.start();
+      env.run(run);
+      // fold the steps of each tau into one sample
+      const auto& steps = env.timing().samples();
+      std::vector<double> totals;
+      std::int64_t overruns = 0;
+      for (std::size_t k = 0; k + per_tau <= steps.size(); k += per_tau) {
+        ssx::StepTiming sum;
+        for (int j = 0; j < per_tau; ++j) {
+          const auto& s = steps[k + j];
+          sum.total += s.total;
+          sum.physics += s.physics;
+          sum.sensors += s.sensors;
+          sum.drivers += s.drivers;
+          sum.lateness = std::max(sum.lateness, s.lateness);
+        }
+        overruns += sum.lateness > 0 ? 1 : 0;
+        totals.push_back(static_cast<double>(sum.total) * 1e-6);
+        if (csv)
+          csv << n << ',' << k / per_tau << ',' << sum.total << ',' << sum.physics << ',' << sum.sensors << ','
+              << sum.drivers << ',' << sum.lateness << '\n';
+      }
+      std::vector<double> sorted = totals;
+      std::sort(sorted.begin(), sorted.end());
+      auto pct = [&](double p) {
+        const auto r = static_cast<std::size_t>(std::ceil(p / 100.0 * sorted.size()));
+        return sorted[std::min(sorted.size() - 1, r == 0 ? 0 : r - 1)];
+      };
+      std::printf("n=%d samples=%zu median_ms=%.3f p95_ms=%.3f p99_ms=%.3f max_ms=%.3f overruns=%lld\n", n,
+                  sorted.size(), pct(50), pct(95), pct(99), sorted.back(), static_cast<long long>(overruns));
+      std::fflush(stdout);
+    } catch (const std::exception& e) {
+      std::fprintf(stderr, "ssx_rt_study: n=%d: %s\n", n, e.what());
+      return 1;
+    }
+  }
+  return 0;
+}
