@@ -58,8 +58,8 @@ class Progress {
       const double f = static_cast<double>(env.stepCount()) / static_cast<double>(total_);
       const int width = 30;
       const int filled = static_cast<int>(f * width);
-      std::fprintf(stderr, "\r[%.*s%*s] %5.1f%%  t = %.2f s ", filled, "##############################",
-                   width - filled, "", 100.0 * f, t);
+      std::fprintf(stderr, "\r[%.*s%*s] %5.1f%%  t = %.2f s ", filled, "##############################", width - filled,
+                   "", 100.0 * f, t);
     } else {
       std::fprintf(stderr, "\rt = %.2f s (Ctrl-C to stop) ", t);
     }
@@ -74,6 +74,12 @@ class Progress {
   std::int64_t total_;
   std::chrono::steady_clock::time_point last_{};
 };
+
+std::string formatFactor(double f) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%g", f);
+  return buf;
+}
 
 struct RunArgs {
   std::string scene;
@@ -109,7 +115,8 @@ int commandRun(const RunArgs& args, bool realtime_given) {
   if (args.steps >= 0) {
     run.steps = args.steps;
   } else {
-    const ssx::Nanoseconds duration = args.duration > 0 ? ssx::toNanoseconds(args.duration) : scene.duration.value_or(-1);
+    const ssx::Nanoseconds duration =
+        args.duration > 0 ? ssx::toNanoseconds(args.duration) : scene.duration.value_or(-1);
     if (duration > 0) run.steps = (duration + env.timestep() - 1) / env.timestep();
   }
   run.stop = &g_stop;
@@ -125,8 +132,7 @@ int commandRun(const RunArgs& args, bool realtime_given) {
     if (!args.quiet)
       std::cerr << "ssx: " << scene.file.string() << ": " << env.artifactCount() << " artifacts, " << env.threadCount()
                 << " thread(s), timestep " << ssx::toSeconds(env.timestep()) * 1e3 << " ms, "
-                << (args.fast ? std::string("as fast as possible")
-                              : "real time x" + std::to_string(run.realtime_factor))
+                << (args.fast ? std::string("as fast as possible") : "real time x" + formatFactor(run.realtime_factor))
                 << '\n';
     summary = env.run(run);
   } catch (const ssx::ConfigError& e) {
@@ -167,8 +173,8 @@ int commandValidate(const std::string& file, const std::vector<std::string>& plu
   try {
     const ssx::Scene scene = ssx::loadScene(file, options);
     printWarnings(scene);
-    std::cout << file << ": ok: " << scene.environment->artifactCount() << " artifacts, "
-              << scene.warnings.size() << " warning(s)\n";
+    std::cout << file << ": ok: " << scene.environment->artifactCount() << " artifacts, " << scene.warnings.size()
+              << " warning(s)\n";
     return 0;
   } catch (const ssx::SceneError& e) {
     std::cerr << e.what() << '\n';
@@ -200,11 +206,13 @@ int main(int argc, char** argv) {
   RunArgs run;
   CLI::App* run_cmd = app.add_subcommand("run", "run a scene");
   run_cmd->add_option("scene", run.scene, "scene file")->required()->check(CLI::ExistingFile);
-  auto* duration = run_cmd->add_option("--duration", run.duration, "simulated seconds to run")->check(CLI::PositiveNumber);
+  auto* duration =
+      run_cmd->add_option("--duration", run.duration, "simulated seconds to run")->check(CLI::PositiveNumber);
   run_cmd->add_option("--steps", run.steps, "steps to run")->check(CLI::NonNegativeNumber)->excludes(duration);
-  auto* realtime = run_cmd->add_option("--realtime", run.realtime, "pace against the wall clock, optionally FACTOR times faster")
-                       ->expected(0, 1)
-                       ->check(CLI::PositiveNumber);
+  auto* realtime =
+      run_cmd->add_option("--realtime", run.realtime, "pace against the wall clock, optionally FACTOR times faster")
+          ->expected(0, 1)
+          ->check(CLI::PositiveNumber);
   run_cmd->add_flag("--fast", run.fast, "run as fast as possible")->excludes(realtime);
   run_cmd->add_option("--threads", run.threads, "worker threads (0: one per core)")->check(CLI::NonNegativeNumber);
   run_cmd->add_option("--seed", run.seed, "scene seed")->check(CLI::NonNegativeNumber);
@@ -228,7 +236,12 @@ int main(int argc, char** argv) {
     const int code = app.exit(e);
     return code == 0 ? 0 : kExitBadInput;
   }
-  if (*run_cmd) return commandRun(run, realtime->count() > 0);
+  if (*run_cmd) {
+    // --realtime alone means factor 1
+    const bool realtime_given = realtime->count() > 0;
+    if (realtime_given && (realtime->results().empty() || realtime->results().front().empty())) run.realtime = 1.0;
+    return commandRun(run, realtime_given);
+  }
   if (*validate_cmd) return commandValidate(validate_file, validate_path);
   if (*plugins_cmd) return commandPlugins(plugins_path);
   return kExitBadInput;

@@ -173,3 +173,14 @@ TEST_CASE("Ctrl-C stops a real-time run cleanly: summary printed, files closed",
   REQUIRE_FALSE(content.empty());
   CHECK(content.back() == '\n');
 }
+
+TEST_CASE("--realtime without a factor runs at factor 1, with one at that factor", "[cli]") {
+  const std::string scene = (kExamples / "scenes" / "hover_swarm.xml").string();
+  const Result plain = run({"run", scene, "--realtime", "--steps", "50"});
+  CHECK(plain.status == 0);
+  CHECK_THAT(plain.err, Contains("real time x1,") || Contains("real time x1\n"));
+  const Result doubled = run({"run", scene, "--steps", "50", "--realtime", "4"});
+  CHECK(doubled.status == 0);
+  CHECK_THAT(doubled.err, Contains("real time x4"));
+  CHECK_THAT(doubled.out, Contains("steps 50"));
+}
