@@ -174,7 +174,7 @@ TEST_CASE("Ctrl-C stops a real-time run cleanly: summary printed, files closed",
   CHECK(content.back() == '\n');
 }
 
-TEST_CASE("--realtime without a factor runs at factor 1, with one at that factor", "[cli]") {
+TEST_CASE("ssx run: a bare --realtime means factor 1, a given factor is used", "[cli]") {
   const std::string scene = (kExamples / "scenes" / "hover_swarm.xml").string();
   const Result plain = run({"run", scene, "--realtime", "--steps", "50"});
   CHECK(plain.status == 0);
