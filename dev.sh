@@ -40,7 +40,7 @@ build() {
 case "${1:-}" in
   demo)
     build
-    "$build_dir/bin/ssx" run examples/scenes/quad_swarm.xml --realtime
+    "$build_dir/bin/ssx" run examples/scenes/formation_sphere.xml --realtime
     ;;
   test)
     build

@@ -267,7 +267,7 @@ void QuadrotorDriver::step(const StepInfo& info) {
 
 // the formation's virtual point: v = gain sum_j g(d_ij, d*_ij) u_ij + repulsion from whatever is too
 // close + a pull towards the own target, then no approach towards anything inside its safety
-// distance, saturated; integrated at the position loop's rate
+// distance, saturated at a speed that drops in a crowd; integrated at the position loop's rate
 void QuadrotorDriver::formationStep(double dt) {
   const Formation& f = formation_;
   Vec3 v = Vec3::Zero();
@@ -296,7 +296,7 @@ void QuadrotorDriver::formationStep(double dt) {
     const double dist = d.relative.norm();
     if (dist <= 1e-9) continue;
     const double outer = d.obstacle ? f.obstacle_distance : f.clearance;
-    const double inner = d.obstacle ? f.obstacle_saturation : 0.6 * f.clearance;
+    const double inner = d.obstacle ? f.obstacle_saturation : 0.9 * f.clearance;
     if (dist >= outer) continue;
     const Vec3 toward = d.relative / dist;
     const double approach = v.dot(toward);
@@ -304,7 +304,12 @@ void QuadrotorDriver::formationStep(double dt) {
     const double weight = std::clamp((outer - dist) / (outer - inner), 0.0, 1.0);
     v -= weight * approach * toward;
   }
-  if (v.norm() > f.max_speed) v *= f.max_speed / v.norm();
+  // slower in a crowd: full speed with nobody within 2 m, a crawl at 0.7 m
+  double nearest = 1e9;
+  for (const auto& d : seen_)
+    if (!d.obstacle) nearest = std::min(nearest, d.relative.norm());
+  const double speed = f.max_speed * std::clamp((nearest - 0.7) / 1.3, 0.15, 1.0);
+  if (v.norm() > speed) v *= speed / v.norm();
   // the virtual point stays close to the vehicle (a short leash: the velocity feed-forward does the
   // driving, so a stop in v is a stop of the vehicle)
   virtual_velocity_ = v;
