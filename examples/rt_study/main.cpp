@@ -9,8 +9,9 @@
 // usage: ssx_rt_study [--n N]... [--samples K] [--threads T] [--physics-hz H] [--tau S] [--csv FILE]
 //                     [--fast]
 //   --physics-hz  physics rate (default 1/tau: one physics step per tau, as the paper). When it is
-//                 faster than 1/tau the environment steps at it, the inner loop runs at
-//                 min(500 Hz, H), and one sample is the compute time of the steps of one tau
+//                 faster than 1/tau the environment steps at min(H, 500 Hz) with the rest as physics
+//                 substeps, the inner loop runs at that step rate, and one sample is the compute
+//                 time of the steps of one tau
 //   --fast        do not pace against the wall clock (for tests; overruns are then not measured)
 #include <ssx/ssx.hpp>
 
@@ -37,23 +38,28 @@ struct Options {
 // the scene for N robots: the environment steps at the physics rate when it is faster than 1/tau
 std::string sceneFor(int n, const Options& o) {
   const double physics_hz = o.physics_hz > 0 ? o.physics_hz : 1.0 / o.tau;
-  const double step = std::min(o.tau, 1.0 / physics_hz);
+  // plugins step at most at 500 Hz (the inner loop's rate); faster physics runs as substeps
+  const double step = std::min(o.tau, std::max(1.0 / physics_hz, 1.0 / 500.0));
+  const int substeps = std::max(1, static_cast<int>(std::lround(step * physics_hz)));
   const double inner_hz = std::min(500.0, 1.0 / step);
   const double radius = std::max(1.5, 4.0 * std::sqrt(n / 70.0));
   const double half = std::max(3.0, 1.6 * radius);
   char xml[2048];
   std::snprintf(
       xml, sizeof xml,
-      "<scene><environment timestep=\"%.6f\" seed=\"5\" threads=\"%s\"/>"
+      "<scene><environment timestep=\"%.6f\" seed=\"5\" threads=\"%s\"/><physics substeps=\"%d\"/>"
       "<type name=\"q\" file=\"mk_quad_formation.xml\"/><ground/>"
       "<obstacle name=\"pillar\" xyz=\"%.3f 0 3\"><cylinder radius=\"0.25\" length=\"6\"/></obstacle>"
       "<swarm type=\"q\" count=\"%d\" name=\"quad{i}\" layout=\"random\" min=\"%.3f %.3f 0.05\" max=\"%.3f %.3f 0.05\" "
       "min_distance=\"1.0\"><driver formation_index=\"{i}\" formation_size=\"%d\" formation_radius=\"%.3f\" "
       "formation_center=\"0 0 %.3f\" inner_rate_hz=\"%.3f\" outer_rate_hz=\"%.3f\" offset=\"0 0 1.5\" "
-      "start_time=\"2\"/><sensor index=\"2\" period=\"%d\"/></swarm></scene>",
-      step, o.threads > 0 ? std::to_string(o.threads).c_str() : "auto", half + 1.5, n, -half, -half, half, half, n,
-      radius, radius + 1.5, inner_hz, std::min(50.0, 1.0 / step),
-      std::max(1, static_cast<int>(std::lround(0.02 / step))));
+      "start_time=\"2\"/><sensor index=\"0\" period=\"%d\"/><sensor index=\"1\" period=\"%d\"/>"
+      "<sensor index=\"2\" period=\"%d\"/></swarm></scene>",
+      step, o.threads > 0 ? std::to_string(o.threads).c_str() : "auto", substeps, half + 1.5, n, -half, -half, half,
+      half, n, radius, radius + 1.5, inner_hz, std::min(50.0, 1.0 / step),
+      // the IMU at the inner loop's rate, motion capture and the range sensor at the outer loop's
+      std::max(1, static_cast<int>(std::lround(1.0 / (inner_hz * step)))),
+      std::max(1, static_cast<int>(std::lround(0.02 / step))), std::max(1, static_cast<int>(std::lround(0.02 / step))));
   return xml;
 }
 
