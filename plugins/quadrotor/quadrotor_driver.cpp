@@ -1,5 +1,6 @@
 #include "quadrotor_driver.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 #include <sstream>
@@ -156,6 +157,7 @@ void QuadrotorDriver::configure(const Descriptor& params) {
       throw params.error("formation_index must be in [0, formation_size) and the members one swarm");
     formation_index_ = static_cast<std::size_t>(index);
     formation_base_ = a.index() - formation_index_;
+    own_target_ = formation_.target(formation_index_);
     formation_.radius = positive(params, "formation_radius", formation_.radius);
     formation_.center = params.get<Vec3>("formation_center", formation_.center);
     formation_.gain = positive(params, "formation_gain", formation_.gain);
@@ -173,6 +175,7 @@ void QuadrotorDriver::configure(const Descriptor& params) {
     }
     if (!have_range) throw params.error("reference=\"formation\" needs a range sensor on the artifact");
     virtual_point_ = start + params.get<Vec3>("offset", Vec3::Zero());
+    own_target_ = formation_.target(formation_index_);
   } else if (source == "external") {
     source_ = Source::External;
     external_ = hover_;
@@ -268,10 +271,20 @@ void QuadrotorDriver::step(const StepInfo& info) {
 // the formation's virtual point: v = gain sum_j g(d_ij, d*_ij) u_ij + repulsion from whatever is too
 // close + a pull towards the own target, then no approach towards anything inside its safety
 // distance, saturated at a speed that drops in a crowd; integrated at the position loop's rate
+// d* to a member: computed the first time it is seen, then looked up (neighbours change slowly)
+double QuadrotorDriver::desiredDistance(std::size_t member) {
+  auto it = std::lower_bound(desired_distance_.begin(), desired_distance_.end(), member,
+                             [](const auto& e, std::size_t m) { return e.first < m; });
+  if (it != desired_distance_.end() && it->first == member) return it->second;
+  const double d = (own_target_ - formation_.target(member)).norm();
+  desired_distance_.insert(it, {member, d});
+  return d;
+}
+
 void QuadrotorDriver::formationStep(double dt) {
   const Formation& f = formation_;
   Vec3 v = Vec3::Zero();
-  const Vec3 own_target = f.target(formation_index_);
+  const Vec3& own_target = own_target_;
   for (const auto& d : seen_) {
     if (d.distance <= 1e-9) continue;
     const Vec3 away = -d.relative / d.relative.norm();  // u_ij, from the neighbour to this robot
@@ -282,7 +295,7 @@ void QuadrotorDriver::formationStep(double dt) {
     // every robot close by is kept clear of; members are also held at their desired distance
     v += f.max_speed * f.clearanceGradient(d.relative.norm()) * away;
     if (d.artifact < formation_base_ || d.artifact >= formation_base_ + f.size) continue;
-    const double d_star = (own_target - f.target(d.artifact - formation_base_)).norm();
+    const double d_star = desiredDistance(d.artifact - formation_base_);
     v += f.gain * f.pairGradient(d.relative.norm(), d_star) * away;
   }
   // v_cmd: each member knows its own place on the sphere, capped at half the top speed

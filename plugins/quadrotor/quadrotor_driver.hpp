@@ -63,6 +63,9 @@ class QuadrotorDriver final : public Driver, public SetpointInterface {
   Vec3 virtual_point_ = Vec3::Zero();
   Vec3 virtual_velocity_ = Vec3::Zero();
   std::vector<RangeMeasurement::Detection> seen_;
+  Vec3 own_target_ = Vec3::Zero();
+  std::vector<std::pair<std::size_t, double>> desired_distance_;  // member -> d*, sorted; filled as met
+  double desiredDistance(std::size_t member);
   Setpoint hover_;
   Setpoint external_;
   FigureEight eight_;
