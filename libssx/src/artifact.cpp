@@ -94,6 +94,20 @@ PhysicNode* Artifact::node(std::string_view name) const {
   return nullptr;
 }
 
+PhysicNode& Artifact::nodeFromParameter(const Descriptor& params, std::string_view key) const {
+  const std::string name = params.get<std::string>(key, "");
+  if (name.empty()) {
+    if (roots_.empty()) throw params.error("artifact '" + name_ + "' has no physic node");
+    return *roots_.front();
+  }
+  PhysicNode* n = node(name);
+  if (n == nullptr) {
+    const auto* a = params.find(key);
+    throw params.error(*a, "no physic node '" + name + "' in artifact '" + name_ + "'");
+  }
+  return *n;
+}
+
 void Artifact::checkWritable() const {
   if (!detail::PhaseGuard::in_phase || detail::PhaseGuard::writer == this) return;
   const Artifact* w = detail::PhaseGuard::writer;

@@ -115,9 +115,7 @@ Channel accelDefaults() {
 class ImuSensor final : public SensorOf<ImuMeasurement> {
  public:
   void configure(const Descriptor& params) override {
-    const std::string name = params.get<std::string>("node", "");
-    node_ = name.empty() ? &artifact().root() : artifact().node(name);
-    if (node_ == nullptr) throw params.error("no physic node '" + name + "' in artifact '" + artifact().name() + "'");
+    node_ = &artifact().nodeFromParameter(params);
     if (node_->isStatic()) throw params.error("an IMU needs a dynamic node");
     const bool noise = params.get<bool>("noise", true);
     gyro_.read(params, "gyro_", gyroDefaults());

@@ -16,9 +16,7 @@ namespace ssx::plugins {
 class PoseSensor final : public SensorOf<PoseMeasurement> {
  public:
   void configure(const Descriptor& params) override {
-    const std::string name = params.get<std::string>("node", "");
-    node_ = name.empty() ? &artifact().root() : artifact().node(name);
-    if (node_ == nullptr) throw params.error("no physic node '" + name + "' in artifact '" + artifact().name() + "'");
+    node_ = &artifact().nodeFromParameter(params);
     position_noise_ = nonNegative(params, "position_noise");
     orientation_noise_ = nonNegative(params, "orientation_noise");
     velocity_noise_ = nonNegative(params, "velocity_noise");

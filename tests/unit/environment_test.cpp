@@ -387,3 +387,25 @@ TEST_CASE("an extension that throws in a step hook stops the run naming it", "[e
   }
   CHECK(env.state() == Environment::State::Failed);
 }
+
+TEST_CASE("plugins find the node a parameter names, or the first root", "[environment]") {
+  Environment env;
+  PhysicNodeSpec body = test::boxBody(Vec3(0.1, 0.1, 0.1), 1.0);
+  PhysicNodeSpec mount;
+  mount.name = "imu_mount";
+  mount.pose.position = Vec3(0.05, 0, 0);
+  body.addChild(mount);
+  Artifact& a = env.addArtifact("robot");
+  a.addPhysicRoot(body);
+  Descriptor none("sensor", {"robot.xml", 4});
+  CHECK(&a.nodeFromParameter(none) == &a.root());
+  Descriptor named("sensor", {"robot.xml", 4});
+  named.set("node", "imu_mount");
+  CHECK(a.nodeFromParameter(named).name() == "imu_mount");
+  Descriptor wrong("sensor", {"robot.xml", 4});
+  wrong.set("node", "imu_mnt", {"robot.xml", 5});
+  CHECK_THROWS_WITH(a.nodeFromParameter(wrong),
+                    "robot.xml:5: error: <sensor>: no physic node 'imu_mnt' in artifact 'robot'");
+  Artifact& empty = env.addArtifact("logic");
+  CHECK_THROWS_WITH(empty.nodeFromParameter(none), Catch::Contains("has no physic node"));
+}

@@ -69,6 +69,9 @@ class SSX_EXPORT Artifact {
   PhysicNode& root(std::size_t i = 0) const { return *roots_.at(i); }
   /// Node by name, searching every tree; nullptr if none.
   PhysicNode* node(std::string_view name) const;
+  /// The node a plugin parameter names (`key`, default "node"), or the first root when the parameter
+  /// is absent or empty; throws the parameter's ConfigError when there is no such node.
+  PhysicNode& nodeFromParameter(const Descriptor& params, std::string_view key = "node") const;
   const std::vector<std::unique_ptr<PhysicNode>>& nodes() const noexcept { return nodes_; }
   const std::vector<RenderNodeSpec>& renderRoots() const noexcept { return render_roots_; }
 
