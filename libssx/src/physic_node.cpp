@@ -12,6 +12,21 @@ namespace {
 
 constexpr double kPi = std::numbers::pi;
 
+// adds a body of `mass` with inertia `inertia` (about its own centre `c`, axes of `total`'s frame)
+// to `total`: combined centre, and both inertias moved there by the parallel-axis theorem
+void addMass(MassProperties& total, double mass, const Vec3& c, const Mat3& inertia) {
+  if (!(mass > 0)) return;
+  const double m = total.mass + mass;
+  const Vec3 com = (total.mass * total.center_of_mass + mass * c) / m;
+  auto shifted = [&com](const Mat3& j, double jm, const Vec3& from) {
+    const Vec3 d = from - com;
+    return Mat3(j + jm * (d.squaredNorm() * Mat3::Identity() - d * d.transpose()));
+  };
+  total.inertia = shifted(total.inertia, total.mass, total.center_of_mass) + shifted(inertia, mass, c);
+  total.mass = m;
+  total.center_of_mass = com;
+}
+
 // mass properties of one node alone, in its own frame
 MassProperties nodeMass(const PhysicNodeSpec& node) {
   MassProperties shapes;
@@ -19,18 +34,7 @@ MassProperties nodeMass(const PhysicNodeSpec& node) {
     if (s.kind == Shape::Kind::Plane) continue;
     const double m = s.volume() * s.density;
     const Mat3 r = s.pose.orientation.toRotationMatrix();
-    const Vec3 c = s.pose.position;
-    // shift the running centre and inertia to include this shape
-    const double total = shapes.mass + m;
-    const Vec3 com = total > 0 ? Vec3((shapes.mass * shapes.center_of_mass + m * c) / total) : Vec3::Zero();
-    auto shifted = [&](const Mat3& inertia, double mass, const Vec3& from) {
-      const Vec3 d = from - com;
-      return Mat3(inertia + mass * (d.squaredNorm() * Mat3::Identity() - d * d.transpose()));
-    };
-    const Mat3 own = r * s.unitInertia(m) * r.transpose();
-    shapes.inertia = shifted(shapes.inertia, shapes.mass, shapes.center_of_mass) + shifted(own, m, c);
-    shapes.mass = total;
-    shapes.center_of_mass = com;
+    addMass(shapes, m, s.pose.position, r * s.unitInertia(m) * r.transpose());
   }
   if (!node.mass) return shapes;
   if (node.inertia) return {*node.mass, node.center_of_mass, *node.inertia};
@@ -43,20 +47,8 @@ MassProperties nodeMass(const PhysicNodeSpec& node) {
 
 void accumulate(const PhysicNodeSpec& node, const Pose& in_root, MassProperties& total) {
   const MassProperties own = nodeMass(node);
-  if (own.mass > 0) {
-    const Mat3 r = in_root.orientation.toRotationMatrix();
-    const Vec3 c = in_root.transformPoint(own.center_of_mass);
-    const double m = total.mass + own.mass;
-    const Vec3 com = (total.mass * total.center_of_mass + own.mass * c) / m;
-    auto shifted = [&](const Mat3& inertia, double mass, const Vec3& from) {
-      const Vec3 d = from - com;
-      return Mat3(inertia + mass * (d.squaredNorm() * Mat3::Identity() - d * d.transpose()));
-    };
-    total.inertia = shifted(total.inertia, total.mass, total.center_of_mass) +
-                    shifted(r * own.inertia * r.transpose(), own.mass, c);
-    total.mass = m;
-    total.center_of_mass = com;
-  }
+  const Mat3 r = in_root.orientation.toRotationMatrix();
+  addMass(total, own.mass, in_root.transformPoint(own.center_of_mass), r * own.inertia * r.transpose());
   for (const auto& child : node.children) accumulate(child, in_root * child.pose, total);
 }
 
