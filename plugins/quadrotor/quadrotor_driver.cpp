@@ -140,7 +140,7 @@ void QuadrotorDriver::configure(const Descriptor& params) {
   hover_.position = params.get<Vec3>("target", Vec3(start + params.get<Vec3>("offset", Vec3::Zero())));
   eight_.center = params.get<Vec3>("center", Vec3(start + params.get<Vec3>("center_offset", Vec3::Zero())));
   eight_.amplitude = positive(params, "amplitude", eight_.amplitude);
-  eight_.period = positive(params, "period", eight_.period);
+  eight_.period = positive(params, "eight_period", eight_.period);
   eight_.yaw_rate = params.get<double>("yaw_rate", eight_.yaw_rate);
   start_time_ = params.get<double>("start_time", 0.0);
   if (source == "hover") {

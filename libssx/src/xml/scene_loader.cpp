@@ -213,6 +213,7 @@ class SceneLoader {
   void place(Environment& env, const std::string& name, const std::string& type, const Pose& pose,
              const Descriptor& element, const std::string& index = {});
   Descriptor withOverrides(const PluginDecl& decl, const Descriptor* overrides, const std::string& index);
+  std::int64_t periodOf(const PluginDecl& decl, const Descriptor* overrides);
   template <class T, class Create>
   T* createPlugin(const PluginDecl& decl, Create create);
 
@@ -560,7 +561,7 @@ Descriptor SceneLoader::withOverrides(const PluginDecl& decl, const Descriptor* 
   if (overrides == nullptr) return decl.params;
   Descriptor params = decl.params;
   for (const auto& a : overrides->attributes()) {
-    if (a.key == "index") continue;
+    if (a.key == "index" || a.key == "period") continue;  // not plugin parameters
     // in a swarm, {i} in a value is the member's index
     std::string value = a.value;
     if (!index.empty())
@@ -569,6 +570,11 @@ Descriptor SceneLoader::withOverrides(const PluginDecl& decl, const Descriptor* 
     params.set(a.key, value, a.where);
   }
   return params;
+}
+
+// the period in steps: the placing element's override, else the type's
+std::int64_t SceneLoader::periodOf(const PluginDecl& decl, const Descriptor* overrides) {
+  return overrides == nullptr ? decl.period : readCount(*overrides, "period", decl.period, 1);
 }
 
 void SceneLoader::place(Environment& env, const std::string& name, const std::string& type_name, const Pose& pose,
@@ -603,13 +609,14 @@ void SceneLoader::place(Environment& env, const std::string& name, const std::st
     const PluginDecl& decl = *type->driver;
     auto create = [&](std::string_view p, std::string_view c) -> Driver& { return loader.createDriver(p, c); };
     if (Driver* d = createPlugin<Driver>(decl, create))
-      a.setDriver(*d, withOverrides(decl, driver_override, index), decl.period, decl.class_name);
+      a.setDriver(*d, withOverrides(decl, driver_override, index), periodOf(decl, driver_override), decl.class_name);
   }
   for (std::size_t i = 0; i < type->sensors.size(); ++i) {
     const PluginDecl& decl = type->sensors[i];
     auto create = [&](std::string_view p, std::string_view c) -> Sensor& { return loader.createSensor(p, c); };
     if (Sensor* s = createPlugin<Sensor>(decl, create))
-      a.addSensor(*s, withOverrides(decl, sensor_overrides[i], index), decl.period, decl.class_name);
+      a.addSensor(*s, withOverrides(decl, sensor_overrides[i], index), periodOf(decl, sensor_overrides[i]),
+                  decl.class_name);
   }
 }
 
