@@ -1,7 +1,7 @@
 // orbit: a driver that flies a rigid body around a horizontal circle at constant speed, with a
 // PD law on the position error to the moving reference and feed-forward of its acceleration.
 //
-// Parameters: center "x y z" (m), radius (m, default 1), period (s, default 8), kp, kd.
+// Parameters: center "x y z" (m), radius (m, default 1), orbit_period (s, default 8), kp, kd.
 #include <ssx/ssx.hpp>
 
 #include <cmath>
@@ -14,7 +14,7 @@ class OrbitDriver final : public ssx::Driver {
   void configure(const ssx::Descriptor& params) override {
     center_ = params.get<ssx::Vec3>("center", artifact().placement().position);
     radius_ = params.getPositive("radius", 1.0);
-    omega_ = 2 * std::numbers::pi / params.getPositive("period", 8.0);
+    omega_ = 2 * std::numbers::pi / params.getPositive("orbit_period", 8.0);
     kp_ = params.getPositive("kp", 16.0);
     kd_ = params.getPositive("kd", 8.0);
     mass_ = ssx::combinedMass(artifact().root().spec()).mass;

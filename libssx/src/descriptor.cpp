@@ -98,6 +98,11 @@ std::string formatNumber(double v) {
 
 Descriptor::Descriptor(std::string name, SourceLocation where) : name_(std::move(name)), where_(std::move(where)) {}
 
+Descriptor& Descriptor::erase(std::string_view key) {
+  std::erase_if(attributes_, [&](const Attribute& a) { return a.key == key; });
+  return *this;
+}
+
 Descriptor& Descriptor::set(std::string key, std::string value, SourceLocation where) {
   if (where.file.empty()) where = where_;
   for (auto& a : attributes_) {

@@ -184,6 +184,7 @@ void Environment::buildBodies() {
           for (Shape s : n->spec().shapes) {
             s.pose = n->pose_in_body_ * s.pose;
             shapes.push_back(s);
+            static_shapes_.push_back({s, root->setup_pose_ * s.pose, artifact->index()});
           }
         }
         physics_->addStatic(shapes, root->setup_pose_);
@@ -334,12 +335,19 @@ void Environment::publishSnapshot(bool first) {
 
 void Environment::enableNeighborQueries(double cell_size) {
   if (!(cell_size > 0)) throw Error("enableNeighborQueries: cell size must be positive");
-  if (!neighbors_enabled_ || cell_size < neighbor_index_.cellSize()) neighbor_index_ = SpatialIndex(cell_size);
+  // positions do not change while plugins are configured: only a new grid needs building
+  const bool new_grid = !neighbors_enabled_ || cell_size < neighbor_index_.cellSize();
+  if (new_grid) neighbor_index_ = SpatialIndex(cell_size);
   neighbors_enabled_ = true;
-  if (state_ == State::Running) rebuildNeighborIndex();
+  if (new_grid && state_ == State::Running) rebuildNeighborIndex();
 }
 
 void Environment::neighbors(const Vec3& point, double radius, std::vector<std::size_t>& out) const {
+  if (!neighbors_enabled_) throw Error("neighbour queries are off: call enableNeighborQueries from configure");
+  neighbor_index_.query(point, radius, out);
+}
+
+void Environment::neighbors(const Vec3& point, double radius, std::vector<SpatialIndex::Hit>& out) const {
   if (!neighbors_enabled_) throw Error("neighbour queries are off: call enableNeighborQueries from configure");
   neighbor_index_.query(point, radius, out);
 }

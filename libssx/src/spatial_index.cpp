@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 namespace ssx {
 
@@ -10,6 +11,12 @@ namespace {
 // 21 bits per axis, offset so that negative cells pack too: +-1,048,575 cells (+-2,000 km at 2 m)
 constexpr std::int64_t kAxisOffset = std::int64_t{1} << 20;
 constexpr std::int64_t kAxisMax = (std::int64_t{1} << 21) - 1;
+constexpr std::uint64_t kEmpty = ~std::uint64_t{0};  // no column has this key (it has 42 bits)
+
+std::size_t hashColumn(std::uint64_t column) {
+  // a multiplicative hash: neighbouring columns land in distant slots
+  return static_cast<std::size_t>((column * 0x9E3779B97F4A7C15ull) >> 20);
+}
 }  // namespace
 
 SpatialIndex::SpatialIndex(double cell_size) : cell_size_(cell_size) {
@@ -32,25 +39,61 @@ void SpatialIndex::rebuild(const std::vector<Vec3>& points, const std::vector<st
   }
   std::sort(entries_.begin(), entries_.end(),
             [](const Entry& a, const Entry& b) { return a.key != b.key ? a.key < b.key : a.id < b.id; });
+  // a hash table of the columns, at most half full
+  if (entries_.size() >= std::numeric_limits<std::uint32_t>::max()) throw Error("spatial index: too many points");
+  std::size_t slots = 16;
+  while (slots < 2 * entries_.size()) slots *= 2;
+  columns_.assign(slots, Column{});
+  for (std::size_t i = 0; i < entries_.size();) {
+    const std::uint64_t column = entries_[i].key >> 21;
+    std::size_t j = i + 1;
+    while (j < entries_.size() && (entries_[j].key >> 21) == column) ++j;
+    std::size_t slot = hashColumn(column) & (slots - 1);
+    while (columns_[slot].key != kEmpty) slot = (slot + 1) & (slots - 1);
+    columns_[slot] = {column, static_cast<std::uint32_t>(i), static_cast<std::uint32_t>(j)};
+    i = j;
+  }
 }
 
-void SpatialIndex::query(const Vec3& center, double radius, std::vector<std::size_t>& out) const {
-  const std::size_t first = out.size();
+const SpatialIndex::Column* SpatialIndex::findColumn(std::uint64_t column_key) const {
+  if (columns_.empty()) return nullptr;
+  const std::size_t mask = columns_.size() - 1;
+  for (std::size_t slot = hashColumn(column_key) & mask;; slot = (slot + 1) & mask) {
+    if (columns_[slot].key == column_key) return &columns_[slot];
+    if (columns_[slot].key == kEmpty) return nullptr;
+  }
+}
+
+template <class Visit>
+void SpatialIndex::visit(const Vec3& center, double radius, Visit&& found) const {
   const double r2 = radius * radius;
   const std::int64_t x0 = cell(center.x() - radius), x1 = cell(center.x() + radius);
   const std::int64_t y0 = cell(center.y() - radius), y1 = cell(center.y() + radius);
   const std::int64_t z0 = cell(center.z() - radius), z1 = cell(center.z() + radius);
   for (std::int64_t x = x0; x <= x1; ++x) {
     for (std::int64_t y = y0; y <= y1; ++y) {
-      // the cells of one (x, y) column are contiguous in key order: one search per column
+      // one hash lookup per column, then the column's entries in the z range
+      const Column* c = findColumn(key(x, y, 0) >> 21);
+      if (c == nullptr) continue;
       const std::uint64_t lo = key(x, y, z0), hi = key(x, y, z1);
-      auto it = std::lower_bound(entries_.begin(), entries_.end(), lo,
-                                 [](const Entry& e, std::uint64_t k) { return e.key < k; });
-      for (; it != entries_.end() && it->key <= hi; ++it)
-        if ((it->point - center).squaredNorm() <= r2) out.push_back(it->id);
+      const Entry* end = entries_.data() + c->end;
+      for (const Entry* e = entries_.data() + c->begin; e != end && e->key <= hi; ++e)
+        if (e->key >= lo && (e->point - center).squaredNorm() <= r2) found(*e);
     }
   }
+}
+
+void SpatialIndex::query(const Vec3& center, double radius, std::vector<std::size_t>& out) const {
+  const std::size_t first = out.size();
+  visit(center, radius, [&](const Entry& e) { out.push_back(e.id); });
   std::sort(out.begin() + static_cast<std::ptrdiff_t>(first), out.end());
+}
+
+void SpatialIndex::query(const Vec3& center, double radius, std::vector<Hit>& out) const {
+  const std::size_t first = out.size();
+  visit(center, radius, [&](const Entry& e) { out.push_back({e.id, e.point}); });
+  std::sort(out.begin() + static_cast<std::ptrdiff_t>(first), out.end(),
+            [](const Hit& a, const Hit& b) { return a.id < b.id; });
 }
 
 }  // namespace ssx

@@ -27,12 +27,11 @@ constexpr std::uint64_t isqrtFloor(std::uint64_t n) {
   std::uint64_t bit = std::uint64_t{1} << 62;
   while (bit > n) bit >>= 2;
   while (bit != 0) {
-    if (n >= result + bit) {
-      n -= result + bit;
-      result = (result >> 1) + bit;
-    } else {
-      result >>= 1;
-    }
+    // branch-free (conditional moves): the outcome of each step is data, not a jump to predict
+    const std::uint64_t trial = result + bit;
+    const std::uint64_t take = n >= trial ? ~std::uint64_t{0} : 0;
+    n -= trial & take;
+    result = (result >> 1) + (bit & take);
     bit >>= 2;
   }
   return result;

@@ -24,12 +24,7 @@ namespace ssx::plugins {
 
 namespace {
 
-// a static shape in the world, for nearest-point queries
-struct ObstacleShape {
-  Shape shape;
-  Pose world;  // the shape's frame
-  std::size_t artifact;
-};
+using ObstacleShape = Environment::StaticShape;
 
 // nearest point of a shape's surface (or the point itself when inside) to p
 Vec3 nearestPoint(const ObstacleShape& o, const Vec3& p) {
@@ -83,16 +78,9 @@ class RangeSensor final : public SensorOf<RangeMeasurement> {
 
     Environment& env = environment();
     env.enableNeighborQueries(range_);
-    if (params.get<bool>("obstacles", true)) {
-      for (std::size_t i = 0; i < env.artifactCount(); ++i) {
-        const Artifact& a = env.artifact(i);
-        for (const auto& node : a.nodes()) {
-          if (!node->isStatic()) continue;
-          for (const Shape& s : node->spec().shapes)
-            if (s.kind != Shape::Kind::Plane) obstacles_.push_back({s, node->pose() * s.pose, i});
-        }
-      }
-    }
+    if (params.get<bool>("obstacles", true))
+      for (const ObstacleShape& o : env.staticShapes())
+        if (o.shape.kind != Shape::Kind::Plane) obstacles_.push_back(&o);
   }
 
   void sense(const StepInfo& info) override {
@@ -109,16 +97,16 @@ class RangeSensor final : public SensorOf<RangeMeasurement> {
     // robots
     found_.clear();
     environment().neighbors(self.position, range_, found_);
-    for (std::size_t j : found_) {
+    for (const auto& [j, position] : found_) {
       if (j == artifact().index()) continue;
-      const Vec3 rel = environment().artifact(j).root().pose().position - self.position;
+      const Vec3 rel = position - self.position;
       if (visible(rel)) m.detections.push_back({rel, rel.norm(), j, false});
     }
     // obstacles, at their nearest point
-    for (const auto& o : obstacles_) {
-      const Vec3 rel = nearestPoint(o, self.position) - self.position;
+    for (const ObstacleShape* o : obstacles_) {
+      const Vec3 rel = nearestPoint(*o, self.position) - self.position;
       const double d = rel.norm();
-      if (d <= range_ && visible(rel)) m.detections.push_back({rel, d, o.artifact, true});
+      if (d <= range_ && visible(rel)) m.detections.push_back({rel, d, o->artifact, true});
     }
     std::sort(m.detections.begin(), m.detections.end(), [](const auto& a, const auto& b) {
       return a.distance != b.distance ? a.distance < b.distance : a.artifact < b.artifact;
@@ -135,8 +123,8 @@ class RangeSensor final : public SensorOf<RangeMeasurement> {
  private:
   double range_ = 2.5, noise_ = 0, cos_half_fov_ = -2;
   std::size_t max_count_ = 0;
-  std::vector<ObstacleShape> obstacles_;
-  std::vector<std::size_t> found_;
+  std::vector<const ObstacleShape*> obstacles_;  // owned by the environment
+  std::vector<SpatialIndex::Hit> found_;
 };
 
 }  // namespace ssx::plugins

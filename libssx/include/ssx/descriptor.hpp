@@ -45,6 +45,8 @@ class SSX_EXPORT Descriptor {
   Descriptor& set(std::string key, const Vec3& value);
 
   /// Appends a child node and returns it.
+  /// Removes an attribute, if there is one.
+  Descriptor& erase(std::string_view key);
   Descriptor& addChild(Descriptor child);
 
   bool has(std::string_view key) const;

@@ -164,6 +164,17 @@ class SSX_EXPORT Environment {
   /// within `radius` of `point`, in ascending order; reads the snapshot's index, so it is safe in
   /// the parallel phases. Throws if queries were not enabled.
   void neighbors(const Vec3& point, double radius, std::vector<std::size_t>& out) const;
+  /// Same, with each artifact's indexed position (as of the snapshot), in ascending artifact order.
+  void neighbors(const Vec3& point, double radius, std::vector<SpatialIndex::Hit>& out) const;
+
+  /// A shape of a static artifact, posed in the world.
+  struct StaticShape {
+    Shape shape;  ///< its pose is the shape's pose in its static root's frame
+    Pose world;   ///< the shape's frame in the world
+    std::size_t artifact = 0;
+  };
+  /// Every shape of every static root (ground planes included), known from start() on.
+  const std::vector<StaticShape>& staticShapes() const noexcept { return static_shapes_; }
 
   /// The render nodes of the last frame drawn, posed in the world.
   const std::vector<RenderNode>& renderNodes() const noexcept { return render_items_; }
@@ -222,6 +233,7 @@ class SSX_EXPORT Environment {
   SpatialIndex neighbor_index_;
   std::vector<Vec3> neighbor_points_;
   std::vector<std::size_t> neighbor_ids_;
+  std::vector<StaticShape> static_shapes_;
   void rebuildNeighborIndex();
   std::uint64_t subscription_sequence_ = 0;
   TimingRecorder timing_;

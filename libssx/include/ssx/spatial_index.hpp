@@ -24,6 +24,13 @@ class SSX_EXPORT SpatialIndex {
   /// Appends to `out` the ids of the points within `radius` of `center` (distance <= radius),
   /// in ascending id order. Safe to call from many threads at once.
   void query(const Vec3& center, double radius, std::vector<std::size_t>& out) const;
+  /// A point found by a query: its id and indexed position.
+  struct Hit {
+    std::size_t id;
+    Vec3 point;
+  };
+  /// Same, with the points (in ascending id order).
+  void query(const Vec3& center, double radius, std::vector<Hit>& out) const;
   std::size_t size() const noexcept { return entries_.size(); }
 
  private:
@@ -34,9 +41,19 @@ class SSX_EXPORT SpatialIndex {
   };
   std::uint64_t key(std::int64_t x, std::int64_t y, std::int64_t z) const;
   std::int64_t cell(double v) const;
+  template <class Visit>
+  void visit(const Vec3& center, double radius, Visit&& found) const;
+
+  // the entries of one (x, y) column of cells, which are contiguous in key order
+  struct Column {
+    std::uint64_t key = ~std::uint64_t{0};  // key >> 21; all ones: empty slot
+    std::uint32_t begin = 0, end = 0;
+  };
+  const Column* findColumn(std::uint64_t column_key) const;
 
   double cell_size_;
   std::vector<Entry> entries_;  // sorted by (key, id)
+  std::vector<Column> columns_;  // open-addressing hash table of the non-empty columns
 };
 
 }  // namespace ssx

@@ -453,7 +453,10 @@ std::optional<PluginDecl> SceneLoader::readPluginDecl(const Descriptor& d) {
   decl.plugin = require(d, "plugin");
   decl.class_name = read<std::string>(d, "class", decl.plugin);
   decl.period = readCount(d, "period", 1, 1);
-  decl.params = d;  // the element is the parameter set; plugin, class, period are marked read
+  // the element is the parameter set, without what the loader itself reads: a plugin never
+  // mistakes its period in steps for a parameter of its own (periodSteps() tells it)
+  decl.params = d;
+  decl.params.erase("plugin").erase("class").erase("period");
   // a plugin's own parameters are checked when it is configured; element children are not allowed
   for (const auto& c : d.children())
     warning(c.where(), "unknown element <" + c.name() + "> in <" + d.name() + "> (ignored)");
@@ -561,7 +564,7 @@ Descriptor SceneLoader::withOverrides(const PluginDecl& decl, const Descriptor* 
   if (overrides == nullptr) return decl.params;
   Descriptor params = decl.params;
   for (const auto& a : overrides->attributes()) {
-    if (a.key == "index" || a.key == "period") continue;  // not plugin parameters
+    if (a.key == "index" || a.key == "period") continue;  // read by the loader, not plugin parameters
     // in a swarm, {i} in a value is the member's index
     std::string value = a.value;
     if (!index.empty())
