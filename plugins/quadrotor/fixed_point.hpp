@@ -53,6 +53,9 @@ inline constexpr std::int64_t kCordicGainQ30 = 652032874;  // prod 1/sqrt(1 + 2^
 // 24 rotations leave an angle error below 2^-23 rad, far under the Q20 filter state's resolution
 inline constexpr int kCordicIterations = 24;
 
+/// v when mask is 0, -v when mask is -1 (all ones): two's complement without a branch.
+constexpr std::int64_t conditionalNegate(std::int64_t v, std::int64_t mask) { return (v ^ mask) - mask; }
+
 /// atan2(y, x) in Q30 radians, (-pi, pi]; inputs of any common scale up to 2^40.
 constexpr std::int64_t atan2Q30(std::int64_t y, std::int64_t x) {
   if (x == 0 && y == 0) return 0;
@@ -74,16 +77,12 @@ constexpr std::int64_t atan2Q30(std::int64_t y, std::int64_t x) {
   x <<= 16;
   y <<= 16;
   for (int i = 0; i < kCordicIterations; ++i) {
+    // rotate towards y = 0: by +atan(2^-i) when y > 0, else by -atan(2^-i) (branch-free)
     const std::int64_t xs = x >> i, ys = y >> i;
-    if (y > 0) {
-      x += ys;
-      y -= xs;
-      angle += kAtanTable[i];
-    } else {
-      x -= ys;
-      y += xs;
-      angle -= kAtanTable[i];
-    }
+    const std::int64_t neg = y > 0 ? 0 : -1;
+    x += conditionalNegate(ys, neg);
+    y -= conditionalNegate(xs, neg);
+    angle += conditionalNegate(kAtanTable[i], neg);
   }
   return angle;
 }
@@ -101,16 +100,12 @@ constexpr void sinCosQ30(std::int64_t angle, std::int64_t& s, std::int64_t& c) {
   }
   std::int64_t x = kCordicGainQ30, y = 0, z = angle;
   for (int i = 0; i < kCordicIterations; ++i) {
+    // rotate towards z = 0 (branch-free)
     const std::int64_t xs = x >> i, ys = y >> i;
-    if (z >= 0) {
-      x -= ys;
-      y += xs;
-      z -= kAtanTable[i];
-    } else {
-      x += ys;
-      y -= xs;
-      z += kAtanTable[i];
-    }
+    const std::int64_t neg = z >= 0 ? 0 : -1;
+    x -= conditionalNegate(ys, neg);
+    y += conditionalNegate(xs, neg);
+    z -= conditionalNegate(kAtanTable[i], neg);
   }
   s = flip ? -y : y;
   c = flip ? -x : x;
