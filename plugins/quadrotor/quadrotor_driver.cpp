@@ -64,7 +64,7 @@ void QuadrotorDriver::configure(const Descriptor& params) {
   }
   const MassProperties mass = combinedMass(a.root().spec());
   com_in_root_ = -a.root().poseInBody().position;
-  rotors_ = std::make_unique<RotorModel>(rotors, rp);
+  rotors_.emplace(rotors, rp);
   const Allocation allocation(rotors, rp);
 
   // loop rates in steps of the environment
@@ -119,7 +119,7 @@ void QuadrotorDriver::configure(const Descriptor& params) {
   // the IMU's LSBs are known once it has been configured (it comes first in the artifact)
   ip.gyro_lsb = imu_->gyroscope_lsb > 0 ? imu_->gyroscope_lsb : ip.gyro_lsb;
   ip.accel_lsb = imu_->accelerometer_lsb > 0 ? imu_->accelerometer_lsb : ip.accel_lsb;
-  inner_ = std::make_unique<InnerLoopFixed>(ip);
+  inner_.emplace(ip);
 
   // outer loop
   PositionParams pp;
@@ -132,7 +132,7 @@ void QuadrotorDriver::configure(const Descriptor& params) {
   pp.max_tilt = positive(params, "max_tilt_deg", 30.0) * std::numbers::pi / 180.0;
   pp.max_thrust = positive(params, "max_thrust", 0.95 * ip.max_thrust);
   pp.min_thrust = 0.05 * pp.max_thrust;
-  outer_ = std::make_unique<PositionController>(pp);
+  outer_.emplace(pp);
 
   // reference source
   const Vec3 start = a.placement().position;

@@ -29,7 +29,7 @@
 
 #include <ssx/ssx.hpp>
 
-#include <memory>
+#include <optional>
 
 namespace ssx::quadrotor {
 
@@ -48,9 +48,11 @@ class QuadrotorDriver final : public Driver, public SetpointInterface {
  private:
   Setpoint reference(double t) const;
 
-  std::unique_ptr<RotorModel> rotors_;
-  std::unique_ptr<InnerLoopFixed> inner_;
-  std::unique_ptr<PositionController> outer_;
+  // held in the driver, not behind pointers: with thousands of robots a step is bound by memory
+  // latency, and every separate allocation is one more cache miss per robot and step
+  std::optional<RotorModel> rotors_;
+  std::optional<InnerLoopFixed> inner_;
+  std::optional<PositionController> outer_;
   InnerCommand command_;
   AttitudeCommand attitude_;
   std::vector<double> commanded_speeds_;

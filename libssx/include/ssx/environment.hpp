@@ -194,6 +194,7 @@ class SSX_EXPORT Environment {
   void publishSnapshot(bool first);
   void runSensors(std::size_t begin, std::size_t end);
   void runDrivers(std::size_t begin, std::size_t end);
+  void prefetchArtifact(std::size_t i, std::size_t end, bool sensors) const;
   void raiseFirstError(const char* phase);
   void drawFrame();
   void fail();
