@@ -92,6 +92,7 @@ struct RunArgs {
   std::vector<std::string> plugin_path;
   std::string stats_csv;
   bool quiet = false;
+  std::string render, snapshot, video, frames;
 };
 
 int commandRun(const RunArgs& args, bool realtime_given) {
@@ -99,6 +100,10 @@ int commandRun(const RunArgs& args, bool realtime_given) {
   options.plugin_path = pluginPath(args.plugin_path);
   if (args.threads >= 0) options.threads = args.threads;
   if (args.seed >= 0) options.seed = static_cast<std::uint64_t>(args.seed);
+  if (!args.render.empty()) options.render_engine = args.render;
+  options.snapshot = args.snapshot;
+  options.video = args.video;
+  options.frames_dir = args.frames;
   ssx::Scene scene;
   try {
     scene = ssx::loadScene(args.scene, options);
@@ -125,6 +130,8 @@ int commandRun(const RunArgs& args, bool realtime_given) {
 
   std::signal(SIGINT, onSignal);
   std::signal(SIGTERM, onSignal);
+  // a video pipe whose ffmpeg died reports an error instead of killing the process
+  std::signal(SIGPIPE, SIG_IGN);
   int status = 0;
   ssx::TimingSummary summary;
   try {
@@ -146,6 +153,7 @@ int commandRun(const RunArgs& args, bool realtime_given) {
   }
   progress.finish();
   if (g_stop) std::cerr << "ssx: interrupted at t = " << ssx::toSeconds(env.time()) << " s\n";
+  const std::vector<ssx::CameraSpec> cameras = env.cameras();
   // stop cleanly: plugins destroyed, engines stopped, extensions shut down (files closed)
   try {
     env.stop();
@@ -155,6 +163,17 @@ int commandRun(const RunArgs& args, bool realtime_given) {
   }
   if (status == 0) {
     if (!args.quiet) std::cout << summary.str() << '\n';
+  }
+  // where the pictures went
+  if (!args.quiet && env.frameCount() > 0) {
+    for (const auto& c : cameras) {
+      if (!c.snapshot.empty() && fs::exists(c.snapshot))
+        std::cout << "camera " << c.name << ": snapshot " << c.snapshot.string() << '\n';
+      if (!c.video.empty() && fs::exists(c.video))
+        std::cout << "camera " << c.name << ": video " << c.video.string() << '\n';
+      if (!c.frames_dir.empty())
+        std::cout << "camera " << c.name << ": " << env.frameCount() << " frames in " << c.frames_dir.string() << '\n';
+    }
   }
   if (!args.stats_csv.empty()) {
     try {
@@ -219,6 +238,10 @@ int main(int argc, char** argv) {
   run_cmd->add_option("--plugin-path", run.plugin_path, "plugin directory (repeatable)");
   run_cmd->add_option("--stats-csv", run.stats_csv, "write per-step timing samples to FILE");
   run_cmd->add_flag("--quiet", run.quiet, "no progress, no summary");
+  run_cmd->add_option("--render", run.render, "render engine (overrides the scene's): null or osmesa");
+  run_cmd->add_option("--snapshot", run.snapshot, "write the first camera's last frame as PNG to FILE");
+  run_cmd->add_option("--video", run.video, "write the first camera's frames as MP4 to FILE (needs ffmpeg)");
+  run_cmd->add_option("--frames", run.frames, "write the first camera's frames as PNG files into DIR");
 
   std::string validate_file;
   std::vector<std::string> validate_path;

@@ -1,4 +1,5 @@
 #include "phase_guard.hpp"
+#include "render/frame_output.hpp"
 #include "worker_pool.hpp"
 
 #include <ssx/environment.hpp>
@@ -8,6 +9,7 @@
 #include <cmath>
 #include <cstring>
 #include <iostream>
+#include <numbers>
 #include <set>
 
 namespace ssx {
@@ -52,6 +54,26 @@ void checkSettings(const EnvironmentSettings& s) {
   if (s.physics.max_contacts < 1) bad("physics max_contacts must be at least 1");
   if (!s.physics.gravity.allFinite()) bad("gravity must be finite");
   if (s.render.period_steps < 0) bad("render period must be 0 (never) or positive");
+  if (!(s.render.rate_hz >= 0) || !std::isfinite(s.render.rate_hz)) bad("render rate_hz must be 0 or positive");
+  if (s.render.width < 1 || s.render.height < 1 || s.render.width > 16384 || s.render.height > 16384)
+    bad("render width and height must be in 1..16384");
+  for (const auto& c : s.render.cameras)
+    if (!(c.fov_deg > 0 && c.fov_deg < 180)) bad("camera '" + c.name + "': fov_deg must be in (0, 180)");
+}
+
+// a camera at `position` looking at `target`, level (its y axis horizontal)
+Pose lookAt(const Vec3& position, const Vec3& target) {
+  Vec3 forward = target - position;
+  if (forward.norm() < 1e-9) forward = Vec3::UnitX();
+  forward.normalize();
+  Vec3 left = Vec3::UnitZ().cross(forward);
+  if (left.norm() < 1e-6) left = Vec3::UnitY();  // looking straight up or down
+  left.normalize();
+  Eigen::Matrix3d r;
+  r.col(0) = forward;
+  r.col(1) = left;
+  r.col(2) = forward.cross(left);
+  return Pose{position, Quat(r).normalized()};
 }
 
 }  // namespace
@@ -59,6 +81,12 @@ void checkSettings(const EnvironmentSettings& s) {
 Environment::Environment(EnvironmentSettings settings)
     : settings_(std::move(settings)), loader_(std::make_unique<ClassLoader>()) {
   checkSettings(settings_);
+  RenderSettings& r = settings_.render;
+  if (r.rate_hz > 0)
+    r.period_steps = std::max<std::int64_t>(1, std::llround(1.0 / (r.rate_hz * toSeconds(settings_.timestep))));
+  // a camera with somewhere to put its frames and no rate given: 25 frames per simulated second
+  if (r.period_steps == 0 && !r.cameras.empty())
+    r.period_steps = std::max<std::int64_t>(1, std::llround(1.0 / (25.0 * toSeconds(settings_.timestep))));
 }
 
 Environment::~Environment() {
@@ -91,6 +119,13 @@ Artifact& Environment::addGround(double z) {
   plane.is_static = true;
   plane.shapes.push_back(Shape::plane());
   ground.addPhysicRoot(std::move(plane));
+  RenderNodeSpec floor;
+  floor.name = "ground";
+  floor.primitive = RenderNodeSpec::Primitive::Plane;
+  floor.size = Vec3(400, 400, 0);
+  floor.color = {0.58f, 0.6f, 0.56f, 1.0f};
+  floor.grid = true;
+  ground.addRenderRoot(std::move(floor));
   return ground;
 }
 
@@ -229,6 +264,12 @@ void Environment::start() {
     renderer_ = createRenderEngine(settings_.render);
     buildBodies();
     publishSnapshot(true);
+    // render roots follow their physic nodes, looked up once
+    for (auto& a : artifacts_) {
+      a->render_follow_.clear();
+      for (const auto& r : a->render_roots_) a->render_follow_.push_back(r.follow.empty() ? nullptr : a->node(r.follow));
+    }
+    startCameras();
     const unsigned threads = settings_.threads > 0 ? static_cast<unsigned>(settings_.threads)
                                                    : std::max(1u, std::thread::hardware_concurrency());
     pool_ = std::make_unique<detail::WorkerPool>(threads);
@@ -276,6 +317,7 @@ void Environment::stop() {
       for (auto& s : a->sensors_) destroy(*s.sensor, "sensor '" + s.sensor->className() + "'");
     }
     pool_.reset();
+    finishCameras();
     renderer_.reset();
     physics_.reset();
   }
@@ -467,7 +509,9 @@ void Environment::raiseFirstError(const char* phase) {
   }
 }
 
-void Environment::drawFrame() {
+void Environment::syncRenderNodes() {
+  if (render_items_step_ == steps_) return;
+  render_items_step_ = steps_;
   render_items_.clear();
   const Artifact* owner = nullptr;
   auto add = [&](auto& self, const RenderNodeSpec& spec, const Pose& parent) -> void {
@@ -477,12 +521,128 @@ void Environment::drawFrame() {
   };
   for (const auto& a : artifacts_) {
     owner = a.get();
-    for (const auto& r : a->render_roots_) {
-      const PhysicNode* follow = r.follow.empty() ? nullptr : a->node(r.follow);
-      add(add, r, follow != nullptr ? follow->pose() : a->placement());
+    for (std::size_t i = 0; i < a->render_roots_.size(); ++i) {
+      const PhysicNode* follow = a->render_follow_[i];
+      add(add, a->render_roots_[i], follow != nullptr ? follow->pose() : a->placement());
     }
   }
-  renderer_->draw(time(), render_items_);
+}
+
+std::vector<CameraSpec> Environment::cameras() const {
+  std::vector<CameraSpec> specs;
+  for (const auto& c : cameras_) specs.push_back(c.spec);
+  return specs;
+}
+
+void Environment::startCameras() {
+  const RenderSettings& r = settings_.render;
+  if (r.cameras.empty()) return;
+  if (!renderer_->drawsPixels()) {
+    std::string names;
+    for (const auto& c : r.cameras) names += (names.empty() ? "'" : ", '") + c.name + "'";
+    log(LogLevel::Warning, "render engine '" + renderer_->name() + "' draws no pixels: camera " + names +
+                               " gets no frames (choose engine=\"osmesa\" in <render> or --render osmesa)");
+    return;
+  }
+  for (const CameraSpec& spec : r.cameras) {
+    SceneCamera c;
+    c.spec = spec;
+    if (!spec.follow.empty()) {
+      c.follow = findArtifact(spec.follow);
+      if (c.follow == nullptr || c.follow->rootCount() == 0)
+        throw ConfigError({}, "camera '" + spec.name + "' follows '" + spec.follow +
+                                  "', which is no artifact with a physic root");
+    }
+    if (spec.frame_scene) {
+      // everything placed, static or not (ground planes aside), seen from the south-east above
+      Eigen::AlignedBox3d box;
+      for (const auto& a : artifacts_) {
+        if (a->rootCount() == 0) {
+          box.extend(a->placement().position);
+          continue;
+        }
+        const auto& shapes = a->root().spec().shapes;
+        const bool ground = !shapes.empty() && std::all_of(shapes.begin(), shapes.end(), [](const Shape& s) {
+          return s.kind == Shape::Kind::Plane;
+        });
+        if (!ground) box.extend(a->root().pose().position);
+      }
+      if (box.isEmpty()) box.extend(Vec3::Zero());
+      const Vec3 centre = box.center();
+      const double extent = std::max(2.0, box.sizes().norm());
+      const double distance = 0.5 * extent / std::tan(spec.fov_deg * std::numbers::pi / 360.0) + 0.5 * extent;
+      c.spec.look_at = centre;
+      c.spec.position = centre + distance * Vec3(0.62, -0.62, 0.48).normalized();
+    }
+    const double fps = 1.0 / (static_cast<double>(r.period_steps) * toSeconds(settings_.timestep));
+    c.output = std::make_unique<detail::FrameOutput>(c.spec, fps, [this](std::string_view m) {
+      log(LogLevel::Warning, m);
+    });
+    cameras_.push_back(std::move(c));
+  }
+}
+
+void Environment::finishCameras() {
+  for (auto& c : cameras_) {
+    try {
+      c.output->finish();
+    } catch (const std::exception& e) {
+      log(LogLevel::Error, e.what());
+    }
+  }
+  cameras_.clear();
+}
+
+void Environment::addCameraRequest(std::string owner, std::function<bool(std::int64_t, CameraView&)> due,
+                                   Image& target) {
+  if (state_ != State::Running || !renderer_) throw Error("addCameraRequest: call it from a plugin's configure");
+  if (!renderer_->drawsPixels())
+    throw ConfigError({}, owner + " needs images, but render engine '" + renderer_->name() +
+                              "' draws none: choose engine=\"osmesa\" in <render> or --render osmesa");
+  camera_requests_.push_back({std::move(owner), std::move(due), &target});
+}
+
+void Environment::renderCameraRequests() {
+  CameraView view;
+  for (auto& r : camera_requests_) {
+    try {
+      view = CameraView{};
+      if (!r.due(current_step_, view)) continue;
+      syncRenderNodes();
+      renderer_->renderView(view, render_items_, settings_.render.background, *r.target);
+    } catch (const std::exception& e) {
+      fail();
+      throw StepError("", r.owner, current_step_, std::string("camera image: ") + e.what());
+    }
+  }
+}
+
+void Environment::drawFrame() {
+  syncRenderNodes();  // also without cameras: renderNodes() serves viewers outside ssx
+  if (cameras_.empty()) return;
+  for (auto& c : cameras_) {
+    CameraView view;
+    view.width = settings_.render.width;
+    view.height = settings_.render.height;
+    view.fov_deg = c.spec.fov_deg;
+    if (c.follow != nullptr) {
+      // in the followed robot's frame, turning with its heading only: the picture stays level
+      const Pose root = c.follow->root().pose();
+      const Vec3 forward = root.orientation * Vec3::UnitX();
+      const Pose base{root.position, Quat(Eigen::AngleAxisd(std::atan2(forward.y(), forward.x()), Vec3::UnitZ()))};
+      view.pose = lookAt(base.transformPoint(c.spec.position), base.transformPoint(c.spec.look_at));
+    } else {
+      view.pose = lookAt(c.spec.position, c.spec.look_at);
+    }
+    try {
+      renderer_->renderView(view, render_items_, settings_.render.background, frame_);
+      c.output->add(frame_);
+    } catch (const std::exception& e) {
+      fail();
+      throw StepError("", "camera '" + c.spec.name + "'", current_step_, e.what());
+    }
+  }
+  ++frames_;
 }
 
 void Environment::step() {
@@ -523,6 +683,11 @@ void Environment::step() {
   publishSnapshot(false);
   if (neighbors_enabled_) rebuildNeighborIndex();
   timing.snapshot = since(t);
+  if (!camera_requests_.empty()) {
+    t = Clock::now();
+    renderCameraRequests();
+    timing.render += since(t);
+  }
 
   const std::size_t n = artifacts_.size();
   const std::size_t chunk = std::max<std::size_t>(1, n / (pool_->size() * 8));
@@ -544,7 +709,7 @@ void Environment::step() {
   if (settings_.render.period_steps > 0 && current_step_ % settings_.render.period_steps == 0) {
     t = Clock::now();
     drawFrame();
-    timing.render = since(t);
+    timing.render += since(t);
   }
 
   runExtensionHook(&SimulationExtension::afterStep, "afterStep");

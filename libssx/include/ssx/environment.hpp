@@ -43,6 +43,7 @@ namespace ssx {
 
 namespace detail {
 class WorkerPool;
+class FrameOutput;
 }
 
 /// Everything that defines an environment before it is populated.
@@ -176,8 +177,19 @@ class SSX_EXPORT Environment {
   /// Every shape of every static root (ground planes included), known from start() on.
   const std::vector<StaticShape>& staticShapes() const noexcept { return static_shapes_; }
 
-  /// The render nodes of the last frame drawn, posed in the world.
+  /// The render nodes of the last frame or camera image drawn, posed in the world.
   const std::vector<RenderNode>& renderNodes() const noexcept { return render_items_; }
+  /// Camera images for sensors. `due(step, view)` is called in the snapshot phase of every step,
+  /// on the stepping thread, after the snapshot is published; when it returns true, the view it
+  /// filled in is drawn from that step's snapshot into `target`, before the sensors phase (so a
+  /// sensor delivers the image of the step it runs in). Call from configure; needs an engine that
+  /// draws pixels (ConfigError otherwise). `owner` names the requester in messages.
+  void addCameraRequest(std::string owner, std::function<bool(std::int64_t step, CameraView& view)> due,
+                        Image& target);
+  /// Frames drawn for the scene's cameras so far.
+  std::int64_t frameCount() const noexcept { return frames_; }
+  /// The scene cameras' specs as used (frame_scene cameras placed), from start() on.
+  std::vector<CameraSpec> cameras() const;
 
   PhysicEngine& physics() const;
   RenderEngine& renderer() const;
@@ -197,6 +209,10 @@ class SSX_EXPORT Environment {
   void prefetchArtifact(std::size_t i, std::size_t end, bool sensors) const;
   void raiseFirstError(const char* phase);
   void drawFrame();
+  void syncRenderNodes();
+  void renderCameraRequests();
+  void startCameras();
+  void finishCameras();
   void fail();
   void warnUnusedParameters() const;
   void runExtensionHook(void (SimulationExtension::*hook)(Environment&), const char* what);
@@ -230,6 +246,21 @@ class SSX_EXPORT Environment {
   std::vector<Artifact*> body_owner_;
   std::vector<PendingError> errors_;  // one per artifact, filled by the parallel phases
   std::vector<RenderNode> render_items_;
+  std::int64_t render_items_step_ = -1;  // the step render_items_ were posed for
+  struct CameraRequest {
+    std::string owner;
+    std::function<bool(std::int64_t, CameraView&)> due;
+    Image* target;
+  };
+  std::vector<CameraRequest> camera_requests_;
+  struct SceneCamera {
+    CameraSpec spec;
+    const Artifact* follow = nullptr;
+    std::unique_ptr<detail::FrameOutput> output;
+  };
+  std::vector<SceneCamera> cameras_;
+  Image frame_;
+  std::int64_t frames_ = 0;
   bool neighbors_enabled_ = false;
   SpatialIndex neighbor_index_;
   std::vector<Vec3> neighbor_points_;

@@ -1,13 +1,23 @@
 #pragma once
 /// @file
-/// The abstract render engine and render node trees. The `null` engine (the default) draws
-/// nothing and costs nothing; an offscreen OpenGL backend comes later.
+/// Rendering: render node trees, cameras, images and the abstract render engine.
+///
+/// Engines: `null` (the default) draws nothing and costs nothing; `osmesa` draws with software
+/// OpenGL offscreen (no display needed). Nothing of OpenGL appears in this header.
+///
+/// Two kinds of pictures are made:
+/// - **frames** of the scene's cameras (`<render>`/`<camera>`), at a rate in simulated time, drawn
+///   in the render phase after the drivers, written as PNG files, an MP4 and/or a snapshot;
+/// - **camera sensor images**, drawn in the snapshot phase of the step they are due in (see
+///   Environment::addCameraRequest), from that step's snapshot.
+/// Both are drawn on the thread that calls Environment::step, one at a time.
 
 #include <ssx/export.hpp>
 #include <ssx/types.hpp>
 
 #include <array>
 #include <cstdint>
+#include <filesystem>
 #include <memory>
 #include <string>
 #include <vector>
@@ -15,6 +25,8 @@
 namespace ssx {
 
 class Artifact;
+
+using Color = std::array<float, 4>;  ///< RGBA, 0..1
 
 /// One node of what the user sees, posed relative to its parent. A root follows the physic node
 /// named in `follow` (its pose is then relative to that node), or stays where it was placed.
@@ -25,39 +37,85 @@ struct RenderNodeSpec {
   Vec3 size = Vec3::Ones();  ///< box edge lengths; plane: x and y extent
   double radius = 0.5;
   double length = 1.0;
-  std::array<float, 4> color{0.7f, 0.7f, 0.7f, 1.0f};  ///< RGBA, 0..1
+  Color color{0.7f, 0.7f, 0.7f, 1.0f};
+  bool grid = false;  ///< draw a 1 m grid on it (the ground)
   Pose pose;
   std::string follow;  ///< physic node name (roots only); empty: fixed
   std::vector<RenderNodeSpec> children;
 };
 
+/// A camera's pose and lens. The camera looks along its +x axis with +z up (the robotics body
+/// convention), so a camera on a robot looks where the robot's nose points.
+struct CameraView {
+  Pose pose;
+  double fov_deg = 60.0;  ///< horizontal field of view
+  int width = 640, height = 480;
+  double near = 0.05, far = 200.0;  ///< m
+  bool depth = false;               ///< also read the depth image
+};
+
+/// An image: rows top to bottom, RGB 8 bits each; depth (when asked for) in m along the optical
+/// axis, +infinity where nothing was hit.
+struct Image {
+  int width = 0, height = 0;
+  std::vector<std::uint8_t> rgb;
+  std::vector<float> depth;
+  const std::uint8_t* pixel(int x, int y) const { return rgb.data() + 3 * (static_cast<std::size_t>(y) * width + x); }
+  float depthAt(int x, int y) const { return depth.at(static_cast<std::size_t>(y) * width + x); }
+};
+
+/// A camera of the scene: fixed (`position` looking at `look_at`), or following an artifact
+/// (`position` and `look_at` then in that artifact's first root's frame, yaw only: the picture
+/// stays level). Its frames go to the outputs given.
+struct CameraSpec {
+  std::string name = "main";
+  Vec3 position{8, -8, 6};
+  Vec3 look_at = Vec3::Zero();
+  std::string follow;  ///< artifact name; empty: fixed
+  bool frame_scene = false;  ///< set position and look_at at start so that every artifact is in view
+  double fov_deg = 60.0;
+  std::filesystem::path frames_dir;  ///< PNG per frame (frame_000000.png, ...); empty: none
+  std::filesystem::path video;       ///< MP4 through ffmpeg; empty: none
+  std::filesystem::path snapshot;    ///< PNG of the last frame drawn, written when the run stops
+};
+
 /// Settings of the render engine.
 struct RenderSettings {
   std::string engine = "null";
-  std::int64_t period_steps = 0;  ///< draw every this many steps; 0: never
+  double rate_hz = 0;             ///< frames per simulated second; 0: as often as period_steps says
+  std::int64_t period_steps = 0;  ///< draw every this many steps; 0: never (set from rate_hz if given)
+  int width = 640, height = 480;
+  Color background{0.62f, 0.72f, 0.85f, 1.0f};
+  std::vector<CameraSpec> cameras;  ///< frames are drawn only when there is a camera
 };
 
 /// A live render node: one node of an artifact's render tree, posed in the world from the
-/// snapshot by the Environment right before `draw`.
+/// snapshot by the Environment right before drawing.
 struct RenderNode {
   const RenderNodeSpec* spec = nullptr;
   const Artifact* artifact = nullptr;
   Pose world;
 };
 
-/// An abstract renderer. Called only from the thread calling Environment::step, in the render
-/// phase, after drivers; it reads the snapshot through the nodes the Environment hands it.
+/// An abstract renderer. Called only from the thread calling Environment::step.
 class SSX_EXPORT RenderEngine {
  public:
   virtual ~RenderEngine();
   virtual std::string name() const = 0;
-  /// Draws one frame of the given nodes at simulated time `time`.
-  virtual void draw(Nanoseconds time, const std::vector<RenderNode>& nodes) = 0;
-  /// Frames drawn so far.
-  virtual std::int64_t frameCount() const = 0;
+  /// False for the null engine: renderView must not be called.
+  virtual bool drawsPixels() const = 0;
+  /// Draws the nodes as seen by `view` into `out` (resized to the view).
+  virtual void renderView(const CameraView& view, const std::vector<RenderNode>& nodes, const Color& background,
+                          Image& out) = 0;
 };
 
-/// Creates a render engine by name ("null"); throws ConfigError for an unknown name.
+/// Creates a render engine by name ("null", and "osmesa" when built with it); throws
+/// ConfigError for an unknown name, naming the ones available.
 SSX_EXPORT std::unique_ptr<RenderEngine> createRenderEngine(const RenderSettings& settings);
+/// The engine names this build knows.
+SSX_EXPORT std::vector<std::string> renderEngineNames();
+
+/// Writes an RGB image as PNG (fast compression); throws Error naming the file if it cannot.
+SSX_EXPORT void writePng(const std::filesystem::path& file, const Image& image);
 
 }  // namespace ssx

@@ -161,8 +161,8 @@ class SceneLoader {
                          Eigen::AngleAxisd(rpy.x(), Vec3::UnitX()));
     return p;
   }
-  std::array<float, 4> readColor(const Descriptor& d, std::array<float, 4> fallback) {
-    const auto* a = d.find("color");
+  std::array<float, 4> readColor(const Descriptor& d, std::array<float, 4> fallback, const char* key = "color") {
+    const auto* a = d.find(key);
     if (a == nullptr) return fallback;
     std::istringstream in(a->value);
     std::vector<double> v;
@@ -171,8 +171,8 @@ class SceneLoader {
     const bool ok = in.eof() && (v.size() == 3 || v.size() == 4) &&
                     std::all_of(v.begin(), v.end(), [](double c) { return c >= 0 && c <= 1; });
     if (!ok) {
-      record(
-          d.error(*a, "attribute 'color' must be \"r g b\" or \"r g b a\" with each in 0..1, got '" + a->value + "'"));
+      record(d.error(*a, "attribute '" + std::string(key) + "' must be \"r g b\" or \"r g b a\" with each in 0..1, got '" +
+                             a->value + "'"));
       return fallback;
     }
     return {static_cast<float>(v[0]), static_cast<float>(v[1]), static_cast<float>(v[2]),
@@ -236,6 +236,7 @@ class SceneLoader {
   std::map<std::string, TypeDecl> type_decls_;
   std::map<std::string, ArtifactType> types_;          // by type name, parsed on first use
   std::map<std::string, std::string> failed_plugins_;  // "plugin/class" -> already reported
+  std::vector<std::pair<std::string, SourceLocation>> camera_follows_;  // checked once artifacts exist
 };
 
 bool SceneLoader::once(const Descriptor& d, const Descriptor*& slot) {
@@ -362,9 +363,40 @@ void SceneLoader::readPhysics(const Descriptor& d) {
 }
 
 void SceneLoader::readRender(const Descriptor& d) {
-  settings_.render.engine = readChoice(d, "engine", settings_.render.engine, {"null"});
-  settings_.render.period_steps = readCount(d, "period", 0, 0);
-  checkUnknown(d);
+  RenderSettings& r = settings_.render;
+  r.engine = readChoice(d, "engine", r.engine, {"null", "osmesa"});
+  const auto names = renderEngineNames();
+  if (std::find(names.begin(), names.end(), r.engine) == names.end()) {
+    error(d.find("engine")->where, "render engine '" + r.engine +
+                                       "' is not in this build of ssx: install libosmesa6-dev and rebuild");
+    r.engine = "null";
+  }
+  r.period_steps = readCount(d, "period", 0, 0);
+  r.rate_hz = read<double>(d, "rate_hz", 0.0);
+  if (!(r.rate_hz >= 0)) error(d.find("rate_hz")->where, "<render>: rate_hz must be 0 or positive");
+  r.width = static_cast<int>(readCount(d, "width", r.width, 16, 16384));
+  r.height = static_cast<int>(readCount(d, "height", r.height, 16, 16384));
+  r.background = readColor(d, r.background, "background");
+  for (const Descriptor* c : d.childrenNamed("camera")) {
+    CameraSpec cam;
+    cam.name = read<std::string>(*c, "name", "camera" + std::to_string(r.cameras.size()));
+    for (const auto& other : r.cameras)
+      if (other.name == cam.name) error(c->where(), "<camera>: duplicate camera name '" + cam.name + "'");
+    cam.frame_scene = !c->has("xyz");
+    cam.position = read<Vec3>(*c, "xyz", cam.position);
+    cam.look_at = read<Vec3>(*c, "look_at", cam.look_at);
+    cam.follow = read<std::string>(*c, "follow", "");
+    if (!cam.follow.empty()) camera_follows_.push_back({cam.follow, c->find("follow")->where});
+    cam.fov_deg = read<double>(*c, "fov_deg", cam.fov_deg);
+    if (!(cam.fov_deg > 0 && cam.fov_deg < 180))
+      error(c->find("fov_deg")->where, "<camera>: fov_deg must be in (0, 180)");
+    cam.frames_dir = read<std::string>(*c, "frames", "");
+    cam.video = read<std::string>(*c, "video", "");
+    cam.snapshot = read<std::string>(*c, "snapshot", "");
+    checkUnknown(*c);
+    r.cameras.push_back(std::move(cam));
+  }
+  checkUnknown(d, {"camera"});
 }
 
 // --- artifact files ------------------------------------------------------------------------------
@@ -742,6 +774,18 @@ void SceneLoader::build(Scene& scene) {
   if (options_.seed) settings_.seed = *options_.seed;
   if (options_.threads) settings_.threads = *options_.threads;
   if (options_.render_engine) settings_.render.engine = *options_.render_engine;
+  // outputs asked for on the command line go to the first camera (one framing the scene if none)
+  if (!options_.snapshot.empty() || !options_.video.empty() || !options_.frames_dir.empty()) {
+    auto& cameras = settings_.render.cameras;
+    if (cameras.empty()) {
+      CameraSpec c;
+      c.frame_scene = true;
+      cameras.push_back(c);
+    }
+    if (!options_.snapshot.empty()) cameras.front().snapshot = options_.snapshot;
+    if (!options_.video.empty()) cameras.front().video = options_.video;
+    if (!options_.frames_dir.empty()) cameras.front().frames_dir = options_.frames_dir;
+  }
   try {
     scene.environment = std::make_unique<Environment>(settings_);
   } catch (const ConfigError& e) {
@@ -792,6 +836,11 @@ void SceneLoader::build(Scene& scene) {
     } else if (d.name() == "obstacle") {
       buildObstacle(env, d);
     }
+  }
+  for (const auto& [name, where] : camera_follows_) {
+    const Artifact* a = env.findArtifact(name);
+    if (a == nullptr || a->rootCount() == 0)
+      error(where, "<camera>: follows '" + name + "', which is no artifact with a physic root in this scene");
   }
 }
 

@@ -1,0 +1,436 @@
+// The osmesa render engine: Mesa's software OpenGL (llvmpipe) into a memory buffer, no display.
+//
+// One OpenGL 3.3 core context, created on the first draw, on the thread that draws (the thread
+// calling Environment::step). Every primitive kind is one unit mesh; each frame uploads one
+// instance record per visible primitive (position, orientation, scale, colour) and draws each mesh
+// with a single instanced call, so a frame costs a handful of draw calls whatever the number of
+// robots. Lighting: a sun from above plus a light at the eye, and a 1 m grid on ground planes.
+#include "render/osmesa_engine.hpp"
+
+#define GL_GLEXT_PROTOTYPES 1
+#include <GL/gl.h>
+#include <GL/glext.h>
+#include <GL/osmesa.h>
+
+#include <ssx/error.hpp>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdlib>
+#include <limits>
+#include <numbers>
+#include <string>
+#include <vector>
+
+namespace ssx::detail {
+
+namespace {
+
+constexpr const char* kVertexShader = R"(#version 330 core
+layout(location = 0) in vec3 a_position;
+layout(location = 1) in vec3 a_normal;
+layout(location = 2) in vec3 i_position;
+layout(location = 3) in vec4 i_rotation;  // quaternion x y z w
+layout(location = 4) in vec3 i_scale;
+layout(location = 5) in vec4 i_color;
+layout(location = 6) in float i_grid;
+uniform mat4 u_view_projection;
+out vec3 v_normal;
+out vec3 v_world;
+out vec4 v_color;
+out float v_grid;
+vec3 rotate(vec4 q, vec3 v) {
+  vec3 t = 2.0 * cross(q.xyz, v);
+  return v + q.w * t + cross(q.xyz, t);
+}
+void main() {
+  vec3 world = rotate(i_rotation, a_position * i_scale) + i_position;
+  v_world = world;
+  v_normal = rotate(i_rotation, a_normal / i_scale);  // inverse transpose of rotation * scale
+  v_color = i_color;
+  v_grid = i_grid;
+  gl_Position = u_view_projection * vec4(world, 1.0);
+}
+)";
+
+constexpr const char* kFragmentShader = R"(#version 330 core
+in vec3 v_normal;
+in vec3 v_world;
+in vec4 v_color;
+in float v_grid;
+uniform vec3 u_sun;  // unit vector towards the sun
+uniform vec3 u_eye;
+out vec4 o_color;
+void main() {
+  vec3 n = normalize(v_normal);
+  if (!gl_FrontFacing) n = -n;
+  vec3 to_eye = normalize(u_eye - v_world);
+  float light = 0.3 + 0.45 * max(dot(n, u_sun), 0.0) + 0.3 * max(dot(n, to_eye), 0.0);
+  vec3 c = v_color.rgb * min(light, 1.0);
+  if (v_grid > 0.5) {
+    vec2 w = max(fwidth(v_world.xy), vec2(1e-4));
+    vec2 d = abs(fract(v_world.xy + 0.5) - 0.5) / w;
+    float line = 1.0 - min(min(d.x, d.y), 1.0);
+    float fade = clamp(1.0 - 6.0 * max(w.x, w.y), 0.0, 1.0);  // no moire far away
+    c *= 1.0 - 0.35 * line * fade;
+  }
+  o_color = vec4(c, v_color.a);
+}
+)";
+
+struct Vertex {
+  float position[3];
+  float normal[3];
+};
+
+// one instance: position, rotation quaternion (x y z w), scale, colour, grid flag
+struct Instance {
+  float position[3];
+  float rotation[4];
+  float scale[3];
+  float color[4];
+  float grid;
+};
+
+enum Mesh { kBox, kSphere, kCylinder, kPlane, kMeshCount };
+
+void addQuad(std::vector<Vertex>& v, std::vector<unsigned>& idx, const std::array<float, 3>& n,
+             const std::array<std::array<float, 3>, 4>& corners) {
+  const auto base = static_cast<unsigned>(v.size());
+  for (const auto& c : corners) v.push_back({{c[0], c[1], c[2]}, {n[0], n[1], n[2]}});
+  for (unsigned k : {0u, 1u, 2u, 0u, 2u, 3u}) idx.push_back(base + k);
+}
+
+// a unit cube centred on the origin
+void boxMesh(std::vector<Vertex>& v, std::vector<unsigned>& idx) {
+  const float h = 0.5f;
+  addQuad(v, idx, {1, 0, 0}, {{{h, -h, -h}, {h, h, -h}, {h, h, h}, {h, -h, h}}});
+  addQuad(v, idx, {-1, 0, 0}, {{{-h, h, -h}, {-h, -h, -h}, {-h, -h, h}, {-h, h, h}}});
+  addQuad(v, idx, {0, 1, 0}, {{{h, h, -h}, {-h, h, -h}, {-h, h, h}, {h, h, h}}});
+  addQuad(v, idx, {0, -1, 0}, {{{-h, -h, -h}, {h, -h, -h}, {h, -h, h}, {-h, -h, h}}});
+  addQuad(v, idx, {0, 0, 1}, {{{-h, -h, h}, {h, -h, h}, {h, h, h}, {-h, h, h}}});
+  addQuad(v, idx, {0, 0, -1}, {{{-h, h, -h}, {h, h, -h}, {h, -h, -h}, {-h, -h, -h}}});
+}
+
+// a unit sphere (radius 1)
+void sphereMesh(std::vector<Vertex>& v, std::vector<unsigned>& idx) {
+  constexpr int stacks = 12, slices = 20;
+  const float pi = std::numbers::pi_v<float>;
+  for (int i = 0; i <= stacks; ++i) {
+    const float theta = pi * static_cast<float>(i) / stacks;
+    for (int j = 0; j <= slices; ++j) {
+      const float phi = 2 * pi * static_cast<float>(j) / slices;
+      const float x = std::sin(theta) * std::cos(phi), y = std::sin(theta) * std::sin(phi), z = std::cos(theta);
+      v.push_back({{x, y, z}, {x, y, z}});
+    }
+  }
+  for (int i = 0; i < stacks; ++i)
+    for (int j = 0; j < slices; ++j) {
+      const auto a = static_cast<unsigned>(i * (slices + 1) + j), b = a + slices + 1;
+      for (unsigned k : {a, b, a + 1, a + 1, b, b + 1}) idx.push_back(k);
+    }
+}
+
+// a cylinder of radius 1 and length 1 along z, centred, with caps
+void cylinderMesh(std::vector<Vertex>& v, std::vector<unsigned>& idx) {
+  constexpr int slices = 20;
+  const float pi = std::numbers::pi_v<float>;
+  const auto side = static_cast<unsigned>(v.size());
+  for (int j = 0; j <= slices; ++j) {
+    const float phi = 2 * pi * static_cast<float>(j) / slices, c = std::cos(phi), s = std::sin(phi);
+    v.push_back({{c, s, -0.5f}, {c, s, 0}});
+    v.push_back({{c, s, 0.5f}, {c, s, 0}});
+  }
+  for (int j = 0; j < slices; ++j) {
+    const auto a = side + static_cast<unsigned>(2 * j);
+    for (unsigned k : {a, a + 2, a + 1, a + 1, a + 2, a + 3}) idx.push_back(k);
+  }
+  for (float z : {-0.5f, 0.5f}) {
+    const auto centre = static_cast<unsigned>(v.size());
+    v.push_back({{0, 0, z}, {0, 0, z > 0 ? 1.0f : -1.0f}});
+    for (int j = 0; j <= slices; ++j) {
+      const float phi = 2 * pi * static_cast<float>(j) / slices;
+      v.push_back({{std::cos(phi), std::sin(phi), z}, {0, 0, z > 0 ? 1.0f : -1.0f}});
+    }
+    for (int j = 0; j < slices; ++j) {
+      const auto a = centre + 1 + static_cast<unsigned>(j);
+      if (z > 0)
+        for (unsigned k : {centre, a, a + 1}) idx.push_back(k);
+      else
+        for (unsigned k : {centre, a + 1, a}) idx.push_back(k);
+    }
+  }
+}
+
+// a unit square in the xy plane, facing +z
+void planeMesh(std::vector<Vertex>& v, std::vector<unsigned>& idx) {
+  addQuad(v, idx, {0, 0, 1}, {{{-0.5f, -0.5f, 0}, {0.5f, -0.5f, 0}, {0.5f, 0.5f, 0}, {-0.5f, 0.5f, 0}}});
+}
+
+GLuint compile(GLenum kind, const char* source) {
+  const GLuint shader = glCreateShader(kind);
+  glShaderSource(shader, 1, &source, nullptr);
+  glCompileShader(shader);
+  GLint ok = 0;
+  glGetShaderiv(shader, GL_COMPILE_STATUS, &ok);
+  if (!ok) {
+    char log[2048] = {};
+    glGetShaderInfoLog(shader, sizeof log, nullptr, log);
+    throw Error(std::string("osmesa renderer: shader does not compile: ") + log);
+  }
+  return shader;
+}
+
+// column-major 4x4 product
+std::array<float, 16> multiply(const std::array<float, 16>& a, const std::array<float, 16>& b) {
+  std::array<float, 16> r{};
+  for (int c = 0; c < 4; ++c)
+    for (int row = 0; row < 4; ++row) {
+      float s = 0;
+      for (int k = 0; k < 4; ++k) s += a[static_cast<std::size_t>(k * 4 + row)] * b[static_cast<std::size_t>(c * 4 + k)];
+      r[static_cast<std::size_t>(c * 4 + row)] = s;
+    }
+  return r;
+}
+
+}  // namespace
+
+struct OsmesaRenderEngine::Gl {
+  OSMesaContext context = nullptr;
+  std::vector<std::uint8_t> buffer;  // RGBA, bottom row first
+  int width = 0, height = 0;
+  GLuint program = 0, vao[kMeshCount] = {}, vertex_buffer[kMeshCount] = {}, index_buffer[kMeshCount] = {},
+         instance_buffer[kMeshCount] = {};
+  GLsizei index_count[kMeshCount] = {};
+  GLint u_view_projection = -1, u_sun = -1, u_eye = -1;
+  std::vector<Instance> instances[kMeshCount];
+  std::vector<float> depth;
+};
+
+OsmesaRenderEngine::OsmesaRenderEngine() : gl_(std::make_unique<Gl>()) {}
+
+OsmesaRenderEngine::~OsmesaRenderEngine() {
+  if (gl_->context != nullptr) OSMesaDestroyContext(gl_->context);
+}
+
+void OsmesaRenderEngine::makeCurrent(int width, int height) {
+  Gl& g = *gl_;
+  if (g.context == nullptr) {
+    // llvmpipe's own rasteriser threads cost more than they give at these image sizes, and they
+    // would compete with the simulation's workers; a user can still set LP_NUM_THREADS
+    setenv("LP_NUM_THREADS", "0", 0);
+    const int attributes[] = {OSMESA_FORMAT,
+                              OSMESA_RGBA,
+                              OSMESA_DEPTH_BITS,
+                              24,
+                              OSMESA_PROFILE,
+                              OSMESA_CORE_PROFILE,
+                              OSMESA_CONTEXT_MAJOR_VERSION,
+                              3,
+                              OSMESA_CONTEXT_MINOR_VERSION,
+                              3,
+                              0};
+    g.context = OSMesaCreateContextAttribs(attributes, nullptr);
+    if (g.context == nullptr)
+      throw Error("osmesa renderer: cannot create an OpenGL 3.3 core context (is Mesa's libOSMesa working?)");
+  }
+  if (width != g.width || height != g.height || OSMesaGetCurrentContext() != g.context) {
+    g.buffer.assign(static_cast<std::size_t>(width) * height * 4, 0);
+    if (!OSMesaMakeCurrent(g.context, g.buffer.data(), GL_UNSIGNED_BYTE, width, height))
+      throw Error("osmesa renderer: cannot bind the context to a " + std::to_string(width) + "x" +
+                  std::to_string(height) + " buffer");
+    g.width = width;
+    g.height = height;
+  }
+  if (g.program == 0) setup();
+}
+
+void OsmesaRenderEngine::setup() {
+  Gl& g = *gl_;
+  const GLuint vs = compile(GL_VERTEX_SHADER, kVertexShader), fs = compile(GL_FRAGMENT_SHADER, kFragmentShader);
+  g.program = glCreateProgram();
+  glAttachShader(g.program, vs);
+  glAttachShader(g.program, fs);
+  glLinkProgram(g.program);
+  GLint ok = 0;
+  glGetProgramiv(g.program, GL_LINK_STATUS, &ok);
+  if (!ok) throw Error("osmesa renderer: shaders do not link");
+  glDeleteShader(vs);
+  glDeleteShader(fs);
+  g.u_view_projection = glGetUniformLocation(g.program, "u_view_projection");
+  g.u_sun = glGetUniformLocation(g.program, "u_sun");
+  g.u_eye = glGetUniformLocation(g.program, "u_eye");
+
+  glGenVertexArrays(kMeshCount, g.vao);
+  glGenBuffers(kMeshCount, g.vertex_buffer);
+  glGenBuffers(kMeshCount, g.index_buffer);
+  glGenBuffers(kMeshCount, g.instance_buffer);
+  for (int m = 0; m < kMeshCount; ++m) {
+    std::vector<Vertex> vertices;
+    std::vector<unsigned> indices;
+    switch (m) {
+      case kBox: boxMesh(vertices, indices); break;
+      case kSphere: sphereMesh(vertices, indices); break;
+      case kCylinder: cylinderMesh(vertices, indices); break;
+      default: planeMesh(vertices, indices); break;
+    }
+    g.index_count[m] = static_cast<GLsizei>(indices.size());
+    glBindVertexArray(g.vao[m]);
+    glBindBuffer(GL_ARRAY_BUFFER, g.vertex_buffer[m]);
+    glBufferData(GL_ARRAY_BUFFER, static_cast<GLsizeiptr>(vertices.size() * sizeof(Vertex)), vertices.data(),
+                 GL_STATIC_DRAW);
+    glEnableVertexAttribArray(0);
+    glVertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, sizeof(Vertex), reinterpret_cast<void*>(offsetof(Vertex, position)));
+    glEnableVertexAttribArray(1);
+    glVertexAttribPointer(1, 3, GL_FLOAT, GL_FALSE, sizeof(Vertex), reinterpret_cast<void*>(offsetof(Vertex, normal)));
+    glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, g.index_buffer[m]);
+    glBufferData(GL_ELEMENT_ARRAY_BUFFER, static_cast<GLsizeiptr>(indices.size() * sizeof(unsigned)), indices.data(),
+                 GL_STATIC_DRAW);
+    glBindBuffer(GL_ARRAY_BUFFER, g.instance_buffer[m]);
+    struct Attribute {
+      GLuint location;
+      GLint size;
+      std::size_t offset;
+    };
+    for (const Attribute& a : {Attribute{2, 3, offsetof(Instance, position)}, Attribute{3, 4, offsetof(Instance, rotation)},
+                               Attribute{4, 3, offsetof(Instance, scale)}, Attribute{5, 4, offsetof(Instance, color)},
+                               Attribute{6, 1, offsetof(Instance, grid)}}) {
+      glEnableVertexAttribArray(a.location);
+      glVertexAttribPointer(a.location, a.size, GL_FLOAT, GL_FALSE, sizeof(Instance), reinterpret_cast<void*>(a.offset));
+      glVertexAttribDivisor(a.location, 1);
+    }
+  }
+  glBindVertexArray(0);
+  glEnable(GL_DEPTH_TEST);
+  glEnable(GL_CULL_FACE);
+  glCullFace(GL_BACK);
+  glFrontFace(GL_CCW);
+}
+
+void OsmesaRenderEngine::renderView(const CameraView& view, const std::vector<RenderNode>& nodes,
+                                    const Color& background, Image& out) {
+  if (view.width <= 0 || view.height <= 0 || view.width > 16384 || view.height > 16384)
+    throw Error("osmesa renderer: image size " + std::to_string(view.width) + "x" + std::to_string(view.height) +
+                " is out of range (1..16384)");
+  makeCurrent(view.width, view.height);
+  Gl& g = *gl_;
+
+  // instances, by mesh
+  for (auto& list : g.instances) list.clear();
+  auto add = [&](Mesh mesh, const Pose& pose, const Vec3& scale, const RenderNodeSpec& spec) {
+    Instance in;
+    for (int k = 0; k < 3; ++k) {
+      in.position[k] = static_cast<float>(pose.position[k]);
+      in.scale[k] = static_cast<float>(std::max(scale[k], 1e-6));
+    }
+    const Quat& q = pose.orientation;
+    in.rotation[0] = static_cast<float>(q.x());
+    in.rotation[1] = static_cast<float>(q.y());
+    in.rotation[2] = static_cast<float>(q.z());
+    in.rotation[3] = static_cast<float>(q.w());
+    for (int k = 0; k < 4; ++k) in.color[k] = spec.color[static_cast<std::size_t>(k)];
+    in.grid = spec.grid ? 1.0f : 0.0f;
+    g.instances[mesh].push_back(in);
+  };
+  using P = RenderNodeSpec::Primitive;
+  for (const RenderNode& n : nodes) {
+    const RenderNodeSpec& s = *n.spec;
+    switch (s.primitive) {
+      case P::None: break;
+      case P::Box: add(kBox, n.world, s.size, s); break;
+      case P::Sphere: add(kSphere, n.world, Vec3::Constant(s.radius), s); break;
+      case P::Cylinder: add(kCylinder, n.world, Vec3(s.radius, s.radius, s.length), s); break;
+      case P::Capsule:
+        add(kCylinder, n.world, Vec3(s.radius, s.radius, s.length), s);
+        for (double end : {-0.5, 0.5})
+          add(kSphere, n.world * Pose{Vec3(0, 0, end * s.length), Quat::Identity()}, Vec3::Constant(s.radius), s);
+        break;
+      case P::Plane: add(kPlane, n.world, Vec3(s.size.x(), s.size.y(), 1.0), s); break;
+    }
+  }
+
+  // view: the camera looks along its +x with +z up; OpenGL's eye looks along -z with +y up
+  const Eigen::Matrix3d r = view.pose.orientation.toRotationMatrix();
+  const Vec3 forward = r.col(0), left = r.col(1), up = r.col(2), eye = view.pose.position;
+  const Vec3 right = -left;
+  std::array<float, 16> v{};
+  for (int k = 0; k < 3; ++k) {
+    v[static_cast<std::size_t>(k * 4 + 0)] = static_cast<float>(right[k]);
+    v[static_cast<std::size_t>(k * 4 + 1)] = static_cast<float>(up[k]);
+    v[static_cast<std::size_t>(k * 4 + 2)] = static_cast<float>(-forward[k]);
+  }
+  v[12] = static_cast<float>(-right.dot(eye));
+  v[13] = static_cast<float>(-up.dot(eye));
+  v[14] = static_cast<float>(forward.dot(eye));
+  v[15] = 1;
+  const double aspect = static_cast<double>(view.width) / view.height;
+  const double tx = std::tan(view.fov_deg * std::numbers::pi / 360.0), ty = tx / aspect;
+  const double n = view.near, f = view.far;
+  std::array<float, 16> p{};
+  p[0] = static_cast<float>(1 / tx);
+  p[5] = static_cast<float>(1 / ty);
+  p[10] = static_cast<float>(-(f + n) / (f - n));
+  p[11] = -1;
+  p[14] = static_cast<float>(-2 * f * n / (f - n));
+  const std::array<float, 16> vp = multiply(p, v);
+
+  glViewport(0, 0, view.width, view.height);
+  glClearColor(background[0], background[1], background[2], background[3]);
+  glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+  glUseProgram(g.program);
+  glUniformMatrix4fv(g.u_view_projection, 1, GL_FALSE, vp.data());
+  const Vec3 sun = Vec3(0.35, 0.25, 0.9).normalized();
+  glUniform3f(g.u_sun, static_cast<float>(sun.x()), static_cast<float>(sun.y()), static_cast<float>(sun.z()));
+  glUniform3f(g.u_eye, static_cast<float>(eye.x()), static_cast<float>(eye.y()), static_cast<float>(eye.z()));
+  for (int m = 0; m < kMeshCount; ++m) {
+    const auto& list = g.instances[m];
+    if (list.empty()) continue;
+    // planes are seen from both sides
+    if (m == kPlane) glDisable(GL_CULL_FACE);
+    glBindVertexArray(g.vao[m]);
+    glBindBuffer(GL_ARRAY_BUFFER, g.instance_buffer[m]);
+    glBufferData(GL_ARRAY_BUFFER, static_cast<GLsizeiptr>(list.size() * sizeof(Instance)), list.data(), GL_STREAM_DRAW);
+    glDrawElementsInstanced(GL_TRIANGLES, g.index_count[m], GL_UNSIGNED_INT, nullptr, static_cast<GLsizei>(list.size()));
+    if (m == kPlane) glEnable(GL_CULL_FACE);
+  }
+  glBindVertexArray(0);
+  if (view.depth) {
+    g.depth.resize(static_cast<std::size_t>(view.width) * view.height);
+    glPixelStorei(GL_PACK_ALIGNMENT, 1);
+    glReadPixels(0, 0, view.width, view.height, GL_DEPTH_COMPONENT, GL_FLOAT, g.depth.data());
+  } else {
+    glFinish();
+  }
+  if (const GLenum e = glGetError(); e != GL_NO_ERROR)
+    throw Error("osmesa renderer: OpenGL error " + std::to_string(e) + " while drawing");
+
+  // the buffer's first row is the bottom one; images are top row first
+  out.width = view.width;
+  out.height = view.height;
+  out.rgb.resize(static_cast<std::size_t>(view.width) * view.height * 3);
+  for (int y = 0; y < view.height; ++y) {
+    const std::uint8_t* src = g.buffer.data() + static_cast<std::size_t>(view.height - 1 - y) * view.width * 4;
+    std::uint8_t* dst = out.rgb.data() + static_cast<std::size_t>(y) * view.width * 3;
+    for (int x = 0; x < view.width; ++x, src += 4, dst += 3) {
+      dst[0] = src[0];
+      dst[1] = src[1];
+      dst[2] = src[2];
+    }
+  }
+  if (view.depth) {
+    // window depth to distance along the optical axis
+    out.depth.resize(g.depth.size());
+    for (int y = 0; y < view.height; ++y)
+      for (int x = 0; x < view.width; ++x) {
+        const double d = g.depth[static_cast<std::size_t>(view.height - 1 - y) * view.width + x];
+        out.depth[static_cast<std::size_t>(y) * view.width + x] =
+            d >= 1.0 ? std::numeric_limits<float>::infinity()
+                     : static_cast<float>(2 * n * f / (f + n - (2 * d - 1) * (f - n)));
+      }
+  } else {
+    out.depth.clear();
+  }
+}
+
+}  // namespace ssx::detail
