@@ -37,4 +37,5 @@ SetpointInterface::~SetpointInterface() = default;
 
 namespace ssx {
 RangeMeasurement::~RangeMeasurement() = default;
+CameraMeasurement::~CameraMeasurement() = default;
 }  // namespace ssx

@@ -5,6 +5,7 @@
 
 #include <ssx/export.hpp>
 #include <ssx/plugin.hpp>
+#include <ssx/render.hpp>
 #include <ssx/types.hpp>
 
 #include <array>
@@ -52,6 +53,14 @@ struct SSX_EXPORT RangeMeasurement : Measurement {
   bool body_frame = false;  ///< `relative` in the sensor's body frame, else the world frame
   std::vector<Detection> detections;
   ~RangeMeasurement() override;
+};
+
+/// A camera image: RGB and, when asked for, depth (m along the optical axis), drawn from the
+/// snapshot of the step it is stamped with.
+struct SSX_EXPORT CameraMeasurement : Measurement {
+  Image image;
+  CameraView view;  ///< the camera's pose (x forward, z up) and lens when it was drawn
+  ~CameraMeasurement() override;
 };
 
 }  // namespace ssx

@@ -399,9 +399,9 @@ void OsmesaRenderEngine::renderView(const CameraView& view, const std::vector<Re
     g.depth.resize(static_cast<std::size_t>(view.width) * view.height);
     glPixelStorei(GL_PACK_ALIGNMENT, 1);
     glReadPixels(0, 0, view.width, view.height, GL_DEPTH_COMPONENT, GL_FLOAT, g.depth.data());
-  } else {
-    glFinish();
   }
+  // the colour reaches our buffer on glFinish (Mesa copies it out then), not on a depth read
+  glFinish();
   if (const GLenum e = glGetError(); e != GL_NO_ERROR)
     throw Error("osmesa renderer: OpenGL error " + std::to_string(e) + " while drawing");
 

@@ -388,8 +388,10 @@ void SceneLoader::readRender(const Descriptor& d) {
     cam.follow = read<std::string>(*c, "follow", "");
     if (!cam.follow.empty()) camera_follows_.push_back({cam.follow, c->find("follow")->where});
     cam.fov_deg = read<double>(*c, "fov_deg", cam.fov_deg);
-    if (!(cam.fov_deg > 0 && cam.fov_deg < 180))
+    if (!(cam.fov_deg > 0 && cam.fov_deg < 180)) {
       error(c->find("fov_deg")->where, "<camera>: fov_deg must be in (0, 180)");
+      cam.fov_deg = 60;  // reported once, here
+    }
     cam.frames_dir = read<std::string>(*c, "frames", "");
     cam.video = read<std::string>(*c, "video", "");
     cam.snapshot = read<std::string>(*c, "snapshot", "");

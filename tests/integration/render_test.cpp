@@ -1,0 +1,161 @@
+// Rendering: pixel facts on known scenes, outputs, and that drawing never changes results.
+// Headless (OSMesa); every test name contains "render".
+#include <ssx/ssx.hpp>
+
+#include <catch2/catch.hpp>
+
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+
+using namespace ssx;
+namespace fs = std::filesystem;
+
+namespace {
+
+const fs::path kData = fs::path(SSX_TEST_DATA_DIR) / "valid" / "render";
+
+bool haveOsmesa() {
+  const auto names = renderEngineNames();
+  return std::find(names.begin(), names.end(), "osmesa") != names.end();
+}
+
+Scene load(const std::string& body) {
+  return loadSceneFromString("<scene><environment timestep=\"0.002\" threads=\"2\"/>" + body + "</scene>",
+                             "render.xml", kData);
+}
+
+const CameraMeasurement& image(Environment& env, const std::string& artifact = "eye") {
+  return dynamic_cast<const CameraMeasurement&>(env.findArtifact(artifact)->sensor(0).latest());
+}
+
+// centroid of the pixels with strong red and green and little blue (the yellow ball), or -1
+double yellowRow(const Image& im) {
+  double sum = 0, count = 0;
+  for (int y = 0; y < im.height; ++y)
+    for (int x = 0; x < im.width; ++x) {
+      const std::uint8_t* p = im.pixel(x, y);
+      if (p[0] > 120 && p[1] > 100 && p[2] < 60) {
+        sum += y;
+        ++count;
+      }
+    }
+  return count > 0 ? sum / count : -1;
+}
+
+}  // namespace
+
+TEST_CASE("render: a red box in front of the camera fills the centre, at its known depth", "[render]") {
+  REQUIRE(haveOsmesa());  // dev.sh installs libosmesa6-dev
+  Scene s = load(R"(<render engine="osmesa" background="0.2 0.4 0.6"/>
+    <type name="post" file="camera_post.xml"/>
+    <artifact name="eye" type="post" xyz="0 0 1"/>
+    <obstacle name="box" xyz="5 0 1" color="1 0 0"><box size="1 1 1"/></obstacle>)");
+  Environment& env = *s.environment;
+  env.step();
+  const CameraMeasurement& m = image(env);
+  REQUIRE(m.image.width == 64);
+  REQUIRE(m.image.height == 48);
+  const std::uint8_t* c = m.image.pixel(32, 24);
+  INFO("centre pixel " << int(c[0]) << " " << int(c[1]) << " " << int(c[2]));
+  CHECK(c[0] > 150);
+  CHECK(c[1] < 40);
+  CHECK(c[2] < 40);
+  // the box's near face is at x = 4.5, the camera at x = 0.2
+  CHECK(m.image.depthAt(32, 24) == Approx(4.3).epsilon(0.01));
+  // a corner pixel misses the box: background colour, depth infinite
+  const std::uint8_t* corner = m.image.pixel(0, 0);
+  CHECK(std::abs(corner[0] - 51) <= 1);
+  CHECK(std::abs(corner[2] - 153) <= 1);
+  CHECK(std::isinf(m.image.depthAt(0, 0)));
+  CHECK(m.view.pose.position.isApprox(Vec3(0.2, 0, 1)));
+}
+
+TEST_CASE("render: an empty scene is all background", "[render]") {
+  REQUIRE(haveOsmesa());  // dev.sh installs libosmesa6-dev
+  Scene s = load(R"(<render engine="osmesa" background="0.2 0.4 0.6"/>
+    <type name="post" file="camera_post.xml"/><artifact name="eye" type="post" xyz="0 0 1"/>)");
+  Environment& env = *s.environment;
+  env.step();
+  const Image& im = image(env).image;
+  int off = 0;
+  for (int y = 0; y < im.height; ++y)
+    for (int x = 0; x < im.width; ++x) {
+      const std::uint8_t* p = im.pixel(x, y);
+      off += (std::abs(p[0] - 51) > 1 || std::abs(p[1] - 102) > 1 || std::abs(p[2] - 153) > 1) ? 1 : 0;
+    }
+  CHECK(off == 0);
+}
+
+TEST_CASE("render: a falling robot moves down in a fixed camera's image", "[render]") {
+  REQUIRE(haveOsmesa());  // dev.sh installs libosmesa6-dev
+  Scene s = load(R"(<render engine="osmesa"/>
+    <type name="post" file="camera_post.xml"/><type name="ball" file="yellow_ball.xml"/>
+    <artifact name="eye" type="post" xyz="0 0 1"/>
+    <artifact name="ball" type="ball" xyz="6 0 2"/>)");
+  Environment& env = *s.environment;
+  env.step();
+  const double row_before = yellowRow(image(env).image);
+  env.step(250);  // 0.5 s: 1.2 m lower
+  const double row_after = yellowRow(image(env).image);
+  INFO("rows " << row_before << " -> " << row_after);
+  REQUIRE(row_before >= 0);
+  REQUIRE(row_after >= 0);
+  CHECK(row_before < 24);        // above the optical axis at first
+  CHECK(row_after > row_before + 5);  // then lower in the picture (rows grow downwards)
+}
+
+TEST_CASE("render: drawing frames and camera images does not change the simulation", "[render][determinism]") {
+  REQUIRE(haveOsmesa());  // dev.sh installs libosmesa6-dev
+  auto run = [](const std::string& engine, bool cameras) {
+    const fs::path frames = fs::temp_directory_path() / "ssx_render_determinism";
+    fs::remove_all(frames);
+    std::string xml = "<render engine=\"" + engine + "\" rate_hz=\"25\">";
+    if (cameras) xml += "<camera name=\"top\" xyz=\"0 -8 6\" frames=\"" + frames.string() + "\"/>";
+    xml += R"(</render><ground/>
+      <type name="post" file="camera_post.xml"/><type name="ball" file="yellow_ball.xml"/>
+      <type name="quad" file=")" + std::string(SSX_EXAMPLES_DIR) + R"(/artifacts/mk_quad.xml"/>
+      <swarm type="quad" count="6" name="q{i}" spacing="1.5"/>)";
+    if (cameras) xml += R"(<artifact name="eye" type="post" xyz="-3 0 1"/>)";
+    xml += R"(<artifact name="ball" type="ball" xyz="2 3 2"/>)";
+    Scene s = load(xml);
+    s.environment->step(300);
+    return s.environment->stateHash();
+  };
+  const std::uint64_t plain = run("null", false);
+  CHECK(run("osmesa", true) == plain);
+  CHECK(run("osmesa", false) == plain);
+}
+
+TEST_CASE("render: scene cameras write numbered PNG frames at their rate and a snapshot at the end", "[render]") {
+  REQUIRE(haveOsmesa());  // dev.sh installs libosmesa6-dev
+  const fs::path dir = fs::temp_directory_path() / "ssx_render_frames";
+  fs::remove_all(dir);
+  Scene s = load(R"(<render engine="osmesa" rate_hz="10" width="160" height="120">
+      <camera name="side" xyz="0 -6 2" look_at="0 0 1" frames=")" + (dir / "side").string() + R"(" snapshot=")" +
+                 (dir / "snap.png").string() + R"("/>
+      <camera name="chase" follow="ball" xyz="-3 0 1" look_at="0 0 0"/>
+    </render><ground/>
+    <type name="ball" file="yellow_ball.xml"/><artifact name="ball" type="ball" xyz="0 0 2"/>)");
+  Environment& env = *s.environment;
+  env.step(250);  // 0.5 s at 10 frames per simulated second: steps 0, 50, ..., 200
+  CHECK(env.frameCount() == 5);
+  env.stop();
+  int files = 0;
+  for (const auto& e : fs::directory_iterator(dir / "side")) files += e.path().extension() == ".png" ? 1 : 0;
+  CHECK(files == 5);
+  CHECK(fs::exists(dir / "side" / "frame_000004.png"));
+  // a PNG of the size asked for: signature, then IHDR with width and height big-endian
+  std::ifstream png(dir / "snap.png", std::ios::binary);
+  unsigned char head[24] = {};
+  png.read(reinterpret_cast<char*>(head), sizeof head);
+  CHECK(std::memcmp(head, "\x89PNG\r\n\x1a\n", 8) == 0);
+  CHECK(((head[16] << 24) | (head[17] << 16) | (head[18] << 8) | head[19]) == 160);
+  CHECK(((head[20] << 24) | (head[21] << 16) | (head[22] << 8) | head[23]) == 120);
+}
+
+TEST_CASE("render: a camera sensor without a drawing engine fails at start and says what to do", "[render]") {
+  Scene s = load(R"(<type name="post" file="camera_post.xml"/><artifact name="eye" type="post"/>)");
+  CHECK_THROWS_WITH(s.environment->start(), Catch::Contains("engine=\"osmesa\""));
+}
