@@ -1,5 +1,6 @@
 #include "phase_guard.hpp"
 #include "render/frame_output.hpp"
+#include "render/frame_worker.hpp"
 #include "worker_pool.hpp"
 
 #include <ssx/environment.hpp>
@@ -574,21 +575,25 @@ void Environment::startCameras() {
       c.spec.look_at = centre;
       c.spec.position = centre + distance * Vec3(0.62, -0.62, 0.48).normalized();
     }
-    const double fps = 1.0 / (static_cast<double>(r.period_steps) * toSeconds(settings_.timestep));
-    c.output = std::make_unique<detail::FrameOutput>(c.spec, fps, [this](std::string_view m) {
-      log(LogLevel::Warning, m);
-    });
     cameras_.push_back(std::move(c));
   }
+  const double fps = 1.0 / (static_cast<double>(r.period_steps) * toSeconds(settings_.timestep));
+  std::vector<std::unique_ptr<detail::FrameOutput>> outputs;
+  for (const auto& c : cameras_)
+    outputs.push_back(std::make_unique<detail::FrameOutput>(c.spec, fps, [this](std::string_view m) {
+      log(LogLevel::Warning, m);
+    }));
+  frame_worker_ = std::make_unique<detail::FrameWorker>(r, std::move(outputs));
 }
 
 void Environment::finishCameras() {
-  for (auto& c : cameras_) {
+  if (frame_worker_) {
     try {
-      c.output->finish();
+      frame_worker_->finish();
     } catch (const std::exception& e) {
-      log(LogLevel::Error, e.what());
+      log(LogLevel::Error, std::string("frames: ") + e.what());
     }
+    frame_worker_.reset();
   }
   cameras_.clear();
 }
@@ -619,7 +624,8 @@ void Environment::renderCameraRequests() {
 
 void Environment::drawFrame() {
   syncRenderNodes();  // also without cameras: renderNodes() serves viewers outside ssx
-  if (cameras_.empty()) return;
+  if (!frame_worker_) return;
+  std::vector<CameraView> views;
   for (auto& c : cameras_) {
     CameraView view;
     view.width = settings_.render.width;
@@ -634,13 +640,13 @@ void Environment::drawFrame() {
     } else {
       view.pose = lookAt(c.spec.position, c.spec.look_at);
     }
-    try {
-      renderer_->renderView(view, render_items_, settings_.render.background, frame_);
-      c.output->add(frame_);
-    } catch (const std::exception& e) {
-      fail();
-      throw StepError("", "camera '" + c.spec.name + "'", current_step_, e.what());
-    }
+    views.push_back(view);
+  }
+  try {
+    frame_worker_->submit(render_items_, std::move(views));
+  } catch (const std::exception& e) {
+    fail();
+    throw StepError("", "render", current_step_, std::string("drawing or writing frames: ") + e.what());
   }
   ++frames_;
 }

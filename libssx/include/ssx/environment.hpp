@@ -44,6 +44,7 @@ namespace ssx {
 namespace detail {
 class WorkerPool;
 class FrameOutput;
+class FrameWorker;
 }
 
 /// Everything that defines an environment before it is populated.
@@ -256,10 +257,9 @@ class SSX_EXPORT Environment {
   struct SceneCamera {
     CameraSpec spec;
     const Artifact* follow = nullptr;
-    std::unique_ptr<detail::FrameOutput> output;
   };
   std::vector<SceneCamera> cameras_;
-  Image frame_;
+  std::unique_ptr<detail::FrameWorker> frame_worker_;  // draws and writes the cameras' frames
   std::int64_t frames_ = 0;
   bool neighbors_enabled_ = false;
   SpatialIndex neighbor_index_;

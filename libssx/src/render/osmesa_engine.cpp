@@ -18,6 +18,7 @@
 #include <array>
 #include <cmath>
 #include <cstdlib>
+#include <malloc.h>
 #include <limits>
 #include <numbers>
 #include <string>
@@ -203,6 +204,7 @@ struct OsmesaRenderEngine::Gl {
   GLuint program = 0, vao[kMeshCount] = {}, vertex_buffer[kMeshCount] = {}, index_buffer[kMeshCount] = {},
          instance_buffer[kMeshCount] = {};
   GLsizei index_count[kMeshCount] = {};
+  std::size_t instance_capacity[kMeshCount] = {};
   GLint u_view_projection = -1, u_sun = -1, u_eye = -1;
   std::vector<Instance> instances[kMeshCount];
   std::vector<float> depth;
@@ -220,6 +222,12 @@ void OsmesaRenderEngine::makeCurrent(int width, int height) {
     // llvmpipe's own rasteriser threads cost more than they give at these image sizes, and they
     // would compete with the simulation's workers; a user can still set LP_NUM_THREADS
     setenv("LP_NUM_THREADS", "0", 0);
+    // llvmpipe allocates and frees large blocks every frame; with glibc's default trim threshold
+    // (128 KiB) each free hands the heap top back to the kernel and the next frame faults it in
+    // again: 2-3x the frame time (measured, 640 x 480: 13.3 -> 4.6 ms with 70 robots, 77 -> 25 ms
+    // with 1,000). Keeping up to 256 MiB of free heap is the cure; it is process-wide, and only a
+    // process that renders pays it.
+    mallopt(M_TRIM_THRESHOLD, 256 << 20);
     const int attributes[] = {OSMESA_FORMAT,
                               OSMESA_RGBA,
                               OSMESA_DEPTH_BITS,
@@ -390,7 +398,13 @@ void OsmesaRenderEngine::renderView(const CameraView& view, const std::vector<Re
     if (m == kPlane) glDisable(GL_CULL_FACE);
     glBindVertexArray(g.vao[m]);
     glBindBuffer(GL_ARRAY_BUFFER, g.instance_buffer[m]);
-    glBufferData(GL_ARRAY_BUFFER, static_cast<GLsizeiptr>(list.size() * sizeof(Instance)), list.data(), GL_STREAM_DRAW);
+    // grow the buffer only when needed, else rewrite it in place
+    const std::size_t bytes = list.size() * sizeof(Instance);
+    if (bytes > g.instance_capacity[m]) {
+      g.instance_capacity[m] = std::max(bytes, 2 * g.instance_capacity[m]);
+      glBufferData(GL_ARRAY_BUFFER, static_cast<GLsizeiptr>(g.instance_capacity[m]), nullptr, GL_DYNAMIC_DRAW);
+    }
+    glBufferSubData(GL_ARRAY_BUFFER, 0, static_cast<GLsizeiptr>(bytes), list.data());
     glDrawElementsInstanced(GL_TRIANGLES, g.index_count[m], GL_UNSIGNED_INT, nullptr, static_cast<GLsizei>(list.size()));
     if (m == kPlane) glEnable(GL_CULL_FACE);
   }
