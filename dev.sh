@@ -11,7 +11,7 @@ set -euo pipefail
 cd "$(dirname "$0")"
 
 packages=(build-essential cmake ninja-build pkg-config ccache
-          libode-dev libeigen3-dev libpugixml-dev libcli11-dev catch2)
+          libode-dev libeigen3-dev libpugixml-dev libcli11-dev catch2 libpng-dev libosmesa6-dev)
 build_dir=${BUILD_DIR:-build}
 jobs=${JOBS:-2}
 
