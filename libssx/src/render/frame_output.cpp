@@ -86,8 +86,8 @@ void FrameOutput::add(const Image& frame) {
       // beside the video so that a failure can be read
       std::ostringstream cmd;
       const std::string log = camera_.video.string() + ".ffmpeg.log";
-      cmd << "ffmpeg -y -loglevel error -f rawvideo -pix_fmt rgb24 -s " << frame.width << 'x' << frame.height
-          << " -r " << fps_ << " -i - -c:v libx264 -preset veryfast -pix_fmt yuv420p";
+      cmd << "nice -n 10 ffmpeg -y -loglevel error -f rawvideo -pix_fmt rgb24 -s " << frame.width << 'x' << frame.height
+          << " -r " << fps_ << " -i - -c:v libx264 -preset ultrafast -crf 23 -pix_fmt yuv420p";
       // yuv420p needs even sizes
       if (frame.width % 2 != 0 || frame.height % 2 != 0) cmd << " -vf crop=trunc(iw/2)*2:trunc(ih/2)*2";
       cmd << " '" << camera_.video.string() << "' 2>'" << log << "'";

@@ -26,7 +26,7 @@ class FrameWorker {
     Pose world;
   };
   FrameWorker(const RenderSettings& settings, std::vector<std::unique_ptr<FrameOutput>> outputs,
-              std::size_t depth = 3);
+              std::size_t depth = 16);
   ~FrameWorker();
   FrameWorker(const FrameWorker&) = delete;
   FrameWorker& operator=(const FrameWorker&) = delete;
