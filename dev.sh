@@ -12,6 +12,9 @@ cd "$(dirname "$0")"
 
 packages=(build-essential cmake ninja-build pkg-config ccache
           libode-dev libeigen3-dev libpugixml-dev libcli11-dev catch2 libpng-dev libosmesa6-dev)
+# for `test` also ROS 1 (Debian's), so that the ros1 extension is built and tested against a real master
+ros_packages=(libroscpp-dev libgeometry-msgs-dev libsensor-msgs-dev libnav-msgs-dev
+              python3-rosmaster python3-rospy python3-rostopic python3-geometry-msgs python3-nav-msgs)
 build_dir=${BUILD_DIR:-build}
 jobs=${JOBS:-2}
 
@@ -43,6 +46,7 @@ case "${1:-}" in
     "$build_dir/bin/ssx" run examples/scenes/formation_sphere.xml --realtime
     ;;
   test)
+    packages+=("${ros_packages[@]}")
     build
     ctest --test-dir "$build_dir" -j "$jobs" --output-on-failure
     ;;

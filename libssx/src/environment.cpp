@@ -12,6 +12,7 @@
 #include <iostream>
 #include <numbers>
 #include <set>
+#include <sstream>
 
 namespace ssx {
 
@@ -181,6 +182,24 @@ unsigned Environment::threadCount() const noexcept {
 Artifact* Environment::findArtifact(std::string_view name) const {
   const auto it = artifact_names_.find(std::string(name));
   return it == artifact_names_.end() ? nullptr : it->second;
+}
+
+std::vector<Artifact*> Environment::selectArtifacts(std::string_view names) const {
+  std::vector<Artifact*> out;
+  if (names == "*") {
+    for (const auto& a : artifacts_)
+      if (a->rootCount() > 0 && !a->root().isStatic()) out.push_back(a.get());
+    return out;
+  }
+  std::istringstream in{std::string(names)};
+  std::string name;
+  while (in >> name) {
+    Artifact* a = findArtifact(name);
+    if (a == nullptr) throw Error("no artifact named '" + name + "'");
+    if (a->rootCount() == 0) throw Error("artifact '" + name + "' has no physic node");
+    out.push_back(a);
+  }
+  return out;
 }
 
 SimulationExtension* Environment::extension(std::string_view name) const {

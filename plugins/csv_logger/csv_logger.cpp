@@ -58,20 +58,10 @@ class CsvLogger final : public SimulationExtension {
  private:
   // every artifact exists when extensions are initialised
   void resolve(Environment& env, const Descriptor& params) {
-    if (names_ == "*") {
-      for (std::size_t i = 0; i < env.artifactCount(); ++i) {
-        const Artifact& a = env.artifact(i);
-        if (a.rootCount() > 0 && !a.root().isStatic()) artifacts_.push_back(&a);
-      }
-      return;
-    }
-    std::istringstream in(names_);
-    std::string name;
-    while (in >> name) {
-      const Artifact* a = env.findArtifact(name);
-      if (a == nullptr) throw params.error("no artifact named '" + name + "' to log");
-      if (a->rootCount() == 0) throw params.error("artifact '" + name + "' has no physic node to log");
-      artifacts_.push_back(a);
+    try {
+      for (const Artifact* a : env.selectArtifacts(names_)) artifacts_.push_back(a);
+    } catch (const Error& e) {
+      throw params.error(*params.find("artifacts"), std::string(e.what()) + " to log");
     }
   }
   void close() {

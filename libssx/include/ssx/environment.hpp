@@ -144,6 +144,10 @@ class SSX_EXPORT Environment {
   Artifact& artifact(std::size_t index) const { return *artifacts_.at(index); }
   /// Artifact by name, or nullptr.
   Artifact* findArtifact(std::string_view name) const;
+  /// Artifacts chosen by a parameter: "*" is every artifact with a dynamic root, else names
+  /// separated by spaces, each of an artifact with a physic root. Throws Error naming the first
+  /// name that is not.
+  std::vector<Artifact*> selectArtifacts(std::string_view names) const;
   /// Extension by name, or nullptr.
   SimulationExtension* extension(std::string_view name) const;
   template <class T>

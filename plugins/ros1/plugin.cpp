@@ -1,0 +1,187 @@
+// ros1: a SimulationExtension that bridges robots to ROS 1, so that real control programs talk to
+// simulated robots (the paper's main use of extensions).
+//
+// Per robot (its artifact name is the namespace): /<name>/odom (nav_msgs/Odometry, world frame
+// pose, body-frame twist), /<name>/imu (sensor_msgs/Imu) when it has an IMU sensor, and a
+// subscription to /<name>/setpoint (geometry_msgs/PoseStamped) that feeds its driver's external
+// set-point (drivers implementing ssx::SetpointInterface, such as the quadrotor); /clock carries
+// simulated time. Stamps are simulated time.
+//
+// The node is started in init (no SIGINT handler of its own: the host keeps Ctrl-C) with an
+// asynchronous spinner; set-points are applied in beforeStep, on the stepping thread. With
+// lockstep="true", after each odometry message the simulation waits (at most lockstep_timeout_s)
+// until every robot has a set-point stamped at or after that odometry's time, so a controller
+// outside sees the same timing in real time and in faster runs.
+//
+// Parameters:
+//   master_uri          default $ROS_MASTER_URI, else http://127.0.0.1:11311
+//   node_name           default "ssx"
+//   timeout_s           how long to wait for the master at start (default 5)
+//   artifacts           "*" (default: every artifact with a dynamic root) or names
+//   odom_rate_hz        default 50
+//   imu_rate_hz         default 100 (0: no IMU topics)
+//   clock_rate_hz       default 100 (0: every step)
+//   lockstep            default false
+//   lockstep_timeout_s  default 2
+#include "ros_bridge.hpp"
+
+#include <ssx/environment.hpp>
+#include <ssx/measurements.hpp>
+#include <ssx/plugin_abi.hpp>
+#include <ssx/setpoint.hpp>
+
+#include <cmath>
+#include <cstdlib>
+
+namespace ssx::plugins {
+
+namespace {
+
+// a rate in simulated time: due at 0, period, 2 period, ...
+struct Rate {
+  Nanoseconds period = 0;  // 0: never
+  Nanoseconds next = 0;
+  bool due(Nanoseconds now) {
+    if (period <= 0 || now < next) return false;
+    next += period;
+    if (next <= now) next = now + period;
+    return true;
+  }
+};
+
+Rate rateOf(const Descriptor& params, const char* key, double fallback, Nanoseconds every_step) {
+  const double hz = params.get<double>(key, fallback);
+  if (hz < 0) throw params.error(*params.find(key), std::string(key) + " must not be negative");
+  Rate r;
+  r.period = hz > 0 ? toNanoseconds(1.0 / hz) : every_step;
+  return r;
+}
+
+std::array<double, 3> array3(const Vec3& v) { return {v.x(), v.y(), v.z()}; }
+std::array<double, 4> array4(const Quat& q) { return {q.w(), q.x(), q.y(), q.z()}; }
+
+}  // namespace
+
+class Ros1Bridge final : public SimulationExtension {
+ public:
+  void init(Environment& env, const Descriptor& params) override {
+    const char* env_uri = std::getenv("ROS_MASTER_URI");
+    const std::string master =
+        params.get<std::string>("master_uri", env_uri != nullptr ? env_uri : "http://127.0.0.1:11311");
+    const std::string node = params.get<std::string>("node_name", "ssx");
+    const double timeout = params.getPositive("timeout_s", 5.0);
+    odom_rate_ = rateOf(params, "odom_rate_hz", 50.0, env.timestep());
+    imu_rate_ = rateOf(params, "imu_rate_hz", 100.0, env.timestep());
+    if (params.get<double>("imu_rate_hz", 100.0) == 0) imu_rate_.period = 0;
+    clock_rate_ = rateOf(params, "clock_rate_hz", 100.0, env.timestep());
+    lockstep_ = params.get<bool>("lockstep", false);
+    lockstep_timeout_ = params.getPositive("lockstep_timeout_s", 2.0);
+    std::vector<Artifact*> chosen;
+    try {
+      chosen = env.selectArtifacts(params.get<std::string>("artifacts", "*"));
+    } catch (const Error& e) {
+      throw params.error(*params.find("artifacts"), std::string(e.what()) + " to bridge");
+    }
+    std::vector<ros1::RobotTopics> topics;
+    for (Artifact* a : chosen) {
+      Robot r;
+      r.artifact = a;
+      r.tracker = dynamic_cast<SetpointInterface*>(a->driver());
+      for (std::size_t k = 0; k < a->sensorCount(); ++k)
+        if (r.imu == nullptr) r.imu = dynamic_cast<const ImuMeasurement*>(&a->sensor(k).latest());
+      topics.push_back({a->name(), r.imu != nullptr && imu_rate_.period > 0, r.tracker != nullptr});
+      robots_.push_back(r);
+    }
+    try {
+      bridge_ = std::make_unique<ros1::Bridge>(master, node, timeout, topics);
+    } catch (const std::exception& e) {
+      throw params.error(e.what());
+    }
+  }
+
+  void beforeStep(Environment& env) override {
+    if (lockstep_ && waiting_for_ >= 0) {
+      const auto missing = bridge_->waitForSetpoints(waiting_for_, lockstep_timeout_);
+      if (!missing.empty()) {
+        std::string names;
+        for (std::size_t i = 0; i < missing.size() && i < 5; ++i) names += (i ? ", " : "") + missing[i];
+        if (missing.size() > 5) names += ", ...";
+        throw Error("lock-step: no set-point stamped at or after t = " + std::to_string(waiting_for_) + " s within " +
+                    std::to_string(lockstep_timeout_) + " s from " + std::to_string(missing.size()) +
+                    " robot(s): " + names);
+      }
+      waiting_for_ = -1;
+    }
+    // the newest set-point of each robot, applied between steps
+    for (std::size_t i = 0; i < robots_.size(); ++i) {
+      Robot& r = robots_[i];
+      if (r.tracker == nullptr) continue;
+      const ros1::Setpoint s = bridge_->latestSetpoint(i);
+      if (s.count == r.applied) continue;
+      r.applied = s.count;
+      Setpoint sp;
+      sp.position = Vec3(s.position[0], s.position[1], s.position[2]);
+      const Quat q(s.orientation[0], s.orientation[1], s.orientation[2], s.orientation[3]);
+      sp.yaw = std::atan2(2 * (q.w() * q.z() + q.x() * q.y()), 1 - 2 * (q.y() * q.y() + q.z() * q.z()));
+      if (!sp.position.allFinite() || !std::isfinite(sp.yaw))
+        throw Error("set-point for '" + r.artifact->name() + "' is not finite");
+      r.tracker->setSetpoint(sp);
+    }
+    (void)env;
+  }
+
+  void afterStep(Environment& env) override {
+    const Nanoseconds now = env.time();
+    const double t = toSeconds(now);
+    if (clock_rate_.due(now)) bridge_->publishClock(t);
+    if (imu_rate_.due(now)) {
+      for (std::size_t i = 0; i < robots_.size(); ++i) {
+        const Robot& r = robots_[i];
+        if (r.imu == nullptr) continue;
+        ros1::Imu m;
+        m.time = t;
+        m.angular_velocity = array3(r.imu->gyroscope);
+        m.linear_acceleration = array3(r.imu->accelerometer);
+        m.orientation = array4(r.artifact->root().pose().orientation);
+        bridge_->publishImu(i, m);
+      }
+    }
+    if (odom_rate_.due(now)) {
+      for (std::size_t i = 0; i < robots_.size(); ++i) {
+        const BodyState s = robots_[i].artifact->root().state();
+        const Quat to_body = s.pose.orientation.conjugate();
+        ros1::Odometry m;
+        m.time = t;
+        m.position = array3(s.pose.position);
+        m.orientation = array4(s.pose.orientation);
+        m.velocity = array3(to_body * s.linear_velocity);
+        m.angular_velocity = array3(to_body * s.angular_velocity);
+        bridge_->publishOdometry(i, m);
+      }
+      if (lockstep_) waiting_for_ = t;
+    }
+  }
+
+  void shutdown(Environment&) override {
+    if (bridge_) bridge_->shutdown();
+    bridge_.reset();
+  }
+
+ private:
+  struct Robot {
+    Artifact* artifact = nullptr;
+    SetpointInterface* tracker = nullptr;
+    const ImuMeasurement* imu = nullptr;
+    std::uint64_t applied = 0;  // set-points applied so far
+  };
+  std::unique_ptr<ros1::Bridge> bridge_;
+  std::vector<Robot> robots_;
+  Rate odom_rate_, imu_rate_, clock_rate_;
+  bool lockstep_ = false;
+  double lockstep_timeout_ = 2.0;
+  double waiting_for_ = -1;  // lock-step: the odometry time set-points must answer
+};
+
+}  // namespace ssx::plugins
+
+SSX_PLUGIN(SSX_EXTENSION(ssx::plugins::Ros1Bridge, "ros1"));

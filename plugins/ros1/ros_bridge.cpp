@@ -1,0 +1,164 @@
+// The ROS 1 side of the ros1 extension (C++17). See ros_bridge.hpp.
+#include "ros_bridge.hpp"
+
+#include <geometry_msgs/PoseStamped.h>
+#include <nav_msgs/Odometry.h>
+#include <ros/ros.h>
+#include <rosgraph_msgs/Clock.h>
+#include <sensor_msgs/Imu.h>
+
+#include <chrono>
+#include <condition_variable>
+#include <map>
+#include <mutex>
+#include <stdexcept>
+#include <thread>
+
+namespace ssx::ros1 {
+
+struct Bridge::Impl {
+  std::unique_ptr<ros::NodeHandle> node;
+  std::unique_ptr<ros::AsyncSpinner> spinner;
+  ros::Publisher clock;
+  std::vector<RobotTopics> robots;
+  std::vector<ros::Publisher> odom, imu;
+  std::vector<ros::Subscriber> setpoint_subscribers;
+  mutable std::mutex mutex;
+  mutable std::condition_variable arrived;
+  std::vector<Setpoint> setpoints;  // guarded by mutex
+  bool running = false;
+};
+
+namespace {
+ros::Time stamp(double t) { return ros::Time(t < 0 ? 0.0 : t); }
+}  // namespace
+
+Bridge::Bridge(const std::string& master_uri, const std::string& node_name, double timeout_s,
+               const std::vector<RobotTopics>& robots)
+    : impl_(std::make_unique<Impl>()) {
+  if (ros::isStarted()) throw std::runtime_error("a ROS node is already running in this process");
+  // the host program keeps its own SIGINT handling (ssx stops cleanly on Ctrl-C)
+  ros::M_string remappings{{"__master", master_uri}};
+  ros::init(remappings, node_name, ros::init_options::NoSigintHandler | ros::init_options::NoRosout);
+  // roscpp would wait for a master forever: ask it ourselves, with a deadline
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(timeout_s);
+  while (!ros::master::check()) {
+    if (std::chrono::steady_clock::now() >= deadline)
+      throw std::runtime_error("no ROS master answers at " + master_uri + " (waited " + std::to_string(timeout_s) +
+                               " s): start one (roscore or rosmaster --core -p PORT) or set master_uri / "
+                               "ROS_MASTER_URI");
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  }
+  ros::start();
+  Impl& d = *impl_;
+  d.running = true;
+  d.node = std::make_unique<ros::NodeHandle>();
+  d.clock = d.node->advertise<rosgraph_msgs::Clock>("/clock", 10);
+  d.robots = robots;
+  d.setpoints.assign(robots.size(), Setpoint{});
+  for (std::size_t i = 0; i < robots.size(); ++i) {
+    const std::string ns = "/" + robots[i].name;
+    d.odom.push_back(d.node->advertise<nav_msgs::Odometry>(ns + "/odom", 10));
+    d.imu.push_back(robots[i].imu ? d.node->advertise<sensor_msgs::Imu>(ns + "/imu", 10) : ros::Publisher());
+    if (robots[i].setpoint) {
+      Impl* self = impl_.get();
+      auto on_setpoint = [self, i](const geometry_msgs::PoseStamped::ConstPtr& m) {
+        {
+          std::lock_guard<std::mutex> lock(self->mutex);
+          Setpoint& s = self->setpoints[i];
+          s.stamp = m->header.stamp.toSec();
+          s.position = {m->pose.position.x, m->pose.position.y, m->pose.position.z};
+          s.orientation = {m->pose.orientation.w, m->pose.orientation.x, m->pose.orientation.y, m->pose.orientation.z};
+          ++s.count;
+        }
+        self->arrived.notify_all();
+      };
+      d.setpoint_subscribers.push_back(d.node->subscribe<geometry_msgs::PoseStamped>(
+          ns + "/setpoint", 10, on_setpoint, ros::VoidConstPtr(), ros::TransportHints().tcpNoDelay()));
+    }
+  }
+  d.spinner = std::make_unique<ros::AsyncSpinner>(1);
+  d.spinner->start();
+}
+
+Bridge::~Bridge() { shutdown(); }
+
+void Bridge::shutdown() {
+  Impl& d = *impl_;
+  if (!d.running) return;
+  d.running = false;
+  if (d.spinner) d.spinner->stop();
+  d.setpoint_subscribers.clear();
+  d.odom.clear();
+  d.imu.clear();
+  d.clock = ros::Publisher();
+  d.spinner.reset();
+  d.node.reset();
+  ros::shutdown();
+}
+
+void Bridge::publishClock(double time) {
+  rosgraph_msgs::Clock m;
+  m.clock = stamp(time);
+  impl_->clock.publish(m);
+}
+
+void Bridge::publishOdometry(std::size_t robot, const Odometry& o) {
+  nav_msgs::Odometry m;
+  m.header.stamp = stamp(o.time);
+  m.header.frame_id = "world";
+  m.child_frame_id = impl_->robots[robot].name + "/base_link";
+  m.pose.pose.position.x = o.position[0];
+  m.pose.pose.position.y = o.position[1];
+  m.pose.pose.position.z = o.position[2];
+  m.pose.pose.orientation.w = o.orientation[0];
+  m.pose.pose.orientation.x = o.orientation[1];
+  m.pose.pose.orientation.y = o.orientation[2];
+  m.pose.pose.orientation.z = o.orientation[3];
+  m.twist.twist.linear.x = o.velocity[0];
+  m.twist.twist.linear.y = o.velocity[1];
+  m.twist.twist.linear.z = o.velocity[2];
+  m.twist.twist.angular.x = o.angular_velocity[0];
+  m.twist.twist.angular.y = o.angular_velocity[1];
+  m.twist.twist.angular.z = o.angular_velocity[2];
+  impl_->odom[robot].publish(m);
+}
+
+void Bridge::publishImu(std::size_t robot, const Imu& u) {
+  if (!impl_->robots[robot].imu) return;
+  sensor_msgs::Imu m;
+  m.header.stamp = stamp(u.time);
+  m.header.frame_id = impl_->robots[robot].name + "/imu";
+  m.orientation.w = u.orientation[0];
+  m.orientation.x = u.orientation[1];
+  m.orientation.y = u.orientation[2];
+  m.orientation.z = u.orientation[3];
+  m.angular_velocity.x = u.angular_velocity[0];
+  m.angular_velocity.y = u.angular_velocity[1];
+  m.angular_velocity.z = u.angular_velocity[2];
+  m.linear_acceleration.x = u.linear_acceleration[0];
+  m.linear_acceleration.y = u.linear_acceleration[1];
+  m.linear_acceleration.z = u.linear_acceleration[2];
+  impl_->imu[robot].publish(m);
+}
+
+Setpoint Bridge::latestSetpoint(std::size_t robot) const {
+  std::lock_guard<std::mutex> lock(impl_->mutex);
+  return impl_->setpoints.at(robot);
+}
+
+std::vector<std::string> Bridge::waitForSetpoints(double time, double timeout_s) const {
+  Impl& d = *impl_;
+  auto missing = [&] {
+    std::vector<std::string> names;
+    for (std::size_t i = 0; i < d.robots.size(); ++i)
+      if (d.robots[i].setpoint && (d.setpoints[i].count == 0 || d.setpoints[i].stamp < time - 1e-9))
+        names.push_back(d.robots[i].name);
+    return names;
+  };
+  std::unique_lock<std::mutex> lock(d.mutex);
+  d.arrived.wait_for(lock, std::chrono::duration<double>(timeout_s), [&] { return missing().empty(); });
+  return missing();
+}
+
+}  // namespace ssx::ros1
