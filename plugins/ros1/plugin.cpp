@@ -30,7 +30,9 @@
 #include <ssx/plugin_abi.hpp>
 #include <ssx/setpoint.hpp>
 
+#include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 
 namespace ssx::plugins {
@@ -162,8 +164,20 @@ class Ros1Bridge final : public SimulationExtension {
     }
   }
 
-  void shutdown(Environment&) override {
-    if (bridge_) bridge_->shutdown();
+  void shutdown(Environment& env) override {
+    if (bridge_) {
+      // how quickly the controllers outside answered, as one line in the log
+      std::vector<double> rt = bridge_->roundTrips();
+      if (!rt.empty()) {
+        std::sort(rt.begin(), rt.end());
+        char line[200];
+        std::snprintf(line, sizeof line,
+                      "ros1: %zu set-points answered odometry; round trip median %.2f ms, p99 %.2f ms, max %.2f ms",
+                      rt.size(), 1e3 * rt[rt.size() / 2], 1e3 * rt[rt.size() * 99 / 100], 1e3 * rt.back());
+        env.log(LogLevel::Info, line);
+      }
+      bridge_->shutdown();
+    }
     bridge_.reset();
   }
 

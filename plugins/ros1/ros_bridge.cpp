@@ -26,6 +26,8 @@ struct Bridge::Impl {
   mutable std::mutex mutex;
   mutable std::condition_variable arrived;
   std::vector<Setpoint> setpoints;  // guarded by mutex
+  std::map<double, std::chrono::steady_clock::time_point> published;  // odometry time -> wall time; mutex
+  std::vector<double> round_trips;                                     // mutex
   bool running = false;
 };
 
@@ -67,6 +69,10 @@ Bridge::Bridge(const std::string& master_uri, const std::string& node_name, doub
           std::lock_guard<std::mutex> lock(self->mutex);
           Setpoint& s = self->setpoints[i];
           s.stamp = m->header.stamp.toSec();
+          const auto sent = self->published.find(s.stamp);
+          if (sent != self->published.end())
+            self->round_trips.push_back(
+                std::chrono::duration<double>(std::chrono::steady_clock::now() - sent->second).count());
           s.position = {m->pose.position.x, m->pose.position.y, m->pose.position.z};
           s.orientation = {m->pose.orientation.w, m->pose.orientation.x, m->pose.orientation.y, m->pose.orientation.z};
           ++s.count;
@@ -104,6 +110,12 @@ void Bridge::publishClock(double time) {
 }
 
 void Bridge::publishOdometry(std::size_t robot, const Odometry& o) {
+  if (robot == 0) {
+    std::lock_guard<std::mutex> lock(impl_->mutex);
+    auto& sent = impl_->published;
+    sent[stamp(o.time).toSec()] = std::chrono::steady_clock::now();
+    while (sent.size() > 1000) sent.erase(sent.begin());
+  }
   nav_msgs::Odometry m;
   m.header.stamp = stamp(o.time);
   m.header.frame_id = "world";
@@ -140,6 +152,11 @@ void Bridge::publishImu(std::size_t robot, const Imu& u) {
   m.linear_acceleration.y = u.linear_acceleration[1];
   m.linear_acceleration.z = u.linear_acceleration[2];
   impl_->imu[robot].publish(m);
+}
+
+std::vector<double> Bridge::roundTrips() const {
+  std::lock_guard<std::mutex> lock(impl_->mutex);
+  return impl_->round_trips;
 }
 
 Setpoint Bridge::latestSetpoint(std::size_t robot) const {

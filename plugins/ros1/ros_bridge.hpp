@@ -55,6 +55,9 @@ class Bridge {
   // Waits until every robot with a set-point topic has one stamped at or after `time` (seconds),
   // at most `timeout_s`; returns the names of those still missing (empty: all there).
   std::vector<std::string> waitForSetpoints(double time, double timeout_s) const;
+  // Round trips in wall-clock seconds: from publishing the odometry of time t to receiving a
+  // set-point stamped t (one sample per set-point that answers an odometry message).
+  std::vector<double> roundTrips() const;
   // Stops the spinner and the node.
   void shutdown();
 

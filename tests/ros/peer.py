@@ -4,6 +4,8 @@
 set-point for 1 s of simulated time.
 
 usage: peer.py COUNT [TIMEOUT_S]   (robots q0 .. q<COUNT-1>; exit 0 on success, 1 otherwise)
+       peer.py COUNT SECONDS --bench  (answer every odometry message at once with a set-point stamped
+                                       like it, for SECONDS; print how many messages came per robot)
 """
 import sys
 import time
@@ -21,12 +23,20 @@ def main():
     target, error, held_since, last_stamp, received = {}, {}, {}, {}, {}
     pubs = {n: rospy.Publisher("/%s/setpoint" % n, PoseStamped, queue_size=10) for n in names}
 
+    bench = "--bench" in sys.argv
+
     def on_odom(msg, name):
         p = msg.pose.pose.position
         t = msg.header.stamp.to_sec()
         received[name] = received.get(name, 0) + 1
         if name not in target:
             target[name] = (p.x + 1.0, p.y - 0.5, 1.5)
+        if bench:
+            m = PoseStamped()
+            m.header.stamp = msg.header.stamp
+            m.pose.position.x, m.pose.position.y, m.pose.position.z = target[name]
+            m.pose.orientation.w = 1.0
+            pubs[name].publish(m)
         x, y, z = target[name]
         e = ((p.x - x) ** 2 + (p.y - y) ** 2 + (p.z - z) ** 2) ** 0.5
         error[name] = e
@@ -38,6 +48,13 @@ def main():
 
     subs = [rospy.Subscriber("/%s/odom" % n, Odometry, on_odom, callback_args=n, tcp_nodelay=True) for n in names]
     start = time.time()
+    if bench:
+        while time.time() - start < timeout:
+            time.sleep(0.1)
+        counts = sorted(received.get(n, 0) for n in names)
+        print("peer: odometry messages per robot: min %d median %d max %d (%d robots heard of %d)"
+              % (counts[0], counts[len(counts) // 2], counts[-1], len(received), count))
+        return 0
     rate = 20.0
     while time.time() - start < timeout:
         for n in names:
