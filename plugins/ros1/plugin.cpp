@@ -23,6 +23,8 @@
 //   clock_rate_hz       default 100 (0: every step)
 //   lockstep            default false
 //   lockstep_timeout_s  default 2
+//   lockstep_connect_timeout_s  how long the first step waits for every robot's controller to
+//                       connect (default 10)
 #include "ros_bridge.hpp"
 
 #include <ssx/environment.hpp>
@@ -78,6 +80,7 @@ class Ros1Bridge final : public SimulationExtension {
     clock_rate_ = rateOf(params, "clock_rate_hz", 100.0, env.timestep());
     lockstep_ = params.get<bool>("lockstep", false);
     lockstep_timeout_ = params.getPositive("lockstep_timeout_s", 2.0);
+    connect_timeout_ = params.getPositive("lockstep_connect_timeout_s", 10.0);
     std::vector<Artifact*> chosen;
     try {
       chosen = env.selectArtifacts(params.get<std::string>("artifacts", "*"));
@@ -102,6 +105,15 @@ class Ros1Bridge final : public SimulationExtension {
   }
 
   void beforeStep(Environment& env) override {
+    if (lockstep_ && !connected_) {
+      // before the first step: the controllers must be connected, or the first odometry is lost
+      const auto missing = bridge_->waitForPeers(connect_timeout_);
+      if (!missing.empty())
+        throw Error("lock-step: no controller connected within " + std::to_string(connect_timeout_) +
+                    " s (subscribed to /<robot>/odom and publishing /<robot>/setpoint) for " +
+                    std::to_string(missing.size()) + " robot(s), first '" + missing.front() + "'");
+      connected_ = true;
+    }
     if (lockstep_ && waiting_for_ >= 0) {
       const auto missing = bridge_->waitForSetpoints(waiting_for_, lockstep_timeout_);
       if (!missing.empty()) {
@@ -192,7 +204,8 @@ class Ros1Bridge final : public SimulationExtension {
   std::vector<Robot> robots_;
   Rate odom_rate_, imu_rate_, clock_rate_;
   bool lockstep_ = false;
-  double lockstep_timeout_ = 2.0;
+  double lockstep_timeout_ = 2.0, connect_timeout_ = 10.0;
+  bool connected_ = false;
   double waiting_for_ = -1;  // lock-step: the odometry time set-points must answer
 };
 

@@ -154,6 +154,24 @@ void Bridge::publishImu(std::size_t robot, const Imu& u) {
   impl_->imu[robot].publish(m);
 }
 
+std::vector<std::string> Bridge::waitForPeers(double timeout_s) const {
+  const Impl& d = *impl_;
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(timeout_s);
+  std::vector<std::string> missing;
+  for (;;) {
+    missing.clear();
+    std::size_t k = 0;  // index into the set-point subscribers
+    for (std::size_t i = 0; i < d.robots.size(); ++i) {
+      if (!d.robots[i].setpoint) continue;
+      if (d.odom[i].getNumSubscribers() == 0 || d.setpoint_subscribers[k].getNumPublishers() == 0)
+        missing.push_back(d.robots[i].name);
+      ++k;
+    }
+    if (missing.empty() || std::chrono::steady_clock::now() >= deadline) return missing;
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+}
+
 std::vector<double> Bridge::roundTrips() const {
   std::lock_guard<std::mutex> lock(impl_->mutex);
   return impl_->round_trips;

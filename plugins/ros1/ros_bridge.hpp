@@ -55,6 +55,10 @@ class Bridge {
   // Waits until every robot with a set-point topic has one stamped at or after `time` (seconds),
   // at most `timeout_s`; returns the names of those still missing (empty: all there).
   std::vector<std::string> waitForSetpoints(double time, double timeout_s) const;
+  // Waits until every robot's odometry has a subscriber and its set-point topic a publisher (ROS
+  // connects them asynchronously: a message sent before that is lost), at most `timeout_s`;
+  // returns the names of the robots still unconnected.
+  std::vector<std::string> waitForPeers(double timeout_s) const;
   // Round trips in wall-clock seconds: from publishing the odometry of time t to receiving a
   // set-point stamped t (one sample per set-point that answers an odometry message).
   std::vector<double> roundTrips() const;
