@@ -33,6 +33,20 @@ struct Bridge::Impl {
 
 namespace {
 ros::Time stamp(double t) { return ros::Time(t < 0 ? 0.0 : t); }
+// into any message with x, y, z (Point, Vector3) or w, x, y, z (Quaternion) fields
+template <class V>
+void setXyz(V& v, const std::array<double, 3>& a) {
+  v.x = a[0];
+  v.y = a[1];
+  v.z = a[2];
+}
+template <class Q>
+void setWxyz(Q& q, const std::array<double, 4>& a) {
+  q.w = a[0];
+  q.x = a[1];
+  q.y = a[2];
+  q.z = a[3];
+}
 }  // namespace
 
 Bridge::Bridge(const std::string& master_uri, const std::string& node_name, double timeout_s,
@@ -120,19 +134,10 @@ void Bridge::publishOdometry(std::size_t robot, const Odometry& o) {
   m.header.stamp = stamp(o.time);
   m.header.frame_id = "world";
   m.child_frame_id = impl_->robots[robot].name + "/base_link";
-  m.pose.pose.position.x = o.position[0];
-  m.pose.pose.position.y = o.position[1];
-  m.pose.pose.position.z = o.position[2];
-  m.pose.pose.orientation.w = o.orientation[0];
-  m.pose.pose.orientation.x = o.orientation[1];
-  m.pose.pose.orientation.y = o.orientation[2];
-  m.pose.pose.orientation.z = o.orientation[3];
-  m.twist.twist.linear.x = o.velocity[0];
-  m.twist.twist.linear.y = o.velocity[1];
-  m.twist.twist.linear.z = o.velocity[2];
-  m.twist.twist.angular.x = o.angular_velocity[0];
-  m.twist.twist.angular.y = o.angular_velocity[1];
-  m.twist.twist.angular.z = o.angular_velocity[2];
+  setXyz(m.pose.pose.position, o.position);
+  setWxyz(m.pose.pose.orientation, o.orientation);
+  setXyz(m.twist.twist.linear, o.velocity);
+  setXyz(m.twist.twist.angular, o.angular_velocity);
   impl_->odom[robot].publish(m);
 }
 
@@ -141,16 +146,9 @@ void Bridge::publishImu(std::size_t robot, const Imu& u) {
   sensor_msgs::Imu m;
   m.header.stamp = stamp(u.time);
   m.header.frame_id = impl_->robots[robot].name + "/imu";
-  m.orientation.w = u.orientation[0];
-  m.orientation.x = u.orientation[1];
-  m.orientation.y = u.orientation[2];
-  m.orientation.z = u.orientation[3];
-  m.angular_velocity.x = u.angular_velocity[0];
-  m.angular_velocity.y = u.angular_velocity[1];
-  m.angular_velocity.z = u.angular_velocity[2];
-  m.linear_acceleration.x = u.linear_acceleration[0];
-  m.linear_acceleration.y = u.linear_acceleration[1];
-  m.linear_acceleration.z = u.linear_acceleration[2];
+  setWxyz(m.orientation, u.orientation);
+  setXyz(m.angular_velocity, u.angular_velocity);
+  setXyz(m.linear_acceleration, u.linear_acceleration);
   impl_->imu[robot].publish(m);
 }
 
