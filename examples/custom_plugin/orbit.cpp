@@ -1,7 +1,8 @@
 // orbit: a driver that flies a rigid body around a horizontal circle at constant speed, with a
 // PD law on the position error to the moving reference and feed-forward of its acceleration.
 //
-// Parameters: center "x y z" (m), radius (m, default 1), orbit_period (s, default 8), kp, kd.
+// Its parameters are declared in kParameters: the scene loader checks every value against them
+// before anything runs, and `ssx plugins --params orbit` lists them.
 #include <ssx/ssx.hpp>
 
 #include <cmath>
@@ -11,12 +12,21 @@ namespace {
 
 class OrbitDriver final : public ssx::Driver {
  public:
+  static constexpr const char* kDoc = "flies a rigid body around a horizontal circle at constant speed";
+  static constexpr ssx_plugin_param kParameters[] = {
+      ssx::param::vec3("center", "", "m", ssx::param::any(), "centre of the circle (default: where it starts)"),
+      ssx::param::real("radius", "1", "m", ssx::param::positive(), "radius of the circle"),
+      ssx::param::real("orbit_period", "8", "s", ssx::param::positive(), "time for one lap"),
+      ssx::param::real("kp", "16", "1/s^2", ssx::param::positive(), "position gain"),
+      ssx::param::real("kd", "8", "1/s", ssx::param::positive(), "velocity gain"),
+  };
+
   void configure(const ssx::Descriptor& params) override {
     center_ = params.get<ssx::Vec3>("center", artifact().placement().position);
-    radius_ = params.getPositive("radius", 1.0);
-    omega_ = 2 * std::numbers::pi / params.getPositive("orbit_period", 8.0);
-    kp_ = params.getPositive("kp", 16.0);
-    kd_ = params.getPositive("kd", 8.0);
+    radius_ = params.get<double>("radius");
+    omega_ = 2 * std::numbers::pi / params.get<double>("orbit_period");
+    kp_ = params.get<double>("kp");
+    kd_ = params.get<double>("kd");
     mass_ = ssx::combinedMass(artifact().root().spec()).mass;
     gravity_ = environment().settings().physics.gravity;
   }

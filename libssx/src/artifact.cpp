@@ -57,6 +57,9 @@ Driver& Artifact::setDriver(Driver& driver, Descriptor params, std::int64_t peri
   requireSetup("a driver can be set");
   if (driver_ != nullptr) throw ConfigError(params.where(), "artifact '" + name_ + "' already has a driver");
   if (period_steps < 1) throw ConfigError(params.where(), "driver period must be at least 1 step");
+  if (driver.artifact_ != nullptr)
+    throw ConfigError(params.where(), "artifact '" + name_ + "': this driver instance belongs to artifact '" +
+                                          driver.artifact_->name() + "' already; create one instance per artifact");
   driver.artifact_ = this;
   driver.period_steps_ = period_steps;
   driver.plugin_index_ = 0;
@@ -78,6 +81,9 @@ Sensor& Artifact::addSensor(std::unique_ptr<Sensor> sensor, Descriptor params, s
 Sensor& Artifact::addSensor(Sensor& sensor, Descriptor params, std::int64_t period_steps, std::string class_name) {
   requireSetup("sensors can be added");
   if (period_steps < 1) throw ConfigError(params.where(), "sensor period must be at least 1 step");
+  if (sensor.artifact_ != nullptr)
+    throw ConfigError(params.where(), "artifact '" + name_ + "': this sensor instance belongs to artifact '" +
+                                          sensor.artifact_->name() + "' already; create one instance per artifact");
   const auto plugin_index = static_cast<std::uint32_t>(sensors_.size() + 1);
   sensor.artifact_ = this;
   sensor.period_steps_ = period_steps;

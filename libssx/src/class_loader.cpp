@@ -29,6 +29,7 @@ namespace {
 
 constexpr const char* kManifestSymbol = "ssx_plugin_manifest_v1";
 constexpr std::uint32_t kMaxClasses = 4096;
+constexpr std::uint32_t kMaxParameters = 4096;
 
 // dlerror text, with any undefined C++ symbol demangled so the user sees what is missing
 std::string explainDlerror(const char* text) {
@@ -80,7 +81,17 @@ std::string checkManifest(const ssx_plugin_manifest* m, PluginLibraryInfo& info)
     const ssx_plugin_class& c = m->classes[i];
     if (c.name == nullptr || c.create == nullptr || c.destroy == nullptr || !validKind(c.kind))
       return "manifest entry " + std::to_string(i) + " is incomplete (kind, name, create and destroy are required)";
-    info.classes.push_back({toKind(c.kind), c.name});
+    if (c.param_count > kMaxParameters || (c.param_count > 0 && c.params == nullptr))
+      return "class '" + std::string(c.name) + "' lists an invalid parameter table";
+    for (std::uint32_t k = 0; k < c.param_count; ++k) {
+      const ssx_plugin_param& p = c.params[k];
+      if (p.name == nullptr || p.doc == nullptr || p.unit == nullptr || p.default_value == nullptr ||
+          p.choices == nullptr || p.type < SSX_PARAM_BOOL || p.type > SSX_PARAM_CHOICE)
+        return "class '" + std::string(c.name) + "': parameter " + std::to_string(k) +
+               " is incomplete (name, type, unit, default, choices and doc are required; use ssx::param)";
+    }
+    info.classes.push_back({toKind(c.kind), c.name, c.doc != nullptr ? c.doc : "",
+                            parameterTable({c.params, c.param_count})});
   }
   return {};
 }
@@ -99,8 +110,9 @@ ClassLoader::ClassLoader() = default;
 ClassLoader::~ClassLoader() { destroyInstances(); }
 
 void ClassLoader::destroyInstances() noexcept {
-  for (auto it = instances_.rbegin(); it != instances_.rend(); ++it) it->destroy(it->object);
+  for (auto it = instances_.rbegin(); it != instances_.rend(); ++it) it->type->destroy(it->object);
   instances_.clear();
+  types_.clear();
 }
 
 void ClassLoader::addSearchDirectory(fs::path dir) {
@@ -182,7 +194,8 @@ fs::path ClassLoader::load(std::string_view plugin) {
   throw PluginError("plugin '" + name + "' could not be loaded; tried:" + tried);
 }
 
-void* ClassLoader::create(std::string_view plugin, std::string_view class_name, PluginKind kind) {
+const ssx_plugin_class& ClassLoader::classInfo(std::string_view plugin, std::string_view class_name,
+                                               PluginKind kind) {
   const fs::path path = load(plugin);
   const Library* lib = by_name_.at(std::string(plugin));
   const std::string where = "plugin '" + std::string(plugin) + "' (" + path.string() + ")";
@@ -199,12 +212,24 @@ void* ClassLoader::create(std::string_view plugin, std::string_view class_name, 
   if (toKind(found->kind) != kind)
     throw PluginError(where + ": class '" + std::string(class_name) + "' is " + withArticle(toKind(found->kind)) +
                       ", not " + withArticle(kind));
+  return *found;
+}
+
+const ssx_plugin_class* ClassLoader::classOf(const void* instance) const noexcept {
+  const auto it = types_.find(instance);
+  return it == types_.end() ? nullptr : it->second;
+}
+
+void* ClassLoader::create(std::string_view plugin, std::string_view class_name, PluginKind kind) {
+  const ssx_plugin_class* found = &classInfo(plugin, class_name, kind);
+  const std::string where = "plugin '" + std::string(plugin) + "' (" + load(plugin).string() + ")";
   char error[512] = {0};
   void* object = found->create(error, sizeof error);
   if (object == nullptr)
     throw PluginError(where + ": creating '" + std::string(class_name) + "' failed: " +
                       (error[0] != '\0' ? std::string(error) : std::string("the constructor returned null")));
-  instances_.push_back({object, found->destroy});
+  instances_.push_back({object, found});
+  types_.emplace(object, found);
   return object;
 }
 

@@ -4,6 +4,7 @@
 #include "worker_pool.hpp"
 
 #include <ssx/environment.hpp>
+#include <ssx/plugin_abi.hpp>
 
 #include <algorithm>
 #include <chrono>
@@ -57,10 +58,10 @@ void checkSettings(const EnvironmentSettings& s) {
   if (!s.physics.gravity.allFinite()) bad("gravity must be finite");
   if (s.render.period_steps < 0) bad("render period must be 0 (never) or positive");
   if (!(s.render.rate_hz >= 0) || !std::isfinite(s.render.rate_hz)) bad("render rate_hz must be 0 or positive");
-  if (s.render.width < 1 || s.render.height < 1 || s.render.width > 16384 || s.render.height > 16384)
-    bad("render width and height must be in 1..16384");
+  if (s.render.width < 1 || s.render.height < 1 || s.render.width > kMaxImageSide || s.render.height > kMaxImageSide)
+    bad("render width and height must be in 1.." + std::to_string(kMaxImageSide));
   for (const auto& c : s.render.cameras)
-    if (!(c.fov_deg > 0 && c.fov_deg < 180)) bad("camera '" + c.name + "': fov_deg must be in (0, 180)");
+    if (!validFieldOfView(c.fov_deg)) bad("camera '" + c.name + "': fov_deg must be in (0, 180)");
 }
 
 // a camera at `position` looking at `target`, level (its y axis horizontal)
@@ -271,9 +272,32 @@ void Environment::buildBodies() {
   wrenches_.assign(states_.size(), Wrench{});
 }
 
+void Environment::checkDeclaredParameters() {
+  // instances made by the class loader get their declared defaults and checks here too when a
+  // program attached them itself (the scene loader has done it already: then nothing changes)
+  std::string errors;
+  auto check = [&](const void* instance, Descriptor& params, const Artifact* a, std::int64_t period,
+                   const std::string& what) {
+    const ssx_plugin_class* type = loader_->classOf(instance);
+    if (type == nullptr) return;
+    const PluginContext context{this, a, period, settings_.timestep};
+    for (const auto& d : checkParameters({type->params, type->param_count}, params, context, what))
+      if (d.severity == Diagnostic::Severity::Error) errors += (errors.empty() ? "" : "\n") + d.str();
+  };
+  for (auto& e : extensions_) check(e.extension, e.params, nullptr, 1, "extension '" + e.name + "'");
+  for (auto& a : artifacts_) {
+    if (a->driver_ != nullptr)
+      check(a->driver_, a->driver_params_, a.get(), a->driver_->periodSteps(), "driver '" + a->driver_->className() + "'");
+    for (auto& s : a->sensors_)
+      check(s.sensor, s.params, a.get(), s.sensor->periodSteps(), "sensor '" + s.sensor->className() + "'");
+  }
+  if (!errors.empty()) throw Error(errors + "\nnothing was run");
+}
+
 void Environment::start() {
   if (state_ == State::Running) return;
   requireSetup("start() is allowed");
+  checkDeclaredParameters();
   try {
     // extensions first, in the order they were added
     for (auto& e : extensions_) {

@@ -5,13 +5,7 @@
 // sensor hands it out in the sensors phase of the same step. Needs a render engine that draws
 // pixels (<render engine="osmesa"/> or --render osmesa); the sensor's period sets its rate.
 //
-// Parameters:
-//   node      physic node it is mounted on (default: the first root)
-//   xyz, rpy  mount pose on that node; the camera looks along its +x with +z up (default: none)
-//   width, height  pixels (default 320 x 240)
-//   fov_deg   horizontal field of view (default 60)
-//   near, far clipping distances, m (default 0.05, 100); depth beyond far reads +infinity
-//   depth     also deliver the depth image (default true)
+// Parameters: kParameters below, or `ssx plugins --params camera`.
 #include <ssx/artifact.hpp>
 #include <ssx/environment.hpp>
 #include <ssx/measurements.hpp>
@@ -23,22 +17,38 @@ namespace ssx::plugins {
 
 class CameraSensor final : public SensorOf<CameraMeasurement> {
  public:
+  static constexpr const char* kDoc = "RGB and depth images from a camera mounted on a node (needs osmesa)";
+  static constexpr ssx_plugin_param kParameters[] = {
+      param::text("node", "", "physic node it is mounted on (default: the first root)"),
+      param::vec3("xyz", "0 0 0", "m", param::any(), "mount position on that node"),
+      param::vec3("rpy", "0 0 0", "rad", param::any(),
+                  "mount roll, pitch, yaw on that node; the camera looks along its +x with +z up"),
+      param::integer("width", "320", param::between(1, kMaxImageSide), "image width, pixels"),
+      param::integer("height", "240", param::between(1, kMaxImageSide), "image height, pixels"),
+      param::real("fov_deg", "60", "deg", param::positive() & param::below(180), "horizontal field of view"),
+      param::real("near", "0.05", "m", param::positive(), "near clipping distance"),
+      param::real("far", "100", "m", param::positive(), "far clipping distance; depth beyond it reads +infinity"),
+      param::flag("depth", "true", "also deliver the depth image"),
+  };
+
+  static void validate(const Descriptor& params, const PluginContext& context) {
+    (void)context.artifact->nodeFromParameter(params);
+    if (params.get<double>("far") <= params.get<double>("near"))
+      throw params.error(*params.find("far"), "far must be beyond near");
+  }
+
   void configure(const Descriptor& params) override {
     node_ = &artifact().nodeFromParameter(params);
-    mount_.position = params.get<Vec3>("xyz", Vec3::Zero());
-    const Vec3 rpy = params.get<Vec3>("rpy", Vec3::Zero());
+    mount_.position = params.get<Vec3>("xyz");
+    const Vec3 rpy = params.get<Vec3>("rpy");
     mount_.orientation = Quat(Eigen::AngleAxisd(rpy.z(), Vec3::UnitZ()) * Eigen::AngleAxisd(rpy.y(), Vec3::UnitY()) *
                               Eigen::AngleAxisd(rpy.x(), Vec3::UnitX()));
-    lens_.width = static_cast<int>(params.get<std::int64_t>("width", 320));
-    lens_.height = static_cast<int>(params.get<std::int64_t>("height", 240));
-    if (lens_.width < 1 || lens_.width > 8192 || lens_.height < 1 || lens_.height > 8192)
-      throw params.error("width and height must be in 1..8192");
-    lens_.fov_deg = params.get<double>("fov_deg", 60.0);
-    if (!(lens_.fov_deg > 0 && lens_.fov_deg < 180)) throw params.error(*params.find("fov_deg"), "fov_deg must be in (0, 180)");
-    lens_.near = params.getPositive("near", 0.05);
-    lens_.far = params.getPositive("far", 100.0);
-    if (lens_.far <= lens_.near) throw params.error("far must be beyond near");
-    lens_.depth = params.get<bool>("depth", true);
+    lens_.width = static_cast<int>(params.get<std::int64_t>("width"));
+    lens_.height = static_cast<int>(params.get<std::int64_t>("height"));
+    lens_.fov_deg = params.get<double>("fov_deg");
+    lens_.near = params.get<double>("near");
+    lens_.far = params.get<double>("far");
+    lens_.depth = params.get<bool>("depth");
     environment().addCameraRequest(
         "sensor 'camera' of artifact '" + artifact().name() + "'",
         [this](std::int64_t step, CameraView& view) {

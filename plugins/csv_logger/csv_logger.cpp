@@ -1,11 +1,7 @@
 // csv_logger: an extension that writes the poses and velocities of chosen artifacts to a CSV file
 // at a rate in simulated time.
 //
-// Parameters:
-//   file       path of the CSV file (relative: to the working directory); required
-//   artifacts  space-separated artifact names, or "*" for every artifact with a dynamic root
-//              (default "*")
-//   rate_hz    rows per artifact per simulated second (default: every step)
+// Parameters: kParameters below, or `ssx plugins --params csv_logger`.
 //
 // Columns: time_s,artifact,x,y,z,qw,qx,qy,qz,vx,vy,vz,wx,wy,wz (world frame, SI units).
 #include <ssx/environment.hpp>
@@ -21,13 +17,31 @@ namespace ssx::plugins {
 
 class CsvLogger final : public SimulationExtension {
  public:
+  static constexpr const char* kDoc = "writes poses and velocities of chosen artifacts to a CSV file";
+  static constexpr ssx_plugin_param kParameters[] = {
+      param::required(param::text("file", "", "path of the CSV file (relative: to the working directory)")),
+      param::text("artifacts", "*", "artifact names separated by spaces, or * for every artifact with a dynamic root"),
+      param::real("rate_hz", "0", "Hz", param::nonNegative(),
+                  "rows per artifact per simulated second; 0 writes one every step"),
+  };
+
+  // what is logged exists before anything is opened
+  static void validate(const Descriptor& params, const PluginContext& context) {
+    try {
+      (void)context.environment->selectArtifacts(params.get<std::string>("artifacts"));
+    } catch (const ConfigError&) {
+      throw;
+    } catch (const Error& e) {
+      throw params.error(*params.find("artifacts"), std::string(e.what()) + " to log");
+    }
+  }
+
   ~CsvLogger() override { close(); }
 
   void init(Environment& env, const Descriptor& params) override {
     path_ = params.get<std::string>("file");
-    names_ = params.get<std::string>("artifacts", "*");
-    const double rate = params.get<double>("rate_hz", 0.0);
-    if (rate < 0) throw params.error(*params.find("rate_hz"), "rate_hz must not be negative");
+    names_ = params.get<std::string>("artifacts");
+    const double rate = params.get<double>("rate_hz");
     period_ = rate > 0 ? toNanoseconds(1.0 / rate) : env.timestep();
     next_ = period_;  // rows at period, 2 period, ... of simulated time
     resolve(env, params);

@@ -4,12 +4,7 @@
 // It reads the artifact's first pose sensor (any sensor producing ssx::PoseMeasurement) when it
 // has one, so sensor noise reaches the controller; otherwise the ground truth.
 //
-// Parameters:
-//   target  "x y z", m (default: where the artifact starts, plus offset)
-//   offset  "x y z", m, added to the start when no target is given (default 0 0 0)
-//   yaw     rad (default 0)
-//   kp, kd  position gains, 1/s^2 and 1/s (default 16, 8: critically damped at 4 rad/s)
-//   kr, kw  attitude gains, 1/s^2 and 1/s (default 36, 12)
+// Parameters: kParameters below, or `ssx plugins --params hover`.
 #include <ssx/artifact.hpp>
 #include <ssx/environment.hpp>
 #include <ssx/measurements.hpp>
@@ -19,17 +14,31 @@ namespace ssx::plugins {
 
 class HoverDriver final : public Driver {
  public:
+  static constexpr const char* kDoc = "holds a rigid body at a set-point with a PD law (force and torque, no rotors)";
+  static constexpr ssx_plugin_param kParameters[] = {
+      param::vec3("target", "", "m", param::any(), "set-point (default: where the artifact starts, plus offset)"),
+      param::vec3("offset", "0 0 0", "m", param::any(), "added to the start when no target is given"),
+      param::real("yaw", "0", "rad", param::any(), "heading to hold"),
+      param::real("kp", "16", "1/s^2", param::positive(), "position gain"),
+      param::real("kd", "8", "1/s", param::positive(), "velocity gain (16, 8: critically damped at 4 rad/s)"),
+      param::real("kr", "36", "1/s^2", param::positive(), "attitude gain"),
+      param::real("kw", "12", "1/s", param::positive(), "angular velocity gain"),
+  };
+
+  static void validate(const Descriptor& params, const PluginContext& context) {
+    const Artifact& a = *context.artifact;
+    if (a.rootCount() == 0 || a.root().isStatic()) throw params.error("hover needs a dynamic physic root");
+  }
+
   void configure(const Descriptor& params) override {
     Artifact& a = artifact();
-    const Vec3 offset = params.get<Vec3>("offset", Vec3::Zero());
+    const Vec3 offset = params.get<Vec3>("offset");
     target_ = params.get<Vec3>("target", Vec3(a.placement().position + offset));
-    const double yaw = params.get<double>("yaw", 0.0);
-    target_orientation_ = Quat(Eigen::AngleAxisd(yaw, Vec3::UnitZ()));
-    kp_ = params.getPositive("kp", 16.0);
-    kd_ = params.getPositive("kd", 8.0);
-    kr_ = params.getPositive("kr", 36.0);
-    kw_ = params.getPositive("kw", 12.0);
-    if (a.rootCount() == 0 || a.root().isStatic()) throw params.error("hover needs a dynamic physic root");
+    target_orientation_ = Quat(Eigen::AngleAxisd(params.get<double>("yaw"), Vec3::UnitZ()));
+    kp_ = params.get<double>("kp");
+    kd_ = params.get<double>("kd");
+    kr_ = params.get<double>("kr");
+    kw_ = params.get<double>("kw");
     const MassProperties mass = combinedMass(a.root().spec());
     mass_ = mass.mass;
     inertia_ = mass.inertia;

@@ -6,21 +6,7 @@
 // through the node's rigid-body kinematics). Noise comes from the sensor's own stream, seeded from
 // (scene seed, artifact, plugin index).
 //
-// Parameters (defaults: ADIS16448, as RotorS):
-//   node                         physic node the IMU sits on (default: the first root)
-//   noise                        false turns every stochastic term off (default true)
-//   gyro_noise_density           rad/s/sqrt(Hz) (3.394e-4)
-//   gyro_bias_random_walk        rad/s^2/sqrt(Hz) (3.8785e-5)
-//   gyro_bias_correlation_time   s (1000)
-//   gyro_turn_on_bias            rad/s, standard deviation (8.7e-3)
-//   gyro_scale                   scale factor (1)
-//   gyro_lsb, gyro_range         rad/s per count (6.98e-4 = 0.04 deg/s), full scale (17.45 = 1000 deg/s)
-//   accel_noise_density          m/s^2/sqrt(Hz) (4.0e-3)
-//   accel_bias_random_walk       m/s^3/sqrt(Hz) (6.0e-3)
-//   accel_bias_correlation_time  s (300)
-//   accel_turn_on_bias           m/s^2 (0.196)
-//   accel_scale                  (1)
-//   accel_lsb, accel_range       m/s^2 per count (8.17e-3 = 0.833 mg), full scale (176.5 = 18 g)
+// Parameters: see kParameters below (defaults: ADIS16448, as RotorS), or `ssx plugins --params imu`.
 #include <ssx/artifact.hpp>
 #include <ssx/environment.hpp>
 #include <ssx/measurements.hpp>
@@ -40,21 +26,15 @@ struct Channel {
   Vec3 turn_on_bias = Vec3::Zero();
   Vec3 bias = Vec3::Zero();
 
-  void read(const Descriptor& p, const std::string& prefix, const Channel& defaults) {
-    *this = defaults;
-    auto positive = [&](const char* key, double fallback) { return p.getPositive(prefix + key, fallback); };
-    auto nonNegative = [&](const char* key, double fallback) {
-      const double v = p.get<double>(prefix + key, fallback);
-      if (v < 0) throw p.error(*p.find(prefix + key), prefix + key + " must not be negative");
-      return v;
-    };
-    noise_density = nonNegative("noise_density", noise_density);
-    bias_random_walk = nonNegative("bias_random_walk", bias_random_walk);
-    correlation_time = positive("bias_correlation_time", correlation_time);
-    turn_on = nonNegative("turn_on_bias", turn_on);
-    scale = positive("scale", scale);
-    lsb = positive("lsb", lsb);
-    range = positive("range", range);
+  // the values were checked against the declarations while loading
+  void read(const Descriptor& p, const std::string& prefix) {
+    noise_density = p.get<double>(prefix + "noise_density");
+    bias_random_walk = p.get<double>(prefix + "bias_random_walk");
+    correlation_time = p.get<double>(prefix + "bias_correlation_time");
+    turn_on = p.get<double>(prefix + "turn_on_bias");
+    scale = p.get<double>(prefix + "scale");
+    lsb = p.get<double>(prefix + "lsb");
+    range = p.get<double>(prefix + "range");
   }
 
   void prepare(double dt, bool noise, Random& rng) {
@@ -88,38 +68,55 @@ struct Channel {
   }
 };
 
-Channel gyroDefaults() {
-  Channel c;
-  c.noise_density = 3.394e-4;
-  c.bias_random_walk = 3.8785e-5;
-  c.correlation_time = 1000.0;
-  c.turn_on = 8.7e-3;
-  c.lsb = 0.04 * M_PI / 180.0;
-  c.range = 1000.0 * M_PI / 180.0;
-  return c;
-}
-
-Channel accelDefaults() {
-  Channel c;
-  c.noise_density = 4.0e-3;
-  c.bias_random_walk = 6.0e-3;
-  c.correlation_time = 300.0;
-  c.turn_on = 0.196;
-  c.lsb = 0.833e-3 * 9.80665;
-  c.range = 18.0 * 9.80665;
-  return c;
-}
-
 }  // namespace
 
 class ImuSensor final : public SensorOf<ImuMeasurement> {
  public:
+  static constexpr const char* kDoc = "accelerometer and gyroscope with noise, bias, scale, quantisation and range";
+  static constexpr ssx_plugin_param kParameters[] = {
+      param::text("node", "", "physic node the IMU sits on (default: the first root)"),
+      param::flag("noise", "true", "false turns every stochastic term off"),
+      param::real("gyro_noise_density", "3.394e-4", "rad/s/sqrt(Hz)", param::nonNegative(), "gyroscope white noise"),
+      param::real("gyro_bias_random_walk", "3.8785e-5", "rad/s^2/sqrt(Hz)", param::nonNegative(),
+                  "gyroscope bias random walk"),
+      param::real("gyro_bias_correlation_time", "1000", "s", param::positive(), "gyroscope bias correlation time"),
+      param::real("gyro_turn_on_bias", "8.7e-3", "rad/s", param::nonNegative(),
+                  "standard deviation of the gyroscope's turn-on bias"),
+      param::real("gyro_scale", "1", "", param::positive(), "gyroscope scale factor"),
+      param::real("gyro_lsb", "0.0006981317007977319", "rad/s", param::positive(),
+                  "gyroscope resolution, one count (0.04 deg/s)"),
+      param::real("gyro_range", "17.453292519943293", "rad/s", param::positive(),
+                  "gyroscope full scale (1000 deg/s)"),
+      param::real("accel_noise_density", "4.0e-3", "m/s^2/sqrt(Hz)", param::nonNegative(),
+                  "accelerometer white noise"),
+      param::real("accel_bias_random_walk", "6.0e-3", "m/s^3/sqrt(Hz)", param::nonNegative(),
+                  "accelerometer bias random walk"),
+      param::real("accel_bias_correlation_time", "300", "s", param::positive(),
+                  "accelerometer bias correlation time"),
+      param::real("accel_turn_on_bias", "0.196", "m/s^2", param::nonNegative(),
+                  "standard deviation of the accelerometer's turn-on bias"),
+      param::real("accel_scale", "1", "", param::positive(), "accelerometer scale factor"),
+      param::real("accel_lsb", "0.008168939449999999", "m/s^2", param::positive(),
+                  "accelerometer resolution, one count (0.833 mg)"),
+      param::real("accel_range", "176.5197", "m/s^2", param::positive(), "accelerometer full scale (18 g)"),
+  };
+
+  static void validate(const Descriptor& params, const PluginContext& context) {
+    const PhysicNode& node = context.artifact->nodeFromParameter(params);
+    if (node.isStatic()) throw params.error("an IMU needs a dynamic node");
+    // counts are 32-bit integers, as an IMU's registers
+    for (const char* prefix : {"gyro_", "accel_"}) {
+      const std::string range = std::string(prefix) + "range", lsb = std::string(prefix) + "lsb";
+      if (params.get<double>(range) / params.get<double>(lsb) >= 2147483647.0)
+        throw params.error(*params.find(lsb), range + " / " + lsb + " must be below 2^31 counts");
+    }
+  }
+
   void configure(const Descriptor& params) override {
     node_ = &artifact().nodeFromParameter(params);
-    if (node_->isStatic()) throw params.error("an IMU needs a dynamic node");
-    const bool noise = params.get<bool>("noise", true);
-    gyro_.read(params, "gyro_", gyroDefaults());
-    accel_.read(params, "accel_", accelDefaults());
+    const bool noise = params.get<bool>("noise");
+    gyro_.read(params, "gyro_");
+    accel_.read(params, "accel_");
     const double dt = toSeconds(periodSteps() * environment().timestep());
     gyro_.prepare(dt, noise, random());
     accel_.prepare(dt, noise, random());

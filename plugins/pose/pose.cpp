@@ -1,12 +1,7 @@
 // pose: ground-truth pose and twist of a node (ssx::PoseMeasurement), with optional Gaussian noise
 // drawn from the sensor's own stream (so runs repeat on any number of threads).
 //
-// Parameters:
-//   node                    physic node to measure (default: the first root)
-//   position_noise          standard deviation per axis, m (default 0)
-//   orientation_noise       standard deviation of a small rotation per axis, rad (default 0)
-//   velocity_noise          m/s (default 0)
-//   angular_velocity_noise  rad/s (default 0)
+// Parameters: kParameters below, or `ssx plugins --params pose`.
 #include <ssx/artifact.hpp>
 #include <ssx/measurements.hpp>
 #include <ssx/plugin_abi.hpp>
@@ -15,12 +10,26 @@ namespace ssx::plugins {
 
 class PoseSensor final : public SensorOf<PoseMeasurement> {
  public:
+  static constexpr const char* kDoc = "pose and twist of a node (a motion-capture stand-in), optionally noisy";
+  static constexpr ssx_plugin_param kParameters[] = {
+      param::text("node", "", "physic node to measure (default: the first root)"),
+      param::real("position_noise", "0", "m", param::nonNegative(), "standard deviation per axis"),
+      param::real("orientation_noise", "0", "rad", param::nonNegative(),
+                  "standard deviation of a small rotation per axis"),
+      param::real("velocity_noise", "0", "m/s", param::nonNegative(), "standard deviation per axis"),
+      param::real("angular_velocity_noise", "0", "rad/s", param::nonNegative(), "standard deviation per axis"),
+  };
+
+  static void validate(const Descriptor& params, const PluginContext& context) {
+    (void)context.artifact->nodeFromParameter(params);
+  }
+
   void configure(const Descriptor& params) override {
     node_ = &artifact().nodeFromParameter(params);
-    position_noise_ = nonNegative(params, "position_noise");
-    orientation_noise_ = nonNegative(params, "orientation_noise");
-    velocity_noise_ = nonNegative(params, "velocity_noise");
-    angular_velocity_noise_ = nonNegative(params, "angular_velocity_noise");
+    position_noise_ = params.get<double>("position_noise");
+    orientation_noise_ = params.get<double>("orientation_noise");
+    velocity_noise_ = params.get<double>("velocity_noise");
+    angular_velocity_noise_ = params.get<double>("angular_velocity_noise");
   }
 
   void sense(const StepInfo& info) override {
@@ -40,11 +49,6 @@ class PoseSensor final : public SensorOf<PoseMeasurement> {
   }
 
  private:
-  static double nonNegative(const Descriptor& params, const char* key) {
-    const double v = params.get<double>(key, 0.0);
-    if (v < 0) throw params.error(*params.find(key), std::string(key) + " must not be negative");
-    return v;
-  }
   // three draws in a fixed order (the order of function arguments is unspecified in C++)
   Vec3 noise(double sigma) {
     Vec3 n;

@@ -16,98 +16,109 @@ std::vector<std::string> words(const std::string& text) {
   return out;
 }
 
-double positive(const Descriptor& p, const char* key, double fallback) { return p.getPositive(key, fallback); }
-
-double nonNegative(const Descriptor& p, const char* key, double fallback) {
-  const double v = p.get<double>(key, fallback);
-  if (v < 0) throw p.error(*p.find(key), std::string(key) + " must not be negative");
-  return v;
+// the rotor and motor constants: the preset, then any override (values checked while loading)
+RotorParams rotorParams(const Descriptor& params) {
+  RotorParams rp = *preset(params.get<std::string>("preset"));
+  auto override = [&](const char* key, double& value) { value = params.get<double>(key, value); };
+  override("thrust_coefficient", rp.thrust_coefficient);
+  override("moment_constant", rp.moment_constant);
+  override("time_constant_up", rp.time_constant_up);
+  override("time_constant_down", rp.time_constant_down);
+  override("max_rotor_speed", rp.max_rotor_speed);
+  override("min_rotor_speed", rp.min_rotor_speed);
+  override("rotor_drag_coefficient", rp.rotor_drag_coefficient);
+  override("rolling_moment_coefficient", rp.rolling_moment_coefficient);
+  override("rotor_inertia", rp.rotor_inertia);
+  if (rp.min_rotor_speed >= rp.max_rotor_speed) {
+    std::ostringstream m;
+    m << "min_rotor_speed (" << rp.min_rotor_speed << " rad/s) must be below max_rotor_speed (" << rp.max_rotor_speed
+      << " rad/s)";
+    throw params.error(m.str());
+  }
+  return rp;
 }
 
-}  // namespace
-
-void QuadrotorDriver::configure(const Descriptor& params) {
-  Artifact& a = artifact();
-  Environment& env = environment();
-  if (a.rootCount() == 0 || a.root().isStatic()) throw params.error("a quadrotor needs a dynamic physic root");
-
-  // rotor and motor constants: the preset, then any override
-  const std::string preset_name = params.get<std::string>("preset", "mk_quad");
-  const auto base = preset(preset_name);
-  if (!base)
-    throw params.error(*params.find("preset"),
-                       "unknown preset '" + preset_name + "' (mk_quad, hummingbird, crazyflie)");
-  RotorParams rp = *base;
-  rp.thrust_coefficient = positive(params, "thrust_coefficient", rp.thrust_coefficient);
-  rp.moment_constant = positive(params, "moment_constant", rp.moment_constant);
-  rp.time_constant_up = positive(params, "time_constant_up", rp.time_constant_up);
-  rp.time_constant_down = positive(params, "time_constant_down", rp.time_constant_down);
-  rp.max_rotor_speed = positive(params, "max_rotor_speed", rp.max_rotor_speed);
-  rp.min_rotor_speed = nonNegative(params, "min_rotor_speed", rp.min_rotor_speed);
-  rp.rotor_drag_coefficient = nonNegative(params, "rotor_drag_coefficient", rp.rotor_drag_coefficient);
-  rp.rolling_moment_coefficient = nonNegative(params, "rolling_moment_coefficient", rp.rolling_moment_coefficient);
-  rp.rotor_inertia = nonNegative(params, "rotor_inertia", rp.rotor_inertia);
-  if (rp.min_rotor_speed >= rp.max_rotor_speed) throw params.error("min_rotor_speed must be below max_rotor_speed");
-
-  // rotors at their physic nodes, positions relative to the centre of mass
-  const auto names = words(params.get<std::string>("rotors", "rotor0 rotor1 rotor2 rotor3"));
-  const auto dirs = words(params.get<std::string>("directions", "1 -1 1 -1"));
+// the rotors at their physic nodes, positions relative to the centre of mass
+std::vector<Rotor> rotorsOf(const Descriptor& params, const Artifact& a) {
+  const auto names = words(params.get<std::string>("rotors"));
+  const auto dirs = words(params.get<std::string>("directions"));
   if (names.size() != dirs.size() || names.size() < 4)
     throw params.error("'rotors' and 'directions' must name the same number (at least 4) of rotors");
   std::vector<Rotor> rotors;
   for (std::size_t i = 0; i < names.size(); ++i) {
     const PhysicNode* node = a.node(names[i]);
     if (node == nullptr)
-      throw params.error("no physic node '" + names[i] + "' for a rotor in artifact '" + a.name() + "'");
-    if (dirs[i] != "1" && dirs[i] != "-1") throw params.error("rotor directions are 1 or -1, got '" + dirs[i] + "'");
+      throw params.error(*params.find("rotors"), "no physic node '" + names[i] + "' for a rotor in artifact '" + a.name() + "'");
+    if (dirs[i] != "1" && dirs[i] != "-1")
+      throw params.error(*params.find("directions"), "rotor directions are 1 or -1, got '" + dirs[i] + "'");
     rotors.push_back({node->poseInBody().position, dirs[i] == "1" ? 1 : -1});
   }
+  return rotors;
+}
+
+template <class M>
+const Sensor* firstSensorOf(const Artifact& a) {
+  for (std::size_t i = 0; i < a.sensorCount(); ++i)
+    if (dynamic_cast<const M*>(&a.sensor(i).latest()) != nullptr) return &a.sensor(i);
+  return nullptr;
+}
+
+}  // namespace
+
+void QuadrotorDriver::validate(const Descriptor& params, const PluginContext& context) {
+  const Artifact& a = *context.artifact;
+  if (a.rootCount() == 0 || a.root().isStatic()) throw params.error("a quadrotor needs a dynamic physic root");
+  (void)rotorParams(params);
+  (void)rotorsOf(params, a);
+  if (firstSensorOf<ImuMeasurement>(a) == nullptr)
+    throw params.error("a quadrotor needs an IMU: add <sensor plugin=\"imu\"/> to the artifact");
+  if (params.get<std::string>("reference") == "formation") {
+    const auto index = params.get<std::int64_t>("formation_index");
+    if (index >= params.get<std::int64_t>("formation_size") || static_cast<std::size_t>(index) > a.index())
+      throw params.error(*params.find("formation_index"),
+                         "formation_index must be below formation_size and the members one swarm");
+    if (firstSensorOf<RangeMeasurement>(a) == nullptr)
+      throw params.error("reference=\"formation\" needs a range sensor on the artifact");
+  }
+}
+
+void QuadrotorDriver::configure(const Descriptor& params) {
+  Artifact& a = artifact();
+  Environment& env = environment();
+  const RotorParams rp = rotorParams(params);
+  const std::vector<Rotor> rotors = rotorsOf(params, a);
   const MassProperties mass = combinedMass(a.root().spec());
   com_in_root_ = -a.root().poseInBody().position;
   rotors_.emplace(rotors, rp);
   const Allocation allocation(rotors, rp);
 
-  // loop rates in steps of the environment
-  const double tau = toSeconds(env.timestep());
-  auto stepsFor = [&](const char* key, double fallback) {
-    const double hz = positive(params, key, fallback);
-    const auto n = static_cast<std::int64_t>(std::llround(1.0 / (hz * tau)));
-    if (n < 1) throw params.error(std::string(key) + " is faster than the timestep allows");
-    return n;
-  };
-  inner_steps_ = stepsFor("inner_rate_hz", 500.0);
-  outer_steps_ = stepsFor("outer_rate_hz", 50.0);
-  outer_dt_ = outer_steps_ * tau;
+  // the loops run every k runs of the driver (whole numbers: checked while loading)
+  const PluginContext context{&env, &a, periodSteps(), env.timestep()};
+  const double period = toSeconds(context.period());
+  inner_runs_ = runsPerPeriod(params.get<double>("inner_rate_hz"), context);
+  outer_runs_ = runsPerPeriod(params.get<double>("outer_rate_hz"), context);
+  if (inner_runs_ < 1 || outer_runs_ < 1)
+    throw params.error("inner_rate_hz and outer_rate_hz must not be faster than the driver runs");
+  outer_dt_ = static_cast<double>(outer_runs_) * period;
 
   // the IMU this controller reads (required) and a pose source (optional)
-  for (std::size_t i = 0; i < a.sensorCount(); ++i) {
-    const Sensor& s = a.sensor(i);
-    if (imu_ == nullptr && dynamic_cast<const ImuMeasurement*>(&s.latest()) != nullptr) {
-      imu_ = static_cast<const ImuMeasurement*>(&s.latest());
-      env.subscribe<ImuMeasurement>(s, a, [this](const ImuMeasurement&) { imu_fresh_ = true; });
-    } else if (!have_pose_ && dynamic_cast<const PoseMeasurement*>(&s.latest()) != nullptr) {
-      have_pose_ = true;
-      env.subscribe<PoseMeasurement>(s, a, [this](const PoseMeasurement& m) { pose_ = m; });
-    }
+  const Sensor* imu = firstSensorOf<ImuMeasurement>(a);
+  if (imu == nullptr) throw params.error("a quadrotor needs an IMU: add <sensor plugin=\"imu\"/> to the artifact");
+  imu_ = static_cast<const ImuMeasurement*>(&imu->latest());
+  env.subscribe<ImuMeasurement>(*imu, a, [this](const ImuMeasurement&) { imu_seen_ = true; });
+  if (const Sensor* pose = firstSensorOf<PoseMeasurement>(a)) {
+    have_pose_ = true;
+    env.subscribe<PoseMeasurement>(*pose, a, [this](const PoseMeasurement& m) { pose_ = m; });
   }
-  if (imu_ == nullptr) throw params.error("a quadrotor needs an IMU: add <sensor plugin=\"imu\"/> to the artifact");
 
   // inner loop
   InnerLoopParams ip;
-  ip.dt = inner_steps_ * tau;
-  auto bounded = [&](const char* key, double fallback, double max) {
-    const double v = positive(params, key, fallback);
-    if (v > max) throw params.error(*params.find(key), std::string(key) + " must be at most " + std::to_string(max));
-    return v;
-  };
-  ip.attitude_kp = bounded("attitude_kp", ip.attitude_kp, InnerLoopLimits::attitude_kp);
-  ip.attitude_kd = bounded("attitude_kd", ip.attitude_kd, InnerLoopLimits::attitude_kd);
-  ip.yaw_rate_kp = bounded("yaw_rate_kp", ip.yaw_rate_kp, InnerLoopLimits::yaw_rate_kp);
-  ip.max_angular_acceleration =
-      bounded("max_angular_acceleration", ip.max_angular_acceleration, InnerLoopLimits::max_angular_acceleration);
-  ip.filter_gyro_weight = positive(params, "filter_gyro_weight", ip.filter_gyro_weight);
-  if (ip.filter_gyro_weight > 1)
-    throw params.error(*params.find("filter_gyro_weight"), "filter_gyro_weight must be at most 1");
+  ip.dt = static_cast<double>(inner_runs_) * period;
+  ip.attitude_kp = params.get<double>("attitude_kp");
+  ip.attitude_kd = params.get<double>("attitude_kd");
+  ip.yaw_rate_kp = params.get<double>("yaw_rate_kp");
+  ip.max_angular_acceleration = params.get<double>("max_angular_acceleration");
+  ip.filter_gyro_weight = params.get<double>("filter_gyro_weight");
   ip.gravity = -env.settings().physics.gravity.z();
   ip.inertia = mass.inertia;
   ip.min_rotor_speed = rp.min_rotor_speed;
@@ -123,26 +134,26 @@ void QuadrotorDriver::configure(const Descriptor& params) {
 
   // outer loop
   PositionParams pp;
-  pp.mass = positive(params, "controller_mass", mass.mass);
+  pp.mass = params.get<double>("controller_mass", mass.mass);
   pp.gravity = ip.gravity;
-  pp.kp = params.get<Vec3>("position_kp", pp.kp);
-  pp.kd = params.get<Vec3>("position_kd", pp.kd);
-  pp.ki = params.get<Vec3>("position_ki", pp.ki);
-  pp.integral_limit = positive(params, "integral_limit", pp.integral_limit);
-  pp.max_tilt = positive(params, "max_tilt_deg", 30.0) * std::numbers::pi / 180.0;
-  pp.max_thrust = positive(params, "max_thrust", 0.95 * ip.max_thrust);
+  pp.kp = params.get<Vec3>("position_kp");
+  pp.kd = params.get<Vec3>("position_kd");
+  pp.ki = params.get<Vec3>("position_ki");
+  pp.integral_limit = params.get<double>("integral_limit");
+  pp.max_tilt = params.get<double>("max_tilt_deg") * std::numbers::pi / 180.0;
+  pp.max_thrust = params.get<double>("max_thrust", 0.95 * ip.max_thrust);
   pp.min_thrust = 0.05 * pp.max_thrust;
   outer_.emplace(pp);
 
   // reference source
   const Vec3 start = a.placement().position;
-  const std::string source = params.get<std::string>("reference", "hover");
-  hover_.position = params.get<Vec3>("target", Vec3(start + params.get<Vec3>("offset", Vec3::Zero())));
-  eight_.center = params.get<Vec3>("center", Vec3(start + params.get<Vec3>("center_offset", Vec3::Zero())));
-  eight_.amplitude = positive(params, "amplitude", eight_.amplitude);
-  eight_.period = positive(params, "eight_period", eight_.period);
-  eight_.yaw_rate = params.get<double>("yaw_rate", eight_.yaw_rate);
-  start_time_ = params.get<double>("start_time", 0.0);
+  const std::string source = params.get<std::string>("reference");
+  hover_.position = params.get<Vec3>("target", Vec3(start + params.get<Vec3>("offset")));
+  eight_.center = params.get<Vec3>("center", Vec3(start + params.get<Vec3>("center_offset")));
+  eight_.amplitude = params.get<double>("amplitude");
+  eight_.period = params.get<double>("eight_period");
+  eight_.yaw_rate = params.get<double>("yaw_rate");
+  start_time_ = params.get<double>("start_time");
   if (source == "hover") {
     source_ = Source::Hover;
   } else if (source == "eight_horizontal" || source == "eight_vertical") {
@@ -150,39 +161,28 @@ void QuadrotorDriver::configure(const Descriptor& params) {
     eight_.vertical = source == "eight_vertical";
   } else if (source == "formation") {
     source_ = Source::Formation;
-    formation_.size =
-        static_cast<std::size_t>(std::max<std::int64_t>(1, params.get<std::int64_t>("formation_size", 70)));
-    const auto index = params.get<std::int64_t>("formation_index", 0);
+    formation_.size = static_cast<std::size_t>(params.get<std::int64_t>("formation_size"));
+    const auto index = params.get<std::int64_t>("formation_index");
     if (index < 0 || static_cast<std::size_t>(index) >= formation_.size || static_cast<std::size_t>(index) > a.index())
       throw params.error("formation_index must be in [0, formation_size) and the members one swarm");
     formation_index_ = static_cast<std::size_t>(index);
     formation_base_ = a.index() - formation_index_;
     own_target_ = formation_.target(formation_index_);
-    formation_.radius = positive(params, "formation_radius", formation_.radius);
-    formation_.center = params.get<Vec3>("formation_center", formation_.center);
-    formation_.gain = positive(params, "formation_gain", formation_.gain);
-    formation_.max_speed = positive(params, "formation_max_speed", formation_.max_speed);
-    formation_.anchor_gain = nonNegative(params, "formation_anchor_gain", formation_.anchor_gain);
-    formation_.obstacle_distance = positive(params, "obstacle_distance", formation_.obstacle_distance);
-    formation_.obstacle_saturation = positive(params, "obstacle_saturation", formation_.obstacle_saturation);
-    bool have_range = false;
-    for (std::size_t i = 0; i < a.sensorCount(); ++i) {
-      const Sensor& s = a.sensor(i);
-      if (dynamic_cast<const RangeMeasurement*>(&s.latest()) == nullptr) continue;
-      env.subscribe<RangeMeasurement>(s, a, [this](const RangeMeasurement& m) { seen_ = m.detections; });
-      have_range = true;
-      break;
-    }
-    if (!have_range) throw params.error("reference=\"formation\" needs a range sensor on the artifact");
-    virtual_point_ = start + params.get<Vec3>("offset", Vec3::Zero());
+    formation_.radius = params.get<double>("formation_radius");
+    formation_.center = params.get<Vec3>("formation_center");
+    formation_.gain = params.get<double>("formation_gain");
+    formation_.max_speed = params.get<double>("formation_max_speed");
+    formation_.anchor_gain = params.get<double>("formation_anchor_gain");
+    formation_.obstacle_distance = params.get<double>("obstacle_distance");
+    formation_.obstacle_saturation = params.get<double>("obstacle_saturation");
+    const Sensor* range = firstSensorOf<RangeMeasurement>(a);
+    if (range == nullptr) throw params.error("reference=\"formation\" needs a range sensor on the artifact");
+    env.subscribe<RangeMeasurement>(*range, a, [this](const RangeMeasurement& m) { seen_ = m.detections; });
+    virtual_point_ = start + params.get<Vec3>("offset");
     own_target_ = formation_.target(formation_index_);
-  } else if (source == "external") {
+  } else {
     source_ = Source::External;
     external_ = hover_;
-  } else {
-    throw params.error(
-        *params.find("reference"),
-        "unknown reference '" + source + "' (hover, eight_horizontal, eight_vertical, external, formation)");
   }
   current_ = reference(0.0);
 
@@ -229,10 +229,11 @@ void QuadrotorDriver::setSetpoint(const Setpoint& setpoint) {
 }
 
 void QuadrotorDriver::step(const StepInfo& info) {
-  const double tau = toSeconds(environment().timestep());
+  const double period = info.periodSeconds();
+  const std::int64_t run = info.step / periodSteps();
   PhysicNode& body = artifact().root();
   // outer loop: position (motion capture or ground truth) to attitude and thrust
-  if (info.step % outer_steps_ == 0) {
+  if (run % outer_runs_ == 0) {
     // the formation starts after start_time; until then the vehicle climbs to its start + offset
     if (source_ == Source::Formation && toSeconds(info.time) >= start_time_) formationStep(outer_dt_);
     current_ = reference(toSeconds(info.time));
@@ -252,13 +253,12 @@ void QuadrotorDriver::step(const StepInfo& info) {
     command_.thrust_q16 = static_cast<std::int32_t>(std::llround(attitude_.thrust * 65536.0));
   }
   // inner loop: IMU counts to motor commands
-  if (info.step % inner_steps_ == 0 && imu_fresh_) {
-    imu_fresh_ = false;
+  if (run % inner_runs_ == 0 && imu_seen_) {
     const InnerOutput out = inner_->step(imu_->gyroscope_counts, imu_->accelerometer_counts, command_);
     for (std::size_t i = 0; i < out.motors; ++i) commanded_speeds_[i] = inner_->commandToSpeed(out.motor_commands[i]);
   }
   // motors and aerodynamics, applied at the centre of mass in body axes
-  rotors_->step(tau, commanded_speeds_);
+  rotors_->step(period, commanded_speeds_);
   const BodyState s = body.state();
   const Quat to_body = s.pose.orientation.conjugate();
   const Vec3 v_com = artifact().environment().bodyState(body.bodyIndex()).linear_velocity;

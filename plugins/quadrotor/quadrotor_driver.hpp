@@ -2,29 +2,18 @@
 // quadrotor: the driver of a quadrotor. Rotor model, cascaded controller (outer position loop in
 // floating point, inner attitude loop in integers fed by the IMU), and reference sources.
 //
-// Parameters (artifact file; every RotorParams field by its name overrides the preset):
-//   preset             mk_quad (default), hummingbird, crazyflie
-//   thrust_coefficient, moment_constant, time_constant_up, time_constant_down, max_rotor_speed,
-//   min_rotor_speed, rotor_drag_coefficient, rolling_moment_coefficient, rotor_inertia
-//   rotors             physic node names of the rotors (default "rotor0 rotor1 rotor2 rotor3")
-//   directions         spin of each, +1 counter-clockwise seen from above (default "1 -1 1 -1")
-//   outer_rate_hz      position loop rate (default 50)
-//   inner_rate_hz      attitude loop rate (default 500); the IMU should run at least as fast
-//   attitude_kp, attitude_kd, yaw_rate_kp, max_angular_acceleration, filter_gyro_weight
-//   position_kp, position_kd, position_ki ("x y z"), integral_limit, max_tilt_deg, max_thrust
-//   controller_mass    the mass the controller assumes (default: the model's)
-//   reference          hover (default), eight_horizontal, eight_vertical, external, formation
-//   target / offset    hover point, or the start plus offset (default 0 0 0)
-//   center, amplitude, period, yaw_rate, start_time   figure eight (center default: the start
-//                      plus center_offset; before start_time the vehicle holds the centre)
-//   formation_index, formation_size, formation_radius, formation_center, formation_gain,
-//   formation_max_speed, formation_anchor_gain, obstacle_distance, obstacle_saturation
-//                      formation on a sphere; needs a `range` sensor; the members must be one
-//                      swarm (consecutive artifacts), member i at artifact index (own - own i + i)
+// Parameters: kParameters in quadrotor_driver.cpp, or `ssx plugins --params quadrotor`. Every
+// RotorParams field by its name overrides the preset.
+//
+// Timing: the driver runs every `period` steps and integrates its motors over that period; the
+// position loop (outer_rate_hz) and the attitude loop (inner_rate_hz) run every k of its runs,
+// so their periods must be whole multiples of the driver's (checked while loading). The attitude
+// loop reads the IMU's latest sample.
 //
 // Needs a sensor producing ssx::ImuMeasurement on the artifact (the `imu` plugin). Uses the first
 // sensor producing ssx::PoseMeasurement (a motion-capture stand-in) for position and velocity,
-// else the ground truth.
+// else the ground truth. The formation needs a `range` sensor; its members must be one swarm
+// (consecutive artifacts), member i at artifact index (own - own i + i).
 #include "quadrotor_model.hpp"
 
 #include <ssx/ssx.hpp>
@@ -35,6 +24,58 @@ namespace ssx::quadrotor {
 
 class QuadrotorDriver final : public Driver, public SetpointInterface {
  public:
+  static constexpr const char* kDoc =
+      "quadrotor: rotor model, integer attitude loop on IMU counts, position loop, reference sources";
+  static constexpr ssx_plugin_param kParameters[] = {
+      param::choice("preset", "mk_quad", "mk_quad hummingbird crazyflie", "rotor and motor constants to start from"),
+      param::real("thrust_coefficient", "", "N s^2", param::positive(), "thrust per squared rotor speed (default: the preset's)"),
+      param::real("moment_constant", "", "m", param::positive(), "drag torque per thrust (default: the preset's)"),
+      param::real("time_constant_up", "", "s", param::positive(), "motor time constant, speeding up (default: the preset's)"),
+      param::real("time_constant_down", "", "s", param::positive(), "motor time constant, slowing down (default: the preset's)"),
+      param::real("max_rotor_speed", "", "rad/s", param::positive(), "(default: the preset's)"),
+      param::real("min_rotor_speed", "", "rad/s", param::nonNegative(), "below max_rotor_speed (default: the preset's)"),
+      param::real("rotor_drag_coefficient", "", "N s/m", param::nonNegative(), "rotor drag (default: the preset's)"),
+      param::real("rolling_moment_coefficient", "", "N m s/m", param::nonNegative(), "rolling moment (default: the preset's)"),
+      param::real("rotor_inertia", "", "kg m^2", param::nonNegative(), "(default: the preset's)"),
+      param::text("rotors", "rotor0 rotor1 rotor2 rotor3", "physic node names of the rotors (at least 4)"),
+      param::text("directions", "1 -1 1 -1", "spin of each rotor: 1 counter-clockwise seen from above, -1 clockwise"),
+      param::rate("outer_rate_hz", "50", param::positive(), "position loop rate"),
+      param::rate("inner_rate_hz", "500", param::positive(), "attitude loop rate; it reads the IMU's latest sample"),
+      param::real("attitude_kp", "200", "1/s^2", param::positive() & param::atMost(InnerLoopLimits::attitude_kp), "attitude gain"),
+      param::real("attitude_kd", "25", "1/s", param::positive() & param::atMost(InnerLoopLimits::attitude_kd), "body rate gain"),
+      param::real("yaw_rate_kp", "8", "1/s", param::positive() & param::atMost(InnerLoopLimits::yaw_rate_kp), "yaw rate gain"),
+      param::real("max_angular_acceleration", "400", "rad/s^2",
+                  param::positive() & param::atMost(InnerLoopLimits::max_angular_acceleration), "per axis"),
+      param::real("filter_gyro_weight", "0.998", "", param::positive() & param::atMost(1),
+                  "complementary filter: weight of the gyro path per step"),
+      param::vec3("position_kp", "9 9 9", "1/s^2", param::nonNegative(), "position gains"),
+      param::vec3("position_kd", "7.5 7.5 7.5", "1/s", param::nonNegative(), "velocity gains"),
+      param::vec3("position_ki", "4.5 4.5 0", "1/s^3", param::nonNegative(), "integral gains"),
+      param::real("integral_limit", "2", "m s", param::positive(), "per axis"),
+      param::real("max_tilt_deg", "30", "deg", param::positive() & param::below(90), "largest roll or pitch commanded"),
+      param::real("max_thrust", "", "N", param::positive(), "largest thrust commanded (default: 0.95 of the rotors' total)"),
+      param::real("controller_mass", "", "kg", param::positive(), "the mass the controller assumes (default: the model's)"),
+      param::choice("reference", "hover", "hover eight_horizontal eight_vertical external formation",
+                    "where the set-point comes from"),
+      param::vec3("target", "", "m", param::any(), "hover point (default: the start plus offset)"),
+      param::vec3("offset", "0 0 0", "m", param::any(), "hover point, or the formation's start, relative to the start"),
+      param::vec3("center", "", "m", param::any(), "figure eight centre (default: the start plus center_offset)"),
+      param::vec3("center_offset", "0 0 0", "m", param::any(), "figure eight centre relative to the start"),
+      param::real("amplitude", "1", "m", param::positive(), "figure eight amplitude A"),
+      param::real("eight_period", "12", "s", param::positive(), "figure eight period T"),
+      param::real("yaw_rate", "0.2", "rad/s", param::any(), "figure eight yaw rate"),
+      param::real("start_time", "0", "s", param::any(), "figure eight or formation start; before it the vehicle holds"),
+      param::integer("formation_index", "0", param::nonNegative(), "this member's index in the formation"),
+      param::integer("formation_size", "70", param::between(1, 10'000'000), "members in the formation"),
+      param::real("formation_radius", "4", "m", param::positive(), "sphere radius"),
+      param::vec3("formation_center", "0 0 5", "m", param::any(), "sphere centre"),
+      param::real("formation_gain", "0.2", "m/s", param::positive(), "gain of the shape potentials"),
+      param::real("formation_max_speed", "1", "m/s", param::positive(), "top speed of the virtual point"),
+      param::real("formation_anchor_gain", "0.5", "1/s", param::nonNegative(), "pull towards the own target"),
+      param::real("obstacle_distance", "0.5", "m", param::positive(), "obstacles repel inside it"),
+      param::real("obstacle_saturation", "0.2", "m", param::positive(), "the repulsion is saturated inside it"),
+  };
+  static void validate(const Descriptor& params, const PluginContext& context);
   void configure(const Descriptor& params) override;
   void step(const StepInfo& info) override;
   void setSetpoint(const Setpoint& setpoint) override;
@@ -56,7 +97,7 @@ class QuadrotorDriver final : public Driver, public SetpointInterface {
   InnerCommand command_;
   AttitudeCommand attitude_;
   std::vector<double> commanded_speeds_;
-  std::int64_t inner_steps_ = 1, outer_steps_ = 10;
+  std::int64_t inner_runs_ = 1, outer_runs_ = 10;  // loop periods in runs of the driver
   double outer_dt_ = 0.02;
   enum class Source { Hover, Eight, External, Formation } source_ = Source::Hover;
   void formationStep(double dt);
@@ -74,7 +115,7 @@ class QuadrotorDriver final : public Driver, public SetpointInterface {
   double start_time_ = 0;
   Setpoint current_;
   const ImuMeasurement* imu_ = nullptr;
-  bool imu_fresh_ = false;
+  bool imu_seen_ = false;  // a sample has arrived
   PoseMeasurement pose_;
   bool have_pose_ = false;
   Vec3 com_in_root_ = Vec3::Zero();

@@ -4,13 +4,7 @@
 // obstacles are the shapes of static artifacts (boxes, spheres, cylinders, capsules; not planes),
 // seen at their nearest surface point.
 //
-// Parameters:
-//   range           m (default 2.5)
-//   frame           world (default) or body: the frame of the relative positions
-//   position_noise  standard deviation per axis of Gaussian noise on each relative position, m (0)
-//   fov_deg         full cone angle around the body x axis; 360 (default) sees all around
-//   max_count       keep at most this many detections, nearest first; 0 (default) keeps all
-//   obstacles       false ignores static obstacles (default true)
+// Parameters: kParameters below, or `ssx plugins --params range`.
 #include <ssx/artifact.hpp>
 #include <ssx/environment.hpp>
 #include <ssx/measurements.hpp>
@@ -60,25 +54,34 @@ Vec3 nearestPoint(const ObstacleShape& o, const Vec3& p) {
 
 class RangeSensor final : public SensorOf<RangeMeasurement> {
  public:
-  void configure(const Descriptor& params) override {
-    range_ = params.getPositive("range", 2.5);
-    const std::string frame = params.get<std::string>("frame", "world");
-    if (frame != "world" && frame != "body") throw params.error(*params.find("frame"), "frame must be world or body");
-    output().body_frame = frame == "body";
-    noise_ = params.get<double>("position_noise", 0.0);
-    if (noise_ < 0) throw params.error(*params.find("position_noise"), "position_noise must not be negative");
-    const double fov = params.get<double>("fov_deg", 360.0);
-    if (!(fov > 0 && fov <= 360)) throw params.error(*params.find("fov_deg"), "fov_deg must be in (0, 360]");
-    cos_half_fov_ = fov >= 360 ? -2.0 : std::cos(fov / 2 * std::numbers::pi / 180.0);
-    const auto max_count = params.get<std::int64_t>("max_count", 0);
-    if (max_count < 0) throw params.error(*params.find("max_count"), "max_count must not be negative");
-    max_count_ = static_cast<std::size_t>(max_count);
-    if (artifact().rootCount() == 0 || artifact().root().isStatic())
+  static constexpr const char* kDoc = "robots and obstacles around an artifact, nearest first";
+  static constexpr ssx_plugin_param kParameters[] = {
+      param::real("range", "2.5", "m", param::positive(), "how far it sees"),
+      param::choice("frame", "world", "world body", "frame of the relative positions"),
+      param::real("position_noise", "0", "m", param::nonNegative(),
+                  "standard deviation per axis of Gaussian noise on each relative position"),
+      param::real("fov_deg", "360", "deg", param::positive() & param::atMost(360),
+                  "full cone angle around the body x axis; 360 sees all around"),
+      param::integer("max_count", "0", param::nonNegative(), "keep at most this many detections, nearest first; 0 keeps all"),
+      param::flag("obstacles", "true", "false ignores static obstacles"),
+  };
+
+  static void validate(const Descriptor& params, const PluginContext& context) {
+    if (context.artifact->rootCount() == 0 || context.artifact->root().isStatic())
       throw params.error("a range sensor needs a dynamic root");
+  }
+
+  void configure(const Descriptor& params) override {
+    range_ = params.get<double>("range");
+    output().body_frame = params.get<std::string>("frame") == "body";
+    noise_ = params.get<double>("position_noise");
+    const double fov = params.get<double>("fov_deg");
+    cos_half_fov_ = fov >= 360 ? -2.0 : std::cos(fov / 2 * std::numbers::pi / 180.0);
+    max_count_ = static_cast<std::size_t>(params.get<std::int64_t>("max_count"));
 
     Environment& env = environment();
     env.enableNeighborQueries(range_);
-    if (params.get<bool>("obstacles", true))
+    if (params.get<bool>("obstacles"))
       for (const ObstacleShape& o : env.staticShapes())
         if (o.shape.kind != Shape::Kind::Plane) obstacles_.push_back(&o);
   }

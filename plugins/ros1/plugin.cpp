@@ -13,18 +13,7 @@
 // until every robot has a set-point stamped at or after that odometry's time, so a controller
 // outside sees the same timing in real time and in faster runs.
 //
-// Parameters:
-//   master_uri          default $ROS_MASTER_URI, else http://127.0.0.1:11311
-//   node_name           default "ssx"
-//   timeout_s           how long to wait for the master at start (default 5)
-//   artifacts           "*" (default: every artifact with a dynamic root) or names
-//   odom_rate_hz        default 50
-//   imu_rate_hz         default 100 (0: no IMU topics)
-//   clock_rate_hz       default 100 (0: every step)
-//   lockstep            default false
-//   lockstep_timeout_s  default 2
-//   lockstep_connect_timeout_s  how long the first step waits for every robot's controller to
-//                       connect (default 10)
+// Parameters: kParameters below, or `ssx plugins --params ros1`.
 #include "ros_bridge.hpp"
 
 #include <ssx/environment.hpp>
@@ -53,9 +42,8 @@ struct Rate {
   }
 };
 
-Rate rateOf(const Descriptor& params, const char* key, double fallback, Nanoseconds every_step) {
-  const double hz = params.get<double>(key, fallback);
-  if (hz < 0) throw params.error(*params.find(key), std::string(key) + " must not be negative");
+Rate rateOf(const Descriptor& params, const char* key, Nanoseconds every_step) {
+  const double hz = params.get<double>(key);
   Rate r;
   r.period = hz > 0 ? toNanoseconds(1.0 / hz) : every_step;
   return r;
@@ -68,22 +56,48 @@ std::array<double, 4> array4(const Quat& q) { return {q.w(), q.x(), q.y(), q.z()
 
 class Ros1Bridge final : public SimulationExtension {
  public:
+  static constexpr const char* kDoc = "bridges robots to ROS 1: odometry, IMU and /clock out, set-points in";
+  static constexpr ssx_plugin_param kParameters[] = {
+      param::text("master_uri", "", "ROS master (default: $ROS_MASTER_URI, else http://127.0.0.1:11311)"),
+      param::text("node_name", "ssx", "name of the ROS node"),
+      param::real("timeout_s", "5", "s", param::positive(), "how long to wait for the master at start"),
+      param::text("artifacts", "*", "artifact names separated by spaces, or * for every artifact with a dynamic root"),
+      param::real("odom_rate_hz", "50", "Hz", param::nonNegative(), "odometry rate in simulated time; 0: every step"),
+      param::real("imu_rate_hz", "100", "Hz", param::nonNegative(), "IMU rate in simulated time; 0: no IMU topics"),
+      param::real("clock_rate_hz", "100", "Hz", param::nonNegative(), "/clock rate in simulated time; 0: every step"),
+      param::flag("lockstep", "false", "wait after each odometry message until every robot answered with a set-point"),
+      param::real("lockstep_timeout_s", "2", "s", param::positive(), "longest wait for the set-points of one step"),
+      param::real("lockstep_connect_timeout_s", "10", "s", param::positive(),
+                  "how long the first step waits for every robot's controller to connect"),
+  };
+
+  // what is bridged exists before the node is started
+  static void validate(const Descriptor& params, const PluginContext& context) {
+    try {
+      (void)context.environment->selectArtifacts(params.get<std::string>("artifacts"));
+    } catch (const ConfigError&) {
+      throw;
+    } catch (const Error& e) {
+      throw params.error(*params.find("artifacts"), std::string(e.what()) + " to bridge");
+    }
+  }
+
   void init(Environment& env, const Descriptor& params) override {
     const char* env_uri = std::getenv("ROS_MASTER_URI");
     const std::string master =
         params.get<std::string>("master_uri", env_uri != nullptr ? env_uri : "http://127.0.0.1:11311");
-    const std::string node = params.get<std::string>("node_name", "ssx");
-    const double timeout = params.getPositive("timeout_s", 5.0);
-    odom_rate_ = rateOf(params, "odom_rate_hz", 50.0, env.timestep());
-    imu_rate_ = rateOf(params, "imu_rate_hz", 100.0, env.timestep());
-    if (params.get<double>("imu_rate_hz", 100.0) == 0) imu_rate_.period = 0;
-    clock_rate_ = rateOf(params, "clock_rate_hz", 100.0, env.timestep());
-    lockstep_ = params.get<bool>("lockstep", false);
-    lockstep_timeout_ = params.getPositive("lockstep_timeout_s", 2.0);
-    connect_timeout_ = params.getPositive("lockstep_connect_timeout_s", 10.0);
+    const std::string node = params.get<std::string>("node_name");
+    const double timeout = params.get<double>("timeout_s");
+    odom_rate_ = rateOf(params, "odom_rate_hz", env.timestep());
+    imu_rate_ = rateOf(params, "imu_rate_hz", env.timestep());
+    if (params.get<double>("imu_rate_hz") == 0) imu_rate_.period = 0;
+    clock_rate_ = rateOf(params, "clock_rate_hz", env.timestep());
+    lockstep_ = params.get<bool>("lockstep");
+    lockstep_timeout_ = params.get<double>("lockstep_timeout_s");
+    connect_timeout_ = params.get<double>("lockstep_connect_timeout_s");
     std::vector<Artifact*> chosen;
     try {
-      chosen = env.selectArtifacts(params.get<std::string>("artifacts", "*"));
+      chosen = env.selectArtifacts(params.get<std::string>("artifacts"));
     } catch (const Error& e) {
       throw params.error(*params.find("artifacts"), std::string(e.what()) + " to bridge");
     }

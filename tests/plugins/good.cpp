@@ -11,6 +11,9 @@ namespace {
 // spins its body about z with a constant torque from parameter `torque`
 class Spinner final : public ssx::Driver {
  public:
+  static constexpr ssx_plugin_param kParameters[] = {
+      ssx::param::real("torque", "0.1", "N m", ssx::param::any(), "torque about z"),
+  };
   void configure(const ssx::Descriptor& params) override { torque_ = params.get<double>("torque", 0.1); }
   void step(const ssx::StepInfo&) override { artifact().root().addTorque(ssx::Vec3(0, 0, torque_)); }
 
@@ -29,6 +32,10 @@ class Counter final : public ssx::SensorOf<ssx::ClockMeasurement> {
 // throws at step `at_step` in the artifact named `only`
 class Bomb final : public ssx::Driver {
  public:
+  static constexpr ssx_plugin_param kParameters[] = {
+      ssx::param::integer("at_step", "0", ssx::param::nonNegative(), "step to throw at"),
+      ssx::param::text("only", "", "throw only in the artifact of this name (default: every artifact)"),
+  };
   void configure(const ssx::Descriptor& params) override {
     at_step_ = params.get<std::int64_t>("at_step", 0);
     armed_ = params.get<std::string>("only", artifact().name()) == artifact().name();
@@ -46,6 +53,9 @@ class Bomb final : public ssx::Driver {
 // test can tell whether a scene ever started
 class Marker final : public ssx::SimulationExtension {
  public:
+  static constexpr ssx_plugin_param kParameters[] = {
+      ssx::param::text("file", "marker_ran.txt", "file to write when initialised"),
+  };
   void init(ssx::Environment&, const ssx::Descriptor& params) override {
     std::ofstream(params.get<std::string>("file", "marker_ran.txt")) << "initialised\n";
   }

@@ -57,6 +57,10 @@ class SSX_EXPORT Artifact {
   Driver* driver() const noexcept { return driver_; }
   std::size_t sensorCount() const noexcept { return sensors_.size(); }
   Sensor& sensor(std::size_t i) const { return *sensors_.at(i).sensor; }
+  /// The parameters the driver is (or will be) configured with.
+  const Descriptor& driverParameters() const noexcept { return driver_params_; }
+  /// The parameters sensor i is (or will be) configured with.
+  const Descriptor& sensorParameters(std::size_t i) const { return sensors_.at(i).params; }
   /// The first sensor of type T, or nullptr.
   template <class T>
   T* findSensor() const {

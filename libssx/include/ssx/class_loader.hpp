@@ -13,6 +13,8 @@
 #include <unordered_map>
 #include <vector>
 
+extern "C" struct ssx_plugin_class;
+
 namespace ssx {
 
 enum class PluginKind : std::uint8_t { Driver, Sensor, Extension };
@@ -35,6 +37,8 @@ struct PluginLibraryInfo {
   struct Class {
     PluginKind kind;
     std::string name;
+    std::string doc;              ///< one line on what it is ("" if the plugin gives none)
+    std::string parameter_table;  ///< its declared parameters as a Markdown table (parameterTable)
   };
   std::vector<Class> classes;
 };
@@ -72,6 +76,11 @@ class SSX_EXPORT ClassLoader {
   Driver& createDriver(std::string_view plugin, std::string_view class_name);
   Sensor& createSensor(std::string_view plugin, std::string_view class_name);
   SimulationExtension& createExtension(std::string_view plugin, std::string_view class_name);
+  /// The manifest entry of `class_name` in `plugin` (loading the library), which must be of
+  /// `kind`. Valid as long as the loader lives. Throws PluginError.
+  const ssx_plugin_class& classInfo(std::string_view plugin, std::string_view class_name, PluginKind kind);
+  /// The manifest entry of the class an instance made by this loader belongs to, or null.
+  const ssx_plugin_class* classOf(const void* instance) const noexcept;
 
   /// Every library on the search path (files ending in .so), checked but not instantiated.
   std::vector<PluginLibraryInfo> scan() const;
@@ -90,9 +99,10 @@ class SSX_EXPORT ClassLoader {
   std::unordered_map<std::string, const Library*> by_name_;  // plugin names already resolved
   struct Instance {
     void* object;
-    void (*destroy)(void*) noexcept;
+    const ssx_plugin_class* type;
   };
   std::vector<Instance> instances_;
+  std::unordered_map<const void*, const ssx_plugin_class*> types_;
 };
 
 }  // namespace ssx

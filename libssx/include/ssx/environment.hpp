@@ -207,6 +207,7 @@ class SSX_EXPORT Environment {
   friend class PhysicNode;
 
   void requireSetup(const char* what) const;
+  void checkDeclaredParameters();
   void buildBodies();
   void publishSnapshot(bool first);
   void runSensors(std::size_t begin, std::size_t end);

@@ -4,8 +4,9 @@
 ///
 /// A plugin library exports one C data symbol, `ssx_plugin_manifest_v1`, of type
 /// `ssx_plugin_manifest`: plain constant data (no code runs to produce it) giving the ABI version,
-/// the record sizes, a build tag, and for every class its kind, name and `noexcept` create /
-/// destroy functions. The ClassLoader reads and checks all of it before calling any plugin code.
+/// the record sizes, a build tag, and for every class its kind, name, `noexcept` create /
+/// destroy functions, one line of doc and its declared parameters (ssx/parameters.hpp). The
+/// ClassLoader reads and checks all of it before calling any plugin code.
 ///
 /// A plugin author writes, in one .cpp of the library:
 ///
@@ -13,8 +14,13 @@
 ///                SSX_SENSOR(PoseSensor, "pose"))
 ///
 /// Types must be default-constructible and derive from ssx::Driver, ssx::Sensor or
-/// ssx::SimulationExtension respectively.
+/// ssx::SimulationExtension respectively. A type may have these static members, which the
+/// manifest then carries:
+///   static constexpr ssx_plugin_param kParameters[] = {...};   // its parameters
+///   static constexpr const char* kDoc = "...";                 // one line on what it is
+///   static void validate(const ssx::Descriptor&, const ssx::PluginContext&);  // load-time checks
 
+#include <ssx/parameters.hpp>
 #include <ssx/plugin.hpp>
 #include <ssx/version.hpp>
 
@@ -24,9 +30,10 @@
 #include <exception>
 #include <new>
 #include <type_traits>
+#include <vector>
 
 /// Incremented whenever the manifest layout or the meaning of its fields changes.
-#define SSX_PLUGIN_ABI_VERSION 1u
+#define SSX_PLUGIN_ABI_VERSION 2u
 
 #define SSX_PLUGIN_STRINGIFY2(x) #x
 #define SSX_PLUGIN_STRINGIFY(x) SSX_PLUGIN_STRINGIFY2(x)
@@ -61,11 +68,19 @@ enum ssx_plugin_kind : std::uint32_t {
 /// One class. `create` returns a new instance (as ssx::Driver*, ssx::Sensor* or
 /// ssx::SimulationExtension*, by kind) or null, writing the reason into `error` (NUL-terminated,
 /// at most `error_size` bytes); it never throws. `destroy` deletes an instance `create` returned.
+/// `params` lists the `param_count` declared parameters. `validate`, when not null, checks a
+/// parameter set (an `ssx::Descriptor*`, defaults added) in a context (an `ssx::PluginContext*`)
+/// and appends what is wrong to `diagnostics` (a `std::vector<ssx::Diagnostic>*`); it runs no
+/// instance's code and never throws.
 struct ssx_plugin_class {
   std::uint32_t kind;
   const char* name;
   void* (*create)(char* error, std::size_t error_size) noexcept;
   void (*destroy)(void* instance) noexcept;
+  const char* doc;
+  const ssx_plugin_param* params;
+  std::uint32_t param_count;
+  void (*validate)(const void* params, const void* context, void* diagnostics) noexcept;
 };
 
 /// The manifest. `record_size` is sizeof(ssx_plugin_manifest) and `class_size` is
@@ -106,10 +121,33 @@ void pluginDestroy(void* instance) noexcept {
   delete static_cast<Base*>(instance);
 }
 
+template <class T>
+void pluginValidate(const void* params, const void* context, void* diagnostics) noexcept {
+  auto& out = *static_cast<std::vector<Diagnostic>*>(diagnostics);
+  const auto& d = *static_cast<const Descriptor*>(params);
+  try {
+    T::validate(d, *static_cast<const PluginContext*>(context));
+  } catch (const ConfigError& e) {
+    out.push_back({Diagnostic::Severity::Error, e.where().line > 0 ? e.where() : d.where(), e.detail()});
+  } catch (const std::exception& e) {
+    out.push_back({Diagnostic::Severity::Error, d.where(), e.what()});
+  } catch (...) {
+    out.push_back({Diagnostic::Severity::Error, d.where(), "validate threw an unknown exception"});
+  }
+}
+
 template <class T, class Base>
 constexpr ssx_plugin_class pluginClass(std::uint32_t kind, const char* name) {
   static_assert(std::is_base_of_v<Base, T>, "SSX_DRIVER / SSX_SENSOR / SSX_EXTENSION: wrong base class");
-  return {kind, name, &pluginCreate<T, Base>, &pluginDestroy<Base>};
+  ssx_plugin_class c{kind, name, &pluginCreate<T, Base>, &pluginDestroy<Base>, "", nullptr, 0, nullptr};
+  if constexpr (requires { T::kDoc; }) c.doc = T::kDoc;
+  if constexpr (requires { T::kParameters; }) {
+    c.params = T::kParameters;
+    c.param_count = static_cast<std::uint32_t>(std::extent_v<decltype(T::kParameters)>);
+  }
+  if constexpr (requires(const Descriptor& d, const PluginContext& ctx) { T::validate(d, ctx); })
+    c.validate = &pluginValidate<T>;
+  return c;
 }
 
 }  // namespace ssx::detail

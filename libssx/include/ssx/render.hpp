@@ -44,6 +44,11 @@ struct RenderNodeSpec {
   std::vector<RenderNodeSpec> children;
 };
 
+/// The largest width or height of an image, in pixels, for frames and camera sensors alike.
+inline constexpr int kMaxImageSide = 16384;
+/// Whether a horizontal field of view, in degrees, can be drawn: in (0, 180).
+constexpr bool validFieldOfView(double fov_deg) { return fov_deg > 0 && fov_deg < 180; }
+
 /// A camera's pose and lens. The camera looks along its +x axis with +z up (the robotics body
 /// convention), so a camera on a robot looks where the robot's nose points.
 struct CameraView {

@@ -5,6 +5,7 @@
 #include <ssx/environment.hpp>
 #include <ssx/error.hpp>
 #include <ssx/export.hpp>
+#include <ssx/parameters.hpp>
 
 #include <cstdint>
 #include <filesystem>
@@ -14,16 +15,6 @@
 #include <vector>
 
 namespace ssx {
-
-/// One problem found in a scene or artifact file.
-struct SSX_EXPORT Diagnostic {
-  enum class Severity : std::uint8_t { Warning, Error };
-  Severity severity = Severity::Error;
-  SourceLocation where;
-  std::string message;
-  /// "file:line: error: message" (or warning).
-  std::string str() const;
-};
 
 /// A scene could not be loaded. `what()` lists every error (and the warnings) found, one per
 /// line; nothing was started.

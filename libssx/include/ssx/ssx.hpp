@@ -11,6 +11,7 @@
 #include <ssx/measurements.hpp>
 #include <ssx/physic_engine.hpp>
 #include <ssx/physic_node.hpp>
+#include <ssx/parameters.hpp>
 #include <ssx/plugin.hpp>
 #include <ssx/plugin_abi.hpp>
 #include <ssx/random.hpp>

@@ -318,7 +318,7 @@ void OsmesaRenderEngine::setup() {
 
 void OsmesaRenderEngine::renderView(const CameraView& view, const std::vector<RenderNode>& nodes,
                                     const Color& background, Image& out) {
-  if (view.width <= 0 || view.height <= 0 || view.width > 16384 || view.height > 16384)
+  if (view.width <= 0 || view.height <= 0 || view.width > kMaxImageSide || view.height > kMaxImageSide)
     throw Error("osmesa renderer: image size " + std::to_string(view.width) + "x" + std::to_string(view.height) +
                 " is out of range (1..16384)");
   makeCurrent(view.width, view.height);

@@ -4,6 +4,7 @@
 // anything starts.
 #include "xml/xml_reader.hpp"
 
+#include <ssx/plugin_abi.hpp>
 #include <ssx/scene.hpp>
 
 #include <cmath>
@@ -17,10 +18,6 @@
 namespace ssx {
 
 namespace fs = std::filesystem;
-
-std::string Diagnostic::str() const {
-  return where.str() + (severity == Severity::Error ? ": error: " : ": warning: ") + message;
-}
 
 namespace {
 
@@ -45,6 +42,7 @@ struct PluginDecl {
   std::string plugin;
   std::string class_name;
   std::int64_t period = 1;
+  SourceLocation period_from;  // where `period` was given, if it was
   Descriptor params;
 };
 
@@ -214,8 +212,15 @@ class SceneLoader {
              const Descriptor& element, const std::string& index = {});
   Descriptor withOverrides(const PluginDecl& decl, const Descriptor* overrides, const std::string& index);
   std::int64_t periodOf(const PluginDecl& decl, const Descriptor* overrides);
+  static SourceLocation periodFrom(const PluginDecl& decl, const Descriptor* overrides);
   template <class T, class Create>
   T* createPlugin(const PluginDecl& decl, Create create);
+  // checks a plugin's parameters against its class's declarations (defaults added)
+  void checkPlugin(Environment& env, const void* instance, Descriptor& params, const Artifact* artifact,
+                   std::int64_t period_steps, const std::string& what, const SourceLocation& period_from = {});
+  // runs a class's own validate on a parameter set that passed checkPlugin
+  void validatePlugin(Environment& env, const void* instance, const Descriptor& params, const Artifact* artifact,
+                      std::int64_t period_steps);
 
   const SceneOptions& options_;
   std::vector<Diagnostic> diagnostics_;
@@ -237,6 +242,7 @@ class SceneLoader {
   std::map<std::string, ArtifactType> types_;          // by type name, parsed on first use
   std::map<std::string, std::string> failed_plugins_;  // "plugin/class" -> already reported
   std::vector<std::pair<std::string, SourceLocation>> camera_follows_;  // checked once artifacts exist
+  std::vector<std::pair<const SimulationExtension*, Descriptor>> extension_checks_;
 };
 
 bool SceneLoader::once(const Descriptor& d, const Descriptor*& slot) {
@@ -374,8 +380,8 @@ void SceneLoader::readRender(const Descriptor& d) {
   r.period_steps = readCount(d, "period", 0, 0);
   r.rate_hz = read<double>(d, "rate_hz", 0.0);
   if (!(r.rate_hz >= 0)) error(d.find("rate_hz")->where, "<render>: rate_hz must be 0 or positive");
-  r.width = static_cast<int>(readCount(d, "width", r.width, 16, 16384));
-  r.height = static_cast<int>(readCount(d, "height", r.height, 16, 16384));
+  r.width = static_cast<int>(readCount(d, "width", r.width, 1, kMaxImageSide));
+  r.height = static_cast<int>(readCount(d, "height", r.height, 1, kMaxImageSide));
   r.background = readColor(d, r.background, "background");
   for (const Descriptor* c : d.childrenNamed("camera")) {
     CameraSpec cam;
@@ -388,7 +394,7 @@ void SceneLoader::readRender(const Descriptor& d) {
     cam.follow = read<std::string>(*c, "follow", "");
     if (!cam.follow.empty()) camera_follows_.push_back({cam.follow, c->find("follow")->where});
     cam.fov_deg = read<double>(*c, "fov_deg", cam.fov_deg);
-    if (!(cam.fov_deg > 0 && cam.fov_deg < 180)) {
+    if (!validFieldOfView(cam.fov_deg)) {
       error(c->find("fov_deg")->where, "<camera>: fov_deg must be in (0, 180)");
       cam.fov_deg = 60;  // reported once, here
     }
@@ -487,6 +493,7 @@ std::optional<PluginDecl> SceneLoader::readPluginDecl(const Descriptor& d) {
   decl.plugin = require(d, "plugin");
   decl.class_name = read<std::string>(d, "class", decl.plugin);
   decl.period = readCount(d, "period", 1, 1);
+  if (const auto* a = d.find("period")) decl.period_from = a->where;
   // the element is the parameter set, without what the loader itself reads: a plugin never
   // mistakes its period in steps for a parameter of its own (periodSteps() tells it)
   decl.params = d;
@@ -593,6 +600,31 @@ T* SceneLoader::createPlugin(const PluginDecl& decl, Create create) {
   }
 }
 
+void SceneLoader::checkPlugin(Environment& env, const void* instance, Descriptor& params, const Artifact* artifact,
+                              std::int64_t period_steps, const std::string& what, const SourceLocation& period_from) {
+  const ssx_plugin_class* type = env.classLoader().classOf(instance);
+  if (type == nullptr) return;
+  const PluginContext context{&env, artifact, period_steps, env.timestep(), period_from};
+  for (auto& d : checkParameters({type->params, type->param_count}, params, context, what))
+    diagnostics_.push_back(std::move(d));
+  // unknown parameters were reported just now: not again when the environment starts
+  for (const auto& a : params.attributes()) a.used = true;
+}
+
+void SceneLoader::validatePlugin(Environment& env, const void* instance, const Descriptor& params,
+                                 const Artifact* artifact, std::int64_t period_steps) {
+  const ssx_plugin_class* type = env.classLoader().classOf(instance);
+  if (type == nullptr || type->validate == nullptr) return;
+  const PluginContext context{&env, artifact, period_steps, env.timestep()};
+  std::vector<Diagnostic> found;
+  type->validate(&params, &context, &found);
+  for (auto& d : found) {
+    // the plugin's message names the element and class, as the declared checks do
+    if (d.message.rfind("<", 0) != 0) d.message = "<" + params.name() + ">: " + type->name + ": " + d.message;
+    diagnostics_.push_back(std::move(d));
+  }
+}
+
 // the type's plugin parameters, with those given on the scene's <artifact> or <swarm> on top
 Descriptor SceneLoader::withOverrides(const PluginDecl& decl, const Descriptor* overrides, const std::string& index) {
   if (overrides == nullptr) return decl.params;
@@ -612,6 +644,13 @@ Descriptor SceneLoader::withOverrides(const PluginDecl& decl, const Descriptor* 
 // the period in steps: the placing element's override, else the type's
 std::int64_t SceneLoader::periodOf(const PluginDecl& decl, const Descriptor* overrides) {
   return overrides == nullptr ? decl.period : readCount(*overrides, "period", decl.period, 1);
+}
+
+// where the period in steps was set: the placing element's override, else the type's, if anywhere
+SourceLocation SceneLoader::periodFrom(const PluginDecl& decl, const Descriptor* overrides) {
+  if (overrides != nullptr)
+    if (const auto* a = overrides->find("period")) return a->where;
+  return decl.period_from;
 }
 
 void SceneLoader::place(Environment& env, const std::string& name, const std::string& type_name, const Pose& pose,
@@ -639,22 +678,37 @@ void SceneLoader::place(Environment& env, const std::string& name, const std::st
     error(driver_override->where(), "<driver>: artifact type '" + type_name + "' has no driver to set parameters of");
 
   Artifact& a = env.addArtifact(name, pose);
+  const std::size_t errors_before = errorCount();
   for (const auto& p : type->physic) a.addPhysicRoot(p);
   for (const auto& r : type->render) a.addRenderRoot(r);
   ClassLoader& loader = env.classLoader();
+  // each plugin's parameters are checked against its declarations as it is attached, then each
+  // class's own checks run on the whole artifact (a driver may need a sensor of some kind)
   if (type->driver) {
     const PluginDecl& decl = *type->driver;
     auto create = [&](std::string_view p, std::string_view c) -> Driver& { return loader.createDriver(p, c); };
-    if (Driver* d = createPlugin<Driver>(decl, create))
-      a.setDriver(*d, withOverrides(decl, driver_override, index), periodOf(decl, driver_override), decl.class_name);
+    if (Driver* d = createPlugin<Driver>(decl, create)) {
+      Descriptor params = withOverrides(decl, driver_override, index);
+      const std::int64_t period = periodOf(decl, driver_override);
+      checkPlugin(env, d, params, &a, period, "driver '" + decl.class_name + "'", periodFrom(decl, driver_override));
+      a.setDriver(*d, std::move(params), period, decl.class_name);
+    }
   }
   for (std::size_t i = 0; i < type->sensors.size(); ++i) {
     const PluginDecl& decl = type->sensors[i];
     auto create = [&](std::string_view p, std::string_view c) -> Sensor& { return loader.createSensor(p, c); };
-    if (Sensor* s = createPlugin<Sensor>(decl, create))
-      a.addSensor(*s, withOverrides(decl, sensor_overrides[i], index), periodOf(decl, sensor_overrides[i]),
-                  decl.class_name);
+    if (Sensor* s = createPlugin<Sensor>(decl, create)) {
+      Descriptor params = withOverrides(decl, sensor_overrides[i], index);
+      const std::int64_t period = periodOf(decl, sensor_overrides[i]);
+      checkPlugin(env, s, params, &a, period, "sensor " + std::to_string(i) + " '" + decl.class_name + "'",
+                  periodFrom(decl, sensor_overrides[i]));
+      a.addSensor(*s, std::move(params), period, decl.class_name);
+    }
   }
+  if (errorCount() != errors_before) return;  // the class checks assume values of the declared types
+  for (std::size_t i = 0; i < a.sensorCount(); ++i)
+    validatePlugin(env, &a.sensor(i), a.sensorParameters(i), &a, a.sensor(i).periodSteps());
+  if (a.driver() != nullptr) validatePlugin(env, a.driver(), a.driverParameters(), &a, a.driver()->periodSteps());
 }
 
 void SceneLoader::buildObstacle(Environment& env, const Descriptor& d) {
@@ -807,9 +861,12 @@ void SceneLoader::build(Scene& scene) {
     const std::string name = require(d, "name");
     std::optional<PluginDecl> decl = readPluginDecl(d);
     if (name.empty() || !decl) continue;
+    decl->params.erase("name");  // the extension's name, read here
     try {
       SimulationExtension& ext = env.classLoader().createExtension(decl->plugin, decl->class_name);
+      checkPlugin(env, &ext, decl->params, nullptr, 1, "extension '" + decl->class_name + "'");
       env.addExtension(name, ext, decl->params);
+      extension_checks_.push_back({&ext, decl->params});
     } catch (const PluginError& err) {
       error(d.where(), "<extension>: " + std::string(err.what()));
     } catch (const ConfigError& err) {
@@ -839,6 +896,9 @@ void SceneLoader::build(Scene& scene) {
       buildObstacle(env, d);
     }
   }
+  // extensions check what they refer to (artifacts by name) once every artifact exists
+  if (!hasErrors())
+    for (const auto& [ext, params] : extension_checks_) validatePlugin(env, ext, params, nullptr, 1);
   for (const auto& [name, where] : camera_follows_) {
     const Artifact* a = env.findArtifact(name);
     if (a == nullptr || a->rootCount() == 0)

@@ -1,0 +1,181 @@
+#pragma once
+/// @file
+/// Declared plugin parameters: what a plugin class accepts (name, type, unit, default, range or
+/// choices, one line of doc), as plain constant data in its manifest. The scene loader checks
+/// every value against the declarations while loading, so `ssx validate` reports every bad
+/// parameter and nothing runs before all checks pass; `ssx plugins --params` prints them and the
+/// tables in docs/scene-format.md are made from them.
+///
+/// A plugin class declares its parameters as a static member:
+///
+///     static constexpr ssx_plugin_param kParameters[] = {
+///         ssx::param::real("range", "2.5", "m", ssx::param::positive(), "how far it sees"),
+///         ssx::param::choice("frame", "world", "world body", "frame of the relative positions"),
+///     };
+///
+/// and may add a static check of what one parameter alone cannot say (names of nodes, one value
+/// below another, a sensor it needs), which runs while loading too:
+///
+///     static void validate(const ssx::Descriptor& params, const ssx::PluginContext& context);
+///
+/// `configure` then reads the values with `params.get<T>(name)`: every declared parameter with a
+/// default is present by then, already checked.
+
+#include <ssx/descriptor.hpp>
+#include <ssx/export.hpp>
+#include <ssx/types.hpp>
+
+#include <cstdint>
+#include <limits>
+#include <span>
+#include <string>
+#include <vector>
+
+extern "C" {
+
+/// The type of a declared parameter.
+enum ssx_param_type : std::uint32_t {
+  SSX_PARAM_BOOL = 1,    ///< true/false/1/0
+  SSX_PARAM_INT = 2,     ///< a whole number (64 bits)
+  SSX_PARAM_REAL = 3,    ///< a finite number
+  SSX_PARAM_TEXT = 4,    ///< any text (names, lists of names)
+  SSX_PARAM_VEC3 = 5,    ///< "x y z", each finite; bounds apply to each component
+  SSX_PARAM_CHOICE = 6,  ///< one of the words in `choices` (separated by spaces)
+};
+
+/// Flags of a declared parameter.
+enum ssx_param_flag : std::uint32_t {
+  SSX_PARAM_REQUIRED = 1u,  ///< must be given
+  SSX_PARAM_HAS_MIN = 2u,   ///< value >= min (> min with MIN_OPEN)
+  SSX_PARAM_MIN_OPEN = 4u,
+  SSX_PARAM_HAS_MAX = 8u,  ///< value <= max (< max with MAX_OPEN)
+  SSX_PARAM_MAX_OPEN = 16u,
+  /// a rate in Hz of a loop inside the plugin: unless 0, its period must be a whole multiple of
+  /// the plugin's own period (the plugin runs its loop every k of its runs)
+  SSX_PARAM_RATE = 32u,
+};
+
+/// One declared parameter. `default_value` is text in the parameter's own syntax, or "" when the
+/// default is computed (say so in `doc`); `unit` is "" when there is none.
+struct ssx_plugin_param {
+  const char* name;
+  std::uint32_t type;
+  std::uint32_t flags;
+  const char* unit;
+  const char* default_value;
+  double min;
+  double max;
+  const char* choices;
+  const char* doc;
+};
+
+}  // extern "C"
+
+namespace ssx {
+
+class Artifact;
+class Environment;
+
+/// A message about a scene or a parameter, with where it came from.
+struct SSX_EXPORT Diagnostic {
+  enum class Severity : std::uint8_t { Warning, Error };
+  Severity severity = Severity::Error;
+  SourceLocation where;
+  std::string message;
+  /// "file:line: error: message" (or warning).
+  std::string str() const;
+};
+
+/// What a plugin's static `validate` may look at, while the scene is loaded (nothing has run).
+struct PluginContext {
+  const Environment* environment = nullptr;  ///< being populated: every artifact so far, nodes and plugins
+  const Artifact* artifact = nullptr;        ///< the plugin's artifact (null for an extension)
+  std::int64_t period_steps = 1;             ///< the plugin's period, in steps
+  Nanoseconds timestep = 0;                  ///< the environment's timestep
+  SourceLocation period_from;                ///< where the period was set, if in a file
+  /// The plugin's period in nanoseconds.
+  Nanoseconds period() const { return period_steps * timestep; }
+};
+
+/// Checks `params` against `declarations`: types, ranges, choices, required parameters, rates
+/// against the plugin's period (`context`). Adds the declared defaults of absent parameters (as
+/// read). Undeclared parameters are warnings (left unread: mark them read to silence the
+/// environment's own warning about parameters no plugin read).
+/// `what` names the plugin in messages ("driver 'quadrotor'"). Returns every problem found.
+SSX_EXPORT std::vector<Diagnostic> checkParameters(std::span<const ssx_plugin_param> declarations,
+                                                   Descriptor& params, const PluginContext& context,
+                                                   const std::string& what);
+
+/// The period, in runs of the plugin, of a rate parameter (SSX_PARAM_RATE) that checkParameters
+/// accepted: how many of the plugin's runs make one period of the rate. 0 for a rate of 0.
+SSX_EXPORT std::int64_t runsPerPeriod(double rate_hz, const PluginContext& context);
+
+/// Builders for declarations, usable in constant expressions.
+namespace param {
+
+/// Bounds of a number (each component of a vector).
+struct Bounds {
+  std::uint32_t flags = 0;
+  double min = 0;
+  double max = 0;
+};
+constexpr Bounds any() { return {}; }
+constexpr Bounds atLeast(double v) { return {SSX_PARAM_HAS_MIN, v, 0}; }
+constexpr Bounds above(double v) { return {SSX_PARAM_HAS_MIN | SSX_PARAM_MIN_OPEN, v, 0}; }
+constexpr Bounds atMost(double v) { return {SSX_PARAM_HAS_MAX, 0, v}; }
+constexpr Bounds below(double v) { return {SSX_PARAM_HAS_MAX | SSX_PARAM_MAX_OPEN, 0, v}; }
+constexpr Bounds positive() { return above(0); }
+constexpr Bounds nonNegative() { return atLeast(0); }
+/// [lo, hi]
+constexpr Bounds between(double lo, double hi) { return {SSX_PARAM_HAS_MIN | SSX_PARAM_HAS_MAX, lo, hi}; }
+/// Both bounds: `positive() & atMost(1)`.
+constexpr Bounds operator&(Bounds a, Bounds b) {
+  return {a.flags | b.flags, (b.flags & SSX_PARAM_HAS_MIN) != 0 ? b.min : a.min,
+          (b.flags & SSX_PARAM_HAS_MAX) != 0 ? b.max : a.max};
+}
+
+constexpr ssx_plugin_param make(const char* name, std::uint32_t type, const char* unit, const char* default_value,
+                                Bounds bounds, const char* choices, const char* doc) {
+  return {name, type, bounds.flags, unit, default_value, bounds.min, bounds.max, choices, doc};
+}
+constexpr ssx_plugin_param real(const char* name, const char* default_value, const char* unit, Bounds bounds,
+                                const char* doc) {
+  return make(name, SSX_PARAM_REAL, unit, default_value, bounds, "", doc);
+}
+constexpr ssx_plugin_param integer(const char* name, const char* default_value, Bounds bounds, const char* doc) {
+  return make(name, SSX_PARAM_INT, "", default_value, bounds, "", doc);
+}
+constexpr ssx_plugin_param flag(const char* name, const char* default_value, const char* doc) {
+  return make(name, SSX_PARAM_BOOL, "", default_value, {}, "", doc);
+}
+constexpr ssx_plugin_param text(const char* name, const char* default_value, const char* doc) {
+  return make(name, SSX_PARAM_TEXT, "", default_value, {}, "", doc);
+}
+constexpr ssx_plugin_param vec3(const char* name, const char* default_value, const char* unit, Bounds bounds,
+                                const char* doc) {
+  return make(name, SSX_PARAM_VEC3, unit, default_value, bounds, "", doc);
+}
+/// `choices`: the accepted words, separated by spaces.
+constexpr ssx_plugin_param choice(const char* name, const char* default_value, const char* choices, const char* doc) {
+  return make(name, SSX_PARAM_CHOICE, "", default_value, {}, choices, doc);
+}
+/// A loop rate in Hz whose period must be a whole multiple of the plugin's period (0 allowed
+/// only when `bounds` allows it).
+constexpr ssx_plugin_param rate(const char* name, const char* default_value, Bounds bounds, const char* doc) {
+  ssx_plugin_param p = make(name, SSX_PARAM_REAL, "Hz", default_value, bounds, "", doc);
+  p.flags |= SSX_PARAM_RATE;
+  return p;
+}
+/// The same declaration, which must be given.
+constexpr ssx_plugin_param required(ssx_plugin_param p) {
+  p.flags |= SSX_PARAM_REQUIRED;
+  return p;
+}
+
+}  // namespace param
+
+/// One line per declared parameter, for `ssx plugins --params` and the docs: a Markdown table
+/// with the columns parameter, type, unit, default, allowed, description.
+SSX_EXPORT std::string parameterTable(std::span<const ssx_plugin_param> declarations);
+
+}  // namespace ssx
