@@ -201,15 +201,29 @@ int commandValidate(const std::string& file, const std::vector<std::string>& plu
   }
 }
 
-int commandPlugins(const std::vector<std::string>& plugin_path) {
+int commandPlugins(const std::vector<std::string>& plugin_path, const std::string& params_of) {
   ssx::ClassLoader loader;
   for (const auto& dir : pluginPath(plugin_path)) loader.addSearchDirectory(dir);
   loader.addSearchDirectory(ssx::ClassLoader::installedPluginDirectory());
+  if (!params_of.empty()) {
+    // one class's declared parameters, as the Markdown table the docs hold
+    for (const auto& lib : loader.scan())
+      for (const auto& c : lib.classes) {
+        if (!lib.ok || c.name != params_of) continue;
+        std::cout << ssx::toString(c.kind) << " '" << c.name << "' (" << lib.path.string() << ")"
+                  << (c.doc.empty() ? "" : ": " + c.doc) << "\n\n"
+                  << c.parameter_table;
+        return 0;
+      }
+    std::cerr << "ssx: error: no plugin class '" << params_of << "' on the search path (ssx plugins lists them)\n";
+    return kExitBadInput;
+  }
   int bad = 0;
   for (const auto& dir : loader.searchPath()) std::cout << "search: " << dir.string() << '\n';
   for (const auto& lib : loader.scan()) {
     std::cout << lib.path.string() << ": " << (lib.ok ? "ok" : "FAILS: " + lib.problem) << '\n';
-    for (const auto& c : lib.classes) std::cout << "  " << ssx::toString(c.kind) << ' ' << c.name << '\n';
+    for (const auto& c : lib.classes)
+      std::cout << "  " << ssx::toString(c.kind) << ' ' << c.name << (c.doc.empty() ? "" : ": " + c.doc) << '\n';
     bad += lib.ok ? 0 : 1;
   }
   return bad == 0 ? 0 : kExitBadInput;
@@ -252,6 +266,8 @@ int main(int argc, char** argv) {
   std::vector<std::string> plugins_path;
   CLI::App* plugins_cmd = app.add_subcommand("plugins", "list plugin libraries, their classes, and ABI checks");
   plugins_cmd->add_option("--plugin-path", plugins_path, "plugin directory (repeatable)");
+  std::string params_of;
+  plugins_cmd->add_option("--params", params_of, "print the declared parameters of class NAME (a Markdown table)");
 
   try {
     app.parse(argc, argv);
@@ -266,6 +282,6 @@ int main(int argc, char** argv) {
     return commandRun(run, realtime_given);
   }
   if (*validate_cmd) return commandValidate(validate_file, validate_path);
-  if (*plugins_cmd) return commandPlugins(plugins_path);
+  if (*plugins_cmd) return commandPlugins(plugins_path, params_of);
   return kExitBadInput;
 }

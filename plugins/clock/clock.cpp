@@ -8,6 +8,7 @@ namespace ssx::plugins {
 
 class ClockSensor final : public SensorOf<ClockMeasurement> {
  public:
+  static constexpr const char* kDoc = "simulated time, as a measurement";
   void sense(const StepInfo& info) override {
     output().stamp = info.time;
     output().step = info.step;

@@ -25,7 +25,7 @@ namespace ssx::quadrotor {
 class QuadrotorDriver final : public Driver, public SetpointInterface {
  public:
   static constexpr const char* kDoc =
-      "quadrotor: rotor model, integer attitude loop on IMU counts, position loop, reference sources";
+      "rotor model, integer attitude loop on IMU counts, position loop, reference sources";
   static constexpr ssx_plugin_param kParameters[] = {
       param::choice("preset", "mk_quad", "mk_quad hummingbird crazyflie", "rotor and motor constants to start from"),
       param::real("thrust_coefficient", "", "N s^2", param::positive(), "thrust per squared rotor speed (default: the preset's)"),

@@ -220,7 +220,7 @@ class SceneLoader {
                    std::int64_t period_steps, const std::string& what, const SourceLocation& period_from = {});
   // runs a class's own validate on a parameter set that passed checkPlugin
   void validatePlugin(Environment& env, const void* instance, const Descriptor& params, const Artifact* artifact,
-                      std::int64_t period_steps);
+                      std::int64_t period_steps, const std::string& what);
 
   const SceneOptions& options_;
   std::vector<Diagnostic> diagnostics_;
@@ -242,7 +242,12 @@ class SceneLoader {
   std::map<std::string, ArtifactType> types_;          // by type name, parsed on first use
   std::map<std::string, std::string> failed_plugins_;  // "plugin/class" -> already reported
   std::vector<std::pair<std::string, SourceLocation>> camera_follows_;  // checked once artifacts exist
-  std::vector<std::pair<const SimulationExtension*, Descriptor>> extension_checks_;
+  struct ExtensionCheck {
+    const SimulationExtension* extension;
+    Descriptor params;
+    std::string what;
+  };
+  std::vector<ExtensionCheck> extension_checks_;
 };
 
 bool SceneLoader::once(const Descriptor& d, const Descriptor*& slot) {
@@ -612,15 +617,17 @@ void SceneLoader::checkPlugin(Environment& env, const void* instance, Descriptor
 }
 
 void SceneLoader::validatePlugin(Environment& env, const void* instance, const Descriptor& params,
-                                 const Artifact* artifact, std::int64_t period_steps) {
+                                 const Artifact* artifact, std::int64_t period_steps, const std::string& what) {
   const ssx_plugin_class* type = env.classLoader().classOf(instance);
   if (type == nullptr || type->validate == nullptr) return;
   const PluginContext context{&env, artifact, period_steps, env.timestep()};
   std::vector<Diagnostic> found;
   type->validate(&params, &context, &found);
   for (auto& d : found) {
-    // the plugin's message names the element and class, as the declared checks do
-    if (d.message.rfind("<", 0) != 0) d.message = "<" + params.name() + ">: " + type->name + ": " + d.message;
+    // named as the declared checks name it: "<driver>: driver 'quadrotor': ..."
+    const std::string element = "<" + params.name() + ">: ";
+    if (d.message.rfind(element, 0) == 0) d.message.erase(0, element.size());
+    d.message = element + what + ": " + d.message;
     diagnostics_.push_back(std::move(d));
   }
 }
@@ -707,8 +714,11 @@ void SceneLoader::place(Environment& env, const std::string& name, const std::st
   }
   if (errorCount() != errors_before) return;  // the class checks assume values of the declared types
   for (std::size_t i = 0; i < a.sensorCount(); ++i)
-    validatePlugin(env, &a.sensor(i), a.sensorParameters(i), &a, a.sensor(i).periodSteps());
-  if (a.driver() != nullptr) validatePlugin(env, a.driver(), a.driverParameters(), &a, a.driver()->periodSteps());
+    validatePlugin(env, &a.sensor(i), a.sensorParameters(i), &a, a.sensor(i).periodSteps(),
+                   "sensor " + std::to_string(i) + " '" + a.sensor(i).className() + "'");
+  if (a.driver() != nullptr)
+    validatePlugin(env, a.driver(), a.driverParameters(), &a, a.driver()->periodSteps(),
+                   "driver '" + a.driver()->className() + "'");
 }
 
 void SceneLoader::buildObstacle(Environment& env, const Descriptor& d) {
@@ -866,7 +876,7 @@ void SceneLoader::build(Scene& scene) {
       SimulationExtension& ext = env.classLoader().createExtension(decl->plugin, decl->class_name);
       checkPlugin(env, &ext, decl->params, nullptr, 1, "extension '" + decl->class_name + "'");
       env.addExtension(name, ext, decl->params);
-      extension_checks_.push_back({&ext, decl->params});
+      extension_checks_.push_back({&ext, decl->params, "extension '" + decl->class_name + "'"});
     } catch (const PluginError& err) {
       error(d.where(), "<extension>: " + std::string(err.what()));
     } catch (const ConfigError& err) {
@@ -898,7 +908,7 @@ void SceneLoader::build(Scene& scene) {
   }
   // extensions check what they refer to (artifacts by name) once every artifact exists
   if (!hasErrors())
-    for (const auto& [ext, params] : extension_checks_) validatePlugin(env, ext, params, nullptr, 1);
+    for (const auto& c : extension_checks_) validatePlugin(env, c.extension, c.params, nullptr, 1, c.what);
   for (const auto& [name, where] : camera_follows_) {
     const Artifact* a = env.findArtifact(name);
     if (a == nullptr || a->rootCount() == 0)
