@@ -11,7 +11,10 @@
 #include <chrono>
 #include <csignal>
 #include <cstdio>
+#include <cerrno>
 #include <cstdlib>
+#include <cstring>
+#include <fstream>
 #include <iostream>
 #include <sstream>
 #include <string>
@@ -93,7 +96,35 @@ struct RunArgs {
   std::string stats_csv;
   bool quiet = false;
   std::string render, snapshot, video, frames;
+  std::string save_state, load_state;
 };
+
+std::vector<std::byte> readFile(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw std::runtime_error("cannot read '" + path + "'");
+  std::vector<char> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  if (in.bad()) throw std::runtime_error("error while reading '" + path + "'");
+  std::vector<std::byte> out(bytes.size());
+  std::memcpy(out.data(), bytes.data(), bytes.size());
+  return out;
+}
+
+// written beside the target and renamed over it: a failed write never leaves a short file
+void writeFileAtomically(const std::string& path, const std::vector<std::byte>& bytes) {
+  const std::string partial = path + ".partial";
+  std::FILE* f = std::fopen(partial.c_str(), "wb");
+  if (f == nullptr) throw std::runtime_error("cannot write '" + partial + "': " + std::strerror(errno));
+  const bool written = std::fwrite(bytes.data(), 1, bytes.size(), f) == bytes.size();
+  const bool closed = std::fclose(f) == 0;
+  if (!written || !closed) {
+    std::remove(partial.c_str());
+    throw std::runtime_error("writing '" + partial + "' failed (disk full?)");
+  }
+  if (std::rename(partial.c_str(), path.c_str()) != 0) {
+    std::remove(partial.c_str());
+    throw std::runtime_error("cannot rename '" + partial + "' to '" + path + "': " + std::strerror(errno));
+  }
+}
 
 int commandRun(const RunArgs& args, bool realtime_given) {
   ssx::SceneOptions options;
@@ -132,10 +163,22 @@ int commandRun(const RunArgs& args, bool realtime_given) {
   std::signal(SIGTERM, onSignal);
   // a video pipe whose ffmpeg died reports an error instead of killing the process
   std::signal(SIGPIPE, SIG_IGN);
+  // a saved state to continue from is read and checked before anything starts
+  std::vector<std::byte> loaded;
+  if (!args.load_state.empty()) {
+    try {
+      loaded = readFile(args.load_state);
+      env.checkState(loaded);
+    } catch (const std::exception& e) {
+      std::cerr << "ssx: error: --load-state " << args.load_state << ": " << e.what() << '\n';
+      return kExitBadInput;
+    }
+  }
   int status = 0;
   ssx::TimingSummary summary;
   try {
     env.start();
+    if (!loaded.empty()) env.restoreState(loaded);
     if (!args.quiet)
       std::cerr << "ssx: " << scene.file.string() << ": " << env.artifactCount() << " artifacts, " << env.threadCount()
                 << " thread(s), timestep " << ssx::toSeconds(env.timestep()) * 1e3 << " ms, "
@@ -153,6 +196,15 @@ int commandRun(const RunArgs& args, bool realtime_given) {
   }
   progress.finish();
   if (g_stop) std::cerr << "ssx: interrupted at t = " << ssx::toSeconds(env.time()) << " s\n";
+  if (!args.save_state.empty()) {
+    try {
+      writeFileAtomically(args.save_state, env.saveState());
+      if (!args.quiet) std::cerr << "ssx: state at t = " << ssx::toSeconds(env.time()) << " s saved to " << args.save_state << '\n';
+    } catch (const std::exception& e) {
+      std::cerr << "ssx: error: --save-state " << args.save_state << ": " << e.what() << '\n';
+      status = kExitRunFailure;
+    }
+  }
   const std::vector<ssx::CameraSpec> cameras = env.cameras();
   // stop cleanly: plugins destroyed, engines stopped, extensions shut down (files closed)
   try {
@@ -256,6 +308,10 @@ int main(int argc, char** argv) {
   run_cmd->add_option("--snapshot", run.snapshot, "write the first camera's last frame as PNG to FILE");
   run_cmd->add_option("--video", run.video, "write the first camera's frames as MP4 to FILE (needs ffmpeg)");
   run_cmd->add_option("--frames", run.frames, "write the first camera's frames as PNG files into DIR");
+  run_cmd->add_option("--save-state", run.save_state, "write the world's state to FILE at the end (ssx run --load-state)");
+  run_cmd->add_option("--load-state", run.load_state,
+                      "continue from a state saved from this scene (--steps and --duration count from there)")
+      ->check(CLI::ExistingFile);
 
   std::string validate_file;
   std::vector<std::string> validate_path;

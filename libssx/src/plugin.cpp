@@ -6,6 +6,8 @@ namespace ssx {
 Plugin::~Plugin() = default;
 void Plugin::configure(const Descriptor&) {}
 void Plugin::destroy() {}
+void Plugin::saveState(StateWriter&) const {}
+void Plugin::loadState(StateReader&) {}
 Environment& Plugin::environment() const noexcept { return artifact_->environment(); }
 
 Measurement::~Measurement() = default;
@@ -15,6 +17,8 @@ void SimulationExtension::init(Environment&, const Descriptor&) {}
 void SimulationExtension::beforeStep(Environment&) {}
 void SimulationExtension::afterStep(Environment&) {}
 void SimulationExtension::shutdown(Environment&) {}
+void SimulationExtension::saveState(StateWriter&) const {}
+void SimulationExtension::loadState(StateReader&) {}
 
 }  // namespace ssx
 

@@ -1,4 +1,5 @@
 #include <ssx/random.hpp>
+#include <ssx/state.hpp>
 
 #include <cmath>
 
@@ -66,6 +67,18 @@ double Random::normal() {
   spare_ = v * f;
   has_spare_ = true;
   return u * f;
+}
+
+void Random::save(StateWriter& out) const {
+  for (std::uint64_t word : s_) out.write(word);
+  out.write(spare_);
+  out.write(has_spare_);
+}
+
+void Random::load(StateReader& in) {
+  for (std::uint64_t& word : s_) in.read(word);
+  in.read(spare_);
+  in.read(has_spare_);
 }
 
 }  // namespace ssx

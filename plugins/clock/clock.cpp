@@ -9,6 +9,9 @@ namespace ssx::plugins {
 class ClockSensor final : public SensorOf<ClockMeasurement> {
  public:
   static constexpr const char* kDoc = "simulated time, as a measurement";
+  void saveState(StateWriter& out) const override { save(out, value()); }
+  void loadState(StateReader& in) override { load(in, output()); }
+
   void sense(const StepInfo& info) override {
     output().stamp = info.time;
     output().step = info.step;

@@ -69,6 +69,10 @@ class CsvLogger final : public SimulationExtension {
 
   void shutdown(Environment&) override { close(); }
 
+  // rows go on at the times they would have been written
+  void saveState(StateWriter& out) const override { out.write(next_); }
+  void loadState(StateReader& in) override { in.read(next_); }
+
  private:
   // every artifact exists when extensions are initialised
   void resolve(Environment& env, const Descriptor& params) {

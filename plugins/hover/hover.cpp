@@ -54,6 +54,15 @@ class HoverDriver final : public Driver {
     }
   }
 
+  void saveState(StateWriter& out) const override {
+    save(out, measured_);
+    out.write(have_measurement_);
+  }
+  void loadState(StateReader& in) override {
+    load(in, measured_);
+    in.read(have_measurement_);
+  }
+
   void step(const StepInfo&) override {
     PhysicNode& body = artifact().root();
     if (!have_measurement_) {

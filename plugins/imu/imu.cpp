@@ -125,6 +125,22 @@ class ImuSensor final : public SensorOf<ImuMeasurement> {
     output().gyroscope_lsb = gyro_.lsb;
   }
 
+  // the bias walks and turn-on biases, and the last reading
+  void saveState(StateWriter& out) const override {
+    for (const Channel* c : {&gyro_, &accel_}) {
+      out.write(c->turn_on_bias);
+      out.write(c->bias);
+    }
+    save(out, value());
+  }
+  void loadState(StateReader& in) override {
+    for (Channel* c : {&gyro_, &accel_}) {
+      in.read(c->turn_on_bias);
+      in.read(c->bias);
+    }
+    load(in, output());
+  }
+
   void sense(const StepInfo& info) override {
     const BodyState s = node_->state();
     const Quat to_imu = s.pose.orientation.conjugate();

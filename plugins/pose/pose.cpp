@@ -32,6 +32,9 @@ class PoseSensor final : public SensorOf<PoseMeasurement> {
     angular_velocity_noise_ = params.get<double>("angular_velocity_noise");
   }
 
+  void saveState(StateWriter& out) const override { save(out, value()); }
+  void loadState(StateReader& in) override { load(in, output()); }
+
   void sense(const StepInfo& info) override {
     const BodyState s = node_->state();
     PoseMeasurement& m = output();

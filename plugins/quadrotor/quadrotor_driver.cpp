@@ -329,4 +329,66 @@ void QuadrotorDriver::formationStep(double dt) {
   virtual_point_ = s.pose.position + (virtual_point_ - s.pose.position).cwiseMin(0.15).cwiseMax(-0.15) + v * dt;
 }
 
+namespace {
+
+void save(StateWriter& out, const Setpoint& s) {
+  out.write(s.position);
+  out.write(s.velocity);
+  out.write(s.acceleration);
+  out.write(s.yaw);
+  out.write(s.yaw_rate);
+}
+
+void load(StateReader& in, Setpoint& s) {
+  in.read(s.position);
+  in.read(s.velocity);
+  in.read(s.acceleration);
+  in.read(s.yaw);
+  in.read(s.yaw_rate);
+}
+
+}  // namespace
+
+// what changes while it flies: motors, both loops, the reference sources, what it last received
+void QuadrotorDriver::saveState(StateWriter& out) const {
+  out.write(rotors_->speeds());
+  out.write(commanded_speeds_);
+  out.write(inner_->estimate());
+  out.write(outer_->integral());
+  out.write(command_);
+  out.write(attitude_);
+  out.write(source_);
+  save(out, current_);
+  save(out, external_);
+  out.write(virtual_point_);
+  out.write(virtual_velocity_);
+  ssx::save(out, seen_);
+  out.write(imu_seen_);
+  ssx::save(out, pose_);
+}
+
+void QuadrotorDriver::loadState(StateReader& in) {
+  std::vector<double> speeds;
+  in.read(speeds);
+  if (speeds.size() != rotors_->speeds().size())
+    throw StateError("quadrotor: saved with " + std::to_string(speeds.size()) + " rotors, this one has " +
+                     std::to_string(rotors_->speeds().size()));
+  rotors_->setSpeeds(speeds);
+  in.read(commanded_speeds_);
+  inner_->reset(in.get<AttitudeEstimate>());
+  Vec3 integral;
+  in.read(integral);
+  outer_->setIntegral(integral);
+  in.read(command_);
+  in.read(attitude_);
+  in.read(source_);
+  load(in, current_);
+  load(in, external_);
+  in.read(virtual_point_);
+  in.read(virtual_velocity_);
+  ssx::load(in, seen_);
+  in.read(imu_seen_);
+  ssx::load(in, pose_);
+}
+
 }  // namespace ssx::quadrotor

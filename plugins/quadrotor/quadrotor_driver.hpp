@@ -78,6 +78,8 @@ class QuadrotorDriver final : public Driver, public SetpointInterface {
   static void validate(const Descriptor& params, const PluginContext& context);
   void configure(const Descriptor& params) override;
   void step(const StepInfo& info) override;
+  void saveState(StateWriter& out) const override;
+  void loadState(StateReader& in) override;
   void setSetpoint(const Setpoint& setpoint) override;
   Setpoint currentSetpoint() const override { return current_; }
 

@@ -189,6 +189,9 @@ class PositionController {
   AttitudeCommand update(double dt, const Setpoint& ref, const Vec3& position, const Vec3& velocity, double roll,
                          double pitch, double yaw);
   void reset() { integral_.setZero(); }
+  /// The integral term's state (for saving and restoring).
+  const Vec3& integral() const { return integral_; }
+  void setIntegral(const Vec3& integral) { integral_ = integral; }
 
  private:
   PositionParams params_;

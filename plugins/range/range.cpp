@@ -86,6 +86,9 @@ class RangeSensor final : public SensorOf<RangeMeasurement> {
         if (o.shape.kind != Shape::Kind::Plane) obstacles_.push_back(&o);
   }
 
+  void saveState(StateWriter& out) const override { save(out, value()); }
+  void loadState(StateReader& in) override { load(in, output()); }
+
   void sense(const StepInfo& info) override {
     RangeMeasurement& m = output();
     m.stamp = info.time;

@@ -34,6 +34,7 @@
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <span>
 #include <string>
 #include <string_view>
 #include <unordered_map>
@@ -128,6 +129,23 @@ class SSX_EXPORT Environment {
   TimingSummary run(const RunOptions& options);
   /// Destroys drivers and sensors, stops the engines, shuts extensions down (reverse order).
   void stop();
+
+  // --- save and restore --------------------------------------------------------------------
+
+  /// Everything that determines the future, between two steps: the physics engine's state (with
+  /// its random seed), the snapshot, the command buffers, every random stream, every plugin's
+  /// and extension's own state (their saveState), the step count. A versioned, checksummed
+  /// buffer. Starts nothing: the environment must be running (after start() or a step).
+  std::vector<std::byte> saveState() const;
+  /// Continues from a saved state: the next steps are bitwise those of the run that saved it,
+  /// on any number of threads, also in another process that loaded the same scene. Starts the
+  /// environment first if it is still being set up. A truncated, corrupted or mismatched buffer
+  /// (another scene, another format) throws StateError and leaves the state as it was.
+  /// Not saved: camera images (drawn again when due) and the outside world of extensions.
+  void restoreState(std::span<const std::byte> state);
+  /// The checks restoreState makes before it changes anything (format, size, checksum, the scene
+  /// it was saved from), without starting the environment. Throws StateError.
+  void checkState(std::span<const std::byte> state) const;
   State state() const noexcept { return state_; }
 
   // --- queries -------------------------------------------------------------------------------
@@ -208,6 +226,8 @@ class SSX_EXPORT Environment {
 
   void requireSetup(const char* what) const;
   void checkDeclaredParameters();
+  std::uint64_t sceneFingerprint() const;
+  void applyState(std::span<const std::byte> payload);
   void buildBodies();
   void publishSnapshot(bool first);
   void runSensors(std::size_t begin, std::size_t end);

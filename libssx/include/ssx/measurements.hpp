@@ -6,6 +6,7 @@
 #include <ssx/export.hpp>
 #include <ssx/plugin.hpp>
 #include <ssx/render.hpp>
+#include <ssx/state.hpp>
 #include <ssx/types.hpp>
 
 #include <array>
@@ -62,5 +63,69 @@ struct SSX_EXPORT CameraMeasurement : Measurement {
   CameraView view;  ///< the camera's pose (x forward, z up) and lens when it was drawn
   ~CameraMeasurement() override;
 };
+
+/// Measurements into and out of a saved state (for sensors' and drivers' saveState / loadState).
+inline void save(StateWriter& out, const ClockMeasurement& m) {
+  out.write(m.stamp);
+  out.write(m.step);
+  out.write(m.seconds);
+}
+inline void load(StateReader& in, ClockMeasurement& m) {
+  in.read(m.stamp);
+  in.read(m.step);
+  in.read(m.seconds);
+}
+inline void save(StateWriter& out, const PoseMeasurement& m) {
+  out.write(m.stamp);
+  out.write(m.pose);
+  out.write(m.linear_velocity);
+  out.write(m.angular_velocity);
+}
+inline void load(StateReader& in, PoseMeasurement& m) {
+  in.read(m.stamp);
+  in.read(m.pose);
+  in.read(m.linear_velocity);
+  in.read(m.angular_velocity);
+}
+inline void save(StateWriter& out, const ImuMeasurement& m) {
+  out.write(m.stamp);
+  out.write(m.accelerometer);
+  out.write(m.gyroscope);
+  out.write(m.accelerometer_counts);
+  out.write(m.gyroscope_counts);
+}
+inline void load(StateReader& in, ImuMeasurement& m) {
+  in.read(m.stamp);
+  in.read(m.accelerometer);
+  in.read(m.gyroscope);
+  in.read(m.accelerometer_counts);
+  in.read(m.gyroscope_counts);
+}
+inline void save(StateWriter& out, const std::vector<RangeMeasurement::Detection>& detections) {
+  out.write(static_cast<std::uint64_t>(detections.size()));
+  for (const auto& d : detections) {
+    out.write(d.relative);
+    out.write(d.distance);
+    out.write(static_cast<std::uint64_t>(d.artifact));
+    out.write(d.obstacle);
+  }
+}
+inline void load(StateReader& in, std::vector<RangeMeasurement::Detection>& detections) {
+  detections.resize(in.count(8 * 3 + 8 + 8 + 1));
+  for (auto& d : detections) {
+    in.read(d.relative);
+    in.read(d.distance);
+    d.artifact = static_cast<std::size_t>(in.get<std::uint64_t>());
+    in.read(d.obstacle);
+  }
+}
+inline void save(StateWriter& out, const RangeMeasurement& m) {
+  out.write(m.stamp);
+  save(out, m.detections);
+}
+inline void load(StateReader& in, RangeMeasurement& m) {
+  in.read(m.stamp);
+  load(in, m.detections);
+}
 
 }  // namespace ssx

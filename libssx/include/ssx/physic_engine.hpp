@@ -5,6 +5,7 @@
 
 #include <ssx/export.hpp>
 #include <ssx/physic_node.hpp>
+#include <ssx/state.hpp>
 #include <ssx/types.hpp>
 
 #include <limits>
@@ -79,6 +80,12 @@ class SSX_EXPORT PhysicEngine {
   virtual std::size_t bodyCount() const = 0;
   /// Contacts generated in the last step.
   virtual std::size_t contactCount() const = 0;
+  /// Writes everything that determines the engine's next steps (body states bit for bit, its
+  /// random seed), for Environment::saveState.
+  virtual void saveState(StateWriter& out) const = 0;
+  /// Reads it back into an engine built from the same scene; throws StateError (the engine is
+  /// then unchanged) when the data does not fit it.
+  virtual void restoreState(StateReader& in) = 0;
 };
 
 /// Creates a physics engine by name ("ode"); throws ConfigError for an unknown name.

@@ -7,6 +7,7 @@
 #include <ssx/descriptor.hpp>
 #include <ssx/export.hpp>
 #include <ssx/random.hpp>
+#include <ssx/state.hpp>
 #include <ssx/types.hpp>
 
 #include <cstdint>
@@ -42,6 +43,12 @@ class SSX_EXPORT Plugin {
   virtual void configure(const Descriptor& params);
   /// Called once when the environment stops, before the engines stop.
   virtual void destroy();
+  /// Writes what this plugin keeps between its runs and what it depends on (see ssx/state.hpp),
+  /// for Environment::saveState. Its random stream is saved for it. Default: nothing.
+  virtual void saveState(StateWriter& out) const;
+  /// Reads back what saveState wrote, in the same order, into a plugin configured from the same
+  /// scene. Default: nothing.
+  virtual void loadState(StateReader& in);
 
   /// The artifact this plugin belongs to.
   Artifact& artifact() const noexcept { return *artifact_; }
@@ -131,6 +138,9 @@ class SSX_EXPORT SimulationExtension {
   /// After each step (drivers done, frame drawn if due).
   virtual void afterStep(Environment& env);
   virtual void shutdown(Environment& env);
+  /// As Plugin::saveState / loadState, for what an extension keeps between steps.
+  virtual void saveState(StateWriter& out) const;
+  virtual void loadState(StateReader& in);
 };
 
 }  // namespace ssx

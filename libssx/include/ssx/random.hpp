@@ -8,6 +8,9 @@
 
 namespace ssx {
 
+class StateWriter;
+class StateReader;
+
 /// Mixes a seed with stream indices into an independent 64-bit seed (SplitMix64 finaliser).
 /// Every stream in ssx is derived from (scene seed, artifact index, plugin index).
 SSX_EXPORT std::uint64_t deriveSeed(std::uint64_t seed, std::uint64_t a, std::uint64_t b = 0);
@@ -33,6 +36,10 @@ class SSX_EXPORT Random {
   double normal();
   /// Normal with mean and standard deviation.
   double normal(double mean, double stddev) { return mean + stddev * normal(); }
+
+  /// The generator's whole state (for Environment::saveState), and back.
+  void save(StateWriter& out) const;
+  void load(StateReader& in);
 
  private:
   std::uint64_t s_[4]{};

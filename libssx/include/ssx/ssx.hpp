@@ -18,6 +18,7 @@
 #include <ssx/render.hpp>
 #include <ssx/scene.hpp>
 #include <ssx/setpoint.hpp>
+#include <ssx/state.hpp>
 #include <ssx/timing.hpp>
 #include <ssx/types.hpp>
 #include <ssx/version.hpp>

@@ -5,6 +5,7 @@
 #include <atomic>
 #include <cstdarg>
 #include <cstdio>
+#include <cstring>
 #include <mutex>
 
 namespace ssx::detail {
@@ -243,6 +244,48 @@ void OdeEngine::setState(int body, const BodyState& s) {
   dBodySetQuaternion(b, q);
   dBodySetLinearVel(b, s.linear_velocity.x(), s.linear_velocity.y(), s.linear_velocity.z());
   dBodySetAngularVel(b, s.angular_velocity.x(), s.angular_velocity.y(), s.angular_velocity.z());
+}
+
+// per body: position, quaternion, rotation matrix (ODE keeps both; R is not recomputed from a
+// restored q, which could differ in the last bit), linear and angular velocity
+namespace {
+constexpr std::size_t kOdeBodyReals = 3 + 4 + 12 + 3 + 3;
+}
+
+void OdeEngine::saveState(StateWriter& out) const {
+  out.write(static_cast<std::uint64_t>(rand_seed_));
+  out.write(static_cast<std::uint64_t>(bodies_.size()));
+  for (dBodyID b : bodies_) {
+    out.bytes(dBodyGetPosition(b), 3 * sizeof(dReal));
+    out.bytes(dBodyGetQuaternion(b), 4 * sizeof(dReal));
+    out.bytes(dBodyGetRotation(b), 12 * sizeof(dReal));
+    out.bytes(dBodyGetLinearVel(b), 3 * sizeof(dReal));
+    out.bytes(dBodyGetAngularVel(b), 3 * sizeof(dReal));
+  }
+}
+
+void OdeEngine::restoreState(StateReader& in) {
+  // everything is read before anything is changed
+  const auto seed = in.get<std::uint64_t>();
+  const auto count = in.get<std::uint64_t>();
+  if (count != bodies_.size())
+    throw StateError("ode: the saved state has " + std::to_string(count) + " bodies, this world " +
+                     std::to_string(bodies_.size()));
+  std::vector<dReal> values(bodies_.size() * kOdeBodyReals);
+  in.bytes(values.data(), values.size() * sizeof(dReal));
+  ensureThreadData();
+  rand_seed_ = static_cast<unsigned long>(seed);
+  for (std::size_t i = 0; i < bodies_.size(); ++i) {
+    dBodyID b = bodies_[i];
+    const dReal* v = values.data() + i * kOdeBodyReals;
+    dBodySetPosition(b, v[0], v[1], v[2]);  // also marks the body's geoms as moved
+    dBodySetQuaternion(b, v + 3);
+    // ODE normalises a quaternion it is given; the saved bits are already what its step left
+    std::memcpy(const_cast<dReal*>(dBodyGetQuaternion(b)), v + 3, 4 * sizeof(dReal));
+    std::memcpy(const_cast<dReal*>(dBodyGetRotation(b)), v + 7, 12 * sizeof(dReal));
+    dBodySetLinearVel(b, v[19], v[20], v[21]);
+    dBodySetAngularVel(b, v[22], v[23], v[24]);
+  }
 }
 
 }  // namespace ssx::detail

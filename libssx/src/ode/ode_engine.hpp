@@ -21,6 +21,8 @@ class OdeEngine final : public PhysicEngine {
   void readStates(std::span<BodyState> out) const override;
   void setState(int body, const BodyState& state) override;
   std::size_t bodyCount() const override { return bodies_.size(); }
+  void saveState(StateWriter& out) const override;
+  void restoreState(StateReader& in) override;
   std::size_t contactCount() const override { return contact_count_; }
 
  private:

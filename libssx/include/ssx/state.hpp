@@ -1,0 +1,139 @@
+#pragma once
+/// @file
+/// StateWriter and StateReader: how the environment, the engines and plugins put what determines
+/// the future into a saved world state (Environment::saveState) and take it back out
+/// (Environment::restoreState). Values are written bit for bit (doubles included), so a restored
+/// run continues bitwise identically.
+///
+/// A plugin whose behaviour depends on anything that changes while it runs (integrators,
+/// filters, motor speeds, the last measurement it got, its own measurement buffer) overrides
+/// `saveState` and `loadState` and writes and reads those values in the same order. Its random
+/// stream is saved by the environment. What it computes once in `configure` from its parameters
+/// is not state: a restore always happens in an environment configured from the same scene.
+
+#include <ssx/error.hpp>
+#include <ssx/export.hpp>
+#include <ssx/types.hpp>
+
+#include <cstddef>
+#include <cstdint>
+#include <cstring>
+#include <span>
+#include <string>
+#include <type_traits>
+#include <vector>
+
+namespace ssx {
+
+/// A saved state that cannot be restored: truncated, corrupted, from another scene or version.
+class SSX_EXPORT StateError : public Error {
+ public:
+  using Error::Error;
+};
+
+/// Appends values to a byte buffer.
+class StateWriter {
+ public:
+  explicit StateWriter(std::vector<std::byte>& out) : out_(&out) {}
+
+  void bytes(const void* data, std::size_t size) {
+    const auto* p = static_cast<const std::byte*>(data);
+    out_->insert(out_->end(), p, p + size);
+  }
+  /// A trivially copyable value (numbers, enums, bools, arrays and structs of them).
+  template <class T>
+    requires std::is_trivially_copyable_v<T>
+  void write(const T& value) {
+    bytes(&value, sizeof value);
+  }
+  void write(const Vec3& v) { bytes(v.data(), 3 * sizeof(double)); }
+  void write(const Quat& q) { bytes(q.coeffs().data(), 4 * sizeof(double)); }
+  void write(const Pose& p) {
+    write(p.position);
+    write(p.orientation);
+  }
+  void write(const std::string& s) {
+    write(static_cast<std::uint64_t>(s.size()));
+    bytes(s.data(), s.size());
+  }
+  /// A vector: its size, then each element as `write` writes it.
+  template <class T>
+  void write(const std::vector<T>& v) {
+    write(static_cast<std::uint64_t>(v.size()));
+    for (const T& x : v) write(x);
+  }
+
+  std::size_t size() const noexcept { return out_->size(); }
+  std::vector<std::byte>& buffer() noexcept { return *out_; }
+
+ private:
+  std::vector<std::byte>* out_;
+};
+
+/// Reads values back in the order they were written; throws StateError when the data ends early.
+class StateReader {
+ public:
+  StateReader() = default;
+  explicit StateReader(std::span<const std::byte> data, std::string what = "saved state")
+      : data_(data), what_(std::move(what)) {}
+
+  void bytes(void* out, std::size_t size) {
+    if (size > remaining())
+      throw StateError(what_ + " ends early: " + std::to_string(size) + " more bytes wanted, " +
+                       std::to_string(remaining()) + " left (truncated, or saved by another version)");
+    std::memcpy(out, data_.data() + at_, size);
+    at_ += size;
+  }
+  template <class T>
+    requires std::is_trivially_copyable_v<T>
+  void read(T& value) {
+    bytes(&value, sizeof value);
+  }
+  void read(Vec3& v) { bytes(v.data(), 3 * sizeof(double)); }
+  void read(Quat& q) { bytes(q.coeffs().data(), 4 * sizeof(double)); }
+  void read(Pose& p) {
+    read(p.position);
+    read(p.orientation);
+  }
+  void read(std::string& s) {
+    s.resize(count(1));
+    bytes(s.data(), s.size());
+  }
+  template <class T>
+  void read(std::vector<T>& v) {
+    v.resize(count(1));
+    for (T& x : v) read(x);
+  }
+  /// A value of type T.
+  template <class T>
+  T get() {
+    T value{};
+    read(value);
+    return value;
+  }
+  /// An element count that cannot exceed what is left (each element at least `min_bytes`).
+  std::size_t count(std::size_t min_bytes) {
+    const auto n = get<std::uint64_t>();
+    if (min_bytes > 0 && n > remaining() / min_bytes)
+      throw StateError(what_ + ": a count of " + std::to_string(n) + " is more than the data holds (corrupted)");
+    return static_cast<std::size_t>(n);
+  }
+  /// The next `size` bytes as a reader of their own (a length-prefixed block).
+  StateReader block(std::size_t size, std::string what) {
+    if (size > remaining()) throw StateError(what_ + " ends early inside " + what + " (truncated)");
+    StateReader r(data_.subspan(at_, size), std::move(what));
+    at_ += size;
+    return r;
+  }
+
+  std::size_t remaining() const noexcept { return data_.size() - at_; }
+  bool done() const noexcept { return at_ == data_.size(); }
+  const std::string& what() const noexcept { return what_; }
+
+ private:
+  std::span<const std::byte> data_;
+  std::size_t at_ = 0;
+  std::string what_;
+};
+
+}  // namespace ssx

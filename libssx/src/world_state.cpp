@@ -1,0 +1,207 @@
+// Saving and restoring the world: everything that determines the future, in one versioned,
+// checksummed buffer.
+//
+// Layout: "SSXSTATE", format version (u32), reserved (u32), scene fingerprint (u64), payload size
+// (u64), FNV-1a of the payload (u64); then the payload: step count, the engine's block, the
+// snapshot (body states with accelerations, the velocities before the last step), the command
+// buffers, then one block per plugin (driver first, then sensors, artifact by artifact: its random
+// stream, then what it saved) and one per extension.
+#include <ssx/environment.hpp>
+
+#include <cstring>
+
+namespace ssx {
+
+namespace {
+
+constexpr char kMagic[8] = {'S', 'S', 'X', 'S', 'T', 'A', 'T', 'E'};
+constexpr std::uint32_t kFormatVersion = 1;
+constexpr std::size_t kHeaderSize = 8 + 4 + 4 + 8 + 8 + 8;
+
+std::uint64_t fnv1a(const std::byte* data, std::size_t size, std::uint64_t h = 0xcbf29ce484222325ULL) {
+  for (std::size_t i = 0; i < size; ++i) {
+    h ^= static_cast<std::uint64_t>(data[i]);
+    h *= 0x100000001b3ULL;
+  }
+  return h;
+}
+
+std::uint64_t fnv1a(std::string_view text, std::uint64_t h) {
+  return fnv1a(reinterpret_cast<const std::byte*>(text.data()), text.size(), h);
+}
+
+void writeBody(StateWriter& out, const BodyState& s) {
+  out.write(s.pose);
+  out.write(s.linear_velocity);
+  out.write(s.angular_velocity);
+  out.write(s.linear_acceleration);
+  out.write(s.angular_acceleration);
+}
+
+void readBody(StateReader& in, BodyState& s) {
+  in.read(s.pose);
+  in.read(s.linear_velocity);
+  in.read(s.angular_velocity);
+  in.read(s.linear_acceleration);
+  in.read(s.angular_acceleration);
+}
+
+// a block: its size first, filled in once written
+template <class Fill>
+void writeBlock(StateWriter& out, Fill fill) {
+  const std::size_t at = out.size();
+  out.write(std::uint64_t{0});
+  fill();
+  const std::uint64_t size = out.size() - at - sizeof(std::uint64_t);
+  std::memcpy(out.buffer().data() + at, &size, sizeof size);
+}
+
+template <class Load>
+void readBlock(StateReader& in, const std::string& what, Load load) {
+  StateReader block = in.block(in.count(1), what);
+  load(block);
+  if (!block.done())
+    throw StateError(what + " left " + std::to_string(block.remaining()) +
+                     " bytes of its saved state unread (its saveState and loadState disagree)");
+}
+
+}  // namespace
+
+std::uint64_t Environment::sceneFingerprint() const {
+  // what a saved state must agree with: the timestep, the bodies, and each artifact's plugins
+  std::uint64_t h = fnv1a("ssx scene", 0xcbf29ce484222325ULL);
+  auto mix = [&h](std::string_view s) { h = fnv1a(s, fnv1a("|", h)); };
+  mix(std::to_string(settings_.timestep));
+  for (const auto& a : artifacts_) {
+    mix(a->name());
+    // each dynamic root is one body (known before the engine is built)
+    std::size_t bodies = 0;
+    for (const PhysicNode* root : a->roots_) bodies += root->isStatic() ? 0 : 1;
+    mix(std::to_string(bodies));
+    if (a->driver_ != nullptr) mix("driver " + a->driver_->className() + " " + std::to_string(a->driver_->periodSteps()));
+    for (const auto& s : a->sensors_)
+      mix("sensor " + s.sensor->className() + " " + std::to_string(s.sensor->periodSteps()));
+  }
+  for (const auto& e : extensions_) mix("extension " + e.name);
+  return h;
+}
+
+std::vector<std::byte> Environment::saveState() const {
+  if (state_ != State::Running)
+    throw Error("saveState: the environment is not running (start it, or it failed or stopped)");
+  std::vector<std::byte> buffer(kHeaderSize);
+  StateWriter out(buffer);
+  out.write(steps_);
+  writeBlock(out, [&] { physics_->saveState(out); });
+  out.write(static_cast<std::uint64_t>(states_.size()));
+  for (const auto& s : states_) writeBody(out, s);
+  for (std::size_t i = 0; i < states_.size(); ++i) {
+    out.write(previous_linear_[i]);
+    out.write(previous_angular_[i]);
+    out.write(wrenches_[i].force);
+    out.write(wrenches_[i].torque);
+  }
+  auto plugin = [&](const Plugin& p) {
+    writeBlock(out, [&] {
+      p.random_.save(out);
+      p.saveState(out);
+    });
+  };
+  for (const auto& a : artifacts_) {
+    if (a->driver_ != nullptr) plugin(*a->driver_);
+    for (const auto& s : a->sensors_) plugin(*s.sensor);
+  }
+  for (const auto& e : extensions_) writeBlock(out, [&] { e.extension->saveState(out); });
+
+  // the header, now that the payload is known
+  const std::uint64_t payload = buffer.size() - kHeaderSize;
+  const std::uint64_t checksum = fnv1a(buffer.data() + kHeaderSize, payload);
+  const std::uint64_t fingerprint = sceneFingerprint();
+  std::byte* h = buffer.data();
+  std::memcpy(h, kMagic, 8);
+  std::memcpy(h + 8, &kFormatVersion, 4);
+  std::memset(h + 12, 0, 4);
+  std::memcpy(h + 16, &fingerprint, 8);
+  std::memcpy(h + 24, &payload, 8);
+  std::memcpy(h + 32, &checksum, 8);
+  return buffer;
+}
+
+void Environment::checkState(std::span<const std::byte> state) const {
+  // the header: what it is, and that it is whole and meant for this scene
+  if (state.size() < kHeaderSize || std::memcmp(state.data(), kMagic, 8) != 0)
+    throw StateError("restoreState: not an ssx saved state (" + std::to_string(state.size()) +
+                     " bytes, no SSXSTATE header)");
+  std::uint32_t version = 0;
+  std::uint64_t fingerprint = 0, payload = 0, checksum = 0;
+  std::memcpy(&version, state.data() + 8, 4);
+  std::memcpy(&fingerprint, state.data() + 16, 8);
+  std::memcpy(&payload, state.data() + 24, 8);
+  std::memcpy(&checksum, state.data() + 32, 8);
+  if (version != kFormatVersion)
+    throw StateError("restoreState: saved state format " + std::to_string(version) + ", this ssx reads format " +
+                     std::to_string(kFormatVersion));
+  if (payload != state.size() - kHeaderSize)
+    throw StateError("restoreState: the saved state is " + std::to_string(state.size()) + " bytes, its header says " +
+                     std::to_string(payload + kHeaderSize) + " (truncated?)");
+  if (fnv1a(state.data() + kHeaderSize, payload) != checksum)
+    throw StateError("restoreState: the saved state is corrupted (checksum mismatch)");
+  if (fingerprint != sceneFingerprint())
+    throw StateError("restoreState: the state was saved from a different scene (timestep, bodies, artifacts or "
+                     "their plugins differ): load the scene it was saved from");
+}
+
+void Environment::restoreState(std::span<const std::byte> state) {
+  checkState(state);  // before anything starts
+  if (state_ == State::Setup) start();
+  if (state_ != State::Running) throw Error("restoreState: the environment failed or was stopped");
+
+  // what can go wrong now is a plugin that reads back differently from how it saved: then the
+  // state taken just before is put back, so a failed restore changes nothing
+  const std::vector<std::byte> before = saveState();
+  try {
+    applyState(state.subspan(kHeaderSize));
+  } catch (const StateError&) {
+    applyState(std::span<const std::byte>(before).subspan(kHeaderSize));
+    throw;
+  } catch (const std::exception& e) {
+    applyState(std::span<const std::byte>(before).subspan(kHeaderSize));
+    throw StateError(std::string("restoreState: ") + e.what());
+  }
+}
+
+void Environment::applyState(std::span<const std::byte> payload) {
+  StateReader in(payload, "saved state");
+  const auto steps = in.get<std::int64_t>();
+  if (steps < 0) throw StateError("saved state: negative step count (corrupted)");
+  readBlock(in, "the physics engine's state", [&](StateReader& block) { physics_->restoreState(block); });
+  const std::size_t bodies = in.count(1);
+  if (bodies != states_.size())
+    throw StateError("saved state: " + std::to_string(bodies) + " bodies, this world " + std::to_string(states_.size()));
+  for (auto& s : states_) readBody(in, s);
+  for (std::size_t i = 0; i < states_.size(); ++i) {
+    in.read(previous_linear_[i]);
+    in.read(previous_angular_[i]);
+    in.read(wrenches_[i].force);
+    in.read(wrenches_[i].torque);
+  }
+  for (const auto& a : artifacts_) {
+    auto plugin = [&](Plugin& p, const std::string& what) {
+      readBlock(in, what + " of artifact '" + a->name() + "'", [&](StateReader& block) {
+        p.random_.load(block);
+        p.loadState(block);
+      });
+    };
+    if (a->driver_ != nullptr) plugin(*a->driver_, "driver '" + a->driver_->className() + "'");
+    for (auto& s : a->sensors_) plugin(*s.sensor, "sensor '" + s.sensor->className() + "'");
+  }
+  for (auto& e : extensions_)
+    readBlock(in, "extension '" + e.name + "'", [&](StateReader& block) { e.extension->loadState(block); });
+  if (!in.done()) throw StateError("saved state: " + std::to_string(in.remaining()) + " bytes left over (corrupted)");
+  steps_ = steps;
+  current_step_ = steps;
+  render_items_step_ = -1;
+  if (neighbors_enabled_) rebuildNeighborIndex();
+}
+
+}  // namespace ssx

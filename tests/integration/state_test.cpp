@@ -1,0 +1,169 @@
+// Saving and restoring a world: continuing after a restore is the run that was never interrupted.
+#include <ssx/ssx.hpp>
+
+#include "test_util.hpp"
+
+#include <catch2/catch.hpp>
+
+#include <sys/wait.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+
+using namespace ssx;
+namespace fs = std::filesystem;
+
+namespace {
+
+const fs::path kArtifacts = fs::path(SSX_EXAMPLES_DIR) / "artifacts";
+
+// quadrotors with noisy IMUs take off from the ground and fly the formation around a pillar,
+// while boxes fall on the ground and on each other: contacts, noise, neighbours, obstacles
+std::string sceneXml(int threads, const std::string& log = "") {
+  return "<scene><environment timestep=\"0.002\" seed=\"11\" threads=\"" + std::to_string(threads) +
+         "\"/>"
+         "<type name=\"quad\" file=\"" + (kArtifacts / "mk_quad_formation.xml").string() +
+         "\"/><type name=\"box\" file=\"" + (kArtifacts / "box.xml").string() + "\"/><ground/>"
+         "<obstacle name=\"pillar\" xyz=\"2.5 0 2\"><cylinder radius=\"0.25\" length=\"4\"/></obstacle>"
+         "<swarm type=\"quad\" count=\"12\" layout=\"random\" min=\"-2 -2 0.05\" max=\"2 2 0.05\" "
+         "min_distance=\"1.0\"><driver formation_index=\"{i}\" formation_size=\"12\" formation_radius=\"1.5\" "
+         "formation_center=\"0 0 2.5\" offset=\"0 0 1\" start_time=\"0.3\"/></swarm>"
+         "<swarm type=\"box\" name=\"box{i}\" count=\"12\" layout=\"random\" min=\"4 -0.3 0.2\" max=\"4.6 0.3 2.5\" "
+         "min_distance=\"0.3\"/>" +
+         (log.empty() ? std::string() : "<extension name=\"log\" plugin=\"csv_logger\" file=\"" + log + "\" rate_hz=\"20\"/>") +
+         "</scene>";
+}
+
+Scene load(int threads, const std::string& log = "") {
+  return loadSceneFromString(sceneXml(threads, log), "state.xml", kArtifacts);
+}
+
+std::vector<std::uint64_t> hashes(Environment& env, int steps, std::size_t* contacts = nullptr) {
+  std::vector<std::uint64_t> out;
+  for (int i = 0; i < steps; ++i) {
+    env.step();
+    out.push_back(env.stateHash());
+    if (contacts != nullptr) *contacts += env.physics().contactCount();
+  }
+  return out;
+}
+
+std::string slurp(const fs::path& file) {
+  std::ifstream in(file, std::ios::binary);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+int runCli(const std::string& args) {
+  const int status = std::system((std::string(SSX_CLI_PATH) + " " + args + " 2>/dev/null").c_str());
+  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+}  // namespace
+
+TEST_CASE("a restored world continues bitwise as the uninterrupted run, on 1, 2 and 4 threads", "[state]") {
+  Scene original = load(1);
+  Environment& env = *original.environment;
+  env.step(300);
+  const std::vector<std::byte> saved = env.saveState();
+  std::size_t contacts = 0;
+  const std::vector<std::uint64_t> reference = hashes(env, 300, &contacts);
+  CHECK(contacts > 0);  // bodies touched after the save
+
+  for (int threads : {1, 2, 4}) {
+    INFO(threads << " thread(s), a freshly loaded scene");
+    Scene fresh = load(threads);
+    fresh.environment->restoreState(saved);
+    CHECK(fresh.environment->stepCount() == 300);
+    CHECK(hashes(*fresh.environment, 300) == reference);
+  }
+  // the same environment, rewound: an exact replay
+  env.restoreState(saved);
+  CHECK(hashes(env, 300) == reference);
+  // and saving again right after a restore gives the same bytes
+  env.restoreState(saved);
+  CHECK(env.saveState() == saved);
+}
+
+TEST_CASE("a truncated, corrupted or foreign state is refused and changes nothing", "[state]") {
+  Scene scene = load(2);
+  Environment& env = *scene.environment;
+  env.step(100);
+  const std::vector<std::byte> saved = env.saveState();
+  env.step(50);
+  const std::vector<std::byte> at150 = env.saveState();
+  const std::uint64_t before = env.stateHash();
+
+  std::vector<std::byte> truncated(saved.begin(), saved.end() - 1);
+  std::vector<std::byte> corrupted = saved;
+  corrupted[corrupted.size() / 2] ^= std::byte{0x10};
+  Scene other = loadSceneFromString(
+      "<scene><type name=\"box\" file=\"box.xml\"/><artifact name=\"b\" type=\"box\"/></scene>", "other.xml", kArtifacts);
+  other.environment->step(3);
+  const std::vector<std::byte> foreign = other.environment->saveState();
+
+  CHECK_THROWS_AS(env.restoreState(truncated), StateError);
+  CHECK_THROWS_WITH(env.restoreState(truncated), Catch::Contains("truncated"));
+  CHECK_THROWS_WITH(env.restoreState(corrupted), Catch::Contains("corrupted (checksum mismatch)"));
+  CHECK_THROWS_WITH(env.restoreState(foreign), Catch::Contains("saved from a different scene"));
+  CHECK_THROWS_WITH(env.restoreState(std::vector<std::byte>(10)), Catch::Contains("not an ssx saved state"));
+  // nothing moved: the world is still at step 150 and goes on as it would have
+  CHECK(env.stepCount() == 150);
+  CHECK(env.stateHash() == before);
+  CHECK(env.saveState() == at150);
+}
+
+namespace {
+
+// a driver whose loadState reads less than its saveState wrote
+class ForgetfulDriver final : public Driver {
+ public:
+  void step(const StepInfo&) override { ++runs_; }
+  void saveState(StateWriter& out) const override {
+    out.write(runs_);
+    out.write(runs_);
+  }
+  void loadState(StateReader& in) override { in.read(runs_); }
+  std::int64_t runs_ = 0;
+};
+
+}  // namespace
+
+TEST_CASE("a plugin that reads back less than it saved fails the restore, which changes nothing", "[state]") {
+  Environment env;
+  Artifact& a = env.addArtifact("body", test::at(0, 0, 1));
+  a.addPhysicRoot(test::boxBody(Vec3(0.1, 0.1, 0.1), 1.0));
+  auto& driver = static_cast<ForgetfulDriver&>(a.setDriver(std::make_unique<ForgetfulDriver>()));
+  env.step(10);
+  const auto saved = env.saveState();
+  env.step(5);
+  const auto hash = env.stateHash();
+  CHECK_THROWS_WITH(env.restoreState(saved), Catch::Contains("driver 'driver' of artifact 'body' left 8 bytes"));
+  CHECK(env.stepCount() == 15);
+  CHECK(env.stateHash() == hash);
+  CHECK(driver.runs_ == 15);
+}
+
+TEST_CASE("ssx run --save-state and --load-state continue a run in another process", "[state][cli]") {
+  const fs::path dir = fs::current_path() / "state_cli";
+  fs::create_directories(dir);
+  const fs::path scene = dir / "scene.xml";
+  std::ofstream(scene) << sceneXml(2, (dir / "poses.csv").string());
+  const std::string sceneArg = "run " + scene.string() + " --fast --quiet ";
+
+  REQUIRE(runCli(sceneArg + "--steps 400 --save-state " + (dir / "whole.bin").string()) == 0);
+  REQUIRE(runCli(sceneArg + "--steps 150 --threads 1 --save-state " + (dir / "first.bin").string()) == 0);
+  REQUIRE(runCli(sceneArg + "--steps 250 --threads 4 --load-state " + (dir / "first.bin").string() +
+                 " --save-state " + (dir / "rest.bin").string()) == 0);
+  CHECK(slurp(dir / "whole.bin") == slurp(dir / "rest.bin"));
+  CHECK_FALSE(fs::exists(dir / "rest.bin.partial"));
+
+  // a state that does not fit is refused before anything starts: the logger's file stays as it was
+  std::ofstream(dir / "poses.csv") << "kept\n";
+  std::string bad = slurp(dir / "first.bin");
+  bad.resize(bad.size() / 2);
+  std::ofstream(dir / "bad.bin", std::ios::binary) << bad;
+  CHECK(runCli(sceneArg + "--steps 10 --load-state " + (dir / "bad.bin").string()) == 2);
+  CHECK(slurp(dir / "poses.csv") == "kept\n");
+}
