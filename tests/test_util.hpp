@@ -18,6 +18,15 @@ class LambdaDriver final : public Driver {
   std::function<void(Driver&, const StepInfo&)> fn_;
 };
 
+/// A sensor that delivers the step it ran in.
+class LambdaSensor final : public SensorOf<ClockMeasurement> {
+ public:
+  void sense(const StepInfo& info) override {
+    output().stamp = info.time;
+    output().step = info.step;
+  }
+};
+
 /// A body made of one box, with explicit mass (and inertia if given).
 inline PhysicNodeSpec boxBody(const Vec3& size, double mass, const Mat3* inertia = nullptr) {
   PhysicNodeSpec spec;

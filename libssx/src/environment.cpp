@@ -150,6 +150,7 @@ SimulationExtension& Environment::addExtension(std::string name, SimulationExten
 
 void Environment::subscribe(const Sensor& sensor, Artifact& subscriber,
                             std::function<void(const Measurement&)> callback) {
+  requireOutsidePhases("subscribe");
   if (state_ != State::Setup && !configuring_)
     throw Error("subscriptions are made before the environment starts or from configure");
   if (&subscriber.environment() != this || sensor.artifact_ == nullptr || &sensor.artifact().environment() != this)
@@ -209,7 +210,7 @@ SimulationExtension* Environment::extension(std::string_view name) const {
   return nullptr;
 }
 
-PhysicEngine& Environment::physics() const {
+const PhysicEngine& Environment::physics() const {
   if (!physics_) throw Error("the physics engine exists only while the environment runs");
   return *physics_;
 }
@@ -419,7 +420,15 @@ void Environment::publishSnapshot(bool first) {
   }
 }
 
+void Environment::requireOutsidePhases(const char* what) const {
+  // the parallel phases read what these calls change: a call from there would be a data race
+  if (detail::PhaseGuard::in_phase)
+    throw Error(std::string(what) + " is not allowed from a " + detail::PhaseGuard::role +
+                " (the parallel phases): call it from configure, or between steps");
+}
+
 void Environment::enableNeighborQueries(double cell_size) {
+  requireOutsidePhases("enableNeighborQueries");
   if (!(cell_size > 0)) throw Error("enableNeighborQueries: cell size must be positive");
   // positions do not change while plugins are configured: only a new grid needs building
   const bool new_grid = !neighbors_enabled_ || cell_size < neighbor_index_.cellSize();
@@ -643,6 +652,7 @@ void Environment::finishCameras() {
 
 void Environment::addCameraRequest(std::string owner, std::function<bool(std::int64_t, CameraView&)> due,
                                    Image& target) {
+  requireOutsidePhases("addCameraRequest");
   if (state_ != State::Running || !renderer_) throw Error("addCameraRequest: call it from a plugin's configure");
   if (!renderer_->drawsPixels())
     throw ConfigError({}, owner + " needs images, but render engine '" + renderer_->name() +

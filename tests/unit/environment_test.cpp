@@ -409,3 +409,31 @@ TEST_CASE("plugins find the node a parameter names, or the first root", "[enviro
   Artifact& empty = env.addArtifact("logic");
   CHECK_THROWS_WITH(empty.nodeFromParameter(none), Catch::Contains("has no physic node"));
 }
+
+TEST_CASE("what only configure may do is refused from the parallel phases, with the reason", "[environment]") {
+  // enabling neighbour queries, subscribing or asking for camera images from a driver's step would
+  // change what other threads read in the same phase
+  auto fromStep = [](std::function<void(Environment&, Driver&)> call) {
+    Environment env(EnvironmentSettings{.threads = 2});
+    Artifact& a = addBall(env, "a");
+    addBall(env, "b", 1).addSensor(std::make_unique<test::LambdaSensor>());
+    a.setDriver(std::make_unique<LambdaDriver>([&env, call](Driver& d, const StepInfo&) { call(env, d); }));
+    try {
+      env.step();
+    } catch (const StepError& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  CHECK_THAT(fromStep([](Environment& env, Driver&) { env.enableNeighborQueries(1.0); }),
+             Catch::Contains("enableNeighborQueries is not allowed from a driver (the parallel phases)"));
+  CHECK_THAT(fromStep([](Environment& env, Driver& d) {
+               env.subscribe(env.findArtifact("b")->sensor(0), d.artifact(), [](const Measurement&) {});
+             }),
+             Catch::Contains("subscribe is not allowed from a driver"));
+  Image image;
+  CHECK_THAT(fromStep([&image](Environment& env, Driver&) {
+               env.addCameraRequest("x", [](std::int64_t, CameraView&) { return false; }, image);
+             }),
+             Catch::Contains("addCameraRequest is not allowed from a driver"));
+}

@@ -179,7 +179,8 @@ class SSX_EXPORT Environment {
   /// A 64-bit hash (FNV-1a) of every body's pose and velocities, bit for bit, and the time.
   std::uint64_t stateHash() const;
 
-  /// Neighbour queries. A plugin that wants them calls enableNeighborQueries from configure; from
+  /// Neighbour queries. A plugin that wants them calls enableNeighborQueries from configure (never
+  /// from sense, step or a callback: those run in parallel with the queries); from
   /// then on the index of every artifact's first dynamic root position is rebuilt once per step,
   /// in the snapshot phase (the smallest cell size asked for wins).
   void enableNeighborQueries(double cell_size);
@@ -214,7 +215,9 @@ class SSX_EXPORT Environment {
   /// The scene cameras' specs as used (frame_scene cameras placed), from start() on.
   std::vector<CameraSpec> cameras() const;
 
-  PhysicEngine& physics() const;
+  /// The physics engine, read-only (bodies are added by the environment, at start); throws when
+  /// the environment is not running.
+  const PhysicEngine& physics() const;
   RenderEngine& renderer() const;
   /// Per-step timing of every step taken so far.
   TimingRecorder& timing() noexcept { return timing_; }
@@ -226,6 +229,7 @@ class SSX_EXPORT Environment {
 
   void requireSetup(const char* what) const;
   void checkDeclaredParameters();
+  void requireOutsidePhases(const char* what) const;
   std::uint64_t sceneFingerprint() const;
   void applyState(std::span<const std::byte> payload);
   void buildBodies();
