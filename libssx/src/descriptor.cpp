@@ -1,4 +1,5 @@
 #include <ssx/descriptor.hpp>
+#include <ssx/parameters.hpp>
 
 #include <cerrno>
 #include <charconv>
@@ -147,10 +148,24 @@ const Descriptor::Attribute* Descriptor::find(std::string_view key) const {
   return nullptr;
 }
 
+const char* Descriptor::declaredDefault(std::string_view key) const noexcept {
+  for (const auto& d : declarations_)
+    if (key == d.name) return d.default_value != nullptr && d.default_value[0] != '\0' ? d.default_value : nullptr;
+  return nullptr;
+}
+
 template <class T>
 T Descriptor::get(std::string_view key) const {
   const Attribute* a = find(key);
-  if (a == nullptr) throw error("missing attribute '" + std::string(key) + "'");
+  if (a == nullptr) {
+    const char* fallback = declaredDefault(key);
+    if (fallback == nullptr) throw error("missing attribute '" + std::string(key) + "'");
+    T value{};
+    if (!parseValue(fallback, value))
+      throw error("the declared default of '" + std::string(key) + "' ('" + fallback + "') is not " + typeName<T>() +
+                  " (a bug in the plugin's declarations)");
+    return value;
+  }
   T value{};
   if (!parseValue(a->value, value))
     throw error(*a, "attribute '" + a->key + "' must be " + typeName<T>() + ", got '" + a->value + "'");
@@ -159,7 +174,7 @@ T Descriptor::get(std::string_view key) const {
 
 template <class T>
 T Descriptor::get(std::string_view key, const T& fallback) const {
-  if (find(key) == nullptr) return fallback;
+  if (find(key) == nullptr && declaredDefault(key) == nullptr) return fallback;
   return get<T>(key);
 }
 

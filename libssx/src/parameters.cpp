@@ -91,9 +91,12 @@ std::vector<Diagnostic> checkParameters(std::span<const ssx_plugin_param> declar
                    "unknown parameter '" + a.key + "' of " + what + " (ignored; it has: " +
                        (known.empty() ? std::string("none") : known) + ")"});
   }
+  // absent parameters read as their declared defaults
+  params.setDeclarations(declarations);
   for (const auto& d : declarations) {
     const Descriptor::Attribute* a = params.find(d.name);
     const bool defaulted = a == nullptr;
+    Descriptor::Attribute declared_default;
     if (a == nullptr) {
       if ((d.flags & SSX_PARAM_REQUIRED) != 0) {
         fail(params.where(), "missing parameter '" + std::string(d.name) + "' (" + d.doc + ")");
@@ -101,8 +104,8 @@ std::vector<Diagnostic> checkParameters(std::span<const ssx_plugin_param> declar
       }
       if (d.default_value == nullptr || d.default_value[0] == '\0') continue;
       // a default is checked too: a rate may not fit this plugin's period
-      params.set(d.name, d.default_value, params.where());
-      a = params.find(d.name);  // and read by definition
+      declared_default = {d.name, d.default_value, params.where(), true};
+      a = &declared_default;
     }
     const std::string unit = d.unit != nullptr && d.unit[0] != '\0' ? std::string(" ") + d.unit : "";
     auto outOfBounds = [&](const std::string& value) {

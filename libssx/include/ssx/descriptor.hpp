@@ -7,9 +7,12 @@
 #include <ssx/types.hpp>
 
 #include <optional>
+#include <span>
 #include <string>
 #include <string_view>
 #include <vector>
+
+extern "C" struct ssx_plugin_param;
 
 namespace ssx {
 
@@ -49,14 +52,22 @@ class SSX_EXPORT Descriptor {
   Descriptor& erase(std::string_view key);
   Descriptor& addChild(Descriptor child);
 
+  /// Declared parameters (ssx/parameters.hpp) whose defaults `get` returns for absent
+  /// attributes. The declarations must outlive this descriptor (a plugin's manifest does).
+  void setDeclarations(std::span<const ssx_plugin_param> declarations) noexcept { declarations_ = declarations; }
+  std::span<const ssx_plugin_param> declarations() const noexcept { return declarations_; }
+
+  /// Whether the attribute was given (a declared default does not count).
   bool has(std::string_view key) const;
   /// The raw text of an attribute, or nullptr. Marks it read.
   const Attribute* find(std::string_view key) const;
 
-  /// The attribute parsed as T; throws ConfigError if missing or malformed.
+  /// The attribute parsed as T, else its declared default; throws ConfigError if it has neither,
+  /// or is malformed.
   template <class T>
   T get(std::string_view key) const;
-  /// The attribute parsed as T, or `fallback` if absent; throws ConfigError if malformed.
+  /// The attribute parsed as T, else its declared default, else `fallback`; throws ConfigError if
+  /// malformed.
   template <class T>
   T get(std::string_view key, const T& fallback) const;
   /// Like get, and also checks `value > 0` (throws ConfigError naming the attribute).
@@ -83,6 +94,9 @@ class SSX_EXPORT Descriptor {
   SourceLocation where_;
   std::vector<Attribute> attributes_;
   std::vector<Descriptor> children_;
+  std::span<const ssx_plugin_param> declarations_;
+  // the declared default of `key`, or null
+  const char* declaredDefault(std::string_view key) const noexcept;
 };
 
 // explicit instantiations live in descriptor.cpp

@@ -98,9 +98,10 @@ struct PluginContext {
 };
 
 /// Checks `params` against `declarations`: types, ranges, choices, required parameters, rates
-/// against the plugin's period (`context`). Adds the declared defaults of absent parameters (as
-/// read). Undeclared parameters are warnings (left unread: mark them read to silence the
-/// environment's own warning about parameters no plugin read).
+/// against the plugin's period (`context`). Attaches the declarations to `params`, so that absent
+/// parameters read as their declared defaults (Descriptor::get). Undeclared parameters are
+/// warnings (left unread: mark them read to silence the environment's own warning about
+/// parameters no plugin read).
 /// `what` names the plugin in messages ("driver 'quadrotor'"). Returns every problem found.
 SSX_EXPORT std::vector<Diagnostic> checkParameters(std::span<const ssx_plugin_param> declarations,
                                                    Descriptor& params, const PluginContext& context,
