@@ -1,6 +1,5 @@
 #include "phase_guard.hpp"
-#include "render/frame_output.hpp"
-#include "render/frame_worker.hpp"
+#include "render/scene_cameras.hpp"
 #include "worker_pool.hpp"
 
 #include <ssx/environment.hpp>
@@ -64,25 +63,12 @@ void checkSettings(const EnvironmentSettings& s) {
     if (!validFieldOfView(c.fov_deg)) bad("camera '" + c.name + "': fov_deg must be in (0, 180)");
 }
 
-// a camera at `position` looking at `target`, level (its y axis horizontal)
-Pose lookAt(const Vec3& position, const Vec3& target) {
-  Vec3 forward = target - position;
-  if (forward.norm() < 1e-9) forward = Vec3::UnitX();
-  forward.normalize();
-  Vec3 left = Vec3::UnitZ().cross(forward);
-  if (left.norm() < 1e-6) left = Vec3::UnitY();  // looking straight up or down
-  left.normalize();
-  Eigen::Matrix3d r;
-  r.col(0) = forward;
-  r.col(1) = left;
-  r.col(2) = forward.cross(left);
-  return Pose{position, Quat(r).normalized()};
-}
-
 }  // namespace
 
 Environment::Environment(EnvironmentSettings settings)
-    : settings_(std::move(settings)), loader_(std::make_unique<ClassLoader>()) {
+    : settings_(std::move(settings)),
+      loader_(std::make_unique<ClassLoader>()),
+      cameras_(std::make_unique<detail::SceneCameras>()) {
   checkSettings(settings_);
   RenderSettings& r = settings_.render;
   if (r.rate_hz > 0)
@@ -309,12 +295,8 @@ void Environment::start() {
     renderer_ = createRenderEngine(settings_.render);
     buildBodies();
     publishSnapshot(true);
-    // render roots follow their physic nodes, looked up once
-    for (auto& a : artifacts_) {
-      a->render_follow_.clear();
-      for (const auto& r : a->render_roots_) a->render_follow_.push_back(r.follow.empty() ? nullptr : a->node(r.follow));
-    }
-    startCameras();
+    cameras_->start(settings_.render, settings_.timestep, *renderer_, artifacts_,
+                    [this](std::string_view m) { log(LogLevel::Warning, m); });
     const unsigned threads = settings_.threads > 0 ? static_cast<unsigned>(settings_.threads)
                                                    : std::max(1u, std::thread::hardware_concurrency());
     pool_ = std::make_unique<detail::WorkerPool>(threads);
@@ -362,7 +344,7 @@ void Environment::stop() {
       for (auto& s : a->sensors_) destroy(*s.sensor, "sensor '" + s.sensor->className() + "'");
     }
     pool_.reset();
-    finishCameras();
+    cameras_->finish([this](std::string_view m) { log(LogLevel::Error, m); });
     renderer_.reset();
     physics_.reset();
   }
@@ -562,93 +544,11 @@ void Environment::raiseFirstError(const char* phase) {
   }
 }
 
-void Environment::syncRenderNodes() {
-  if (render_items_step_ == steps_) return;
-  render_items_step_ = steps_;
-  render_items_.clear();
-  const Artifact* owner = nullptr;
-  auto add = [&](auto& self, const RenderNodeSpec& spec, const Pose& parent) -> void {
-    const Pose world = parent * spec.pose;
-    render_items_.push_back({&spec, owner, world});
-    for (const auto& c : spec.children) self(self, c, world);
-  };
-  for (const auto& a : artifacts_) {
-    owner = a.get();
-    for (std::size_t i = 0; i < a->render_roots_.size(); ++i) {
-      const PhysicNode* follow = a->render_follow_[i];
-      add(add, a->render_roots_[i], follow != nullptr ? follow->pose() : a->placement());
-    }
-  }
-}
+std::vector<CameraSpec> Environment::cameras() const { return cameras_->specs(); }
 
-std::vector<CameraSpec> Environment::cameras() const {
-  std::vector<CameraSpec> specs;
-  for (const auto& c : cameras_) specs.push_back(c.spec);
-  return specs;
-}
+const std::vector<RenderNode>& Environment::renderNodes() const noexcept { return cameras_->renderNodes(); }
 
-void Environment::startCameras() {
-  const RenderSettings& r = settings_.render;
-  if (r.cameras.empty()) return;
-  if (!renderer_->drawsPixels()) {
-    std::string names;
-    for (const auto& c : r.cameras) names += (names.empty() ? "'" : ", '") + c.name + "'";
-    log(LogLevel::Warning, "render engine '" + renderer_->name() + "' draws no pixels: camera " + names +
-                               " gets no frames (choose engine=\"osmesa\" in <render> or --render osmesa)");
-    return;
-  }
-  for (const CameraSpec& spec : r.cameras) {
-    SceneCamera c;
-    c.spec = spec;
-    if (!spec.follow.empty()) {
-      c.follow = findArtifact(spec.follow);
-      if (c.follow == nullptr || c.follow->rootCount() == 0)
-        throw ConfigError({}, "camera '" + spec.name + "' follows '" + spec.follow +
-                                  "', which is no artifact with a physic root");
-    }
-    if (spec.frame_scene) {
-      // everything placed, static or not (ground planes aside), seen from the south-east above
-      Eigen::AlignedBox3d box;
-      for (const auto& a : artifacts_) {
-        if (a->rootCount() == 0) {
-          box.extend(a->placement().position);
-          continue;
-        }
-        const auto& shapes = a->root().spec().shapes;
-        const bool ground = !shapes.empty() && std::all_of(shapes.begin(), shapes.end(), [](const Shape& s) {
-          return s.kind == Shape::Kind::Plane;
-        });
-        if (!ground) box.extend(a->root().pose().position);
-      }
-      if (box.isEmpty()) box.extend(Vec3::Zero());
-      const Vec3 centre = box.center();
-      const double extent = std::max(2.0, box.sizes().norm());
-      const double distance = 0.5 * extent / std::tan(spec.fov_deg * std::numbers::pi / 360.0) + 0.5 * extent;
-      c.spec.look_at = centre;
-      c.spec.position = centre + distance * Vec3(0.62, -0.62, 0.48).normalized();
-    }
-    cameras_.push_back(std::move(c));
-  }
-  const double fps = 1.0 / (static_cast<double>(r.period_steps) * toSeconds(settings_.timestep));
-  std::vector<std::unique_ptr<detail::FrameOutput>> outputs;
-  for (const auto& c : cameras_)
-    outputs.push_back(std::make_unique<detail::FrameOutput>(c.spec, fps, [this](std::string_view m) {
-      log(LogLevel::Warning, m);
-    }));
-  frame_worker_ = std::make_unique<detail::FrameWorker>(r, std::move(outputs));
-}
-
-void Environment::finishCameras() {
-  if (frame_worker_) {
-    try {
-      frame_worker_->finish();
-    } catch (const std::exception& e) {
-      log(LogLevel::Error, std::string("frames: ") + e.what());
-    }
-    frame_worker_.reset();
-  }
-  cameras_.clear();
-}
+std::int64_t Environment::frameCount() const noexcept { return cameras_->frameCount(); }
 
 void Environment::addCameraRequest(std::string owner, std::function<bool(std::int64_t, CameraView&)> due,
                                    Image& target) {
@@ -657,51 +557,7 @@ void Environment::addCameraRequest(std::string owner, std::function<bool(std::in
   if (!renderer_->drawsPixels())
     throw ConfigError({}, owner + " needs images, but render engine '" + renderer_->name() +
                               "' draws none: choose engine=\"osmesa\" in <render> or --render osmesa");
-  camera_requests_.push_back({std::move(owner), std::move(due), &target});
-}
-
-void Environment::renderCameraRequests() {
-  CameraView view;
-  for (auto& r : camera_requests_) {
-    try {
-      view = CameraView{};
-      if (!r.due(current_step_, view)) continue;
-      syncRenderNodes();
-      renderer_->renderView(view, render_items_, settings_.render.background, *r.target);
-    } catch (const std::exception& e) {
-      fail();
-      throw StepError("", r.owner, current_step_, std::string("camera image: ") + e.what());
-    }
-  }
-}
-
-void Environment::drawFrame() {
-  syncRenderNodes();  // also without cameras: renderNodes() serves viewers outside ssx
-  if (!frame_worker_) return;
-  std::vector<CameraView> views;
-  for (auto& c : cameras_) {
-    CameraView view;
-    view.width = settings_.render.width;
-    view.height = settings_.render.height;
-    view.fov_deg = c.spec.fov_deg;
-    if (c.follow != nullptr) {
-      // in the followed robot's frame, turning with its heading only: the picture stays level
-      const Pose root = c.follow->root().pose();
-      const Vec3 forward = root.orientation * Vec3::UnitX();
-      const Pose base{root.position, Quat(Eigen::AngleAxisd(std::atan2(forward.y(), forward.x()), Vec3::UnitZ()))};
-      view.pose = lookAt(base.transformPoint(c.spec.position), base.transformPoint(c.spec.look_at));
-    } else {
-      view.pose = lookAt(c.spec.position, c.spec.look_at);
-    }
-    views.push_back(view);
-  }
-  try {
-    frame_worker_->submit(render_items_, std::move(views));
-  } catch (const std::exception& e) {
-    fail();
-    throw StepError("", "render", current_step_, std::string("drawing or writing frames: ") + e.what());
-  }
-  ++frames_;
+  cameras_->addRequest(std::move(owner), std::move(due), target);
 }
 
 void Environment::step() {
@@ -742,9 +598,14 @@ void Environment::step() {
   publishSnapshot(false);
   if (neighbors_enabled_) rebuildNeighborIndex();
   timing.snapshot = since(t);
-  if (!camera_requests_.empty()) {
+  if (cameras_->hasRequests()) {
     t = Clock::now();
-    renderCameraRequests();
+    try {
+      cameras_->renderRequests(current_step_, *renderer_, settings_.render.background, artifacts_);
+    } catch (...) {
+      fail();
+      throw;
+    }
     timing.render += since(t);
   }
 
@@ -767,7 +628,12 @@ void Environment::step() {
   // render, when due
   if (settings_.render.period_steps > 0 && current_step_ % settings_.render.period_steps == 0) {
     t = Clock::now();
-    drawFrame();
+    try {
+      cameras_->drawFrame(current_step_, settings_.render, artifacts_);
+    } catch (...) {
+      fail();
+      throw;
+    }
     timing.render += since(t);
   }
 

@@ -6,6 +6,8 @@
 // snapshot (body states with accelerations, the velocities before the last step), the command
 // buffers, then one block per plugin (driver first, then sensors, artifact by artifact: its random
 // stream, then what it saved) and one per extension.
+#include "render/scene_cameras.hpp"
+
 #include <ssx/environment.hpp>
 
 #include <cstring>
@@ -200,7 +202,7 @@ void Environment::applyState(std::span<const std::byte> payload) {
   if (!in.done()) throw StateError("saved state: " + std::to_string(in.remaining()) + " bytes left over (corrupted)");
   steps_ = steps;
   current_step_ = steps;
-  render_items_step_ = -1;
+  cameras_->invalidate();
   if (neighbors_enabled_) rebuildNeighborIndex();
 }
 

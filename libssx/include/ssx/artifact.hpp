@@ -114,7 +114,6 @@ class SSX_EXPORT Artifact {
   std::vector<std::unique_ptr<PhysicNode>> nodes_;  // every node, trees in order
   std::vector<PhysicNode*> roots_;
   std::vector<RenderNodeSpec> render_roots_;
-  std::vector<const PhysicNode*> render_follow_;  // per render root, resolved at start
   Driver* driver_ = nullptr;
   std::unique_ptr<Driver> owned_driver_;  // null when a ClassLoader owns it
   Descriptor driver_params_;

@@ -44,8 +44,7 @@ namespace ssx {
 
 namespace detail {
 class WorkerPool;
-class FrameOutput;
-class FrameWorker;
+class SceneCameras;
 }
 
 /// Everything that defines an environment before it is populated.
@@ -202,7 +201,7 @@ class SSX_EXPORT Environment {
   const std::vector<StaticShape>& staticShapes() const noexcept { return static_shapes_; }
 
   /// The render nodes of the last frame or camera image drawn, posed in the world.
-  const std::vector<RenderNode>& renderNodes() const noexcept { return render_items_; }
+  const std::vector<RenderNode>& renderNodes() const noexcept;
   /// Camera images for sensors. `due(step, view)` is called in the snapshot phase of every step,
   /// on the stepping thread, after the snapshot is published; when it returns true, the view it
   /// filled in is drawn from that step's snapshot into `target`, before the sensors phase (so a
@@ -211,7 +210,7 @@ class SSX_EXPORT Environment {
   void addCameraRequest(std::string owner, std::function<bool(std::int64_t step, CameraView& view)> due,
                         Image& target);
   /// Frames drawn for the scene's cameras so far.
-  std::int64_t frameCount() const noexcept { return frames_; }
+  std::int64_t frameCount() const noexcept;
   /// The scene cameras' specs as used (frame_scene cameras placed), from start() on.
   std::vector<CameraSpec> cameras() const;
 
@@ -238,11 +237,6 @@ class SSX_EXPORT Environment {
   void runDrivers(std::size_t begin, std::size_t end);
   void prefetchArtifact(std::size_t i, std::size_t end, bool sensors) const;
   void raiseFirstError(const char* phase);
-  void drawFrame();
-  void syncRenderNodes();
-  void renderCameraRequests();
-  void startCameras();
-  void finishCameras();
   void fail();
   void warnUnusedParameters() const;
   void runExtensionHook(void (SimulationExtension::*hook)(Environment&), const char* what);
@@ -275,21 +269,7 @@ class SSX_EXPORT Environment {
   std::vector<Wrench> wrenches_;  // command buffers, one per body, owned by artifacts
   std::vector<Artifact*> body_owner_;
   std::vector<PendingError> errors_;  // one per artifact, filled by the parallel phases
-  std::vector<RenderNode> render_items_;
-  std::int64_t render_items_step_ = -1;  // the step render_items_ were posed for
-  struct CameraRequest {
-    std::string owner;
-    std::function<bool(std::int64_t, CameraView&)> due;
-    Image* target;
-  };
-  std::vector<CameraRequest> camera_requests_;
-  struct SceneCamera {
-    CameraSpec spec;
-    const Artifact* follow = nullptr;
-  };
-  std::vector<SceneCamera> cameras_;
-  std::unique_ptr<detail::FrameWorker> frame_worker_;  // draws and writes the cameras' frames
-  std::int64_t frames_ = 0;
+  std::unique_ptr<detail::SceneCameras> cameras_;  // scene cameras, camera images, render items
   bool neighbors_enabled_ = false;
   SpatialIndex neighbor_index_;
   std::vector<Vec3> neighbor_points_;
