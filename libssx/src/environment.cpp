@@ -1,4 +1,5 @@
 #include "phase_guard.hpp"
+#include "neighbor_index.hpp"
 #include "render/scene_cameras.hpp"
 #include "worker_pool.hpp"
 
@@ -68,7 +69,8 @@ void checkSettings(const EnvironmentSettings& s) {
 Environment::Environment(EnvironmentSettings settings)
     : settings_(std::move(settings)),
       loader_(std::make_unique<ClassLoader>()),
-      cameras_(std::make_unique<detail::SceneCameras>()) {
+      cameras_(std::make_unique<detail::SceneCameras>()),
+      neighbors_(std::make_unique<detail::NeighborIndex>()) {
   checkSettings(settings_);
   RenderSettings& r = settings_.render;
   if (r.rate_hz > 0)
@@ -267,7 +269,7 @@ void Environment::checkDeclaredParameters() {
                    const std::string& what) {
     const ssx_plugin_class* type = loader_->classOf(instance);
     if (type == nullptr) return;
-    const PluginContext context{this, a, period, settings_.timestep};
+    const PluginContext context{this, a, period, settings_.timestep, {}};
     for (const auto& d : checkParameters({type->params, type->param_count}, params, context, what))
       if (d.severity == Diagnostic::Severity::Error) errors += (errors.empty() ? "" : "\n") + d.str();
   };
@@ -411,38 +413,17 @@ void Environment::requireOutsidePhases(const char* what) const {
 
 void Environment::enableNeighborQueries(double cell_size) {
   requireOutsidePhases("enableNeighborQueries");
-  if (!(cell_size > 0)) throw Error("enableNeighborQueries: cell size must be positive");
-  // positions do not change while plugins are configured: only a new grid needs building
-  const bool new_grid = !neighbors_enabled_ || cell_size < neighbor_index_.cellSize();
-  if (new_grid) neighbor_index_ = SpatialIndex(cell_size);
-  neighbors_enabled_ = true;
-  if (new_grid && state_ == State::Running) rebuildNeighborIndex();
+  if (neighbors_->enable(cell_size) && state_ == State::Running) neighbors_->rebuild(artifacts_);
 }
 
+bool Environment::neighborQueriesEnabled() const noexcept { return neighbors_->enabled(); }
+
 void Environment::neighbors(const Vec3& point, double radius, std::vector<std::size_t>& out) const {
-  if (!neighbors_enabled_) throw Error("neighbour queries are off: call enableNeighborQueries from configure");
-  neighbor_index_.query(point, radius, out);
+  neighbors_->query(point, radius, out);
 }
 
 void Environment::neighbors(const Vec3& point, double radius, std::vector<SpatialIndex::Hit>& out) const {
-  if (!neighbors_enabled_) throw Error("neighbour queries are off: call enableNeighborQueries from configure");
-  neighbor_index_.query(point, radius, out);
-}
-
-void Environment::rebuildNeighborIndex() {
-  // one point per artifact with a dynamic root: its first root's position
-  neighbor_points_.clear();
-  neighbor_ids_.clear();
-  for (const auto& a : artifacts_) {
-    if (a->body_begin_ == a->body_end_) continue;
-    for (const PhysicNode* root : a->roots_) {
-      if (root->isStatic()) continue;
-      neighbor_points_.push_back(root->pose().position);
-      neighbor_ids_.push_back(a->index());
-      break;
-    }
-  }
-  neighbor_index_.rebuild(neighbor_points_, neighbor_ids_);
+  neighbors_->query(point, radius, out);
 }
 
 namespace {
@@ -596,7 +577,7 @@ void Environment::step() {
       for (int b = a->body_begin_; b < a->body_end_; ++b) wrenches_[static_cast<std::size_t>(b)] = Wrench{};
   ++steps_;
   publishSnapshot(false);
-  if (neighbors_enabled_) rebuildNeighborIndex();
+  if (neighbors_->enabled()) neighbors_->rebuild(artifacts_);
   timing.snapshot = since(t);
   if (cameras_->hasRequests()) {
     t = Clock::now();

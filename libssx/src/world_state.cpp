@@ -6,6 +6,7 @@
 // snapshot (body states with accelerations, the velocities before the last step), the command
 // buffers, then one block per plugin (driver first, then sensors, artifact by artifact: its random
 // stream, then what it saved) and one per extension.
+#include "neighbor_index.hpp"
 #include "render/scene_cameras.hpp"
 
 #include <ssx/environment.hpp>
@@ -203,7 +204,7 @@ void Environment::applyState(std::span<const std::byte> payload) {
   steps_ = steps;
   current_step_ = steps;
   cameras_->invalidate();
-  if (neighbors_enabled_) rebuildNeighborIndex();
+  if (neighbors_->enabled()) neighbors_->rebuild(artifacts_);
 }
 
 }  // namespace ssx

@@ -93,7 +93,7 @@ void QuadrotorDriver::configure(const Descriptor& params) {
   const Allocation allocation(rotors, rp);
 
   // the loops run every k runs of the driver (whole numbers: checked while loading)
-  const PluginContext context{&env, &a, periodSteps(), env.timestep()};
+  const PluginContext context{&env, &a, periodSteps(), env.timestep(), {}};
   const double period = toSeconds(context.period());
   inner_runs_ = runsPerPeriod(params.get<double>("inner_rate_hz"), context);
   outer_runs_ = runsPerPeriod(params.get<double>("outer_rate_hz"), context);

@@ -414,7 +414,9 @@ TEST_CASE("what only configure may do is refused from the parallel phases, with 
   // enabling neighbour queries, subscribing or asking for camera images from a driver's step would
   // change what other threads read in the same phase
   auto fromStep = [](std::function<void(Environment&, Driver&)> call) {
-    Environment env(EnvironmentSettings{.threads = 2});
+    EnvironmentSettings settings;
+    settings.threads = 2;
+    Environment env(settings);
     Artifact& a = addBall(env, "a");
     addBall(env, "b", 1).addSensor(std::make_unique<test::LambdaSensor>());
     a.setDriver(std::make_unique<LambdaDriver>([&env, call](Driver& d, const StepInfo&) { call(env, d); }));

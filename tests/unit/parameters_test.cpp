@@ -56,7 +56,7 @@ std::map<std::string, std::string> docTables() {
 }  // namespace
 
 TEST_CASE("declared defaults are added and every declared check holds", "[parameters]") {
-  const PluginContext context{nullptr, nullptr, 1, 1'000'000};
+  const PluginContext context{nullptr, nullptr, 1, 1'000'000, {}};
   Descriptor d = element({{"file", "out.csv"}});
   CHECK(errorsOf(checkParameters(kDeclared, d, context, "driver 'x'")).empty());
   CHECK(d.get<double>("gain") == 2.5);
@@ -68,7 +68,7 @@ TEST_CASE("declared defaults are added and every declared check holds", "[parame
 }
 
 TEST_CASE("each kind of bad parameter is an error at its own line", "[parameters]") {
-  const PluginContext context{nullptr, nullptr, 1, 1'000'000};
+  const PluginContext context{nullptr, nullptr, 1, 1'000'000, {}};
   struct Case {
     const char* key;
     const char* value;
@@ -109,7 +109,7 @@ TEST_CASE("a loop rate fits when its period is a whole multiple of the plugin's"
   // 100 Hz is every 10 ms: plugins every 1, 2, 5 or 10 steps of 1 ms fit; 3 or 20 do not
   for (std::int64_t period : {1, 2, 5, 10, 3, 20}) {
     INFO("period " << period);
-    const PluginContext context{nullptr, nullptr, period, 1'000'000};
+    const PluginContext context{nullptr, nullptr, period, 1'000'000, {}};
     Descriptor d = element({{"file", "f"}});
     const bool fits = 10 % period == 0;
     CHECK(errorsOf(checkParameters(kDeclared, d, context, "driver 'x'")).empty() == fits);

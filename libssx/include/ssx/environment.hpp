@@ -45,6 +45,7 @@ namespace ssx {
 namespace detail {
 class WorkerPool;
 class SceneCameras;
+class NeighborIndex;
 }
 
 /// Everything that defines an environment before it is populated.
@@ -183,7 +184,7 @@ class SSX_EXPORT Environment {
   /// then on the index of every artifact's first dynamic root position is rebuilt once per step,
   /// in the snapshot phase (the smallest cell size asked for wins).
   void enableNeighborQueries(double cell_size);
-  bool neighborQueriesEnabled() const noexcept { return neighbors_enabled_; }
+  bool neighborQueriesEnabled() const noexcept;
   /// Appends to `out` the indices of the artifacts (with a dynamic root) whose first root is
   /// within `radius` of `point`, in ascending order; reads the snapshot's index, so it is safe in
   /// the parallel phases. Throws if queries were not enabled.
@@ -270,12 +271,8 @@ class SSX_EXPORT Environment {
   std::vector<Artifact*> body_owner_;
   std::vector<PendingError> errors_;  // one per artifact, filled by the parallel phases
   std::unique_ptr<detail::SceneCameras> cameras_;  // scene cameras, camera images, render items
-  bool neighbors_enabled_ = false;
-  SpatialIndex neighbor_index_;
-  std::vector<Vec3> neighbor_points_;
-  std::vector<std::size_t> neighbor_ids_;
+  std::unique_ptr<detail::NeighborIndex> neighbors_;
   std::vector<StaticShape> static_shapes_;
-  void rebuildNeighborIndex();
   std::uint64_t subscription_sequence_ = 0;
   TimingRecorder timing_;
   LogSink log_;

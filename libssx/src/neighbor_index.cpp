@@ -1,0 +1,44 @@
+#include "neighbor_index.hpp"
+
+namespace ssx::detail {
+
+bool NeighborIndex::enable(double cell_size) {
+  if (!(cell_size > 0)) throw Error("enableNeighborQueries: cell size must be positive");
+  // positions do not change while plugins are configured: only a new grid needs building
+  const bool fresh = !enabled_ || cell_size < index_.cellSize();
+  if (fresh) index_ = SpatialIndex(cell_size);
+  enabled_ = true;
+  return fresh;
+}
+
+void NeighborIndex::rebuild(const Artifacts& artifacts) {
+  // one point per artifact with a dynamic root: its first dynamic root's position
+  points_.clear();
+  ids_.clear();
+  for (const auto& a : artifacts) {
+    for (std::size_t r = 0; r < a->rootCount(); ++r) {
+      const PhysicNode& root = a->root(r);
+      if (root.isStatic()) continue;
+      points_.push_back(root.pose().position);
+      ids_.push_back(a->index());
+      break;
+    }
+  }
+  index_.rebuild(points_, ids_);
+}
+
+void NeighborIndex::requireEnabled() const {
+  if (!enabled_) throw Error("neighbour queries are off: call enableNeighborQueries from configure");
+}
+
+void NeighborIndex::query(const Vec3& point, double radius, std::vector<std::size_t>& out) const {
+  requireEnabled();
+  index_.query(point, radius, out);
+}
+
+void NeighborIndex::query(const Vec3& point, double radius, std::vector<SpatialIndex::Hit>& out) const {
+  requireEnabled();
+  index_.query(point, radius, out);
+}
+
+}  // namespace ssx::detail
