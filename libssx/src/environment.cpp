@@ -17,12 +17,6 @@
 
 namespace ssx {
 
-namespace detail {
-thread_local bool PhaseGuard::in_phase = false;
-thread_local const Artifact* PhaseGuard::writer = nullptr;
-thread_local const char* PhaseGuard::role = "";
-}  // namespace detail
-
 namespace {
 
 void checkSettings(const EnvironmentSettings& s) {
