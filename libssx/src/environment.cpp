@@ -163,6 +163,18 @@ std::vector<Artifact*> Environment::selectArtifacts(std::string_view names) cons
   return out;
 }
 
+std::vector<Artifact*> Environment::selectArtifacts(const Descriptor& params, std::string_view key,
+                                                    std::string_view purpose) const {
+  const std::string names = params.get<std::string>(key);
+  try {
+    return selectArtifacts(names);
+  } catch (const Error& e) {
+    const std::string message = std::string(e.what()) + " to " + std::string(purpose);
+    const auto* a = params.find(key);
+    throw a != nullptr ? params.error(*a, message) : params.error(message);
+  }
+}
+
 SimulationExtension* Environment::extension(std::string_view name) const {
   for (const auto& e : extensions_)
     if (e.name == name) return e.extension;

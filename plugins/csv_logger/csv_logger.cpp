@@ -10,6 +10,7 @@
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
+#include <filesystem>
 #include <sstream>
 #include <vector>
 
@@ -27,13 +28,12 @@ class CsvLogger final : public SimulationExtension {
 
   // what is logged exists before anything is opened
   static void validate(const Descriptor& params, const PluginContext& context) {
-    try {
-      (void)context.environment->selectArtifacts(params.get<std::string>("artifacts"));
-    } catch (const ConfigError&) {
-      throw;
-    } catch (const Error& e) {
-      throw params.error(*params.find("artifacts"), std::string(e.what()) + " to log");
-    }
+    (void)context.environment->selectArtifacts(params, "artifacts", "log");
+    const std::filesystem::path file = params.get<std::string>("file");
+    const std::filesystem::path dir = file.has_parent_path() ? file.parent_path() : ".";
+    std::error_code ec;
+    if (!std::filesystem::is_directory(dir, ec))
+      throw params.error(*params.find("file"), "the directory of '" + file.string() + "' does not exist");
   }
 
   ~CsvLogger() override { close(); }
@@ -76,11 +76,7 @@ class CsvLogger final : public SimulationExtension {
  private:
   // every artifact exists when extensions are initialised
   void resolve(Environment& env, const Descriptor& params) {
-    try {
-      for (const Artifact* a : env.selectArtifacts(names_)) artifacts_.push_back(a);
-    } catch (const Error& e) {
-      throw params.error(*params.find("artifacts"), std::string(e.what()) + " to log");
-    }
+    for (const Artifact* a : env.selectArtifacts(params, "artifacts", "log")) artifacts_.push_back(a);
   }
   void close() {
     if (file_ != nullptr) std::fclose(file_);

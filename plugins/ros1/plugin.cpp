@@ -73,13 +73,7 @@ class Ros1Bridge final : public SimulationExtension {
 
   // what is bridged exists before the node is started
   static void validate(const Descriptor& params, const PluginContext& context) {
-    try {
-      (void)context.environment->selectArtifacts(params.get<std::string>("artifacts"));
-    } catch (const ConfigError&) {
-      throw;
-    } catch (const Error& e) {
-      throw params.error(*params.find("artifacts"), std::string(e.what()) + " to bridge");
-    }
+    (void)context.environment->selectArtifacts(params, "artifacts", "bridge");
   }
 
   void init(Environment& env, const Descriptor& params) override {
@@ -95,12 +89,7 @@ class Ros1Bridge final : public SimulationExtension {
     lockstep_ = params.get<bool>("lockstep");
     lockstep_timeout_ = params.get<double>("lockstep_timeout_s");
     connect_timeout_ = params.get<double>("lockstep_connect_timeout_s");
-    std::vector<Artifact*> chosen;
-    try {
-      chosen = env.selectArtifacts(params.get<std::string>("artifacts"));
-    } catch (const Error& e) {
-      throw params.error(*params.find("artifacts"), std::string(e.what()) + " to bridge");
-    }
+    const std::vector<Artifact*> chosen = env.selectArtifacts(params, "artifacts", "bridge");
     std::vector<ros1::RobotTopics> topics;
     for (Artifact* a : chosen) {
       Robot r;

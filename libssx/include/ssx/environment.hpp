@@ -166,6 +166,9 @@ class SSX_EXPORT Environment {
   /// separated by spaces, each of an artifact with a physic root. Throws Error naming the first
   /// name that is not.
   std::vector<Artifact*> selectArtifacts(std::string_view names) const;
+  /// The same for the names a plugin parameter `key` gives; throws the parameter's ConfigError,
+  /// "... to <purpose>", when a name does not fit.
+  std::vector<Artifact*> selectArtifacts(const Descriptor& params, std::string_view key, std::string_view purpose) const;
   /// Extension by name, or nullptr.
   SimulationExtension* extension(std::string_view name) const;
   template <class T>

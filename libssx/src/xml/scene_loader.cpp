@@ -236,9 +236,12 @@ void SceneLoader::build(Scene& scene) {
     decl->params.erase("name");  // the extension's name, read here
     try {
       SimulationExtension& ext = env.classLoader().createExtension(decl->plugin, decl->class_name);
+      const std::size_t errors_before = errorCount();
       checkPlugin(env, &ext, decl->params, nullptr, 1, "extension '" + decl->class_name + "'");
       env.addExtension(name, ext, decl->params);
-      extension_checks_.push_back({&ext, decl->params, "extension '" + decl->class_name + "'"});
+      // its own checks run once every artifact exists, if its parameters are of the declared types
+      if (errorCount() == errors_before)
+        extension_checks_.push_back({&ext, decl->params, "extension '" + decl->class_name + "'"});
     } catch (const PluginError& err) {
       error(d.where(), "<extension>: " + std::string(err.what()));
     } catch (const ConfigError& err) {
@@ -269,8 +272,7 @@ void SceneLoader::build(Scene& scene) {
     }
   }
   // extensions check what they refer to (artifacts by name) once every artifact exists
-  if (!hasErrors())
-    for (const auto& c : extension_checks_) validatePlugin(env, c.extension, c.params, nullptr, 1, c.what);
+  for (const auto& c : extension_checks_) validatePlugin(env, c.extension, c.params, nullptr, 1, c.what);
   for (const auto& [name, where] : camera_follows_) {
     const Artifact* a = env.findArtifact(name);
     if (a == nullptr || a->rootCount() == 0)
