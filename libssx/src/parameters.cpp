@@ -1,5 +1,6 @@
 #include <ssx/parameters.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <sstream>
