@@ -216,6 +216,11 @@ ConfigError Descriptor::error(const Attribute& attribute, const std::string& mes
   return ConfigError(attribute.where, "<" + name_ + ">: " + message);
 }
 
+ConfigError Descriptor::errorAt(std::string_view key, const std::string& message) const {
+  const Attribute* a = find(key);
+  return a != nullptr ? error(*a, message) : error(message);
+}
+
 #define SSX_INSTANTIATE_GET(T)                                      \
   template SSX_EXPORT T Descriptor::get<T>(std::string_view) const; \
   template SSX_EXPORT T Descriptor::get<T>(std::string_view, const T&) const;

@@ -169,9 +169,7 @@ std::vector<Artifact*> Environment::selectArtifacts(const Descriptor& params, st
   try {
     return selectArtifacts(names);
   } catch (const Error& e) {
-    const std::string message = std::string(e.what()) + " to " + std::string(purpose);
-    const auto* a = params.find(key);
-    throw a != nullptr ? params.error(*a, message) : params.error(message);
+    throw params.errorAt(key, std::string(e.what()) + " to " + std::string(purpose));
   }
 }
 

@@ -34,7 +34,7 @@ class CameraSensor final : public SensorOf<CameraMeasurement> {
   static void validate(const Descriptor& params, const PluginContext& context) {
     (void)context.artifact->nodeFromParameter(params);
     if (params.get<double>("far") <= params.get<double>("near"))
-      throw params.error(*params.find("far"), "far must be beyond near");
+      throw params.errorAt("far", "far must be beyond near");
   }
 
   void configure(const Descriptor& params) override {

@@ -33,7 +33,7 @@ class CsvLogger final : public SimulationExtension {
     const std::filesystem::path dir = file.has_parent_path() ? file.parent_path() : ".";
     std::error_code ec;
     if (!std::filesystem::is_directory(dir, ec))
-      throw params.error(*params.find("file"), "the directory of '" + file.string() + "' does not exist");
+      throw params.errorAt("file", "the directory of '" + file.string() + "' does not exist");
   }
 
   ~CsvLogger() override { close(); }

@@ -108,7 +108,7 @@ class ImuSensor final : public SensorOf<ImuMeasurement> {
     for (const char* prefix : {"gyro_", "accel_"}) {
       const std::string range = std::string(prefix) + "range", lsb = std::string(prefix) + "lsb";
       if (params.get<double>(range) / params.get<double>(lsb) >= 2147483647.0)
-        throw params.error(*params.find(lsb), range + " / " + lsb + " must be below 2^31 counts");
+        throw params.errorAt(lsb, range + " / " + lsb + " must be below 2^31 counts");
     }
   }
 

@@ -48,9 +48,9 @@ std::vector<Rotor> rotorsOf(const Descriptor& params, const Artifact& a) {
   for (std::size_t i = 0; i < names.size(); ++i) {
     const PhysicNode* node = a.node(names[i]);
     if (node == nullptr)
-      throw params.error(*params.find("rotors"), "no physic node '" + names[i] + "' for a rotor in artifact '" + a.name() + "'");
+      throw params.errorAt("rotors", "no physic node '" + names[i] + "' for a rotor in artifact '" + a.name() + "'");
     if (dirs[i] != "1" && dirs[i] != "-1")
-      throw params.error(*params.find("directions"), "rotor directions are 1 or -1, got '" + dirs[i] + "'");
+      throw params.errorAt("directions", "rotor directions are 1 or -1, got '" + dirs[i] + "'");
     rotors.push_back({node->poseInBody().position, dirs[i] == "1" ? 1 : -1});
   }
   return rotors;
@@ -75,7 +75,7 @@ void QuadrotorDriver::validate(const Descriptor& params, const PluginContext& co
   if (params.get<std::string>("reference") == "formation") {
     const auto index = params.get<std::int64_t>("formation_index");
     if (index >= params.get<std::int64_t>("formation_size") || static_cast<std::size_t>(index) > a.index())
-      throw params.error(*params.find("formation_index"),
+      throw params.errorAt("formation_index",
                          "formation_index must be below formation_size and the members one swarm");
     if (firstSensorOf<RangeMeasurement>(a) == nullptr)
       throw params.error("reference=\"formation\" needs a range sensor on the artifact");

@@ -88,6 +88,9 @@ class SSX_EXPORT Descriptor {
   ConfigError error(const std::string& message) const;
   /// Builds the ConfigError for one attribute of this element.
   ConfigError error(const Attribute& attribute, const std::string& message) const;
+  /// Builds the ConfigError for attribute `key`: at its line when it was given, at the element's
+  /// when it was not (a declared default, say).
+  ConfigError errorAt(std::string_view key, const std::string& message) const;
 
  private:
   std::string name_;

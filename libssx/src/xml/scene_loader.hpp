@@ -111,11 +111,9 @@ class SceneLoader {
                          std::int64_t max = kMaxCount) {
     const std::int64_t v = read<std::int64_t>(d, key, fallback);
     if (v < min || v > max) {
-      const auto* a = d.find(key);
-      const std::string message = "attribute '" + std::string(key) + "' must be " +
-                                  (v < min ? "at least " + std::to_string(min) : "at most " + std::to_string(max)) +
-                                  ", got " + std::to_string(v);
-      record(a != nullptr ? d.error(*a, message) : d.error(message));
+      record(d.errorAt(key, "attribute '" + std::string(key) + "' must be " +
+                                (v < min ? "at least " + std::to_string(min) : "at most " + std::to_string(max)) +
+                                ", got " + std::to_string(v)));
       return fallback;
     }
     return v;
