@@ -198,18 +198,21 @@ const ssx_plugin_class& ClassLoader::classInfo(std::string_view plugin, std::str
                                                PluginKind kind) {
   const fs::path path = load(plugin);
   const Library* lib = by_name_.at(std::string(plugin));
-  const std::string where = "plugin '" + std::string(plugin) + "' (" + path.string() + ")";
   const ssx_plugin_class* found = nullptr;
-  std::string available;
-  for (std::uint32_t i = 0; i < lib->manifest->class_count; ++i) {
-    const ssx_plugin_class& c = lib->manifest->classes[i];
-    available += std::string(available.empty() ? "" : ", ") + c.name + " (" + toString(toKind(c.kind)) + ")";
-    if (class_name == c.name) found = &c;
-  }
-  if (found == nullptr)
+  for (std::uint32_t i = 0; i < lib->manifest->class_count && found == nullptr; ++i)
+    if (class_name == lib->manifest->classes[i].name) found = &lib->manifest->classes[i];
+  if (found != nullptr && toKind(found->kind) == kind) return *found;
+  // what went wrong, said only when it did (a swarm creates thousands of instances)
+  const std::string where = "plugin '" + std::string(plugin) + "' (" + path.string() + ")";
+  if (found == nullptr) {
+    std::string available;
+    for (std::uint32_t i = 0; i < lib->manifest->class_count; ++i) {
+      const ssx_plugin_class& c = lib->manifest->classes[i];
+      available += std::string(available.empty() ? "" : ", ") + c.name + " (" + toString(toKind(c.kind)) + ")";
+    }
     throw PluginError(where + " has no class '" + std::string(class_name) +
                       "'; it has: " + (available.empty() ? std::string("none") : available));
-  if (toKind(found->kind) != kind)
+  }
     throw PluginError(where + ": class '" + std::string(class_name) + "' is " + withArticle(toKind(found->kind)) +
                       ", not " + withArticle(kind));
   return *found;
@@ -222,11 +225,10 @@ const ssx_plugin_class* ClassLoader::classOf(const void* instance) const noexcep
 
 void* ClassLoader::create(std::string_view plugin, std::string_view class_name, PluginKind kind) {
   const ssx_plugin_class* found = &classInfo(plugin, class_name, kind);
-  const std::string where = "plugin '" + std::string(plugin) + "' (" + load(plugin).string() + ")";
   char error[512] = {0};
   void* object = found->create(error, sizeof error);
   if (object == nullptr)
-    throw PluginError(where + ": creating '" + std::string(class_name) + "' failed: " +
+    throw PluginError("plugin '" + std::string(plugin) + "' (" + load(plugin).string() + "): creating '" + std::string(class_name) + "' failed: " +
                       (error[0] != '\0' ? std::string(error) : std::string("the constructor returned null")));
   instances_.push_back({object, found});
   types_.emplace(object, found);

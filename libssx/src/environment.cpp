@@ -195,20 +195,22 @@ void Environment::checkDeclaredParameters() {
   // instances made by the class loader get their declared defaults and checks here too when a
   // program attached them itself (the scene loader has done it already: then nothing changes)
   std::string errors;
-  auto check = [&](const void* instance, Descriptor& params, const Artifact* a, std::int64_t period,
-                   const std::string& what) {
+  // `what` names the plugin, made only when its parameters are checked here
+  auto check = [&](const void* instance, Descriptor& params, const Artifact* a, std::int64_t period, auto what) {
+    if (!params.declarations().empty()) return;  // checked already (by the scene loader)
     const ssx_plugin_class* type = loader_->classOf(instance);
     if (type == nullptr) return;
     const PluginContext context{this, a, period, settings_.timestep, {}};
-    for (const auto& d : checkParameters({type->params, type->param_count}, params, context, what))
+    for (const auto& d : checkParameters({type->params, type->param_count}, params, context, what()))
       if (d.severity == Diagnostic::Severity::Error) errors += (errors.empty() ? "" : "\n") + d.str();
   };
-  for (auto& e : extensions_) check(e.extension, e.params, nullptr, 1, "extension '" + e.name + "'");
+  for (auto& e : extensions_)
+    check(e.extension, e.params, nullptr, 1, [&] { return "extension '" + e.name + "'"; });
   for (auto& a : artifacts_) {
-    if (a->driver_ != nullptr)
-      check(a->driver_, a->driver_params_, a.get(), a->driver_->periodSteps(), "driver '" + a->driver_->className() + "'");
+    if (Driver* d = a->driver_)
+      check(d, a->driver_params_, a.get(), d->periodSteps(), [&] { return "driver '" + d->className() + "'"; });
     for (auto& s : a->sensors_)
-      check(s.sensor, s.params, a.get(), s.sensor->periodSteps(), "sensor '" + s.sensor->className() + "'");
+      check(s.sensor, s.params, a.get(), s.sensor->periodSteps(), [&] { return "sensor '" + s.sensor->className() + "'"; });
   }
   if (!errors.empty()) throw Error(errors + "\nnothing was run");
 }
