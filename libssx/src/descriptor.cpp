@@ -3,6 +3,7 @@
 
 #include <cerrno>
 #include <charconv>
+#include <cctype>
 #include <cmath>
 #include <cstdlib>
 #include <sstream>
@@ -55,10 +56,20 @@ bool parseValue(const std::string& text, double& out) {
 }
 
 bool parseValue(const std::string& text, Vec3& out) {
-  std::istringstream in(text);
-  std::string a, b, c, extra;
-  if (!(in >> a >> b >> c) || (in >> extra)) return false;
-  return parseValue(a, out.x()) && parseValue(b, out.y()) && parseValue(c, out.z());
+  // three words separated by white space, each a complete number (no stream: a swarm's members
+  // each parse their vectors while loading)
+  std::string word;
+  std::size_t at = 0;
+  for (int i = 0; i < 3; ++i) {
+    while (at < text.size() && std::isspace(static_cast<unsigned char>(text[at])) != 0) ++at;
+    const std::size_t begin = at;
+    while (at < text.size() && std::isspace(static_cast<unsigned char>(text[at])) == 0) ++at;
+    if (begin == at) return false;
+    word.assign(text, begin, at - begin);
+    if (!parseValue(word, out[i])) return false;
+  }
+  while (at < text.size() && std::isspace(static_cast<unsigned char>(text[at])) != 0) ++at;
+  return at == text.size();
 }
 
 template <class T>
