@@ -1,4 +1,7 @@
+// Artifact and PhysicNode: handles into the world state (world.hpp), and the writes plugins make
+// through them.
 #include "phase_guard.hpp"
+#include "world.hpp"
 
 #include <ssx/artifact.hpp>
 #include <ssx/environment.hpp>
@@ -7,21 +10,26 @@
 
 namespace ssx {
 
-Artifact::Artifact(Environment& env, std::string name, std::size_t index, const Pose& placement)
-    : env_(&env), name_(std::move(name)), index_(index), placement_(placement) {}
+Artifact::Artifact(detail::World& world, std::string name, std::size_t index, const Pose& placement)
+    : world_(&world), name_(std::move(name)), index_(index), placement_(placement) {}
 
 Artifact::~Artifact() = default;
 
+Environment& Artifact::environment() const noexcept { return world_->env; }
+
 void Artifact::requireSetup(const char* what) const {
-  if (env_->state() != Environment::State::Setup)
+  if (world_->state != Environment::State::Setup)
     throw Error("artifact '" + name_ + "': " + what + " only before the environment starts");
 }
 
 void Artifact::buildNodes(PhysicNode* parent, const PhysicNodeSpec& spec) {
-  nodes_.push_back(std::unique_ptr<PhysicNode>(new PhysicNode(*this, spec, parent)));
+  const std::size_t index = world_->nodes.size();
+  detail::NodeData data;
+  data.setup_pose = (parent != nullptr ? parent->pose() : placement_) * spec.pose;
+  data.is_static = parent != nullptr ? parent->isStatic() : spec.is_static;
+  world_->nodes.push_back(data);
+  nodes_.push_back(std::make_unique<PhysicNode>(*world_, *this, spec, parent, index));
   PhysicNode* node = nodes_.back().get();
-  node->setup_pose_ = (parent != nullptr ? parent->setup_pose_ : placement_) * spec.pose;
-  node->static_ = parent != nullptr ? parent->static_ : spec.is_static;
   if (parent == nullptr) roots_.push_back(node);
   for (const auto& child : spec.children) buildNodes(node, child);
 }
@@ -45,28 +53,42 @@ void Artifact::addRenderRoot(RenderNodeSpec spec) {
   render_roots_.push_back(std::move(spec));
 }
 
+Plugin& Artifact::attach(Plugin& plugin, std::uint32_t plugin_index, std::int64_t period_steps,
+                         std::string class_name, const Descriptor& params) {
+  const char* kind = plugin_index == 0 ? "driver" : "sensor";
+  if (period_steps < 1) throw ConfigError(params.where(), std::string(kind) + " period must be at least 1 step");
+  if (plugin.attached())
+    throw ConfigError(params.where(), "artifact '" + name_ + "': this " + kind + " instance belongs to artifact '" +
+                                          plugin.artifact().name() + "' already; create one instance per artifact");
+  detail::PluginSlot slot;
+  slot.artifact = static_cast<std::uint32_t>(index_);
+  slot.index = plugin_index;
+  slot.period_steps = period_steps;
+  slot.class_name = !class_name.empty() ? std::move(class_name)
+                    : plugin_index == 0 ? std::string("driver")
+                                        : "sensor" + std::to_string(plugin_index - 1);
+  slot.random.reseed(deriveSeed(world_->settings.seed, index_, plugin_index));
+  world_->plugins.push_back(std::move(slot));
+  plugin.bind(*world_, *this, static_cast<std::uint32_t>(world_->plugins.size() - 1));
+  return plugin;
+}
+
 Driver& Artifact::setDriver(std::unique_ptr<Driver> driver, Descriptor params, std::int64_t period_steps,
                             std::string class_name) {
   if (!driver) throw Error("artifact '" + name_ + "': setDriver given a null driver");
   Driver& d = setDriver(*driver, std::move(params), period_steps, std::move(class_name));
-  owned_driver_ = std::move(driver);
+  world_->data(*this).owned_driver = std::move(driver);
   return d;
 }
 
 Driver& Artifact::setDriver(Driver& driver, Descriptor params, std::int64_t period_steps, std::string class_name) {
   requireSetup("a driver can be set");
-  if (driver_ != nullptr) throw ConfigError(params.where(), "artifact '" + name_ + "' already has a driver");
-  if (period_steps < 1) throw ConfigError(params.where(), "driver period must be at least 1 step");
-  if (driver.artifact_ != nullptr)
-    throw ConfigError(params.where(), "artifact '" + name_ + "': this driver instance belongs to artifact '" +
-                                          driver.artifact_->name() + "' already; create one instance per artifact");
-  driver.artifact_ = this;
-  driver.period_steps_ = period_steps;
-  driver.plugin_index_ = 0;
-  driver.class_name_ = class_name.empty() ? std::string("driver") : std::move(class_name);
-  driver.random_.reseed(deriveSeed(env_->settings().seed, index_, 0));
-  driver_ = &driver;
-  driver_params_ = std::move(params);
+  detail::ArtifactData& data = world_->data(*this);
+  if (data.driver != nullptr) throw ConfigError(params.where(), "artifact '" + name_ + "' already has a driver");
+  attach(driver, 0, period_steps, std::move(class_name), params);
+  data.driver = &driver;
+  data.driver_params = std::move(params);
+  data.driver_period = period_steps;
   return driver;
 }
 
@@ -74,25 +96,23 @@ Sensor& Artifact::addSensor(std::unique_ptr<Sensor> sensor, Descriptor params, s
                             std::string class_name) {
   if (!sensor) throw Error("artifact '" + name_ + "': addSensor given a null sensor");
   Sensor& s = addSensor(*sensor, std::move(params), period_steps, std::move(class_name));
-  sensors_.back().owned = std::move(sensor);
+  world_->data(*this).sensors.back().owned = std::move(sensor);
   return s;
 }
 
 Sensor& Artifact::addSensor(Sensor& sensor, Descriptor params, std::int64_t period_steps, std::string class_name) {
   requireSetup("sensors can be added");
-  if (period_steps < 1) throw ConfigError(params.where(), "sensor period must be at least 1 step");
-  if (sensor.artifact_ != nullptr)
-    throw ConfigError(params.where(), "artifact '" + name_ + "': this sensor instance belongs to artifact '" +
-                                          sensor.artifact_->name() + "' already; create one instance per artifact");
-  const auto plugin_index = static_cast<std::uint32_t>(sensors_.size() + 1);
-  sensor.artifact_ = this;
-  sensor.period_steps_ = period_steps;
-  sensor.plugin_index_ = plugin_index;
-  sensor.class_name_ = class_name.empty() ? "sensor" + std::to_string(plugin_index - 1) : std::move(class_name);
-  sensor.random_.reseed(deriveSeed(env_->settings().seed, index_, plugin_index));
-  sensors_.push_back({&sensor, nullptr, std::move(params), false});
+  detail::ArtifactData& data = world_->data(*this);
+  attach(sensor, static_cast<std::uint32_t>(data.sensors.size() + 1), period_steps, std::move(class_name), params);
+  data.sensors.push_back({&sensor, nullptr, std::move(params), period_steps, false});
   return sensor;
 }
+
+Driver* Artifact::driver() const noexcept { return world_->data(*this).driver; }
+std::size_t Artifact::sensorCount() const noexcept { return world_->data(*this).sensors.size(); }
+Sensor& Artifact::sensor(std::size_t i) const { return *world_->data(*this).sensors.at(i).sensor; }
+const Descriptor& Artifact::driverParameters() const noexcept { return world_->data(*this).driver_params; }
+const Descriptor& Artifact::sensorParameters(std::size_t i) const { return world_->data(*this).sensors.at(i).params; }
 
 PhysicNode* Artifact::node(std::string_view name) const {
   for (const auto& n : nodes_)
@@ -114,62 +134,90 @@ PhysicNode& Artifact::nodeFromParameter(const Descriptor& params, std::string_vi
   return *n;
 }
 
-void Artifact::checkWritable() const {
-  if (!detail::PhaseGuard::in_phase || detail::PhaseGuard::writer == this) return;
-  const Artifact* w = detail::PhaseGuard::writer;
-  std::string who = w != nullptr ? std::string(detail::PhaseGuard::role) + " of artifact '" + w->name() + "'"
-                                 : std::string("a ") + detail::PhaseGuard::role;
-  throw Error(who + " tried to write to artifact '" + name_ +
-              "': during a step, only an artifact's own driver writes its forces and torques");
+// --- Plugin: its slot in the world ---------------------------------------------------------------
+
+void Plugin::bind(detail::World& world, Artifact& artifact, std::uint32_t slot) noexcept {
+  world_ = &world;
+  artifact_ = &artifact;
+  slot_ = slot;
 }
 
-Wrench& Artifact::wrench(int body) { return env_->wrenches_[static_cast<std::size_t>(body)]; }
+Environment& Plugin::environment() const noexcept { return world_->env; }
 
-// --- PhysicNode (needs the environment's snapshot) -----------------------------------------------
+Random& Plugin::random() {
+  if (world_ == nullptr) throw Error("random(): the plugin is not attached to an artifact yet");
+  return world_->plugins[slot_].random;
+}
+
+std::int64_t Plugin::periodSteps() const noexcept { return world_ != nullptr ? world_->plugins[slot_].period_steps : 1; }
+
+const std::string& Plugin::className() const noexcept {
+  static const std::string unattached = "plugin";
+  return world_ != nullptr ? world_->plugins[slot_].class_name : unattached;
+}
+
+// --- PhysicNode: reads the snapshot, writes its artifact's command buffer -------------------------
+
+bool PhysicNode::isStatic() const noexcept { return world_->nodes[index_].is_static; }
+int PhysicNode::bodyIndex() const noexcept { return world_->nodes[index_].body; }
+const Pose& PhysicNode::poseInBody() const noexcept { return world_->nodes[index_].pose_in_body; }
 
 BodyState PhysicNode::state() const {
-  const Environment& env = artifact_->environment();
-  if (body_ >= 0 && !env.states_.empty()) return env.states_[static_cast<std::size_t>(body_)].attached(pose_in_body_);
+  const detail::NodeData& n = world_->nodes[index_];
+  if (n.body >= 0 && world_->started()) return world_->states[static_cast<std::size_t>(n.body)].attached(n.pose_in_body);
   BodyState s;
-  s.pose = setup_pose_;
-  if (!static_) {
-    s.linear_velocity = initial_linear_;
-    s.angular_velocity = initial_angular_;
+  s.pose = n.setup_pose;
+  if (!n.is_static) {
+    s.linear_velocity = n.initial_linear;
+    s.angular_velocity = n.initial_angular;
   }
   return s;
 }
 
 Pose PhysicNode::pose() const {
-  const Environment& env = artifact_->environment();
-  if (body_ < 0 || env.states_.empty()) return setup_pose_;
-  return env.states_[static_cast<std::size_t>(body_)].pose * pose_in_body_;
+  const detail::NodeData& n = world_->nodes[index_];
+  if (n.body < 0 || !world_->started()) return n.setup_pose;
+  return world_->states[static_cast<std::size_t>(n.body)].pose * n.pose_in_body;
+}
+
+void PhysicNode::requireWritable() const {
+  if (!detail::PhaseGuard::in_phase || detail::PhaseGuard::writer == artifact_) return;
+  const Artifact* w = detail::PhaseGuard::writer;
+  std::string who = w != nullptr ? std::string(detail::PhaseGuard::role) + " of artifact '" + w->name() + "'"
+                                 : std::string("a ") + detail::PhaseGuard::role;
+  throw Error(who + " tried to write to artifact '" + artifact_->name() +
+              "': during a step, only an artifact's own driver writes its forces and torques");
 }
 
 void PhysicNode::addForce(const Vec3& force, Frame force_frame, const Vec3& point, Frame point_frame) {
-  artifact_->checkWritable();
-  if (body_ < 0 || artifact_->environment().states_.empty())
+  requireWritable();
+  const detail::NodeData& n = world_->nodes[index_];
+  if (n.body < 0 || !world_->started())
     throw Error("artifact '" + artifact_->name() + "', node '" + name() +
                 "': forces apply to dynamic nodes once the environment has started");
   if (!force.allFinite() || !point.allFinite())
     throw Error("artifact '" + artifact_->name() + "', node '" + name() + "': force or point is NaN or infinite");
-  const BodyState& b = artifact_->environment().states_[static_cast<std::size_t>(body_)];
-  const Pose node = b.pose * pose_in_body_;
+  const auto body = static_cast<std::size_t>(n.body);
+  const BodyState& b = world_->states[body];
+  const Pose node = b.pose * n.pose_in_body;
   const Vec3 f = force_frame == Frame::World ? force : Vec3(node.orientation * force);
   const Vec3 p = point_frame == Frame::Local ? node.transformPoint(point) : point;
-  Wrench& w = artifact_->wrench(body_);
+  Wrench& w = world_->wrenches[body];
   w.force += f;
   w.torque += (p - b.pose.position).cross(f);
 }
 
 void PhysicNode::addTorque(const Vec3& torque, Frame frame) {
-  artifact_->checkWritable();
-  if (body_ < 0 || artifact_->environment().states_.empty())
+  requireWritable();
+  const detail::NodeData& n = world_->nodes[index_];
+  if (n.body < 0 || !world_->started())
     throw Error("artifact '" + artifact_->name() + "', node '" + name() +
                 "': torques apply to dynamic nodes once the environment has started");
   if (!torque.allFinite())
     throw Error("artifact '" + artifact_->name() + "', node '" + name() + "': torque is NaN or infinite");
   const Pose node = pose();
-  artifact_->wrench(body_).torque += frame == Frame::World ? torque : Vec3(node.orientation * torque);
+  world_->wrenches[static_cast<std::size_t>(n.body)].torque +=
+      frame == Frame::World ? torque : Vec3(node.orientation * torque);
 }
 
 void PhysicNode::setVelocity(const Vec3& linear, const Vec3& angular) {
@@ -180,18 +228,19 @@ void PhysicNode::setVelocity(const Vec3& linear, const Vec3& angular) {
       angular.norm() > ps.max_angular_speed)
     throw Error("artifact '" + artifact_->name() + "', node '" + name() +
                 "': velocity must be finite and within max_linear_speed / max_angular_speed");
+  detail::NodeData& n = world_->nodes[index_];
   if (env.state() == Environment::State::Setup) {
-    initial_linear_ = linear;
-    initial_angular_ = angular;
+    n.initial_linear = linear;
+    n.initial_angular = angular;
     return;
   }
-  if (static_) throw Error("node '" + name() + "' of artifact '" + artifact_->name() + "' is static");
+  if (n.is_static) throw Error("node '" + name() + "' of artifact '" + artifact_->name() + "' is static");
   if (env.state() != Environment::State::Running) throw Error("setVelocity: the environment is not running");
-  BodyState& b = env.states_[static_cast<std::size_t>(body_)];
+  BodyState b = world_->states[static_cast<std::size_t>(n.body)];
   const Vec3 r = b.pose.position - pose().position;  // node origin to centre of mass
   b.linear_velocity = linear + angular.cross(r);
   b.angular_velocity = angular;
-  env.physics_->setState(body_, b);
+  env.setBodyState(n.body, b);
 }
 
 }  // namespace ssx

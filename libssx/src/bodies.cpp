@@ -1,5 +1,6 @@
 // The world's bodies: node trees flattened into rigid bodies at start, and the snapshot published
 // after each physics step (poses, velocities, accelerations, checked for divergence).
+#include "phases.hpp"
 #include "state_checks.hpp"
 
 #include <ssx/environment.hpp>
@@ -8,81 +9,95 @@
 
 namespace ssx {
 
-void Environment::buildBodies() {
+namespace detail {
+
+void buildBodies(World& world, PhysicEngine& engine, std::vector<Environment::StaticShape>& static_shapes) {
   // flatten each node tree into one rigid body whose frame is the tree's centre-of-mass frame
-  for (auto& artifact : artifacts_) {
-    artifact->body_begin_ = static_cast<int>(physics_->bodyCount());
-    for (PhysicNode* root : artifact->roots_) {
-      const PhysicNodeSpec& spec = root->spec();
+  for (auto& artifact : world.artifacts) {
+    ArtifactData& data = world.data(*artifact);
+    data.body_begin = static_cast<int>(engine.bodyCount());
+    for (std::size_t r = 0; r < artifact->rootCount(); ++r) {
+      const PhysicNode& root = artifact->root(r);
+      const PhysicNodeSpec& spec = root.spec();
+      const NodeData& root_data = world.nodes[root.nodeIndex()];
       std::vector<Shape> shapes;
-      std::vector<PhysicNode*> tree;  // the root and its descendants, in order
-      for (auto& n : artifact->nodes_) {
-        const PhysicNode* r = n.get();
-        while (r->parent_ != nullptr) r = r->parent_;
-        if (r == root) tree.push_back(n.get());
+      std::vector<NodeData*> tree;  // the root and its descendants, in order
+      std::vector<const PhysicNodeSpec*> specs;
+      for (const auto& n : artifact->nodes()) {
+        const PhysicNode* top = n.get();
+        while (top->parent() != nullptr) top = top->parent();
+        if (top != &root) continue;
+        tree.push_back(&world.nodes[n->nodeIndex()]);
+        specs.push_back(&n->spec());
       }
       if (spec.is_static) {
-        for (PhysicNode* n : tree) {
-          n->pose_in_body_ = root->setup_pose_.inverse() * n->setup_pose_;
-          for (Shape s : n->spec().shapes) {
-            s.pose = n->pose_in_body_ * s.pose;
+        for (std::size_t k = 0; k < tree.size(); ++k) {
+          NodeData& n = *tree[k];
+          n.pose_in_body = root_data.setup_pose.inverse() * n.setup_pose;
+          for (Shape s : specs[k]->shapes) {
+            s.pose = n.pose_in_body * s.pose;
             shapes.push_back(s);
-            static_shapes_.push_back({s, root->setup_pose_ * s.pose, artifact->index()});
+            static_shapes.push_back({s, root_data.setup_pose * s.pose, artifact->index()});
           }
         }
-        physics_->addStatic(shapes, root->setup_pose_);
+        engine.addStatic(shapes, root_data.setup_pose);
         continue;
       }
       const MassProperties mass = combinedMass(spec);
       const Pose root_in_body{-mass.center_of_mass, Quat::Identity()};
-      for (PhysicNode* n : tree) {
-        n->pose_in_body_ = root_in_body * (root->setup_pose_.inverse() * n->setup_pose_);
-        for (Shape s : n->spec().shapes) {
-          s.pose = n->pose_in_body_ * s.pose;
+      for (std::size_t k = 0; k < tree.size(); ++k) {
+        NodeData& n = *tree[k];
+        n.pose_in_body = root_in_body * (root_data.setup_pose.inverse() * n.setup_pose);
+        for (Shape s : specs[k]->shapes) {
+          s.pose = n.pose_in_body * s.pose;
           shapes.push_back(s);
         }
       }
       BodyState initial;
-      initial.pose = root->setup_pose_ * root_in_body.inverse();
-      initial.angular_velocity = root->initial_angular_;
-      initial.linear_velocity =
-          root->initial_linear_ + root->initial_angular_.cross(initial.pose.position - root->setup_pose_.position);
-      const int body = physics_->addBody(mass, shapes, initial);
-      for (PhysicNode* n : tree) n->body_ = body;
-      body_owner_.push_back(artifact.get());
+      initial.pose = root_data.setup_pose * root_in_body.inverse();
+      initial.angular_velocity = root_data.initial_angular;
+      initial.linear_velocity = root_data.initial_linear +
+                                root_data.initial_angular.cross(initial.pose.position - root_data.setup_pose.position);
+      const int body = engine.addBody(mass, shapes, initial);
+      for (NodeData* n : tree) n->body = body;
+      world.body_owner.push_back(static_cast<std::uint32_t>(artifact->index()));
     }
-    artifact->body_end_ = static_cast<int>(physics_->bodyCount());
+    data.body_end = static_cast<int>(engine.bodyCount());
   }
-  states_.assign(physics_->bodyCount(), BodyState{});
-  previous_linear_.assign(states_.size(), Vec3::Zero());
-  previous_angular_.assign(states_.size(), Vec3::Zero());
-  wrenches_.assign(states_.size(), Wrench{});
+  world.states.assign(engine.bodyCount(), BodyState{});
+  world.previous_linear.assign(world.states.size(), Vec3::Zero());
+  world.previous_angular.assign(world.states.size(), Vec3::Zero());
+  world.wrenches.assign(world.states.size(), Wrench{});
 }
 
-void Environment::publishSnapshot(bool first) {
+void publishSnapshot(World& world, const PhysicEngine& engine, bool first) {
+  std::vector<BodyState>& states = world.states;
   if (!first) {
-    for (std::size_t i = 0; i < states_.size(); ++i) {
-      previous_linear_[i] = states_[i].linear_velocity;
-      previous_angular_[i] = states_[i].angular_velocity;
+    for (std::size_t i = 0; i < states.size(); ++i) {
+      world.previous_linear[i] = states[i].linear_velocity;
+      world.previous_angular[i] = states[i].angular_velocity;
     }
   }
-  physics_->readStates(states_);
-  const double inv_dt = 1.0 / toSeconds(settings_.timestep);
-  const double max_v2 = settings_.physics.max_linear_speed * settings_.physics.max_linear_speed;
-  const double max_w2 = settings_.physics.max_angular_speed * settings_.physics.max_angular_speed;
-  for (std::size_t i = 0; i < states_.size(); ++i) {
-    BodyState& s = states_[i];
-    if (!detail::finite(s) || s.linear_velocity.squaredNorm() > max_v2 || s.angular_velocity.squaredNorm() > max_w2) {
-      fail();
-      throw StepError(body_owner_[i]->name(), "physics", steps_ - 1,
+  engine.readStates(states);
+  const PhysicsSettings& ps = world.settings.physics;
+  const double inv_dt = 1.0 / toSeconds(world.settings.timestep);
+  const double max_v2 = ps.max_linear_speed * ps.max_linear_speed;
+  const double max_w2 = ps.max_angular_speed * ps.max_angular_speed;
+  for (std::size_t i = 0; i < states.size(); ++i) {
+    BodyState& s = states[i];
+    if (!finite(s) || s.linear_velocity.squaredNorm() > max_v2 || s.angular_velocity.squaredNorm() > max_w2) {
+      world.state = Environment::State::Failed;
+      throw StepError(world.artifacts[world.body_owner[i]]->name(), "physics", world.steps - 1,
                       "the simulation diverged: the state is NaN, infinite or faster than max_linear_speed / "
                       "max_angular_speed (an absurd force, or a timestep too large for the contacts)");
     }
     if (first) continue;
-    s.linear_acceleration = (s.linear_velocity - previous_linear_[i]) * inv_dt;
-    s.angular_acceleration = (s.angular_velocity - previous_angular_[i]) * inv_dt;
+    s.linear_acceleration = (s.linear_velocity - world.previous_linear[i]) * inv_dt;
+    s.angular_acceleration = (s.angular_velocity - world.previous_angular[i]) * inv_dt;
   }
 }
+
+}  // namespace detail
 
 std::uint64_t Environment::stateHash() const {
   // FNV-1a over the raw bits of every pose and velocity, then the step count
@@ -97,13 +112,13 @@ std::uint64_t Environment::stateHash() const {
       }
     }
   };
-  for (const auto& s : states_) {
+  for (const auto& s : world_->states) {
     mix(s.pose.position.data(), 3);
     mix(s.pose.orientation.coeffs().data(), 4);
     mix(s.linear_velocity.data(), 3);
     mix(s.angular_velocity.data(), 3);
   }
-  const double steps = static_cast<double>(steps_);
+  const double steps = static_cast<double>(world_->steps);
   mix(&steps, 1);
   return h;
 }

@@ -1,6 +1,9 @@
-#include "phase_guard.hpp"
 #include "neighbor_index.hpp"
+#include "phase_guard.hpp"
+#include "phases.hpp"
 #include "render/scene_cameras.hpp"
+#include "state_checks.hpp"
+#include "world.hpp"
 #include "worker_pool.hpp"
 
 #include <ssx/environment.hpp>
@@ -40,6 +43,7 @@ void checkSettings(const EnvironmentSettings& s) {
 Environment::Environment(EnvironmentSettings settings)
     : settings_(std::move(settings)),
       loader_(std::make_unique<ClassLoader>()),
+      world_(std::make_unique<detail::World>(*this, settings_)),
       cameras_(std::make_unique<detail::SceneCameras>()),
       neighbors_(std::make_unique<detail::NeighborIndex>()) {
   checkSettings(settings_);
@@ -61,17 +65,45 @@ Environment::~Environment() {
   loader_->destroyInstances();
 }
 
+Environment::State Environment::state() const noexcept { return world_->state; }
+std::int64_t Environment::stepCount() const noexcept { return world_->steps; }
+std::size_t Environment::artifactCount() const noexcept { return world_->artifacts.size(); }
+Artifact& Environment::artifact(std::size_t index) const { return *world_->artifacts.at(index); }
+const BodyState& Environment::bodyState(int i) const { return world_->states.at(static_cast<std::size_t>(i)); }
+std::size_t Environment::bodyCount() const noexcept { return world_->states.size(); }
+
+void Environment::setBodyState(int i, const BodyState& state) {
+  requireOutsidePhases("setBodyState");
+  if (world_->state != State::Running) throw Error("setBodyState: the environment is not running");
+  if (i < 0 || static_cast<std::size_t>(i) >= world_->states.size())
+    throw Error("setBodyState: no body " + std::to_string(i) + " (there are " + std::to_string(bodyCount()) + ")");
+  const PhysicsSettings& ps = settings_.physics;
+  if (!detail::finite(state) || state.linear_velocity.norm() > ps.max_linear_speed ||
+      state.angular_velocity.norm() > ps.max_angular_speed)
+    throw Error("setBodyState: body " + std::to_string(i) + " of artifact '" +
+                world_->artifacts[world_->body_owner[static_cast<std::size_t>(i)]]->name() +
+                "': the state must be finite and within max_linear_speed / max_angular_speed");
+  BodyState& b = world_->states[static_cast<std::size_t>(i)];
+  b.pose = state.pose;
+  b.pose.orientation.normalize();
+  b.linear_velocity = state.linear_velocity;
+  b.angular_velocity = state.angular_velocity;
+  physics_->setState(i, b);
+}
+
 void Environment::requireSetup(const char* what) const {
-  if (state_ != State::Setup) throw Error(std::string(what) + " only before the environment starts");
+  if (world_->state != State::Setup) throw Error(std::string(what) + " only before the environment starts");
 }
 
 Artifact& Environment::addArtifact(std::string name, const Pose& placement) {
   requireSetup("artifacts can be added");
   if (name.empty()) throw ConfigError({}, "an artifact needs a name");
   if (findArtifact(name) != nullptr) throw ConfigError({}, "duplicate artifact name '" + name + "'");
-  artifacts_.push_back(std::unique_ptr<Artifact>(new Artifact(*this, std::move(name), artifacts_.size(), placement)));
-  artifact_names_.emplace(artifacts_.back()->name(), artifacts_.back().get());
-  return *artifacts_.back();
+  detail::World& w = *world_;
+  w.artifacts.push_back(std::make_unique<Artifact>(w, std::move(name), w.artifacts.size(), placement));
+  w.artifact_data.emplace_back();
+  w.names.emplace(w.artifacts.back()->name(), w.artifacts.back().get());
+  return *w.artifacts.back();
 }
 
 Artifact& Environment::addGround(double z) {
@@ -110,12 +142,17 @@ SimulationExtension& Environment::addExtension(std::string name, SimulationExten
 void Environment::subscribe(const Sensor& sensor, Artifact& subscriber,
                             std::function<void(const Measurement&)> callback) {
   requireOutsidePhases("subscribe");
-  if (state_ != State::Setup && !configuring_)
+  detail::World& w = *world_;
+  if (w.state != State::Setup && !w.configuring)
     throw Error("subscriptions are made before the environment starts or from configure");
-  if (&subscriber.environment() != this || sensor.artifact_ == nullptr || &sensor.artifact().environment() != this)
+  if (&subscriber.environment() != this || !sensor.attached() || &sensor.artifact().environment() != this)
     throw Error("subscribe: sensor and subscriber must belong to this environment");
   const Artifact& source = sensor.artifact();
-  subscriber.inbox_.push_back({&source, sensor.plugin_index_ - 1u, subscription_sequence_++, std::move(callback)});
+  const auto& sensors = w.data(source).sensors;
+  std::uint32_t k = 0;
+  while (sensors[k].sensor != &sensor) ++k;  // attached there: it is in the list
+  w.data(subscriber).inbox.push_back({static_cast<std::uint32_t>(source.index()), k, w.subscription_sequence++,
+                                      std::move(callback)});
 }
 
 void Environment::setLogSink(LogSink sink) { log_ = std::move(sink); }
@@ -141,14 +178,14 @@ unsigned Environment::threadCount() const noexcept {
 }
 
 Artifact* Environment::findArtifact(std::string_view name) const {
-  const auto it = artifact_names_.find(std::string(name));
-  return it == artifact_names_.end() ? nullptr : it->second;
+  const auto it = world_->names.find(std::string(name));
+  return it == world_->names.end() ? nullptr : it->second;
 }
 
 std::vector<Artifact*> Environment::selectArtifacts(std::string_view names) const {
   std::vector<Artifact*> out;
   if (names == "*") {
-    for (const auto& a : artifacts_)
+    for (const auto& a : world_->artifacts)
       if (a->rootCount() > 0 && !a->root().isStatic()) out.push_back(a.get());
     return out;
   }
@@ -206,17 +243,19 @@ void Environment::checkDeclaredParameters() {
   };
   for (auto& e : extensions_)
     check(e.extension, e.params, nullptr, 1, [&] { return "extension '" + e.name + "'"; });
-  for (auto& a : artifacts_) {
-    if (Driver* d = a->driver_)
-      check(d, a->driver_params_, a.get(), d->periodSteps(), [&] { return "driver '" + d->className() + "'"; });
-    for (auto& s : a->sensors_)
+  for (auto& a : world_->artifacts) {
+    detail::ArtifactData& data = world_->data(*a);
+    if (Driver* d = data.driver)
+      check(d, data.driver_params, a.get(), d->periodSteps(), [&] { return "driver '" + d->className() + "'"; });
+    for (auto& s : data.sensors)
       check(s.sensor, s.params, a.get(), s.sensor->periodSteps(), [&] { return "sensor '" + s.sensor->className() + "'"; });
   }
   if (!errors.empty()) throw Error(errors + "\nnothing was run");
 }
 
 void Environment::start() {
-  if (state_ == State::Running) return;
+  detail::World& w = *world_;
+  if (w.state == State::Running) return;
   requireSetup("start() is allowed");
   checkDeclaredParameters();
   try {
@@ -227,46 +266,48 @@ void Environment::start() {
     }
     physics_ = createPhysicEngine(settings_.physics);
     renderer_ = createRenderEngine(settings_.render);
-    buildBodies();
-    publishSnapshot(true);
-    cameras_->start(settings_.render, settings_.timestep, *renderer_, artifacts_,
+    detail::buildBodies(w, *physics_, static_shapes_);
+    detail::publishSnapshot(w, *physics_, true);
+    cameras_->start(settings_.render, settings_.timestep, *renderer_, w.artifacts,
                     [this](std::string_view m) { log(LogLevel::Warning, m); });
     const unsigned threads = settings_.threads > 0 ? static_cast<unsigned>(settings_.threads)
                                                    : std::max(1u, std::thread::hardware_concurrency());
     pool_ = std::make_unique<detail::WorkerPool>(threads);
-    errors_.assign(artifacts_.size(), PendingError{});
-    state_ = State::Running;  // configure may subscribe and read the snapshot
-    configuring_ = true;
-    for (auto& a : artifacts_) {
+    w.errors.assign(w.artifacts.size(), detail::PendingError{});
+    w.state = State::Running;  // configure may subscribe and read the snapshot
+    w.configuring = true;
+    for (auto& data : w.artifact_data) {
       // sensors first: a driver may read their configuration (rates, resolutions)
-      for (auto& s : a->sensors_) s.sensor->configure(s.params);
-      if (a->driver_) a->driver_->configure(a->driver_params_);
+      for (auto& s : data.sensors) s.sensor->configure(s.params);
+      if (data.driver) data.driver->configure(data.driver_params);
     }
-    configuring_ = false;
+    w.configuring = false;
     warnUnusedParameters();
     // callbacks are delivered by source artifact, then sensor, then subscription order
-    for (auto& a : artifacts_) {
-      std::sort(a->inbox_.begin(), a->inbox_.end(), [](const auto& x, const auto& y) {
-        if (x.source->index() != y.source->index()) return x.source->index() < y.source->index();
+    for (auto& data : w.artifact_data) {
+      std::sort(data.inbox.begin(), data.inbox.end(), [](const auto& x, const auto& y) {
+        if (x.source != y.source) return x.source < y.source;
         if (x.sensor_index != y.sensor_index) return x.sensor_index < y.sensor_index;
         return x.sequence < y.sequence;
       });
     }
   } catch (...) {
-    configuring_ = false;
-    state_ = State::Failed;
+    w.configuring = false;
+    w.state = State::Failed;
     stop();
     throw;
   }
 }
 
 void Environment::stop() {
-  if (state_ == State::Stopped) return;
-  const bool started = state_ != State::Setup;
-  state_ = State::Stopped;
+  detail::World& w = *world_;
+  if (w.state == State::Stopped) return;
+  const bool started = w.state != State::Setup;
+  w.state = State::Stopped;
   if (started) {
     // plugins first, then engines, then extensions in reverse order
-    for (auto& a : artifacts_) {
+    for (auto& a : w.artifacts) {
+      detail::ArtifactData& data = w.data(*a);
       auto destroy = [&](Plugin& p, const std::string& what) {
         try {
           p.destroy();
@@ -274,8 +315,8 @@ void Environment::stop() {
           log(LogLevel::Error, "artifact '" + a->name() + "', " + what + ": destroy threw: " + e.what());
         }
       };
-      if (a->driver_) destroy(*a->driver_, "driver '" + a->driver_->className() + "'");
-      for (auto& s : a->sensors_) destroy(*s.sensor, "sensor '" + s.sensor->className() + "'");
+      if (data.driver) destroy(*data.driver, "driver '" + data.driver->className() + "'");
+      for (auto& s : data.sensors) destroy(*s.sensor, "sensor '" + s.sensor->className() + "'");
     }
     pool_.reset();
     cameras_->finish([this](std::string_view m) { log(LogLevel::Error, m); });
@@ -293,7 +334,7 @@ void Environment::stop() {
   }
 }
 
-void Environment::fail() { state_ = State::Failed; }
+void Environment::fail() { world_->state = State::Failed; }
 
 void Environment::warnUnusedParameters() const {
   // parameters no plugin read are typos or leftovers: say so once per place they were written
@@ -303,9 +344,9 @@ void Environment::warnUnusedParameters() const {
       if (seen.insert(w).second) log(LogLevel::Warning, w);
   };
   for (const auto& e : extensions_) report(e.params);
-  for (const auto& a : artifacts_) {
-    if (a->driver_ != nullptr) report(a->driver_params_);
-    for (const auto& s : a->sensors_) report(s.params);
+  for (const auto& data : world_->artifact_data) {
+    if (data.driver != nullptr) report(data.driver_params);
+    for (const auto& s : data.sensors) report(s.params);
   }
 }
 
@@ -318,7 +359,7 @@ void Environment::requireOutsidePhases(const char* what) const {
 
 void Environment::enableNeighborQueries(double cell_size) {
   requireOutsidePhases("enableNeighborQueries");
-  if (neighbors_->enable(cell_size) && state_ == State::Running) neighbors_->rebuild(artifacts_);
+  if (neighbors_->enable(cell_size) && world_->state == State::Running) neighbors_->rebuild(world_->artifacts);
 }
 
 bool Environment::neighborQueriesEnabled() const noexcept { return neighbors_->enabled(); }
@@ -340,7 +381,7 @@ std::int64_t Environment::frameCount() const noexcept { return cameras_->frameCo
 void Environment::addCameraRequest(std::string owner, std::function<bool(std::int64_t, CameraView&)> due,
                                    Image& target) {
   requireOutsidePhases("addCameraRequest");
-  if (state_ != State::Running || !renderer_) throw Error("addCameraRequest: call it from a plugin's configure");
+  if (world_->state != State::Running || !renderer_) throw Error("addCameraRequest: call it from a plugin's configure");
   if (!renderer_->drawsPixels())
     throw ConfigError({}, owner + " needs images, but render engine '" + renderer_->name() +
                               "' draws none: choose engine=\"osmesa\" in <render> or --render osmesa");

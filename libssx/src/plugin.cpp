@@ -8,7 +8,6 @@ void Plugin::configure(const Descriptor&) {}
 void Plugin::destroy() {}
 void Plugin::saveState(StateWriter&) const {}
 void Plugin::loadState(StateReader&) {}
-Environment& Plugin::environment() const noexcept { return artifact_->environment(); }
 
 Measurement::~Measurement() = default;
 

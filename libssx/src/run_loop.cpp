@@ -36,7 +36,7 @@ TimingSummary Environment::run(const RunOptions& options) {
   if (options.mode == RunOptions::Mode::RealTime &&
       !(options.realtime_factor > 0 && std::isfinite(options.realtime_factor)))
     throw ConfigError({}, "real-time factor must be a positive number");
-  if (state_ == State::Setup) start();
+  if (state() == State::Setup) start();
   const bool realtime = options.mode == RunOptions::Mode::RealTime;
   if (realtime) prctl(PR_SET_TIMERSLACK, 1UL, 0, 0, 0);  // wake within 1 ns of the deadline, not 50 us
 

@@ -2,6 +2,7 @@
 // extensions' hooks around them (the order is documented in environment.hpp).
 #include "neighbor_index.hpp"
 #include "phase_guard.hpp"
+#include "phases.hpp"
 #include "render/scene_cameras.hpp"
 #include "state_checks.hpp"
 #include "worker_pool.hpp"
@@ -49,139 +50,155 @@ void prefetch(const void* p, std::size_t bytes = 64) {
 }
 }  // namespace
 
-void Environment::prefetchArtifact(std::size_t i, std::size_t end, bool sensors) const {
-  if (i + 2 < end) prefetch(artifacts_[i + 2].get(), sizeof(Artifact));
+namespace detail {
+
+namespace {
+void prefetchArtifact(const World& world, std::size_t i, std::size_t end, bool sensors) {
   if (i + 1 >= end) return;
-  const Artifact& next = *artifacts_[i + 1];
+  const ArtifactData& next = world.artifact_data[i + 1];
   if (sensors) {
-    for (const auto& slot : next.sensors_) prefetch(slot.sensor, 256);
+    for (const auto& slot : next.sensors) prefetch(slot.sensor, 256);
   } else {
-    if (next.driver_ != nullptr) prefetch(next.driver_, 512);
-    if (!next.inbox_.empty()) prefetch(next.inbox_.data(), next.inbox_.size() * sizeof(next.inbox_[0]));
+    if (next.driver != nullptr) prefetch(next.driver, 512);
+    if (!next.inbox.empty()) prefetch(next.inbox.data(), next.inbox.size() * sizeof(next.inbox[0]));
   }
 }
+}  // namespace
 
-void Environment::runSensors(std::size_t begin, std::size_t end) {
-  const StepInfo base{current_step_, time(), 0};
+void runSensors(World& world, std::size_t begin, std::size_t end) {
+  const std::int64_t step = world.current_step;
+  const StepInfo base{step, world.steps * world.settings.timestep, 0};
   for (std::size_t i = begin; i < end; ++i) {
-    prefetchArtifact(i, end, true);
-    Artifact& a = *artifacts_[i];
-    for (std::size_t k = 0; k < a.sensors_.size(); ++k) {
-      auto& slot = a.sensors_[k];
+    prefetchArtifact(world, i, end, true);
+    ArtifactData& a = world.artifact_data[i];
+    for (std::size_t k = 0; k < a.sensors.size(); ++k) {
+      SensorSlot& slot = a.sensors[k];
       slot.fresh = false;
       Sensor& sensor = *slot.sensor;
-      if (current_step_ % sensor.period_steps_ != 0) continue;
+      const std::int64_t period = slot.period_steps;
+      if (step % period != 0) continue;
       StepInfo info = base;
-      info.period = sensor.period_steps_ * settings_.timestep;
+      info.period = period * world.settings.timestep;
       try {
-        detail::PhaseGuard guard(nullptr, "sensor");
+        PhaseGuard guard(nullptr, "sensor");
         sensor.sense(info);
         slot.fresh = true;
       } catch (...) {
-        errors_[i] = {"sensor " + std::to_string(k) + " '" + sensor.className() + "'",
-                      describe(std::current_exception())};
+        world.errors[i] = {"sensor " + std::to_string(k) + " '" + sensor.className() + "'",
+                           describe(std::current_exception())};
         break;
       }
     }
   }
 }
 
-void Environment::runDrivers(std::size_t begin, std::size_t end) {
-  const StepInfo base{current_step_, time(), 0};
+void runDrivers(World& world, std::size_t begin, std::size_t end) {
+  const std::int64_t step = world.current_step;
+  const StepInfo base{step, world.steps * world.settings.timestep, 0};
   for (std::size_t i = begin; i < end; ++i) {
-    prefetchArtifact(i, end, false);
-    Artifact& a = *artifacts_[i];
-    if (!errors_[i].plugin.empty()) continue;
+    prefetchArtifact(world, i, end, false);
+    ArtifactData& a = world.artifact_data[i];
+    if (!world.errors[i].plugin.empty()) continue;
     // deliver fresh measurements, in the order fixed at start
-    const Artifact::Subscription* current = nullptr;
+    const Subscription* current = nullptr;
     try {
-      detail::PhaseGuard guard(nullptr, "callback");
-      for (const auto& sub : a.inbox_) {
-        const auto& slot = sub.source->sensors_[sub.sensor_index];
+      PhaseGuard guard(nullptr, "callback");
+      for (const auto& sub : a.inbox) {
+        const SensorSlot& slot = world.artifact_data[sub.source].sensors[sub.sensor_index];
         if (!slot.fresh) continue;
         current = &sub;
         sub.callback(slot.sensor->latest());
       }
     } catch (...) {
-      errors_[i] = {"callback subscribed to sensor '" +
-                        current->source->sensors_[current->sensor_index].sensor->className() + "' of artifact '" +
-                        current->source->name() + "'",
-                    describe(std::current_exception())};
+      world.errors[i] = {"callback subscribed to sensor '" +
+                             world.artifact_data[current->source].sensors[current->sensor_index].sensor->className() +
+                             "' of artifact '" + world.artifacts[current->source]->name() + "'",
+                         describe(std::current_exception())};
       continue;
     }
-    Driver* driver = a.driver_;
-    if (driver == nullptr || current_step_ % driver->period_steps_ != 0) continue;
+    Driver* driver = a.driver;
+    if (driver == nullptr) continue;
+    const std::int64_t period = a.driver_period;
+    if (step % period != 0) continue;
     StepInfo info = base;
-    info.period = driver->period_steps_ * settings_.timestep;
-    for (int b = a.body_begin_; b < a.body_end_; ++b) wrenches_[static_cast<std::size_t>(b)] = Wrench{};
+    info.period = period * world.settings.timestep;
+    for (int b = a.body_begin; b < a.body_end; ++b) world.wrenches[static_cast<std::size_t>(b)] = Wrench{};
     try {
-      detail::PhaseGuard guard(&a, "driver");
+      PhaseGuard guard(world.artifacts[i].get(), "driver");
       driver->step(info);
     } catch (...) {
-      errors_[i] = {"driver '" + driver->className() + "'", describe(std::current_exception())};
+      world.errors[i] = {"driver '" + driver->className() + "'", describe(std::current_exception())};
       continue;
     }
-    for (int b = a.body_begin_; b < a.body_end_; ++b) {
-      if (!detail::finite(wrenches_[static_cast<std::size_t>(b)])) {
-        errors_[i] = {"driver '" + driver->className() + "'", "applied a NaN or infinite force or torque"};
+    for (int b = a.body_begin; b < a.body_end; ++b) {
+      if (!finite(world.wrenches[static_cast<std::size_t>(b)])) {
+        world.errors[i] = {"driver '" + driver->className() + "'", "applied a NaN or infinite force or torque"};
         break;
       }
     }
   }
 }
 
+void clearUndrivenCommands(World& world) {
+  for (const ArtifactData& a : world.artifact_data)
+    if (a.driver == nullptr)
+      for (int b = a.body_begin; b < a.body_end; ++b) world.wrenches[static_cast<std::size_t>(b)] = Wrench{};
+}
+
+}  // namespace detail
+
 void Environment::raiseFirstError(const char* phase) {
   // the lowest artifact index wins, so the report does not depend on the thread count
-  for (std::size_t i = 0; i < errors_.size(); ++i) {
-    if (errors_[i].plugin.empty()) continue;
+  const detail::World& w = *world_;
+  for (std::size_t i = 0; i < w.errors.size(); ++i) {
+    if (w.errors[i].plugin.empty()) continue;
     fail();
-    throw StepError(artifacts_[i]->name(), errors_[i].plugin, current_step_,
-                    std::string(errors_[i].message) + " (in the " + phase + " phase)");
+    throw StepError(w.artifacts[i]->name(), w.errors[i].plugin, w.current_step,
+                    std::string(w.errors[i].message) + " (in the " + phase + " phase)");
   }
 }
 
 void Environment::step() {
-  if (state_ == State::Setup) start();
-  if (state_ != State::Running)
-    throw Error(state_ == State::Failed ? "the environment failed in an earlier step; it cannot step again"
+  detail::World& w = *world_;
+  if (w.state == State::Setup) start();
+  if (w.state != State::Running)
+    throw Error(w.state == State::Failed ? "the environment failed in an earlier step; it cannot step again"
                                         : "the environment is stopped");
   const auto t_step = Clock::now();
   StepTiming timing;
-  current_step_ = steps_;
-  timing.step = current_step_;
+  w.current_step = w.steps;
+  timing.step = w.current_step;
 
   runExtensionHook(&SimulationExtension::beforeStep, "beforeStep");
 
   // physics, with the actuation written before
   auto t = Clock::now();
   try {
-    physics_->step(settings_.timestep, wrenches_);
+    physics_->step(settings_.timestep, w.wrenches);
   } catch (const std::exception& e) {
     // the engine gave up (ODE reports a NaN it met as an internal error): name the first
     // artifact whose state is no longer finite, if the engine can still tell
     fail();
     std::string who;
     try {
-      physics_->readStates(states_);
-      for (std::size_t i = 0; i < states_.size() && who.empty(); ++i)
-        if (!detail::finite(states_[i])) who = body_owner_[i]->name();
+      physics_->readStates(w.states);
+      for (std::size_t i = 0; i < w.states.size() && who.empty(); ++i)
+        if (!detail::finite(w.states[i])) who = w.artifacts[w.body_owner[i]]->name();
     } catch (...) {
     }
-    throw StepError(who, "physics", current_step_, e.what());
+    throw StepError(who, "physics", w.current_step, e.what());
   }
   timing.physics = since(t);
   t = Clock::now();
-  for (const auto& a : artifacts_)
-    if (!a->driver_)
-      for (int b = a->body_begin_; b < a->body_end_; ++b) wrenches_[static_cast<std::size_t>(b)] = Wrench{};
-  ++steps_;
-  publishSnapshot(false);
-  if (neighbors_->enabled()) neighbors_->rebuild(artifacts_);
+  detail::clearUndrivenCommands(w);
+  ++w.steps;
+  detail::publishSnapshot(w, *physics_, false);
+  if (neighbors_->enabled()) neighbors_->rebuild(w.artifacts);
   timing.snapshot = since(t);
   if (cameras_->hasRequests()) {
     t = Clock::now();
     try {
-      cameras_->renderRequests(current_step_, *renderer_, settings_.render.background, artifacts_);
+      cameras_->renderRequests(w.current_step, *renderer_, settings_.render.background, w.artifacts);
     } catch (...) {
       fail();
       throw;
@@ -189,27 +206,27 @@ void Environment::step() {
     timing.render += since(t);
   }
 
-  const std::size_t n = artifacts_.size();
+  const std::size_t n = w.artifacts.size();
   const std::size_t chunk = std::max<std::size_t>(1, n / (pool_->size() * 8));
   // sensors, in parallel
   t = Clock::now();
-  auto sensors = [this](std::size_t b, std::size_t e) { runSensors(b, e); };
+  auto sensors = [&w](std::size_t b, std::size_t e) { detail::runSensors(w, b, e); };
   pool_->parallelFor(n, chunk, sensors);
   timing.sensors = since(t);
   raiseFirstError("sensors");
 
   // callbacks and drivers, in parallel
   t = Clock::now();
-  auto drivers = [this](std::size_t b, std::size_t e) { runDrivers(b, e); };
+  auto drivers = [&w](std::size_t b, std::size_t e) { detail::runDrivers(w, b, e); };
   pool_->parallelFor(n, chunk, drivers);
   timing.drivers = since(t);
   raiseFirstError("drivers");
 
   // render, when due
-  if (settings_.render.period_steps > 0 && current_step_ % settings_.render.period_steps == 0) {
+  if (settings_.render.period_steps > 0 && w.current_step % settings_.render.period_steps == 0) {
     t = Clock::now();
     try {
-      cameras_->drawFrame(current_step_, settings_.render, artifacts_);
+      cameras_->drawFrame(w.current_step, settings_.render, w.artifacts);
     } catch (...) {
       fail();
       throw;
@@ -228,7 +245,7 @@ void Environment::runExtensionHook(void (SimulationExtension::*hook)(Environment
       (e.extension->*hook)(*this);
     } catch (const std::exception& ex) {
       fail();
-      throw StepError("", "extension '" + e.name + "'", current_step_, std::string(what) + ": " + ex.what());
+      throw StepError("", "extension '" + e.name + "'", world_->current_step, std::string(what) + ": " + ex.what());
     }
   }
 }

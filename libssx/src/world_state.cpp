@@ -4,10 +4,11 @@
 // Layout: "SSXSTATE", format version (u32), reserved (u32), scene fingerprint (u64), payload size
 // (u64), FNV-1a of the payload (u64); then the payload: step count, the engine's block, the
 // snapshot (body states with accelerations, the velocities before the last step), the command
-// buffers, then one block per plugin (driver first, then sensors, artifact by artifact: its random
-// stream, then what it saved) and one per extension.
+// buffers, every plugin's random stream (the world's plugin table, in order), then one block per
+// plugin (driver first, then sensors, artifact by artifact: what it saved) and one per extension.
 #include "neighbor_index.hpp"
 #include "render/scene_cameras.hpp"
+#include "world.hpp"
 
 #include <ssx/environment.hpp>
 
@@ -18,7 +19,7 @@ namespace ssx {
 namespace {
 
 constexpr char kMagic[8] = {'S', 'S', 'X', 'S', 'T', 'A', 'T', 'E'};
-constexpr std::uint32_t kFormatVersion = 1;
+constexpr std::uint32_t kFormatVersion = 2;
 constexpr std::size_t kHeaderSize = 8 + 4 + 4 + 8 + 8 + 8;
 
 std::uint64_t fnv1a(const std::byte* data, std::size_t size, std::uint64_t h = 0xcbf29ce484222325ULL) {
@@ -75,44 +76,41 @@ std::uint64_t Environment::sceneFingerprint() const {
   std::uint64_t h = fnv1a("ssx scene", 0xcbf29ce484222325ULL);
   auto mix = [&h](std::string_view s) { h = fnv1a(s, fnv1a("|", h)); };
   mix(std::to_string(settings_.timestep));
-  for (const auto& a : artifacts_) {
+  for (const auto& a : world_->artifacts) {
     mix(a->name());
     // each dynamic root is one body (known before the engine is built)
     std::size_t bodies = 0;
-    for (const PhysicNode* root : a->roots_) bodies += root->isStatic() ? 0 : 1;
+    for (std::size_t r = 0; r < a->rootCount(); ++r) bodies += a->root(r).isStatic() ? 0 : 1;
     mix(std::to_string(bodies));
-    if (a->driver_ != nullptr) mix("driver " + a->driver_->className() + " " + std::to_string(a->driver_->periodSteps()));
-    for (const auto& s : a->sensors_)
-      mix("sensor " + s.sensor->className() + " " + std::to_string(s.sensor->periodSteps()));
   }
+  for (const auto& p : world_->plugins)
+    mix((p.index == 0 ? "driver " : "sensor ") + p.class_name + " " + std::to_string(p.period_steps) + " of " +
+        std::to_string(p.artifact));
   for (const auto& e : extensions_) mix("extension " + e.name);
   return h;
 }
 
 std::vector<std::byte> Environment::saveState() const {
-  if (state_ != State::Running)
+  const detail::World& w = *world_;
+  if (w.state != State::Running)
     throw Error("saveState: the environment is not running (start it, or it failed or stopped)");
   std::vector<std::byte> buffer(kHeaderSize);
   StateWriter out(buffer);
-  out.write(steps_);
+  out.write(w.steps);
   writeBlock(out, [&] { physics_->saveState(out); });
-  out.write(static_cast<std::uint64_t>(states_.size()));
-  for (const auto& s : states_) writeBody(out, s);
-  for (std::size_t i = 0; i < states_.size(); ++i) {
-    out.write(previous_linear_[i]);
-    out.write(previous_angular_[i]);
-    out.write(wrenches_[i].force);
-    out.write(wrenches_[i].torque);
+  out.write(static_cast<std::uint64_t>(w.states.size()));
+  for (const auto& s : w.states) writeBody(out, s);
+  for (std::size_t i = 0; i < w.states.size(); ++i) {
+    out.write(w.previous_linear[i]);
+    out.write(w.previous_angular[i]);
+    out.write(w.wrenches[i].force);
+    out.write(w.wrenches[i].torque);
   }
-  auto plugin = [&](const Plugin& p) {
-    writeBlock(out, [&] {
-      p.random_.save(out);
-      p.saveState(out);
-    });
-  };
-  for (const auto& a : artifacts_) {
-    if (a->driver_ != nullptr) plugin(*a->driver_);
-    for (const auto& s : a->sensors_) plugin(*s.sensor);
+  // the random streams, then each plugin's own state (driver first, then sensors, by artifact)
+  for (const auto& p : w.plugins) p.random.save(out);
+  for (const auto& a : w.artifact_data) {
+    if (a.driver != nullptr) writeBlock(out, [&] { a.driver->saveState(out); });
+    for (const auto& s : a.sensors) writeBlock(out, [&] { s.sensor->saveState(out); });
   }
   for (const auto& e : extensions_) writeBlock(out, [&] { e.extension->saveState(out); });
 
@@ -156,8 +154,8 @@ void Environment::checkState(std::span<const std::byte> state) const {
 
 void Environment::restoreState(std::span<const std::byte> state) {
   checkState(state);  // before anything starts
-  if (state_ == State::Setup) start();
-  if (state_ != State::Running) throw Error("restoreState: the environment failed or was stopped");
+  if (world_->state == State::Setup) start();
+  if (world_->state != State::Running) throw Error("restoreState: the environment failed or was stopped");
 
   // what can go wrong now is a plugin that reads back differently from how it saved: then the
   // state taken just before is put back, so a failed restore changes nothing
@@ -179,32 +177,33 @@ void Environment::applyState(std::span<const std::byte> payload) {
   if (steps < 0) throw StateError("saved state: negative step count (corrupted)");
   readBlock(in, "the physics engine's state", [&](StateReader& block) { physics_->restoreState(block); });
   const std::size_t bodies = in.count(1);
-  if (bodies != states_.size())
-    throw StateError("saved state: " + std::to_string(bodies) + " bodies, this world " + std::to_string(states_.size()));
-  for (auto& s : states_) readBody(in, s);
-  for (std::size_t i = 0; i < states_.size(); ++i) {
-    in.read(previous_linear_[i]);
-    in.read(previous_angular_[i]);
-    in.read(wrenches_[i].force);
-    in.read(wrenches_[i].torque);
+  detail::World& w = *world_;
+  if (bodies != w.states.size())
+    throw StateError("saved state: " + std::to_string(bodies) + " bodies, this world " +
+                     std::to_string(w.states.size()));
+  for (auto& s : w.states) readBody(in, s);
+  for (std::size_t i = 0; i < w.states.size(); ++i) {
+    in.read(w.previous_linear[i]);
+    in.read(w.previous_angular[i]);
+    in.read(w.wrenches[i].force);
+    in.read(w.wrenches[i].torque);
   }
-  for (const auto& a : artifacts_) {
-    auto plugin = [&](Plugin& p, const std::string& what) {
-      readBlock(in, what + " of artifact '" + a->name() + "'", [&](StateReader& block) {
-        p.random_.load(block);
-        p.loadState(block);
-      });
-    };
-    if (a->driver_ != nullptr) plugin(*a->driver_, "driver '" + a->driver_->className() + "'");
-    for (auto& s : a->sensors_) plugin(*s.sensor, "sensor '" + s.sensor->className() + "'");
+  for (auto& p : w.plugins) p.random.load(in);
+  for (std::size_t i = 0; i < w.artifacts.size(); ++i) {
+    const std::string of = " of artifact '" + w.artifacts[i]->name() + "'";
+    detail::ArtifactData& a = w.artifact_data[i];
+    if (a.driver != nullptr)
+      readBlock(in, "driver '" + a.driver->className() + "'" + of, [&](StateReader& b) { a.driver->loadState(b); });
+    for (auto& s : a.sensors)
+      readBlock(in, "sensor '" + s.sensor->className() + "'" + of, [&](StateReader& b) { s.sensor->loadState(b); });
   }
   for (auto& e : extensions_)
     readBlock(in, "extension '" + e.name + "'", [&](StateReader& block) { e.extension->loadState(block); });
   if (!in.done()) throw StateError("saved state: " + std::to_string(in.remaining()) + " bytes left over (corrupted)");
-  steps_ = steps;
-  current_step_ = steps;
+  w.steps = steps;
+  w.current_step = steps;
   cameras_->invalidate();
-  if (neighbors_->enabled()) neighbors_->rebuild(artifacts_);
+  if (neighbors_->enabled()) neighbors_->rebuild(w.artifacts);
 }
 
 }  // namespace ssx

@@ -19,11 +19,19 @@
 namespace ssx {
 
 class Environment;
+namespace detail {
+struct World;
+}
 
 /// An artifact. Created by `Environment::addArtifact`; owned by the environment.
 /// Node trees, drivers and sensors are added before the environment starts.
+///
+/// A handle: what changes while the world runs (its plugins' slots, subscriptions, bodies) lives
+/// in the environment's world state, indexed by `index()`.
 class SSX_EXPORT Artifact {
  public:
+  /// Made by Environment::addArtifact (the world is the core's and cannot be named outside it).
+  Artifact(detail::World& world, std::string name, std::size_t index, const Pose& placement);
   Artifact(const Artifact&) = delete;
   Artifact& operator=(const Artifact&) = delete;
   ~Artifact();
@@ -31,7 +39,7 @@ class SSX_EXPORT Artifact {
   const std::string& name() const noexcept { return name_; }
   /// Position in the environment's artifact list; streams and orders derive from it.
   std::size_t index() const noexcept { return index_; }
-  Environment& environment() const noexcept { return *env_; }
+  Environment& environment() const noexcept;
   /// The pose the artifact was placed at; root nodes are posed relative to it.
   const Pose& placement() const noexcept { return placement_; }
 
@@ -54,18 +62,18 @@ class SSX_EXPORT Artifact {
 
   // --- access -------------------------------------------------------------------------------
 
-  Driver* driver() const noexcept { return driver_; }
-  std::size_t sensorCount() const noexcept { return sensors_.size(); }
-  Sensor& sensor(std::size_t i) const { return *sensors_.at(i).sensor; }
+  Driver* driver() const noexcept;
+  std::size_t sensorCount() const noexcept;
+  Sensor& sensor(std::size_t i) const;
   /// The parameters the driver is (or will be) configured with.
-  const Descriptor& driverParameters() const noexcept { return driver_params_; }
+  const Descriptor& driverParameters() const noexcept;
   /// The parameters sensor i is (or will be) configured with.
-  const Descriptor& sensorParameters(std::size_t i) const { return sensors_.at(i).params; }
+  const Descriptor& sensorParameters(std::size_t i) const;
   /// The first sensor of type T, or nullptr.
   template <class T>
   T* findSensor() const {
-    for (const auto& s : sensors_)
-      if (auto* t = dynamic_cast<T*>(s.sensor)) return t;
+    for (std::size_t i = 0; i < sensorCount(); ++i)
+      if (auto* t = dynamic_cast<T*>(&sensor(i))) return t;
     return nullptr;
   }
 
@@ -84,29 +92,12 @@ class SSX_EXPORT Artifact {
   Pose pose() const { return root().pose(); }
 
  private:
-  friend class Environment;
-  friend class PhysicNode;
-  Artifact(Environment& env, std::string name, std::size_t index, const Pose& placement);
-
-  struct SensorSlot {
-    Sensor* sensor;
-    std::unique_ptr<Sensor> owned;  // null when a ClassLoader owns it
-    Descriptor params;
-    bool fresh = false;  // wrote a measurement in this step
-  };
-  struct Subscription {
-    const Artifact* source;
-    std::size_t sensor_index;
-    std::uint64_t sequence;
-    std::function<void(const Measurement&)> callback;
-  };
-
   void buildNodes(PhysicNode* parent, const PhysicNodeSpec& spec);
-  void checkWritable() const;
-  Wrench& wrench(int body);
   void requireSetup(const char* what) const;
+  Plugin& attach(Plugin& plugin, std::uint32_t plugin_index, std::int64_t period_steps, std::string class_name,
+                 const Descriptor& params);
 
-  Environment* env_;
+  detail::World* world_;
   std::string name_;
   std::size_t index_;
   Pose placement_;
@@ -114,14 +105,6 @@ class SSX_EXPORT Artifact {
   std::vector<std::unique_ptr<PhysicNode>> nodes_;  // every node, trees in order
   std::vector<PhysicNode*> roots_;
   std::vector<RenderNodeSpec> render_roots_;
-  Driver* driver_ = nullptr;
-  std::unique_ptr<Driver> owned_driver_;  // null when a ClassLoader owns it
-  Descriptor driver_params_;
-  std::vector<SensorSlot> sensors_;
-  std::vector<Subscription> inbox_;  // sorted (source index, sensor index, sequence) at start
-  // bodies of this artifact: [body_begin_, body_end_) in the environment's body arrays
-  int body_begin_ = 0;
-  int body_end_ = 0;
 };
 
 }  // namespace ssx

@@ -43,6 +43,7 @@
 namespace ssx {
 
 namespace detail {
+struct World;
 class WorkerPool;
 class SceneCameras;
 class NeighborIndex;
@@ -146,20 +147,20 @@ class SSX_EXPORT Environment {
   /// The checks restoreState makes before it changes anything (format, size, checksum, the scene
   /// it was saved from), without starting the environment. Throws StateError.
   void checkState(std::span<const std::byte> state) const;
-  State state() const noexcept { return state_; }
+  State state() const noexcept;
 
   // --- queries -------------------------------------------------------------------------------
 
   const EnvironmentSettings& settings() const noexcept { return settings_; }
   Nanoseconds timestep() const noexcept { return settings_.timestep; }
   /// Simulated time: steps taken times the timestep.
-  Nanoseconds time() const noexcept { return steps_ * settings_.timestep; }
-  std::int64_t stepCount() const noexcept { return steps_; }
+  Nanoseconds time() const noexcept { return stepCount() * settings_.timestep; }
+  std::int64_t stepCount() const noexcept;
   /// Worker threads used by the parallel phases (1: inline).
   unsigned threadCount() const noexcept;
 
-  std::size_t artifactCount() const noexcept { return artifacts_.size(); }
-  Artifact& artifact(std::size_t index) const { return *artifacts_.at(index); }
+  std::size_t artifactCount() const noexcept;
+  Artifact& artifact(std::size_t index) const;
   /// Artifact by name, or nullptr.
   Artifact* findArtifact(std::string_view name) const;
   /// Artifacts chosen by a parameter: "*" is every artifact with a dynamic root, else names
@@ -177,8 +178,13 @@ class SSX_EXPORT Environment {
   }
 
   /// The published state of body `i` (see PhysicNode::bodyIndex).
-  const BodyState& bodyState(int i) const { return states_.at(static_cast<std::size_t>(i)); }
-  std::size_t bodyCount() const noexcept { return states_.size(); }
+  const BodyState& bodyState(int i) const;
+  std::size_t bodyCount() const noexcept;
+  /// Sets body `i`'s pose and velocities (centre-of-mass frame, world) between steps: in the
+  /// engine and in the snapshot at once (accelerations are kept). To reset or teleport a robot;
+  /// not allowed from plugins during a step. Throws Error for a static or unknown body, a
+  /// non-finite state or one faster than the speed guards.
+  void setBodyState(int i, const BodyState& state);
   /// A 64-bit hash (FNV-1a) of every body's pose and velocities, bit for bit, and the time.
   std::uint64_t stateHash() const;
 
@@ -227,19 +233,11 @@ class SSX_EXPORT Environment {
   const TimingRecorder& timing() const noexcept { return timing_; }
 
  private:
-  friend class Artifact;
-  friend class PhysicNode;
-
   void requireSetup(const char* what) const;
   void checkDeclaredParameters();
   void requireOutsidePhases(const char* what) const;
   std::uint64_t sceneFingerprint() const;
   void applyState(std::span<const std::byte> payload);
-  void buildBodies();
-  void publishSnapshot(bool first);
-  void runSensors(std::size_t begin, std::size_t end);
-  void runDrivers(std::size_t begin, std::size_t end);
-  void prefetchArtifact(std::size_t i, std::size_t end, bool sensors) const;
   void raiseFirstError(const char* phase);
   void fail();
   void warnUnusedParameters() const;
@@ -252,35 +250,19 @@ class SSX_EXPORT Environment {
     Descriptor params;
     bool initialised = false;
   };
-  struct PendingError {
-    std::string plugin;
-    std::string message;
-  };
 
   EnvironmentSettings settings_;
   std::unique_ptr<ClassLoader> loader_;  // declared first: destroyed last
-  State state_ = State::Setup;
-  std::int64_t steps_ = 0;
-  std::vector<std::unique_ptr<Artifact>> artifacts_;
-  std::unordered_map<std::string, Artifact*> artifact_names_;
+  std::unique_ptr<detail::World> world_;  // artifacts, plugin slots, bodies: what the phases work on
   std::vector<ExtensionSlot> extensions_;
   std::unique_ptr<PhysicEngine> physics_;
   std::unique_ptr<RenderEngine> renderer_;
   std::unique_ptr<detail::WorkerPool> pool_;
-  std::vector<BodyState> states_;      // the snapshot, one per body
-  std::vector<Vec3> previous_linear_;  // velocities before the step, for accelerations
-  std::vector<Vec3> previous_angular_;
-  std::vector<Wrench> wrenches_;  // command buffers, one per body, owned by artifacts
-  std::vector<Artifact*> body_owner_;
-  std::vector<PendingError> errors_;  // one per artifact, filled by the parallel phases
   std::unique_ptr<detail::SceneCameras> cameras_;  // scene cameras, camera images, render items
   std::unique_ptr<detail::NeighborIndex> neighbors_;
   std::vector<StaticShape> static_shapes_;
-  std::uint64_t subscription_sequence_ = 0;
   TimingRecorder timing_;
   LogSink log_;
-  std::int64_t current_step_ = 0;
-  bool configuring_ = false;
 };
 
 template <class M>

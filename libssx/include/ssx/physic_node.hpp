@@ -14,6 +14,9 @@
 namespace ssx {
 
 class Artifact;
+namespace detail {
+struct World;
+}
 
 /// A collision and mass shape, posed relative to the node that holds it. Cylinders and capsules
 /// lie along their local z axis. A plane is the half-space below its local xy-plane (normal +z)
@@ -83,17 +86,27 @@ SSX_EXPORT MassProperties combinedMass(const PhysicNodeSpec& root);
 /// that artifact's own driver may write; outside a step, the embedding program may.
 class SSX_EXPORT PhysicNode {
  public:
+  /// Made by Artifact::addPhysicRoot (the world is the core's and cannot be named outside it).
+  /// `index` is the node's place in the world's node table.
+  PhysicNode(detail::World& world, Artifact& artifact, const PhysicNodeSpec& spec, PhysicNode* parent,
+             std::size_t index)
+      : world_(&world), artifact_(&artifact), spec_(&spec), parent_(parent), index_(index) {}
+  PhysicNode(const PhysicNode&) = delete;
+  PhysicNode& operator=(const PhysicNode&) = delete;
+
   const std::string& name() const noexcept { return spec_->name; }
   const PhysicNodeSpec& spec() const noexcept { return *spec_; }
   Artifact& artifact() const noexcept { return *artifact_; }
   /// The parent node, or nullptr for a root.
   PhysicNode* parent() const noexcept { return parent_; }
   /// Fixed in the world (its root is static).
-  bool isStatic() const noexcept { return static_; }
+  bool isStatic() const noexcept;
+  /// Index of this node among all nodes of the environment (artifact by artifact, trees in order).
+  std::size_t nodeIndex() const noexcept { return index_; }
   /// Index of the rigid body this node belongs to (children share their root's body), or -1.
-  int bodyIndex() const noexcept { return body_; }
+  int bodyIndex() const noexcept;
   /// This node's frame relative to its body's centre-of-mass frame.
-  const Pose& poseInBody() const noexcept { return pose_in_body_; }
+  const Pose& poseInBody() const noexcept;
 
   /// Pose, velocities and accelerations of this node's frame origin, world frame.
   BodyState state() const;
@@ -110,20 +123,13 @@ class SSX_EXPORT PhysicNode {
   void setVelocity(const Vec3& linear, const Vec3& angular);
 
  private:
-  friend class Artifact;
-  friend class Environment;
-  PhysicNode(Artifact& artifact, const PhysicNodeSpec& spec, PhysicNode* parent)
-      : artifact_(&artifact), spec_(&spec), parent_(parent) {}
+  void requireWritable() const;
 
+  detail::World* world_;
   Artifact* artifact_;
   const PhysicNodeSpec* spec_;
   PhysicNode* parent_;
-  int body_ = -1;  // -1: static, or not started
-  bool static_ = false;
-  Pose pose_in_body_;                   // node frame in body (centre-of-mass) frame
-  Pose setup_pose_;                     // world pose as placed (static nodes keep it)
-  Vec3 initial_linear_ = Vec3::Zero();  // of this node's origin, set before start
-  Vec3 initial_angular_ = Vec3::Zero();
+  std::size_t index_;  // in the world's node table
 };
 
 }  // namespace ssx

@@ -18,6 +18,9 @@ namespace ssx {
 
 class Artifact;
 class Environment;
+namespace detail {
+struct World;
+}
 
 /// What a driver or sensor is told about the step it runs in.
 struct StepInfo {
@@ -56,20 +59,23 @@ class SSX_EXPORT Plugin {
   Environment& environment() const noexcept;
   /// This instance's random stream, seeded from (scene seed, artifact index, plugin index):
   /// the same numbers whatever the number of threads. Use it only inside this plugin's calls.
-  Random& random() noexcept { return random_; }
-  /// Runs every this many steps.
-  std::int64_t periodSteps() const noexcept { return period_steps_; }
+  /// Kept in the world state (saved and restored with it). Throws before the plugin is attached.
+  Random& random();
+  /// Runs every this many steps (1 before the plugin is attached).
+  std::int64_t periodSteps() const noexcept;
   /// A name for messages: the class name given when attached.
-  const std::string& className() const noexcept { return class_name_; }
+  const std::string& className() const noexcept;
+  /// Whether this instance is attached to an artifact.
+  bool attached() const noexcept { return world_ != nullptr; }
+
+  /// Done by Artifact::setDriver / addSensor (the world is the core's and cannot be named
+  /// outside it): binds this instance to its slot.
+  void bind(detail::World& world, Artifact& artifact, std::uint32_t slot) noexcept;
 
  private:
-  friend class Artifact;
-  friend class Environment;
+  detail::World* world_ = nullptr;
   Artifact* artifact_ = nullptr;
-  Random random_;
-  std::int64_t period_steps_ = 1;
-  std::string class_name_;
-  std::uint32_t plugin_index_ = 0;  // 0 driver, 1.. sensors
+  std::uint32_t slot_ = 0;
 };
 
 /// The behaviour of an artifact: a flight controller, a door. At most one per artifact.
