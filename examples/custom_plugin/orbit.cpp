@@ -21,7 +21,7 @@ class OrbitDriver final : public ssx::Driver {
       ssx::param::real("kd", "8", "1/s", ssx::param::positive(), "velocity gain"),
   };
 
-  void configure(const ssx::Descriptor& params) override {
+  void configure(const ssx::Descriptor& params, ssx::PluginSetup& /*setup*/) override {
     center_ = params.get<ssx::Vec3>("center", artifact().placement().position);
     radius_ = params.get<double>("radius");
     omega_ = 2 * std::numbers::pi / params.get<double>("orbit_period");

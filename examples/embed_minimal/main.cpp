@@ -12,7 +12,7 @@ namespace {
 // a PD position hold: force = m (kp (target - p) - kd v) + weight compensation
 class HoldDriver final : public ssx::Driver {
  public:
-  void configure(const ssx::Descriptor& params) override {
+  void configure(const ssx::Descriptor& params, ssx::PluginSetup& /*setup*/) override {
     target_ = params.get<ssx::Vec3>("target", ssx::Vec3(0, 0, 1));
     kp_ = params.getPositive("kp", 20.0);
     kd_ = params.getPositive("kd", 8.0);

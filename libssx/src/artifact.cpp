@@ -15,7 +15,7 @@ Artifact::Artifact(detail::World& world, std::string name, std::size_t index, co
 
 Artifact::~Artifact() = default;
 
-Environment& Artifact::environment() const noexcept { return world_->env; }
+const Environment& Artifact::environment() const noexcept { return world_->env; }
 
 void Artifact::requireSetup(const char* what) const {
   if (world_->state != Environment::State::Setup)
@@ -108,19 +108,27 @@ Sensor& Artifact::addSensor(Sensor& sensor, Descriptor params, std::int64_t peri
   return sensor;
 }
 
-Driver* Artifact::driver() const noexcept { return world_->data(*this).driver; }
+Driver* Artifact::driver() noexcept { return world_->data(*this).driver; }
+const Driver* Artifact::driver() const noexcept { return world_->data(*this).driver; }
 std::size_t Artifact::sensorCount() const noexcept { return world_->data(*this).sensors.size(); }
-Sensor& Artifact::sensor(std::size_t i) const { return *world_->data(*this).sensors.at(i).sensor; }
+Sensor& Artifact::sensor(std::size_t i) { return *world_->data(*this).sensors.at(i).sensor; }
+const Sensor& Artifact::sensor(std::size_t i) const { return *world_->data(*this).sensors.at(i).sensor; }
 const Descriptor& Artifact::driverParameters() const noexcept { return world_->data(*this).driver_params; }
 const Descriptor& Artifact::sensorParameters(std::size_t i) const { return world_->data(*this).sensors.at(i).params; }
 
-PhysicNode* Artifact::node(std::string_view name) const {
+PhysicNode* Artifact::node(std::string_view name) {
   for (const auto& n : nodes_)
     if (n->name() == name) return n.get();
   return nullptr;
 }
 
-PhysicNode& Artifact::nodeFromParameter(const Descriptor& params, std::string_view key) const {
+const PhysicNode* Artifact::node(std::string_view name) const { return const_cast<Artifact*>(this)->node(name); }
+
+const PhysicNode& Artifact::nodeFromParameter(const Descriptor& params, std::string_view key) const {
+  return const_cast<Artifact*>(this)->nodeFromParameter(params, key);
+}
+
+PhysicNode& Artifact::nodeFromParameter(const Descriptor& params, std::string_view key) {
   const std::string name = params.get<std::string>(key, "");
   if (name.empty()) {
     if (roots_.empty()) throw params.error("artifact '" + name_ + "' has no physic node");
@@ -142,7 +150,7 @@ void Plugin::bind(detail::World& world, Artifact& artifact, std::uint32_t slot) 
   slot_ = slot;
 }
 
-Environment& Plugin::environment() const noexcept { return world_->env; }
+const Environment& Plugin::environment() const noexcept { return world_->env; }
 
 Random& Plugin::random() {
   if (world_ == nullptr) throw Error("random(): the plugin is not attached to an artifact yet");
@@ -221,7 +229,7 @@ void PhysicNode::addTorque(const Vec3& torque, Frame frame) {
 }
 
 void PhysicNode::setVelocity(const Vec3& linear, const Vec3& angular) {
-  Environment& env = artifact_->environment();
+  Environment& env = world_->env;
   if (detail::PhaseGuard::in_phase) throw Error("setVelocity is not allowed during a step");
   const PhysicsSettings& ps = env.settings().physics;
   if (!linear.allFinite() || !angular.allFinite() || linear.norm() > ps.max_linear_speed ||

@@ -23,12 +23,13 @@ void buildBodies(World& world, PhysicEngine& engine, std::vector<Environment::St
       std::vector<Shape> shapes;
       std::vector<NodeData*> tree;  // the root and its descendants, in order
       std::vector<const PhysicNodeSpec*> specs;
-      for (const auto& n : artifact->nodes()) {
-        const PhysicNode* top = n.get();
+      for (std::size_t k = 0; k < artifact->nodeCount(); ++k) {
+        const PhysicNode& n = artifact->nodeAt(k);
+        const PhysicNode* top = &n;
         while (top->parent() != nullptr) top = top->parent();
         if (top != &root) continue;
-        tree.push_back(&world.nodes[n->nodeIndex()]);
-        specs.push_back(&n->spec());
+        tree.push_back(&world.nodes[n.nodeIndex()]);
+        specs.push_back(&n.spec());
       }
       if (spec.is_static) {
         for (std::size_t k = 0; k < tree.size(); ++k) {

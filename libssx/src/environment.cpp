@@ -68,7 +68,8 @@ Environment::~Environment() {
 Environment::State Environment::state() const noexcept { return world_->state; }
 std::int64_t Environment::stepCount() const noexcept { return world_->steps; }
 std::size_t Environment::artifactCount() const noexcept { return world_->artifacts.size(); }
-Artifact& Environment::artifact(std::size_t index) const { return *world_->artifacts.at(index); }
+Artifact& Environment::artifact(std::size_t index) { return *world_->artifacts.at(index); }
+const Artifact& Environment::artifact(std::size_t index) const { return *world_->artifacts.at(index); }
 const BodyState& Environment::bodyState(int i) const { return world_->states.at(static_cast<std::size_t>(i)); }
 std::size_t Environment::bodyCount() const noexcept { return world_->states.size(); }
 
@@ -177,12 +178,27 @@ unsigned Environment::threadCount() const noexcept {
   return std::max(1u, std::thread::hardware_concurrency());
 }
 
-Artifact* Environment::findArtifact(std::string_view name) const {
+const Artifact* Environment::findArtifact(std::string_view name) const {
+  return const_cast<Environment*>(this)->findArtifact(name);
+}
+
+Artifact* Environment::findArtifact(std::string_view name) {
   const auto it = world_->names.find(std::string(name));
   return it == world_->names.end() ? nullptr : it->second;
 }
 
-std::vector<Artifact*> Environment::selectArtifacts(std::string_view names) const {
+std::vector<const Artifact*> Environment::selectArtifacts(std::string_view names) const {
+  const std::vector<Artifact*> chosen = const_cast<Environment*>(this)->selectArtifacts(names);
+  return {chosen.begin(), chosen.end()};
+}
+
+std::vector<const Artifact*> Environment::selectArtifacts(const Descriptor& params, std::string_view key,
+                                                          std::string_view purpose) const {
+  const std::vector<Artifact*> chosen = const_cast<Environment*>(this)->selectArtifacts(params, key, purpose);
+  return {chosen.begin(), chosen.end()};
+}
+
+std::vector<Artifact*> Environment::selectArtifacts(std::string_view names) {
   std::vector<Artifact*> out;
   if (names == "*") {
     for (const auto& a : world_->artifacts)
@@ -201,7 +217,7 @@ std::vector<Artifact*> Environment::selectArtifacts(std::string_view names) cons
 }
 
 std::vector<Artifact*> Environment::selectArtifacts(const Descriptor& params, std::string_view key,
-                                                    std::string_view purpose) const {
+                                                    std::string_view purpose) {
   const std::string names = params.get<std::string>(key);
   try {
     return selectArtifacts(names);
@@ -221,7 +237,7 @@ const PhysicEngine& Environment::physics() const {
   return *physics_;
 }
 
-RenderEngine& Environment::renderer() const {
+const RenderEngine& Environment::renderer() const {
   if (!renderer_) throw Error("the render engine exists only while the environment runs");
   return *renderer_;
 }
@@ -278,8 +294,14 @@ void Environment::start() {
     w.configuring = true;
     for (auto& data : w.artifact_data) {
       // sensors first: a driver may read their configuration (rates, resolutions)
-      for (auto& s : data.sensors) s.sensor->configure(s.params);
-      if (data.driver) data.driver->configure(data.driver_params);
+      for (auto& s : data.sensors) {
+        PluginSetup setup(*this, *s.sensor);
+        s.sensor->configure(s.params, setup);
+      }
+      if (data.driver) {
+        PluginSetup setup(*this, *data.driver);
+        data.driver->configure(data.driver_params, setup);
+      }
     }
     w.configuring = false;
     warnUnusedParameters();

@@ -1,13 +1,33 @@
 #include <ssx/artifact.hpp>
+#include <ssx/environment.hpp>
 #include <ssx/plugin.hpp>
 
 namespace ssx {
 
 Plugin::~Plugin() = default;
-void Plugin::configure(const Descriptor&) {}
+void Plugin::configure(const Descriptor&, PluginSetup&) {}
 void Plugin::destroy() {}
 void Plugin::saveState(StateWriter&) const {}
 void Plugin::loadState(StateReader&) {}
+
+void PluginSetup::subscribe(const Sensor& sensor, std::function<void(const Measurement&)> callback) {
+  env_->subscribe(sensor, env_->artifact(plugin_->artifact().index()), std::move(callback));
+}
+
+void PluginSetup::requireMeasurement(const Sensor& sensor, bool matches) const {
+  if (!matches)
+    throw ConfigError({}, plugin_->className() + " of artifact '" + plugin_->artifact().name() +
+                              "' subscribed to sensor '" + sensor.className() + "' of artifact '" +
+                              sensor.artifact().name() + "' for a measurement type it does not produce");
+}
+
+void PluginSetup::enableNeighborQueries(double cell_size) { env_->enableNeighborQueries(cell_size); }
+
+void PluginSetup::addCameraRequest(std::function<bool(std::int64_t, CameraView&)> due, Image& target) {
+  const char* kind = dynamic_cast<const Driver*>(plugin_) != nullptr ? "driver '" : "sensor '";
+  env_->addCameraRequest(kind + plugin_->className() + "' of artifact '" + plugin_->artifact().name() + "'",
+                         std::move(due), target);
+}
 
 Measurement::~Measurement() = default;
 

@@ -37,7 +37,7 @@ class CameraSensor final : public SensorOf<CameraMeasurement> {
       throw params.errorAt("far", "far must be beyond near");
   }
 
-  void configure(const Descriptor& params) override {
+  void configure(const Descriptor& params, PluginSetup& setup) override {
     node_ = &artifact().nodeFromParameter(params);
     mount_.position = params.get<Vec3>("xyz");
     const Vec3 rpy = params.get<Vec3>("rpy");
@@ -49,8 +49,7 @@ class CameraSensor final : public SensorOf<CameraMeasurement> {
     lens_.near = params.get<double>("near");
     lens_.far = params.get<double>("far");
     lens_.depth = params.get<bool>("depth");
-    environment().addCameraRequest(
-        "sensor 'camera' of artifact '" + artifact().name() + "'",
+    setup.addCameraRequest(
         [this](std::int64_t step, CameraView& view) {
           if (step % periodSteps() != 0) return false;
           view = lens_;

@@ -30,7 +30,7 @@ class HoverDriver final : public Driver {
     if (a.rootCount() == 0 || a.root().isStatic()) throw params.error("hover needs a dynamic physic root");
   }
 
-  void configure(const Descriptor& params) override {
+  void configure(const Descriptor& params, PluginSetup& setup) override {
     Artifact& a = artifact();
     const Vec3 offset = params.get<Vec3>("offset");
     target_ = params.get<Vec3>("target", Vec3(a.placement().position + offset));
@@ -46,7 +46,7 @@ class HoverDriver final : public Driver {
     // use the first pose sensor of this artifact, if any
     for (std::size_t i = 0; i < a.sensorCount(); ++i) {
       if (dynamic_cast<const PoseMeasurement*>(&a.sensor(i).latest()) == nullptr) continue;
-      environment().subscribe<PoseMeasurement>(a.sensor(i), a, [this](const PoseMeasurement& m) {
+      setup.subscribe<PoseMeasurement>(a.sensor(i), [this](const PoseMeasurement& m) {
         measured_ = m;
         have_measurement_ = true;
       });

@@ -112,7 +112,7 @@ class ImuSensor final : public SensorOf<ImuMeasurement> {
     }
   }
 
-  void configure(const Descriptor& params) override {
+  void configure(const Descriptor& params, PluginSetup& /*setup*/) override {
     node_ = &artifact().nodeFromParameter(params);
     const bool noise = params.get<bool>("noise");
     gyro_.read(params, "gyro_");

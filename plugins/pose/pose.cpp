@@ -24,7 +24,7 @@ class PoseSensor final : public SensorOf<PoseMeasurement> {
     (void)context.artifact->nodeFromParameter(params);
   }
 
-  void configure(const Descriptor& params) override {
+  void configure(const Descriptor& params, PluginSetup& /*setup*/) override {
     node_ = &artifact().nodeFromParameter(params);
     position_noise_ = params.get<double>("position_noise");
     orientation_noise_ = params.get<double>("orientation_noise");

@@ -82,9 +82,9 @@ void QuadrotorDriver::validate(const Descriptor& params, const PluginContext& co
   }
 }
 
-void QuadrotorDriver::configure(const Descriptor& params) {
+void QuadrotorDriver::configure(const Descriptor& params, PluginSetup& setup) {
   Artifact& a = artifact();
-  Environment& env = environment();
+  const Environment& env = environment();
   const RotorParams rp = rotorParams(params);
   const std::vector<Rotor> rotors = rotorsOf(params, a);
   const MassProperties mass = combinedMass(a.root().spec());
@@ -105,10 +105,10 @@ void QuadrotorDriver::configure(const Descriptor& params) {
   const Sensor* imu = firstSensorOf<ImuMeasurement>(a);
   if (imu == nullptr) throw params.error("a quadrotor needs an IMU: add <sensor plugin=\"imu\"/> to the artifact");
   imu_ = static_cast<const ImuMeasurement*>(&imu->latest());
-  env.subscribe<ImuMeasurement>(*imu, a, [this](const ImuMeasurement&) { imu_seen_ = true; });
+  setup.subscribe<ImuMeasurement>(*imu, [this](const ImuMeasurement&) { imu_seen_ = true; });
   if (const Sensor* pose = firstSensorOf<PoseMeasurement>(a)) {
     have_pose_ = true;
-    env.subscribe<PoseMeasurement>(*pose, a, [this](const PoseMeasurement& m) { pose_ = m; });
+    setup.subscribe<PoseMeasurement>(*pose, [this](const PoseMeasurement& m) { pose_ = m; });
   }
 
   // inner loop
@@ -177,7 +177,7 @@ void QuadrotorDriver::configure(const Descriptor& params) {
     formation_.obstacle_saturation = params.get<double>("obstacle_saturation");
     const Sensor* range = firstSensorOf<RangeMeasurement>(a);
     if (range == nullptr) throw params.error("reference=\"formation\" needs a range sensor on the artifact");
-    env.subscribe<RangeMeasurement>(*range, a, [this](const RangeMeasurement& m) { seen_ = m.detections; });
+    setup.subscribe<RangeMeasurement>(*range, [this](const RangeMeasurement& m) { seen_ = m.detections; });
     virtual_point_ = start + params.get<Vec3>("offset");
     own_target_ = formation_.target(formation_index_);
   } else {

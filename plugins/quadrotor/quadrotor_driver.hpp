@@ -76,7 +76,7 @@ class QuadrotorDriver final : public Driver, public SetpointInterface {
       param::real("obstacle_saturation", "0.2", "m", param::positive(), "the repulsion is saturated inside it"),
   };
   static void validate(const Descriptor& params, const PluginContext& context);
-  void configure(const Descriptor& params) override;
+  void configure(const Descriptor& params, PluginSetup& setup) override;
   void step(const StepInfo& info) override;
   void saveState(StateWriter& out) const override;
   void loadState(StateReader& in) override;

@@ -71,7 +71,7 @@ class RangeSensor final : public SensorOf<RangeMeasurement> {
       throw params.error("a range sensor needs a dynamic root");
   }
 
-  void configure(const Descriptor& params) override {
+  void configure(const Descriptor& params, PluginSetup& setup) override {
     range_ = params.get<double>("range");
     output().body_frame = params.get<std::string>("frame") == "body";
     noise_ = params.get<double>("position_noise");
@@ -79,8 +79,8 @@ class RangeSensor final : public SensorOf<RangeMeasurement> {
     cos_half_fov_ = fov >= 360 ? -2.0 : std::cos(fov / 2 * std::numbers::pi / 180.0);
     max_count_ = static_cast<std::size_t>(params.get<std::int64_t>("max_count"));
 
-    Environment& env = environment();
-    env.enableNeighborQueries(range_);
+    const Environment& env = environment();
+    setup.enableNeighborQueries(range_);
     if (params.get<bool>("obstacles"))
       for (const ObstacleShape& o : env.staticShapes())
         if (o.shape.kind != Shape::Kind::Plane) obstacles_.push_back(&o);

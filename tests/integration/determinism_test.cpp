@@ -26,10 +26,10 @@ class NoisyPoseSensor final : public SensorOf<NoisyPose> {
 // pushes towards the neighbour's noisy position it hears about, plus a random kick
 class JitterDriver final : public Driver {
  public:
-  void configure(const Descriptor&) override {
-    Environment& env = environment();
-    Artifact& next = env.artifact((artifact().index() % (env.artifactCount() - 1)) + 1);
-    env.subscribe<NoisyPose>(next.sensor(0), artifact(), [this](const NoisyPose& p) { heard_ = p.position; });
+  void configure(const Descriptor&, PluginSetup& setup) override {
+    const Environment& env = environment();
+    const Artifact& next = env.artifact((artifact().index() % (env.artifactCount() - 1)) + 1);
+    setup.subscribe<NoisyPose>(next.sensor(0), [this](const NoisyPose& p) { heard_ = p.position; });
   }
   void step(const StepInfo&) override {
     const Vec3 toward = heard_ - artifact().pose().position;

@@ -14,7 +14,7 @@ class Spinner final : public ssx::Driver {
   static constexpr ssx_plugin_param kParameters[] = {
       ssx::param::real("torque", "0.1", "N m", ssx::param::any(), "torque about z"),
   };
-  void configure(const ssx::Descriptor& params) override { torque_ = params.get<double>("torque", 0.1); }
+  void configure(const ssx::Descriptor& params, ssx::PluginSetup& /*setup*/) override { torque_ = params.get<double>("torque", 0.1); }
   void step(const ssx::StepInfo&) override { artifact().root().addTorque(ssx::Vec3(0, 0, torque_)); }
 
  private:
@@ -36,7 +36,7 @@ class Bomb final : public ssx::Driver {
       ssx::param::integer("at_step", "0", ssx::param::nonNegative(), "step to throw at"),
       ssx::param::text("only", "", "throw only in the artifact of this name (default: every artifact)"),
   };
-  void configure(const ssx::Descriptor& params) override {
+  void configure(const ssx::Descriptor& params, ssx::PluginSetup& /*setup*/) override {
     at_step_ = params.get<std::int64_t>("at_step", 0);
     armed_ = params.get<std::string>("only", artifact().name()) == artifact().name();
   }

@@ -4,6 +4,8 @@
 
 #include <limits>
 #include <string>
+#include <type_traits>
+#include <utility>
 #include <vector>
 
 using namespace ssx;
@@ -322,13 +324,31 @@ TEST_CASE("substeps split the timestep", "[environment]") {
   CHECK(fall(4, 0.004, 100) != Approx(fall(1, 0.004, 100)).margin(1e-9));
 }
 
-TEST_CASE("sensors cannot write forces", "[environment]") {
+// what a plugin reaches is read-only unless it is its own to write: checked by the compiler
+template <class T>
+concept Pushable = requires(T& node) { node.addForce(Vec3(1, 0, 0)); };
+template <class T>
+concept Subscribable = requires(T& env, const Sensor& s, Artifact& a) { env.subscribe(s, a, [](const Measurement&) {}); };
+static_assert(Pushable<PhysicNode> && !Pushable<const PhysicNode>);
+static_assert(std::is_same_v<decltype(std::declval<Sensor&>().artifact()), const Artifact&>);
+static_assert(std::is_same_v<decltype(std::declval<Driver&>().artifact()), Artifact&>);
+static_assert(std::is_same_v<decltype(std::declval<const Artifact&>().root()), const PhysicNode&>);
+static_assert(std::is_same_v<decltype(std::declval<Driver&>().environment()), const Environment&>);
+static_assert(std::is_same_v<decltype(std::declval<const Environment&>().artifact(0)), const Artifact&>);
+static_assert(std::is_same_v<decltype(std::declval<const Environment&>().physics()), const PhysicEngine&>);
+static_assert(Subscribable<Environment> && !Subscribable<const Environment>);
+
+TEST_CASE("sensors cannot write forces, even through a writable handle they were given", "[environment]") {
+  // the types keep a sensor's own artifact read-only; a handle smuggled in is refused at run time
   struct Pushy : SensorOf<Counter> {
-    void sense(const StepInfo&) override { artifact().root().addForce(Vec3(1, 0, 0)); }
+    Artifact* target = nullptr;
+    void sense(const StepInfo&) override { target->root().addForce(Vec3(1, 0, 0)); }
   };
   Environment env;
   Artifact& a = addBall(env, "a");
-  a.addSensor(std::make_unique<Pushy>(), {}, 1, "pushy");
+  auto pushy = std::make_unique<Pushy>();
+  pushy->target = &a;
+  a.addSensor(std::move(pushy), {}, 1, "pushy");
   CHECK_THROWS_WITH(env.step(), Catch::Contains("a sensor tried to write to artifact 'a'"));
 }
 

@@ -39,7 +39,9 @@ class SSX_EXPORT Artifact {
   const std::string& name() const noexcept { return name_; }
   /// Position in the environment's artifact list; streams and orders derive from it.
   std::size_t index() const noexcept { return index_; }
-  Environment& environment() const noexcept;
+  /// The environment, read-only: what may change it (subscriptions, neighbour queries, camera
+  /// requests) is reached from a plugin's configure (PluginSetup) or by the embedding program.
+  const Environment& environment() const noexcept;
   /// The pose the artifact was placed at; root nodes are posed relative to it.
   const Pose& placement() const noexcept { return placement_; }
 
@@ -61,30 +63,46 @@ class SSX_EXPORT Artifact {
   Sensor& addSensor(Sensor& sensor, Descriptor params, std::int64_t period_steps, std::string class_name);
 
   // --- access -------------------------------------------------------------------------------
+  // Through a const Artifact (what plugins see of other artifacts, and sensors of their own)
+  // nodes, driver and sensors are const: reading the state, not writing commands.
 
-  Driver* driver() const noexcept;
+  Driver* driver() noexcept;
+  const Driver* driver() const noexcept;
   std::size_t sensorCount() const noexcept;
-  Sensor& sensor(std::size_t i) const;
+  Sensor& sensor(std::size_t i);
+  const Sensor& sensor(std::size_t i) const;
   /// The parameters the driver is (or will be) configured with.
   const Descriptor& driverParameters() const noexcept;
   /// The parameters sensor i is (or will be) configured with.
   const Descriptor& sensorParameters(std::size_t i) const;
   /// The first sensor of type T, or nullptr.
   template <class T>
-  T* findSensor() const {
+  T* findSensor() {
     for (std::size_t i = 0; i < sensorCount(); ++i)
       if (auto* t = dynamic_cast<T*>(&sensor(i))) return t;
     return nullptr;
   }
+  template <class T>
+  const T* findSensor() const {
+    for (std::size_t i = 0; i < sensorCount(); ++i)
+      if (auto* t = dynamic_cast<const T*>(&sensor(i))) return t;
+    return nullptr;
+  }
 
   std::size_t rootCount() const noexcept { return roots_.size(); }
-  PhysicNode& root(std::size_t i = 0) const { return *roots_.at(i); }
+  PhysicNode& root(std::size_t i = 0) { return *roots_.at(i); }
+  const PhysicNode& root(std::size_t i = 0) const { return *roots_.at(i); }
   /// Node by name, searching every tree; nullptr if none.
-  PhysicNode* node(std::string_view name) const;
+  PhysicNode* node(std::string_view name);
+  const PhysicNode* node(std::string_view name) const;
   /// The node a plugin parameter names (`key`, default "node"), or the first root when the parameter
   /// is absent or empty; throws the parameter's ConfigError when there is no such node.
-  PhysicNode& nodeFromParameter(const Descriptor& params, std::string_view key = "node") const;
-  const std::vector<std::unique_ptr<PhysicNode>>& nodes() const noexcept { return nodes_; }
+  PhysicNode& nodeFromParameter(const Descriptor& params, std::string_view key = "node");
+  const PhysicNode& nodeFromParameter(const Descriptor& params, std::string_view key = "node") const;
+  /// Every node of every tree, trees in order (node i of nodeCount()).
+  std::size_t nodeCount() const noexcept { return nodes_.size(); }
+  PhysicNode& nodeAt(std::size_t i) { return *nodes_.at(i); }
+  const PhysicNode& nodeAt(std::size_t i) const { return *nodes_.at(i); }
   const std::vector<RenderNodeSpec>& renderRoots() const noexcept { return render_roots_; }
 
   /// State of the first root node (world frame). Requires a physic root.

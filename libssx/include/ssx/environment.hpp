@@ -160,16 +160,21 @@ class SSX_EXPORT Environment {
   unsigned threadCount() const noexcept;
 
   std::size_t artifactCount() const noexcept;
-  Artifact& artifact(std::size_t index) const;
+  Artifact& artifact(std::size_t index);
+  const Artifact& artifact(std::size_t index) const;
   /// Artifact by name, or nullptr.
-  Artifact* findArtifact(std::string_view name) const;
+  Artifact* findArtifact(std::string_view name);
+  const Artifact* findArtifact(std::string_view name) const;
   /// Artifacts chosen by a parameter: "*" is every artifact with a dynamic root, else names
   /// separated by spaces, each of an artifact with a physic root. Throws Error naming the first
   /// name that is not.
-  std::vector<Artifact*> selectArtifacts(std::string_view names) const;
+  std::vector<Artifact*> selectArtifacts(std::string_view names);
+  std::vector<const Artifact*> selectArtifacts(std::string_view names) const;
   /// The same for the names a plugin parameter `key` gives; throws the parameter's ConfigError,
   /// "... to <purpose>", when a name does not fit.
-  std::vector<Artifact*> selectArtifacts(const Descriptor& params, std::string_view key, std::string_view purpose) const;
+  std::vector<Artifact*> selectArtifacts(const Descriptor& params, std::string_view key, std::string_view purpose);
+  std::vector<const Artifact*> selectArtifacts(const Descriptor& params, std::string_view key,
+                                               std::string_view purpose) const;
   /// Extension by name, or nullptr.
   SimulationExtension* extension(std::string_view name) const;
   template <class T>
@@ -227,7 +232,7 @@ class SSX_EXPORT Environment {
   /// The physics engine, read-only (bodies are added by the environment, at start); throws when
   /// the environment is not running.
   const PhysicEngine& physics() const;
-  RenderEngine& renderer() const;
+  const RenderEngine& renderer() const;
   /// Per-step timing of every step taken so far.
   TimingRecorder& timing() noexcept { return timing_; }
   const TimingRecorder& timing() const noexcept { return timing_; }

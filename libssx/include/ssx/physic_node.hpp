@@ -96,9 +96,10 @@ class SSX_EXPORT PhysicNode {
 
   const std::string& name() const noexcept { return spec_->name; }
   const PhysicNodeSpec& spec() const noexcept { return *spec_; }
-  Artifact& artifact() const noexcept { return *artifact_; }
+  Artifact& artifact() noexcept { return *artifact_; }
+  const Artifact& artifact() const noexcept { return *artifact_; }
   /// The parent node, or nullptr for a root.
-  PhysicNode* parent() const noexcept { return parent_; }
+  const PhysicNode* parent() const noexcept { return parent_; }
   /// Fixed in the world (its root is static).
   bool isStatic() const noexcept;
   /// Index of this node among all nodes of the environment (artifact by artifact, trees in order).

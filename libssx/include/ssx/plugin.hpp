@@ -18,6 +18,11 @@ namespace ssx {
 
 class Artifact;
 class Environment;
+class PluginSetup;
+class Sensor;
+struct Image;
+struct CameraView;
+struct Measurement;
 namespace detail {
 struct World;
 }
@@ -40,10 +45,12 @@ class SSX_EXPORT Plugin {
 
   /// Called once when the environment starts, after the engines are configured and the first
   /// snapshot is published, on the thread that starts the environment; artifact by artifact,
-  /// each artifact's sensors before its driver. `params` are this
-  /// instance's parameters (from the artifact file, or given in code). Subscriptions to sensors
-  /// are made here. Throw ConfigError (use `params.error(...)`) for bad parameters.
-  virtual void configure(const Descriptor& params);
+  /// each artifact's sensors before its driver. `params` are this instance's parameters (from the
+  /// artifact file, or given in code), already checked against the class's declarations.
+  /// `setup` is what only configure may do: subscribe to sensors, enable neighbour queries,
+  /// request camera images; it is valid during this call only. Throw ConfigError (use
+  /// `params.error(...)`) for what the declarations cannot say.
+  virtual void configure(const Descriptor& params, PluginSetup& setup);
   /// Called once when the environment stops, before the engines stop.
   virtual void destroy();
   /// Writes what this plugin keeps between its runs and what it depends on (see ssx/state.hpp),
@@ -53,10 +60,10 @@ class SSX_EXPORT Plugin {
   /// scene. Default: nothing.
   virtual void loadState(StateReader& in);
 
-  /// The artifact this plugin belongs to.
-  Artifact& artifact() const noexcept { return *artifact_; }
-  /// The environment of that artifact.
-  Environment& environment() const noexcept;
+  /// The artifact this plugin belongs to, read-only (a Driver gets it writable: see there).
+  const Artifact& artifact() const noexcept { return *artifact_; }
+  /// The environment of that artifact, read-only.
+  const Environment& environment() const noexcept;
   /// This instance's random stream, seeded from (scene seed, artifact index, plugin index):
   /// the same numbers whatever the number of threads. Use it only inside this plugin's calls.
   /// Kept in the world state (saved and restored with it). Throws before the plugin is attached.
@@ -88,6 +95,8 @@ class SSX_EXPORT Plugin {
 class SSX_EXPORT Driver : public Plugin {
  public:
   virtual void step(const StepInfo& info) = 0;
+  /// Its own artifact, writable: its nodes take this driver's forces and torques.
+  Artifact& artifact() const noexcept { return const_cast<Artifact&>(Plugin::artifact()); }
 };
 
 /// Base of every measurement a sensor delivers; `stamp` is the simulated time it was taken.
@@ -125,6 +134,33 @@ class SensorOf : public Sensor {
   M measurement_{};
 };
 
+/// What a driver or sensor may do only while it is configured: the calls that change what the
+/// parallel phases read. Handed to Plugin::configure, valid during that call only.
+class SSX_EXPORT PluginSetup {
+ public:
+  PluginSetup(Environment& environment, Plugin& plugin) noexcept : env_(&environment), plugin_(&plugin) {}
+  PluginSetup(const PluginSetup&) = delete;
+  PluginSetup& operator=(const PluginSetup&) = delete;
+
+  const Environment& environment() const noexcept { return *env_; }
+  /// Delivers `sensor`'s fresh measurements to `callback`, in the drivers phase, on the thread of
+  /// this plugin's artifact (which receives them).
+  void subscribe(const Sensor& sensor, std::function<void(const Measurement&)> callback);
+  /// Typed form: the sensor's measurement must be an M (checked now).
+  template <class M>
+  void subscribe(const Sensor& sensor, std::function<void(const M&)> callback);
+  /// Turns the environment's neighbour queries on (Environment::neighbors), with cells of at most
+  /// `cell_size` m.
+  void enableNeighborQueries(double cell_size);
+  /// Asks for camera images (Environment::addCameraRequest), named after this plugin.
+  void addCameraRequest(std::function<bool(std::int64_t step, CameraView& view)> due, Image& target);
+
+ private:
+  void requireMeasurement(const Sensor& sensor, bool matches) const;
+  Environment* env_;
+  Plugin* plugin_;
+};
+
 /// A bridge to the outside world (ROS, a logger, a network link). Runs on the thread that calls
 /// Environment::start/step/stop.
 ///
@@ -148,5 +184,11 @@ class SSX_EXPORT SimulationExtension {
   virtual void saveState(StateWriter& out) const;
   virtual void loadState(StateReader& in);
 };
+
+template <class M>
+void PluginSetup::subscribe(const Sensor& sensor, std::function<void(const M&)> callback) {
+  requireMeasurement(sensor, dynamic_cast<const M*>(&sensor.latest()) != nullptr);
+  subscribe(sensor, [cb = std::move(callback)](const Measurement& m) { cb(static_cast<const M&>(m)); });
+}
 
 }  // namespace ssx

@@ -32,8 +32,9 @@
 #include <type_traits>
 #include <vector>
 
-/// Incremented whenever the manifest layout or the meaning of its fields changes.
-#define SSX_PLUGIN_ABI_VERSION 2u
+/// Incremented whenever the manifest layout, the meaning of its fields or the plugin base classes
+/// (Plugin, Driver, Sensor, SimulationExtension: their virtual functions and members) change.
+#define SSX_PLUGIN_ABI_VERSION 3u
 
 #define SSX_PLUGIN_STRINGIFY2(x) #x
 #define SSX_PLUGIN_STRINGIFY(x) SSX_PLUGIN_STRINGIFY2(x)
