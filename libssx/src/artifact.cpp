@@ -11,11 +11,10 @@
 namespace ssx {
 
 Artifact::Artifact(detail::World& world, std::string name, std::size_t index, const Pose& placement)
-    : world_(&world), name_(std::move(name)), index_(index), placement_(placement) {}
+    : world_(&world), env_(&world.env), name_(std::move(name)), index_(index), placement_(placement) {}
 
 Artifact::~Artifact() = default;
 
-const Environment& Artifact::environment() const noexcept { return world_->env; }
 
 void Artifact::requireSetup(const char* what) const {
   if (world_->state != Environment::State::Setup)
@@ -24,10 +23,13 @@ void Artifact::requireSetup(const char* what) const {
 
 void Artifact::buildNodes(PhysicNode* parent, const PhysicNodeSpec& spec) {
   const std::size_t index = world_->nodes.size();
+  detail::ArtifactData& own = world_->data(*this);
+  if (own.node_end == 0) own.first_node = static_cast<std::uint32_t>(index);
+  own.node_end = static_cast<std::uint32_t>(index + 1);
   detail::NodeData data;
-  data.setup_pose = (parent != nullptr ? parent->pose() : placement_) * spec.pose;
   data.is_static = parent != nullptr ? parent->isStatic() : spec.is_static;
   world_->nodes.push_back(data);
+  world_->node_setup.push_back({(parent != nullptr ? parent->pose() : placement_) * spec.pose});
   nodes_.push_back(std::make_unique<PhysicNode>(*world_, *this, spec, parent, index));
   PhysicNode* node = nodes_.back().get();
   if (parent == nullptr) roots_.push_back(node);
@@ -60,6 +62,10 @@ Plugin& Artifact::attach(Plugin& plugin, std::uint32_t plugin_index, std::int64_
   if (plugin.attached())
     throw ConfigError(params.where(), "artifact '" + name_ + "': this " + kind + " instance belongs to artifact '" +
                                           plugin.artifact().name() + "' already; create one instance per artifact");
+  detail::ArtifactData& own = world_->data(*this);
+  const std::size_t at = world_->plugins.size();
+  if (own.slot_end == 0) own.first_slot = static_cast<std::uint32_t>(at);
+  own.slot_end = static_cast<std::uint32_t>(at + 1);
   detail::PluginSlot slot;
   slot.artifact = static_cast<std::uint32_t>(index_);
   slot.index = plugin_index;
@@ -67,9 +73,9 @@ Plugin& Artifact::attach(Plugin& plugin, std::uint32_t plugin_index, std::int64_
   slot.class_name = !class_name.empty() ? std::move(class_name)
                     : plugin_index == 0 ? std::string("driver")
                                         : "sensor" + std::to_string(plugin_index - 1);
-  slot.random.reseed(deriveSeed(world_->settings.seed, index_, plugin_index));
   world_->plugins.push_back(std::move(slot));
-  plugin.bind(*world_, *this, static_cast<std::uint32_t>(world_->plugins.size() - 1));
+  world_->randoms.emplace_back(deriveSeed(world_->settings.seed, index_, plugin_index));
+  plugin.bind(*world_, *this, static_cast<std::uint32_t>(world_->plugins.size() - 1), period_steps);
   return plugin;
 }
 
@@ -77,7 +83,7 @@ Driver& Artifact::setDriver(std::unique_ptr<Driver> driver, Descriptor params, s
                             std::string class_name) {
   if (!driver) throw Error("artifact '" + name_ + "': setDriver given a null driver");
   Driver& d = setDriver(*driver, std::move(params), period_steps, std::move(class_name));
-  world_->data(*this).owned_driver = std::move(driver);
+  world_->model(*this).owned_driver = std::move(driver);
   return d;
 }
 
@@ -87,7 +93,7 @@ Driver& Artifact::setDriver(Driver& driver, Descriptor params, std::int64_t peri
   if (data.driver != nullptr) throw ConfigError(params.where(), "artifact '" + name_ + "' already has a driver");
   attach(driver, 0, period_steps, std::move(class_name), params);
   data.driver = &driver;
-  data.driver_params = std::move(params);
+  world_->model(*this).driver_params = std::move(params);
   data.driver_period = period_steps;
   return driver;
 }
@@ -96,7 +102,7 @@ Sensor& Artifact::addSensor(std::unique_ptr<Sensor> sensor, Descriptor params, s
                             std::string class_name) {
   if (!sensor) throw Error("artifact '" + name_ + "': addSensor given a null sensor");
   Sensor& s = addSensor(*sensor, std::move(params), period_steps, std::move(class_name));
-  world_->data(*this).sensors.back().owned = std::move(sensor);
+  world_->model(*this).owned_sensors.back() = std::move(sensor);
   return s;
 }
 
@@ -104,7 +110,10 @@ Sensor& Artifact::addSensor(Sensor& sensor, Descriptor params, std::int64_t peri
   requireSetup("sensors can be added");
   detail::ArtifactData& data = world_->data(*this);
   attach(sensor, static_cast<std::uint32_t>(data.sensors.size() + 1), period_steps, std::move(class_name), params);
-  data.sensors.push_back({&sensor, nullptr, std::move(params), period_steps, false});
+  data.sensors.push_back({&sensor, period_steps, false});
+  detail::ArtifactModel& model = world_->model(*this);
+  model.owned_sensors.emplace_back();
+  model.sensor_params.push_back(std::move(params));
   return sensor;
 }
 
@@ -113,8 +122,8 @@ const Driver* Artifact::driver() const noexcept { return world_->data(*this).dri
 std::size_t Artifact::sensorCount() const noexcept { return world_->data(*this).sensors.size(); }
 Sensor& Artifact::sensor(std::size_t i) { return *world_->data(*this).sensors.at(i).sensor; }
 const Sensor& Artifact::sensor(std::size_t i) const { return *world_->data(*this).sensors.at(i).sensor; }
-const Descriptor& Artifact::driverParameters() const noexcept { return world_->data(*this).driver_params; }
-const Descriptor& Artifact::sensorParameters(std::size_t i) const { return world_->data(*this).sensors.at(i).params; }
+const Descriptor& Artifact::driverParameters() const noexcept { return world_->model(*this).driver_params; }
+const Descriptor& Artifact::sensorParameters(std::size_t i) const { return world_->model(*this).sensor_params.at(i); }
 
 PhysicNode* Artifact::node(std::string_view name) {
   for (const auto& n : nodes_)
@@ -144,20 +153,19 @@ PhysicNode& Artifact::nodeFromParameter(const Descriptor& params, std::string_vi
 
 // --- Plugin: its slot in the world ---------------------------------------------------------------
 
-void Plugin::bind(detail::World& world, Artifact& artifact, std::uint32_t slot) noexcept {
+void Plugin::bind(detail::World& world, Artifact& artifact, std::uint32_t slot, std::int64_t period_steps) noexcept {
   world_ = &world;
   artifact_ = &artifact;
+  env_ = &world.env;
   slot_ = slot;
+  period_steps_ = period_steps;
 }
-
-const Environment& Plugin::environment() const noexcept { return world_->env; }
 
 Random& Plugin::random() {
   if (world_ == nullptr) throw Error("random(): the plugin is not attached to an artifact yet");
-  return world_->plugins[slot_].random;
+  return world_->randoms[slot_];
 }
 
-std::int64_t Plugin::periodSteps() const noexcept { return world_ != nullptr ? world_->plugins[slot_].period_steps : 1; }
 
 const std::string& Plugin::className() const noexcept {
   static const std::string unattached = "plugin";
@@ -173,18 +181,19 @@ const Pose& PhysicNode::poseInBody() const noexcept { return world_->nodes[index
 BodyState PhysicNode::state() const {
   const detail::NodeData& n = world_->nodes[index_];
   if (n.body >= 0 && world_->started()) return world_->states[static_cast<std::size_t>(n.body)].attached(n.pose_in_body);
+  const detail::NodeSetup& setup = world_->node_setup[index_];
   BodyState s;
-  s.pose = n.setup_pose;
+  s.pose = setup.pose;
   if (!n.is_static) {
-    s.linear_velocity = n.initial_linear;
-    s.angular_velocity = n.initial_angular;
+    s.linear_velocity = setup.initial_linear;
+    s.angular_velocity = setup.initial_angular;
   }
   return s;
 }
 
 Pose PhysicNode::pose() const {
   const detail::NodeData& n = world_->nodes[index_];
-  if (n.body < 0 || !world_->started()) return n.setup_pose;
+  if (n.body < 0 || !world_->started()) return world_->node_setup[index_].pose;
   return world_->states[static_cast<std::size_t>(n.body)].pose * n.pose_in_body;
 }
 
@@ -238,8 +247,8 @@ void PhysicNode::setVelocity(const Vec3& linear, const Vec3& angular) {
                 "': velocity must be finite and within max_linear_speed / max_angular_speed");
   detail::NodeData& n = world_->nodes[index_];
   if (env.state() == Environment::State::Setup) {
-    n.initial_linear = linear;
-    n.initial_angular = angular;
+    world_->node_setup[index_].initial_linear = linear;
+    world_->node_setup[index_].initial_angular = angular;
     return;
   }
   if (n.is_static) throw Error("node '" + name() + "' of artifact '" + artifact_->name() + "' is static");

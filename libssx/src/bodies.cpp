@@ -19,48 +19,48 @@ void buildBodies(World& world, PhysicEngine& engine, std::vector<Environment::St
     for (std::size_t r = 0; r < artifact->rootCount(); ++r) {
       const PhysicNode& root = artifact->root(r);
       const PhysicNodeSpec& spec = root.spec();
-      const NodeData& root_data = world.nodes[root.nodeIndex()];
+      const NodeSetup& root_data = world.node_setup[root.nodeIndex()];
       std::vector<Shape> shapes;
-      std::vector<NodeData*> tree;  // the root and its descendants, in order
+      std::vector<std::size_t> tree;  // the root and its descendants, in order
       std::vector<const PhysicNodeSpec*> specs;
       for (std::size_t k = 0; k < artifact->nodeCount(); ++k) {
         const PhysicNode& n = artifact->nodeAt(k);
         const PhysicNode* top = &n;
         while (top->parent() != nullptr) top = top->parent();
         if (top != &root) continue;
-        tree.push_back(&world.nodes[n.nodeIndex()]);
+        tree.push_back(n.nodeIndex());
         specs.push_back(&n.spec());
       }
       if (spec.is_static) {
         for (std::size_t k = 0; k < tree.size(); ++k) {
-          NodeData& n = *tree[k];
-          n.pose_in_body = root_data.setup_pose.inverse() * n.setup_pose;
+          NodeData& n = world.nodes[tree[k]];
+          n.pose_in_body = root_data.pose.inverse() * world.node_setup[tree[k]].pose;
           for (Shape s : specs[k]->shapes) {
             s.pose = n.pose_in_body * s.pose;
             shapes.push_back(s);
-            static_shapes.push_back({s, root_data.setup_pose * s.pose, artifact->index()});
+            static_shapes.push_back({s, root_data.pose * s.pose, artifact->index()});
           }
         }
-        engine.addStatic(shapes, root_data.setup_pose);
+        engine.addStatic(shapes, root_data.pose);
         continue;
       }
       const MassProperties mass = combinedMass(spec);
       const Pose root_in_body{-mass.center_of_mass, Quat::Identity()};
       for (std::size_t k = 0; k < tree.size(); ++k) {
-        NodeData& n = *tree[k];
-        n.pose_in_body = root_in_body * (root_data.setup_pose.inverse() * n.setup_pose);
+        NodeData& n = world.nodes[tree[k]];
+        n.pose_in_body = root_in_body * (root_data.pose.inverse() * world.node_setup[tree[k]].pose);
         for (Shape s : specs[k]->shapes) {
           s.pose = n.pose_in_body * s.pose;
           shapes.push_back(s);
         }
       }
       BodyState initial;
-      initial.pose = root_data.setup_pose * root_in_body.inverse();
+      initial.pose = root_data.pose * root_in_body.inverse();
       initial.angular_velocity = root_data.initial_angular;
       initial.linear_velocity = root_data.initial_linear +
-                                root_data.initial_angular.cross(initial.pose.position - root_data.setup_pose.position);
+                                root_data.initial_angular.cross(initial.pose.position - root_data.pose.position);
       const int body = engine.addBody(mass, shapes, initial);
-      for (NodeData* n : tree) n->body = body;
+      for (std::size_t k : tree) world.nodes[k].body = body;
       world.body_owner.push_back(static_cast<std::uint32_t>(artifact->index()));
     }
     data.body_end = static_cast<int>(engine.bodyCount());

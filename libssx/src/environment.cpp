@@ -103,6 +103,7 @@ Artifact& Environment::addArtifact(std::string name, const Pose& placement) {
   detail::World& w = *world_;
   w.artifacts.push_back(std::make_unique<Artifact>(w, std::move(name), w.artifacts.size(), placement));
   w.artifact_data.emplace_back();
+  w.models.emplace_back();
   w.names.emplace(w.artifacts.back()->name(), w.artifacts.back().get());
   return *w.artifacts.back();
 }
@@ -261,10 +262,13 @@ void Environment::checkDeclaredParameters() {
     check(e.extension, e.params, nullptr, 1, [&] { return "extension '" + e.name + "'"; });
   for (auto& a : world_->artifacts) {
     detail::ArtifactData& data = world_->data(*a);
+    detail::ArtifactModel& model = world_->model(*a);
     if (Driver* d = data.driver)
-      check(d, data.driver_params, a.get(), d->periodSteps(), [&] { return "driver '" + d->className() + "'"; });
-    for (auto& s : data.sensors)
-      check(s.sensor, s.params, a.get(), s.sensor->periodSteps(), [&] { return "sensor '" + s.sensor->className() + "'"; });
+      check(d, model.driver_params, a.get(), d->periodSteps(), [&] { return "driver '" + d->className() + "'"; });
+    for (std::size_t k = 0; k < data.sensors.size(); ++k) {
+      Sensor* s = data.sensors[k].sensor;
+      check(s, model.sensor_params[k], a.get(), s->periodSteps(), [&] { return "sensor '" + s->className() + "'"; });
+    }
   }
   if (!errors.empty()) throw Error(errors + "\nnothing was run");
 }
@@ -292,15 +296,17 @@ void Environment::start() {
     w.errors.assign(w.artifacts.size(), detail::PendingError{});
     w.state = State::Running;  // configure may subscribe and read the snapshot
     w.configuring = true;
-    for (auto& data : w.artifact_data) {
+    for (std::size_t i = 0; i < w.artifacts.size(); ++i) {
+      const detail::ArtifactData& data = w.artifact_data[i];
+      const detail::ArtifactModel& model = w.models[i];
       // sensors first: a driver may read their configuration (rates, resolutions)
-      for (auto& s : data.sensors) {
-        PluginSetup setup(*this, *s.sensor);
-        s.sensor->configure(s.params, setup);
+      for (std::size_t k = 0; k < data.sensors.size(); ++k) {
+        PluginSetup setup(*this, *data.sensors[k].sensor);
+        data.sensors[k].sensor->configure(model.sensor_params[k], setup);
       }
       if (data.driver) {
         PluginSetup setup(*this, *data.driver);
-        data.driver->configure(data.driver_params, setup);
+        data.driver->configure(model.driver_params, setup);
       }
     }
     w.configuring = false;
@@ -366,9 +372,9 @@ void Environment::warnUnusedParameters() const {
       if (seen.insert(w).second) log(LogLevel::Warning, w);
   };
   for (const auto& e : extensions_) report(e.params);
-  for (const auto& data : world_->artifact_data) {
-    if (data.driver != nullptr) report(data.driver_params);
-    for (const auto& s : data.sensors) report(s.params);
+  for (const auto& model : world_->models) {
+    report(model.driver_params);  // empty when there is no driver
+    for (const auto& params : model.sensor_params) report(params);
   }
 }
 

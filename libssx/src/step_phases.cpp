@@ -54,14 +54,19 @@ namespace detail {
 
 namespace {
 void prefetchArtifact(const World& world, std::size_t i, std::size_t end, bool sensors) {
+  // (the world's node, random-stream and artifact tables are walked in order: the hardware
+  // prefetcher follows them; what is scattered over the heap is what is fetched here)
   if (i + 1 >= end) return;
   const ArtifactData& next = world.artifact_data[i + 1];
   if (sensors) {
     for (const auto& slot : next.sensors) prefetch(slot.sensor, 256);
-  } else {
-    if (next.driver != nullptr) prefetch(next.driver, 512);
-    if (!next.inbox.empty()) prefetch(next.inbox.data(), next.inbox.size() * sizeof(next.inbox[0]));
+    return;
   }
+  // a driver's handles and the sensors whose measurements its callbacks get
+  if (i + 2 < end) prefetch(world.artifacts[i + 2].get(), sizeof(Artifact));
+  if (next.driver != nullptr) prefetch(next.driver, 512);
+  if (!next.inbox.empty()) prefetch(next.inbox.data(), next.inbox.size() * sizeof(next.inbox[0]));
+  for (const auto& slot : next.sensors) prefetch(slot.sensor);
 }
 }  // namespace
 

@@ -23,30 +23,34 @@
 
 namespace ssx::detail {
 
-/// One physic node's placement and, from start on, its body.
+/// One physic node's body, from start on (read by every state() and addForce: kept to one cache
+/// line).
 struct NodeData {
-  int body = -1;  // -1: static, or not started
+  Pose pose_in_body;  // node frame in the body's centre-of-mass frame
+  int body = -1;      // -1: static, or not started
   bool is_static = false;
-  Pose pose_in_body;                   // node frame in the body's centre-of-mass frame
-  Pose setup_pose;                     // world pose as placed (static nodes keep it)
+};
+
+/// One physic node as placed before start (static nodes keep their pose).
+struct NodeSetup {
+  Pose pose;                           // world pose as placed
   Vec3 initial_linear = Vec3::Zero();  // of this node's origin, set before start
   Vec3 initial_angular = Vec3::Zero();
 };
 
-/// One attached driver or sensor: who it is, when it runs, its random stream.
+/// One attached driver or sensor: who it is and when it runs (its random stream is in
+/// World::randoms, at the same index).
 struct PluginSlot {
   std::uint32_t artifact = 0;
   std::uint32_t index = 0;  // 0: the driver; i + 1: sensor i
   std::int64_t period_steps = 1;
   std::string class_name;
-  Random random;
 };
 
+/// What the sensors phase reads of one sensor (its parameters are in ArtifactModel).
 struct SensorSlot {
   Sensor* sensor = nullptr;
-  std::unique_ptr<Sensor> owned;  // null when a ClassLoader owns it
-  Descriptor params;
-  std::int64_t period_steps = 1;  // a copy of its slot's, beside what the sensors phase reads
+  std::int64_t period_steps = 1;  // a copy of its plugin slot's, beside what the phase reads
   bool fresh = false;             // wrote a measurement in this step
 };
 
@@ -57,16 +61,29 @@ struct Subscription {
   std::function<void(const Measurement&)> callback;
 };
 
-/// One artifact's plugins, its subscriptions and its bodies.
+/// One artifact's part of the model: its plugins' parameters and the instances it owns. Set before
+/// start, read by configure, checks and messages; never by the phases.
+struct ArtifactModel {
+  std::unique_ptr<Driver> owned_driver;  // null when a ClassLoader owns it (or there is none)
+  Descriptor driver_params;
+  std::vector<std::unique_ptr<Sensor>> owned_sensors;  // per sensor; null when a ClassLoader owns it
+  std::vector<Descriptor> sensor_params;
+};
+
+/// What the phases read and write of one artifact: its plugins, subscriptions and bodies.
 struct ArtifactData {
   Driver* driver = nullptr;
-  std::unique_ptr<Driver> owned_driver;  // null when a ClassLoader owns it
-  Descriptor driver_params;
   std::int64_t driver_period = 1;  // a copy of its slot's, beside what the drivers phase reads
   std::vector<SensorSlot> sensors;
   std::vector<Subscription> inbox;  // sorted (source, sensor, sequence) at start
   int body_begin = 0;               // bodies [body_begin, body_end) in the body arrays
   int body_end = 0;
+  // where its nodes and plugin slots are in the world's tables, for prefetching: [first, end)
+  // (contiguous when the artifact was built in one go, as the scene loader does)
+  std::uint32_t first_node = 0;
+  std::uint32_t node_end = 0;
+  std::uint32_t first_slot = 0;
+  std::uint32_t slot_end = 0;
 };
 
 struct PendingError {
@@ -87,13 +104,16 @@ struct World {
   // per artifact
   std::vector<std::unique_ptr<Artifact>> artifacts;
   std::vector<ArtifactData> artifact_data;
+  std::vector<ArtifactModel> models;
   std::unordered_map<std::string, Artifact*> names;
   std::vector<PendingError> errors;  // filled by the parallel phases
   std::uint64_t subscription_sequence = 0;
 
   // per node and per plugin slot
   std::vector<NodeData> nodes;
+  std::vector<NodeSetup> node_setup;
   std::vector<PluginSlot> plugins;
+  std::vector<Random> randoms;
 
   // per body, from start on: the snapshot, the velocities before the step, the command buffers
   std::vector<BodyState> states;
@@ -105,6 +125,8 @@ struct World {
   bool started() const noexcept { return !states.empty(); }
   ArtifactData& data(const Artifact& a) { return artifact_data[a.index()]; }
   const ArtifactData& data(const Artifact& a) const { return artifact_data[a.index()]; }
+  ArtifactModel& model(const Artifact& a) { return models[a.index()]; }
+  const ArtifactModel& model(const Artifact& a) const { return models[a.index()]; }
 };
 
 }  // namespace ssx::detail

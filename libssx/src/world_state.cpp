@@ -107,7 +107,7 @@ std::vector<std::byte> Environment::saveState() const {
     out.write(w.wrenches[i].torque);
   }
   // the random streams, then each plugin's own state (driver first, then sensors, by artifact)
-  for (const auto& p : w.plugins) p.random.save(out);
+  for (const Random& r : w.randoms) r.save(out);
   for (const auto& a : w.artifact_data) {
     if (a.driver != nullptr) writeBlock(out, [&] { a.driver->saveState(out); });
     for (const auto& s : a.sensors) writeBlock(out, [&] { s.sensor->saveState(out); });
@@ -188,7 +188,7 @@ void Environment::applyState(std::span<const std::byte> payload) {
     in.read(w.wrenches[i].force);
     in.read(w.wrenches[i].torque);
   }
-  for (auto& p : w.plugins) p.random.load(in);
+  for (Random& r : w.randoms) r.load(in);
   for (std::size_t i = 0; i < w.artifacts.size(); ++i) {
     const std::string of = " of artifact '" + w.artifacts[i]->name() + "'";
     detail::ArtifactData& a = w.artifact_data[i];

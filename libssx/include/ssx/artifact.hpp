@@ -41,7 +41,7 @@ class SSX_EXPORT Artifact {
   std::size_t index() const noexcept { return index_; }
   /// The environment, read-only: what may change it (subscriptions, neighbour queries, camera
   /// requests) is reached from a plugin's configure (PluginSetup) or by the embedding program.
-  const Environment& environment() const noexcept;
+  const Environment& environment() const noexcept { return *env_; }
   /// The pose the artifact was placed at; root nodes are posed relative to it.
   const Pose& placement() const noexcept { return placement_; }
 
@@ -116,6 +116,7 @@ class SSX_EXPORT Artifact {
                  const Descriptor& params);
 
   detail::World* world_;
+  const Environment* env_;
   std::string name_;
   std::size_t index_;
   Pose placement_;

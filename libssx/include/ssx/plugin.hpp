@@ -63,13 +63,13 @@ class SSX_EXPORT Plugin {
   /// The artifact this plugin belongs to, read-only (a Driver gets it writable: see there).
   const Artifact& artifact() const noexcept { return *artifact_; }
   /// The environment of that artifact, read-only.
-  const Environment& environment() const noexcept;
+  const Environment& environment() const noexcept { return *env_; }
   /// This instance's random stream, seeded from (scene seed, artifact index, plugin index):
   /// the same numbers whatever the number of threads. Use it only inside this plugin's calls.
   /// Kept in the world state (saved and restored with it). Throws before the plugin is attached.
   Random& random();
   /// Runs every this many steps (1 before the plugin is attached).
-  std::int64_t periodSteps() const noexcept;
+  std::int64_t periodSteps() const noexcept { return period_steps_; }
   /// A name for messages: the class name given when attached.
   const std::string& className() const noexcept;
   /// Whether this instance is attached to an artifact.
@@ -77,12 +77,14 @@ class SSX_EXPORT Plugin {
 
   /// Done by Artifact::setDriver / addSensor (the world is the core's and cannot be named
   /// outside it): binds this instance to its slot.
-  void bind(detail::World& world, Artifact& artifact, std::uint32_t slot) noexcept;
+  void bind(detail::World& world, Artifact& artifact, std::uint32_t slot, std::int64_t period_steps) noexcept;
 
  private:
   detail::World* world_ = nullptr;
   Artifact* artifact_ = nullptr;
+  const Environment* env_ = nullptr;
   std::uint32_t slot_ = 0;
+  std::int64_t period_steps_ = 1;  // as in its slot (fixed when attached)
 };
 
 /// The behaviour of an artifact: a flight controller, a door. At most one per artifact.
