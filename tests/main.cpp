@@ -1,2 +1,28 @@
-#define CATCH_CONFIG_MAIN
+// The test runner. ctest runs every test case in its own process (catch_discover_tests); each
+// process works in a fresh directory of its own, so that tests writing files (CSV logs, frames,
+// saved states, scenes made on the fly) never meet, however many ctest runs at once. The directory
+// is removed when every test in the process passed and kept for inspection when one failed.
+#define CATCH_CONFIG_RUNNER
 #include <catch2/catch.hpp>
+
+#include <unistd.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <string>
+#include <system_error>
+
+int main(int argc, char* argv[]) {
+  namespace fs = std::filesystem;
+  const fs::path parent = fs::current_path();
+  std::string pattern = (parent / "case_XXXXXX").string();
+  if (mkdtemp(pattern.data()) == nullptr || chdir(pattern.c_str()) != 0) {
+    std::perror("ssx_tests: cannot make a working directory of its own");
+    return 2;
+  }
+  const int failed = Catch::Session().run(argc, argv);
+  std::error_code ignored;
+  fs::current_path(parent, ignored);
+  if (failed == 0) fs::remove_all(pattern, ignored);
+  return failed;
+}

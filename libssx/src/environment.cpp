@@ -332,6 +332,9 @@ void Environment::stop() {
   if (w.state == State::Stopped) return;
   const bool started = w.state != State::Setup;
   w.state = State::Stopped;
+  // everything is stopped whatever fails; what failed is reported together at the end
+  std::vector<std::string> failures;
+  auto failed = [&](std::string what) { failures.push_back(std::move(what)); };
   if (started) {
     // plugins first, then engines, then extensions in reverse order
     for (auto& a : w.artifacts) {
@@ -340,14 +343,14 @@ void Environment::stop() {
         try {
           p.destroy();
         } catch (const std::exception& e) {
-          log(LogLevel::Error, "artifact '" + a->name() + "', " + what + ": destroy threw: " + e.what());
+          failed("artifact '" + a->name() + "', " + what + ": destroy threw: " + e.what());
         }
       };
       if (data.driver) destroy(*data.driver, "driver '" + data.driver->className() + "'");
       for (auto& s : data.sensors) destroy(*s.sensor, "sensor '" + s.sensor->className() + "'");
     }
     pool_.reset();
-    cameras_->finish([this](std::string_view m) { log(LogLevel::Error, m); });
+    cameras_->finish([&](std::string_view m) { failed(std::string(m)); });
     renderer_.reset();
     physics_.reset();
   }
@@ -357,9 +360,13 @@ void Environment::stop() {
     try {
       it->extension->shutdown(*this);
     } catch (const std::exception& e) {
-      log(LogLevel::Error, "extension '" + it->name + "': shutdown threw: " + e.what());
+      failed("extension '" + it->name + "': shutdown: " + e.what());
     }
   }
+  if (failures.empty()) return;
+  std::string message = failures.front();
+  for (std::size_t i = 1; i < failures.size(); ++i) message += "; " + failures[i];
+  throw Error(message);
 }
 
 void Environment::fail() { world_->state = State::Failed; }

@@ -1,6 +1,10 @@
 #include <ssx/artifact.hpp>
+#include <ssx/measurements.hpp>
 #include <ssx/environment.hpp>
 #include <ssx/plugin.hpp>
+
+#include <algorithm>
+#include <cmath>
 
 namespace ssx {
 
@@ -30,6 +34,7 @@ void PluginSetup::addCameraRequest(std::function<bool(std::int64_t, CameraView&)
 }
 
 Measurement::~Measurement() = default;
+bool Measurement::finite() const noexcept { return true; }
 
 SimulationExtension::~SimulationExtension() = default;
 void SimulationExtension::init(Environment&, const Descriptor&) {}
@@ -45,11 +50,20 @@ void SimulationExtension::loadState(StateReader&) {}
 
 namespace ssx {
 ClockMeasurement::~ClockMeasurement() = default;
+bool ClockMeasurement::finite() const noexcept { return std::isfinite(seconds); }
 PoseMeasurement::~PoseMeasurement() = default;
+bool PoseMeasurement::finite() const noexcept {
+  return pose.position.allFinite() && pose.orientation.coeffs().allFinite() && linear_velocity.allFinite() &&
+         angular_velocity.allFinite();
+}
 }  // namespace ssx
 
 namespace ssx {
 ImuMeasurement::~ImuMeasurement() = default;
+bool ImuMeasurement::finite() const noexcept {
+  return accelerometer.allFinite() && gyroscope.allFinite() && std::isfinite(accelerometer_lsb) &&
+         std::isfinite(gyroscope_lsb);
+}
 }  // namespace ssx
 
 #include <ssx/setpoint.hpp>
@@ -60,5 +74,13 @@ SetpointInterface::~SetpointInterface() = default;
 
 namespace ssx {
 RangeMeasurement::~RangeMeasurement() = default;
+bool RangeMeasurement::finite() const noexcept {
+  return std::all_of(detections.begin(), detections.end(),
+                     [](const Detection& d) { return d.relative.allFinite() && std::isfinite(d.distance); });
+}
 CameraMeasurement::~CameraMeasurement() = default;
+// depth is +infinity where nothing was hit, by design: only the camera's pose is checked
+bool CameraMeasurement::finite() const noexcept {
+  return view.pose.position.allFinite() && view.pose.orientation.coeffs().allFinite();
+}
 }  // namespace ssx

@@ -87,6 +87,11 @@ void runSensors(World& world, std::size_t begin, std::size_t end) {
       try {
         PhaseGuard guard(nullptr, "sensor");
         sensor.sense(info);
+        if (!sensor.latest().finite()) {
+          world.errors[i] = {"sensor " + std::to_string(k) + " '" + sensor.className() + "'",
+                             "wrote a NaN or infinite value into its measurement"};
+          break;
+        }
         slot.fresh = true;
       } catch (...) {
         world.errors[i] = {"sensor " + std::to_string(k) + " '" + sensor.className() + "'",

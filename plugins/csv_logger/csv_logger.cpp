@@ -24,6 +24,8 @@ class CsvLogger final : public SimulationExtension {
       param::text("artifacts", "*", "artifact names separated by spaces, or * for every artifact with a dynamic root"),
       param::real("rate_hz", "0", "Hz", param::nonNegative(),
                   "rows per artifact per simulated second; 0 writes one every step"),
+      param::real("flush_s", "1", "s", param::positive(),
+                  "simulated time between flushes to the file (and at the end of the run)"),
   };
 
   // what is logged exists before anything is opened
@@ -44,13 +46,20 @@ class CsvLogger final : public SimulationExtension {
     const double rate = params.get<double>("rate_hz");
     period_ = rate > 0 ? toNanoseconds(1.0 / rate) : env.timestep();
     next_ = period_;  // rows at period, 2 period, ... of simulated time
+    flush_period_ = toNanoseconds(params.get<double>("flush_s"));
+    next_flush_ = flush_period_;
     resolve(env, params);
     file_ = std::fopen(path_.c_str(), "w");
     if (file_ == nullptr) throw params.error("cannot open '" + path_ + "' for writing: " + std::strerror(errno));
-    std::fputs("time_s,artifact,x,y,z,qw,qx,qy,qz,vx,vy,vz,wx,wy,wz\n", file_);
+    check(std::fputs("time_s,artifact,x,y,z,qw,qx,qy,qz,vx,vy,vz,wx,wy,wz\n", file_) >= 0);
   }
 
   void afterStep(Environment& env) override {
+    if (env.time() >= next_flush_) {
+      next_flush_ += flush_period_;
+      if (next_flush_ <= env.time()) next_flush_ = env.time() + flush_period_;
+      check(std::fflush(file_) == 0);
+    }
     if (env.time() < next_) return;
     next_ += period_;
     if (next_ <= env.time()) next_ = env.time() + period_;
@@ -61,22 +70,47 @@ class CsvLogger final : public SimulationExtension {
       const Quat& q = s.pose.orientation;
       const Vec3& v = s.linear_velocity;
       const Vec3& w = s.angular_velocity;
-      std::fprintf(file_, "%.9g,%s,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g\n", t,
+      const int written = std::fprintf(file_, "%.9g,%s,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g\n", t,
                    a->name().c_str(), p.x(), p.y(), p.z(), q.w(), q.x(), q.y(), q.z(), v.x(), v.y(), v.z(), w.x(),
                    w.y(), w.z());
+      check(written > 0);
     }
   }
 
-  void shutdown(Environment&) override { close(); }
+  // the last rows reach the file, or the run fails saying why
+  void shutdown(Environment&) override {
+    if (file_ == nullptr) return;
+    const bool flushed = std::fflush(file_) == 0;
+    const int error = errno;
+    const bool closed = std::fclose(file_) == 0;
+    file_ = nullptr;
+    if (!flushed || !closed) fail(flushed ? errno : error);
+  }
 
-  // rows go on at the times they would have been written
-  void saveState(StateWriter& out) const override { out.write(next_); }
-  void loadState(StateReader& in) override { in.read(next_); }
+  // rows and flushes go on at the times they would have been
+  void saveState(StateWriter& out) const override {
+    out.write(next_);
+    out.write(next_flush_);
+  }
+  void loadState(StateReader& in) override {
+    in.read(next_);
+    in.read(next_flush_);
+  }
 
  private:
   // every artifact exists when extensions are initialised
   void resolve(Environment& env, const Descriptor& params) {
     for (const Artifact* a : env.selectArtifacts(params, "artifacts", "log")) artifacts_.push_back(a);
+  }
+  // a write that fails (a full disk, a removed device) stops the run naming the file
+  void check(bool ok) {
+    if (ok) return;
+    const int error = errno;
+    close();  // reported once, here, not again when the run stops
+    fail(error);
+  }
+  [[noreturn]] void fail(int error) const {
+    throw Error("csv_logger: cannot write '" + path_ + "': " + std::strerror(error != 0 ? error : EIO));
   }
   void close() {
     if (file_ != nullptr) std::fclose(file_);
@@ -84,7 +118,7 @@ class CsvLogger final : public SimulationExtension {
   }
 
   std::string path_, names_;
-  Nanoseconds period_ = 0, next_ = 0;
+  Nanoseconds period_ = 0, next_ = 0, flush_period_ = 0, next_flush_ = 0;
   std::FILE* file_ = nullptr;
   std::vector<const Artifact*> artifacts_;
 };

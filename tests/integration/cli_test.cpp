@@ -174,6 +174,17 @@ TEST_CASE("Ctrl-C stops a real-time run cleanly: summary printed, files closed",
   CHECK(content.back() == '\n');
 }
 
+TEST_CASE("ssx run: a log file that cannot be written fails the run with status 1 naming the file", "[cli][csv]") {
+  std::ofstream("full.xml") << R"(<scene duration="0.2"><environment timestep="0.01"/>
+    <type name="ball" file=")" << (kData / "valid" / "ball.xml").string() << R"("/>
+    <artifact name="b" type="ball" xyz="0 0 1"/>
+    <extension name="log" plugin="csv_logger" file="/dev/full" flush_s="0.05"/></scene>)";
+  const Result r = run({"run", "full.xml", "--fast"});
+  CHECK(r.status == 1);
+  CHECK_THAT(r.err, Contains("cannot write '/dev/full'") && Contains("No space left on device"));
+  CHECK_FALSE(Contains("step time ms").match(r.out));  // no summary of a failed run
+}
+
 TEST_CASE("ssx run: a bare --realtime means factor 1, a given factor is used", "[cli]") {
   const std::string scene = (kExamples / "scenes" / "hover_swarm.xml").string();
   const Result plain = run({"run", scene, "--realtime", "--steps", "50"});

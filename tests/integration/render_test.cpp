@@ -109,7 +109,7 @@ TEST_CASE("render: a falling robot moves down in a fixed camera's image", "[rend
 TEST_CASE("render: drawing frames and camera images does not change the simulation", "[render][determinism]") {
   REQUIRE(haveOsmesa());  // dev.sh installs libosmesa6-dev
   auto run = [](const std::string& engine, bool cameras) {
-    const fs::path frames = fs::temp_directory_path() / "ssx_render_determinism";
+    const fs::path frames = fs::current_path() / "frames";
     fs::remove_all(frames);
     std::string xml = "<render engine=\"" + engine + "\" rate_hz=\"25\">";
     if (cameras) xml += "<camera name=\"top\" xyz=\"0 -8 6\" frames=\"" + frames.string() + "\"/>";
@@ -130,7 +130,7 @@ TEST_CASE("render: drawing frames and camera images does not change the simulati
 
 TEST_CASE("render: scene cameras write numbered PNG frames at their rate and a snapshot at the end", "[render]") {
   REQUIRE(haveOsmesa());  // dev.sh installs libosmesa6-dev
-  const fs::path dir = fs::temp_directory_path() / "ssx_render_frames";
+  const fs::path dir = fs::current_path() / "render";
   fs::remove_all(dir);
   Scene s = load(R"(<render engine="osmesa" rate_hz="10" width="160" height="120">
       <camera name="side" xyz="0 -6 2" look_at="0 0 1" frames=")" + (dir / "side").string() + R"(" snapshot=")" +

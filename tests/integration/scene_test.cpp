@@ -7,8 +7,11 @@
 #include <filesystem>
 #include <fstream>
 #include <regex>
+#include <string>
+#include <vector>
 
 using namespace ssx;
+using Catch::Contains;
 namespace fs = std::filesystem;
 
 namespace {
@@ -172,6 +175,59 @@ TEST_CASE("the example scene loads, flies and logs", "[scene]") {
   int rows = 0;
   for (std::string line; std::getline(csv, line);) ++rows;
   CHECK(rows == 3 * 250);  // three robots at 50 Hz for 5 s
+}
+
+namespace {
+std::string loggerScene(const std::string& file, const std::string& flush_s) {
+  return R"(<scene><environment timestep="0.01"/><type name="ball" file="ball.xml"/>
+    <artifact name="b" type="ball" xyz="0 0 1"/>
+    <extension name="log" plugin="csv_logger" file=")" +
+         file + R"(" rate_hz="100" flush_s=")" + flush_s + R"("/></scene>)";
+}
+std::vector<std::string> lines(const fs::path& file) {
+  std::ifstream in(file);
+  std::vector<std::string> out;
+  for (std::string line; std::getline(in, line);) out.push_back(line);
+  return out;
+}
+}  // namespace
+
+TEST_CASE("csv_logger flushes at its simulated interval and when the run stops", "[scene][csv]") {
+  Scene scene = loadSceneFromString(loggerScene("log.csv", "0.1"), "memory.xml", kData / "valid");
+  Environment& env = *scene.environment;
+  env.step(5);  // t = 0.05 s: nothing flushed yet
+  CHECK(fs::file_size("log.csv") == 0);
+  env.step(7);  // t = 0.12 s: flushed at 0.1 s, before that step's row: the header and 0.01 ... 0.09 s
+  std::vector<std::string> rows = lines("log.csv");
+  REQUIRE(rows.size() == 1 + 9);
+  CHECK(rows.back().rfind("0.09,b,", 0) == 0);
+  env.stop();
+  rows = lines("log.csv");
+  REQUIRE(rows.size() == 1 + 12);
+  CHECK(rows.back().rfind("0.12,b,", 0) == 0);
+}
+
+TEST_CASE("csv_logger: a write that fails stops the run naming the file", "[scene][csv]") {
+  REQUIRE(fs::exists("/dev/full"));  // writes there fail with ENOSPC, as on a full disk
+  SECTION("at a flush while running") {
+    Scene scene = loadSceneFromString(loggerScene("/dev/full", "0.05"), "memory.xml", kData / "valid");
+    try {
+      scene.environment->step(10);
+      FAIL("no StepError");
+    } catch (const StepError& e) {
+      CHECK(e.step() == 4);  // the step that ends at t = 0.05 s
+      CHECK_THAT(e.what(), Contains("cannot write '/dev/full'") && Contains("No space left on device"));
+    }
+    // reported once: the file is closed, stopping has nothing more to say
+    CHECK_NOTHROW(scene.environment->stop());
+  }
+  SECTION("at the end of the run") {
+    Scene scene = loadSceneFromString(loggerScene("/dev/full", "100"), "memory.xml", kData / "valid");
+    scene.environment->step(10);
+    CHECK_THROWS_WITH(scene.environment->stop(),
+                      Contains("extension 'log'") && Contains("cannot write '/dev/full'") &&
+                          Contains("No space left on device"));
+  }
 }
 
 TEST_CASE("scenes load from memory with paths relative to a base directory", "[scene]") {

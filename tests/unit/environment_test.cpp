@@ -202,6 +202,36 @@ TEST_CASE("a throwing sensor is named with its index and class", "[environment]"
   }
 }
 
+TEST_CASE("a sensor writing a NaN into its measurement is stopped by name before anyone reads it", "[environment]") {
+  // a pose sensor whose velocity becomes NaN at step 3 (a division by a zero time, say)
+  class BrokenPose final : public SensorOf<PoseMeasurement> {
+   public:
+    void sense(const StepInfo& info) override {
+      output().stamp = info.time;
+      output().linear_velocity.x() = info.step == 3 ? std::numeric_limits<double>::quiet_NaN() : 1.0;
+    }
+  };
+  Environment env;
+  Artifact& a = addBall(env, "scout");
+  Sensor& pose = a.addSensor(std::make_unique<BrokenPose>(), {}, 1, "mocap");
+  Artifact& b = addBall(env, "listener", 2);
+  std::vector<double> delivered;
+  env.subscribe<PoseMeasurement>(pose, b, [&](const PoseMeasurement& m) { delivered.push_back(m.linear_velocity.x()); });
+  env.step(3);
+  CHECK(delivered == std::vector<double>{1.0, 1.0, 1.0});
+  try {
+    env.step();
+    FAIL("no StepError");
+  } catch (const StepError& e) {
+    CHECK(e.artifact() == "scout");
+    CHECK(e.plugin() == "sensor 0 'mocap'");
+    CHECK(e.step() == 3);
+    CHECK_THAT(e.what(), Catch::Contains("NaN or infinite") && Catch::Contains("sensors phase"));
+  }
+  CHECK(delivered.size() == 3);  // the NaN never reached a subscriber
+  CHECK(env.state() == Environment::State::Failed);
+}
+
 TEST_CASE("a driver producing a NaN force is stopped by name", "[environment]") {
   Environment env;
   Artifact& a = addBall(env, "quad3");

@@ -128,7 +128,10 @@ class SSX_EXPORT Environment {
   void step(std::int64_t n);
   /// Runs and paces steps; returns the timing summary of this run. Throws StepError.
   TimingSummary run(const RunOptions& options);
-  /// Destroys drivers and sensors, stops the engines, shuts extensions down (reverse order).
+  /// Destroys drivers and sensors, stops the engines, finishes frames and videos, shuts
+  /// extensions down (reverse order). All of it happens even when a part fails; then it throws
+  /// Error naming every part that failed (a plugin's destroy, a video ffmpeg could not finish, a
+  /// file an extension could not write to the end).
   void stop();
 
   // --- save and restore --------------------------------------------------------------------

@@ -21,6 +21,7 @@ struct SSX_EXPORT ClockMeasurement : Measurement {
   std::int64_t step = 0;
   double seconds = 0.0;
   ~ClockMeasurement() override;
+  bool finite() const noexcept override;
 };
 
 /// Pose and twist of a node, world frame, possibly with noise.
@@ -29,6 +30,7 @@ struct SSX_EXPORT PoseMeasurement : Measurement {
   Vec3 linear_velocity = Vec3::Zero();   ///< m/s, world frame
   Vec3 angular_velocity = Vec3::Zero();  ///< rad/s, world frame
   ~PoseMeasurement() override;
+  bool finite() const noexcept override;
 };
 
 /// An inertial measurement: specific force and angular rate in the IMU's frame, after bias, noise,
@@ -41,6 +43,7 @@ struct SSX_EXPORT ImuMeasurement : Measurement {
   double accelerometer_lsb = 0.0;                      ///< m/s^2 per count
   double gyroscope_lsb = 0.0;                          ///< rad/s per count
   ~ImuMeasurement() override;
+  bool finite() const noexcept override;
 };
 
 /// What a range sensor sees: other robots and obstacles within its range, nearest first.
@@ -54,6 +57,7 @@ struct SSX_EXPORT RangeMeasurement : Measurement {
   bool body_frame = false;  ///< `relative` in the sensor's body frame, else the world frame
   std::vector<Detection> detections;
   ~RangeMeasurement() override;
+  bool finite() const noexcept override;
 };
 
 /// A camera image: RGB and, when asked for, depth (m along the optical axis), drawn from the
@@ -62,6 +66,7 @@ struct SSX_EXPORT CameraMeasurement : Measurement {
   Image image;
   CameraView view;  ///< the camera's pose (x forward, z up) and lens when it was drawn
   ~CameraMeasurement() override;
+  bool finite() const noexcept override;
 };
 
 /// Measurements into and out of a saved state (for sensors' and drivers' saveState / loadState).

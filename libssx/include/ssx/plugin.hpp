@@ -105,6 +105,10 @@ class SSX_EXPORT Driver : public Plugin {
 struct SSX_EXPORT Measurement {
   Nanoseconds stamp = 0;
   virtual ~Measurement();
+  /// Whether every number in it is finite. The core calls this after each `sense`: a NaN or an
+  /// infinity stops the step with an error naming the artifact and the sensor, as a driver's NaN
+  /// force does. Measurement types with floating-point fields override it.
+  virtual bool finite() const noexcept;
 };
 
 /// Produces measurements from the simulated world.

@@ -34,7 +34,7 @@
 
 /// Incremented whenever the manifest layout, the meaning of its fields or the plugin base classes
 /// (Plugin, Driver, Sensor, SimulationExtension: their virtual functions and members) change.
-#define SSX_PLUGIN_ABI_VERSION 3u
+#define SSX_PLUGIN_ABI_VERSION 4u
 
 #define SSX_PLUGIN_STRINGIFY2(x) #x
 #define SSX_PLUGIN_STRINGIFY(x) SSX_PLUGIN_STRINGIFY2(x)

@@ -2,7 +2,10 @@
 
 #include <ssx/error.hpp>
 
+#include <fcntl.h>
 #include <png.h>
+#include <spawn.h>
+#include <sys/wait.h>
 #include <unistd.h>
 
 #include <cerrno>
@@ -10,6 +13,10 @@
 #include <cstring>
 #include <filesystem>
 #include <sstream>
+#include <string>
+#include <vector>
+
+extern char** environ;  // the environment ffmpeg inherits
 
 namespace ssx {
 
@@ -65,6 +72,44 @@ FrameOutput::FrameOutput(const CameraSpec& camera, double fps, const Warn& warn)
          camera_.video.string() + "; install it (apt-get install ffmpeg) or use frames=\"DIR\" for PNG frames");
     camera_.video.clear();
   }
+  if (!camera_.video.empty()) ffmpeg_ = findOnPath("ffmpeg");
+}
+
+void FrameOutput::startVideo(int width, int height) {
+  // ffmpeg gets an argument vector, not a shell line: the video's path is one argument whatever
+  // characters it holds. Its own messages go to a log beside the video, so that a failure can
+  // be read; it runs at a lower priority (nice) than the simulation.
+  const std::string size = std::to_string(width) + "x" + std::to_string(height);
+  char rate[32];
+  std::snprintf(rate, sizeof rate, "%.9g", fps_);
+  std::vector<std::string> args = {"nice", "-n", "10", ffmpeg_, "-nostdin", "-y", "-loglevel", "error",
+                                   "-f", "rawvideo", "-pix_fmt", "rgb24", "-s", size, "-r", rate, "-i", "pipe:0",
+                                   "-c:v", "libx264", "-preset", "ultrafast", "-crf", "23", "-pix_fmt", "yuv420p"};
+  // yuv420p needs even sizes
+  if (width % 2 != 0 || height % 2 != 0) args.insert(args.end(), {"-vf", "crop=trunc(iw/2)*2:trunc(ih/2)*2"});
+  args.push_back("file:" + camera_.video.string());  // "file:" so that a name like "-x.mp4" is no option
+  std::vector<char*> argv;
+  for (auto& a : args) argv.push_back(a.data());
+  argv.push_back(nullptr);
+
+  int fds[2];
+  if (::pipe2(fds, O_CLOEXEC) != 0) throw Error("camera '" + camera_.name + "': cannot start ffmpeg: " + std::strerror(errno));
+  const std::string log = camera_.video.string() + ".ffmpeg.log";
+  posix_spawn_file_actions_t actions;
+  posix_spawn_file_actions_init(&actions);
+  posix_spawn_file_actions_adddup2(&actions, fds[0], STDIN_FILENO);
+  posix_spawn_file_actions_addopen(&actions, STDOUT_FILENO, "/dev/null", O_WRONLY, 0);
+  posix_spawn_file_actions_addopen(&actions, STDERR_FILENO, log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+  pid_t pid = -1;
+  const int failed = ::posix_spawnp(&pid, "nice", &actions, nullptr, argv.data(), environ);
+  posix_spawn_file_actions_destroy(&actions);
+  ::close(fds[0]);
+  if (failed != 0) {
+    ::close(fds[1]);
+    throw Error("camera '" + camera_.name + "': cannot start ffmpeg: " + std::strerror(failed));
+  }
+  video_fd_ = fds[1];
+  video_pid_ = pid;
 }
 
 FrameOutput::~FrameOutput() {
@@ -81,22 +126,18 @@ void FrameOutput::add(const Image& frame) {
     writePng(camera_.frames_dir / name, frame);
   }
   if (!camera_.video.empty()) {
-    if (video_ == nullptr) {
-      // started with the first frame, when its size is known; ffmpeg's own output goes to a log
-      // beside the video so that a failure can be read
-      std::ostringstream cmd;
-      const std::string log = camera_.video.string() + ".ffmpeg.log";
-      cmd << "nice -n 10 ffmpeg -y -loglevel error -f rawvideo -pix_fmt rgb24 -s " << frame.width << 'x' << frame.height
-          << " -r " << fps_ << " -i - -c:v libx264 -preset ultrafast -crf 23 -pix_fmt yuv420p";
-      // yuv420p needs even sizes
-      if (frame.width % 2 != 0 || frame.height % 2 != 0) cmd << " -vf crop=trunc(iw/2)*2:trunc(ih/2)*2";
-      cmd << " '" << camera_.video.string() << "' 2>'" << log << "'";
-      video_ = ::popen(cmd.str().c_str(), "w");
-      if (video_ == nullptr) throw Error("camera '" + camera_.name + "': cannot start ffmpeg: " + std::strerror(errno));
+    if (video_pid_ < 0) startVideo(frame.width, frame.height);  // when the first frame's size is known
+    const auto* data = reinterpret_cast<const char*>(frame.rgb.data());
+    std::size_t left = frame.rgb.size();
+    while (left > 0) {
+      const ssize_t n = ::write(video_fd_, data, left);
+      if (n < 0 && errno == EINTR) continue;
+      if (n <= 0)
+        throw Error("camera '" + camera_.name + "': ffmpeg stopped taking frames for " + camera_.video.string() +
+                    " (see " + camera_.video.string() + ".ffmpeg.log)");
+      data += n;
+      left -= static_cast<std::size_t>(n);
     }
-    if (std::fwrite(frame.rgb.data(), 1, frame.rgb.size(), video_) != frame.rgb.size())
-      throw Error("camera '" + camera_.name + "': ffmpeg stopped taking frames (see " + camera_.video.string() +
-                  ".ffmpeg.log)");
   }
   if (!camera_.snapshot.empty()) last_ = frame;
   ++frames_;
@@ -105,10 +146,15 @@ void FrameOutput::add(const Image& frame) {
 void FrameOutput::finish() {
   if (finished_) return;
   finished_ = true;
-  if (video_ != nullptr) {
-    const int status = ::pclose(video_);
-    video_ = nullptr;
-    if (status != 0)
+  if (video_pid_ >= 0) {
+    ::close(video_fd_);  // ffmpeg sees the end of its input and finishes the file
+    video_fd_ = -1;
+    int status = 0;
+    pid_t waited;
+    do waited = ::waitpid(video_pid_, &status, 0);
+    while (waited < 0 && errno == EINTR);
+    video_pid_ = -1;
+    if (waited < 0 || !WIFEXITED(status) || WEXITSTATUS(status) != 0)
       throw Error("camera '" + camera_.name + "': ffmpeg failed writing " + camera_.video.string() + " (see " +
                   camera_.video.string() + ".ffmpeg.log)");
     std::filesystem::remove(camera_.video.string() + ".ffmpeg.log");

@@ -4,6 +4,8 @@
 
 #include <ssx/render.hpp>
 
+#include <sys/types.h>
+
 #include <cstdio>
 #include <functional>
 #include <string>
@@ -28,9 +30,13 @@ class FrameOutput {
   std::int64_t frames() const noexcept { return frames_; }
 
  private:
+  void startVideo(int width, int height);
+
   CameraSpec camera_;
   double fps_;
-  std::FILE* video_ = nullptr;
+  std::string ffmpeg_;    ///< its full path, found on PATH when the output was made
+  int video_fd_ = -1;     ///< the write end of ffmpeg's standard input
+  pid_t video_pid_ = -1;
   Image last_;
   std::int64_t frames_ = 0;
   bool finished_ = false;

@@ -1,6 +1,8 @@
 #include "render/frame_worker.hpp"
 
+#include <pthread.h>
 #include <sys/resource.h>
+#include <csignal>
 #include <unistd.h>
 
 namespace ssx::detail {
@@ -36,6 +38,12 @@ void FrameWorker::submit(const std::vector<RenderNode>& nodes, std::vector<Camer
 void FrameWorker::loop() {
   // below the simulation's threads: on a busy machine the steps come first and frames wait
   setpriority(PRIO_PROCESS, static_cast<id_t>(::gettid()), 10);
+  // a video pipe whose ffmpeg died must give an error (EPIPE), not kill the embedding program:
+  // SIGPIPE is blocked on this thread only, the one that writes to the pipes
+  sigset_t pipe_signal;
+  sigemptyset(&pipe_signal);
+  sigaddset(&pipe_signal, SIGPIPE);
+  pthread_sigmask(SIG_BLOCK, &pipe_signal, nullptr);
   std::unique_ptr<RenderEngine> engine;
   Image image;
   for (;;) {
