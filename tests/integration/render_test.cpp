@@ -5,9 +5,12 @@
 #include <catch2/catch.hpp>
 
 #include <cmath>
+#include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
+#include <string>
 
 using namespace ssx;
 namespace fs = std::filesystem;
@@ -24,6 +27,11 @@ bool haveOsmesa() {
 Scene load(const std::string& body) {
   return loadSceneFromString("<scene><environment timestep=\"0.002\" threads=\"2\"/>" + body + "</scene>",
                              "render.xml", kData);
+}
+
+std::string slurpText(const fs::path& file) {
+  std::ifstream in(file);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
 }
 
 const CameraMeasurement& image(Environment& env, const std::string& artifact = "eye") {
@@ -158,4 +166,58 @@ TEST_CASE("render: scene cameras write numbered PNG frames at their rate and a s
 TEST_CASE("render: a camera sensor without a drawing engine fails at start and says what to do", "[render]") {
   Scene s = load(R"(<type name="post" file="camera_post.xml"/><artifact name="eye" type="post"/>)");
   CHECK_THROWS_WITH(s.environment->start(), Catch::Contains("engine=\"osmesa\""));
+}
+
+TEST_CASE("render: a video path is only a file name: ffmpeg gets it as one argument, never through a shell",
+          "[render][video]") {
+  REQUIRE(haveOsmesa());  // dev.sh installs libosmesa6-dev
+  // a stand-in ffmpeg first on PATH: copies its input to the file named by its last argument
+  const fs::path bin = fs::current_path() / "bin";
+  fs::create_directories(bin);
+  std::ofstream(bin / "ffmpeg") << "#!/bin/sh\nfor a in \"$@\"; do last=\"$a\"; done\ncat > \"${last#file:}\"\n";
+  fs::permissions(bin / "ffmpeg", fs::perms::owner_all);
+  const char* path = std::getenv("PATH");
+  REQUIRE(setenv("PATH", (bin.string() + ":" + (path != nullptr ? path : "/usr/bin:/bin")).c_str(), 1) == 0);
+  // a shell would run "touch pwned" (the quote ends the quoted name); an argument vector does not
+  const fs::path video = fs::current_path() / "clip'; touch pwned; echo '.mp4";
+  Scene s = load(R"(<render engine="osmesa" rate_hz="10" width="64" height="48">
+      <camera name="side" xyz="0 -6 2" look_at="0 0 1" video=")" + video.string() + R"("/>
+    </render><ground/>
+    <type name="ball" file="yellow_ball.xml"/><artifact name="ball" type="ball" xyz="0 0 2"/>)");
+  s.environment->step(250);  // frames at steps 0, 50, ..., 200
+  s.environment->stop();
+  REQUIRE(fs::exists(video));
+  CHECK(fs::file_size(video) == 5u * 64 * 48 * 3);
+  CHECK_FALSE(fs::exists("pwned"));
+  CHECK_FALSE(fs::exists(video.string() + ".ffmpeg.log"));  // removed after ffmpeg succeeded
+}
+
+TEST_CASE("render: an ffmpeg that fails makes stopping fail with the video's name", "[render][video]") {
+  REQUIRE(haveOsmesa());
+  const fs::path bin = fs::current_path() / "bin";
+  fs::create_directories(bin);
+  std::ofstream(bin / "ffmpeg") << "#!/bin/sh\necho 'no encoder here' >&2\nexit 1\n";
+  fs::permissions(bin / "ffmpeg", fs::perms::owner_all);
+  const char* path = std::getenv("PATH");
+  REQUIRE(setenv("PATH", (bin.string() + ":" + (path != nullptr ? path : "/usr/bin:/bin")).c_str(), 1) == 0);
+  Scene s = load(R"(<render engine="osmesa" rate_hz="10" width="64" height="48">
+      <camera name="side" xyz="0 -6 2" look_at="0 0 1" video="out.mp4"/>
+    </render><ground/>
+    <type name="ball" file="yellow_ball.xml"/><artifact name="ball" type="ball" xyz="0 0 2"/>)");
+  // the dead pipe is found by a frame write (EPIPE, no SIGPIPE) or by ffmpeg's exit status
+  bool reported = false;
+  try {
+    s.environment->step(250);
+  } catch (const StepError& e) {
+    CHECK_THAT(e.what(), Catch::Contains("out.mp4"));
+    reported = true;
+  }
+  try {
+    s.environment->stop();
+  } catch (const Error& e) {
+    CHECK_THAT(e.what(), Catch::Contains("ffmpeg") && Catch::Contains("out.mp4"));
+    reported = true;
+  }
+  CHECK(reported);
+  CHECK_THAT(slurpText("out.mp4.ffmpeg.log"), Catch::Contains("no encoder here"));
 }
