@@ -1,12 +1,9 @@
 #include <ssx/descriptor.hpp>
 #include <ssx/parameters.hpp>
 
-#include <cerrno>
 #include <charconv>
 #include <cctype>
 #include <cmath>
-#include <cstdlib>
-#include <sstream>
 
 namespace ssx {
 
@@ -45,14 +42,15 @@ bool parseValue(const std::string& text, int& out) { return parseInt(text, out);
 bool parseValue(const std::string& text, std::int64_t& out) { return parseInt(text, out); }
 
 bool parseValue(const std::string& text, double& out) {
-  // strtod accepts what users write (1e-3, .5, inf is rejected below)
-  const char* begin = text.c_str();
-  char* end = nullptr;
-  errno = 0;
-  out = std::strtod(begin, &end);
-  if (end == begin || errno == ERANGE) return false;
-  while (*end == ' ') ++end;
-  return *end == '\0' && std::isfinite(out);
+  // std::from_chars: what users write (1e-3, .5, -2), independent of the process's locale (strtod
+  // would read "0.5" as 0 under a locale with a decimal comma); out of range is no number
+  const char* begin = text.data();
+  const char* end = begin + text.size();
+  while (begin < end && *begin == ' ') ++begin;
+  while (end > begin && end[-1] == ' ') --end;
+  if (begin < end && *begin == '+') ++begin;
+  auto [ptr, ec] = std::from_chars(begin, end, out);
+  return ec == std::errc() && ptr == end && begin != end && std::isfinite(out);
 }
 
 bool parseValue(const std::string& text, Vec3& out) {
@@ -100,10 +98,10 @@ const char* typeName<Vec3>() {
 }
 
 std::string formatNumber(double v) {
-  std::ostringstream out;
-  out.precision(17);
-  out << v;
-  return out.str();
+  // the shortest text that reads back as the same double, whatever the locale
+  char text[32];
+  const auto [end, ec] = std::to_chars(text, text + sizeof text, v);
+  return ec == std::errc() ? std::string(text, end) : std::string("nan");
 }
 
 }  // namespace

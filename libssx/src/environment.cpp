@@ -25,13 +25,15 @@ namespace {
 void checkSettings(const EnvironmentSettings& s) {
   auto bad = [](const std::string& what) { throw ConfigError({}, what); };
   if (s.timestep <= 0) bad("timestep must be positive");
+  if (s.timestep > toNanoseconds(kMaxTimestepSeconds)) bad("timestep must be at most 1 s");
   if (s.threads < 0) bad("threads must be 0 (one per core), 1 (inline) or more");
   if (s.physics.substeps < 1) bad("physics substeps must be at least 1");
   if (s.physics.iterations < 1) bad("physics iterations must be at least 1");
   if (s.physics.max_contacts < 1) bad("physics max_contacts must be at least 1");
   if (!s.physics.gravity.allFinite()) bad("gravity must be finite");
   if (s.render.period_steps < 0) bad("render period must be 0 (never) or positive");
-  if (!(s.render.rate_hz >= 0) || !std::isfinite(s.render.rate_hz)) bad("render rate_hz must be 0 or positive");
+  if (!(s.render.rate_hz == 0 || (s.render.rate_hz >= kMinRateHz && std::isfinite(s.render.rate_hz))))
+    bad("render rate_hz must be 0 (none) or at least 1e-6");
   if (s.render.width < 1 || s.render.height < 1 || s.render.width > kMaxImageSide || s.render.height > kMaxImageSide)
     bad("render width and height must be in 1.." + std::to_string(kMaxImageSide));
   for (const auto& c : s.render.cameras)

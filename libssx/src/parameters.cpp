@@ -1,3 +1,4 @@
+#include <ssx/environment.hpp>
 #include <ssx/parameters.hpp>
 
 #include <algorithm>
@@ -127,6 +128,12 @@ std::vector<Diagnostic> checkParameters(std::span<const ssx_plugin_param> declar
           const double v = params.get<double>(d.name);  // finite: get refuses anything else
           if (!inBounds(d, v)) {
             outOfBounds(a->value);
+            break;
+          }
+          // a rate's period must fit the nanosecond clock
+          if (d.unit != nullptr && std::string_view(d.unit) == "Hz" && v > 0 && v < kMinRateHz) {
+            fail(a->where, "parameter '" + std::string(d.name) + "' must be 0 or at least 1e-6 Hz, got '" +
+                               a->value + "' (" + d.doc + ")");
             break;
           }
           if ((d.flags & SSX_PARAM_RATE) != 0 && v > 0 && context.period() > 0) {

@@ -34,11 +34,25 @@ void waitUntil(Nanoseconds deadline, Nanoseconds spin) {
 
 TimingSummary Environment::run(const RunOptions& options) {
   if (options.mode == RunOptions::Mode::RealTime &&
-      !(options.realtime_factor > 0 && std::isfinite(options.realtime_factor)))
-    throw ConfigError({}, "real-time factor must be a positive number");
+      !(options.realtime_factor >= kMinRealtimeFactor && options.realtime_factor <= kMaxRealtimeFactor))
+    throw ConfigError({}, "real-time factor must be from 0.001 to 1e6");
   if (state() == State::Setup) start();
   const bool realtime = options.mode == RunOptions::Mode::RealTime;
-  if (realtime) prctl(PR_SET_TIMERSLACK, 1UL, 0, 0, 0);  // wake within 1 ns of the deadline, not 50 us
+  // wake within 1 ns of the deadline, not the default 50 us; the slack is the calling thread's,
+  // so it is put back when the run ends, however it ends
+  struct TimerSlack {
+    long before = -1;
+    explicit TimerSlack(bool tight) {
+      if (!tight) return;
+      before = prctl(PR_GET_TIMERSLACK, 0, 0, 0, 0);
+      if (before >= 0) prctl(PR_SET_TIMERSLACK, 1UL, 0, 0, 0);
+    }
+    ~TimerSlack() {
+      if (before > 0) prctl(PR_SET_TIMERSLACK, static_cast<unsigned long>(before), 0, 0, 0);
+    }
+    TimerSlack(const TimerSlack&) = delete;
+    TimerSlack& operator=(const TimerSlack&) = delete;
+  } slack(realtime);
 
   const double period = static_cast<double>(settings_.timestep) / (realtime ? options.realtime_factor : 1.0);
   const std::size_t first_sample = timing_.samples().size();

@@ -24,7 +24,7 @@ class CsvLogger final : public SimulationExtension {
       param::text("artifacts", "*", "artifact names separated by spaces, or * for every artifact with a dynamic root"),
       param::real("rate_hz", "0", "Hz", param::nonNegative(),
                   "rows per artifact per simulated second; 0 writes one every step"),
-      param::real("flush_s", "1", "s", param::positive(),
+      param::real("flush_s", "1", "s", param::positive() & param::atMost(1e9),
                   "simulated time between flushes to the file (and at the end of the run)"),
   };
 

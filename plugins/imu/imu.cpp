@@ -13,8 +13,12 @@
 #include <ssx/plugin_abi.hpp>
 
 #include <cmath>
+#include <cstdio>
 
 namespace ssx::plugins {
+
+// the most counts a reading may have, each way (24-bit converters)
+constexpr double kMaxCounts = 16777216.0;
 
 namespace {
 
@@ -59,8 +63,9 @@ struct Channel {
       if (bias_sigma > 0) bias[i] = bias_phi * bias[i] + bias_sigma * rng.normal();
       if (white_sigma > 0) white = white_sigma * rng.normal();
       const double m = scale * (truth[i] + turn_on_bias[i] + bias[i] + white);
-      std::int64_t c = std::llround(m / lsb);
-      c = std::clamp<std::int64_t>(c, -max_count, max_count);
+      // saturated before the conversion: a crash can read far beyond the range
+      const double scaled = std::clamp(m / lsb, -static_cast<double>(max_count), static_cast<double>(max_count));
+      const std::int64_t c = std::llround(scaled);
       counts[static_cast<std::size_t>(i)] = static_cast<std::int32_t>(c);
       out[i] = static_cast<double>(c) * lsb;
     }
@@ -85,7 +90,7 @@ class ImuSensor final : public SensorOf<ImuMeasurement> {
       param::real("gyro_scale", "1", "", param::positive(), "gyroscope scale factor"),
       param::real("gyro_lsb", "0.0006981317007977319", "rad/s", param::positive(),
                   "gyroscope resolution, one count (0.04 deg/s)"),
-      param::real("gyro_range", "17.453292519943293", "rad/s", param::positive(),
+      param::real("gyro_range", "17.453292519943293", "rad/s", param::positive() & param::atMost(1000),
                   "gyroscope full scale (1000 deg/s)"),
       param::real("accel_noise_density", "4.0e-3", "m/s^2/sqrt(Hz)", param::nonNegative(),
                   "accelerometer white noise"),
@@ -98,17 +103,24 @@ class ImuSensor final : public SensorOf<ImuMeasurement> {
       param::real("accel_scale", "1", "", param::positive(), "accelerometer scale factor"),
       param::real("accel_lsb", "0.008168939449999999", "m/s^2", param::positive(),
                   "accelerometer resolution, one count (0.833 mg)"),
-      param::real("accel_range", "176.5197", "m/s^2", param::positive(), "accelerometer full scale (18 g)"),
+      param::real("accel_range", "176.5197", "m/s^2", param::positive() & param::atMost(10000),
+                  "accelerometer full scale (18 g)"),
   };
 
   static void validate(const Descriptor& params, const PluginContext& context) {
     const PhysicNode& node = context.artifact->nodeFromParameter(params);
     if (node.isStatic()) throw params.error("an IMU needs a dynamic node");
-    // counts are 32-bit integers, as an IMU's registers
+    // at most 24 bits of counts, as the finest MEMS IMUs (most have 16): what reads the counts
+    // (the quadrotor's integer inner loop squares and sums them in 64 bits) can rely on it
     for (const char* prefix : {"gyro_", "accel_"}) {
       const std::string range = std::string(prefix) + "range", lsb = std::string(prefix) + "lsb";
-      if (params.get<double>(range) / params.get<double>(lsb) >= 2147483647.0)
-        throw params.errorAt(lsb, range + " / " + lsb + " must be below 2^31 counts");
+      const double counts = params.get<double>(range) / params.get<double>(lsb);
+      if (counts > kMaxCounts) {
+        char text[32];
+        std::snprintf(text, sizeof text, "%.3g", counts);
+        throw params.errorAt(lsb, range + " / " + lsb + " must be at most 2^24 counts (" + text + " here): make " +
+                                      lsb + " larger");
+      }
     }
   }
 

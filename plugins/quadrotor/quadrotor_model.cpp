@@ -114,8 +114,10 @@ InnerLoopFixed::InnerLoopFixed(const InnerLoopParams& p) : params_(p) {
   max_alpha_q12 = toFixed(p.max_angular_acceleration, kQ12);
   gyro_weight_q15 = toFixed(p.filter_gyro_weight, 32768.0);
   const double g_counts = p.gravity / p.accel_lsb;
-  accel_gate_low2 = toFixed(0.25 * g_counts * g_counts, 1.0);
-  accel_gate_high2 = toFixed(2.25 * g_counts * g_counts, 1.0);
+  // (saturated: with a fine accelerometer LSB the squares of 1 g can exceed 64 bits; the IMU's
+  // at most 2^24 counts keep the measured norm far below that)
+  accel_gate_low2 = toFixed(std::min(0.25 * g_counts * g_counts, 4e18), 1.0);
+  accel_gate_high2 = toFixed(std::min(2.25 * g_counts * g_counts, 4e18), 1.0);
   // mixer coefficients: Q12 for the angular-acceleration columns, Q20 for the thrust column; with
   // alpha in Q12 and thrust in Q16 every product and the sum of four stay below 2^62
   double worst = 0;
@@ -172,8 +174,12 @@ InnerOutput InnerLoopFixed::evaluate(const AttitudeEstimate& prior, const std::a
   // correct towards the accelerometer's gravity direction when it reads about 1 g
   const std::int64_t ax = accel[0], ay = accel[1], az = accel[2];
   const std::int64_t norm2 = ax * ax + ay * ay + az * az;
+  const std::int64_t pi_q20 = fx::roundShift(fx::kPiQ30, 10);
   if (norm2 >= accel_gate_low2 && norm2 <= accel_gate_high2) {
-    const std::int64_t roll_acc = fx::roundShift(fx::atan2Q30(ay, az), 10);
+    std::int64_t roll_acc = fx::roundShift(fx::atan2Q30(ay, az), 10);
+    // blend the shorter way round: upside down, +179 deg and -179 deg are 2 deg apart
+    if (roll_acc - roll > pi_q20) roll_acc -= 2 * pi_q20;
+    if (roll_acc - roll < -pi_q20) roll_acc += 2 * pi_q20;
     const std::int64_t pitch_acc = fx::roundShift(
         fx::atan2Q30(-ax, static_cast<std::int64_t>(fx::isqrtRound(static_cast<std::uint64_t>(ay * ay + az * az)))),
         10);
@@ -181,7 +187,6 @@ InnerOutput InnerLoopFixed::evaluate(const AttitudeEstimate& prior, const std::a
     pitch = fx::roundShift(gyro_weight_q15 * pitch + (32768 - gyro_weight_q15) * pitch_acc, 15);
   }
   // keep roll in (-pi, pi], pitch within +-80 deg
-  const std::int64_t pi_q20 = fx::roundShift(fx::kPiQ30, 10);
   if (roll > pi_q20) roll -= 2 * pi_q20;
   if (roll < -pi_q20) roll += 2 * pi_q20;
   const std::int64_t max_pitch = toFixed(kMaxPitch, kQ20);
@@ -230,9 +235,16 @@ InnerOutput innerLoopFloat(const InnerLoopParams& p, const AttitudeEstimate& pri
   const double ax = accel[0], ay = accel[1], az = accel[2];
   const double g_counts = p.gravity / p.accel_lsb;
   const double norm2 = ax * ax + ay * ay + az * az;
-  if (norm2 >= std::llround(0.25 * g_counts * g_counts) && norm2 <= std::llround(2.25 * g_counts * g_counts)) {
+  // the same gate as the integer loop's, rounded as it is
+  const double gate_low2 = std::round(std::min(0.25 * g_counts * g_counts, 4e18));
+  const double gate_high2 = std::round(std::min(2.25 * g_counts * g_counts, 4e18));
+  if (norm2 >= gate_low2 && norm2 <= gate_high2) {
     const double w = p.filter_gyro_weight;
-    roll = w * roll + (1 - w) * std::atan2(ay, az);
+    double roll_acc = std::atan2(ay, az);
+    // blend the shorter way round, as the integer loop
+    if (roll_acc - roll > std::numbers::pi) roll_acc -= 2 * std::numbers::pi;
+    if (roll_acc - roll < -std::numbers::pi) roll_acc += 2 * std::numbers::pi;
+    roll = w * roll + (1 - w) * roll_acc;
     pitch = w * pitch + (1 - w) * std::atan2(-ax, std::sqrt(ay * ay + az * az));
   }
   if (roll > std::numbers::pi) roll -= 2 * std::numbers::pi;

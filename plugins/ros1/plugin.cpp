@@ -60,14 +60,14 @@ class Ros1Bridge final : public SimulationExtension {
   static constexpr ssx_plugin_param kParameters[] = {
       param::text("master_uri", "", "ROS master (default: $ROS_MASTER_URI, else http://127.0.0.1:11311)"),
       param::text("node_name", "ssx", "name of the ROS node"),
-      param::real("timeout_s", "5", "s", param::positive(), "how long to wait for the master at start"),
+      param::real("timeout_s", "5", "s", param::positive() & param::atMost(86400), "how long to wait for the master at start"),
       param::text("artifacts", "*", "artifact names separated by spaces, or * for every artifact with a dynamic root"),
       param::real("odom_rate_hz", "50", "Hz", param::nonNegative(), "odometry rate in simulated time; 0: every step"),
       param::real("imu_rate_hz", "100", "Hz", param::nonNegative(), "IMU rate in simulated time; 0: no IMU topics"),
       param::real("clock_rate_hz", "100", "Hz", param::nonNegative(), "/clock rate in simulated time; 0: every step"),
       param::flag("lockstep", "false", "wait after each odometry message until every robot answered with a set-point"),
-      param::real("lockstep_timeout_s", "2", "s", param::positive(), "longest wait for the set-points of one step"),
-      param::real("lockstep_connect_timeout_s", "10", "s", param::positive(),
+      param::real("lockstep_timeout_s", "2", "s", param::positive() & param::atMost(86400), "longest wait for the set-points of one step"),
+      param::real("lockstep_connect_timeout_s", "10", "s", param::positive() & param::atMost(86400),
                   "how long the first step waits for every robot's controller to connect"),
   };
 

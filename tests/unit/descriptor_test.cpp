@@ -2,6 +2,9 @@
 
 #include <catch2/catch.hpp>
 
+#include <locale>
+#include <string>
+
 using ssx::ConfigError;
 using ssx::Descriptor;
 
@@ -76,4 +79,34 @@ TEST_CASE("numbers written by set read back exactly", "[descriptor]") {
   d.set("v", v).set("vec", ssx::Vec3(1.0 / 3.0, -2e-9, 7.0));
   CHECK(d.get<double>("v") == v);
   CHECK(d.get<ssx::Vec3>("vec") == ssx::Vec3(1.0 / 3.0, -2e-9, 7.0));
+}
+
+TEST_CASE("numbers are read and written the same under a program's decimal-comma locale", "[descriptor]") {
+  // an embedding program may set a global C++ locale whose decimal point is a comma; scene values
+  // and the numbers Descriptor writes must not follow it
+  struct Comma : std::numpunct<char> {
+    char do_decimal_point() const override { return ','; }
+  };
+  const std::locale before = std::locale::global(std::locale(std::locale::classic(), new Comma));
+  Descriptor d("x");
+  d.set("a", 0.5).set("vec", ssx::Vec3(1.5, -2.25, 1e-3));
+  d.set("b", std::string(" +2.5e-1 "));
+  const std::string written = d.find("a")->value;
+  const double a = d.get<double>("a"), b = d.get<double>("b");
+  const ssx::Vec3 vec = d.get<ssx::Vec3>("vec");
+  std::locale::global(before);
+  CHECK(written == "0.5");
+  CHECK(a == 0.5);
+  CHECK(b == 0.25);
+  CHECK(vec == ssx::Vec3(1.5, -2.25, 1e-3));
+}
+
+TEST_CASE("numbers out of the double range, hex and trailing text are no numbers", "[descriptor]") {
+  Descriptor d("x");
+  for (const char* bad : {"1e400", "-1e400", "nan", "inf", "0x10", "1.5m", "1,5", "", " "}) {
+    d.set("v", std::string(bad));
+    CHECK_THROWS_AS(d.get<double>("v"), ssx::ConfigError);
+  }
+  d.set("v", std::string("1e-400"));  // underflows to a denormal or 0: from_chars calls that out of range
+  CHECK_THROWS_AS(d.get<double>("v"), ssx::ConfigError);
 }

@@ -2,7 +2,11 @@
 
 #include <catch2/catch.hpp>
 
+#include <sys/prctl.h>
+
 #include <chrono>
+#include <limits>
+#include <stdexcept>
 
 using namespace ssx;
 
@@ -130,4 +134,43 @@ TEST_CASE("a stop flag ends the run", "[run]") {
   };
   env.run(o);
   CHECK(env.stepCount() == 123);
+}
+
+TEST_CASE("a real-time run leaves the calling thread's timer slack as it found it", "[run]") {
+  // the library tightens the slack while it paces, and must not keep it so behind the program's back
+  REQUIRE(prctl(PR_SET_TIMERSLACK, 123456UL, 0, 0, 0) == 0);
+  EnvironmentSettings s;
+  s.timestep = toNanoseconds(0.001);
+  Environment env(s);
+  withBall(env);
+  RunOptions o;
+  o.steps = 5;
+  env.run(o);
+  CHECK(prctl(PR_GET_TIMERSLACK, 0, 0, 0, 0) == 123456);
+  // also when the run ends by an exception
+  o.on_step = [](const Environment&) { throw std::runtime_error("controller gave up"); };
+  CHECK_THROWS_WITH(env.run(o), "controller gave up");
+  CHECK(prctl(PR_GET_TIMERSLACK, 0, 0, 0, 0) == 123456);
+}
+
+TEST_CASE("real-time factors outside 0.001 .. 1e6 are refused before anything runs", "[run]") {
+  Environment env;
+  withBall(env);
+  RunOptions o;
+  o.steps = 1;
+  for (const double bad : {0.0, -1.0, 1e-300, 1e-4, 1e7, std::numeric_limits<double>::infinity(),
+                           std::numeric_limits<double>::quiet_NaN()}) {
+    o.realtime_factor = bad;
+    CHECK_THROWS_AS(env.run(o), ConfigError);
+  }
+  CHECK(env.stepCount() == 0);
+}
+
+TEST_CASE("times that do not fit 64-bit nanoseconds are refused, not wrapped", "[run]") {
+  CHECK(toNanoseconds(1.5) == 1'500'000'000);
+  CHECK(toNanoseconds(-2e-9) == -2);
+  CHECK(toNanoseconds(9e9) == 9'000'000'000'000'000'000);
+  for (const double bad : {1e300, -1e300, 9.3e9, std::numeric_limits<double>::quiet_NaN(),
+                           std::numeric_limits<double>::infinity()})
+    CHECK_THROWS_AS(toNanoseconds(bad), std::out_of_range);
 }

@@ -50,6 +50,14 @@ class NeighborIndex;
 }
 
 /// Everything that defines an environment before it is populated.
+/// Limits that keep time arithmetic (integer nanoseconds) in range, checked where the values are
+/// given: the scene loader with file:line, the Environment and run() with a ConfigError.
+inline constexpr double kMaxTimestepSeconds = 1.0;    ///< one physics step
+inline constexpr double kMaxDurationSeconds = 1e9;    ///< about 31 years of simulated time
+inline constexpr double kMinRealtimeFactor = 1e-3;    ///< a thousand times slower than real time
+inline constexpr double kMaxRealtimeFactor = 1e6;
+inline constexpr double kMinRateHz = 1e-6;            ///< a rate (frames, loops) that is not 0: about one per 12 days
+
 struct EnvironmentSettings {
   Nanoseconds timestep = 1'000'000;  ///< tau, ns (default 1 ms)
   std::uint64_t seed = 0;            ///< root of every random stream

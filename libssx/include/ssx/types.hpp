@@ -7,6 +7,8 @@
 #include <Eigen/Geometry>
 
 #include <cstdint>
+#include <stdexcept>
+#include <string>
 
 namespace ssx {
 
@@ -18,8 +20,11 @@ using Quat = Eigen::Quaterniond;
 /// timestep, so it never drifts.
 using Nanoseconds = std::int64_t;
 
-/// Seconds (floating point) to integer nanoseconds, rounded to the nearest nanosecond.
+/// Seconds (floating point) to integer nanoseconds, rounded to the nearest nanosecond. Throws
+/// std::out_of_range for NaN and for more than 9.2e9 s (292 years) either way, which would not fit.
 constexpr Nanoseconds toNanoseconds(double seconds) {
+  if (!(seconds > -9.2e9 && seconds < 9.2e9))
+    throw std::out_of_range("a time of " + std::to_string(seconds) + " s does not fit in 64-bit nanoseconds");
   return static_cast<Nanoseconds>(seconds * 1e9 + (seconds >= 0 ? 0.5 : -0.5));
 }
 /// Integer nanoseconds to seconds.

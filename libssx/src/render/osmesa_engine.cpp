@@ -18,7 +18,6 @@
 #include <array>
 #include <cmath>
 #include <cstdlib>
-#include <malloc.h>
 #include <limits>
 #include <numbers>
 #include <string>
@@ -219,15 +218,8 @@ OsmesaRenderEngine::~OsmesaRenderEngine() {
 void OsmesaRenderEngine::makeCurrent(int width, int height) {
   Gl& g = *gl_;
   if (g.context == nullptr) {
-    // llvmpipe's own rasteriser threads cost more than they give at these image sizes, and they
-    // would compete with the simulation's workers; a user can still set LP_NUM_THREADS
-    setenv("LP_NUM_THREADS", "0", 0);
-    // llvmpipe allocates and frees large blocks every frame; with glibc's default trim threshold
-    // (128 KiB) each free hands the heap top back to the kernel and the next frame faults it in
-    // again: 2-3x the frame time (measured, 640 x 480: 13.3 -> 4.6 ms with 70 robots, 77 -> 25 ms
-    // with 1,000). Keeping up to 256 MiB of free heap is the cure; it is process-wide, and only a
-    // process that renders pays it.
-    mallopt(M_TRIM_THRESHOLD, 256 << 20);
+    // (the process settings that make llvmpipe fast, LP_NUM_THREADS=0 and a large malloc trim
+    // threshold, are the program's to choose: the ssx command sets them, see the README)
     const int attributes[] = {OSMESA_FORMAT,
                               OSMESA_RGBA,
                               OSMESA_DEPTH_BITS,

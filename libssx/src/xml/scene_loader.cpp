@@ -105,8 +105,12 @@ void SceneLoader::collect(const Descriptor& scene, const fs::path& dir, std::vec
 }
 
 void SceneLoader::readEnvironment(const Descriptor& d) {
-  settings_.timestep = toNanoseconds(readPositive(d, "timestep", toSeconds(settings_.timestep)));
-  if (settings_.timestep <= 0) error(d.where(), "<environment>: timestep is below one nanosecond");
+  settings_.timestep = toNanoseconds(readPositiveAtMost(d, "timestep", toSeconds(settings_.timestep), kMaxTimestepSeconds,
+                                                       "a step of the physics, in seconds"));
+  if (settings_.timestep <= 0) {
+    error(d.where(), "<environment>: timestep is below one nanosecond");
+    settings_.timestep = EnvironmentSettings{}.timestep;  // reported once, here
+  }
   const std::int64_t seed = readCount(d, "seed", 0, 0);
   settings_.seed = static_cast<std::uint64_t>(seed);
   const std::string threads = read<std::string>(d, "threads", "auto");
@@ -123,10 +127,15 @@ void SceneLoader::readEnvironment(const Descriptor& d) {
     else
       settings_.threads = static_cast<int>(n);
   }
-  run_.realtime_factor = readPositive(d, "realtime_factor", 1.0);
+  run_.realtime_factor = readPositiveAtMost(d, "realtime_factor", 1.0, kMaxRealtimeFactor, "times real time");
+  if (run_.realtime_factor < kMinRealtimeFactor)
+    record(d.error(*d.find("realtime_factor"), "attribute 'realtime_factor' must be at least 0.001 (a thousand "
+                                               "times slower than real time), got '" +
+                                                   d.find("realtime_factor")->value + "'"));
   run_.overrun = readChoice(d, "overrun", "catchup", {"catchup", "resync"}) == "resync" ? RunOptions::Overrun::Resync
                                                                                         : RunOptions::Overrun::CatchUp;
-  if (d.has("duration")) duration_ = toNanoseconds(readPositive(d, "duration", 1.0));
+  if (d.has("duration"))
+    duration_ = toNanoseconds(readPositiveAtMost(d, "duration", 1.0, kMaxDurationSeconds, "about 31 years of simulated time"));
   checkUnknown(d);
 }
 
@@ -170,7 +179,10 @@ void SceneLoader::readRender(const Descriptor& d) {
   }
   r.period_steps = readCount(d, "period", 0, 0);
   r.rate_hz = read<double>(d, "rate_hz", 0.0);
-  if (!(r.rate_hz >= 0)) error(d.find("rate_hz")->where, "<render>: rate_hz must be 0 or positive");
+  if (!(r.rate_hz == 0 || r.rate_hz >= kMinRateHz)) {
+    error(d.find("rate_hz")->where, "<render>: rate_hz must be 0 (no frames) or at least 1e-6");
+    r.rate_hz = 0;  // reported once, here
+  }
   r.width = static_cast<int>(readCount(d, "width", r.width, 1, kMaxImageSide));
   r.height = static_cast<int>(readCount(d, "height", r.height, 1, kMaxImageSide));
   r.background = readColor(d, r.background, "background");

@@ -5,6 +5,7 @@
 // checks every parameter against its class's declarations (placement.cpp). Every problem is
 // collected; any error stops the load before anything starts.
 
+#include <cstdio>
 #include <ssx/scene.hpp>
 
 #include <array>
@@ -105,6 +106,17 @@ class SceneLoader {
       record(e);
       return fallback;
     }
+  }
+  // positive and at most `max` (`why` says where the bound comes from)
+  double readPositiveAtMost(const Descriptor& d, std::string_view key, double fallback, double max,
+                            const std::string& why) {
+    const double v = readPositive(d, key, fallback);
+    if (v <= max) return v;
+    char text[64];
+    std::snprintf(text, sizeof text, "%g", max);
+    record(d.error(*d.find(key), "attribute '" + std::string(key) + "' must be at most " + text + " (" + why +
+                                     "), got '" + d.find(key)->value + "'"));
+    return fallback;
   }
   // a whole number in [min, max]; the upper bounds keep absurd input from allocating the machine away
   std::int64_t readCount(const Descriptor& d, std::string_view key, std::int64_t fallback, std::int64_t min,

@@ -43,13 +43,21 @@ std::ptrdiff_t attributeOffset(std::string_view text, std::ptrdiff_t tag, std::s
   return tag;
 }
 
-Descriptor convert(const pugi::xml_node& node, std::string_view text, const LineIndex& lines, const std::string& file) {
+// deeper than any scene or artifact needs (a physic tree of a robot arm is a dozen levels); what
+// reads the tree recursively can rely on it
+constexpr int kMaxDepth = 64;
+
+Descriptor convert(const pugi::xml_node& node, std::string_view text, const LineIndex& lines, const std::string& file,
+                   int depth = 1) {
   const std::ptrdiff_t offset = node.offset_debug();
+  if (depth > kMaxDepth)
+    throw ConfigError({file, lines.line(offset)}, "<" + std::string(node.name()) + ">: elements are nested more than " +
+                                                      std::to_string(kMaxDepth) + " levels deep");
   Descriptor d(node.name(), {file, lines.line(offset)});
   for (const auto& a : node.attributes())
     d.set(a.name(), a.value(), {file, lines.line(attributeOffset(text, offset, a.name()))});
   for (const auto& child : node.children())
-    if (child.type() == pugi::node_element) d.addChild(convert(child, text, lines, file));
+    if (child.type() == pugi::node_element) d.addChild(convert(child, text, lines, file, depth + 1));
   return d;
 }
 

@@ -191,6 +191,27 @@ TEST_CASE("the integer inner loop agrees with its float reference within 1 LSB",
   CHECK(g.command <= 1);
 }
 
+TEST_CASE("the attitude filter blends across +-pi the shorter way, in both implementations", "[quadrotor][fixed]") {
+  // upside down: the estimate at +179 deg, the accelerometer's gravity direction at -179 deg;
+  // they are 2 deg apart, and the blend moves the estimate 2 (1 - w) deg further round
+  const InnerLoopParams p = mkInnerParams(200.0, 25.0, 8.0);
+  const InnerLoopFixed fixedLoop(p);
+  const double w = p.filter_gyro_weight, g_counts = p.gravity / p.accel_lsb, deg = std::numbers::pi / 180;
+  for (const double sign : {1.0, -1.0}) {
+    const AttitudeEstimate prior{static_cast<std::int32_t>(std::llround(sign * 179 * deg * 1048576.0)), 0};
+    const std::array<std::int32_t, 3> gyro{}, accel{
+        0, static_cast<std::int32_t>(std::llround(std::sin(-sign * 179 * deg) * g_counts)),
+        static_cast<std::int32_t>(std::llround(std::cos(-sign * 179 * deg) * g_counts))};
+    double expected = sign * (179 + 2 * (1 - w)) * deg;
+    if (expected > std::numbers::pi) expected -= 2 * std::numbers::pi;
+    if (expected < -std::numbers::pi) expected += 2 * std::numbers::pi;
+    const InnerOutput f = fixedLoop.evaluate(prior, gyro, accel, InnerCommand{});
+    const InnerOutput d = innerLoopFloat(p, prior, gyro, accel, InnerCommand{});
+    CHECK(f.estimate.roll_q20 / 1048576.0 == Approx(expected).margin(1e-3 * deg));
+    CHECK(d.estimate.roll_q20 / 1048576.0 == Approx(expected).margin(1e-3 * deg));
+  }
+}
+
 TEST_CASE("the integer inner loop does not overflow at the largest gains", "[quadrotor][fixed]") {
   // the largest gains the driver accepts, far beyond useful tuning, and inputs at full scale
   InnerLoopParams p =
