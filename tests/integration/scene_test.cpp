@@ -243,24 +243,6 @@ TEST_CASE("scenes load from memory with paths relative to a base directory", "[s
                     Catch::StartsWith("memory.xml:1: error: XML syntax"));
 }
 
-TEST_CASE("inputs the fuzzer found problems with load or fail cleanly", "[scene][fuzz]") {
-  // each file is a scene, optionally followed by "\n----\n" and an artifact (see tests/fuzz)
-  int files = 0;
-  for (const auto& entry : fs::directory_iterator(kData / "fuzz")) {
-    ++files;
-    std::ifstream in(entry.path(), std::ios::binary);
-    const std::string input((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-    INFO(entry.path().filename().string());
-    const std::string scene = input.substr(0, input.find("\n----\n"));
-    try {
-      (void)loadSceneFromString(scene, "fuzz.xml", kData / "valid", testOptions());
-    } catch (const SceneError& e) {
-      CHECK_FALSE(e.diagnostics().empty());
-    }
-  }
-  CHECK(files >= 1);
-}
-
 TEST_CASE("counts have upper bounds", "[scene]") {
   const std::string xml = R"(<scene>
     <physics quadtree_depth="40" max_contacts="100000000"/>

@@ -1,0 +1,190 @@
+// What the fuzz targets do with one input (see fuzz_inputs.hpp).
+#include "fuzz_inputs.hpp"
+
+#include <ssx/ssx.hpp>
+
+#include <unistd.h>
+
+#include <cstdlib>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <memory>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace ssx::fuzz {
+
+namespace {
+
+namespace fs = std::filesystem;
+
+const fs::path kExamples = SSX_EXAMPLES_DIR;
+const fs::path kFuzzDir = SSX_FUZZ_DIR;
+
+// one scratch directory per process for the files an input names
+const fs::path& scratch() {
+  static const fs::path dir = [] {
+    std::string pattern = (fs::temp_directory_path() / "ssx_fuzz_XXXXXX").string();
+    if (mkdtemp(pattern.data()) == nullptr) std::abort();
+    return fs::path(pattern);
+  }();
+  return dir;
+}
+
+std::string_view text(std::span<const std::uint8_t> data) {
+  return {reinterpret_cast<const char*>(data.data()), data.size()};
+}
+
+void write(const fs::path& file, std::string_view content) {
+  std::ofstream out(file, std::ios::binary | std::ios::trunc);
+  out.write(content.data(), static_cast<std::streamsize>(content.size()));
+}
+
+SceneOptions options() {
+  SceneOptions o;
+  o.search_installed_plugins = true;  // the built-in plugins beside this libssx
+  o.threads = 1;
+  return o;
+}
+
+// an attribute value as XML text
+std::string escape(std::string_view value) {
+  std::string out;
+  for (const char c : value) {
+    switch (c) {
+      case '&': out += "&amp;"; break;
+      case '<': out += "&lt;"; break;
+      case '"': out += "&quot;"; break;
+      case '\0': break;  // not XML
+      default: out += c;
+    }
+  }
+  return out;
+}
+
+// loads, then steps: the expected ways to refuse are SceneError and ssx::Error
+void loadAndStep(const std::string& xml, const fs::path& base, std::int64_t steps) {
+  Scene scene;
+  try {
+    scene = loadSceneFromString(xml, "fuzz.xml", base, options());
+  } catch (const SceneError&) {
+    return;
+  }
+  try {
+    scene.environment->step(steps);
+    scene.environment->stop();
+  } catch (const Error&) {
+  }
+}
+
+}  // namespace
+
+void sceneInput(std::span<const std::uint8_t> data) {
+  const std::string_view input = text(data);
+  const auto split = input.find("\n----\n");
+  write(scratch() / "a.xml", split == std::string_view::npos ? std::string_view() : input.substr(split + 6));
+  try {
+    (void)loadSceneFromString(input.substr(0, split), "fuzz.xml", scratch(), options());
+  } catch (const SceneError&) {
+  }
+}
+
+void artifactInput(std::span<const std::uint8_t> data) {
+  write(scratch() / "a.xml", text(data));
+  loadAndStep(R"(<scene><environment timestep="0.002"/><ground/><type name="a" file="a.xml"/>
+      <swarm type="a" count="3" name="a{i}" layout="grid" spacing="1" xyz="0 0 0.5"/></scene>)",
+              scratch(), 25);
+}
+
+void parameterInput(std::span<const std::uint8_t> data) {
+  // the plugins of an mk_quad, their declared parameters read from the classes themselves
+  struct Target {
+    const char* element;  // how the scene addresses it
+    const char* plugin;
+    PluginKind kind;
+  };
+  static const Target targets[] = {{"driver", "quadrotor", PluginKind::Driver},
+                                   {"sensor index=\"0\"", "imu", PluginKind::Sensor},
+                                   {"sensor index=\"1\"", "pose", PluginKind::Sensor}};
+  static const std::vector<std::vector<std::string>> names = [] {
+    ClassLoader loader;
+    loader.addSearchDirectory(ClassLoader::installedPluginDirectory());
+    std::vector<std::vector<std::string>> out;
+    for (const auto& t : targets) {
+      const ssx_plugin_class& c = loader.classInfo(t.plugin, t.plugin, t.kind);
+      std::vector<std::string> params;
+      for (std::uint32_t i = 0; i < c.param_count; ++i) params.emplace_back(c.params[i].name);
+      out.push_back(std::move(params));
+    }
+    return out;
+  }();
+  std::string attributes[3];
+  std::string_view input = text(data);
+  for (int line = 0; line < 4 && input.size() >= 2; ++line) {
+    const auto end = input.find('\n');
+    const std::string_view item = input.substr(0, end);
+    input = end == std::string_view::npos ? std::string_view() : input.substr(end + 1);
+    if (item.size() < 2) continue;
+    const std::size_t t = static_cast<unsigned char>(item[0]) % 3;
+    if (names[t].empty()) continue;
+    const std::string& name = names[t][static_cast<unsigned char>(item[1]) % names[t].size()];
+    attributes[t] += " " + name + "=\"" + escape(item.substr(2)) + "\"";
+  }
+  std::string xml = R"(<scene><environment timestep="0.001"/><ground/><type name="q" file=")" +
+                    (kExamples / "artifacts" / "mk_quad.xml").string() +
+                    R"("/><artifact name="q0" type="q" xyz="0 0 0.3">)";
+  for (int t = 0; t < 3; ++t)
+    if (!attributes[t].empty()) xml += std::string("<") + targets[t].element + attributes[t] + "/>";
+  xml += "</artifact></scene>";
+  loadAndStep(xml, scratch(), 200);
+}
+
+void stateInput(std::span<const std::uint8_t> data) {
+  // one environment per process, rewound to its saved state before every input
+  struct World {
+    Scene scene;
+    std::vector<std::byte> start;
+  };
+  static World* world = [] {
+    auto* w = new World;
+    w->scene = loadScene(kFuzzDir / "state_scene.xml", options());
+    w->scene.environment->step(50);
+    w->start = w->scene.environment->saveState();
+    return w;
+  }();
+  Environment& env = *world->scene.environment;
+  if (env.state() != Environment::State::Running) {  // an earlier input made it fail: start again
+    world->scene = loadScene(kFuzzDir / "state_scene.xml", options());
+    world->scene.environment->step(50);
+  }
+  Environment& e = *world->scene.environment;
+  e.restoreState(world->start);
+
+  std::vector<std::byte> buffer(data.size());
+  if (!data.empty()) std::memcpy(buffer.data(), data.data(), data.size());
+  if (text(data).substr(0, 8) != "SSXSTATE") {
+    // a payload: give it the header of a state of this scene, with its size and checksum
+    constexpr std::size_t kHeader = 40;
+    std::vector<std::byte> whole(world->start.begin(), world->start.begin() + kHeader);
+    whole.insert(whole.end(), buffer.begin(), buffer.end());
+    const std::uint64_t payload = buffer.size();
+    std::uint64_t h = 0xcbf29ce484222325ULL;  // FNV-1a, as the format says
+    for (const std::byte b : buffer) h = (h ^ static_cast<std::uint64_t>(b)) * 0x100000001b3ULL;
+    std::memcpy(whole.data() + 24, &payload, 8);
+    std::memcpy(whole.data() + 32, &h, 8);
+    buffer = std::move(whole);
+  }
+  try {
+    e.restoreState(buffer);
+  } catch (const Error&) {
+    return;
+  }
+  try {
+    e.step(20);
+  } catch (const Error&) {
+  }
+}
+
+}  // namespace ssx::fuzz
