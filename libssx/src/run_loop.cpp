@@ -55,7 +55,7 @@ TimingSummary Environment::run(const RunOptions& options) {
   } slack(realtime);
 
   const double period = static_cast<double>(settings_.timestep) / (realtime ? options.realtime_factor : 1.0);
-  const std::size_t first_sample = timing_.samples().size();
+  const std::int64_t first_sample = timing_.recorded();
   const Nanoseconds sim_start = time();
   const Nanoseconds wall_start = monotonicNow();
   Nanoseconds grid_start = wall_start;  // deadlines are grid_start + k * period

@@ -26,22 +26,33 @@ double medianMs(std::vector<Nanoseconds> values) {
 
 }  // namespace
 
-TimingRecorder::TimingRecorder(std::size_t max_samples) : max_samples_(std::max<std::size_t>(2, max_samples)) {}
+TimingRecorder::TimingRecorder(std::size_t capacity) : ring_(std::max<std::size_t>(2, capacity)) {}
 
-void TimingRecorder::add(const StepTiming& sample) {
-  // beyond the cap, drop the older half at once (amortised O(1))
-  if (samples_.size() >= max_samples_)
-    samples_.erase(samples_.begin(), samples_.begin() + static_cast<std::ptrdiff_t>(max_samples_ / 2));
-  samples_.push_back(sample);
+void TimingRecorder::add(const StepTiming& sample) noexcept {
+  ring_[head_] = sample;
+  head_ = (head_ + 1) % ring_.size();
+  size_ = std::min(size_ + 1, ring_.size());
+  ++recorded_;
 }
 
-void TimingRecorder::clear() { samples_.clear(); }
+void TimingRecorder::clear() noexcept {
+  head_ = size_ = 0;
+  recorded_ = 0;
+}
 
-TimingSummary TimingRecorder::summary(Nanoseconds wall, Nanoseconds simulated, std::size_t first) const {
+std::vector<StepTiming> TimingRecorder::samples() const {
+  std::vector<StepTiming> out;
+  out.reserve(size_);
+  for (std::size_t i = 0; i < size_; ++i) out.push_back((*this)[i]);
+  return out;
+}
+
+TimingSummary TimingRecorder::summary(Nanoseconds wall, Nanoseconds simulated, std::int64_t since) const {
   TimingSummary s;
-  if (first > samples_.size()) first = samples_.size();
-  const auto begin = samples_.begin() + static_cast<std::ptrdiff_t>(first);
-  const std::size_t n = samples_.size() - first;
+  // the kept samples are the recorded ones numbered recorded_ - size_ ... recorded_ - 1
+  const std::int64_t oldest = recorded_ - static_cast<std::int64_t>(size_);
+  const std::size_t first = static_cast<std::size_t>(std::clamp<std::int64_t>(since - oldest, 0, static_cast<std::int64_t>(size_)));
+  const std::size_t n = size_ - first;
   s.steps = static_cast<std::int64_t>(n);
   s.wall_s = toSeconds(wall);
   s.simulated_s = toSeconds(simulated);
@@ -51,7 +62,8 @@ TimingSummary TimingRecorder::summary(Nanoseconds wall, Nanoseconds simulated, s
   total.reserve(n);
   double sum = 0;
   Nanoseconds max_late = 0;
-  for (auto it = begin; it != samples_.end(); ++it) {
+  for (std::size_t i = first; i < size_; ++i) {
+    const StepTiming* it = &(*this)[i];
     total.push_back(it->total);
     physics.push_back(it->physics);
     sensors.push_back(it->sensors);
@@ -90,16 +102,19 @@ std::string TimingSummary::str() const {
 
 void TimingRecorder::writeCsv(std::ostream& out) const {
   out << "step,physics_ns,snapshot_ns,sensors_ns,drivers_ns,render_ns,total_ns,lateness_ns\n";
-  for (const auto& s : samples_)
+  for (std::size_t i = 0; i < size_; ++i) {
+    const StepTiming& s = (*this)[i];
     out << s.step << ',' << s.physics << ',' << s.snapshot << ',' << s.sensors << ',' << s.drivers << ',' << s.render
         << ',' << s.total << ',' << s.lateness << '\n';
+  }
 }
 
 void TimingRecorder::writeCsv(const std::string& path) const {
   std::ofstream out(path);
   if (!out) throw Error("cannot write timing CSV '" + path + "': check the directory exists and is writable");
   writeCsv(out);
-  if (!out.flush()) throw Error("error while writing timing CSV '" + path + "'");
+  out.close();
+  if (!out) throw Error("error while writing timing CSV '" + path + "' (disk full?)");
 }
 
 }  // namespace ssx

@@ -9,6 +9,9 @@ namespace ssx::quadrotor {
 
 namespace {
 
+// room for the neighbours a formation robot senses at once, reserved at start
+constexpr std::size_t kTypicalNeighbours = 64;
+
 std::vector<std::string> words(const std::string& text) {
   std::istringstream in(text);
   std::vector<std::string> out;
@@ -178,6 +181,10 @@ void QuadrotorDriver::configure(const Descriptor& params, PluginSetup& setup) {
     const Sensor* range = firstSensorOf<RangeMeasurement>(a);
     if (range == nullptr) throw params.error("reference=\"formation\" needs a range sensor on the artifact");
     setup.subscribe<RangeMeasurement>(*range, [this](const RangeMeasurement& m) { seen_ = m.detections; });
+    // room for the neighbours a robot usually has, so that flying allocates nothing; a robot
+    // that meets more grows these once, to the most it has met
+    seen_.reserve(kTypicalNeighbours);
+    desired_distance_.reserve(std::min(kTypicalNeighbours, formation_.size));
     virtual_point_ = start + params.get<Vec3>("offset");
     own_target_ = formation_.target(formation_index_);
   } else {

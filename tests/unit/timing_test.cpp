@@ -42,9 +42,23 @@ TEST_CASE("timing samples are written as CSV", "[timing]") {
   CHECK_THROWS_WITH(r.writeCsv("/nonexistent-dir/t.csv"), Catch::Contains("cannot write timing CSV"));
 }
 
-TEST_CASE("the recorder keeps a bounded number of samples", "[timing]") {
+TEST_CASE("the recorder keeps the newest samples in a ring of fixed capacity", "[timing]") {
   TimingRecorder r(10);
-  for (int i = 0; i < 25; ++i) r.add({i, 0, 0, 0, 0, 0, i, 0});
-  CHECK(r.samples().size() <= 10);
-  CHECK(r.samples().back().step == 24);
+  for (int i = 0; i < 25; ++i) r.add({i, 0, 0, 0, 0, 0, (i + 1) * 1'000'000, 0});
+  CHECK(r.capacity() == 10);
+  CHECK(r.size() == 10);
+  CHECK(r.recorded() == 25);
+  const std::vector<StepTiming> kept = r.samples();
+  REQUIRE(kept.size() == 10);
+  CHECK(kept.front().step == 15);  // oldest first
+  CHECK(kept.back().step == 24);
+  CHECK(r.last()->step == 24);
+  // a mark taken before a run covers that run's samples only
+  CHECK(r.summary(0, 0, 20).steps == 5);
+  CHECK(r.summary(0, 0, 20).max_ms == Approx(25));
+  CHECK(r.summary(0, 0, 3).steps == 10);  // older than the ring holds: what is kept
+  r.clear();
+  CHECK(r.size() == 0);
+  CHECK(r.last() == nullptr);
+  CHECK(r.capacity() == 10);
 }

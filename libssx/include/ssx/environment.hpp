@@ -62,6 +62,8 @@ struct EnvironmentSettings {
   Nanoseconds timestep = 1'000'000;  ///< tau, ns (default 1 ms)
   std::uint64_t seed = 0;            ///< root of every random stream
   int threads = 0;                   ///< worker threads for the parallel phases; 0: one per core; 1: inline
+  /// Steps whose timing is kept (timing()), in a ring allocated when the environment is made.
+  std::size_t timing_samples = TimingRecorder::kDefaultCapacity;
   PhysicsSettings physics;
   RenderSettings render;
 };
@@ -277,7 +279,7 @@ class SSX_EXPORT Environment {
   std::unique_ptr<detail::SceneCameras> cameras_;  // scene cameras, camera images, render items
   std::unique_ptr<detail::NeighborIndex> neighbors_;
   std::vector<StaticShape> static_shapes_;
-  TimingRecorder timing_;
+  TimingRecorder timing_{settings_.timing_samples};
   LogSink log_;
 };
 
