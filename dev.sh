@@ -4,6 +4,9 @@
 #   ./dev.sh demo   build, then run the default swarm scenario in real time
 #   ./dev.sh test   build, then run every test (ctest)
 #   ./dev.sh build  build only
+#   ./dev.sh sanitize  the whole suite under ASan+UBSan (clang, build-asan/), each fuzz target for
+#                   FUZZ_SECONDS (default 60) in that build, and the parallel and determinism tests
+#                   under TSan (build-tsan/)
 #
 # Environment: BUILD_DIR (default: build), SSX_WARNINGS_AS_ERRORS=ON to fail on warnings (CI),
 # JOBS (default: 2).
@@ -15,6 +18,8 @@ packages=(build-essential cmake ninja-build pkg-config ccache
 # for `test` also ROS 1 (Debian's), so that the ros1 extension is built and tested against a real master
 ros_packages=(libroscpp-dev libgeometry-msgs-dev libsensor-msgs-dev libnav-msgs-dev
               python3-rosmaster python3-rospy python3-rostopic python3-geometry-msgs python3-nav-msgs)
+# for `sanitize`: clang with its sanitizer and libFuzzer runtimes
+sanitize_packages=(clang libclang-rt-14-dev)
 build_dir=${BUILD_DIR:-build}
 jobs=${JOBS:-2}
 
@@ -53,8 +58,31 @@ case "${1:-}" in
   build)
     build
     ;;
+  sanitize)
+    packages+=("${ros_packages[@]}" "${sanitize_packages[@]}")
+    install_packages
+    launcher=()
+    command -v ccache >/dev/null && launcher=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache -DCMAKE_C_COMPILER_LAUNCHER=ccache)
+    # a finding ends the test that found it, with a stack
+    export ASAN_OPTIONS=detect_leaks=1:abort_on_error=1:strict_string_checks=1:detect_stack_use_after_return=1
+    export UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
+    export LSAN_OPTIONS=suppressions=$PWD/tests/sanitizers/lsan.supp
+    export TSAN_OPTIONS=halt_on_error=1:second_deadlock_stack=1
+    CC=clang CXX=clang++ cmake -S . -B build-asan -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DSSX_FUZZ=ON \
+      -DSSX_WARNINGS_AS_ERRORS="${SSX_WARNINGS_AS_ERRORS:-OFF}" "${launcher[@]}" >/dev/null
+    cmake --build build-asan -j "$jobs"
+    # install_and_consume builds a plain consumer against the library, which an instrumented
+    # libssx cannot link into; the plain build (./dev.sh test) runs it
+    ctest --test-dir build-asan -j "$jobs" --output-on-failure -E '^install_and_consume$'
+    tests/fuzz/run.sh build-asan "${FUZZ_SECONDS:-60}"
+    cmake -S . -B build-tsan -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DSSX_SANITIZE=thread \
+      -DSSX_BUILD_EXAMPLES=OFF -DSSX_WITH_ROS1=OFF -DSSX_WARNINGS_AS_ERRORS="${SSX_WARNINGS_AS_ERRORS:-OFF}" \
+      "${launcher[@]}" >/dev/null
+    cmake --build build-tsan -j "$jobs" --target ssx_tests
+    ctest --test-dir build-tsan -j "$jobs" --output-on-failure -R 'thread|bitwise|worker pool|parallel'
+    ;;
   *)
-    sed -n '2,12p' "$0"
+    sed -n '2,15p' "$0"
     exit 2
     ;;
 esac

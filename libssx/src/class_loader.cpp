@@ -141,7 +141,9 @@ PluginLibraryInfo ClassLoader::inspect(const fs::path& file) {
   const auto* m = static_cast<const ssx_plugin_manifest*>(dlsym(handle, kManifestSymbol));
   info.problem = checkManifest(m, info);
   info.ok = info.problem.empty();
-  // never unloaded: see the class comment
+  // a library that fails is closed (what it reported was copied); one that passes stays loaded,
+  // as every library the loader uses (see the class comment)
+  if (!info.ok) dlclose(handle);
   return info;
 }
 
@@ -183,6 +185,7 @@ fs::path ClassLoader::load(std::string_view plugin) {
     const std::string problem = checkManifest(lib->manifest, lib->info);
     if (!problem.empty()) {
       tried += "\n  " + candidate.string() + ": " + problem;
+      dlclose(lib->handle);  // nothing of it is used: it failed before any of its classes was
       continue;
     }
     lib->info.ok = true;

@@ -152,6 +152,18 @@ TEST_CASE("ssx plugins lists libraries, classes and failing checks", "[cli]") {
   CHECK_THAT(tests.out, Contains("  sensor counter"));
 }
 
+TEST_CASE("ssx plugins survives a library that crashes while loading, and lists the others", "[cli]") {
+  const Result r = run({"plugins", "--plugin-path", SSX_TEST_CRASHING_PLUGIN_DIR, "--plugin-path", SSX_TEST_PLUGIN_DIR});
+  CHECK(r.status == 2);
+  CHECK_THAT(r.out, Contains("libssx_test_crashing.so: FAILS: crashed while being loaded (signal 11"));
+  // it went on: the libraries after it are listed, and the built-in ones
+  CHECK_THAT(r.out, Contains("libssx_test_good.so: ok") && Contains("libssx_hover.so: ok"));
+  // --params looks past it too
+  const Result params = run({"plugins", "--plugin-path", SSX_TEST_CRASHING_PLUGIN_DIR, "--params", "hover"});
+  CHECK(params.status == 0);
+  CHECK_THAT(params.out, Contains("| `kp` |"));
+}
+
 TEST_CASE("Ctrl-C stops a real-time run cleanly: summary printed, files closed", "[cli]") {
   fs::remove("hover_swarm_poses.csv");
   bool sent = false;

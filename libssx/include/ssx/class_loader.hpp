@@ -44,7 +44,15 @@ struct PluginLibraryInfo {
 };
 
 /// Loads plugin libraries with dlopen(RTLD_NOW | RTLD_LOCAL) and checks their manifest (ABI
-/// version, record sizes, build tag, classes) before calling any of their functions.
+/// version, record sizes, build tag, classes) before it creates anything from them.
+///
+/// What runs when: dlopen itself runs the library's static initialisers (and those of the
+/// libraries it pulls in); no loader can check anything before that. Then the manifest is read
+/// (`ssx_plugin_manifest_v1`, plain data) and checked; a library that fails is closed again
+/// (dlclose) and none of its functions is called. A class's `create` runs only when an instance is
+/// made: for a scene, after every check of the whole scene passed. `ssx plugins` inspects each
+/// library in a child process of its own, so a library that crashes while loading is reported,
+/// not fatal.
 ///
 /// Ownership: the loader owns every instance it creates and destroys all of them (newest first)
 /// in `destroyInstances()` or its destructor. It never unloads a library: callbacks, type
