@@ -89,6 +89,9 @@ TEST_CASE("torque-free symmetric top precesses at (J3 - J1)/J1 w3", "[physics]")
   INFO("energy drift " << (e - e0) / e0 << ", momentum drift " << (l - l0).norm() / l0.norm());
   CHECK(std::abs(e - e0) / e0 < 1e-3);
   CHECK((l - l0).norm() / l0.norm() < 1e-3);
+  // the figures the README gives, to their last digit
+  CHECK((e - e0) / e0 == Approx(-1.9e-4).margin(0.05e-4));
+  CHECK((l - l0).norm() / l0.norm() == Approx(1.1e-4).margin(0.05e-4));
 }
 
 TEST_CASE("spin about the intermediate axis flips (Dzhanibekov)", "[physics]") {
@@ -105,6 +108,7 @@ TEST_CASE("spin about the intermediate axis flips (Dzhanibekov)", "[physics]") {
   }
   INFO("first sign change of the body y rate at " << first_flip_s << " s");
   CHECK(first_flip_s > 0);
+  CHECK(first_flip_s == Approx(2.7).margin(0.05));  // the README's figure
   // a full flip: the body y rate reverses to nearly its full magnitude
   CHECK(min_wy < -4.5);
 }
