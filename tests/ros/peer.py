@@ -4,10 +4,16 @@
 set-point for 1 s of simulated time.
 
 usage: peer.py COUNT [TIMEOUT_S]   (robots q0 .. q<COUNT-1>; exit 0 on success, 1 otherwise)
+       peer.py COUNT TIMEOUT_S --lockstep  (answer each odometry message after a varying delay of
+                                       0-30 ms with a set-point stamped like it, and check lock-step:
+                                       no odometry of a round may arrive before every robot's answer
+                                       to the round before was sent; exit 0 when there were at least
+                                       100 rounds, no violation, and every robot held its set-point)
        peer.py COUNT SECONDS --bench  (answer every odometry message at once with a set-point stamped
                                        like it, for SECONDS; print how many messages came per robot)
 """
 import sys
+import threading
 import time
 
 import rospy
@@ -24,6 +30,31 @@ def main():
     pubs = {n: rospy.Publisher("/%s/setpoint" % n, PoseStamped, queue_size=10) for n in names}
 
     bench = "--bench" in sys.argv
+    lockstep = "--lockstep" in sys.argv
+    period = 0.02  # odometry at 50 Hz of simulated time
+    lock = threading.Lock()
+    answered = {}          # robot -> newest stamp answered (sent)
+    pending = []           # (due wall time, robot, stamp)
+    violations = []
+    rounds = set()
+
+    def answer(name, stamp, ros_stamp):
+        m = PoseStamped()
+        m.header.stamp = ros_stamp  # exactly the odometry's (a float would round some below it)
+        m.pose.position.x, m.pose.position.y, m.pose.position.z = target[name]
+        m.pose.orientation.w = 1.0
+        pubs[name].publish(m)
+        answered[name] = max(answered.get(name, -1.0), stamp)
+
+    def answerer():
+        while not rospy.is_shutdown():
+            now = time.time()
+            with lock:
+                due = [p for p in pending if p[0] <= now]
+                for p in due:
+                    pending.remove(p)
+                    answer(p[1], p[2], p[3])
+            time.sleep(0.001)
 
     def on_odom(msg, name):
         p = msg.pose.pose.position
@@ -31,6 +62,18 @@ def main():
         received[name] = received.get(name, 0) + 1
         if name not in target:
             target[name] = (p.x + 1.0, p.y - 0.5, 1.5)
+        if lockstep:
+            with lock:
+                # the round before this one must have been answered by every robot already
+                previous = t - period
+                if rounds and previous >= min(rounds) - 1e-9:
+                    late = [n for n in names if answered.get(n, -1.0) < previous - 1e-9]
+                    if late:
+                        violations.append((t, name, late[:3]))
+                rounds.add(round(t, 6))
+                # a delay of 0-30 ms that varies with the robot and the round
+                delay = ((hash((name, round(t, 6))) % 31) / 1000.0)
+                pending.append((time.time() + delay, name, t, msg.header.stamp))
         if bench:
             m = PoseStamped()
             m.header.stamp = msg.header.stamp
@@ -48,6 +91,24 @@ def main():
 
     subs = [rospy.Subscriber("/%s/odom" % n, Odometry, on_odom, callback_args=n, tcp_nodelay=True) for n in names]
     start = time.time()
+    if lockstep:
+        threading.Thread(target=answerer, daemon=True).start()
+        # answer until the simulation is over: no odometry for 2 s of wall time
+        last_count, quiet_since = -1, time.time()
+        while time.time() - start < timeout:
+            with lock:
+                n_rounds = len(rounds)
+            if n_rounds != last_count:
+                last_count, quiet_since = n_rounds, time.time()
+            elif n_rounds > 0 and time.time() - quiet_since > 2.0:
+                break
+            time.sleep(0.05)
+        done = [n for n in names if n in held_since and last_stamp[n] - held_since[n] >= 1.0]
+        with lock:
+            print("peer: lock-step: %d rounds, %d violations%s; %d of %d robots held their set-points"
+                  % (len(rounds), len(violations), (" (first: t=%.3f %s before %s answered)" % violations[0])
+                     if violations else "", len(done), count))
+        return 0 if not violations and len(rounds) >= 100 and len(done) == count else 1
     if bench:
         while time.time() - start < timeout:
             time.sleep(0.1)
