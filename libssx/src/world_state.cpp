@@ -175,6 +175,10 @@ void Environment::applyState(std::span<const std::byte> payload) {
   StateReader in(payload, "saved state");
   const auto steps = in.get<std::int64_t>();
   if (steps < 0) throw StateError("saved state: negative step count (corrupted)");
+  // time is steps * timestep in 64-bit nanoseconds: the count must leave room to go on
+  if (steps > static_cast<std::int64_t>(kMaxDurationSeconds * 1e9) / settings_.timestep)
+    throw StateError("saved state: a step count of " + std::to_string(steps) +
+                     " is beyond the longest run (1e9 s of simulated time; corrupted?)");
   readBlock(in, "the physics engine's state", [&](StateReader& block) { physics_->restoreState(block); });
   const std::size_t bodies = in.count(1);
   detail::World& w = *world_;
