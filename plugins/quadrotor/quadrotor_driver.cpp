@@ -388,7 +388,12 @@ void QuadrotorDriver::loadState(StateReader& in) {
   outer_->setIntegral(integral);
   in.read(command_);
   in.read(attitude_);
-  in.read(source_);
+  Source source = Source::Hover;
+  in.read(source);
+  if (static_cast<int>(source) < 0 || static_cast<int>(source) > static_cast<int>(Source::Formation) ||
+      (source == Source::Formation) != (source_ == Source::Formation))
+    throw StateError("quadrotor: the saved reference source does not fit this driver (corrupted, or another scene)");
+  source_ = source;
   load(in, current_);
   load(in, external_);
   in.read(virtual_point_);

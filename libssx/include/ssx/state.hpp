@@ -89,6 +89,13 @@ class StateReader {
   void read(T& value) {
     bytes(&value, sizeof value);
   }
+  /// A flag: a byte that is 0 or 1 (anything else is a corrupted state, not a bool).
+  void read(bool& value) {
+    unsigned char byte = 0;
+    bytes(&byte, 1);
+    if (byte > 1) throw StateError(what_ + ": a flag reads " + std::to_string(byte) + ", not 0 or 1 (corrupted)");
+    value = byte == 1;
+  }
   void read(Vec3& v) { bytes(v.data(), 3 * sizeof(double)); }
   void read(Quat& q) { bytes(q.coeffs().data(), 4 * sizeof(double)); }
   void read(Pose& p) {
