@@ -62,6 +62,7 @@ void buildBodies(World& world, PhysicEngine& engine, std::vector<Environment::St
       const int body = engine.addBody(mass, shapes, initial);
       for (std::size_t k : tree) world.nodes[k].body = body;
       world.body_owner.push_back(static_cast<std::uint32_t>(artifact->index()));
+      world.wrench_limits.push_back(wrenchLimit(mass, world.settings.physics, world.settings.timestep));
     }
     data.body_end = static_cast<int>(engine.bodyCount());
   }

@@ -141,8 +141,15 @@ void runDrivers(World& world, std::size_t begin, std::size_t end) {
       continue;
     }
     for (int b = a.body_begin; b < a.body_end; ++b) {
-      if (!finite(world.wrenches[static_cast<std::size_t>(b)])) {
+      const Wrench& w = world.wrenches[static_cast<std::size_t>(b)];
+      if (!finite(w)) {
         world.errors[i] = {"driver '" + driver->className() + "'", "applied a NaN or infinite force or torque"};
+        break;
+      }
+      if (!withinLimit(w, world.wrench_limits[static_cast<std::size_t>(b)])) {
+        world.errors[i] = {"driver '" + driver->className() + "'",
+                           "applied a force or torque that would change a body's speed by more than "
+                           "max_linear_speed or max_angular_speed in one step"};
         break;
       }
     }

@@ -14,6 +14,8 @@
 #include <ssx/plugin.hpp>
 #include <ssx/random.hpp>
 
+#include "state_checks.hpp"
+
 #include <cstdint>
 #include <functional>
 #include <memory>
@@ -121,6 +123,9 @@ struct World {
   std::vector<Vec3> previous_angular;
   std::vector<Wrench> wrenches;
   std::vector<std::uint32_t> body_owner;  // artifact index
+  // per body: the largest force and torque that change its speeds by at most the speed guards in
+  // one step (commands beyond them are refused before the engine sees them)
+  std::vector<WrenchLimit> wrench_limits;
 
   bool started() const noexcept { return !states.empty(); }
   ArtifactData& data(const Artifact& a) { return artifact_data[a.index()]; }

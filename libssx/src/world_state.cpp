@@ -8,6 +8,7 @@
 // plugin (driver first, then sensors, artifact by artifact: what it saved) and one per extension.
 #include "neighbor_index.hpp"
 #include "render/scene_cameras.hpp"
+#include "state_checks.hpp"
 #include "world.hpp"
 
 #include <ssx/environment.hpp>
@@ -191,6 +192,10 @@ void Environment::applyState(std::span<const std::byte> payload) {
     in.read(w.previous_angular[i]);
     in.read(w.wrenches[i].force);
     in.read(w.wrenches[i].torque);
+    // a command a driver could have given (the engine applies it in the next step)
+    if (!detail::finite(w.wrenches[i]) || !detail::withinLimit(w.wrenches[i], w.wrench_limits[i]))
+      throw StateError("saved state: the command held for body " + std::to_string(i) +
+                       " is not finite or beyond the speed guards (corrupted)");
   }
   for (Random& r : w.randoms) r.load(in);
   for (std::size_t i = 0; i < w.artifacts.size(); ++i) {

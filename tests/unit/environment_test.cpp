@@ -251,6 +251,26 @@ TEST_CASE("a driver producing a NaN force is stopped by name", "[environment]") 
   }
 }
 
+TEST_CASE("a driver's force or torque beyond the speed guards for one step is refused before physics", "[environment]") {
+  // the engine would meet speeds it cannot integrate (ODE asserts inside its step); the run stops
+  // naming the driver instead
+  Environment env;
+  Artifact& a = addBall(env, "spinner");
+  a.setDriver(std::make_unique<LambdaDriver>([](Driver& d, const StepInfo& info) {
+                d.artifact().root().addTorque(Vec3(0, 0, info.step == 3 ? 1e12 : 1.0));
+              }),
+              {}, 1, "wild_pid");
+  env.step(3);
+  try {
+    env.step();
+    FAIL("no StepError");
+  } catch (const StepError& e) {
+    CHECK(e.artifact() == "spinner");
+    CHECK(e.plugin() == "driver 'wild_pid'");
+    CHECK_THAT(e.what(), Catch::Contains("max_angular_speed"));
+  }
+}
+
 TEST_CASE("a diverging state after physics is reported naming the artifact", "[environment]") {
   Environment env;
   addBall(env, "calm");
