@@ -96,7 +96,6 @@ namespace {
 constexpr double kQ12 = 4096.0;
 constexpr double kQ16 = 65536.0;
 constexpr double kQ20 = 1048576.0;
-constexpr double kQ30 = 1073741824.0;
 constexpr double kMaxPitch = 80.0 * std::numbers::pi / 180.0;
 
 std::int64_t toFixed(double v, double scale) { return std::llround(v * scale); }
