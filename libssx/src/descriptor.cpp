@@ -27,8 +27,10 @@ bool parseValue(const std::string& text, bool& out) {
   return false;
 }
 
-template <class Int>
-bool parseInt(const std::string& text, Int& out) {
+// std::from_chars: what users write (1e-3, .5, +2, surrounding spaces), independent of the
+// process's locale (strtod would read "0.5" as 0 under a decimal comma); out of range is no number
+template <class Number>
+bool parseNumber(const std::string& text, Number& out) {
   const char* begin = text.data();
   const char* end = begin + text.size();
   while (begin < end && *begin == ' ') ++begin;
@@ -38,20 +40,9 @@ bool parseInt(const std::string& text, Int& out) {
   return ec == std::errc() && ptr == end && begin != end;
 }
 
-bool parseValue(const std::string& text, int& out) { return parseInt(text, out); }
-bool parseValue(const std::string& text, std::int64_t& out) { return parseInt(text, out); }
-
-bool parseValue(const std::string& text, double& out) {
-  // std::from_chars: what users write (1e-3, .5, -2), independent of the process's locale (strtod
-  // would read "0.5" as 0 under a locale with a decimal comma); out of range is no number
-  const char* begin = text.data();
-  const char* end = begin + text.size();
-  while (begin < end && *begin == ' ') ++begin;
-  while (end > begin && end[-1] == ' ') --end;
-  if (begin < end && *begin == '+') ++begin;
-  auto [ptr, ec] = std::from_chars(begin, end, out);
-  return ec == std::errc() && ptr == end && begin != end && std::isfinite(out);
-}
+bool parseValue(const std::string& text, int& out) { return parseNumber(text, out); }
+bool parseValue(const std::string& text, std::int64_t& out) { return parseNumber(text, out); }
+bool parseValue(const std::string& text, double& out) { return parseNumber(text, out) && std::isfinite(out); }
 
 bool parseValue(const std::string& text, Vec3& out) {
   // three words separated by white space, each a complete number (no stream: a swarm's members
