@@ -25,6 +25,7 @@ class NullRenderEngine final : public RenderEngine {
 }  // namespace
 
 PhysicEngine::~PhysicEngine() = default;
+TaskRunner::~TaskRunner() = default;
 RenderEngine::~RenderEngine() = default;
 
 std::unique_ptr<PhysicEngine> createPhysicEngine(const PhysicsSettings& settings) {

@@ -295,6 +295,7 @@ void Environment::start() {
     const unsigned threads = settings_.threads > 0 ? static_cast<unsigned>(settings_.threads)
                                                    : std::max(1u, std::thread::hardware_concurrency());
     pool_ = std::make_unique<detail::WorkerPool>(threads);
+    physics_->setTaskRunner(pool_.get());
     w.errors.assign(w.artifacts.size(), detail::PendingError{});
     w.state = State::Running;  // configure may subscribe and read the snapshot
     w.configuring = true;
@@ -351,6 +352,7 @@ void Environment::stop() {
       if (data.driver) destroy(*data.driver, "driver '" + data.driver->className() + "'");
       for (auto& s : data.sensors) destroy(*s.sensor, "sensor '" + s.sensor->className() + "'");
     }
+    if (physics_) physics_->setTaskRunner(nullptr);
     pool_.reset();
     cameras_->finish([&](std::string_view m) { failed(std::string(m)); });
     renderer_.reset();

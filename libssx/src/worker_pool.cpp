@@ -43,6 +43,11 @@ void WorkerPool::workerLoop() {
 
 void WorkerPool::run(std::size_t n, std::size_t chunk, Invoke invoke, void* ctx) {
   if (n == 0) return;
+  if (n <= chunk || workers_.empty()) {
+    // one chunk: waking the workers would cost more than it saves
+    invoke(ctx, 0, n);
+    return;
+  }
   n_ = n;
   chunk_ = chunk == 0 ? 1 : chunk;
   invoke_ = invoke;

@@ -3,6 +3,8 @@
 // threads meet at the end of each job (a barrier). Work is handed out in chunks of indices from
 // a shared counter, so a slow artifact does not hold up a whole thread's share.
 
+#include <ssx/physic_engine.hpp>
+
 #include <atomic>
 #include <cstddef>
 #include <cstdint>
@@ -12,15 +14,31 @@
 
 namespace ssx::detail {
 
-class WorkerPool {
+class WorkerPool final : public TaskRunner {
  public:
   /// `threads` in total, the caller included (>= 1); threads - 1 are started.
   explicit WorkerPool(unsigned threads);
-  ~WorkerPool();
+  ~WorkerPool() override;
   WorkerPool(const WorkerPool&) = delete;
   WorkerPool& operator=(const WorkerPool&) = delete;
 
   unsigned size() const noexcept { return static_cast<unsigned>(workers_.size()) + 1; }
+
+  // TaskRunner, for the physics engine: one task per index
+  unsigned threads() const override { return size(); }
+  void forEach(std::size_t n, void (*task)(void*, std::size_t), void* context) override {
+    struct Each {
+      void (*task)(void*, std::size_t);
+      void* context;
+    } each{task, context};
+    run(
+        n, 1,
+        [](void* ctx, std::size_t b, std::size_t e) {
+          auto& x = *static_cast<Each*>(ctx);
+          for (std::size_t i = b; i < e; ++i) x.task(x.context, i);
+        },
+        &each);
+  }
 
   /// Calls fn(begin, end) over [0, n) in chunks of `chunk`, on every thread; returns when all
   /// are done. If fn throws, the first exception caught is rethrown here after the barrier.

@@ -20,7 +20,7 @@ namespace ssx {
 namespace {
 
 constexpr char kMagic[8] = {'S', 'S', 'X', 'S', 'T', 'A', 'T', 'E'};
-constexpr std::uint32_t kFormatVersion = 2;
+constexpr std::uint32_t kFormatVersion = 3;
 constexpr std::size_t kHeaderSize = 8 + 4 + 4 + 8 + 8 + 8;
 
 std::uint64_t fnv1a(const std::byte* data, std::size_t size, std::uint64_t h = 0xcbf29ce484222325ULL) {

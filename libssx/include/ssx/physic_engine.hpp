@@ -22,10 +22,6 @@ struct PhysicsSettings {
     QuickStep,  ///< iterative (ODE's dWorldQuickStep): O(n) in constraints; the default
     Exact,      ///< direct LCP (ODE's dWorldStep): accurate, O(n^3) per island
   };
-  enum class Broadphase : std::uint8_t {
-    SweepAndPrune,  ///< sorts bounds along the axes; scales to tens of thousands of bodies
-    QuadTree,       ///< fixed region, see quadtree_center / quadtree_extents
-  };
   std::string engine = "ode";
   Vec3 gravity{0.0, 0.0, -9.81};  ///< m/s^2, world frame
   Solver solver = Solver::QuickStep;
@@ -34,10 +30,6 @@ struct PhysicsSettings {
   int substeps = 1;     ///< equal physics steps per environment timestep
   double erp = 0.2;     ///< error reduction parameter
   double cfm = 1e-9;    ///< constraint force mixing
-  Broadphase broadphase = Broadphase::SweepAndPrune;
-  Vec3 quadtree_center = Vec3::Zero();
-  Vec3 quadtree_extents{1000.0, 1000.0, 200.0};
-  int quadtree_depth = 6;
   // contacts
   double friction = 1.0;     ///< Coulomb coefficient (pyramid approximation)
   double restitution = 0.0;  ///< bounce, 0..1
@@ -45,6 +37,10 @@ struct PhysicsSettings {
   double contact_soft_erp = 0.2;
   double contact_surface_layer = 1e-3;  ///< m of allowed penetration, for resting stability
   int max_contacts = 8;                 ///< per pair of geoms
+  /// Worlds the bodies are spread over, stepped in parallel on the worker pool (bodies in
+  /// contact are moved into one). Results do not depend on it when no two bodies touch, and never
+  /// on the thread count.
+  int partitions = 16;
   // divergence guards: a body past these speeds stops the run (StepError) before the engine
   // meets a NaN; far beyond anything a robot does, far below where the arithmetic breaks
   double max_linear_speed = 1e5;   ///< m/s
@@ -57,13 +53,29 @@ struct Wrench {
   Vec3 torque = Vec3::Zero();
 };
 
+/// Runs independent tasks on the environment's worker pool, for an engine that can step parts
+/// of its world in parallel.
+class SSX_EXPORT TaskRunner {
+ public:
+  virtual ~TaskRunner();
+  virtual unsigned threads() const = 0;
+  /// Calls task(context, i) for every i in [0, n), on any of the pool's threads; returns when all
+  /// are done. The first exception a task throws is rethrown here.
+  virtual void forEach(std::size_t n, void (*task)(void* context, std::size_t i), void* context) = 0;
+};
+
 /// An abstract rigid-body engine. Bodies are created with their centre of mass at the body
 /// origin; the Environment flattens node trees into bodies. Called from one thread at a time
-/// (the thread calling Environment::step), never from the parallel phases.
+/// (the thread calling Environment::step), never from the parallel phases; it may use the
+/// TaskRunner it is given inside its own calls.
 class SSX_EXPORT PhysicEngine {
  public:
   virtual ~PhysicEngine();
   virtual std::string name() const = 0;
+
+  /// The pool the engine may run its own parallel work on (null: everything on the caller's
+  /// thread). Results must not depend on it.
+  virtual void setTaskRunner(TaskRunner* runner) { (void)runner; }
 
   /// Adds a dynamic body; `state.pose` is the pose of its centre-of-mass frame. Returns its index.
   virtual int addBody(const MassProperties& mass, const std::vector<Shape>& shapes, const BodyState& state) = 0;

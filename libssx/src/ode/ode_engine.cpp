@@ -5,6 +5,8 @@
 #include <atomic>
 #include <cstdarg>
 #include <cstdio>
+#include <algorithm>
+#include <cstdint>
 #include <cstring>
 #include <mutex>
 
@@ -72,51 +74,67 @@ void toOde(const Quat& q, dQuaternion out) {
 
 OdeEngine::OdeEngine(const PhysicsSettings& settings) : settings_(settings) {
   acquireOde();
-  ensureThreadData();
-  world_ = dWorldCreate();
-  const Vec3& g = settings_.gravity;
-  dWorldSetGravity(world_, g.x(), g.y(), g.z());
-  dWorldSetERP(world_, settings_.erp);
-  dWorldSetCFM(world_, settings_.cfm);
-  dWorldSetQuickStepNumIterations(world_, settings_.iterations);
-  dWorldSetQuickStepW(world_, settings_.sor);
-  dWorldSetContactSurfaceLayer(world_, settings_.contact_surface_layer);
-  dWorldSetAutoDisableFlag(world_, 0);
-
-  if (settings_.broadphase == PhysicsSettings::Broadphase::QuadTree) {
-    dVector3 c{settings_.quadtree_center.x(), settings_.quadtree_center.y(), settings_.quadtree_center.z(), 0};
-    dVector3 e{settings_.quadtree_extents.x(), settings_.quadtree_extents.y(), settings_.quadtree_extents.z(), 0};
-    space_ = dQuadTreeSpaceCreate(nullptr, c, e, settings_.quadtree_depth);
-  } else {
-    space_ = dSweepAndPruneSpaceCreate(nullptr, dSAP_AXES_XYZ);
+  try {
+    ensureThreadData();
+    partitions_.resize(static_cast<std::size_t>(std::max(1, settings_.partitions)));
+    for (Partition& p : partitions_) {
+      p.world = dWorldCreate();
+      const Vec3& g = settings_.gravity;
+      dWorldSetGravity(p.world, g.x(), g.y(), g.z());
+      dWorldSetERP(p.world, settings_.erp);
+      dWorldSetCFM(p.world, settings_.cfm);
+      dWorldSetQuickStepNumIterations(p.world, settings_.iterations);
+      dWorldSetQuickStepW(p.world, settings_.sor);
+      dWorldSetContactSurfaceLayer(p.world, settings_.contact_surface_layer);
+      dWorldSetAutoDisableFlag(p.world, 0);
+      // each world its own (single-threaded) threading implementation: ODE's default one is
+      // shared by every world and not meant for worlds stepped at the same time
+      p.threading = dThreadingAllocateSelfThreadedImplementation();
+      if (p.threading == nullptr) throw Error("ode: could not allocate a threading implementation");
+      dWorldSetStepThreadingImplementation(p.world, dThreadingImplementationGetFunctions(p.threading), p.threading);
+      p.contacts = dJointGroupCreate(0);
+    }
+  } catch (...) {
+    for (Partition& p : partitions_) {
+      if (p.contacts != nullptr) dJointGroupDestroy(p.contacts);
+      if (p.world != nullptr) dWorldDestroy(p.world);
+      if (p.threading != nullptr) dThreadingFreeImplementation(p.threading);
+    }
+    releaseOde();
+    throw;
   }
-  dSpaceSetCleanup(space_, 1);
-  contact_group_ = dJointGroupCreate(0);
-  contact_scratch_.resize(static_cast<std::size_t>(std::max(1, settings_.max_contacts)));
+
+  contacts_per_pair_ = static_cast<std::size_t>(std::max(1, settings_.max_contacts));
 }
 
 OdeEngine::~OdeEngine() {
   if (g_ode_poisoned) {
-    releaseOde();  // the world is leaked on purpose: ODE cannot tear it down after an internal error
+    releaseOde();  // the worlds are leaked on purpose: ODE cannot tear them down after an internal error
     return;
   }
   ensureThreadData();
-  dJointGroupDestroy(contact_group_);
-  dSpaceDestroy(space_);  // destroys its geoms (cleanup mode)
-  dWorldDestroy(world_);  // destroys its bodies
+  for (const Body& b : bodies_)
+    for (const Geom& g : b.geoms) dGeomDestroy(g.id);
+  for (dGeomID g : static_geoms_) dGeomDestroy(g);
+  for (Partition& p : partitions_) {
+    dJointGroupDestroy(p.contacts);
+    dWorldSetStepThreadingImplementation(p.world, nullptr, nullptr);
+    dWorldDestroy(p.world);  // destroys its bodies
+    dThreadingFreeImplementation(p.threading);
+  }
   releaseOde();
 }
 
 dGeomID OdeEngine::createGeom(const Shape& s) {
   switch (s.kind) {
     case Shape::Kind::Box:
-      return dCreateBox(space_, s.size.x(), s.size.y(), s.size.z());
+      return dCreateBox(nullptr, s.size.x(), s.size.y(), s.size.z());
     case Shape::Kind::Sphere:
-      return dCreateSphere(space_, s.radius);
+      return dCreateSphere(nullptr, s.radius);
     case Shape::Kind::Cylinder:
-      return dCreateCylinder(space_, s.radius, s.length);
+      return dCreateCylinder(nullptr, s.radius, s.length);
     case Shape::Kind::Capsule:
-      return dCreateCapsule(space_, s.radius, s.length);
+      return dCreateCapsule(nullptr, s.radius, s.length);
     case Shape::Kind::Plane:
       break;
   }
@@ -125,24 +143,41 @@ dGeomID OdeEngine::createGeom(const Shape& s) {
 
 int OdeEngine::addBody(const MassProperties& mass, const std::vector<Shape>& shapes, const BodyState& state) {
   ensureThreadData();
-  dBodyID body = dBodyCreate(world_);
-  dMass m;
+  const int index = static_cast<int>(bodies_.size());
+  Body body;
+  body.home = homeOf(index);
+  body.partition = body.home;
+  Partition& p = partitions_[static_cast<std::size_t>(body.home)];
+  body.id = dBodyCreate(p.world);
   const Mat3& j = mass.inertia;
   // the body frame is the centre-of-mass frame: ODE requires the centre at the origin
-  dMassSetParameters(&m, mass.mass, 0, 0, 0, j(0, 0), j(1, 1), j(2, 2), j(0, 1), j(0, 2), j(1, 2));
-  dBodySetMass(body, &m);
+  dMassSetParameters(&body.mass, mass.mass, 0, 0, 0, j(0, 0), j(1, 1), j(2, 2), j(0, 1), j(0, 2), j(1, 2));
+  dBodySetMass(body.id, &body.mass);
+  dBodySetData(body.id, reinterpret_cast<void*>(static_cast<std::intptr_t>(index)));
   for (const auto& s : shapes) {
-    if (s.kind == Shape::Kind::Plane) throw Error("ode: a plane cannot belong to a dynamic body");
-    dGeomID g = createGeom(s);
-    dGeomSetBody(g, body);
+    if (s.kind == Shape::Kind::Plane) {
+      dBodyDestroy(body.id);
+      for (const Geom& g : body.geoms) dGeomDestroy(g.id);
+      throw Error("ode: a plane cannot belong to a dynamic body");
+    }
+    Geom g{createGeom(s), {}, {}};
+    // the offset as dGeomSetOffsetPosition and dGeomSetOffsetQuaternion would keep it
+    g.offset_position[0] = s.pose.position.x();
+    g.offset_position[1] = s.pose.position.y();
+    g.offset_position[2] = s.pose.position.z();
+    g.offset_position[3] = 0;
     dQuaternion q;
     toOde(s.pose.orientation, q);
-    dGeomSetOffsetPosition(g, s.pose.position.x(), s.pose.position.y(), s.pose.position.z());
-    dGeomSetOffsetQuaternion(g, q);
+    dRfromQ(g.offset_rotation, q);
+    // which body a geom belongs to, for the contact callback (static geoms: 0)
+    dGeomSetData(g.id, reinterpret_cast<void*>(static_cast<std::intptr_t>(index) + 1));
+    body.geoms.push_back(g);
   }
-  bodies_.push_back(body);
-  setState(static_cast<int>(bodies_.size() - 1), state);
-  return static_cast<int>(bodies_.size() - 1);
+  p.order.push_back(index);
+  bodies_.push_back(std::move(body));
+  proxies_stale_ = true;
+  setState(index, state);
+  return index;
 }
 
 void OdeEngine::addStatic(const std::vector<Shape>& shapes, const Pose& pose) {
@@ -151,7 +186,9 @@ void OdeEngine::addStatic(const std::vector<Shape>& shapes, const Pose& pose) {
     const Pose world = pose * s.pose;
     if (s.kind == Shape::Kind::Plane) {
       const Vec3 n = world.orientation * Vec3::UnitZ();
-      dCreatePlane(space_, n.x(), n.y(), n.z(), n.dot(world.position));
+      dGeomID plane = dCreatePlane(nullptr, n.x(), n.y(), n.z(), n.dot(world.position));
+      static_geoms_.push_back(plane);
+      planes_.push_back(plane);
       continue;
     }
     dGeomID g = createGeom(s);
@@ -159,20 +196,112 @@ void OdeEngine::addStatic(const std::vector<Shape>& shapes, const Pose& pose) {
     toOde(world.orientation, q);
     dGeomSetPosition(g, world.position.x(), world.position.y(), world.position.z());
     dGeomSetQuaternion(g, q);
+    static_geoms_.push_back(g);
+  }
+  proxies_stale_ = true;
+}
+
+void OdeEngine::moveBody(int index, int to) {
+  Body& body = bodies_[static_cast<std::size_t>(index)];
+  Partition& from = partitions_[static_cast<std::size_t>(body.partition)];
+  Partition& into = partitions_[static_cast<std::size_t>(to)];
+  const dBodyID old = body.id;
+  const dBodyID b = dBodyCreate(into.world);
+  dBodySetMass(b, &body.mass);
+  dBodySetData(b, dBodyGetData(old));
+  dBodySetPosition(b, dBodyGetPosition(old)[0], dBodyGetPosition(old)[1], dBodyGetPosition(old)[2]);
+  dBodySetQuaternion(b, dBodyGetQuaternion(old));
+  // ODE normalises a quaternion it is given and derives the rotation from it: copy the bits
+  std::memcpy(const_cast<dReal*>(dBodyGetQuaternion(b)), dBodyGetQuaternion(old), 4 * sizeof(dReal));
+  std::memcpy(const_cast<dReal*>(dBodyGetRotation(b)), dBodyGetRotation(old), 12 * sizeof(dReal));
+  const dReal* v = dBodyGetLinearVel(old);
+  const dReal* w = dBodyGetAngularVel(old);
+  dBodySetLinearVel(b, v[0], v[1], v[2]);
+  dBodySetAngularVel(b, w[0], w[1], w[2]);
+  dBodyDestroy(old);
+  body.id = b;
+  const auto it = std::find(from.order.begin(), from.order.end(), index);
+  if (it != from.order.end()) from.order.erase(it);
+  into.order.push_back(index);
+  body.partition = to;
+}
+
+void OdeEngine::placeGeoms(std::size_t begin, std::size_t end) {
+  // what ODE's dxGeom::computePosr does for a geom offset from its body, bit for bit
+  for (std::size_t i = begin; i < end; ++i) {
+    const Body& body = bodies_[i];
+    if (body.geoms.empty()) continue;
+    const dReal* p = dBodyGetPosition(body.id);
+    const dReal* r = dBodyGetRotation(body.id);
+    for (std::size_t k = 0; k < body.geoms.size(); ++k) {
+      const Geom& g = body.geoms[k];
+      dVector3 position;
+      dMatrix3 rotation;
+      dMultiply0_331(position, r, g.offset_position);
+      position[0] += p[0];
+      position[1] += p[1];
+      position[2] += p[2];
+      dMultiply0_333(rotation, r, g.offset_rotation);
+      dGeomSetPosition(g.id, position[0], position[1], position[2]);
+      dGeomSetRotation(g.id, rotation);
+      dReal aabb[6];
+      dGeomGetAABB(g.id, aabb);
+      GridBroadphase::Box& box = boxes_[first_proxy_[i] + k];
+      box.min = Vec3(aabb[0], aabb[2], aabb[4]);
+      box.max = Vec3(aabb[1], aabb[3], aabb[5]);
+    }
   }
 }
 
-void OdeEngine::nearCallback(void* data, dGeomID a, dGeomID b) {
-  auto* self = static_cast<OdeEngine*>(data);
-  dBodyID ba = dGeomGetBody(a);
-  dBodyID bb = dGeomGetBody(b);
-  if (ba == nullptr && bb == nullptr) return;  // two static geoms
-  if (ba != nullptr && bb != nullptr && dAreConnectedExcluding(ba, bb, dJointTypeContact)) return;
-  const int n = dCollide(a, b, static_cast<int>(self->contact_scratch_.size()), &self->contact_scratch_[0].geom,
-                         sizeof(dContact));
-  const PhysicsSettings& s = self->settings_;
+void OdeEngine::indexGeoms() {
+  // the grid's boxes: the bodies' geoms in body order, then the static ones but the planes
+  proxies_stale_ = false;
+  proxy_geoms_.clear();
+  boxes_.clear();
+  first_proxy_.assign(bodies_.size(), 0);
+  for (std::size_t i = 0; i < bodies_.size(); ++i) {
+    first_proxy_[i] = static_cast<std::uint32_t>(proxy_geoms_.size());
+    for (const Geom& g : bodies_[i].geoms) {
+      proxy_geoms_.push_back(g.id);
+      boxes_.push_back({Vec3::Zero(), Vec3::Zero(), static_cast<int>(i)});
+    }
+  }
+  dynamic_proxies_ = proxy_geoms_.size();
+  // room for what a step usually needs, so that steps do not allocate: every body resting on
+  // something with a few contacts, a contact group's bookkeeping for every body
+  contacts_.reserve(4 * bodies_.size() + 64);
+  touched_.reserve(bodies_.size());
+  away_.reserve(bodies_.size());
+  for (dGeomID g : static_geoms_) {
+    if (dGeomGetClass(g) == dPlaneClass) continue;
+    dReal aabb[6];
+    dGeomGetAABB(g, aabb);
+    proxy_geoms_.push_back(g);
+    boxes_.push_back({Vec3(aabb[0], aabb[2], aabb[4]), Vec3(aabb[1], aabb[3], aabb[5]), -1});
+  }
+}
+
+template <class F>
+void OdeEngine::forEach(std::size_t n, F&& task) {
+  constexpr std::size_t kParallelFrom = 2 * kBlock;  // bodies
+  if (runner_ == nullptr || runner_->threads() < 2 || bodies_.size() < kParallelFrom || n < 2) {
+    for (std::size_t i = 0; i < n; ++i) task(i);
+    return;
+  }
+  runner_->forEach(
+      n,
+      [](void* context, std::size_t i) {
+        ensureThreadData();
+        (*static_cast<F*>(context))(i);
+      },
+      &task);
+}
+
+void OdeEngine::collidePair(dGeomID a, dGeomID b, std::vector<dContact>& out, std::vector<dContact>& scratch) const {
+  const int n = dCollide(a, b, static_cast<int>(scratch.size()), &scratch[0].geom, sizeof(dContact));
+  const PhysicsSettings& s = settings_;
   for (int i = 0; i < n; ++i) {
-    dContact& c = self->contact_scratch_[static_cast<std::size_t>(i)];
+    dContact c = scratch[static_cast<std::size_t>(i)];
     c.surface.mode = dContactApprox1 | dContactSoftCFM | dContactSoftERP;
     c.surface.mu = s.friction;
     c.surface.soft_cfm = s.contact_soft_cfm;
@@ -182,20 +311,129 @@ void OdeEngine::nearCallback(void* data, dGeomID a, dGeomID b) {
       c.surface.bounce = s.restitution;
       c.surface.bounce_vel = 0.01;
     }
-    dJointID j = dJointCreateContact(self->world_, self->contact_group_, &c);
-    dJointAttach(j, ba, bb);
+    out.push_back(c);
   }
-  self->contact_count_ += static_cast<std::size_t>(n);
 }
 
-void OdeEngine::step(Nanoseconds dt, std::span<const Wrench> wrenches) {
-  ensureThreadData();
-  const int substeps = std::max(1, settings_.substeps);
-  const double h = toSeconds(dt) / substeps;
-  contact_count_ = 0;
+void OdeEngine::collide() {
+  contacts_.clear();
+  if (proxies_stale_) indexGeoms();
+  // pose the geoms, in chunks of bodies
+  constexpr std::size_t kBodiesPerChunk = 256;
+  forEach((bodies_.size() + kBodiesPerChunk - 1) / kBodiesPerChunk, [&](std::size_t c) {
+    placeGeoms(c * kBodiesPerChunk, std::min(bodies_.size(), (c + 1) * kBodiesPerChunk));
+  });
+  grid_.build(boxes_);
+  // pairs and their contacts, in chunks: the dynamic geoms against each plane (their number
+  // fixed by the scene: each chunk keeps the room it needs), then the grid's
+  constexpr std::size_t kGeomsPerPlaneChunk = 512;
+  const std::size_t grid_chunks = grid_.chunkCount();
+  const std::size_t plane_chunks =
+      planes_.empty() ? 0 : (dynamic_proxies_ + kGeomsPerPlaneChunk - 1) / kGeomsPerPlaneChunk;
+  if (chunks_.size() < grid_chunks + plane_chunks) {
+    const std::size_t had = chunks_.size();
+    chunks_.resize(grid_chunks + plane_chunks);
+    for (std::size_t c = had; c < chunks_.size(); ++c) {
+      chunks_[c].scratch.resize(contacts_per_pair_);
+      chunks_[c].pairs.reserve(c < plane_chunks ? 0 : 256);
+      chunks_[c].contacts.reserve(c < plane_chunks ? 4 * kGeomsPerPlaneChunk : 64);
+    }
+  }
+  forEach(grid_chunks + plane_chunks, [&](std::size_t c) {
+    Chunk& chunk = chunks_[c];
+    chunk.contacts.clear();
+    if (c < plane_chunks) {
+      const std::size_t begin = c * kGeomsPerPlaneChunk;
+      const std::size_t end = std::min(dynamic_proxies_, begin + kGeomsPerPlaneChunk);
+      for (std::size_t k = begin; k < end; ++k)
+        for (dGeomID plane : planes_) collidePair(proxy_geoms_[k], plane, chunk.contacts, chunk.scratch);
+      return;
+    }
+    chunk.pairs.clear();
+    grid_.pairs(c - plane_chunks, chunk.pairs);
+    for (const auto& [a, b] : chunk.pairs)
+      collidePair(proxy_geoms_[static_cast<std::size_t>(a)], proxy_geoms_[static_cast<std::size_t>(b)], chunk.contacts,
+                  chunk.scratch);
+  });
+  for (std::size_t c = 0; c < grid_chunks + plane_chunks; ++c)
+    contacts_.insert(contacts_.end(), chunks_[c].contacts.begin(), chunks_[c].contacts.end());
+
+  // contact groups: union-find over the bodies that touch each other (smallest index as the root)
+  auto find = [&](int x) {
+    if (group_[static_cast<std::size_t>(x)] < 0) {
+      group_[static_cast<std::size_t>(x)] = x;
+      touched_.push_back(x);
+    }
+    while (group_[static_cast<std::size_t>(x)] != x) {
+      const int up = group_[static_cast<std::size_t>(group_[static_cast<std::size_t>(x)])];
+      group_[static_cast<std::size_t>(x)] = up;
+      x = up;
+    }
+    return x;
+  };
+  for (const dContact& c : contacts_) {
+    const auto owner_a = reinterpret_cast<std::intptr_t>(dGeomGetData(c.geom.g1));
+    const auto owner_b = reinterpret_cast<std::intptr_t>(dGeomGetData(c.geom.g2));
+    if (owner_a == 0 || owner_b == 0) continue;
+    const int ra = find(static_cast<int>(owner_a - 1));
+    const int rb = find(static_cast<int>(owner_b - 1));
+    if (ra != rb) group_[static_cast<std::size_t>(std::max(ra, rb))] = std::min(ra, rb);
+  }
+}
+
+void OdeEngine::groupContacts() {
+  // where each body steps this substep: a body in contact with others in the home world of the
+  // group's lowest-numbered body, every other body at home
+  for (const int i : touched_) {
+    int r = i;
+    while (group_[static_cast<std::size_t>(r)] != r) r = group_[static_cast<std::size_t>(r)];
+    const int target = bodies_[static_cast<std::size_t>(r)].home;
+    if (bodies_[static_cast<std::size_t>(i)].partition != target) {
+      if (bodies_[static_cast<std::size_t>(i)].partition == bodies_[static_cast<std::size_t>(i)].home) away_.push_back(i);
+      moveBody(i, target);
+    }
+  }
+  // the bodies away from home whose group no longer needs them there go back, lowest first
+  std::sort(away_.begin(), away_.end());
+  std::size_t kept = 0;
+  for (const int i : away_) {
+    Body& body = bodies_[static_cast<std::size_t>(i)];
+    if (body.partition == body.home) continue;
+    if (group_[static_cast<std::size_t>(i)] >= 0) {
+      away_[kept++] = i;
+      continue;
+    }
+    moveBody(i, body.home);
+  }
+  away_.resize(kept);
+  for (const int i : touched_) group_[static_cast<std::size_t>(i)] = -1;
+  touched_.clear();
+}
+
+void OdeEngine::stepPartition(Partition& p, double h, std::span<const Wrench> wrenches) {
+  if (p.order.empty()) return;
+  // ODE clears force accumulators after each step: apply the held wrenches every substep
+  for (const int i : p.order) {
+    const Wrench& w = wrenches[static_cast<std::size_t>(i)];
+    const dBodyID b = bodies_[static_cast<std::size_t>(i)].id;
+    dBodyAddForce(b, w.force.x(), w.force.y(), w.force.z());
+    dBodyAddTorque(b, w.torque.x(), w.torque.y(), w.torque.z());
+  }
+  auto solve = [&] {
+    if (settings_.solver == PhysicsSettings::Solver::Exact)
+      dWorldStep(p.world, h);
+    else
+      dWorldQuickStep(p.world, h);
+  };
+  if (!p.has_joints) {
+    solve();  // no constraints: ODE draws no random numbers
+    return;
+  }
+  // QuickStep reorders constraints with ODE's one process-wide random seed: worlds with contacts
+  // take turns, each with its own copy of the seed swapped in
   std::lock_guard lock(g_ode_step_mutex);
   const unsigned long outer_seed = dRandGetSeed();
-  dRandSetSeed(rand_seed_);
+  dRandSetSeed(p.rand_seed);
   struct RestoreSeed {
     unsigned long& mine;
     unsigned long outer;
@@ -203,26 +441,42 @@ void OdeEngine::step(Nanoseconds dt, std::span<const Wrench> wrenches) {
       mine = dRandGetSeed();
       dRandSetSeed(outer);
     }
-  } restore{rand_seed_, outer_seed};
+  } restore{p.rand_seed, outer_seed};
+  solve();
+  dJointGroupEmpty(p.contacts);
+}
+
+void OdeEngine::step(Nanoseconds dt, std::span<const Wrench> wrenches) {
+  ensureThreadData();
+  const int substeps = std::max(1, settings_.substeps);
+  const double h = toSeconds(dt) / substeps;
+  contact_count_ = 0;
+  if (group_.size() != bodies_.size()) group_.assign(bodies_.size(), -1);
   for (int k = 0; k < substeps; ++k) {
-    // ODE clears force accumulators after each step: apply the held wrenches every substep
-    for (std::size_t i = 0; i < bodies_.size(); ++i) {
-      const Wrench& w = wrenches[i];
-      dBodyAddForce(bodies_[i], w.force.x(), w.force.y(), w.force.z());
-      dBodyAddTorque(bodies_[i], w.torque.x(), w.torque.y(), w.torque.z());
+    // contacts in one space over every world, then the groups they make into one world each
+    collide();
+    groupContacts();
+    for (Partition& p : partitions_) p.has_joints = false;
+    for (const dContact& c : contacts_) {
+      const auto owner_a = reinterpret_cast<std::intptr_t>(dGeomGetData(c.geom.g1));
+      const auto owner_b = reinterpret_cast<std::intptr_t>(dGeomGetData(c.geom.g2));
+      const dBodyID a = owner_a != 0 ? bodies_[static_cast<std::size_t>(owner_a - 1)].id : nullptr;
+      const dBodyID b = owner_b != 0 ? bodies_[static_cast<std::size_t>(owner_b - 1)].id : nullptr;
+      const int owner = static_cast<int>((owner_a != 0 ? owner_a : owner_b) - 1);
+      Partition& p = partitions_[static_cast<std::size_t>(bodies_[static_cast<std::size_t>(owner)].partition)];
+      dJointID j = dJointCreateContact(p.world, p.contacts, &c);
+      dJointAttach(j, a, b);
+      p.has_joints = true;
     }
-    dSpaceCollide(space_, this, &OdeEngine::nearCallback);
-    if (settings_.solver == PhysicsSettings::Solver::Exact)
-      dWorldStep(world_, h);
-    else
-      dWorldQuickStep(world_, h);
-    dJointGroupEmpty(contact_group_);
+    contact_count_ += contacts_.size();
+    // the worlds, in parallel (serially for small worlds: the same results either way)
+    forEach(partitions_.size(), [&](std::size_t i) { stepPartition(partitions_[i], h, wrenches); });
   }
 }
 
 void OdeEngine::readStates(std::span<BodyState> out) const {
   for (std::size_t i = 0; i < bodies_.size(); ++i) {
-    dBodyID b = bodies_[i];
+    dBodyID b = bodies_[i].id;
     const dReal* p = dBodyGetPosition(b);
     const dReal* q = dBodyGetQuaternion(b);
     const dReal* v = dBodyGetLinearVel(b);
@@ -237,7 +491,7 @@ void OdeEngine::readStates(std::span<BodyState> out) const {
 
 void OdeEngine::setState(int body, const BodyState& s) {
   ensureThreadData();
-  dBodyID b = bodies_.at(static_cast<std::size_t>(body));
+  dBodyID b = bodies_.at(static_cast<std::size_t>(body)).id;
   dQuaternion q;
   toOde(s.pose.orientation.normalized(), q);
   dBodySetPosition(b, s.pose.position.x(), s.pose.position.y(), s.pose.position.z());
@@ -254,9 +508,17 @@ constexpr double kMaxRestoredPosition = 1e9;  // m
 }
 
 void OdeEngine::saveState(StateWriter& out) const {
-  out.write(static_cast<std::uint64_t>(rand_seed_));
+  // per world: its random seed and its bodies in creation order (which decides the order ODE
+  // solves its contact groups in); then every body
+  out.write(static_cast<std::uint64_t>(partitions_.size()));
+  for (const Partition& p : partitions_) {
+    out.write(static_cast<std::uint64_t>(p.rand_seed));
+    out.write(static_cast<std::uint64_t>(p.order.size()));
+    for (const int i : p.order) out.write(static_cast<std::uint32_t>(i));
+  }
   out.write(static_cast<std::uint64_t>(bodies_.size()));
-  for (dBodyID b : bodies_) {
+  for (const Body& body : bodies_) {
+    const dBodyID b = body.id;
     out.bytes(dBodyGetPosition(b), 3 * sizeof(dReal));
     out.bytes(dBodyGetQuaternion(b), 4 * sizeof(dReal));
     out.bytes(dBodyGetRotation(b), 12 * sizeof(dReal));
@@ -267,7 +529,27 @@ void OdeEngine::saveState(StateWriter& out) const {
 
 void OdeEngine::restoreState(StateReader& in) {
   // everything is read before anything is changed
-  const auto seed = in.get<std::uint64_t>();
+  const auto worlds = in.get<std::uint64_t>();
+  if (worlds != partitions_.size())
+    throw StateError("ode: the saved state has " + std::to_string(worlds) + " partitions, this world " +
+                     std::to_string(partitions_.size()));
+  std::vector<unsigned long> seeds(partitions_.size());
+  std::vector<std::vector<int>> orders(partitions_.size());
+  std::vector<int> where(bodies_.size(), -1);
+  for (std::size_t p = 0; p < partitions_.size(); ++p) {
+    seeds[p] = static_cast<unsigned long>(in.get<std::uint64_t>());
+    const auto size = in.get<std::uint64_t>();
+    if (size > bodies_.size()) throw StateError("ode: a partition in the saved state has more bodies than the world");
+    for (std::uint64_t k = 0; k < size; ++k) {
+      const auto i = in.get<std::uint32_t>();
+      if (i >= bodies_.size() || where[i] >= 0)
+        throw StateError("ode: the saved state's partitions do not hold every body exactly once");
+      where[i] = static_cast<int>(p);
+      orders[p].push_back(static_cast<int>(i));
+    }
+  }
+  if (std::find(where.begin(), where.end(), -1) != where.end())
+    throw StateError("ode: the saved state's partitions do not hold every body exactly once");
   const auto count = in.get<std::uint64_t>();
   if (count != bodies_.size())
     throw StateError("ode: the saved state has " + std::to_string(count) + " bodies, this world " +
@@ -297,9 +579,20 @@ void OdeEngine::restoreState(StateReader& in) {
       throw bad("is faster than max_linear_speed or max_angular_speed");
   }
   ensureThreadData();
-  rand_seed_ = static_cast<unsigned long>(seed);
+  // every body created again in its saved world and order, so that ODE lists them as it did
+  for (Partition& p : partitions_) p.order.clear();
+  away_.clear();
+  for (std::size_t p = 0; p < partitions_.size(); ++p) {
+    partitions_[p].rand_seed = seeds[p];
+    for (const int i : orders[p]) {
+      Body& body = bodies_[static_cast<std::size_t>(i)];
+      body.partition = static_cast<int>(p);  // (in no order list now: moveBody only appends it)
+      moveBody(i, static_cast<int>(p));
+      if (body.home != static_cast<int>(p)) away_.push_back(i);
+    }
+  }
   for (std::size_t i = 0; i < bodies_.size(); ++i) {
-    dBodyID b = bodies_[i];
+    dBodyID b = bodies_[i].id;
     const dReal* v = values.data() + i * kOdeBodyReals;
     dBodySetPosition(b, v[0], v[1], v[2]);  // also marks the body's geoms as moved
     dBodySetQuaternion(b, v + 3);

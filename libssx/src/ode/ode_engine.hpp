@@ -1,5 +1,23 @@
 #pragma once
 // The ODE backend of PhysicEngine. Private: nothing of ODE leaves libssx.
+//
+// Parallel and deterministic: the bodies are spread over `partitions` ODE worlds, stepped at the
+// same time on the environment's worker pool. One collision space holds every geom, so contacts
+// are found as in one world; before the solver runs, bodies that touch are moved into one world
+// (the home world of the lowest-numbered body of their contact group), and back home once they
+// no longer touch. A body's home world follows from its index alone (blocks of kBlock bodies,
+// dealt round the worlds), so which world steps which body never depends on the thread count.
+// A free body's step does not depend on its world at all; a contact group is solved in one world
+// as ODE would solve it anywhere, with that world's own copy of ODE's random seed.
+//
+// The geoms are not attached to ODE bodies: ODE's step would mark them moved in a shared space
+// from every world's thread at once. They are posed from their body before each collision pass,
+// with ODE's own arithmetic for a geom offset from its body, so contacts are what they would be.
+// They are in no ODE space at all: posing them, finding the pairs (GridBroadphase, linear in the
+// bodies however they are laid out, where ODE's sweep-and-prune is quadratic in a grid) and the
+// contacts (dCollide) run in parallel chunks too.
+
+#include "ode/grid_broadphase.hpp"
 
 #include <ssx/physic_engine.hpp>
 
@@ -17,6 +35,7 @@ class OdeEngine final : public PhysicEngine {
   std::string name() const override { return "ode"; }
   int addBody(const MassProperties& mass, const std::vector<Shape>& shapes, const BodyState& state) override;
   void addStatic(const std::vector<Shape>& shapes, const Pose& pose) override;
+  void setTaskRunner(TaskRunner* runner) override { runner_ = runner; }
   void step(Nanoseconds dt, std::span<const Wrench> wrenches) override;
   void readStates(std::span<BodyState> out) const override;
   void setState(int body, const BodyState& state) override;
@@ -25,18 +44,71 @@ class OdeEngine final : public PhysicEngine {
   void restoreState(StateReader& in) override;
   std::size_t contactCount() const override { return contact_count_; }
 
+  static constexpr int kBlock = 64;  // consecutive bodies that share a home world
+
  private:
-  static void nearCallback(void* data, dGeomID a, dGeomID b);
+  struct Partition {
+    dWorldID world = nullptr;
+    dJointGroupID contacts = nullptr;
+    dThreadingImplementationID threading = nullptr;
+    unsigned long rand_seed = 0;  // this world's own copy of ODE's process-wide dRand seed
+    std::vector<int> order;       // its bodies in creation order (ODE lists them newest first)
+    bool has_joints = false;      // contact joints in this substep
+  };
+  struct Geom {
+    dGeomID id;
+    dVector3 offset_position;  // in the body frame
+    dMatrix3 offset_rotation;
+  };
+  struct Body {
+    dBodyID id = nullptr;
+    int partition = 0;
+    int home = 0;
+    dMass mass;
+    std::vector<Geom> geoms;
+  };
+
   dGeomID createGeom(const Shape& shape);
+  // appends the contacts between two geoms, with the surface settings
+  void collidePair(dGeomID a, dGeomID b, std::vector<dContact>& out, std::vector<dContact>& scratch) const;
+  void collide();
+  void indexGeoms();
+  // runs task(i) for i in [0, n) on the pool when the world is large enough, else here
+  template <class F>
+  void forEach(std::size_t n, F&& task);
+  int homeOf(int body) const { return (body / kBlock) % static_cast<int>(partitions_.size()); }
+  // recreates body i in partition p, bit for bit, last in its creation order
+  void moveBody(int body, int partition);
+  void groupContacts();
+  void placeGeoms(std::size_t begin, std::size_t end);
+  void stepPartition(Partition& p, double h, std::span<const Wrench> wrenches);
 
   PhysicsSettings settings_;
-  dWorldID world_ = nullptr;
-  dSpaceID space_ = nullptr;
-  dJointGroupID contact_group_ = nullptr;
-  std::vector<dBodyID> bodies_;
-  std::vector<dContact> contact_scratch_;
+  TaskRunner* runner_ = nullptr;
+  std::vector<Partition> partitions_;
+  std::vector<Body> bodies_;
+  std::size_t contacts_per_pair_ = 8;
+  std::vector<dContact> contacts_;  // found in this substep, in a fixed order
+  // the grid broadphase: one box per geom (the bodies' geoms in body order, then static ones),
+  // the planes apart; contacts found per chunk, joined in chunk order
+  std::vector<dGeomID> static_geoms_;
+  std::vector<dGeomID> planes_;
+  std::vector<dGeomID> proxy_geoms_;
+  std::vector<GridBroadphase::Box> boxes_;
+  std::vector<std::uint32_t> first_proxy_;  // per body
+  std::size_t dynamic_proxies_ = 0;
+  bool proxies_stale_ = true;
+  GridBroadphase grid_;
+  struct Chunk {
+    std::vector<std::pair<int, int>> pairs;
+    std::vector<dContact> contacts;
+    std::vector<dContact> scratch;
+  };
+  std::vector<Chunk> chunks_;
+  std::vector<int> group_;          // union-find over bodies, for contact groups (-1: untouched)
+  std::vector<int> touched_;        // bodies in a body-body contact this substep, first seen first
+  std::vector<int> away_;           // bodies not in their home world
   std::size_t contact_count_ = 0;
-  unsigned long rand_seed_ = 0;  // this world's own copy of ODE's process-wide dRand seed
 };
 
 }  // namespace ssx::detail

@@ -151,17 +151,18 @@ void SceneLoader::readPhysics(const Descriptor& d) {
   p.gravity = read<Vec3>(d, "gravity", p.gravity);
   p.erp = readPositive(d, "erp", p.erp);
   p.cfm = readPositive(d, "cfm", p.cfm);
-  p.broadphase = readChoice(d, "broadphase", "sap", {"sap", "quadtree"}) == "quadtree"
-                     ? PhysicsSettings::Broadphase::QuadTree
-                     : PhysicsSettings::Broadphase::SweepAndPrune;
-  p.quadtree_center = read<Vec3>(d, "quadtree_center", p.quadtree_center);
-  p.quadtree_extents = read<Vec3>(d, "quadtree_extents", p.quadtree_extents);
-  p.quadtree_depth = static_cast<int>(readCount(d, "quadtree_depth", p.quadtree_depth, 1, 12));
+  // ODE's broadphases were replaced by ssx's grid (linear in the bodies, parallel)
+  for (const char* gone : {"broadphase", "quadtree_center", "quadtree_extents", "quadtree_depth"})
+    if (d.has(gone))
+      error(d.where(), std::string("<physics>: attribute '") + gone +
+                               "' is no longer offered: ssx finds contacts with its own grid broadphase "
+                               "(linear in the bodies however they are laid out, run in parallel); remove it");
   p.friction = read<double>(d, "friction", p.friction);
   if (p.friction < 0) error(d.where(), "<physics>: friction must not be negative");
   p.restitution = read<double>(d, "restitution", p.restitution);
   if (p.restitution < 0 || p.restitution > 1) error(d.where(), "<physics>: restitution must be in 0..1");
   p.max_contacts = static_cast<int>(readCount(d, "max_contacts", p.max_contacts, 1, 1024));
+  p.partitions = static_cast<int>(readCount(d, "partitions", p.partitions, 1, 1024));
   p.contact_surface_layer = read<double>(d, "contact_surface_layer", p.contact_surface_layer);
   p.max_linear_speed = readPositive(d, "max_linear_speed", p.max_linear_speed);
   p.max_angular_speed = readPositive(d, "max_angular_speed", p.max_angular_speed);
