@@ -1,6 +1,29 @@
 #include "worker_pool.hpp"
 
+#include <chrono>
+
 namespace ssx::detail {
+
+namespace {
+// Waking a sleeping thread costs tens of microseconds on a virtual machine, more than a small
+// phase takes: a thread that has just finished, or the caller waiting for the others, first spins
+// this long on the value it waits for, then sleeps.
+constexpr auto kSpin = std::chrono::microseconds(50);
+
+template <class T>
+void spinThenWait(const std::atomic<T>& value, T old) {
+  const auto until = std::chrono::steady_clock::now() + kSpin;
+  for (int k = 0; value.load(std::memory_order_acquire) == old; ++k) {
+#if defined(__x86_64__) || defined(__i386__)
+    __builtin_ia32_pause();
+#endif
+    if ((k & 63) == 63 && std::chrono::steady_clock::now() > until) {
+      value.wait(old, std::memory_order_acquire);
+      return;
+    }
+  }
+}
+}  // namespace
 
 WorkerPool::WorkerPool(unsigned threads) {
   const unsigned extra = threads > 1 ? threads - 1 : 0;
@@ -32,7 +55,7 @@ void WorkerPool::work() {
 void WorkerPool::workerLoop() {
   std::uint64_t seen = 0;
   for (;;) {
-    generation_.wait(seen, std::memory_order_acquire);
+    spinThenWait(generation_, seen);
     seen = generation_.load(std::memory_order_acquire);
     if (stop_.load(std::memory_order_relaxed)) return;
     work();
@@ -64,7 +87,7 @@ void WorkerPool::run(std::size_t n, std::size_t chunk, Invoke invoke, void* ctx)
   work();
   // barrier: wait for every worker to finish its chunks
   for (unsigned left = busy_.load(std::memory_order_acquire); left != 0; left = busy_.load(std::memory_order_acquire))
-    busy_.wait(left, std::memory_order_acquire);
+    spinThenWait(busy_, left);
   if (has_error_.load(std::memory_order_acquire)) std::rethrow_exception(error_);
 }
 

@@ -5,38 +5,63 @@
 
 namespace ssx::detail {
 
-void GridBroadphase::build(std::span<const Box> boxes) {
+bool GridBroadphase::isBig(const Box& b) const {
+  return (b.max - b.min).maxCoeff() > cell_ || !std::isfinite(b.min.y()) || !std::isfinite(b.min.z());
+}
+
+std::int64_t GridBroadphase::band(double v) const {
+  constexpr double kMaxBand = 4e18;  // band numbers stay inside int64
+  return static_cast<std::int64_t>(std::clamp(std::floor(v / cell_), -kMaxBand, kMaxBand));
+}
+
+void GridBroadphase::build(std::span<const Box> boxes, double cell) {
   boxes_ = boxes;
-  entries_.clear();
   bands_.clear();
   big_.clear();
   band_chunks_ = 0;
   if (boxes.empty()) return;
 
-  // the cell: twice the median box's largest side (boxes larger than a cell are tested against all)
-  scratch_.clear();
-  for (const Box& b : boxes) scratch_.push_back((b.max - b.min).maxCoeff());
-  auto middle = scratch_.begin() + static_cast<std::ptrdiff_t>(scratch_.size() / 2);
-  std::nth_element(scratch_.begin(), middle, scratch_.end());
-  cell_ = std::max(2.0 * *middle, 1e-3);
-
-  constexpr double kMaxBand = 4e18;  // band numbers stay inside int64 (positions are checked finite)
-  for (int i = 0; i < static_cast<int>(boxes.size()); ++i) {
-    const Box& b = boxes[static_cast<std::size_t>(i)];
-    if ((b.max - b.min).maxCoeff() > cell_ || !std::isfinite(b.min.y()) || !std::isfinite(b.min.z())) {
-      big_.push_back(i);
-      continue;
-    }
-    const double y = std::clamp(std::floor(b.min.y() / cell_), -kMaxBand, kMaxBand);
-    const double z = std::clamp(std::floor(b.min.z() / cell_), -kMaxBand, kMaxBand);
-    entries_.push_back({static_cast<std::int64_t>(y), static_cast<std::int64_t>(z), b.min.x(), i});
+  // boxes larger than a cell are tested against all
+  if (boxes.size() != small_.size() || cell != cell_) {
+    cell_ = cell;
+    small_.assign(boxes.size(), 2);  // (neither: the entries are made again below)
   }
-  std::sort(entries_.begin(), entries_.end(), [](const Entry& a, const Entry& b) {
+  // the entries of the last build, moved to where their boxes are now: bodies move little from one
+  // step to the next, so they are nearly in order and an insertion sort costs about one pass
+  bool same = true;
+  for (std::size_t i = 0; i < boxes.size(); ++i) {
+    const std::uint8_t is_small = isBig(boxes[i]) ? 0 : 1;
+    if (is_small == 0) big_.push_back(static_cast<int>(i));
+    same = same && small_[i] == is_small;
+    small_[i] = is_small;
+  }
+  if (!same) {
+    entries_.clear();
+    for (std::size_t i = 0; i < boxes.size(); ++i)
+      if (small_[i] != 0) entries_.push_back({0, 0, 0, static_cast<int>(i)});
+  }
+  for (Entry& e : entries_) {
+    const Box& b = boxes[static_cast<std::size_t>(e.box)];
+    e.y = band(b.min.y());
+    e.z = band(b.min.z());
+    e.min_x = b.min.x();
+  }
+  const auto before = [](const Entry& a, const Entry& b) {
     if (a.y != b.y) return a.y < b.y;
     if (a.z != b.z) return a.z < b.z;
     if (a.min_x != b.min_x) return a.min_x < b.min_x;
     return a.box < b.box;
-  });
+  };
+  // insertion sort with a budget; past it, a full sort (the same order either way: it is total)
+  std::size_t moves = 0;
+  const std::size_t budget = 8 * entries_.size() + 64;
+  for (std::size_t k = 1; k < entries_.size() && moves <= budget; ++k) {
+    const Entry e = entries_[k];
+    std::size_t m = k;
+    for (; m > 0 && before(e, entries_[m - 1]) && moves <= budget; --m, ++moves) entries_[m] = entries_[m - 1];
+    entries_[m] = e;
+  }
+  if (moves > budget) std::sort(entries_.begin(), entries_.end(), before);
   for (std::uint32_t k = 0; k < entries_.size();) {
     std::uint32_t end = k + 1;
     while (end < entries_.size() && entries_[end].y == entries_[k].y && entries_[end].z == entries_[k].z) ++end;

@@ -2,7 +2,10 @@
 
 #include <ssx/error.hpp>
 
+#include <dlfcn.h>
+
 #include <atomic>
+#include <cmath>
 #include <cstdarg>
 #include <cstdio>
 #include <algorithm>
@@ -23,6 +26,16 @@ unsigned g_ode_generation = 0;
 // ODE keeps the seed that QuickStep uses to reorder constraints in one global; each world keeps
 // its own copy and swaps it in around its step under this lock, so worlds never disturb each other
 std::mutex g_ode_step_mutex;
+
+// The seed of the world being stepped on this thread, or null. QuickStep reorders constraints with
+// dRandInt, which ODE draws (dRand) from one process-wide seed: stepped at the same time, worlds
+// with contacts would take numbers from each other. ssx defines dRand itself (below); ODE calls it
+// through its PLT, so on this thread the numbers come from the world's own seed. Whether the
+// definition really takes ODE's place (it does when libssx comes before libode in the lookup
+// order, as when linked or dlopen'd as usual) is checked once, by stepping a small world; if not,
+// worlds with contacts take turns under g_ode_step_mutex with their seed swapped in, as before.
+thread_local unsigned long* t_world_seed = nullptr;
+thread_local bool t_interposed_call = false;
 
 // set once ODE reported an internal error: its state (worlds, the threading job list) can no
 // longer be torn down safely, so nothing of it is freed from then on
@@ -70,12 +83,59 @@ void toOde(const Quat& q, dQuaternion out) {
   out[3] = q.z();
 }
 
+// does ODE's QuickStep call our dRandInt? (a world with one constrained pair, stepped once)
+bool seedIsPerWorld() {
+  static const bool per_world = [] {
+    dWorldID w = dWorldCreate();
+    dJointGroupID group = dJointGroupCreate(0);
+    dBodyID a = dBodyCreate(w);
+    dBodyID b = dBodyCreate(w);
+    dBodySetPosition(b, 0, 0, 0.5);
+    dJointID j = dJointCreateBall(w, group);
+    dJointAttach(j, a, b);
+    dJointSetBallAnchor(j, 0, 0, 0.25);
+    unsigned long seed = 1;
+    t_world_seed = &seed;
+    t_interposed_call = false;
+    dWorldQuickStep(w, 0.001);
+    const bool called = t_interposed_call;
+    t_world_seed = nullptr;
+    dJointGroupDestroy(group);
+    dWorldDestroy(w);
+    return called;
+  }();
+  return per_world;
+}
+
 }  // namespace
+
+}  // namespace ssx::detail
+
+// ODE's dRand, from the stepping world's own seed when there is one (see t_world_seed), else
+// ODE's own, found behind this definition. The generator is ODE's (a 32-bit linear congruence) and
+// dRandInt stays ODE's: the numbers are those ODE draws with that seed set, to the bit.
+extern "C" __attribute__((visibility("default"))) unsigned long dRand() {
+  using ssx::detail::t_world_seed;
+  if (t_world_seed != nullptr) {
+    ssx::detail::t_interposed_call = true;
+    *t_world_seed = (1664525UL * *t_world_seed + 1013904223UL) & 0xffffffffUL;
+    return *t_world_seed;
+  }
+  static const auto ode = reinterpret_cast<unsigned long (*)()>(dlsym(RTLD_NEXT, "dRand"));
+  if (ode != nullptr && ode != &dRand) return ode();
+  // (no other definition: ODE's generator on its own seed, not atomically)
+  const unsigned long next = (1664525UL * dRandGetSeed() + 1013904223UL) & 0xffffffffUL;
+  dRandSetSeed(next);
+  return next;
+}
+
+namespace ssx::detail {
 
 OdeEngine::OdeEngine(const PhysicsSettings& settings) : settings_(settings) {
   acquireOde();
   try {
     ensureThreadData();
+    (void)seedIsPerWorld();  // (checked here, on the caller's thread, once per process)
     partitions_.resize(static_cast<std::size_t>(std::max(1, settings_.partitions)));
     for (Partition& p : partitions_) {
       p.world = dWorldCreate();
@@ -160,7 +220,14 @@ int OdeEngine::addBody(const MassProperties& mass, const std::vector<Shape>& sha
       for (const Geom& g : body.geoms) dGeomDestroy(g.id);
       throw Error("ode: a plane cannot belong to a dynamic body");
     }
-    Geom g{createGeom(s), {}, {}};
+    Geom g{createGeom(s), {}, {}, 0.0};
+    switch (s.kind) {
+      case Shape::Kind::Box: g.diameter = s.size.norm(); break;
+      case Shape::Kind::Sphere: g.diameter = 2 * s.radius; break;
+      case Shape::Kind::Cylinder: g.diameter = 2 * std::hypot(s.radius, s.length / 2); break;
+      case Shape::Kind::Capsule: g.diameter = 2 * s.radius + s.length; break;
+      case Shape::Kind::Plane: break;
+    }
     // the offset as dGeomSetOffsetPosition and dGeomSetOffsetQuaternion would keep it
     g.offset_position[0] = s.pose.position.x();
     g.offset_position[1] = s.pose.position.y();
@@ -267,6 +334,14 @@ void OdeEngine::indexGeoms() {
     }
   }
   dynamic_proxies_ = proxy_geoms_.size();
+  std::vector<double> diameters;
+  for (const Body& b : bodies_)
+    for (const Geom& g : b.geoms) diameters.push_back(g.diameter);
+  if (!diameters.empty()) {
+    auto middle = diameters.begin() + static_cast<std::ptrdiff_t>(diameters.size() / 2);
+    std::nth_element(diameters.begin(), middle, diameters.end());
+    cell_ = std::max(2.0 * *middle, 1e-3);
+  }
   // room for what a step usually needs, so that steps do not allocate: every body resting on
   // something with a few contacts, a contact group's bookkeeping for every body
   contacts_.reserve(4 * bodies_.size() + 64);
@@ -323,7 +398,7 @@ void OdeEngine::collide() {
   forEach((bodies_.size() + kBodiesPerChunk - 1) / kBodiesPerChunk, [&](std::size_t c) {
     placeGeoms(c * kBodiesPerChunk, std::min(bodies_.size(), (c + 1) * kBodiesPerChunk));
   });
-  grid_.build(boxes_);
+  grid_.build(boxes_, cell_);
   // pairs and their contacts, in chunks: the dynamic geoms against each plane (their number
   // fixed by the scene: each chunk keeps the room it needs), then the grid's
   constexpr std::size_t kGeomsPerPlaneChunk = 512;
@@ -427,6 +502,15 @@ void OdeEngine::stepPartition(Partition& p, double h, std::span<const Wrench> wr
   };
   if (!p.has_joints) {
     solve();  // no constraints: ODE draws no random numbers
+    return;
+  }
+  if (seedIsPerWorld()) {
+    t_world_seed = &p.rand_seed;
+    struct Reset {
+      ~Reset() { t_world_seed = nullptr; }
+    } reset;
+    solve();
+    dJointGroupEmpty(p.contacts);
     return;
   }
   // QuickStep reorders constraints with ODE's one process-wide random seed: worlds with contacts

@@ -59,6 +59,7 @@ class OdeEngine final : public PhysicEngine {
     dGeomID id;
     dVector3 offset_position;  // in the body frame
     dMatrix3 offset_rotation;
+    double diameter;  // of a sphere around it: its box is never longer, however it turns
   };
   struct Body {
     dBodyID id = nullptr;
@@ -98,6 +99,7 @@ class OdeEngine final : public PhysicEngine {
   std::vector<std::uint32_t> first_proxy_;  // per body
   std::size_t dynamic_proxies_ = 0;
   bool proxies_stale_ = true;
+  double cell_ = 1.0;  // the grid's: twice the median geom diameter (fixed by the scene)
   GridBroadphase grid_;
   struct Chunk {
     std::vector<std::pair<int, int>> pairs;
