@@ -37,11 +37,21 @@ void Artifact::buildNodes(PhysicNode* parent, const PhysicNodeSpec& spec) {
 }
 
 PhysicNode& Artifact::addPhysicRoot(PhysicNodeSpec spec) {
+  return addPhysicRoot(std::make_shared<const PhysicNodeSpec>(std::move(spec)));
+}
+
+PhysicNode& Artifact::addPhysicRoot(std::shared_ptr<const PhysicNodeSpec> shared) {
   requireSetup("physic nodes can be added");
-  validatePhysicTree(spec);
+  if (shared == nullptr) throw Error("artifact '" + name_ + "': addPhysicRoot got no node tree");
+  const PhysicNodeSpec& spec = *shared;
+  // a swarm adds one tree to thousands of artifacts: it is checked once
+  if (world_->last_validated_spec.lock() != shared) {
+    validatePhysicTree(spec);
+    world_->last_validated_spec = shared;
+  }
   if (!spec.name.empty() && node(spec.name) != nullptr)
     throw ConfigError(spec.where, "artifact '" + name_ + "': duplicate physic node name '" + spec.name + "'");
-  root_specs_.push_back(std::make_unique<PhysicNodeSpec>(std::move(spec)));
+  root_specs_.push_back(std::move(shared));
   const std::size_t first = nodes_.size();
   buildNodes(nullptr, *root_specs_.back());
   return *nodes_[first];

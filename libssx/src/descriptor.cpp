@@ -2,6 +2,7 @@
 #include <ssx/parameters.hpp>
 
 #include <charconv>
+#include <cstring>
 #include <cctype>
 #include <cmath>
 
@@ -149,8 +150,11 @@ const Descriptor::Attribute* Descriptor::find(std::string_view key) const {
 }
 
 const char* Descriptor::declaredDefault(std::string_view key) const noexcept {
+  // (a plugin declares dozens of parameters and every swarm member reads each: no strlen per name)
   for (const auto& d : declarations_)
-    if (key == d.name) return d.default_value != nullptr && d.default_value[0] != '\0' ? d.default_value : nullptr;
+    if (!key.empty() && d.name[0] == key[0] && std::strncmp(d.name, key.data(), key.size()) == 0 &&
+        d.name[key.size()] == '\0')
+      return d.default_value != nullptr && d.default_value[0] != '\0' ? d.default_value : nullptr;
   return nullptr;
 }
 

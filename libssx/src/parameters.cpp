@@ -76,6 +76,22 @@ std::int64_t runsPerPeriod(double rate_hz, const PluginContext& context) {
   return std::llround(runsOf(rate_hz, context));
 }
 
+namespace {
+// whether v is one of the space-separated words of `choices`
+bool isChoice(const char* choices, std::string_view v) {
+  std::string_view rest = choices != nullptr ? choices : "";
+  while (!rest.empty()) {
+    const std::size_t start = rest.find_first_not_of(' ');
+    if (start == std::string_view::npos) break;
+    rest.remove_prefix(start);
+    const std::size_t end = std::min(rest.find(' '), rest.size());
+    if (rest.substr(0, end) == v) return true;
+    rest.remove_prefix(end);
+  }
+  return false;
+}
+}  // namespace
+
 std::vector<Diagnostic> checkParameters(std::span<const ssx_plugin_param> declarations, Descriptor& params,
                                         const PluginContext& context, const std::string& what) {
   std::vector<Diagnostic> out;
@@ -109,8 +125,8 @@ std::vector<Diagnostic> checkParameters(std::span<const ssx_plugin_param> declar
       declared_default = {d.name, d.default_value, params.where(), true};
       a = &declared_default;
     }
-    const std::string unit = d.unit != nullptr && d.unit[0] != '\0' ? std::string(" ") + d.unit : "";
     auto outOfBounds = [&](const std::string& value) {
+      const std::string unit = d.unit != nullptr && d.unit[0] != '\0' ? std::string(" ") + d.unit : "";
       fail(a->where, "parameter '" + std::string(d.name) + "' must be " + boundsText(d) + unit + ", got '" + value +
                          "' (" + d.doc + ")");
     };
@@ -157,9 +173,9 @@ std::vector<Diagnostic> checkParameters(std::span<const ssx_plugin_param> declar
           break;
         }
         case SSX_PARAM_CHOICE: {
-          const auto choices = words(d.choices);
           const std::string v = params.get<std::string>(d.name);
-          if (std::find(choices.begin(), choices.end(), v) == choices.end()) {
+          if (!isChoice(d.choices, v)) {
+            const auto choices = words(d.choices);
             std::string list;
             for (const auto& c : choices) list += (list.empty() ? "" : ", ") + c;
             fail(a->where, "parameter '" + std::string(d.name) + "' must be one of " + list + ", got '" + v + "'");

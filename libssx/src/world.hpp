@@ -109,6 +109,7 @@ struct World {
   std::vector<ArtifactModel> models;
   std::unordered_map<std::string, Artifact*> names;
   std::vector<PendingError> errors;  // filled by the parallel phases
+  std::weak_ptr<const PhysicNodeSpec> last_validated_spec;  // a tree shared by a swarm: checked once
   std::uint64_t subscription_sequence = 0;
 
   // per node and per plugin slot

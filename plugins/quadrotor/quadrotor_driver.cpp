@@ -10,7 +10,7 @@ namespace ssx::quadrotor {
 namespace {
 
 // room for the neighbours a formation robot senses at once, reserved at start
-constexpr std::size_t kTypicalNeighbours = 64;
+constexpr std::size_t kTypicalNeighbours = 16;
 
 std::vector<std::string> words(const std::string& text) {
   std::istringstream in(text);

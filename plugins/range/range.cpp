@@ -86,7 +86,7 @@ class RangeSensor final : public SensorOf<RangeMeasurement> {
         if (o.shape.kind != Shape::Kind::Plane) obstacles_.push_back(&o);
     // room for what a robot usually sees, so that sensing allocates nothing; a robot that sees
     // more grows these once, to the most it has seen
-    const std::size_t typical = std::min<std::size_t>(64, env.artifactCount() + obstacles_.size());
+    const std::size_t typical = std::min<std::size_t>(16, env.artifactCount() + obstacles_.size());
     found_.reserve(typical);
     output().detections.reserve(typical);
   }

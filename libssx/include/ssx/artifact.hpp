@@ -49,6 +49,8 @@ class SSX_EXPORT Artifact {
 
   /// Adds a physic node tree (checked with validatePhysicTree) and returns its root node.
   PhysicNode& addPhysicRoot(PhysicNodeSpec spec);
+  /// The same, for a tree shared by many artifacts (a swarm's type): it is not copied.
+  PhysicNode& addPhysicRoot(std::shared_ptr<const PhysicNodeSpec> spec);
   /// Adds a render node tree.
   void addRenderRoot(RenderNodeSpec spec);
   /// Sets the driver. `class_name` names it in messages; `period_steps` >= 1.
@@ -120,7 +122,7 @@ class SSX_EXPORT Artifact {
   std::string name_;
   std::size_t index_;
   Pose placement_;
-  std::vector<std::unique_ptr<PhysicNodeSpec>> root_specs_;
+  std::vector<std::shared_ptr<const PhysicNodeSpec>> root_specs_;
   std::vector<std::unique_ptr<PhysicNode>> nodes_;  // every node, trees in order
   std::vector<PhysicNode*> roots_;
   std::vector<RenderNodeSpec> render_roots_;

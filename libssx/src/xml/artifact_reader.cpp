@@ -114,12 +114,12 @@ ArtifactType SceneLoader::parseArtifact(const Descriptor& root) {
       try {
         validatePhysicTree(spec);
         for (const auto& other : t.physic)
-          if (!spec.name.empty() && other.name == spec.name)
+          if (!spec.name.empty() && other->name == spec.name)
             throw ConfigError(spec.where, "physic node '" + spec.name + "': duplicate node name in this artifact");
       } catch (const ConfigError& e) {
         record(e);
       }
-      t.physic.push_back(std::move(spec));
+      t.physic.push_back(std::make_shared<const PhysicNodeSpec>(std::move(spec)));
     } else if (c.name() == "render") {
       t.render.push_back(readRenderNode(c, true));
     } else if (c.name() == "driver") {
@@ -141,7 +141,7 @@ ArtifactType SceneLoader::parseArtifact(const Descriptor& root) {
       found = found || n.name == follow;
       for (const auto& c : n.children) self(self, c);
     };
-    for (const auto& p : t.physic) search(search, p);
+    for (const auto& p : t.physic) search(search, *p);
     if (!found) {
       const Descriptor& rd = *root.childrenNamed("render")[i];
       error(rd.where(), "<render>: follows unknown physic node '" + follow + "'");

@@ -32,7 +32,7 @@ struct PluginDecl {
 
 struct ArtifactType {
   bool ok = true;
-  std::vector<PhysicNodeSpec> physic;
+  std::vector<std::shared_ptr<const PhysicNodeSpec>> physic;  // shared by every instance
   std::vector<RenderNodeSpec> render;
   std::optional<PluginDecl> driver;
   std::vector<PluginDecl> sensors;
