@@ -29,6 +29,23 @@ struct Bridge::Impl {
   std::map<double, std::chrono::steady_clock::time_point> published;  // odometry time -> wall time; mutex
   std::vector<double> round_trips;                                     // mutex
   bool running = false;
+
+  // the publishing thread: the stepping thread queues plain messages, this one serialises them
+  struct Outgoing {
+    enum class Kind : std::uint8_t { Clock, Odometry, Imu } kind;
+    std::size_t robot;
+    double time;  // clock
+    Odometry odometry;
+    Imu imu;
+  };
+  std::mutex queue_mutex;
+  std::condition_variable queue_changed;
+  std::vector<Outgoing> queue, sending;  // queue_mutex guards queue, busy, stop
+  bool busy = false, stop = false, uncommitted = false;
+  std::thread publisher;
+  void enqueue(const Outgoing& m);
+  void publishLoop();
+  void send(const Outgoing& m);
 };
 
 namespace {
@@ -99,6 +116,48 @@ Bridge::Bridge(const std::string& master_uri, const std::string& node_name, doub
   }
   d.spinner = std::make_unique<ros::AsyncSpinner>(1);
   d.spinner->start();
+  d.queue.reserve(4 * robots.size() + 16);
+  d.sending.reserve(4 * robots.size() + 16);
+  d.publisher = std::thread([&d] { d.publishLoop(); });
+}
+
+void Bridge::Impl::enqueue(const Outgoing& m) {
+  std::lock_guard<std::mutex> lock(queue_mutex);
+  queue.push_back(m);
+  uncommitted = true;
+}
+
+void Bridge::commit() {
+  Impl& d = *impl_;
+  {
+    std::lock_guard<std::mutex> lock(d.queue_mutex);
+    if (!d.uncommitted) return;  // (most steps publish nothing: no wake-up for them)
+    d.uncommitted = false;
+  }
+  d.queue_changed.notify_all();
+}
+
+void Bridge::Impl::publishLoop() {
+  std::unique_lock<std::mutex> lock(queue_mutex);
+  for (;;) {
+    queue_changed.wait(lock, [&] { return stop || !queue.empty(); });
+    if (queue.empty() && stop) return;
+    sending.swap(queue);
+    busy = true;
+    lock.unlock();
+    for (const Outgoing& m : sending) send(m);
+    sending.clear();
+    lock.lock();
+    busy = false;
+    queue_changed.notify_all();  // (flush waits for this)
+  }
+}
+
+void Bridge::flush() {
+  Impl& d = *impl_;
+  d.queue_changed.notify_all();
+  std::unique_lock<std::mutex> lock(d.queue_mutex);
+  d.queue_changed.wait(lock, [&] { return d.queue.empty() && !d.busy; });
 }
 
 Bridge::~Bridge() { shutdown(); }
@@ -107,6 +166,14 @@ void Bridge::shutdown() {
   Impl& d = *impl_;
   if (!d.running) return;
   d.running = false;
+  if (d.publisher.joinable()) {
+    {
+      std::lock_guard<std::mutex> lock(d.queue_mutex);
+      d.stop = true;
+    }
+    d.queue_changed.notify_all();
+    d.publisher.join();  // after sending what was queued
+  }
   if (d.spinner) d.spinner->stop();
   d.setpoint_subscribers.clear();
   d.odom.clear();
@@ -118,38 +185,67 @@ void Bridge::shutdown() {
 }
 
 void Bridge::publishClock(double time) {
-  rosgraph_msgs::Clock m;
-  m.clock = stamp(time);
-  impl_->clock.publish(m);
+  Impl::Outgoing m{};
+  m.kind = Impl::Outgoing::Kind::Clock;
+  m.time = time;
+  impl_->enqueue(m);
 }
 
 void Bridge::publishOdometry(std::size_t robot, const Odometry& o) {
-  if (robot == 0) {
-    std::lock_guard<std::mutex> lock(impl_->mutex);
-    auto& sent = impl_->published;
-    sent[stamp(o.time).toSec()] = std::chrono::steady_clock::now();
-    while (sent.size() > 1000) sent.erase(sent.begin());
-  }
-  nav_msgs::Odometry m;
-  m.header.stamp = stamp(o.time);
-  m.header.frame_id = "world";
-  m.child_frame_id = impl_->robots[robot].name + "/base_link";
-  setXyz(m.pose.pose.position, o.position);
-  setWxyz(m.pose.pose.orientation, o.orientation);
-  setXyz(m.twist.twist.linear, o.velocity);
-  setXyz(m.twist.twist.angular, o.angular_velocity);
-  impl_->odom[robot].publish(m);
+  Impl::Outgoing m{};
+  m.kind = Impl::Outgoing::Kind::Odometry;
+  m.robot = robot;
+  m.odometry = o;
+  impl_->enqueue(m);
 }
 
 void Bridge::publishImu(std::size_t robot, const Imu& u) {
   if (!impl_->robots[robot].imu) return;
-  sensor_msgs::Imu m;
-  m.header.stamp = stamp(u.time);
-  m.header.frame_id = impl_->robots[robot].name + "/imu";
-  setWxyz(m.orientation, u.orientation);
-  setXyz(m.angular_velocity, u.angular_velocity);
-  setXyz(m.linear_acceleration, u.linear_acceleration);
-  impl_->imu[robot].publish(m);
+  Impl::Outgoing m{};
+  m.kind = Impl::Outgoing::Kind::Imu;
+  m.robot = robot;
+  m.imu = u;
+  impl_->enqueue(m);
+}
+
+void Bridge::Impl::send(const Outgoing& out) {
+  switch (out.kind) {
+    case Outgoing::Kind::Clock: {
+      rosgraph_msgs::Clock m;
+      m.clock = stamp(out.time);
+      clock.publish(m);
+      break;
+    }
+    case Outgoing::Kind::Odometry: {
+      const Odometry& o = out.odometry;
+      if (out.robot == 0) {  // the round trip starts when it leaves
+        std::lock_guard<std::mutex> lock(mutex);
+        published[stamp(o.time).toSec()] = std::chrono::steady_clock::now();
+        while (published.size() > 1000) published.erase(published.begin());
+      }
+      nav_msgs::Odometry m;
+      m.header.stamp = stamp(o.time);
+      m.header.frame_id = "world";
+      m.child_frame_id = robots[out.robot].name + "/base_link";
+      setXyz(m.pose.pose.position, o.position);
+      setWxyz(m.pose.pose.orientation, o.orientation);
+      setXyz(m.twist.twist.linear, o.velocity);
+      setXyz(m.twist.twist.angular, o.angular_velocity);
+      odom[out.robot].publish(m);
+      break;
+    }
+    case Outgoing::Kind::Imu: {
+      const Imu& u = out.imu;
+      sensor_msgs::Imu m;
+      m.header.stamp = stamp(u.time);
+      m.header.frame_id = robots[out.robot].name + "/imu";
+      setWxyz(m.orientation, u.orientation);
+      setXyz(m.angular_velocity, u.angular_velocity);
+      setXyz(m.linear_acceleration, u.linear_acceleration);
+      imu[out.robot].publish(m);
+      break;
+    }
+  }
 }
 
 std::vector<std::string> Bridge::waitForPeers(double timeout_s) const {

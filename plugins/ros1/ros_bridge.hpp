@@ -47,9 +47,16 @@ class Bridge {
   Bridge(const Bridge&) = delete;
   Bridge& operator=(const Bridge&) = delete;
 
+  // Queue a message for the bridge's publishing thread, which serialises and sends it: the caller
+  // (the stepping thread) only copies a few numbers. commit() hands what is queued to that
+  // thread (one wake-up per step, not per message). Messages go out in the order queued, with the
+  // stamps given (simulated time).
   void publishClock(double time);
   void publishOdometry(std::size_t robot, const Odometry& odom);
   void publishImu(std::size_t robot, const Imu& imu);
+  void commit();
+  // Waits until everything queued so far has been handed to ROS.
+  void flush();
   // The newest set-point of a robot (count 0: none yet). Thread-safe.
   Setpoint latestSetpoint(std::size_t robot) const;
   // Waits until every robot with a set-point topic has one stamped at or after `time` (seconds),
@@ -62,7 +69,7 @@ class Bridge {
   // Round trips in wall-clock seconds: from publishing the odometry of time t to receiving a
   // set-point stamped t (one sample per set-point that answers an odometry message).
   std::vector<double> roundTrips() const;
-  // Stops the spinner and the node.
+  // Sends what is queued, then stops the publishing thread, the spinner and the node.
   void shutdown();
 
  private:

@@ -20,5 +20,5 @@ sed -i "s|file=\"../../examples|file=\"$here/../../examples|" "$ROS_HOME/scene.x
 /usr/bin/python3 "$here/peer.py" "$n" "$((seconds + 3))" --bench &
 peer=$!
 sleep 1
-"$ssx" run "$ROS_HOME/scene.xml" --realtime
+"$ssx" run "$ROS_HOME/scene.xml" --realtime ${SSX_BENCH_ARGS:-}
 wait "$peer"
