@@ -377,6 +377,13 @@ void OdeEngine::collidePair(dGeomID a, dGeomID b, std::vector<dContact>& out, st
   const PhysicsSettings& s = settings_;
   for (int i = 0; i < n; ++i) {
     dContact c = scratch[static_cast<std::size_t>(i)];
+    // ODE's narrowphase can report a contact with no direction (two cylinders touching along a
+    // line give a zero normal): its solver would fail on it inside the step, so it is dropped
+    const dContactGeom& g = c.geom;
+    const double length2 = g.normal[0] * g.normal[0] + g.normal[1] * g.normal[1] + g.normal[2] * g.normal[2];
+    if (!(length2 > 0.5 && length2 < 2.0) || !std::isfinite(g.depth) || !std::isfinite(g.pos[0]) ||
+        !std::isfinite(g.pos[1]) || !std::isfinite(g.pos[2]))
+      continue;
     c.surface.mode = dContactApprox1 | dContactSoftCFM | dContactSoftERP;
     c.surface.mu = s.friction;
     c.surface.soft_cfm = s.contact_soft_cfm;
