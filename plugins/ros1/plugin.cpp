@@ -154,9 +154,11 @@ class Ros1Bridge final : public SimulationExtension {
     const auto started = std::chrono::steady_clock::now();
     const Nanoseconds now = env.time();
     const double t = toSeconds(now);
-    const bool publishing = clock_rate_.due(now) || imu_rate_.due(now) || odom_rate_.due(now);
-    if (clock_rate_.due(now)) bridge_->publishClock(t);
-    if (imu_rate_.due(now)) {
+    // (due() moves a rate on to its next time: asked once per step)
+    const bool clock_due = clock_rate_.due(now), imu_due = imu_rate_.due(now), odom_due = odom_rate_.due(now);
+    const bool publishing = clock_due || imu_due || odom_due;
+    if (clock_due) bridge_->publishClock(t);
+    if (imu_due) {
       for (std::size_t i = 0; i < robots_.size(); ++i) {
         const Robot& r = robots_[i];
         if (r.imu == nullptr) continue;
@@ -168,7 +170,7 @@ class Ros1Bridge final : public SimulationExtension {
         bridge_->publishImu(i, m);
       }
     }
-    if (odom_rate_.due(now)) {
+    if (odom_due) {
       for (std::size_t i = 0; i < robots_.size(); ++i) {
         const BodyState s = robots_[i].artifact->root().state();
         const Quat to_body = s.pose.orientation.conjugate();

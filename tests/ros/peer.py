@@ -3,7 +3,8 @@
 0.5 m south of where it started, 1.5 m up; succeeds when every robot has held within 0.1 m of its
 set-point for 1 s of simulated time.
 
-usage: peer.py COUNT [TIMEOUT_S]   (robots q0 .. q<COUNT-1>; exit 0 on success, 1 otherwise)
+usage: peer.py COUNT [TIMEOUT_S]   (robots q0 .. q<COUNT-1>; exit 0 on success, 1 otherwise; it also
+                                    checks that /clock came at its 100 Hz of simulated time)
        peer.py COUNT TIMEOUT_S --lockstep  (answer each odometry message after a varying delay of
                                        0-30 ms with a set-point stamped like it, and check lock-step:
                                        no odometry of a round may arrive before every robot's answer
@@ -19,6 +20,7 @@ import time
 import rospy
 from geometry_msgs.msg import PoseStamped
 from nav_msgs.msg import Odometry
+from rosgraph_msgs.msg import Clock
 
 
 def main():
@@ -90,6 +92,8 @@ def main():
             held_since.pop(name, None)
 
     subs = [rospy.Subscriber("/%s/odom" % n, Odometry, on_odom, callback_args=n, tcp_nodelay=True) for n in names]
+    clock_stamps = []
+    clock_sub = rospy.Subscriber("/clock", Clock, lambda m: clock_stamps.append(m.clock.to_sec()), queue_size=1000)
     start = time.time()
     if lockstep:
         threading.Thread(target=answerer, daemon=True).start()
@@ -131,7 +135,12 @@ def main():
         if len(done) == count:
             print("peer: all %d robots held their set-points (errors: %s m; odometry messages: %s)"
                   % (count, " ".join("%.3f" % error[n] for n in names), " ".join(str(received[n]) for n in names)))
-            return 0
+            # /clock at 100 Hz of simulated time: at least 90 % of the ticks between the first and last heard
+            ticks = list(clock_stamps)
+            expected = (ticks[-1] - ticks[0]) / 0.01 + 1 if len(ticks) > 1 else 0
+            print("peer: /clock: %d messages over %.2f s of simulated time (%d expected)"
+                  % (len(ticks), ticks[-1] - ticks[0] if ticks else 0.0, round(expected)))
+            return 0 if expected >= 100 and len(ticks) >= 0.9 * expected else 1
         time.sleep(1.0 / rate)
     print("peer: timed out; odometry from %d of %d robots; errors: %s"
           % (len(target), count, " ".join("%s=%.3f" % (n, error.get(n, float("nan"))) for n in names)))
