@@ -268,6 +268,30 @@ void OdeEngine::addStatic(const std::vector<Shape>& shapes, const Pose& pose) {
   proxies_stale_ = true;
 }
 
+namespace {
+// A body's state bit for bit: position, quaternion, rotation matrix (ODE keeps both; R is not
+// recomputed from a copied q, which could differ in the last bit), linear and angular velocity.
+constexpr std::size_t kOdeBodyReals = 3 + 4 + 12 + 3 + 3;
+
+void readBits(dBodyID b, dReal* out) {
+  std::memcpy(out, dBodyGetPosition(b), 3 * sizeof(dReal));
+  std::memcpy(out + 3, dBodyGetQuaternion(b), 4 * sizeof(dReal));
+  std::memcpy(out + 7, dBodyGetRotation(b), 12 * sizeof(dReal));
+  std::memcpy(out + 19, dBodyGetLinearVel(b), 3 * sizeof(dReal));
+  std::memcpy(out + 22, dBodyGetAngularVel(b), 3 * sizeof(dReal));
+}
+
+void writeBits(dBodyID b, const dReal* in) {
+  dBodySetPosition(b, in[0], in[1], in[2]);
+  dBodySetQuaternion(b, in + 3);
+  // ODE normalises a quaternion it is given and derives the rotation from it: copy the bits
+  std::memcpy(const_cast<dReal*>(dBodyGetQuaternion(b)), in + 3, 4 * sizeof(dReal));
+  std::memcpy(const_cast<dReal*>(dBodyGetRotation(b)), in + 7, 12 * sizeof(dReal));
+  dBodySetLinearVel(b, in[19], in[20], in[21]);
+  dBodySetAngularVel(b, in[22], in[23], in[24]);
+}
+}  // namespace
+
 void OdeEngine::moveBody(int index, int to) {
   Body& body = bodies_[static_cast<std::size_t>(index)];
   Partition& from = partitions_[static_cast<std::size_t>(body.partition)];
@@ -276,15 +300,9 @@ void OdeEngine::moveBody(int index, int to) {
   const dBodyID b = dBodyCreate(into.world);
   dBodySetMass(b, &body.mass);
   dBodySetData(b, dBodyGetData(old));
-  dBodySetPosition(b, dBodyGetPosition(old)[0], dBodyGetPosition(old)[1], dBodyGetPosition(old)[2]);
-  dBodySetQuaternion(b, dBodyGetQuaternion(old));
-  // ODE normalises a quaternion it is given and derives the rotation from it: copy the bits
-  std::memcpy(const_cast<dReal*>(dBodyGetQuaternion(b)), dBodyGetQuaternion(old), 4 * sizeof(dReal));
-  std::memcpy(const_cast<dReal*>(dBodyGetRotation(b)), dBodyGetRotation(old), 12 * sizeof(dReal));
-  const dReal* v = dBodyGetLinearVel(old);
-  const dReal* w = dBodyGetAngularVel(old);
-  dBodySetLinearVel(b, v[0], v[1], v[2]);
-  dBodySetAngularVel(b, w[0], w[1], w[2]);
+  dReal bits[kOdeBodyReals];
+  readBits(old, bits);
+  writeBits(b, bits);
   dBodyDestroy(old);
   body.id = b;
   const auto it = std::find(from.order.begin(), from.order.end(), index);
@@ -591,10 +609,7 @@ void OdeEngine::setState(int body, const BodyState& s) {
   dBodySetAngularVel(b, s.angular_velocity.x(), s.angular_velocity.y(), s.angular_velocity.z());
 }
 
-// per body: position, quaternion, rotation matrix (ODE keeps both; R is not recomputed from a
-// restored q, which could differ in the last bit), linear and angular velocity
 namespace {
-constexpr std::size_t kOdeBodyReals = 3 + 4 + 12 + 3 + 3;
 constexpr double kMaxRestoredPosition = 1e9;  // m
 }
 
@@ -609,12 +624,9 @@ void OdeEngine::saveState(StateWriter& out) const {
   }
   out.write(static_cast<std::uint64_t>(bodies_.size()));
   for (const Body& body : bodies_) {
-    const dBodyID b = body.id;
-    out.bytes(dBodyGetPosition(b), 3 * sizeof(dReal));
-    out.bytes(dBodyGetQuaternion(b), 4 * sizeof(dReal));
-    out.bytes(dBodyGetRotation(b), 12 * sizeof(dReal));
-    out.bytes(dBodyGetLinearVel(b), 3 * sizeof(dReal));
-    out.bytes(dBodyGetAngularVel(b), 3 * sizeof(dReal));
+    dReal bits[kOdeBodyReals];
+    readBits(body.id, bits);
+    out.bytes(bits, sizeof bits);
   }
 }
 
@@ -682,17 +694,7 @@ void OdeEngine::restoreState(StateReader& in) {
       if (body.home != static_cast<int>(p)) away_.push_back(i);
     }
   }
-  for (std::size_t i = 0; i < bodies_.size(); ++i) {
-    dBodyID b = bodies_[i].id;
-    const dReal* v = values.data() + i * kOdeBodyReals;
-    dBodySetPosition(b, v[0], v[1], v[2]);  // also marks the body's geoms as moved
-    dBodySetQuaternion(b, v + 3);
-    // ODE normalises a quaternion it is given; the saved bits are already what its step left
-    std::memcpy(const_cast<dReal*>(dBodyGetQuaternion(b)), v + 3, 4 * sizeof(dReal));
-    std::memcpy(const_cast<dReal*>(dBodyGetRotation(b)), v + 7, 12 * sizeof(dReal));
-    dBodySetLinearVel(b, v[19], v[20], v[21]);
-    dBodySetAngularVel(b, v[22], v[23], v[24]);
-  }
+  for (std::size_t i = 0; i < bodies_.size(); ++i) writeBits(bodies_[i].id, values.data() + i * kOdeBodyReals);
 }
 
 }  // namespace ssx::detail
