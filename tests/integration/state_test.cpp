@@ -114,6 +114,24 @@ TEST_CASE("a truncated, corrupted or foreign state is refused and changes nothin
   CHECK(env.saveState() == at150);
 }
 
+TEST_CASE("the scene's physics partitions are part of the state: a restore needs the same count", "[state]") {
+  auto scene = [](const std::string& physics) {
+    return loadSceneFromString("<scene>" + physics + "<ground/><type name=\"box\" file=\"box.xml\"/>"
+                               "<swarm type=\"box\" count=\"150\" name=\"b{i}\" spacing=\"1\" xyz=\"0 0 0.5\"/></scene>",
+                               "partitions.xml", kArtifacts);
+  };
+  Scene three = scene("<physics partitions=\"3\"/>");
+  three.environment->step(20);
+  const std::vector<std::byte> saved = three.environment->saveState();
+  Scene again = scene("<physics partitions=\"3\"/>");
+  again.environment->start();
+  again.environment->restoreState(saved);
+  CHECK(again.environment->stateHash() == three.environment->stateHash());
+  Scene sixteen = scene("");  // the default, 16
+  sixteen.environment->start();
+  CHECK_THROWS_AS(sixteen.environment->restoreState(saved), StateError);
+}
+
 namespace {
 
 // a driver whose loadState reads less than its saveState wrote
