@@ -67,7 +67,7 @@ Score fly(const fs::path& scene_file, const fs::path& csv_file, const ssx::Scene
 }  // namespace
 
 int main(int argc, char** argv) {
-  fs::path scenes = fs::path(SSX_EXAMPLES_DIR) / "scenes";
+  fs::path scenes = ssx::installedDataDirectory() / "scenes";
   fs::path out = ".";
   ssx::SceneOptions options;
   for (int i = 1; i + 1 < argc; i += 2) {

@@ -110,7 +110,7 @@ int main(int argc, char** argv) {
   for (int n : o.sizes) {
     try {
       ssx::Scene scene =
-          ssx::loadSceneFromString(sceneFor(n, o), "rt_study.xml", std::string(SSX_EXAMPLES_DIR) + "/artifacts");
+          ssx::loadSceneFromString(sceneFor(n, o), "rt_study.xml", ssx::installedDataDirectory() / "artifacts");
       ssx::Environment& env = *scene.environment;
       env.setLogSink([](ssx::LogLevel, std::string_view) {});  // overruns are counted, not printed
       ssx::RunOptions run;

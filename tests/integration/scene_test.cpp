@@ -287,3 +287,55 @@ TEST_CASE("a placing element's period overrides the type's plugin period and is 
   scene.environment->start();
   for (const auto& m : log) CHECK_THAT(m, !Catch::Contains("period"));
 }
+
+TEST_CASE("a type named without a file is the installed artifact type; a given file or directory wins", "[scene]") {
+  // the build tree mirrors the installation: <build>/share/ssx/artifacts
+  const fs::path data = installedDataDirectory();
+  REQUIRE_FALSE(data.empty());
+  REQUIRE(fs::is_regular_file(data / "artifacts" / "mk_quad.xml"));
+  REQUIRE(fs::is_regular_file(data / "scenes" / "quad_swarm.xml"));
+
+  const std::string by_name = R"(<scene>
+    <type name="mk_quad"/>
+    <artifact name="q" type="mk_quad" xyz="0 0 1"/>
+  </scene>)";
+  {
+    Scene scene = loadSceneFromString(by_name, "m.xml", "/nonexistent");
+    const Artifact& q = *scene.environment->findArtifact("q");
+    REQUIRE(q.driver() != nullptr);
+    CHECK(q.driver()->className() == "quadrotor");
+    CHECK(q.sensorCount() == 2);
+  }
+
+  // a directory of the caller's, holding its own mk_quad.xml (here: a passive box), comes first
+  const fs::path dir = fs::current_path() / "installed_type_test";
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  fs::copy_file(fs::path(SSX_EXAMPLES_DIR) / "artifacts" / "box.xml", dir / "mk_quad.xml");
+  SceneOptions options;
+  options.artifact_path.push_back(dir);
+  {
+    Scene scene = loadSceneFromString(by_name, "m.xml", "/nonexistent", options);
+    CHECK(scene.environment->findArtifact("q")->driver() == nullptr);
+  }
+  // a scene-relative file wins over every directory
+  {
+    Scene scene = loadSceneFromString(R"(<scene><type name="mk_quad" file="mk_quad.xml"/>
+      <artifact name="q" type="mk_quad"/></scene>)", "m.xml", dir);
+    CHECK(scene.environment->findArtifact("q")->driver() == nullptr);
+  }
+  // an unknown name says where it looked and what to do
+  try {
+    (void)loadSceneFromString(R"(<scene>
+      <type name="no_such_robot"/><type name="../mk_quad"/><type name="e" file=""/>
+    </scene>)", "m.xml", dir, options);
+    FAIL("loaded");
+  } catch (const SceneError& e) {
+    CHECK_THAT(e.what(), Contains("m.xml:2: error: <type>: no 'file' given and no installed artifact type "
+                                  "'no_such_robot' (looked for no_such_robot.xml in " + dir.string() + ", " +
+                                  (data / "artifacts").string() + "); give file="));
+    CHECK_THAT(e.what(), Contains("no installed artifact type '../mk_quad'"));
+    CHECK_THAT(e.what(), Contains("m.xml:2: error: <type>: attribute 'file' is empty"));
+  }
+  fs::remove_all(dir);
+}

@@ -39,6 +39,10 @@ struct SceneOptions {
   /// a PNG of the last frame, an MP4, a directory of PNG frames. Empty: as the scene says.
   std::filesystem::path snapshot, video, frames_dir;
   bool search_installed_plugins = true;      ///< append ClassLoader::installedPluginDirectory()
+  /// Directories where a `<type name="X"/>` without `file` finds `X.xml`, searched before the
+  /// installed artifact directory (installedDataDirectory()/artifacts). A `file` always wins.
+  std::vector<std::filesystem::path> artifact_path;
+  bool search_installed_artifacts = true;    ///< append installedDataDirectory()/artifacts
 };
 
 /// A loaded scene: an environment ready to start, and how the file asks to run it.
@@ -49,6 +53,11 @@ struct Scene {
   std::optional<Nanoseconds> duration;  ///< <environment duration>, if given
   std::vector<Diagnostic> warnings;     ///< unknown elements and attributes, and the like
 };
+
+/// Where the installed artifact types (`artifacts/`) and example scenes (`scenes/`) are: the
+/// package's data directory (<prefix>/share/ssx), found from the location of this libssx, so it
+/// moves with the installation; in a build tree, <build>/share/ssx. Empty if there is none.
+SSX_EXPORT std::filesystem::path installedDataDirectory();
 
 /// Parses a scene file and every file it includes, loads every plugin it names and creates every
 /// artifact. All problems are collected; if any is an error, throws SceneError before anything

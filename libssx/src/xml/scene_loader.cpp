@@ -6,6 +6,7 @@
 #include <ssx/scene.hpp>
 
 #include <cmath>
+#include <dlfcn.h>
 #include <deque>
 #include <map>
 #include <numbers>
@@ -66,10 +67,17 @@ void SceneLoader::collect(const Descriptor& scene, const fs::path& dir, std::vec
       extensions_.push_back({&d, dir});
     } else if (n == "type") {
       const std::string name = require(d, "name");
-      const std::string file = require(d, "file");
+      const std::string file = d.get<std::string>("file", "");
       checkUnknown(d);
-      if (name.empty() || file.empty()) continue;
-      const auto [it, fresh] = type_decls_.try_emplace(name, TypeDecl{resolve(dir, file), d.where()});
+      if (name.empty()) continue;
+      if (d.has("file") && file.empty()) {
+        error(d.where(), "<type>: attribute 'file' is empty; give an artifact file, or leave 'file' out to use the "
+                         "installed type '" + name + "'");
+        continue;
+      }
+      const fs::path path = file.empty() ? findArtifactType(d, name) : resolve(dir, file);
+      if (path.empty()) continue;
+      const auto [it, fresh] = type_decls_.try_emplace(name, TypeDecl{path, d.where()});
       if (!fresh)
         error(d.where(),
               "<type>: artifact type '" + name + "' declared twice (first at " + it->second.where.str() + ")");
@@ -102,6 +110,24 @@ void SceneLoader::collect(const Descriptor& scene, const fs::path& dir, std::vec
   }
   checkUnknown(scene, {"environment", "physics", "render", "plugin_path", "extension", "type", "artifact", "swarm",
                        "ground", "obstacle", "include"});
+}
+
+fs::path SceneLoader::findArtifactType(const Descriptor& d, const std::string& name) {
+  std::vector<fs::path> dirs = options_.artifact_path;
+  if (options_.search_installed_artifacts)
+    if (const fs::path data = installedDataDirectory(); !data.empty()) dirs.push_back(data / "artifacts");
+  const bool plain = name.find('/') == std::string::npos && name != "." && name != "..";
+  std::string looked;
+  for (const fs::path& dir : dirs) {
+    std::error_code ec;
+    const fs::path candidate = dir / (name + ".xml");
+    if (plain && fs::is_regular_file(candidate, ec)) return candidate;
+    looked += (looked.empty() ? "" : ", ") + dir.string();
+  }
+  error(d.where(), "<type>: no 'file' given and no installed artifact type '" + name + "' (looked for " + name +
+                       ".xml in " + (looked.empty() ? std::string("no directory") : looked) +
+                       "); give file=\"path/to/" + name + ".xml\" relative to this scene");
+  return {};
 }
 
 void SceneLoader::readEnvironment(const Descriptor& d) {
@@ -311,6 +337,20 @@ Scene SceneLoader::load(Descriptor root, const fs::path& file, const fs::path& d
 }
 
 }  // namespace detail
+
+fs::path installedDataDirectory() {
+  // the directory of the libssx that holds this very function, then the data directory relative
+  // to it as installed (SSX_DATA_FROM_LIBDIR, e.g. ../share/ssx) or as in a build tree
+  Dl_info info{};
+  if (dladdr(reinterpret_cast<void*>(&installedDataDirectory), &info) == 0 || info.dli_fname == nullptr) return {};
+  std::error_code ec;
+  const fs::path lib = fs::weakly_canonical(fs::path(info.dli_fname), ec).parent_path();
+  for (const char* relative : {SSX_DATA_FROM_LIBDIR, "../share/ssx"}) {
+    const fs::path dir = (lib / relative).lexically_normal();
+    if (fs::is_directory(dir, ec)) return dir;
+  }
+  return {};
+}
 
 Scene loadScene(const fs::path& file, const SceneOptions& options) {
   Descriptor root;

@@ -184,6 +184,9 @@ class SceneLoader {
 
   // --- pass 1: the scene and its includes ---
   void collect(const Descriptor& scene, const fs::path& dir, std::vector<fs::path>& stack);
+  // an installed artifact type by name (options_.artifact_path, then the installed directory);
+  // records the error and returns empty when there is none
+  fs::path findArtifactType(const Descriptor& d, const std::string& name);
   void readEnvironment(const Descriptor& d);
   void readPhysics(const Descriptor& d);
   void readRender(const Descriptor& d);
