@@ -152,6 +152,10 @@ void QuadrotorDriver::configure(const Descriptor& params, PluginSetup& setup) {
   const Vec3 start = a.placement().position;
   const std::string source = params.get<std::string>("reference");
   hover_.position = params.get<Vec3>("target", Vec3(start + params.get<Vec3>("offset")));
+  // an external reference starts at the placed heading, which it holds until a set-point says otherwise
+  const Vec3 placed_forward = a.placement().orientation * Vec3::UnitX();
+  hover_.yaw = std::atan2(placed_forward.y(), placed_forward.x());
+  heading_kp_ = params.get<double>("heading_kp");
   eight_.center = params.get<Vec3>("center", Vec3(start + params.get<Vec3>("center_offset")));
   eight_.amplitude = params.get<double>("amplitude");
   eight_.period = params.get<double>("eight_period");
@@ -253,6 +257,10 @@ void QuadrotorDriver::step(const StepInfo& info) {
     const double roll = inner_->estimate().roll_q20 / 1048576.0;
     const double pitch = inner_->estimate().pitch_q20 / 1048576.0;
     attitude_ = outer_->update(outer_dt_, current_, pose.position, velocity, roll, pitch, yaw);
+    // an external set-point's heading is held: its yaw error, wrapped to [-pi, pi], adds a yaw
+    // rate (the other references command a yaw rate only, as the TeleKyb controller does)
+    if (source_ == Source::External)
+      attitude_.yaw_rate += heading_kp_ * std::remainder(current_.yaw - yaw, 2.0 * std::numbers::pi);
     // handed to the inner loop as integers
     command_.roll_q12 = static_cast<std::int32_t>(std::llround(attitude_.roll * 4096.0));
     command_.pitch_q12 = static_cast<std::int32_t>(std::llround(attitude_.pitch * 4096.0));

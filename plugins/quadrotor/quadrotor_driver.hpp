@@ -44,6 +44,8 @@ class QuadrotorDriver final : public Driver, public SetpointInterface {
       param::real("attitude_kp", "200", "1/s^2", param::positive() & param::atMost(InnerLoopLimits::attitude_kp), "attitude gain"),
       param::real("attitude_kd", "25", "1/s", param::positive() & param::atMost(InnerLoopLimits::attitude_kd), "body rate gain"),
       param::real("yaw_rate_kp", "8", "1/s", param::positive() & param::atMost(InnerLoopLimits::yaw_rate_kp), "yaw rate gain"),
+      param::real("heading_kp", "2", "1/s", param::nonNegative() & param::atMost(50),
+                  "heading gain for external set-points (their yaw); the other references give a yaw rate only"),
       param::real("max_angular_acceleration", "400", "rad/s^2",
                   param::positive() & param::atMost(InnerLoopLimits::max_angular_acceleration), "per axis"),
       param::real("filter_gyro_weight", "0.998", "", param::positive() & param::atMost(1),
@@ -115,6 +117,7 @@ class QuadrotorDriver final : public Driver, public SetpointInterface {
   Setpoint external_;
   FigureEight eight_;
   double start_time_ = 0;
+  double heading_kp_ = 2.0;  // 1/s, external set-points' yaw
   Setpoint current_;
   const ImuMeasurement* imu_ = nullptr;
   bool imu_seen_ = false;  // a sample has arrived

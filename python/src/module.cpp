@@ -1,0 +1,491 @@
+// The Python module `ssx._ssx` (imported as `ssx`): scenes, stepping, state as numpy arrays,
+// set-points, measurements, save and restore. See python/ssx/__init__.py and README "Python".
+//
+// Threads: every call comes in holding the GIL; stepping and running release it. An environment
+// is used by one thread at a time (as in C++): a call made while another thread is stepping the
+// same environment raises RuntimeError instead of racing it.
+#include <ssx/ssx.hpp>
+
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+#include <pybind11/stl/filesystem.h>
+
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace py = pybind11;
+namespace fs = std::filesystem;
+
+namespace {
+
+using Array = py::array_t<double, py::array::c_style | py::array::forcecast>;
+
+// Marks an environment as in use for the length of one call.
+class InUse {
+ public:
+  explicit InUse(std::atomic<bool>& flag) : flag_(flag) {
+    if (flag_.exchange(true))
+      throw std::runtime_error("ssx: this Environment is in use by another thread (stepping or running); "
+                               "an environment is used from one thread at a time");
+  }
+  InUse(const InUse&) = delete;
+  InUse& operator=(const InUse&) = delete;
+  ~InUse() { flag_.store(false); }
+
+ private:
+  std::atomic<bool>& flag_;
+};
+
+py::array_t<double> vector3(const ssx::Vec3& v) {
+  py::array_t<double> a(3);
+  auto r = a.mutable_unchecked<1>();
+  for (py::ssize_t i = 0; i < 3; ++i) r(i) = v[i];
+  return a;
+}
+
+py::array_t<double> quaternion(const ssx::Quat& q) {
+  py::array_t<double> a(4);
+  auto r = a.mutable_unchecked<1>();
+  r(0) = q.w();
+  r(1) = q.x();
+  r(2) = q.y();
+  r(3) = q.z();
+  return a;
+}
+
+template <std::size_t N>
+py::array_t<std::int32_t> counts(const std::array<std::int32_t, N>& c) {
+  py::array_t<std::int32_t> a(static_cast<py::ssize_t>(N));
+  auto r = a.mutable_unchecked<1>();
+  for (std::size_t i = 0; i < N; ++i) r(static_cast<py::ssize_t>(i)) = c[i];
+  return a;
+}
+
+py::dict summaryDict(const ssx::TimingSummary& s) {
+  py::dict d;
+  d["steps"] = s.steps;
+  d["median_ms"] = s.median_ms;
+  d["p95_ms"] = s.p95_ms;
+  d["p99_ms"] = s.p99_ms;
+  d["max_ms"] = s.max_ms;
+  d["mean_ms"] = s.mean_ms;
+  d["physics_median_ms"] = s.physics_median_ms;
+  d["sensors_median_ms"] = s.sensors_median_ms;
+  d["drivers_median_ms"] = s.drivers_median_ms;
+  d["render_median_ms"] = s.render_median_ms;
+  d["overruns"] = s.overruns;
+  d["max_lateness_ms"] = s.max_lateness_ms;
+  d["wall_s"] = s.wall_s;
+  d["simulated_s"] = s.simulated_s;
+  d["realtime_factor"] = s.realtime_factor;
+  return d;
+}
+
+// rows x cols of float64, C order, finite; `what` names it in errors
+Array requireRows(const py::handle& value, py::ssize_t rows, py::ssize_t cols, const char* what) {
+  Array a = Array::ensure(value);
+  if (!a) throw py::type_error(std::string("ssx: ") + what + " must be an array of numbers");
+  const bool shape_ok = cols == 0 ? (a.ndim() == 1 && a.shape(0) == rows)
+                                  : (a.ndim() == 2 && a.shape(0) == rows && a.shape(1) == cols);
+  if (!shape_ok) {
+    std::string got = "(";
+    for (py::ssize_t i = 0; i < a.ndim(); ++i) got += (i ? ", " : "") + std::to_string(a.shape(i));
+    got += a.ndim() == 1 ? ",)" : ")";
+    throw py::value_error(std::string("ssx: ") + what + " must have shape (" + std::to_string(rows) +
+                          (cols == 0 ? ",)" : ", " + std::to_string(cols) + ")") + ", one row per set-point driver (" +
+                          "Environment.setpoint_names()), got " + got);
+  }
+  const double* p = a.data();
+  for (py::ssize_t i = 0; i < a.size(); ++i)
+    if (!std::isfinite(p[i]))
+      throw py::value_error(std::string("ssx: ") + what + " holds a NaN or an infinity (row " +
+                            std::to_string(cols == 0 ? i : i / cols) + ")");
+  return a;
+}
+
+class PyEnvironment {
+ public:
+  explicit PyEnvironment(ssx::Scene scene) : scene_(std::move(scene)), env_(*scene_.environment) {
+    for (const ssx::Artifact* a : std::as_const(env_).selectArtifacts("*")) dynamic_.push_back(a);
+    for (std::size_t i = 0; i < env_.artifactCount(); ++i) {
+      ssx::Artifact& a = env_.artifact(i);
+      if (auto* s = dynamic_cast<ssx::SetpointInterface*>(a.driver())) {
+        setpoint_artifacts_.push_back(&a);
+        setpoint_targets_.push_back(s);
+      }
+    }
+  }
+
+  ssx::Environment& env() { return env_; }
+
+  void step(std::int64_t n) {
+    if (n < 0) throw py::value_error("ssx: step(n) needs n >= 0, got " + std::to_string(n));
+    InUse use(busy_);
+    py::gil_scoped_release release;
+    env_.step(n);
+  }
+
+  double time() const { return ssx::toSeconds(env_.time()); }
+  double timestep() const { return ssx::toSeconds(env_.timestep()); }
+  std::optional<double> duration() const {
+    if (!scene_.duration) return std::nullopt;
+    return ssx::toSeconds(*scene_.duration);
+  }
+
+  std::vector<std::string> artifactNames() const {
+    std::vector<std::string> names;
+    names.reserve(env_.artifactCount());
+    for (std::size_t i = 0; i < env_.artifactCount(); ++i) names.push_back(std::as_const(env_).artifact(i).name());
+    return names;
+  }
+  std::vector<std::string> dynamicNames() const {
+    std::vector<std::string> names;
+    names.reserve(dynamic_.size());
+    for (const ssx::Artifact* a : dynamic_) names.push_back(a->name());
+    return names;
+  }
+  std::vector<std::string> setpointNames() const {
+    std::vector<std::string> names;
+    names.reserve(setpoint_artifacts_.size());
+    for (const ssx::Artifact* a : setpoint_artifacts_) names.push_back(a->name());
+    return names;
+  }
+
+  // N x 3 (or N x 4) of every dynamic artifact's first root, from the published snapshot
+  template <int Cols, class Fill>
+  py::array_t<double> rows(Fill fill) {
+    InUse use(busy_);
+    py::array_t<double> out({static_cast<py::ssize_t>(dynamic_.size()), static_cast<py::ssize_t>(Cols)});
+    double* p = out.mutable_data();
+    for (const ssx::Artifact* a : dynamic_) {
+      fill(a->root(), p);
+      p += Cols;
+    }
+    return out;
+  }
+  py::array_t<double> positions() {
+    return rows<3>([](const ssx::PhysicNode& n, double* p) {
+      const ssx::Vec3 v = n.pose().position;
+      p[0] = v.x(), p[1] = v.y(), p[2] = v.z();
+    });
+  }
+  py::array_t<double> orientations() {
+    return rows<4>([](const ssx::PhysicNode& n, double* p) {
+      const ssx::Quat q = n.pose().orientation;
+      p[0] = q.w(), p[1] = q.x(), p[2] = q.y(), p[3] = q.z();
+    });
+  }
+  py::array_t<double> linearVelocities() {
+    return rows<3>([](const ssx::PhysicNode& n, double* p) {
+      const ssx::Vec3 v = n.state().linear_velocity;
+      p[0] = v.x(), p[1] = v.y(), p[2] = v.z();
+    });
+  }
+  py::array_t<double> angularVelocities() {
+    return rows<3>([](const ssx::PhysicNode& n, double* p) {
+      const ssx::Vec3 v = n.state().angular_velocity;
+      p[0] = v.x(), p[1] = v.y(), p[2] = v.z();
+    });
+  }
+
+  void setSetpoints(const py::handle& positions, const py::handle& velocities, const py::handle& yaws) {
+    InUse use(busy_);
+    const auto n = static_cast<py::ssize_t>(setpoint_targets_.size());
+    if (n == 0) throw std::runtime_error("ssx: no artifact of this scene has a driver that follows set-points");
+    const Array pos = requireRows(positions, n, 3, "positions");
+    std::optional<Array> vel, yaw;
+    if (!velocities.is_none()) vel = requireRows(velocities, n, 3, "velocities");
+    if (!yaws.is_none()) yaw = requireRows(yaws, n, 0, "yaws");
+    if (env_.state() == ssx::Environment::State::Setup) env_.start();
+    for (py::ssize_t i = 0; i < n; ++i) {
+      ssx::Setpoint sp;
+      sp.position = ssx::Vec3(pos.at(i, 0), pos.at(i, 1), pos.at(i, 2));
+      if (vel) sp.velocity = ssx::Vec3(vel->at(i, 0), vel->at(i, 1), vel->at(i, 2));
+      if (yaw) sp.yaw = yaw->at(i);
+      setpoint_targets_[static_cast<std::size_t>(i)]->setSetpoint(sp);
+    }
+  }
+
+  // the latest measurement of type M of an artifact's sensors: the first such sensor, or sensor `index`
+  template <class M>
+  const M& measurement(const std::string& artifact, std::optional<std::size_t> index, const char* kind) {
+    const ssx::Artifact* a = std::as_const(env_).findArtifact(artifact);
+    if (a == nullptr) throw py::key_error("ssx: no artifact named '" + artifact + "'");
+    if (index) {
+      if (*index >= a->sensorCount())
+        throw py::index_error("ssx: artifact '" + artifact + "' has " + std::to_string(a->sensorCount()) +
+                              " sensor(s), no sensor " + std::to_string(*index));
+      if (const auto* m = dynamic_cast<const M*>(&a->sensor(*index).latest())) return *m;
+      throw py::value_error("ssx: sensor " + std::to_string(*index) + " of artifact '" + artifact + "' (" +
+                            a->sensor(*index).className() + ") does not measure " + kind);
+    }
+    for (std::size_t i = 0; i < a->sensorCount(); ++i)
+      if (const auto* m = dynamic_cast<const M*>(&a->sensor(i).latest())) return *m;
+    throw py::value_error("ssx: artifact '" + artifact + "' has no " + kind + " sensor");
+  }
+
+  py::dict imu(const std::string& artifact, std::optional<std::size_t> index) {
+    InUse use(busy_);
+    const auto& m = measurement<ssx::ImuMeasurement>(artifact, index, "imu");
+    py::dict d;
+    d["stamp"] = ssx::toSeconds(m.stamp);
+    d["accelerometer"] = vector3(m.accelerometer);
+    d["gyroscope"] = vector3(m.gyroscope);
+    d["accelerometer_counts"] = counts(m.accelerometer_counts);
+    d["gyroscope_counts"] = counts(m.gyroscope_counts);
+    d["accelerometer_lsb"] = m.accelerometer_lsb;
+    d["gyroscope_lsb"] = m.gyroscope_lsb;
+    return d;
+  }
+
+  py::dict pose(const std::string& artifact, std::optional<std::size_t> index) {
+    InUse use(busy_);
+    const auto& m = measurement<ssx::PoseMeasurement>(artifact, index, "pose");
+    py::dict d;
+    d["stamp"] = ssx::toSeconds(m.stamp);
+    d["position"] = vector3(m.pose.position);
+    d["orientation"] = quaternion(m.pose.orientation);
+    d["linear_velocity"] = vector3(m.linear_velocity);
+    d["angular_velocity"] = vector3(m.angular_velocity);
+    return d;
+  }
+
+  py::dict range(const std::string& artifact, std::optional<std::size_t> index) {
+    InUse use(busy_);
+    const auto& m = measurement<ssx::RangeMeasurement>(artifact, index, "range");
+    const auto n = static_cast<py::ssize_t>(m.detections.size());
+    py::array_t<double> relative({n, py::ssize_t{3}});
+    py::array_t<double> distance(n);
+    py::array_t<std::int64_t> seen(n);
+    py::array_t<bool> obstacle(n);
+    auto rel = relative.mutable_unchecked<2>();
+    auto dist = distance.mutable_unchecked<1>();
+    auto idx = seen.mutable_unchecked<1>();
+    auto obs = obstacle.mutable_unchecked<1>();
+    for (py::ssize_t i = 0; i < n; ++i) {
+      const auto& det = m.detections[static_cast<std::size_t>(i)];
+      for (py::ssize_t k = 0; k < 3; ++k) rel(i, k) = det.relative[k];
+      dist(i) = det.distance;
+      idx(i) = static_cast<std::int64_t>(det.artifact);
+      obs(i) = det.obstacle;
+    }
+    py::dict d;
+    d["stamp"] = ssx::toSeconds(m.stamp);
+    d["body_frame"] = m.body_frame;
+    d["relative"] = relative;
+    d["distance"] = distance;
+    d["artifact"] = seen;
+    d["obstacle"] = obstacle;
+    return d;
+  }
+
+  py::bytes saveState() {
+    InUse use(busy_);
+    std::vector<std::byte> state;
+    {
+      py::gil_scoped_release release;
+      if (env_.state() == ssx::Environment::State::Setup) env_.start();
+      state = env_.saveState();
+    }
+    return {reinterpret_cast<const char*>(state.data()), state.size()};
+  }
+
+  void restoreState(const py::bytes& state) {
+    InUse use(busy_);
+    const std::string_view view = state;
+    const std::span<const std::byte> bytes(reinterpret_cast<const std::byte*>(view.data()), view.size());
+    py::gil_scoped_release release;
+    env_.restoreState(bytes);
+  }
+
+  // Paces steps for `seconds` of simulated time (the scene's duration when None). Ctrl-C (any
+  // Python signal handler that raises) ends the run between two steps and raises here; the
+  // environment stays usable.
+  py::dict run(std::optional<double> seconds, bool realtime, std::optional<double> realtime_factor) {
+    InUse use(busy_);
+    ssx::RunOptions run = scene_.run;
+    run.mode = realtime ? ssx::RunOptions::Mode::RealTime : ssx::RunOptions::Mode::Fast;
+    if (realtime_factor) {
+      if (!(*realtime_factor >= ssx::kMinRealtimeFactor && *realtime_factor <= ssx::kMaxRealtimeFactor))
+        throw py::value_error("ssx: realtime_factor must be in [1e-3, 1e6], got " + std::to_string(*realtime_factor));
+      run.realtime_factor = *realtime_factor;
+    }
+    ssx::Nanoseconds duration = 0;
+    if (seconds) {
+      if (!(*seconds >= 0.0 && *seconds <= ssx::kMaxDurationSeconds))
+        throw py::value_error("ssx: run(seconds) needs 0 <= seconds <= 1e9, got " + std::to_string(*seconds));
+      duration = ssx::toNanoseconds(*seconds);
+    } else if (scene_.duration) {
+      duration = *scene_.duration;
+    } else {
+      throw py::value_error("ssx: run() needs seconds: the scene gives no <environment duration>");
+    }
+    run.steps = (duration + env_.timestep() - 1) / env_.timestep();
+    std::atomic<bool> stop{false};
+    run.stop = &stop;
+    bool interrupted = false;
+    // Python's signal handlers run only when Python code runs: ask for them every 50 ms of wall time
+    auto last_check = std::chrono::steady_clock::now();
+    run.on_step = [&](const ssx::Environment&) {
+      const auto now = std::chrono::steady_clock::now();
+      if (now - last_check < std::chrono::milliseconds(50)) return;
+      last_check = now;
+      py::gil_scoped_acquire acquire;
+      if (PyErr_CheckSignals() != 0) {
+        interrupted = true;
+        stop.store(true);
+      }
+    };
+    ssx::TimingSummary summary;
+    {
+      py::gil_scoped_release release;
+      summary = env_.run(run);
+    }
+    if (interrupted) throw py::error_already_set();
+    return summaryDict(summary);
+  }
+
+  void close() {
+    InUse use(busy_);
+    py::gil_scoped_release release;
+    if (env_.state() == ssx::Environment::State::Running) env_.stop();
+  }
+
+  std::string repr() const {
+    return "<ssx.Environment " + scene_.file.string() + ": " + std::to_string(env_.artifactCount()) +
+           " artifacts, t = " + std::to_string(time()) + " s>";
+  }
+
+ private:
+  ssx::Scene scene_;
+  ssx::Environment& env_;
+  std::vector<const ssx::Artifact*> dynamic_;
+  std::vector<ssx::Artifact*> setpoint_artifacts_;
+  std::vector<ssx::SetpointInterface*> setpoint_targets_;
+  std::atomic<bool> busy_{false};
+};
+
+ssx::SceneOptions sceneOptions(std::optional<std::uint64_t> seed, std::optional<int> threads,
+                               const std::vector<fs::path>& plugin_path) {
+  ssx::SceneOptions o;
+  o.seed = seed;
+  if (threads) {
+    if (*threads < 0) throw py::value_error("ssx: threads must be >= 0 (0: one per core), got " + std::to_string(*threads));
+    o.threads = threads;
+  }
+  o.plugin_path = plugin_path;
+  return o;
+}
+
+}  // namespace
+
+PYBIND11_MODULE(_ssx, m) {
+  m.doc() = "ssx: real-time simulation of robot swarms in 3D";
+  m.attr("__version__") = SSX_VERSION_STRING;
+
+  static py::exception<ssx::Error> error(m, "Error", PyExc_RuntimeError);
+  static py::exception<ssx::SceneError> scene_error(m, "SceneError", error.ptr());
+  static py::exception<ssx::StepError> step_error(m, "StepError", error.ptr());
+  static py::exception<ssx::StateError> state_error(m, "StateError", error.ptr());
+  static py::exception<ssx::ConfigError> config_error(m, "ConfigError", error.ptr());
+  py::register_exception_translator([](std::exception_ptr p) {
+    try {
+      if (p) std::rethrow_exception(p);
+    } catch (const ssx::SceneError& e) {
+      scene_error(e.what());
+    } catch (const ssx::StepError& e) {
+      step_error(e.what());
+    } catch (const ssx::StateError& e) {
+      state_error(e.what());
+    } catch (const ssx::ConfigError& e) {
+      config_error(e.what());
+    } catch (const ssx::Error& e) {
+      error(e.what());
+    }
+  });
+
+  py::class_<PyEnvironment>(m, "Environment",
+                            "A loaded scene: step it, read its state as numpy arrays, command it. Made by "
+                            "load_scene or load_scene_string.")
+      .def("step", &PyEnvironment::step, py::arg("n") = 1,
+           "Advances n timesteps (starting the environment first if needed). Releases the GIL.")
+      .def_property_readonly("time", &PyEnvironment::time, "Simulated time, s.")
+      .def_property_readonly("time_ns", [](PyEnvironment& e) { return e.env().time(); }, "Simulated time, ns.")
+      .def_property_readonly("timestep", &PyEnvironment::timestep, "Physics timestep, s.")
+      .def_property_readonly("step_count", [](PyEnvironment& e) { return e.env().stepCount(); })
+      .def_property_readonly("duration", &PyEnvironment::duration, "<environment duration> in s, or None.")
+      .def_property_readonly("seed", [](PyEnvironment& e) { return e.env().settings().seed; })
+      .def_property_readonly("threads", [](PyEnvironment& e) { return e.env().threadCount(); },
+                             "Worker threads of the parallel phases (known once started).")
+      .def("artifact_names", &PyEnvironment::artifactNames, "Every artifact, in artifact order.")
+      .def("dynamic_names", &PyEnvironment::dynamicNames,
+           "The artifacts with a dynamic root: the rows of positions() and the other state arrays.")
+      .def("setpoint_names", &PyEnvironment::setpointNames,
+           "The artifacts whose driver follows set-points: the rows of set_setpoints().")
+      .def("state_hash", [](PyEnvironment& e) { return e.env().stateHash(); },
+           "64-bit hash of every body's pose and velocities, bit for bit, and the time.")
+      .def("positions", &PyEnvironment::positions, "N x 3 positions (m, world) of the dynamic artifacts' first roots.")
+      .def("orientations", &PyEnvironment::orientations, "N x 4 orientations as quaternions (w, x, y, z).")
+      .def("linear_velocities", &PyEnvironment::linearVelocities, "N x 3, m/s, world frame.")
+      .def("angular_velocities", &PyEnvironment::angularVelocities, "N x 3, rad/s, world frame.")
+      .def("set_setpoints", &PyEnvironment::setSetpoints, py::arg("positions"), py::arg("velocities") = py::none(),
+           py::arg("yaws") = py::none(),
+           "One row per set-point driver (setpoint_names()): positions N x 3 (m), velocities N x 3 (m/s, "
+           "feed-forward), yaws N (rad). Held until the next call.")
+      .def("imu", &PyEnvironment::imu, py::arg("artifact"), py::arg("sensor") = py::none(),
+           "The latest IMU measurement of an artifact (its first IMU, or sensor index `sensor`), as a dict.")
+      .def("pose", &PyEnvironment::pose, py::arg("artifact"), py::arg("sensor") = py::none(),
+           "The latest pose measurement of an artifact, as a dict.")
+      .def("range", &PyEnvironment::range, py::arg("artifact"), py::arg("sensor") = py::none(),
+           "The latest range measurement of an artifact: detections as arrays, nearest first.")
+      .def("save_state", &PyEnvironment::saveState, "Everything that determines the future, as bytes.")
+      .def("restore_state", &PyEnvironment::restoreState, py::arg("state"),
+           "Continues from save_state() bytes: the next steps are bitwise those of the saving run.")
+      .def("run", &PyEnvironment::run, py::arg("seconds") = py::none(), py::arg("realtime") = true,
+           py::arg("realtime_factor") = py::none(),
+           "Runs `seconds` of simulated time (default: the scene's duration), paced to the wall clock "
+           "unless realtime=False; returns the timing summary. Ctrl-C stops it between two steps.")
+      .def("close", &PyEnvironment::close, "Stops the environment: plugins destroyed, files and videos finished.")
+      .def("__enter__", [](py::object self) { return self; })
+      .def("__exit__", [](PyEnvironment& e, const py::args&) { e.close(); })
+      .def("__repr__", &PyEnvironment::repr);
+
+  m.def(
+      "load_scene",
+      [](const fs::path& path, std::optional<std::uint64_t> seed, std::optional<int> threads,
+         const std::vector<fs::path>& plugin_path) {
+        ssx::SceneOptions options = sceneOptions(seed, threads, plugin_path);
+        std::optional<ssx::Scene> scene;
+        {
+          py::gil_scoped_release release;
+          scene.emplace(ssx::loadScene(path, options));
+        }
+        return std::make_unique<PyEnvironment>(std::move(*scene));
+      },
+      py::arg("path"), py::arg("seed") = py::none(), py::arg("threads") = py::none(),
+      py::arg("plugin_path") = std::vector<fs::path>{},
+      "Loads a scene file. Raises SceneError (its text: every `file:line: error:` line) before anything starts.");
+  m.def(
+      "load_scene_string",
+      [](const std::string& xml, const fs::path& base_dir, std::optional<std::uint64_t> seed,
+         std::optional<int> threads, const std::string& label, const std::vector<fs::path>& plugin_path) {
+        ssx::SceneOptions options = sceneOptions(seed, threads, plugin_path);
+        std::optional<ssx::Scene> scene;
+        {
+          py::gil_scoped_release release;
+          scene.emplace(ssx::loadSceneFromString(xml, label, base_dir, options));
+        }
+        return std::make_unique<PyEnvironment>(std::move(*scene));
+      },
+      py::arg("xml"), py::arg("base_dir") = fs::path("."), py::arg("seed") = py::none(),
+      py::arg("threads") = py::none(), py::arg("label") = "<string>",
+      py::arg("plugin_path") = std::vector<fs::path>{},
+      "Loads a scene from text; relative files resolve against base_dir, messages name `label`.");
+  m.def("data_directory", &ssx::installedDataDirectory,
+        "The installed artifact types (artifacts/) and example scenes (scenes/).");
+}

@@ -1,0 +1,247 @@
+"""The Python module: loading, stepping, state arrays, set-points, measurements, save and restore,
+run and Ctrl-C, the GIL. Run by ctest (python_tests) with PYTHONPATH=<build>/python."""
+import os
+import signal
+import threading
+import time
+
+import numpy as np
+import pytest
+
+import ssx
+
+G = 9.80665
+
+# nine mk_quads on a 3 x 3 grid, installed type by name, hovering 1 m above their start
+HOVER = """<scene>
+  <environment timestep="0.002" seed="7" duration="3"/>
+  <type name="mk_quad"/>
+  <ground/>
+  <swarm type="mk_quad" count="9" name="q{i}" spacing="1.5" xyz="0 0 0.05"><driver offset="0 0 1"/></swarm>
+</scene>"""
+
+# two formation quadrotors 1.5 m apart: each sees the other with its range sensor (2.5 m)
+PAIR = """<scene>
+  <environment timestep="0.002" seed="3"/>
+  <type name="f" file="mk_quad_formation.xml"/>
+  <artifact name="a" type="f" xyz="0 0 1"><driver formation_index="0" formation_size="2"/></artifact>
+  <artifact name="b" type="f" xyz="1.5 0 1"><driver formation_index="1" formation_size="2"/></artifact>
+</scene>"""
+
+
+def hover(**kw):
+    return ssx.load_scene_string(HOVER, label="hover.xml", **kw)
+
+
+def artifacts_dir():
+    return ssx.data_directory() / "artifacts"
+
+
+def test_load_step_and_names():
+    env = hover(threads=1)
+    assert env.artifact_names() == ["ground"] + [f"q{i}" for i in range(9)]
+    assert env.dynamic_names() == [f"q{i}" for i in range(9)]
+    assert env.setpoint_names() == env.dynamic_names()
+    assert env.step_count == 0 and env.time == 0.0
+    assert env.timestep == pytest.approx(0.002)
+    assert env.duration == pytest.approx(3.0)
+    env.step()
+    env.step(9)
+    assert env.step_count == 10
+    assert env.time_ns == 20_000_000
+    assert env.time == pytest.approx(0.02)
+    with pytest.raises(ValueError):
+        env.step(-1)
+
+
+def test_scene_errors_carry_file_and_line_and_start_nothing(tmp_path):
+    scene = tmp_path / "broken.xml"
+    log = tmp_path / "poses.csv"
+    scene.write_text(f"""<scene>
+  <type name="mk_quad"/>
+  <extension name="log" plugin="csv_logger" file="{log}" rate_hz="10"/>
+  <swarm type="mk_quad" count="2"><driver period="0"/></swarm>
+  <physics partitions="0"/>
+</scene>""")
+    with pytest.raises(ssx.SceneError) as info:
+        ssx.load_scene(scene)
+    text = str(info.value)
+    assert f"{scene}:4: error:" in text
+    assert f"{scene}:5: error: <physics>: attribute 'partitions'" in text
+    assert "nothing was run" in text
+    assert isinstance(info.value, ssx.Error)
+    assert not log.exists()  # the logger's file was never opened
+    with pytest.raises(ssx.SceneError, match=r"memory.xml:1: error: the root element"):
+        ssx.load_scene_string("<robot/>", label="memory.xml")
+
+
+def test_state_arrays_are_the_bodies_in_artifact_order():
+    env = hover(threads=1)
+    p0 = env.positions()
+    assert p0.shape == (9, 3) and p0.dtype == np.float64
+    # the 3 x 3 grid, 1.5 m apart, placed at z = 0.05
+    np.testing.assert_allclose(p0[:, 2], 0.05)
+    np.testing.assert_allclose(p0[1] - p0[0], [1.5, 0, 0], atol=1e-12)
+    env.step(1000)  # 2 s: climbing to 1.05 m
+    p, q, v, w = env.positions(), env.orientations(), env.linear_velocities(), env.angular_velocities()
+    assert q.shape == (9, 4) and v.shape == (9, 3) and w.shape == (9, 3)
+    np.testing.assert_allclose(np.linalg.norm(q, axis=1), 1.0, atol=1e-9)
+    assert np.all(p[:, 2] > 0.5)
+    # the velocity is the derivative of the position: one more step moves each body by v * dt
+    env.step(1)
+    p1, v1 = env.positions(), env.linear_velocities()
+    np.testing.assert_allclose((p1 - p) / env.timestep, (v + v1) / 2, atol=2e-3)
+    # the pose sensor's reading (0.5 mm noise) agrees with the arrays
+    m = env.pose("q4")
+    np.testing.assert_allclose(m["position"], p1[4], atol=5e-3)
+    assert m["stamp"] == pytest.approx(env.time)
+    assert m["orientation"].shape == (4,)
+
+
+def test_same_seed_same_bits_on_any_thread_count():
+    a, b = hover(threads=1), hover(threads=2)
+    a.step(300)
+    b.step(300)
+    assert a.state_hash() == b.state_hash()
+    assert np.array_equal(a.positions(), b.positions())
+    c = hover(threads=1, seed=8)
+    c.step(300)
+    assert c.seed == 8 and c.state_hash() != a.state_hash()
+
+
+def test_setpoints_fly_the_swarm_there():
+    env = hover(threads=2)
+    start = env.positions()
+    target = start + np.array([0.5, -0.5, 1.5])
+    env.set_setpoints(target, velocities=np.zeros((9, 3)), yaws=np.full(9, 0.3))
+    env.step(3000)  # 6 s
+    np.testing.assert_allclose(env.positions(), target, atol=0.05)
+    yaw = np.array([np.arctan2(2 * (w * z + x * y), 1 - 2 * (y * y + z * z)) for w, x, y, z in env.orientations()])
+    np.testing.assert_allclose(yaw, 0.3, atol=0.02)
+    # every row is checked before any driver gets one
+    with pytest.raises(ValueError, match=r"shape \(9, 3\).*got \(8, 3\)"):
+        env.set_setpoints(target[:8])
+    bad = target.copy()
+    bad[3, 1] = np.nan
+    with pytest.raises(ValueError, match="NaN or an infinity \\(row 3\\)"):
+        env.set_setpoints(bad)
+    with pytest.raises(ValueError, match=r"yaws must have shape \(9,\)"):
+        env.set_setpoints(target, yaws=np.zeros(3))
+
+
+def test_imu_reads_gravity_when_hovering():
+    env = hover(threads=1)
+    env.step(2500)  # 5 s: settled at 1.05 m
+    m = env.imu("q0")
+    assert m["stamp"] == pytest.approx(env.time)
+    assert m["accelerometer"][2] == pytest.approx(G, abs=0.3)
+    assert np.all(np.abs(m["gyroscope"]) < 0.1)
+    np.testing.assert_array_equal(m["accelerometer_counts"], np.round(m["accelerometer"] / m["accelerometer_lsb"]))
+    with pytest.raises(KeyError):
+        env.imu("nobody")
+    with pytest.raises(ValueError, match="has no range sensor"):
+        env.range("q0")
+    with pytest.raises(ValueError, match=r"sensor 0 of artifact 'q0' \(imu\) does not measure pose"):
+        env.pose("q0", sensor=0)
+    with pytest.raises(IndexError):
+        env.imu("q0", sensor=7)
+
+
+def test_range_sees_the_neighbour():
+    env = ssx.load_scene_string(PAIR, base_dir=artifacts_dir(), threads=1)
+    env.step(10)  # the range sensor runs every 10 steps
+    r = env.range("a")
+    assert list(r["artifact"]) == [env.artifact_names().index("b")]
+    assert r["distance"][0] == pytest.approx(1.5, abs=0.02)
+    assert r["relative"].shape == (1, 3)
+    np.testing.assert_allclose(r["relative"][0], env.positions()[1] - env.positions()[0], atol=0.02)
+    assert not r["obstacle"][0]
+
+
+def test_save_and_restore_continue_bitwise():
+    env = hover(threads=2)
+    env.step(200)
+    saved = env.save_state()
+    assert isinstance(saved, bytes) and len(saved) > 0
+    env.step(300)
+    expected, expected_p = env.state_hash(), env.positions()
+    env.restore_state(saved)
+    assert env.step_count == 200
+    env.step(300)
+    assert env.state_hash() == expected
+    assert np.array_equal(env.positions(), expected_p)
+    # in another environment loaded from the same scene, on another thread count
+    other = hover(threads=1)
+    other.restore_state(saved)
+    other.step(300)
+    assert other.state_hash() == expected
+    # a damaged state is refused and changes nothing
+    before = env.state_hash()
+    damaged = bytearray(saved)
+    damaged[len(damaged) // 2] ^= 0xFF
+    with pytest.raises(ssx.StateError):
+        env.restore_state(bytes(damaged))
+    with pytest.raises(ssx.StateError):
+        ssx.load_scene_string(PAIR, base_dir=artifacts_dir()).restore_state(saved)
+    assert env.state_hash() == before
+
+
+def test_run_returns_the_timing_summary():
+    env = hover(threads=1)
+    s = env.run(0.5, realtime=False)
+    assert s["steps"] == 250 and env.step_count == 250
+    assert s["simulated_s"] == pytest.approx(0.5)
+    assert 0 < s["median_ms"] <= s["p99_ms"] <= s["max_ms"]
+    s = env.run(realtime=False)  # the scene's duration, 3 s
+    assert env.step_count == 250 + 1500
+    with pytest.raises(ValueError, match="needs seconds"):
+        ssx.load_scene_string(PAIR, base_dir=artifacts_dir()).run()
+
+
+def test_ctrl_c_stops_a_run_between_steps():
+    env = hover(threads=1)
+    # a real SIGINT, sent from another thread while the main thread is inside run()
+    timer = threading.Timer(0.3, lambda: os.kill(os.getpid(), signal.SIGINT))
+    began = time.monotonic()
+    timer.start()
+    with pytest.raises(KeyboardInterrupt):
+        env.run(60.0, realtime=True)
+    timer.join()
+    assert time.monotonic() - began < 10
+    stopped = env.step_count
+    assert 0 < stopped < 30000
+    env.step(5)  # still usable
+    assert env.step_count == stopped + 5
+
+
+def test_stepping_releases_the_gil():
+    env = hover(threads=1)
+    done = threading.Event()
+
+    def long_step():
+        env.step(20000)
+        done.set()
+
+    t = threading.Thread(target=long_step)
+    t.start()
+    refused = 0
+    # while the other thread is inside step(), this thread runs Python (so the GIL is free) and the
+    # environment refuses a second user instead of racing it
+    while not done.is_set():
+        try:
+            env.positions()
+        except RuntimeError as e:
+            assert "in use by another thread" in str(e)
+            refused += 1
+    t.join()
+    assert refused > 0
+    assert env.step_count == 20000
+
+
+def test_close_finishes_the_run(tmp_path):
+    log = tmp_path / "log.csv"
+    scene = HOVER.replace("<ground/>", f'<ground/><extension name="log" plugin="csv_logger" file="{log}" rate_hz="10"/>')
+    with ssx.load_scene_string(scene) as env:
+        env.step(500)  # 1 s at 10 Hz
+    rows = log.read_text().splitlines()
+    assert len(rows) == 1 + 9 * 10
