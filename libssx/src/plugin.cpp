@@ -66,10 +66,12 @@ bool ImuMeasurement::finite() const noexcept {
 }
 }  // namespace ssx
 
+#include <ssx/metrics.hpp>
 #include <ssx/setpoint.hpp>
 
 namespace ssx {
 SetpointInterface::~SetpointInterface() = default;
+MetricSource::~MetricSource() = default;
 }  // namespace ssx
 
 namespace ssx {

@@ -1,6 +1,7 @@
 #include "quadrotor_driver.hpp"
 
 #include <algorithm>
+#include <limits>
 #include <cmath>
 #include <numbers>
 #include <sstream>
@@ -294,6 +295,25 @@ double QuadrotorDriver::desiredDistance(std::size_t member) {
   const double d = (own_target_ - formation_.target(member)).norm();
   desired_distance_.insert(it, {member, d});
   return d;
+}
+
+std::vector<std::string> QuadrotorDriver::metricNames() const {
+  if (source_ == Source::Formation) return {"formation_error"};
+  return {};
+}
+
+void QuadrotorDriver::metrics(std::vector<Metric>& out) const {
+  if (source_ != Source::Formation) return;
+  double sum = 0;
+  std::size_t members = 0;
+  for (const auto& d : seen_) {
+    if (d.obstacle || d.artifact < formation_base_ || d.artifact >= formation_base_ + formation_.size) continue;
+    const double d_star = (own_target_ - formation_.target(d.artifact - formation_base_)).norm();
+    sum += std::abs(d.relative.norm() - d_star);
+    ++members;
+  }
+  out.push_back({"formation_error", members > 0 ? sum / static_cast<double>(members)
+                                                : std::numeric_limits<double>::quiet_NaN()});
 }
 
 void QuadrotorDriver::formationStep(double dt) {

@@ -22,7 +22,7 @@
 
 namespace ssx::quadrotor {
 
-class QuadrotorDriver final : public Driver, public SetpointInterface {
+class QuadrotorDriver final : public Driver, public SetpointInterface, public MetricSource {
  public:
   static constexpr const char* kDoc =
       "rotor model, integer attitude loop on IMU counts, position loop, reference sources";
@@ -84,6 +84,10 @@ class QuadrotorDriver final : public Driver, public SetpointInterface {
   void loadState(StateReader& in) override;
   void setSetpoint(const Setpoint& setpoint) override;
   Setpoint currentSetpoint() const override { return current_; }
+  /// In formation: `formation_error`, the mean over the members its range sensor sees of
+  /// | distance - desired distance | (m), as of its latest range measurement.
+  std::vector<std::string> metricNames() const override;
+  void metrics(std::vector<Metric>& out) const override;
 
   /// For tests: the rotor model and the controller's pieces.
   const RotorModel& rotors() const { return *rotors_; }

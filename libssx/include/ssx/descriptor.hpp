@@ -75,6 +75,7 @@ class SSX_EXPORT Descriptor {
 
   const std::vector<Attribute>& attributes() const noexcept { return attributes_; }
   const std::vector<Descriptor>& children() const noexcept { return children_; }
+  std::vector<Descriptor>& children() noexcept { return children_; }
   /// The first child with this element name, or nullptr.
   const Descriptor* child(std::string_view name) const;
   /// Every child with this element name, in document order.

@@ -27,6 +27,20 @@ class SSX_EXPORT SceneError : public Error {
   std::vector<Diagnostic> diagnostics_;
 };
 
+/// An attribute of the scene file set before the file is read: how a sweep varies a scene.
+/// `target` is a path from <scene>: steps separated by '/', each `name`, `name[k]` (the k-th child
+/// of that name, from 1) or `name[attribute=value]`, then `@attribute`; for example
+/// `environment@timestep` or `swarm[name=quad{i}]/driver@formation_gain`. Every step must match
+/// exactly one element of the scene file itself (not of its includes or artifact files), except
+/// that a missing `driver` or `sensor[index=K]` of an <artifact> or <swarm> is added (that is
+/// where a placement sets its type's plugin parameters). A path that does not fit, and the
+/// value's own problems, are reported at `where`.
+struct AttributeOverride {
+  std::string target;
+  std::string value;
+  SourceLocation where;
+};
+
 /// How to load a scene, beyond what the file says.
 struct SceneOptions {
   /// Plugin directories searched after the scene's own <plugin_path>s and before the installed
@@ -43,6 +57,11 @@ struct SceneOptions {
   /// installed artifact directory (installedDataDirectory()/artifacts). A `file` always wins.
   std::vector<std::filesystem::path> artifact_path;
   bool search_installed_artifacts = true;    ///< append installedDataDirectory()/artifacts
+  /// Attributes set before the scene file is read (see AttributeOverride), in order.
+  std::vector<AttributeOverride> overrides;
+  /// false: the scene's <extension> elements are left out (headless batch runs: no logger writes,
+  /// no bridge connects).
+  bool extensions = true;
 };
 
 /// A loaded scene: an environment ready to start, and how the file asks to run it.

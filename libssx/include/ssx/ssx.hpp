@@ -9,6 +9,7 @@
 #include <ssx/error.hpp>
 #include <ssx/export.hpp>
 #include <ssx/measurements.hpp>
+#include <ssx/metrics.hpp>
 #include <ssx/physic_engine.hpp>
 #include <ssx/physic_node.hpp>
 #include <ssx/parameters.hpp>

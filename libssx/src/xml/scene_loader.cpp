@@ -64,7 +64,7 @@ void SceneLoader::collect(const Descriptor& scene, const fs::path& dir, std::vec
       if (!p.empty()) plugin_dirs_.push_back(resolve(dir, p));
       checkUnknown(d);
     } else if (n == "extension") {
-      extensions_.push_back({&d, dir});
+      if (options_.extensions) extensions_.push_back({&d, dir});
     } else if (n == "type") {
       const std::string name = require(d, "name");
       const std::string file = d.get<std::string>("file", "");
@@ -322,6 +322,11 @@ void SceneLoader::build(Scene& scene) {
 Scene SceneLoader::load(Descriptor root, const fs::path& file, const fs::path& dir) {
   Scene scene;
   scene.file = file;
+  if (!options_.overrides.empty()) {
+    for (const auto& o : options_.overrides)
+      if (auto problem = applyOverride(root, o)) error(o.where, *problem);
+    if (hasErrors()) throw SceneError(std::move(diagnostics_));
+  }
   documents_.push_back(std::move(root));
   std::error_code ec;
   std::vector<fs::path> stack{fs::weakly_canonical(file, ec)};

@@ -50,6 +50,10 @@ constexpr std::int64_t kMaxCount = 10'000'000;
 // the names a file may use for primitive shapes
 inline const std::set<std::string> kShapeElements{"box", "sphere", "cylinder", "capsule"};
 
+// Sets the attribute an override names in the tree of a scene file (see AttributeOverride);
+// returns what is wrong with its target, if anything.
+std::optional<std::string> applyOverride(Descriptor& scene, const AttributeOverride& o);
+
 class SceneLoader {
  public:
   explicit SceneLoader(const SceneOptions& options) : options_(options) {}
