@@ -1,6 +1,8 @@
 // ssx: the command-line client. run, validate, plugins.
 //
 // Exit status: 0 success, 2 bad input (scene, arguments, plugins), 1 failure while running.
+#include "sweep.hpp"
+
 #include <ssx/ssx.hpp>
 
 #include <CLI/CLI.hpp>
@@ -24,7 +26,9 @@
 #include <iostream>
 #include <sstream>
 #include <stdexcept>
+#include <optional>
 #include <string>
+#include <thread>
 #include <vector>
 
 extern char** environ;
@@ -400,6 +404,58 @@ int commandPlugins(const std::vector<std::string>& plugin_path, const std::strin
   return bad == 0 ? 0 : kExitBadInput;
 }
 
+struct SweepArgs {
+  std::string file, out, robots;
+  std::vector<std::string> plugin_path;
+  int jobs = 0;
+  bool check = false, quiet = false;
+};
+
+int commandSweep(const SweepArgs& args) {
+  namespace sw = ssx::sweep;
+  const fs::path out = args.out.empty() ? fs::path(fs::path(args.file).stem().string() + ".csv") : fs::path(args.out);
+  const auto plugin_path = pluginPath(args.plugin_path);
+  if (sw::underMpi()) return sw::runMpi(args.file, plugin_path, out, args.robots, args.check);
+  std::optional<sw::Spec> spec;
+  try {
+    spec = sw::readSpec(args.file, plugin_path);
+    sw::check(*spec);
+  } catch (const ssx::SceneError& e) {
+    std::cerr << e.what() << '\n';
+    return kExitBadInput;
+  }
+  if (args.check) {
+    std::cout << args.file << ": ok: " << spec->points.size() << " point(s) x " << spec->seeds
+              << " seed(s) = " << spec->runCount() << " runs\n";
+    return 0;
+  }
+  std::optional<sw::Output> output;
+  try {
+    output.emplace(*spec, out, args.robots);
+  } catch (const std::exception& e) {
+    std::cerr << "ssx: error: " << e.what() << '\n';
+    return kExitBadInput;
+  }
+  if (output->pending() == 0) {
+    std::cout << "ssx sweep: all " << spec->runCount() << " runs are in " << out.string() << "; nothing to do\n";
+    return 0;
+  }
+  if (output->pending() < spec->runCount())
+    std::cout << "ssx sweep: resuming: " << spec->runCount() - output->pending() << " of " << spec->runCount()
+              << " runs are in " << out.string() << '\n';
+  const int jobs = args.jobs > 0 ? args.jobs : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+  try {
+    const auto t0 = std::chrono::steady_clock::now();
+    const sw::Stats stats = sw::runLocal(*spec, *output, jobs, !args.quiet && isatty(STDERR_FILENO) == 1);
+    const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    sw::printStats(stats, *output, wall, jobs, output->writeSummary());
+  } catch (const std::exception& e) {
+    std::cerr << "ssx: error: " << e.what() << '\n';
+    return kExitRunFailure;
+  }
+  return 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -448,6 +504,18 @@ int main(int argc, char** argv) {
   plugins_cmd->add_option("--inspect", inspect_file, "(internal) report one library from a child process")
       ->group("");
 
+  SweepArgs sweep;
+  CLI::App* sweep_cmd =
+      app.add_subcommand("sweep", "run a scene many times over varied attributes and seeds (docs/sweep-format.md)");
+  sweep_cmd->add_option("sweep", sweep.file, "sweep file")->required()->check(CLI::ExistingFile);
+  sweep_cmd->add_option("--out", sweep.out, "results CSV (default: SWEEP's name .csv); an existing one is resumed");
+  sweep_cmd->add_option("--robots", sweep.robots, "also write per-robot metrics to this CSV");
+  sweep_cmd->add_option("--jobs", sweep.jobs, "worker processes (default: one per core; under mpirun: the ranks)")
+      ->check(CLI::Range(1, 4096));
+  sweep_cmd->add_option("--plugin-path", sweep.plugin_path, "plugin directory (repeatable)");
+  sweep_cmd->add_flag("--check", sweep.check, "check the sweep and every point's scene; run nothing");
+  sweep_cmd->add_flag("--quiet", sweep.quiet, "no progress");
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -461,6 +529,7 @@ int main(int argc, char** argv) {
     return commandRun(run, realtime_given);
   }
   if (*validate_cmd) return commandValidate(validate_file, validate_path);
+  if (*sweep_cmd) return commandSweep(sweep);
   if (*plugins_cmd && !inspect_file.empty()) return inspectOne(inspect_file, params_of);
   if (*plugins_cmd) return commandPlugins(plugins_path, params_of);
   return kExitBadInput;

@@ -308,7 +308,9 @@ void QuadrotorDriver::metrics(std::vector<Metric>& out) const {
   std::size_t members = 0;
   for (const auto& d : seen_) {
     if (d.obstacle || d.artifact < formation_base_ || d.artifact >= formation_base_ + formation_.size) continue;
+    // the pairs the shape is made of: neighbours on the target sphere within sensing range
     const double d_star = (own_target_ - formation_.target(d.artifact - formation_base_)).norm();
+    if (d_star >= formation_.sensing_range) continue;
     sum += std::abs(d.relative.norm() - d_star);
     ++members;
   }

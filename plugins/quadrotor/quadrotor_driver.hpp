@@ -84,8 +84,9 @@ class QuadrotorDriver final : public Driver, public SetpointInterface, public Me
   void loadState(StateReader& in) override;
   void setSetpoint(const Setpoint& setpoint) override;
   Setpoint currentSetpoint() const override { return current_; }
-  /// In formation: `formation_error`, the mean over the members its range sensor sees of
-  /// | distance - desired distance | (m), as of its latest range measurement.
+  /// In formation: `formation_error`, the mean over the members its range sensor sees whose
+  /// places on the sphere are within sensing range of its own, of | distance - desired distance |
+  /// (m), as of its latest range measurement (NaN when it sees none).
   std::vector<std::string> metricNames() const override;
   void metrics(std::vector<Metric>& out) const override;
 

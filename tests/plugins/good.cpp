@@ -1,4 +1,5 @@
 // A good plugin library with three classes of three kinds.
+#include <cstdlib>
 #include <ssx/artifact.hpp>
 #include <ssx/measurements.hpp>
 #include <ssx/plugin_abi.hpp>
@@ -29,24 +30,29 @@ class Counter final : public ssx::SensorOf<ssx::ClockMeasurement> {
   }
 };
 
-// throws at step `at_step` in the artifact named `only`
+// throws (or, how="abort", takes its process down) at step `at_step` in the artifact named `only`
 class Bomb final : public ssx::Driver {
  public:
   static constexpr ssx_plugin_param kParameters[] = {
       ssx::param::integer("at_step", "0", ssx::param::nonNegative(), "step to throw at"),
       ssx::param::text("only", "", "throw only in the artifact of this name (default: every artifact)"),
+      ssx::param::choice("how", "throw", "throw abort", "throw an exception, or abort the process"),
   };
   void configure(const ssx::Descriptor& params, ssx::PluginSetup& /*setup*/) override {
     at_step_ = params.get<std::int64_t>("at_step", 0);
     armed_ = params.get<std::string>("only", artifact().name()) == artifact().name();
+    abort_ = params.get<std::string>("how", "throw") == "abort";
   }
   void step(const ssx::StepInfo& info) override {
-    if (armed_ && info.step == at_step_) throw std::runtime_error("exploded as asked");
+    if (!armed_ || info.step != at_step_) return;
+    if (abort_) std::abort();
+    throw std::runtime_error("exploded as asked");
   }
 
  private:
   std::int64_t at_step_ = 0;
   bool armed_ = false;
+  bool abort_ = false;
 };
 
 // writes the file named by `file` (relative: to the working directory) when initialised, so a

@@ -322,11 +322,9 @@ void SceneLoader::build(Scene& scene) {
 Scene SceneLoader::load(Descriptor root, const fs::path& file, const fs::path& dir) {
   Scene scene;
   scene.file = file;
-  if (!options_.overrides.empty()) {
-    for (const auto& o : options_.overrides)
-      if (auto problem = applyOverride(root, o)) error(o.where, *problem);
-    if (hasErrors()) throw SceneError(std::move(diagnostics_));
-  }
+  // an override that does not fit is reported with the rest (the scene is read without it)
+  for (const auto& o : options_.overrides)
+    if (auto problem = applyOverride(root, o)) error(o.where, *problem);
   documents_.push_back(std::move(root));
   std::error_code ec;
   std::vector<fs::path> stack{fs::weakly_canonical(file, ec)};

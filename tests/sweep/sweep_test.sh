@@ -1,0 +1,115 @@
+#!/usr/bin/env bash
+# ssx sweep, end to end: checks before any run, the same rows on 1 and 2 processes and under
+# mpirun, failed runs recorded, resume after a kill, a results file of another sweep refused.
+#   sweep_test.sh SSX TEST_PLUGIN_DIR WORK_DIR EXPECT_MPI(ON|OFF)
+set -euo pipefail
+ssx=$1 plugins=$2 work=$3 expect_mpi=$4
+here=$(cd "$(dirname "$0")" && pwd)
+data=$here/../data/sweeps
+rm -rf "$work" && mkdir -p "$work" && cd "$work"
+fail() { echo "FAIL: $*" >&2; exit 1; }
+rows() { tail -n +3 "$1" | sort -t, -k1,1n; }  # the runs' rows, by run index
+
+# --- a broken sweep: every problem with file:line, nothing written ---
+cat > broken.xml <<'XML'
+<sweep scene="SCENE" seeds="0">
+  <grid>
+    <parameter name="gain" target="swarm/driver@formation_gain" values="0.1 -1"/>
+    <parameter name="g2" target="swarm/driver@formation_gian" values="1"/>
+    <parameter name="nope" target="swarm[7]/driver@x" values="1"/>
+  </grid>
+  <metrics><plugin name="no_such_metric"/></metrics>
+</sweep>
+XML
+sed -i "s|SCENE|$data/scene.xml|" broken.xml
+set +e
+"$ssx" sweep broken.xml --plugin-path "$plugins" --out broken.csv > broken.out 2>&1
+status=$?
+set -e
+cat broken.out
+[ "$status" -eq 2 ] || fail "a broken sweep exits with $status, expected 2"
+grep -q "broken.xml:1: error: <sweep>: attribute 'seeds' must be a whole number in \[1, 1000000\], got '0'" broken.out || fail "seeds"
+[ ! -e broken.csv ] || fail "a broken sweep created its output"
+sed -i 's/seeds="0"/seeds="1"/' broken.xml
+set +e
+"$ssx" sweep broken.xml --plugin-path "$plugins" --out broken.csv > broken.out 2>&1
+status=$?
+set -e
+cat broken.out
+[ "$status" -eq 2 ] || fail "exit $status"
+grep -q "broken.xml:3: error: <driver>: driver 'quadrotor': parameter 'formation_gain' must be > 0" broken.out || fail "value check"
+grep -q "broken.xml:4: error: unknown parameter 'formation_gian' of driver 'quadrotor'" broken.out || fail "unknown attribute"
+grep -q "broken.xml:5: error: target 'swarm\[7\]/driver@x': no element 'swarm\[7\]'" broken.out || fail "bad target"
+[ ! -e broken.csv ] || fail "a broken sweep created its output"
+# the metric is checked once the values are right
+sed -i 's/values="0.1 -1"/values="0.1"/; /formation_gian/d; /swarm\[7\]/d' broken.xml
+set +e
+"$ssx" sweep broken.xml --plugin-path "$plugins" --out broken.csv > broken.out 2>&1
+status=$?
+set -e
+[ "$status" -eq 2 ] && grep -q "broken.xml:5: error: metric 'no_such_metric': no plugin of this scene publishes it (published: formation_error, tracking_error)" broken.out \
+  || { cat broken.out; fail "unknown metric"; }
+
+# --- the example sweep passes its checks ---
+"$ssx" sweep "$here/../../examples/sweeps/formation_gains.xml" --check | grep -q "5 point(s) x 10 seed(s) = 50 runs" \
+  || fail "the example sweep"
+
+# --- one process, two processes: the same rows ---
+"$ssx" sweep "$data/small.xml" --plugin-path "$plugins" --out one.csv --robots one_robots.csv --jobs 1
+"$ssx" sweep "$data/small.xml" --plugin-path "$plugins" --out two.csv --jobs 2
+[ "$(rows one.csv | wc -l)" -eq 12 ] || fail "12 runs expected"
+diff <(rows one.csv) <(rows two.csv) || fail "--jobs 1 and --jobs 2 differ"
+# the failing runs are rows with their message, the others complete
+[ "$(rows one.csv | grep -c ',failed,.*exploded as asked')" -eq 6 ] || fail "6 failed rows expected"
+[ "$(rows one.csv | grep -c ',ok,')" -eq 6 ] || fail "6 ok rows expected"
+rows one.csv | grep ',box,' | grep -q ',ok,' && fail "a run whose bomb names the box succeeded"
+# per robot: 5 robots (4 quadrotors and the box) per run that finished
+[ "$(tail -n +2 one_robots.csv | wc -l)" -eq 30 ] || fail "per-robot rows"
+# the summary: one line per point, runs ok failed
+[ "$(wc -l < one.summary.csv)" -eq 7 ] || fail "summary lines"
+grep -q '^1,0.1,box,2,0,2,' one.summary.csv || fail "summary of point 1"
+# the seeds differ between runs, the runs of one point differ
+[ "$(rows one.csv | cut -d, -f3 | sort -u | wc -l)" -eq 12 ] || fail "run seeds"
+
+# --- a run that takes its process down is a row too, and the sweep goes on ---
+cat > crash.xml <<XML
+<sweep scene="$data/scene.xml" seeds="2">
+  <list>
+    <parameter name="how" target="artifact[name=box]/driver@how" values="abort throw"/>
+    <parameter name="only" target="artifact[name=box]/driver@only" values="box nobody"/>
+  </list>
+  <metrics><min_distance/></metrics>
+</sweep>
+XML
+"$ssx" sweep crash.xml --plugin-path "$plugins" --out crash.csv --jobs 1
+[ "$(rows crash.csv | grep -c ',crashed,.*signal 6')" -eq 2 ] || { cat crash.csv; fail "2 crashed rows expected"; }
+[ "$(rows crash.csv | grep -c ',ok,')" -eq 2 ] || { cat crash.csv; fail "2 ok rows after the crashes expected"; }
+
+# --- resume: a file cut short after 5 rows and half a row ---
+{ head -n 7 one.csv; tail -n 1 one.csv | head -c 20; } > resumed.csv
+"$ssx" sweep "$data/small.xml" --plugin-path "$plugins" --out resumed.csv --jobs 2 > resumed.out
+cat resumed.out
+grep -q "resuming: 5 of 12 runs are in resumed.csv" resumed.out || fail "resume message"
+grep -q "ssx sweep: 7 run(s)" resumed.out || fail "resume ran 7"
+diff <(rows one.csv) <(rows resumed.csv) || fail "resumed rows differ"
+"$ssx" sweep "$data/small.xml" --plugin-path "$plugins" --out resumed.csv | grep -q "nothing to do" || fail "all done"
+# another sweep's results file is refused and left alone
+sed 's/seed="5"/seed="6"/' "$data/small.xml" > other.xml
+sed -i "s|scene=\"scene.xml\"|scene=\"$data/scene.xml\"|" other.xml
+cp resumed.csv before.csv
+set +e
+"$ssx" sweep other.xml --plugin-path "$plugins" --out resumed.csv > other.out 2>&1
+status=$?
+set -e
+[ "$status" -eq 2 ] && grep -q "holds the results of another sweep" other.out || { cat other.out; fail "another sweep's file"; }
+cmp -s before.csv resumed.csv || fail "another sweep's file was changed"
+
+# --- under mpirun: rank 0 hands out runs, the same rows ---
+if [ "$expect_mpi" = ON ]; then
+  export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 OMPI_MCA_rmaps_base_oversubscribe=1
+  mpirun --oversubscribe -np 3 "$ssx" sweep "$data/small.xml" --plugin-path "$plugins" --out mpi.csv
+  diff <(rows one.csv) <(rows mpi.csv) || fail "mpirun -np 3 differs from --jobs 1"
+else
+  echo "ssx was built without MPI: the mpirun part is skipped"
+fi
+echo "sweep tests passed"
