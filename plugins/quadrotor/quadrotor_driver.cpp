@@ -33,6 +33,7 @@ RotorParams rotorParams(const Descriptor& params) {
   override("rotor_drag_coefficient", rp.rotor_drag_coefficient);
   override("rolling_moment_coefficient", rp.rolling_moment_coefficient);
   override("rotor_inertia", rp.rotor_inertia);
+  override("rotor_radius", rp.rotor_radius);
   if (rp.min_rotor_speed >= rp.max_rotor_speed) {
     std::ostringstream m;
     m << "min_rotor_speed (" << rp.min_rotor_speed << " rad/s) must be below max_rotor_speed (" << rp.max_rotor_speed
@@ -95,6 +96,15 @@ void QuadrotorDriver::configure(const Descriptor& params, PluginSetup& setup) {
   com_in_root_ = -a.root().poseInBody().position;
   rotors_.emplace(rotors, rp);
   const Allocation allocation(rotors, rp);
+  // ground effect: over the highest horizontal ground plane, if there is one
+  ground_effect_ = params.get<bool>("ground_effect");
+  ground_z_ = -std::numeric_limits<double>::infinity();
+  for (const auto& shape : env.staticShapes()) {
+    if (shape.shape.kind != Shape::Kind::Plane) continue;
+    const Pose world = shape.world * shape.shape.pose;
+    if ((world.orientation * Vec3::UnitZ()).z() > 1.0 - 1e-9) ground_z_ = std::max(ground_z_, world.position.z());
+  }
+  gains_.assign(rotors.size(), 1.0);
 
   // the loops run every k runs of the driver (whole numbers: checked while loading)
   const PluginContext context{&env, &a, periodSteps(), env.timestep(), {}};
@@ -277,7 +287,14 @@ void QuadrotorDriver::step(const StepInfo& info) {
   rotors_->step(period, commanded_speeds_);
   const BodyState s = body.state();
   const Quat to_body = s.pose.orientation.conjugate();
-  const Vec3 v_com = artifact().environment().bodyState(body.bodyIndex()).linear_velocity;
+  const BodyState& com = artifact().environment().bodyState(body.bodyIndex());
+  const Vec3 v_com = com.linear_velocity;
+  if (ground_effect_) {
+    const auto& rotors = rotors_->rotors();
+    for (std::size_t i = 0; i < rotors.size(); ++i)
+      gains_[i] = groundEffectGain(com.pose.transformPoint(rotors[i].position).z() - ground_z_, rotors_->params().rotor_radius);
+    rotors_->setThrustGains(gains_);
+  }
   Vec3 force, torque;
   rotors_->wrench(to_body * v_com, to_body * s.angular_velocity, force, torque);
   body.addForce(force, Frame::Local, com_in_root_, Frame::Local);

@@ -36,6 +36,8 @@ class QuadrotorDriver final : public Driver, public SetpointInterface, public Me
       param::real("min_rotor_speed", "", "rad/s", param::nonNegative(), "below max_rotor_speed (default: the preset's)"),
       param::real("rotor_drag_coefficient", "", "N s/m", param::nonNegative(), "rotor drag (default: the preset's)"),
       param::real("rolling_moment_coefficient", "", "N m s/m", param::nonNegative(), "rolling moment (default: the preset's)"),
+      param::real("rotor_radius", "", "m", param::positive(), "propeller radius, for ground effect (default: the preset's)"),
+      param::flag("ground_effect", "false", "thrust gain near the ground (Cheeseman-Bennett), per rotor"),
       param::real("rotor_inertia", "", "kg m^2", param::nonNegative(), "(default: the preset's)"),
       param::text("rotors", "rotor0 rotor1 rotor2 rotor3", "physic node names of the rotors (at least 4)"),
       param::text("directions", "1 -1 1 -1", "spin of each rotor: 1 counter-clockwise seen from above, -1 clockwise"),
@@ -123,6 +125,9 @@ class QuadrotorDriver final : public Driver, public SetpointInterface, public Me
   FigureEight eight_;
   double start_time_ = 0;
   double heading_kp_ = 2.0;  // 1/s, external set-points' yaw
+  bool ground_effect_ = false;
+  double ground_z_ = 0;       // the ground plane's height (-inf: none)
+  std::vector<double> gains_;  // per rotor thrust gains, handed to the rotor model
   Setpoint current_;
   const ImuMeasurement* imu_ = nullptr;
   bool imu_seen_ = false;  // a sample has arrived

@@ -17,6 +17,7 @@ std::optional<RotorParams> preset(const std::string& name) {
   RotorParams p;  // the defaults are mk_quad
   if (name == "mk_quad") return p;
   if (name == "hummingbird") {
+    p.rotor_radius = 0.1;  // 8-inch propellers (RotorS's hummingbird)
     p.thrust_coefficient = 8.54858e-6;
     p.moment_constant = 0.016;
     p.max_rotor_speed = 838.0;
@@ -26,6 +27,7 @@ std::optional<RotorParams> preset(const std::string& name) {
     p.thrust_coefficient = 1.28192e-8;
     p.moment_constant = 5.964552e-3;
     p.max_rotor_speed = 3052.0;
+    p.rotor_radius = 0.0231;  // as gym-pybullet-drones' cf2x
     p.rotor_drag_coefficient = 0.0;  // no published figure
     p.rolling_moment_coefficient = 0.0;
     return p;
@@ -49,7 +51,7 @@ Allocation::Allocation(const std::vector<Rotor>& rotors, const RotorParams& p) {
 }
 
 RotorModel::RotorModel(std::vector<Rotor> rotors, const RotorParams& params)
-    : rotors_(std::move(rotors)), params_(params), speeds_(rotors_.size(), 0.0) {}
+    : rotors_(std::move(rotors)), params_(params), speeds_(rotors_.size(), 0.0), gains_(rotors_.size(), 1.0) {}
 
 void RotorModel::step(double dt, const std::vector<double>& commanded) {
   if (dt != alpha_dt_) {  // the filter factors depend only on dt: compute them once
@@ -64,6 +66,12 @@ void RotorModel::step(double dt, const std::vector<double>& commanded) {
   }
 }
 
+double groundEffectGain(double height, double radius) {
+  const double h = std::max(height, 0.5 * radius);
+  const double r = radius / (4.0 * h);
+  return 1.0 / (1.0 - r * r);
+}
+
 void RotorModel::wrench(const Vec3& v_body, const Vec3& w_body, Vec3& force, Vec3& torque) const {
   force.setZero();
   torque.setZero();
@@ -72,7 +80,7 @@ void RotorModel::wrench(const Vec3& v_body, const Vec3& w_body, Vec3& force, Vec
   for (std::size_t i = 0; i < rotors_.size(); ++i) {
     const Rotor& r = rotors_[i];
     const double w = speeds_[i];
-    const double thrust = params_.thrust_coefficient * w * w;
+    const double thrust = params_.thrust_coefficient * w * w * gains_[i];
     // thrust and reaction torque
     const Vec3 f = thrust * z;
     torque += r.position.cross(f) + Vec3(0, 0, -r.direction * params_.moment_constant * thrust);

@@ -31,7 +31,14 @@ struct RotorParams {
   double rotor_drag_coefficient = 8.06428e-5;  ///< lambda1, N/(m/s)/(rad/s)
   double rolling_moment_coefficient = 1e-6;    ///< mu1, N m/(m/s)/(rad/s)
   double rotor_inertia = 0.0;                  ///< kg m^2; > 0 adds the rotors' gyroscopic torque
+  double rotor_radius = 0.127;                 ///< m, for ground effect (10-inch propellers; EST)
 };
+
+/// Ground effect on one rotor (Cheeseman and Bennett 1955, the form gym-pybullet-drones uses):
+/// thrust in ground effect / thrust out of it = 1 / (1 - (R / (4 h))^2) for a rotor of radius R
+/// at height h above the ground. The formula diverges at h = R/4; heights below R/2 count as R/2
+/// (a gain of at most 4/3).
+double groundEffectGain(double height, double radius);
 
 /// The named presets: "mk_quad" (default), "hummingbird", "crazyflie". Empty if unknown.
 std::optional<RotorParams> preset(const std::string& name);
@@ -69,6 +76,10 @@ class RotorModel {
   /// Force and torque on the body about its centre of mass, body frame, given the body's
   /// velocity and angular velocity in the body frame (air at rest).
   void wrench(const Vec3& velocity_body, const Vec3& angular_velocity_body, Vec3& force, Vec3& torque) const;
+  /// Each rotor's thrust (and its reaction torque) at a given speed is multiplied by its gain
+  /// (default 1): ground effect, battery voltage, downwash.
+  void setThrustGains(const std::vector<double>& gains) { gains_ = gains; }
+  const std::vector<double>& thrustGains() const { return gains_; }
   const std::vector<Rotor>& rotors() const { return rotors_; }
   const RotorParams& params() const { return params_; }
 
@@ -76,6 +87,7 @@ class RotorModel {
   std::vector<Rotor> rotors_;
   RotorParams params_;
   std::vector<double> speeds_;
+  std::vector<double> gains_;
   double alpha_dt_ = -1, alpha_up_ = 0, alpha_down_ = 0;  // exp(-dt/tau) for the last dt
 };
 

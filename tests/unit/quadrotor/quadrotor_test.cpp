@@ -7,10 +7,13 @@
 #include <catch2/catch.hpp>
 
 #include <cmath>
+#include <filesystem>
 #include <numbers>
+#include <string>
 
 using namespace ssx;
 using namespace ssx::quadrotor;
+namespace fs = std::filesystem;
 
 namespace {
 
@@ -220,4 +223,46 @@ TEST_CASE("the integer inner loop does not overflow at the largest gains", "[qua
   const Gaps g = compare(p, 50000, 2);
   CHECK(g.estimate <= 1);
   CHECK(g.command <= 1);
+}
+
+TEST_CASE("ground effect: the thrust gain at three heights is Cheeseman-Bennett's", "[quadrotor][fidelity]") {
+  const RotorParams p = *preset("mk_quad");
+  const double R = p.rotor_radius;
+  RotorModel model(plusRotors(0.225), p);
+  model.setSpeeds({400, 410, 420, 430});
+  Vec3 f0, t0;
+  model.wrench(Vec3::Zero(), Vec3::Zero(), f0, t0);
+  for (double h : {0.1, 0.2, 0.5}) {
+    const double expected = 1.0 / (1.0 - std::pow(R / (4 * h), 2));
+    CHECK(groundEffectGain(h, R) == Approx(expected).epsilon(1e-12));
+    model.setThrustGains(std::vector<double>(4, groundEffectGain(h, R)));
+    Vec3 f, t;
+    model.wrench(Vec3::Zero(), Vec3::Zero(), f, t);
+    CHECK(f.z() / f0.z() == Approx(expected).epsilon(1e-12));
+    CHECK(t.z() / t0.z() == Approx(expected).epsilon(1e-12));  // reaction torque scales with thrust
+  }
+  // far up it fades (2 m: 0.025 %), and below R/2 the gain holds at 4/3
+  CHECK(groundEffectGain(2.0, R) == Approx(1.0).margin(3e-4));
+  CHECK(groundEffectGain(0.01, R) == Approx(4.0 / 3.0).epsilon(1e-12));
+}
+
+TEST_CASE("ground effect in flight: a quadrotor low over the ground gets the gain of its rotors' height",
+          "[quadrotor][fidelity]") {
+  // from hover speed; the difference in vertical acceleration with and without the effect
+  // is (gain - 1) times the thrust, about m g
+  const double R = preset("mk_quad")->rotor_radius;
+  for (double h : {0.15, 0.25, 0.5}) {  // rotor height; the rotors sit 2 cm above the body's origin
+    double accel[2];
+    for (int on = 0; on < 2; ++on) {
+      const std::string xml = "<scene><environment timestep=\"0.002\" seed=\"1\"/><type name=\"q\" file=\"mk_quad.xml\"/>"
+                              "<ground/><artifact name=\"q\" type=\"q\" xyz=\"0 0 " + std::to_string(h - 0.02) +
+                              "\"><driver ground_effect=\"" + (on ? "true" : "false") + "\"/></artifact></scene>";
+      Scene scene = loadSceneFromString(xml, "ground_effect.xml", fs::path(SSX_EXAMPLES_DIR) / "artifacts");
+      scene.environment->step(2);  // the driver's first forces act in the second step's physics
+      accel[on] = scene.environment->findArtifact("q")->state().linear_acceleration.z();
+    }
+    const double gain = 1.0 / (1.0 - std::pow(R / (4 * h), 2));
+    INFO("h = " << h << " m: gain " << gain);
+    CHECK(accel[1] - accel[0] == Approx((gain - 1) * 9.81).epsilon(0.02));
+  }
 }
