@@ -135,10 +135,11 @@ void QuadrotorDriver::configure(const Descriptor& params, PluginSetup& setup) {
   ip.filter_gyro_weight = params.get<double>("filter_gyro_weight");
   ip.gravity = -env.settings().physics.gravity.z();
   ip.inertia = mass.inertia;
+  if (params.has("controller_inertia")) ip.inertia = params.get<Vec3>("controller_inertia").asDiagonal();
   ip.min_rotor_speed = rp.min_rotor_speed;
   ip.max_rotor_speed = rp.max_rotor_speed;
   Eigen::Matrix4d scale = Eigen::Matrix4d::Identity();
-  scale.topLeftCorner<3, 3>() = mass.inertia;
+  scale.topLeftCorner<3, 3>() = ip.inertia;
   ip.mixer = allocation.inverse() * scale;
   ip.max_thrust = allocation.matrix().row(3).sum() * rp.max_rotor_speed * rp.max_rotor_speed;
   // the IMU's LSBs are known once it has been configured (it comes first in the artifact)
@@ -158,6 +159,31 @@ void QuadrotorDriver::configure(const Descriptor& params, PluginSetup& setup) {
   pp.max_thrust = params.get<double>("max_thrust", 0.95 * ip.max_thrust);
   pp.min_thrust = 0.05 * pp.max_thrust;
   outer_.emplace(pp);
+  controller_mass_ = pp.mass;
+  thrust_estimator_ = params.get<bool>("thrust_estimator");
+  estimator_tau_ = params.get<double>("thrust_estimator_time_constant");
+  command_link_ = params.get<bool>("command_link");
+  angle_step_ = params.get<double>("command_angle_step_deg") * std::numbers::pi / 180.0;
+  {
+    const double ticks = params.get<double>("command_delay") / ip.dt;
+    if (std::abs(ticks - std::round(ticks)) > 1e-6)
+      throw params.errorAt("command_delay", "command_delay must be a whole number of inner-loop periods (" +
+                                                std::to_string(ip.dt * 1e3) + " ms)");
+    command_queue_.assign(static_cast<std::size_t>(std::llround(ticks)) + 1, InnerCommand{});
+  }
+  if (params.get<bool>("battery")) {
+    BatteryParams bp;
+    bp.full_voltage = params.get<double>("battery_full_voltage");
+    bp.empty_voltage = params.get<double>("battery_empty_voltage");
+    bp.capacity = params.get<double>("battery_capacity");
+    bp.resistance = params.get<double>("battery_resistance");
+    bp.efficiency = params.get<double>("battery_efficiency");
+    bp.initial_charge = params.get<double>("battery_initial_charge");
+    bp.nominal_voltage = params.get<double>("battery_nominal_voltage");
+    if (!(bp.empty_voltage < bp.full_voltage) || !(bp.nominal_voltage > bp.zero_thrust_voltage))
+      throw params.error("battery: needs battery_empty_voltage < battery_full_voltage and battery_nominal_voltage > 7.575 V");
+    battery_.emplace(bp);
+  }
 
   // reference source
   const Vec3 start = a.placement().position;
@@ -216,6 +242,8 @@ void QuadrotorDriver::configure(const Descriptor& params, PluginSetup& setup) {
     commanded_speeds_.assign(rotors.size(), hover);
     command_.thrust_q16 = static_cast<std::int32_t>(std::llround(mass.mass * ip.gravity * 65536.0));
   }
+  // before the first delayed command arrives, the inner loop has the initial one
+  std::fill(command_queue_.begin(), command_queue_.end(), command_);
 }
 
 Setpoint QuadrotorDriver::reference(double t) const {
@@ -272,6 +300,18 @@ void QuadrotorDriver::step(const StepInfo& info) {
     // rate (the other references command a yaw rate only, as the TeleKyb controller does)
     if (source_ == Source::External)
       attitude_.yaw_rate += heading_kp_ * std::remainder(current_.yaw - yaw, 2.0 * std::numbers::pi);
+    // the online thrust estimator: the specific force the IMU reads along z against what the
+    // commanded thrust should give the mass the controller believes; the command is divided by it
+    if (thrust_estimator_) {
+      const double expected = static_cast<double>(command_.thrust_q16) / 65536.0 / controller_mass_;
+      if (expected > 0.2 * -environment().settings().physics.gravity.z() && imu_seen_)
+        thrust_ratio_ += outer_dt_ / estimator_tau_ * (imu_->accelerometer.z() / expected - thrust_ratio_);
+      thrust_ratio_ = std::clamp(thrust_ratio_, 0.5, 2.0);
+      attitude_.thrust /= thrust_ratio_;
+    }
+    // the serial link: thrust in 8 bits of m g / 128 (255: 2 m g), angles in whole steps
+    if (command_link_)
+      attitude_ = linkCommand(attitude_, controller_mass_, -environment().settings().physics.gravity.z(), angle_step_);
     // handed to the inner loop as integers
     command_.roll_q12 = static_cast<std::int32_t>(std::llround(attitude_.roll * 4096.0));
     command_.pitch_q12 = static_cast<std::int32_t>(std::llround(attitude_.pitch * 4096.0));
@@ -280,7 +320,11 @@ void QuadrotorDriver::step(const StepInfo& info) {
   }
   // inner loop: IMU counts to motor commands
   if (run % inner_runs_ == 0 && imu_seen_) {
-    const InnerOutput out = inner_->step(imu_->gyroscope_counts, imu_->accelerometer_counts, command_);
+    // the command as it arrives: command_delay late (the queue holds that many inner-loop ticks)
+    command_queue_[queue_at_] = command_;
+    queue_at_ = (queue_at_ + 1) % command_queue_.size();
+    const InnerCommand& arrived = command_queue_.size() == 1 ? command_ : command_queue_[queue_at_];
+    const InnerOutput out = inner_->step(imu_->gyroscope_counts, imu_->accelerometer_counts, arrived);
     for (std::size_t i = 0; i < out.motors; ++i) commanded_speeds_[i] = inner_->commandToSpeed(out.motor_commands[i]);
   }
   // motors and aerodynamics, applied at the centre of mass in body axes
@@ -289,10 +333,24 @@ void QuadrotorDriver::step(const StepInfo& info) {
   const Quat to_body = s.pose.orientation.conjugate();
   const BodyState& com = artifact().environment().bodyState(body.bodyIndex());
   const Vec3 v_com = com.linear_velocity;
-  if (ground_effect_) {
+  if (ground_effect_ || battery_) {
     const auto& rotors = rotors_->rotors();
+    const RotorParams& rp = rotors_->params();
+    double battery_gain = 1.0;
+    if (battery_) {
+      // the power the rotors take at the last gains: torque times speed
+      double power = 0;
+      for (std::size_t i = 0; i < rotors.size(); ++i) {
+        const double w = std::abs(rotors_->speeds()[i]);
+        power += rp.moment_constant * rp.thrust_coefficient * w * w * gains_[i] * w;
+      }
+      battery_->step(period, power);
+      battery_gain = battery_->thrustGain();
+    }
     for (std::size_t i = 0; i < rotors.size(); ++i)
-      gains_[i] = groundEffectGain(com.pose.transformPoint(rotors[i].position).z() - ground_z_, rotors_->params().rotor_radius);
+      gains_[i] = battery_gain * (ground_effect_ ? groundEffectGain(com.pose.transformPoint(rotors[i].position).z() -
+                                                                        ground_z_, rp.rotor_radius)
+                                                 : 1.0);
     rotors_->setThrustGains(gains_);
   }
   Vec3 force, torque;
@@ -419,6 +477,12 @@ void QuadrotorDriver::saveState(StateWriter& out) const {
   ssx::save(out, seen_);
   out.write(imu_seen_);
   ssx::save(out, pose_);
+  out.write(gains_);
+  out.write(thrust_ratio_);
+  out.write(command_queue_);
+  out.write(static_cast<std::uint64_t>(queue_at_));
+  out.write(battery_ ? battery_->charge() : 0.0);
+  out.write(battery_ ? battery_->voltage() : 0.0);
 }
 
 void QuadrotorDriver::loadState(StateReader& in) {
@@ -448,6 +512,21 @@ void QuadrotorDriver::loadState(StateReader& in) {
   ssx::load(in, seen_);
   in.read(imu_seen_);
   ssx::load(in, pose_);
+  std::vector<double> gains;
+  in.read(gains);
+  if (gains.size() != gains_.size()) throw StateError("quadrotor: the saved thrust gains do not fit this driver");
+  gains_ = gains;
+  rotors_->setThrustGains(gains_);
+  in.read(thrust_ratio_);
+  std::vector<InnerCommand> queue;
+  in.read(queue);
+  const auto at = static_cast<std::size_t>(in.get<std::uint64_t>());
+  if (queue.size() != command_queue_.size() || at >= queue.size())
+    throw StateError("quadrotor: the saved command delay does not fit this driver");
+  command_queue_ = queue;
+  queue_at_ = at;
+  const double charge = in.get<double>(), voltage = in.get<double>();
+  if (battery_) battery_->setState(charge, voltage);
 }
 
 }  // namespace ssx::quadrotor

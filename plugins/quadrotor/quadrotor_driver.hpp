@@ -38,6 +38,25 @@ class QuadrotorDriver final : public Driver, public SetpointInterface, public Me
       param::real("rolling_moment_coefficient", "", "N m s/m", param::nonNegative(), "rolling moment (default: the preset's)"),
       param::real("rotor_radius", "", "m", param::positive(), "propeller radius, for ground effect (default: the preset's)"),
       param::flag("ground_effect", "false", "thrust gain near the ground (Cheeseman-Bennett), per rotor"),
+      param::flag("battery", "false", "a battery whose voltage sags with current and charge drawn; thrust at a fixed command follows it"),
+      param::real("battery_full_voltage", "16.8", "V", param::positive(), "open circuit when full"),
+      param::real("battery_empty_voltage", "14", "V", param::positive(), "open circuit when the capacity is drawn (EST)"),
+      param::real("battery_capacity", "2.2", "Ah", param::positive(), "capacity (EST)"),
+      param::real("battery_resistance", "0.04", "ohm", param::nonNegative(), "internal resistance (EST)"),
+      param::real("battery_efficiency", "0.6", "", param::positive() & param::atMost(1), "mechanical / electrical power (EST)"),
+      param::real("battery_initial_charge", "1", "", param::nonNegative() & param::atMost(1), "fraction of the capacity at the start"),
+      param::real("battery_nominal_voltage", "15.5", "V", param::positive(), "voltage at which the rotor model's thrust holds (MK law)"),
+      param::flag("thrust_estimator", "false",
+                  "the controller estimates thrust per command online (from the accelerometer) and corrects for it"),
+      param::real("thrust_estimator_time_constant", "1", "s", param::positive(), "its low-pass time constant"),
+      param::flag("command_link", "false",
+                  "the inner loop gets commands as over the MK serial link: 8-bit thrust in steps of m g / 128, angles in steps"),
+      param::real("command_angle_step_deg", "0.5", "deg", param::positive() & param::atMost(10),
+                  "roll and pitch step on the link (EST)"),
+      param::real("command_delay", "0", "s", param::nonNegative() & param::atMost(1),
+                  "the outer loop's commands reach the inner loop this late (a whole number of inner-loop periods)"),
+      param::vec3("controller_inertia", "", "kg m^2", param::positive(),
+                  "diagonal inertia the inner loop assumes (default: the model's)"),
       param::real("rotor_inertia", "", "kg m^2", param::nonNegative(), "(default: the preset's)"),
       param::text("rotors", "rotor0 rotor1 rotor2 rotor3", "physic node names of the rotors (at least 4)"),
       param::text("directions", "1 -1 1 -1", "spin of each rotor: 1 counter-clockwise seen from above, -1 clockwise"),
@@ -126,6 +145,14 @@ class QuadrotorDriver final : public Driver, public SetpointInterface, public Me
   double start_time_ = 0;
   double heading_kp_ = 2.0;  // 1/s, external set-points' yaw
   bool ground_effect_ = false;
+  std::optional<Battery> battery_;
+  bool thrust_estimator_ = false;
+  double estimator_tau_ = 1.0, thrust_ratio_ = 1.0;  // estimated actual / expected thrust per command
+  double controller_mass_ = 0;
+  bool command_link_ = false;
+  double angle_step_ = 0;                   // rad
+  std::vector<InnerCommand> command_queue_;  // a ring: the commands of the last command_delay
+  std::size_t queue_at_ = 0;
   double ground_z_ = 0;       // the ground plane's height (-inf: none)
   std::vector<double> gains_;  // per rotor thrust gains, handed to the rotor model
   Setpoint current_;

@@ -66,6 +66,16 @@ void RotorModel::step(double dt, const std::vector<double>& commanded) {
   }
 }
 
+void Battery::step(double dt, double mechanical_power) {
+  const double electrical = std::max(0.0, mechanical_power) / p_.efficiency;
+  const double u_oc = openCircuit();
+  const double disc = u_oc * u_oc - 4.0 * p_.resistance * electrical;
+  // past the pack's largest power the voltage is the one at that power, half the open circuit
+  voltage_ = disc > 0 ? 0.5 * (u_oc + std::sqrt(disc)) : 0.5 * u_oc;
+  const double current = electrical / voltage_;
+  charge_ = std::max(0.0, charge_ - current * dt / (3600.0 * p_.capacity));
+}
+
 double groundEffectGain(double height, double radius) {
   const double h = std::max(height, 0.5 * radius);
   const double r = radius / (4.0 * h);
@@ -282,6 +292,14 @@ InnerOutput innerLoopFloat(const InnerLoopParams& p, const AttitudeEstimate& pri
     out.motor_commands[out.motors++] = static_cast<std::uint8_t>(std::clamp(cmd, 0.0, 255.0));
   }
   return out;
+}
+
+AttitudeCommand linkCommand(AttitudeCommand c, double mass, double gravity, double angle_step) {
+  const double unit = mass * gravity / 128.0;
+  c.thrust = std::clamp(std::round(c.thrust / unit), 0.0, 255.0) * unit;
+  c.roll = std::round(c.roll / angle_step) * angle_step;
+  c.pitch = std::round(c.pitch / angle_step) * angle_step;
+  return c;
 }
 
 // --- outer loop --------------------------------------------------------------------------------

@@ -40,6 +40,47 @@ struct RotorParams {
 /// (a gain of at most 4/3).
 double groundEffectGain(double height, double radius);
 
+/// A battery pack: its open-circuit voltage falls linearly with the charge drawn, an internal
+/// resistance sags it under load, and the thrust of a rotor at a fixed command follows the
+/// MikroKopter law F proportional to (U - 7.575 V), equal to the model's at the nominal voltage.
+/// Values marked EST are guesses for a 4S 2200 mAh pack (no published figure for the MK's).
+struct BatteryParams {
+  double full_voltage = 16.8;          ///< V, open circuit when full (4S LiPo, 4.2 V a cell)
+  double empty_voltage = 14.0;         ///< V, open circuit when the capacity is drawn (EST, 3.5 V a cell)
+  double capacity = 2.2;               ///< Ah (EST)
+  double resistance = 0.04;            ///< ohm, internal (EST)
+  double efficiency = 0.6;             ///< mechanical / electrical power of motors and controllers (EST)
+  double nominal_voltage = 15.5;       ///< V: thrust gain 1 (the MK law's reference)
+  double zero_thrust_voltage = 7.575;  ///< V: the MK law's offset
+  double initial_charge = 1.0;         ///< fraction of the capacity at the start
+};
+
+class Battery {
+ public:
+  explicit Battery(const BatteryParams& p) : p_(p), charge_(p.initial_charge), voltage_(openCircuit()) {}
+  /// Thrust at a fixed command relative to the nominal voltage's: (U - U0) / (U_nom - U0).
+  double thrustGain(double voltage) const {
+    return (voltage - p_.zero_thrust_voltage) / (p_.nominal_voltage - p_.zero_thrust_voltage);
+  }
+  double thrustGain() const { return thrustGain(voltage_); }
+  /// The open-circuit voltage at the charge left.
+  double openCircuit() const { return p_.empty_voltage + (p_.full_voltage - p_.empty_voltage) * charge_; }
+  /// Delivers `mechanical_power` W for dt s: the terminal voltage U solves U = U_oc - R P / (eta U);
+  /// the charge drops by the current times dt.
+  void step(double dt, double mechanical_power);
+  double voltage() const { return voltage_; }
+  double charge() const { return charge_; }
+  void setState(double charge, double voltage) {
+    charge_ = charge;
+    voltage_ = voltage;
+  }
+  const BatteryParams& params() const { return p_; }
+
+ private:
+  BatteryParams p_;
+  double charge_, voltage_;
+};
+
 /// The named presets: "mk_quad" (default), "hummingbird", "crazyflie". Empty if unknown.
 std::optional<RotorParams> preset(const std::string& name);
 
@@ -192,6 +233,10 @@ struct PositionParams {
 struct AttitudeCommand {
   double roll = 0, pitch = 0, yaw_rate = 0, thrust = 0;
 };
+
+/// A command as the MK serial link carries it: thrust in 8 bits of `mass` g / 128 (so 255 is about
+/// 2 m g), roll and pitch rounded to whole `angle_step`s (rad); the yaw rate passes.
+AttitudeCommand linkCommand(AttitudeCommand c, double mass, double gravity, double angle_step);
 
 /// The outer loop: position and velocity errors to thrust and attitude (ENU, z up).
 class PositionController {

@@ -266,3 +266,111 @@ TEST_CASE("ground effect in flight: a quadrotor low over the ground gets the gai
     CHECK(accel[1] - accel[0] == Approx((gain - 1) * 9.81).epsilon(0.02));
   }
 }
+
+TEST_CASE("battery: thrust at a fixed command follows (U - 7.575 V); the voltage sags with current", "[quadrotor][fidelity]") {
+  BatteryParams bp;
+  Battery battery(bp);
+  RotorModel model(plusRotors(0.225), *preset("mk_quad"));
+  model.setSpeeds({500, 500, 500, 500});
+  auto thrustAt = [&](double volts) {
+    model.setThrustGains(std::vector<double>(4, battery.thrustGain(volts)));
+    Vec3 f, t;
+    model.wrench(Vec3::Zero(), Vec3::Zero(), f, t);
+    return f.z();
+  };
+  CHECK(thrustAt(16.0) / thrustAt(14.5) == Approx((16.0 - 7.575) / (14.5 - 7.575)).epsilon(1e-9));
+  CHECK(battery.thrustGain(15.5) == 1.0);
+  // under load: U = U_oc - R P / (eta U), and the charge drops by I dt / C
+  CHECK(battery.voltage() == 16.8);
+  const double power = 120.0;  // W of mechanical power, about what an mk_quad takes to hover (EST)
+  battery.step(10.0, power);
+  const double u = battery.voltage();
+  CHECK(u == Approx(16.8 - bp.resistance * power / (bp.efficiency * u)).epsilon(1e-12));
+  CHECK(battery.charge() == Approx(1.0 - power / bp.efficiency / u * 10.0 / (3600.0 * bp.capacity)).epsilon(1e-12));
+  CHECK(battery.openCircuit() < 16.8);
+}
+
+TEST_CASE("the MK serial link: thrust in steps of m g / 128 up to 255, angles in whole steps", "[quadrotor][fidelity]") {
+  const double m = 0.82, g = 9.81, unit = m * g / 128, step = 0.5 * std::numbers::pi / 180;
+  const AttitudeCommand c = linkCommand({0.0123, -0.0311, 0.7, 8.1234}, m, g, step);
+  CHECK(c.thrust == Approx(std::round(8.1234 / unit) * unit).epsilon(1e-15));
+  CHECK(c.roll == Approx(std::round(0.0123 / step) * step).epsilon(1e-15));
+  CHECK(c.pitch == Approx(std::round(-0.0311 / step) * step).epsilon(1e-15));
+  CHECK(c.yaw_rate == 0.7);
+  CHECK(linkCommand({0, 0, 0, 100.0}, m, g, step).thrust == Approx(255 * unit));
+  CHECK(linkCommand({0, 0, 0, -1.0}, m, g, step).thrust == 0.0);
+}
+
+namespace {
+
+// hovers one mk_quad 1 m up for `seconds` with the driver attributes given; returns the mean
+// height error (set-point minus position) over the last 2 s
+double hoverError(const std::string& driver_attributes, double seconds) {
+  const std::string xml = "<scene><environment timestep=\"0.002\" seed=\"3\"/><type name=\"q\" file=\"mk_quad.xml\"/>"
+                          "<ground/><artifact name=\"q\" type=\"q\" xyz=\"0 0 1\"><driver " + driver_attributes +
+                          "/></artifact></scene>";
+  Scene scene = loadSceneFromString(xml, "hover.xml", fs::path(SSX_EXAMPLES_DIR) / "artifacts");
+  Environment& env = *scene.environment;
+  const Artifact& q = *env.findArtifact("q");
+  const auto steps = static_cast<int>(seconds / 0.002);
+  double sum = 0;
+  int n = 0;
+  for (int k = 0; k < steps; ++k) {
+    env.step();
+    if (k >= steps - 1000) sum += 1.0 - q.pose().position.z(), ++n;
+  }
+  return sum / n;
+}
+
+}  // namespace
+
+TEST_CASE("mass mismatch: hover offset eps g / Kp with the thrust estimator off, back under 5 mm with it on",
+          "[quadrotor][fidelity]") {
+  // the vehicle is 5 % heavier than the controller believes: eps = m / m_c - 1 = 0.05; no integral
+  // on z (position_ki "4.5 4.5 0"), position_kp 9
+  const std::string mismatch = "controller_mass=\"" + std::to_string(0.82 / 1.05) + "\"";
+  const double expected = 0.05 * 9.81 / 9.0;
+  // measured from the matched vehicle's own offset (its 8-bit motor commands leave one of a few mm)
+  const double matched = hoverError("", 12.0);
+  const double off = hoverError(mismatch, 12.0) - matched;
+  INFO("offset " << off << " m beyond the matched vehicle's " << matched << " m, expected " << expected << " m");
+  CHECK(off == Approx(expected).epsilon(0.05));
+  const double on = hoverError(mismatch + " thrust_estimator=\"true\"", 20.0);
+  INFO("with the estimator: " << on << " m");
+  CHECK(std::abs(on) < 0.005);
+  // a battery that sags is what the estimator is also for
+  CHECK(std::abs(hoverError("battery=\"true\" thrust_estimator=\"true\"", 20.0)) < 0.005);
+}
+
+TEST_CASE("command delay: the vehicle answers a set-point step `command_delay` later, within one inner-loop period",
+          "[quadrotor][fidelity]") {
+  // when does the attitude of a run whose set-point steps at 1 s first differ from one whose does not?
+  auto divergence = [](const std::string& delay) {
+    std::vector<std::vector<Quat>> attitude(2);
+    for (int stepped = 0; stepped < 2; ++stepped) {
+      const std::string xml = "<scene><environment timestep=\"0.002\" seed=\"3\"/><type name=\"q\" file=\"mk_quad.xml\"/>"
+                              "<artifact name=\"q\" type=\"q\" xyz=\"0 0 1\"><driver reference=\"external\" "
+                              "command_delay=\"" + delay + "\"/></artifact></scene>";
+      Scene scene = loadSceneFromString(xml, "delay.xml", fs::path(SSX_EXAMPLES_DIR) / "artifacts");
+      Environment& env = *scene.environment;
+      Artifact& q = *env.findArtifact("q");
+      env.start();
+      for (int k = 0; k < 1000; ++k) {
+        if (k == 500 && stepped == 1) {
+          Setpoint sp;
+          sp.position = Vec3(0.5, 0, 1);
+          dynamic_cast<SetpointInterface*>(q.driver())->setSetpoint(sp);
+        }
+        env.step();
+        attitude[static_cast<std::size_t>(stepped)].push_back(q.pose().orientation);
+      }
+    }
+    for (std::size_t k = 0; k < attitude[0].size(); ++k)
+      if (!attitude[0][k].isApprox(attitude[1][k], 1e-12)) return static_cast<double>(k) * 0.002;
+    return -1.0;
+  };
+  const double now = divergence("0"), late = divergence("0.012");
+  INFO("the attitude answers at " << now << " s without delay, " << late << " s with 12 ms");
+  REQUIRE(now > 0);
+  CHECK(std::abs((late - now) - 0.012) <= 0.002 + 1e-9);
+}
