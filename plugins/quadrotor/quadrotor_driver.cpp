@@ -105,6 +105,19 @@ void QuadrotorDriver::configure(const Descriptor& params, PluginSetup& setup) {
     if ((world.orientation * Vec3::UnitZ()).z() > 1.0 - 1e-9) ground_z_ = std::max(ground_z_, world.position.z());
   }
   gains_.assign(rotors.size(), 1.0);
+  // the air: mean wind, one gust, Dryden turbulence
+  wind_ = params.get<Vec3>("wind");
+  gust_ = params.get<Vec3>("gust");
+  gust_start_ = params.get<double>("gust_start");
+  gust_duration_ = params.get<double>("gust_duration");
+  turbulence_w20_ = params.get<double>("turbulence_w20");
+  min_airspeed_ = params.get<double>("turbulence_min_airspeed");
+  downwash_ = params.get<bool>("downwash");
+  downwash_c_[0] = params.get<double>("downwash_c1");
+  downwash_c_[1] = params.get<double>("downwash_c2");
+  downwash_c_[2] = params.get<double>("downwash_c3");
+  downwash_range_ = params.get<double>("downwash_range");
+  if (downwash_) setup.enableNeighborQueries(downwash_range_);
 
   // the loops run every k runs of the driver (whole numbers: checked while loading)
   const PluginContext context{&env, &a, periodSteps(), env.timestep(), {}};
@@ -332,7 +345,39 @@ void QuadrotorDriver::step(const StepInfo& info) {
   const BodyState s = body.state();
   const Quat to_body = s.pose.orientation.conjugate();
   const BodyState& com = artifact().environment().bodyState(body.bodyIndex());
-  const Vec3 v_com = com.linear_velocity;
+  Vec3 v_com = com.linear_velocity;
+  // the body moves relative to the air: mean wind, the gust, the turbulence
+  if (!wind_.isZero() || !gust_.isZero() || turbulence_w20_ > 0) {
+    Vec3 air = wind_;
+    const double tg = toSeconds(info.time) - gust_start_;
+    if (tg >= 0 && tg <= gust_duration_) air += 0.5 * (1.0 - std::cos(2.0 * std::numbers::pi * tg / gust_duration_)) * gust_;
+    if (turbulence_w20_ > 0) {
+      const double height = com.pose.position.z() - (std::isfinite(ground_z_) ? ground_z_ : 0.0);
+      const auto scales = DrydenTurbulence::scales(height, turbulence_w20_);
+      const double airspeed = std::max((v_com - wind_).norm(), min_airspeed_);
+      const Vec3 uvw = turbulence_.step(period, scales, airspeed, random());
+      // u along the mean wind's horizontal direction (x without one), w up
+      const Vec3 flat(wind_.x(), wind_.y(), 0);
+      const Vec3 along = flat.norm() > 1e-9 ? Vec3(flat.normalized()) : Vec3(Vec3::UnitX());
+      air += uvw.x() * along + uvw.y() * Vec3::UnitZ().cross(along) + uvw.z() * Vec3::UnitZ();
+    }
+    v_com -= air;
+  }
+  // robots above push this one down
+  if (downwash_) {
+    const Vec3 here = artifact().pose().position;
+    artifact().environment().neighbors(here, downwash_range_, above_);
+    double push = 0;
+    for (const auto& hit : above_) {
+      if (hit.id == artifact().index()) continue;
+      // rotorcraft only (reading what another artifact's driver is, not its state)
+      if (dynamic_cast<const QuadrotorDriver*>(environment().artifact(hit.id).driver()) == nullptr) continue;
+      const Vec3 d = hit.point - here;
+      push += downwashForce(d.z(), d.head<2>().norm(), rotors_->params().rotor_radius, downwash_c_[0], downwash_c_[1],
+                            downwash_c_[2]);
+    }
+    if (push != 0) body.addForce(Vec3(0, 0, push), Frame::World, com_in_root_, Frame::Local);
+  }
   if (ground_effect_ || battery_) {
     const auto& rotors = rotors_->rotors();
     const RotorParams& rp = rotors_->params();
@@ -483,6 +528,7 @@ void QuadrotorDriver::saveState(StateWriter& out) const {
   out.write(static_cast<std::uint64_t>(queue_at_));
   out.write(battery_ ? battery_->charge() : 0.0);
   out.write(battery_ ? battery_->voltage() : 0.0);
+  out.write(turbulence_.state());
 }
 
 void QuadrotorDriver::loadState(StateReader& in) {
@@ -527,6 +573,7 @@ void QuadrotorDriver::loadState(StateReader& in) {
   queue_at_ = at;
   const double charge = in.get<double>(), voltage = in.get<double>();
   if (battery_) battery_->setState(charge, voltage);
+  turbulence_.setState(in.get<std::array<double, 5>>());
 }
 
 }  // namespace ssx::quadrotor

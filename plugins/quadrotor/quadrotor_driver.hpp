@@ -55,6 +55,19 @@ class QuadrotorDriver final : public Driver, public SetpointInterface, public Me
                   "roll and pitch step on the link (EST)"),
       param::real("command_delay", "0", "s", param::nonNegative() & param::atMost(1),
                   "the outer loop's commands reach the inner loop this late (a whole number of inner-loop periods)"),
+      param::vec3("wind", "0 0 0", "m/s", param::any(), "mean wind, world frame"),
+      param::real("turbulence_w20", "0", "m/s", param::nonNegative() & param::atMost(50),
+                  "Dryden turbulence (MIL-F-8785C): the wind speed at 20 ft it is scaled by (0: none; light 7.7, moderate 15.4)"),
+      param::real("turbulence_min_airspeed", "1", "m/s", param::positive(),
+                  "the airspeed the turbulence's length scales are travelled at, at least (frozen turbulence; EST)"),
+      param::vec3("gust", "0 0 0", "m/s", param::any(), "amplitude of one 1-cosine gust, world frame"),
+      param::real("gust_start", "0", "s", param::nonNegative(), "when the gust begins"),
+      param::real("gust_duration", "1", "s", param::positive(), "how long it lasts (rises and falls)"),
+      param::flag("downwash", "false", "robots above push this one down (gym-pybullet-drones' model)"),
+      param::real("downwash_c1", "2267.18", "N", param::positive(), "model coefficient (fitted on Crazyflies)"),
+      param::real("downwash_c2", "0.16", "", param::any(), "model coefficient (fitted on Crazyflies)"),
+      param::real("downwash_c3", "-0.11", "m", param::any(), "model coefficient (fitted on Crazyflies)"),
+      param::real("downwash_range", "3", "m", param::positive(), "robots farther than this are not looked at"),
       param::vec3("controller_inertia", "", "kg m^2", param::positive(),
                   "diagonal inertia the inner loop assumes (default: the model's)"),
       param::real("rotor_inertia", "", "kg m^2", param::nonNegative(), "(default: the preset's)"),
@@ -153,6 +166,13 @@ class QuadrotorDriver final : public Driver, public SetpointInterface, public Me
   double angle_step_ = 0;                   // rad
   std::vector<InnerCommand> command_queue_;  // a ring: the commands of the last command_delay
   std::size_t queue_at_ = 0;
+  Vec3 wind_ = Vec3::Zero(), gust_ = Vec3::Zero();
+  double gust_start_ = 0, gust_duration_ = 1;
+  double turbulence_w20_ = 0, min_airspeed_ = 1;
+  DrydenTurbulence turbulence_;
+  bool downwash_ = false;
+  double downwash_c_[3] = {0, 0, 0}, downwash_range_ = 3;
+  std::vector<SpatialIndex::Hit> above_;  // neighbours, reused
   double ground_z_ = 0;       // the ground plane's height (-inf: none)
   std::vector<double> gains_;  // per rotor thrust gains, handed to the rotor model
   Setpoint current_;

@@ -1,5 +1,7 @@
 #include "quadrotor_model.hpp"
 
+#include <unsupported/Eigen/MatrixFunctions>
+
 #include "fixed_point.hpp"
 
 #include <Eigen/QR>
@@ -74,6 +76,83 @@ void Battery::step(double dt, double mechanical_power) {
   voltage_ = disc > 0 ? 0.5 * (u_oc + std::sqrt(disc)) : 0.5 * u_oc;
   const double current = electrical / voltage_;
   charge_ = std::max(0.0, charge_ - current * dt / (3600.0 * p_.capacity));
+}
+
+double downwashForce(double dz, double dxy, double rotor_radius, double c1, double c2, double c3) {
+  if (dz <= 0) return 0.0;
+  const double alpha = c1 * std::pow(rotor_radius / (4.0 * dz), 2);
+  const double beta = c2 * dz + c3;
+  return -alpha * std::exp(-0.5 * std::pow(dxy / beta, 2));
+}
+
+DrydenTurbulence::Scales DrydenTurbulence::scales(double height, double w20) {
+  const double h = std::clamp(height / 0.3048, 10.0, 1000.0);  // ft
+  const double k = 0.177 + 0.000823 * h;
+  Scales s;
+  s.sigma_w = 0.1 * w20;
+  s.sigma_u = s.sigma_v = s.sigma_w / std::pow(k, 0.4);
+  s.length_w = h * 0.3048;
+  s.length_u = s.length_v = h / std::pow(k, 1.2) * 0.3048;
+  return s;
+}
+
+double DrydenTurbulence::spectrum(int axis, double omega, const Scales& s, double airspeed) {
+  const double sigma = axis == 0 ? s.sigma_u : axis == 1 ? s.sigma_v : s.sigma_w;
+  const double length = axis == 0 ? s.length_u : axis == 1 ? s.length_v : s.length_w;
+  const double x = length * omega / airspeed;
+  if (axis == 0) return sigma * sigma * 2.0 * length / (std::numbers::pi * airspeed) / (1.0 + x * x);
+  return sigma * sigma * length / (std::numbers::pi * airspeed) * (1.0 + 3.0 * x * x) / std::pow(1.0 + x * x, 2);
+}
+
+namespace {
+
+// x' = A x + B n, n white with intensity 1. The exact discretisation over dt (Van Loan):
+// x_k+1 = F x_k + L e_k, L L^T the covariance the noise adds over dt, e_k standard normal.
+void discretise(const Eigen::Matrix2d& A, const Eigen::Vector2d& B, double dt, Eigen::Matrix2d& F, Eigen::Matrix2d& L) {
+  Eigen::Matrix4d M = Eigen::Matrix4d::Zero();
+  M.topLeftCorner<2, 2>() = -A * dt;
+  M.topRightCorner<2, 2>() = B * B.transpose() * dt;
+  M.bottomRightCorner<2, 2>() = A.transpose() * dt;
+  const Eigen::Matrix4d E = M.exp();
+  F = E.bottomRightCorner<2, 2>().transpose();
+  Eigen::Matrix2d Q = F * E.topRightCorner<2, 2>();
+  Q = 0.5 * (Q + Q.transpose());
+  L = Q.llt().matrixL();
+}
+
+}  // namespace
+
+Vec3 DrydenTurbulence::step(double dt, const Scales& s, double airspeed, ssx::Random& random) {
+  Vec3 out;
+  // u: H(s) = K / (1 + T s), K^2 = 2 sigma^2 T (unit-intensity noise), T = L / V
+  {
+    const double T = s.length_u / airspeed;
+    const double a = std::exp(-dt / T);
+    // the first-order filter in closed form: its stationary variance is sigma_u^2
+    x_[0] = a * x_[0] + s.sigma_u * std::sqrt(1.0 - a * a) * random.normal();
+    out[0] = x_[0];
+  }
+  // v, w: H(s) = K (1 + sqrt(3) T s) / (1 + T s)^2, K^2 = sigma^2 T
+  for (int axis = 1; axis <= 2; ++axis) {
+    const double sigma = axis == 1 ? s.sigma_v : s.sigma_w;
+    const double T = (axis == 1 ? s.length_v : s.length_w) / airspeed;
+    Discrete& d = discrete_[static_cast<std::size_t>(axis - 1)];
+    if (d.dt != dt || d.T != T) {
+      Eigen::Matrix2d A;
+      A << 0, 1, -1 / (T * T), -2 / T;
+      discretise(A, Eigen::Vector2d(0, 1), dt, d.F, d.L);
+      d.dt = dt;
+      d.T = T;
+    }
+    double* x = &x_[static_cast<std::size_t>(1 + 2 * (axis - 1))];
+    const double e0 = random.normal(), e1 = random.normal();
+    const Eigen::Vector2d next = d.F * Eigen::Vector2d(x[0], x[1]) + d.L * Eigen::Vector2d(e0, e1);
+    x[0] = next[0];
+    x[1] = next[1];
+    const double K = sigma * std::sqrt(T);
+    out[axis] = K / (T * T) * (x[0] + std::sqrt(3.0) * T * x[1]);
+  }
+  return out;
 }
 
 double groundEffectGain(double height, double radius) {

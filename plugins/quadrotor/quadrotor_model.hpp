@@ -9,6 +9,7 @@
 //   PositionController  the outer loop in floating point (TeleKyb form)
 //   FigureEight     reference trajectories of the fidelity study
 
+#include <ssx/random.hpp>
 #include <ssx/setpoint.hpp>
 #include <ssx/types.hpp>
 
@@ -79,6 +80,45 @@ class Battery {
  private:
   BatteryParams p_;
   double charge_, voltage_;
+};
+
+/// Downwash on a rotorcraft below another (gym-pybullet-drones' model, fitted on Crazyflies by
+/// Zhou at the Dynamic Systems Lab): a vertical force -alpha exp(-(dxy / beta)^2 / 2) with
+/// alpha = c1 (R / (4 dz))^2 and beta = c2 dz + c3, for a robot dz above (dz > 0) and dxy apart
+/// horizontally. Returns the force's z component (N, negative: down).
+double downwashForce(double dz, double dxy, double rotor_radius, double c1, double c2, double c3);
+
+/// Dryden turbulence (MIL-F-8785C, low altitude): three gust velocities (m/s) in the frame of the
+/// mean wind (u along it, v across, w up), each the output of its forming filter driven by white
+/// noise, discretised exactly (the sampled process has the continuous one's covariance at every lag).
+/// Scales for a height h (ft, 10 to 1000): sigma_w = 0.1 W20, sigma_u = sigma_v = sigma_w /
+/// (0.177 + 0.000823 h)^0.4, L_w = h, L_u = L_v = h / (0.177 + 0.000823 h)^1.2; V is the airspeed.
+/// One-sided spectra (rad/s): Phi_u = sigma_u^2 (2 L_u / (pi V)) / (1 + (L_u w / V)^2),
+/// Phi_v,w = sigma^2 (L / (pi V)) (1 + 3 (L w / V)^2) / (1 + (L w / V)^2)^2.
+class DrydenTurbulence {
+ public:
+  struct Scales {
+    double sigma_u, sigma_v, sigma_w;  ///< m/s
+    double length_u, length_v, length_w;  ///< m
+  };
+  /// The scales at `height` m for the wind speed `w20` m/s at 20 ft (6.1 m).
+  static Scales scales(double height, double w20);
+  /// One-sided spectrum of component `axis` (0 u, 1 v, 2 w) at `omega` rad/s, (m/s)^2 / (rad/s).
+  static double spectrum(int axis, double omega, const Scales& s, double airspeed);
+  /// Advances the three filters by dt at these scales and airspeed; returns (u, v, w).
+  Vec3 step(double dt, const Scales& s, double airspeed, ssx::Random& random);
+  /// The filters' state (for save and restore).
+  std::array<double, 5> state() const { return x_; }
+  void setState(const std::array<double, 5>& x) { x_ = x; }
+
+ private:
+  std::array<double, 5> x_{};  // u: 1 state; v, w: 2 each
+  // the discretisation of the v and w filters, kept while dt and their time constants stay
+  struct Discrete {
+    double dt = -1, T = -1;
+    Eigen::Matrix2d F, L;
+  };
+  std::array<Discrete, 2> discrete_{};
 };
 
 /// The named presets: "mk_quad" (default), "hummingbird", "crazyflie". Empty if unknown.

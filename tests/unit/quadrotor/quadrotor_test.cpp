@@ -374,3 +374,121 @@ TEST_CASE("command delay: the vehicle answers a set-point step `command_delay` l
   REQUIRE(now > 0);
   CHECK(std::abs((late - now) - 0.012) <= 0.002 + 1e-9);
 }
+
+TEST_CASE("Dryden turbulence: the spectrum of each component within 10 % at three frequencies", "[quadrotor][fidelity]") {
+  // 10 m up, W20 = 7.7 m/s (15 knots, light turbulence), flying through it at 5 m/s, sampled at 500 Hz
+  const auto scales = DrydenTurbulence::scales(10.0, 7.7);
+  const double V = 5.0, dt = 0.002;
+  // Welch: Hann-windowed segments of 16 s (0.06 Hz apart: little leakage from the steep low end), averaged
+  const std::size_t segment = 8192, segments = 1200;  // the estimate scatters about 3 % (1 / sqrt(1200))
+  DrydenTurbulence turbulence;
+  Random random(42);
+  for (int k = 0; k < 20000; ++k) (void)turbulence.step(dt, scales, V, random);  // settle
+  const std::array<double, 3> hz{1.0, 2.0, 5.0};
+  std::array<std::array<double, 3>, 3> power{};  // [axis][frequency]
+  std::array<double, 3> variance{};
+  std::vector<Vec3> x(segment);
+  double window_power = 0;
+  for (std::size_t n = 0; n < segment; ++n) {
+    const double w = 0.5 - 0.5 * std::cos(2 * std::numbers::pi * static_cast<double>(n) / static_cast<double>(segment));
+    window_power += w * w;
+  }
+  for (std::size_t s = 0; s < segments; ++s) {
+    for (auto& v : x) v = turbulence.step(dt, scales, V, random);
+    for (int axis = 0; axis < 3; ++axis) {
+      for (const auto& v : x) variance[axis] += v[axis] * v[axis] / static_cast<double>(segment * segments);
+      for (std::size_t f = 0; f < hz.size(); ++f) {
+        double re = 0, im = 0;
+        for (std::size_t n = 0; n < segment; ++n) {
+          const double w = 0.5 - 0.5 * std::cos(2 * std::numbers::pi * static_cast<double>(n) / static_cast<double>(segment));
+          const double phase = 2 * std::numbers::pi * hz[f] * static_cast<double>(n) * dt;
+          re += w * x[n][axis] * std::cos(phase);
+          im -= w * x[n][axis] * std::sin(phase);
+        }
+        // one-sided density per Hz: 2 |X|^2 dt / sum(w^2)
+        power[axis][f] += 2 * (re * re + im * im) * dt / window_power / static_cast<double>(segments);
+      }
+    }
+  }
+  for (int axis = 0; axis < 3; ++axis) {
+    for (std::size_t f = 0; f < hz.size(); ++f) {
+      // per Hz = per rad/s times 2 pi
+      const double expected = 2 * std::numbers::pi * DrydenTurbulence::spectrum(axis, 2 * std::numbers::pi * hz[f], scales, V);
+      INFO("axis " << axis << " at " << hz[f] << " Hz: " << power[axis][f] << " vs " << expected);
+      CHECK(power[axis][f] == Approx(expected).epsilon(0.10));
+    }
+  }
+  // and the variances are the scales' (the long correlation of u makes its estimate the loosest)
+  CHECK(std::sqrt(variance[0]) == Approx(scales.sigma_u).epsilon(0.15));
+  CHECK(std::sqrt(variance[1]) == Approx(scales.sigma_v).epsilon(0.10));
+  CHECK(std::sqrt(variance[2]) == Approx(scales.sigma_w).epsilon(0.10));
+}
+
+TEST_CASE("downwash: the drop below another robot at known offsets is the fitted model's", "[quadrotor][fidelity]") {
+  // gym-pybullet-drones' Crazyflie coefficients
+  const double R = 0.0231, c1 = 2267.18, c2 = 0.16, c3 = -0.11;
+  for (const auto& [dz, dxy] : {std::pair{0.3, 0.0}, std::pair{0.5, 0.02}, std::pair{1.0, 0.05}}) {
+    const double beta = c2 * dz + c3;
+    CHECK(downwashForce(dz, dxy, R, c1, c2, c3) ==
+          Approx(-c1 * std::pow(R / (4 * dz), 2) * std::exp(-0.5 * std::pow(dxy / beta, 2))).epsilon(1e-12));
+  }
+  CHECK(downwashForce(-0.5, 0.0, R, c1, c2, c3) == 0.0);  // nobody above
+}
+
+namespace {
+
+// the vertical and x accelerations of artifact `name` after two steps (the first forces act in the
+// second step's physics), in a scene of `artifacts` over the examples' artifact types
+Vec3 accelerationAfterTwoSteps(const std::string& artifacts, const std::string& name) {
+  const std::string xml = "<scene><environment timestep=\"0.002\" seed=\"1\"/><type name=\"cf\" file=\"crazyflie.xml\"/>"
+                          "<type name=\"q\" file=\"mk_quad.xml\"/>" + artifacts + "</scene>";
+  Scene scene = loadSceneFromString(xml, "air.xml", fs::path(SSX_EXAMPLES_DIR) / "artifacts");
+  scene.environment->step(2);
+  return scene.environment->findArtifact(name)->state().linear_acceleration;
+}
+
+}  // namespace
+
+TEST_CASE("downwash in flight: a Crazyflie 0.5 m below another drops by the model's force", "[quadrotor][fidelity]") {
+  auto pair = [](const char* on) {
+    return std::string("<artifact name=\"up\" type=\"cf\" xyz=\"0 0 1.5\"/>") +
+           "<artifact name=\"low\" type=\"cf\" xyz=\"0.02 0 1.0\"><driver downwash=\"" + on + "\"/></artifact>";
+  };
+  const double off = accelerationAfterTwoSteps(pair("false"), "low").z();
+  const double on = accelerationAfterTwoSteps(pair("true"), "low").z();
+  const double force = downwashForce(0.5, 0.02, 0.0231, 2267.18, 0.16, -0.11);
+  CHECK((on - off) * 0.027 == Approx(force).epsilon(0.02));
+  // the upper one feels nothing from the one below
+  CHECK(accelerationAfterTwoSteps(pair("true"), "up").z() == accelerationAfterTwoSteps(pair("false"), "up").z());
+}
+
+TEST_CASE("wind: a hovering quadrotor in a 3 m/s wind is pushed by its rotors' drag", "[quadrotor][fidelity]") {
+  const double still = accelerationAfterTwoSteps("<artifact name=\"q\" type=\"q\" xyz=\"0 0 1\"/>", "q").x();
+  const double windy =
+      accelerationAfterTwoSteps("<artifact name=\"q\" type=\"q\" xyz=\"0 0 1\"><driver wind=\"3 0 0\"/></artifact>", "q").x();
+  // four rotors near hover speed: F = 4 w_h lambda1 V
+  const RotorParams p = *preset("mk_quad");
+  const double w_h = std::sqrt(0.82 * 9.81 / (4 * p.thrust_coefficient));
+  CHECK((windy - still) * 0.82 == Approx(4 * w_h * p.rotor_drag_coefficient * 3.0).epsilon(0.02));
+}
+
+TEST_CASE("a 1-cosine gust begins to act at gust_start", "[quadrotor][fidelity]") {
+  // the first step whose state differs from a run without the gust, and the last whose force does
+  auto trace = [](const std::string& gust) {
+    const std::string xml = "<scene><environment timestep=\"0.002\" seed=\"1\"/><type name=\"q\" file=\"mk_quad.xml\"/>"
+                            "<artifact name=\"q\" type=\"q\" xyz=\"0 0 1\"><driver " + gust + "/></artifact></scene>";
+    Scene scene = loadSceneFromString(xml, "gust.xml", fs::path(SSX_EXAMPLES_DIR) / "artifacts");
+    std::vector<Vec3> a;
+    for (int k = 0; k < 600; ++k) {
+      scene.environment->step();
+      a.push_back(scene.environment->findArtifact("q")->state().linear_acceleration);
+    }
+    return a;
+  };
+  const auto calm = trace("");
+  const auto gusty = trace("gust=\"2 0 0\" gust_start=\"0.4\" gust_duration=\"0.3\"");
+  std::size_t first = 0;
+  while (first < calm.size() && calm[first] == gusty[first]) ++first;
+  // the driver of step k writes forces for step k + 1's physics; the gust is 0 at gust_start itself
+  CHECK(static_cast<double>(first + 1) * 0.002 == Approx(0.4 + 2 * 0.002).margin(1e-9));  // state k: time (k + 1) dt
+}
