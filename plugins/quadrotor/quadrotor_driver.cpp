@@ -313,13 +313,20 @@ void QuadrotorDriver::step(const StepInfo& info) {
     // rate (the other references command a yaw rate only, as the TeleKyb controller does)
     if (source_ == Source::External)
       attitude_.yaw_rate += heading_kp_ * std::remainder(current_.yaw - yaw, 2.0 * std::numbers::pi);
-    // the online thrust estimator: the specific force the IMU reads along z against what the
-    // commanded thrust should give the mass the controller believes; the command is divided by it
+    // the online thrust estimator: the specific force along the body's z axis, from the position
+    // source's velocity (motion capture: no accelerometer bias), against what the commanded thrust
+    // should give the mass the controller believes; the command is divided by their ratio
     if (thrust_estimator_) {
+      const double g = -environment().settings().physics.gravity.z();
       const double expected = static_cast<double>(command_.thrust_q16) / 65536.0 / controller_mass_;
-      if (expected > 0.2 * -environment().settings().physics.gravity.z() && imu_seen_)
-        thrust_ratio_ += outer_dt_ / estimator_tau_ * (imu_->accelerometer.z() / expected - thrust_ratio_);
-      thrust_ratio_ = std::clamp(thrust_ratio_, 0.5, 2.0);
+      if (have_last_velocity_ && expected > 0.2 * g) {
+        const Vec3 specific = (velocity - last_velocity_) / outer_dt_ + Vec3(0, 0, g);
+        const double along = specific.dot(pose.orientation * Vec3::UnitZ());
+        thrust_ratio_ += outer_dt_ / estimator_tau_ * (along / expected - thrust_ratio_);
+        thrust_ratio_ = std::clamp(thrust_ratio_, 0.5, 2.0);
+      }
+      last_velocity_ = velocity;
+      have_last_velocity_ = true;
       attitude_.thrust /= thrust_ratio_;
     }
     // the serial link: thrust in 8 bits of m g / 128 (255: 2 m g), angles in whole steps
@@ -529,6 +536,8 @@ void QuadrotorDriver::saveState(StateWriter& out) const {
   out.write(battery_ ? battery_->charge() : 0.0);
   out.write(battery_ ? battery_->voltage() : 0.0);
   out.write(turbulence_.state());
+  out.write(last_velocity_);
+  out.write(have_last_velocity_);
 }
 
 void QuadrotorDriver::loadState(StateReader& in) {
@@ -574,6 +583,8 @@ void QuadrotorDriver::loadState(StateReader& in) {
   const double charge = in.get<double>(), voltage = in.get<double>();
   if (battery_) battery_->setState(charge, voltage);
   turbulence_.setState(in.get<std::array<double, 5>>());
+  in.read(last_velocity_);
+  in.read(have_last_velocity_);
 }
 
 }  // namespace ssx::quadrotor

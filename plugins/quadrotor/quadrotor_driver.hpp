@@ -47,7 +47,7 @@ class QuadrotorDriver final : public Driver, public SetpointInterface, public Me
       param::real("battery_initial_charge", "1", "", param::nonNegative() & param::atMost(1), "fraction of the capacity at the start"),
       param::real("battery_nominal_voltage", "15.5", "V", param::positive(), "voltage at which the rotor model's thrust holds (MK law)"),
       param::flag("thrust_estimator", "false",
-                  "the controller estimates thrust per command online (from the accelerometer) and corrects for it"),
+                  "the controller estimates thrust per command online (from the position source's velocity) and corrects for it"),
       param::real("thrust_estimator_time_constant", "1", "s", param::positive(), "its low-pass time constant"),
       param::flag("command_link", "false",
                   "the inner loop gets commands as over the MK serial link: 8-bit thrust in steps of m g / 128, angles in steps"),
@@ -161,6 +161,8 @@ class QuadrotorDriver final : public Driver, public SetpointInterface, public Me
   std::optional<Battery> battery_;
   bool thrust_estimator_ = false;
   double estimator_tau_ = 1.0, thrust_ratio_ = 1.0;  // estimated actual / expected thrust per command
+  Vec3 last_velocity_ = Vec3::Zero();                 // the estimator's, at the last outer run
+  bool have_last_velocity_ = false;
   double controller_mass_ = 0;
   bool command_link_ = false;
   double angle_step_ = 0;                   // rad
