@@ -117,6 +117,7 @@ void QuadrotorDriver::configure(const Descriptor& params, PluginSetup& setup) {
   downwash_c_[1] = params.get<double>("downwash_c2");
   downwash_c_[2] = params.get<double>("downwash_c3");
   downwash_range_ = params.get<double>("downwash_range");
+  downwash_min_dz_ = params.get<double>("downwash_min_height");
   if (downwash_) setup.enableNeighborQueries(downwash_range_);
 
   // the loops run every k runs of the driver (whole numbers: checked while loading)
@@ -193,8 +194,11 @@ void QuadrotorDriver::configure(const Descriptor& params, PluginSetup& setup) {
     bp.efficiency = params.get<double>("battery_efficiency");
     bp.initial_charge = params.get<double>("battery_initial_charge");
     bp.nominal_voltage = params.get<double>("battery_nominal_voltage");
-    if (!(bp.empty_voltage < bp.full_voltage) || !(bp.nominal_voltage > bp.zero_thrust_voltage))
-      throw params.error("battery: needs battery_empty_voltage < battery_full_voltage and battery_nominal_voltage > 7.575 V");
+    bp.zero_thrust_voltage = params.get<double>("battery_zero_thrust_voltage");
+    if (!(bp.empty_voltage < bp.full_voltage) || !(bp.nominal_voltage > bp.zero_thrust_voltage) ||
+        !(bp.empty_voltage > bp.zero_thrust_voltage))
+      throw params.error("battery: needs battery_zero_thrust_voltage < battery_empty_voltage < battery_full_voltage "
+                         "and battery_nominal_voltage > battery_zero_thrust_voltage");
     battery_.emplace(bp);
   }
 
@@ -373,6 +377,7 @@ void QuadrotorDriver::step(const StepInfo& info) {
   // robots above push this one down
   if (downwash_) {
     const Vec3 here = artifact().pose().position;
+    above_.clear();  // neighbors() appends
     artifact().environment().neighbors(here, downwash_range_, above_);
     double push = 0;
     for (const auto& hit : above_) {
@@ -381,7 +386,7 @@ void QuadrotorDriver::step(const StepInfo& info) {
       if (dynamic_cast<const QuadrotorDriver*>(environment().artifact(hit.id).driver()) == nullptr) continue;
       const Vec3 d = hit.point - here;
       push += downwashForce(d.z(), d.head<2>().norm(), rotors_->params().rotor_radius, downwash_c_[0], downwash_c_[1],
-                            downwash_c_[2]);
+                            downwash_c_[2], downwash_min_dz_);
     }
     if (push != 0) body.addForce(Vec3(0, 0, push), Frame::World, com_in_root_, Frame::Local);
   }

@@ -46,6 +46,8 @@ class QuadrotorDriver final : public Driver, public SetpointInterface, public Me
       param::real("battery_efficiency", "0.6", "", param::positive() & param::atMost(1), "mechanical / electrical power (EST)"),
       param::real("battery_initial_charge", "1", "", param::nonNegative() & param::atMost(1), "fraction of the capacity at the start"),
       param::real("battery_nominal_voltage", "15.5", "V", param::positive(), "voltage at which the rotor model's thrust holds (MK law)"),
+      param::real("battery_zero_thrust_voltage", "7.575", "V", param::nonNegative(),
+                  "the MK law's offset: thrust at a fixed command is proportional to U minus this"),
       param::flag("thrust_estimator", "false",
                   "the controller estimates thrust per command online (from the position source's velocity) and corrects for it"),
       param::real("thrust_estimator_time_constant", "1", "s", param::positive(), "its low-pass time constant"),
@@ -68,6 +70,8 @@ class QuadrotorDriver final : public Driver, public SetpointInterface, public Me
       param::real("downwash_c2", "0.16", "", param::any(), "model coefficient (fitted on Crazyflies)"),
       param::real("downwash_c3", "-0.11", "m", param::any(), "model coefficient (fitted on Crazyflies)"),
       param::real("downwash_range", "3", "m", param::positive(), "robots farther than this are not looked at"),
+      param::real("downwash_min_height", "0.1", "m", param::nonNegative(),
+                  "robots less than this above count as beside, not above (the fitted form diverges; EST)"),
       param::vec3("controller_inertia", "", "kg m^2", param::positive(),
                   "diagonal inertia the inner loop assumes (default: the model's)"),
       param::real("rotor_inertia", "", "kg m^2", param::nonNegative(), "(default: the preset's)"),
@@ -173,7 +177,7 @@ class QuadrotorDriver final : public Driver, public SetpointInterface, public Me
   double turbulence_w20_ = 0, min_airspeed_ = 1;
   DrydenTurbulence turbulence_;
   bool downwash_ = false;
-  double downwash_c_[3] = {0, 0, 0}, downwash_range_ = 3;
+  double downwash_c_[3] = {0, 0, 0}, downwash_range_ = 3, downwash_min_dz_ = 0.1;
   std::vector<SpatialIndex::Hit> above_;  // neighbours, reused
   double ground_z_ = 0;       // the ground plane's height (-inf: none)
   std::vector<double> gains_;  // per rotor thrust gains, handed to the rotor model

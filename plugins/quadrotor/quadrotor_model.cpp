@@ -78,8 +78,10 @@ void Battery::step(double dt, double mechanical_power) {
   charge_ = std::max(0.0, charge_ - current * dt / (3600.0 * p_.capacity));
 }
 
-double downwashForce(double dz, double dxy, double rotor_radius, double c1, double c2, double c3) {
-  if (dz <= 0) return 0.0;
+double downwashForce(double dz, double dxy, double rotor_radius, double c1, double c2, double c3, double min_dz) {
+  // the fitted form diverges as dz -> 0 (alpha grows as 1 / dz^2 while the width stays 0.11 m):
+  // robots less than min_dz above count as beside this one, not above it
+  if (dz < min_dz) return 0.0;
   const double alpha = c1 * std::pow(rotor_radius / (4.0 * dz), 2);
   const double beta = c2 * dz + c3;
   return -alpha * std::exp(-0.5 * std::pow(dxy / beta, 2));

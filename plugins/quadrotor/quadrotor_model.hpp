@@ -85,8 +85,10 @@ class Battery {
 /// Downwash on a rotorcraft below another (gym-pybullet-drones' model, fitted on Crazyflies by
 /// Zhou at the Dynamic Systems Lab): a vertical force -alpha exp(-(dxy / beta)^2 / 2) with
 /// alpha = c1 (R / (4 dz))^2 and beta = c2 dz + c3, for a robot dz above (dz > 0) and dxy apart
-/// horizontally. Returns the force's z component (N, negative: down).
-double downwashForce(double dz, double dxy, double rotor_radius, double c1, double c2, double c3);
+/// horizontally. Returns the force's z component (N, negative: down); 0 for dz below `min_dz`,
+/// where the form diverges (our cut: a robot that little above is beside this one, or colliding).
+/// Fitted on Crazyflies; directly below, it exceeds a Crazyflie's weight for dz under about 0.5 m.
+double downwashForce(double dz, double dxy, double rotor_radius, double c1, double c2, double c3, double min_dz);
 
 /// Dryden turbulence (MIL-F-8785C, low altitude): three gust velocities (m/s) in the frame of the
 /// mean wind (u along it, v across, w up), each the output of its forming filter driven by white

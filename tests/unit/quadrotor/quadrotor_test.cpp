@@ -429,10 +429,11 @@ TEST_CASE("downwash: the drop below another robot at known offsets is the fitted
   const double R = 0.0231, c1 = 2267.18, c2 = 0.16, c3 = -0.11;
   for (const auto& [dz, dxy] : {std::pair{0.3, 0.0}, std::pair{0.5, 0.02}, std::pair{1.0, 0.05}}) {
     const double beta = c2 * dz + c3;
-    CHECK(downwashForce(dz, dxy, R, c1, c2, c3) ==
+    CHECK(downwashForce(dz, dxy, R, c1, c2, c3, 0.1) ==
           Approx(-c1 * std::pow(R / (4 * dz), 2) * std::exp(-0.5 * std::pow(dxy / beta, 2))).epsilon(1e-12));
   }
-  CHECK(downwashForce(-0.5, 0.0, R, c1, c2, c3) == 0.0);  // nobody above
+  CHECK(downwashForce(-0.5, 0.0, R, c1, c2, c3, 0.1) == 0.0);  // nobody above
+  CHECK(downwashForce(0.05, 0.0, R, c1, c2, c3, 0.1) == 0.0);  // beside, not above
 }
 
 namespace {
@@ -456,7 +457,7 @@ TEST_CASE("downwash in flight: a Crazyflie 0.5 m below another drops by the mode
   };
   const double off = accelerationAfterTwoSteps(pair("false"), "low").z();
   const double on = accelerationAfterTwoSteps(pair("true"), "low").z();
-  const double force = downwashForce(0.5, 0.02, 0.0231, 2267.18, 0.16, -0.11);
+  const double force = downwashForce(0.5, 0.02, 0.0231, 2267.18, 0.16, -0.11, 0.1);
   CHECK((on - off) * 0.027 == Approx(force).epsilon(0.02));
   // the upper one feels nothing from the one below
   CHECK(accelerationAfterTwoSteps(pair("true"), "up").z() == accelerationAfterTwoSteps(pair("false"), "up").z());
