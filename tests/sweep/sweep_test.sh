@@ -53,6 +53,8 @@ set -e
 # --- the example sweep passes its checks ---
 "$ssx" sweep "$here/../../examples/sweeps/formation_gains.xml" --check | grep -q "5 point(s) x 10 seed(s) = 50 runs" \
   || fail "the example sweep"
+"$ssx" sweep "$here/../../examples/sweeps/realistic_guesses.xml" --check | grep -q "27 point(s) x 1 seed(s) = 27 runs" \
+  || fail "the realistic guesses sweep"
 
 # --- one process, two processes: the same rows ---
 "$ssx" sweep "$data/small.xml" --plugin-path "$plugins" --out one.csv --robots one_robots.csv --jobs 1
