@@ -4,6 +4,7 @@
 #include <pugixml.hpp>
 
 #include <algorithm>
+#include <cerrno>
 #include <chrono>
 #include <cinttypes>
 #include <cmath>
@@ -233,6 +234,7 @@ Spec readSpec(const fs::path& file, const std::vector<fs::path>& plugin_path) {
   }
   r.allow(root, {"scene", "seed", "seeds", "duration", "threads", "sample_hz", "extensions"});
   const SourceLocation root_at = r.at(root);
+  spec.where = root_at;
   if (!root.attribute("scene") || std::string(root.attribute("scene").value()).empty()) {
     r.error(root_at, "<sweep>: missing attribute 'scene' (the scene file to vary, relative to this file)");
   } else {
@@ -446,7 +448,7 @@ void check(const Spec& spec) {
         if (w.where.file == spec.file.string()) add({Diagnostic::Severity::Error, w.where, w.message});
       if (point == 0 && found.empty()) {
         if (!spec.duration && !scene.duration)
-          add({Diagnostic::Severity::Error, {spec.file.string(), 1},
+          add({Diagnostic::Severity::Error, spec.where,
                "<sweep>: no 'duration', and the scene gives no <environment duration>: how long is a run?"});
         // the metrics the plugins publish are known once they are configured
         Environment& env = *scene.environment;

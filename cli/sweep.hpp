@@ -37,6 +37,7 @@ struct MetricSpec {
 
 struct Spec {
   fs::path file;
+  SourceLocation where;  // the <sweep> element
   fs::path scene;
   std::uint64_t seed = 0;
   std::int64_t seeds = 1;  // runs per point

@@ -68,6 +68,37 @@ const Sensor* firstSensorOf(const Artifact& a) {
   return nullptr;
 }
 
+
+
+// the battery, its voltages checked against each other
+BatteryParams batteryParams(const Descriptor& params) {
+  BatteryParams bp;
+  bp.full_voltage = params.get<double>("battery_full_voltage");
+  bp.empty_voltage = params.get<double>("battery_empty_voltage");
+  bp.capacity = params.get<double>("battery_capacity");
+  bp.resistance = params.get<double>("battery_resistance");
+  bp.efficiency = params.get<double>("battery_efficiency");
+  bp.initial_charge = params.get<double>("battery_initial_charge");
+  bp.nominal_voltage = params.get<double>("battery_nominal_voltage");
+  bp.zero_thrust_voltage = params.get<double>("battery_zero_thrust_voltage");
+  if (!(bp.empty_voltage < bp.full_voltage) || !(bp.nominal_voltage > bp.zero_thrust_voltage) ||
+      !(bp.empty_voltage > bp.zero_thrust_voltage))
+    throw params.error("battery: needs battery_zero_thrust_voltage < battery_empty_voltage < battery_full_voltage "
+                       "and battery_nominal_voltage > battery_zero_thrust_voltage");
+  return bp;
+}
+
+// command_delay in inner-loop periods (a whole number of them)
+std::size_t commandDelayTicks(const Descriptor& params, const PluginContext& context) {
+  const double inner_period =
+      static_cast<double>(runsPerPeriod(params.get<double>("inner_rate_hz"), context)) * toSeconds(context.period());
+  const double ticks = params.get<double>("command_delay") / inner_period;
+  if (std::abs(ticks - std::round(ticks)) > 1e-6)
+    throw params.errorAt("command_delay", "command_delay must be a whole number of inner-loop periods (" +
+                                              std::to_string(inner_period * 1e3) + " ms)");
+  return static_cast<std::size_t>(std::llround(ticks));
+}
+
 }  // namespace
 
 void QuadrotorDriver::validate(const Descriptor& params, const PluginContext& context) {
@@ -75,6 +106,9 @@ void QuadrotorDriver::validate(const Descriptor& params, const PluginContext& co
   if (a.rootCount() == 0 || a.root().isStatic()) throw params.error("a quadrotor needs a dynamic physic root");
   (void)rotorParams(params);
   (void)rotorsOf(params, a);
+  // checked while loading, so that `ssx validate` refuses what `ssx run` would
+  (void)commandDelayTicks(params, context);
+  if (params.get<bool>("battery")) (void)batteryParams(params);
   if (firstSensorOf<ImuMeasurement>(a) == nullptr)
     throw params.error("a quadrotor needs an IMU: add <sensor plugin=\"imu\"/> to the artifact");
   if (params.get<std::string>("reference") == "formation") {
@@ -178,29 +212,8 @@ void QuadrotorDriver::configure(const Descriptor& params, PluginSetup& setup) {
   estimator_tau_ = params.get<double>("thrust_estimator_time_constant");
   command_link_ = params.get<bool>("command_link");
   angle_step_ = params.get<double>("command_angle_step_deg") * std::numbers::pi / 180.0;
-  {
-    const double ticks = params.get<double>("command_delay") / ip.dt;
-    if (std::abs(ticks - std::round(ticks)) > 1e-6)
-      throw params.errorAt("command_delay", "command_delay must be a whole number of inner-loop periods (" +
-                                                std::to_string(ip.dt * 1e3) + " ms)");
-    command_queue_.assign(static_cast<std::size_t>(std::llround(ticks)) + 1, InnerCommand{});
-  }
-  if (params.get<bool>("battery")) {
-    BatteryParams bp;
-    bp.full_voltage = params.get<double>("battery_full_voltage");
-    bp.empty_voltage = params.get<double>("battery_empty_voltage");
-    bp.capacity = params.get<double>("battery_capacity");
-    bp.resistance = params.get<double>("battery_resistance");
-    bp.efficiency = params.get<double>("battery_efficiency");
-    bp.initial_charge = params.get<double>("battery_initial_charge");
-    bp.nominal_voltage = params.get<double>("battery_nominal_voltage");
-    bp.zero_thrust_voltage = params.get<double>("battery_zero_thrust_voltage");
-    if (!(bp.empty_voltage < bp.full_voltage) || !(bp.nominal_voltage > bp.zero_thrust_voltage) ||
-        !(bp.empty_voltage > bp.zero_thrust_voltage))
-      throw params.error("battery: needs battery_zero_thrust_voltage < battery_empty_voltage < battery_full_voltage "
-                         "and battery_nominal_voltage > battery_zero_thrust_voltage");
-    battery_.emplace(bp);
-  }
+  command_queue_.assign(commandDelayTicks(params, context) + 1, InnerCommand{});
+  if (params.get<bool>("battery")) battery_.emplace(batteryParams(params));
 
   // reference source
   const Vec3 start = a.placement().position;

@@ -9,6 +9,13 @@ data=$here/../data/sweeps
 rm -rf "$work" && mkdir -p "$work" && cd "$work"
 fail() { echo "FAIL: $*" >&2; exit 1; }
 rows() { tail -n +3 "$1" | sort -t, -k1,1n; }  # the runs' rows, by run index
+# refused SWEEP OUT LOG: ssx sweep must refuse SWEEP (exit status 2) writing to OUT; what it said goes to LOG
+refused() {
+  local status=0
+  "$ssx" sweep "$1" --plugin-path "$plugins" --out "$2" > "$3" 2>&1 || status=$?
+  cat "$3"
+  [ "$status" -eq 2 ] || fail "ssx sweep $1 exited with $status, expected 2"
+}
 
 # --- a broken sweep: every problem with file:line, nothing written ---
 cat > broken.xml <<'XML'
@@ -22,33 +29,20 @@ cat > broken.xml <<'XML'
 </sweep>
 XML
 sed -i "s|SCENE|$data/scene.xml|" broken.xml
-set +e
-"$ssx" sweep broken.xml --plugin-path "$plugins" --out broken.csv > broken.out 2>&1
-status=$?
-set -e
-cat broken.out
-[ "$status" -eq 2 ] || fail "a broken sweep exits with $status, expected 2"
+refused broken.xml broken.csv broken.out
 grep -q "broken.xml:1: error: <sweep>: attribute 'seeds' must be a whole number in \[1, 1000000\], got '0'" broken.out || fail "seeds"
 [ ! -e broken.csv ] || fail "a broken sweep created its output"
 sed -i 's/seeds="0"/seeds="1"/' broken.xml
-set +e
-"$ssx" sweep broken.xml --plugin-path "$plugins" --out broken.csv > broken.out 2>&1
-status=$?
-set -e
-cat broken.out
-[ "$status" -eq 2 ] || fail "exit $status"
+refused broken.xml broken.csv broken.out
 grep -q "broken.xml:3: error: <driver>: driver 'quadrotor': parameter 'formation_gain' must be > 0" broken.out || fail "value check"
 grep -q "broken.xml:4: error: unknown parameter 'formation_gian' of driver 'quadrotor'" broken.out || fail "unknown attribute"
 grep -q "broken.xml:5: error: target 'swarm\[7\]/driver@x': no element 'swarm\[7\]'" broken.out || fail "bad target"
 [ ! -e broken.csv ] || fail "a broken sweep created its output"
 # the metric is checked once the values are right
 sed -i 's/values="0.1 -1"/values="0.1"/; /formation_gian/d; /swarm\[7\]/d' broken.xml
-set +e
-"$ssx" sweep broken.xml --plugin-path "$plugins" --out broken.csv > broken.out 2>&1
-status=$?
-set -e
-[ "$status" -eq 2 ] && grep -q "broken.xml:5: error: metric 'no_such_metric': no plugin of this scene publishes it (published: formation_error, tracking_error)" broken.out \
-  || { cat broken.out; fail "unknown metric"; }
+refused broken.xml broken.csv broken.out
+grep -q "broken.xml:5: error: metric 'no_such_metric': no plugin of this scene publishes it (published: formation_error, tracking_error)" broken.out \
+  || fail "unknown metric"
 
 # --- the example sweep passes its checks ---
 "$ssx" sweep "$here/../../examples/sweeps/formation_gains.xml" --check | grep -q "5 point(s) x 10 seed(s) = 50 runs" \
@@ -99,11 +93,8 @@ diff <(rows one.csv) <(rows resumed.csv) || fail "resumed rows differ"
 sed 's/seed="5"/seed="6"/' "$data/small.xml" > other.xml
 sed -i "s|scene=\"scene.xml\"|scene=\"$data/scene.xml\"|" other.xml
 cp resumed.csv before.csv
-set +e
-"$ssx" sweep other.xml --plugin-path "$plugins" --out resumed.csv > other.out 2>&1
-status=$?
-set -e
-[ "$status" -eq 2 ] && grep -q "holds the results of another sweep" other.out || { cat other.out; fail "another sweep's file"; }
+refused other.xml resumed.csv other.out
+grep -q "holds the results of another sweep" other.out || fail "another sweep's file"
 cmp -s before.csv resumed.csv || fail "another sweep's file was changed"
 
 # --- under mpirun: rank 0 hands out runs, the same rows ---

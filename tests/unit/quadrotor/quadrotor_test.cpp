@@ -493,3 +493,22 @@ TEST_CASE("a 1-cosine gust begins to act at gust_start", "[quadrotor][fidelity]"
   // the driver of step k writes forces for step k + 1's physics; the gust is 0 at gust_start itself
   CHECK(static_cast<double>(first + 1) * 0.002 == Approx(0.4 + 2 * 0.002).margin(1e-9));  // state k: time (k + 1) dt
 }
+
+TEST_CASE("a command delay off the inner loop's period and inconsistent battery voltages are refused while loading",
+          "[quadrotor][fidelity]") {
+  auto load = [](const std::string& driver) {
+    const std::string xml = "<scene><environment timestep=\"0.002\"/><type name=\"q\" file=\"mk_quad.xml\"/>"
+                            "<artifact name=\"q\" type=\"q\" xyz=\"0 0 1\"><driver " + driver + "/></artifact></scene>";
+    try {
+      (void)loadSceneFromString(xml, "refused.xml", fs::path(SSX_EXAMPLES_DIR) / "artifacts");
+    } catch (const SceneError& e) {
+      return std::string(e.what());
+    }
+    return std::string("loaded");  // the scene is not started: a refusal at start would not show here
+  };
+  CHECK_THAT(load("command_delay=\"0.003\""),
+             Catch::Contains("command_delay must be a whole number of inner-loop periods (2.000000 ms)"));
+  CHECK_THAT(load("battery=\"true\" battery_empty_voltage=\"17\""),
+             Catch::Contains("battery: needs battery_zero_thrust_voltage < battery_empty_voltage < battery_full_voltage"));
+  CHECK(load("command_delay=\"0.004\" battery=\"true\"") == "loaded");
+}
