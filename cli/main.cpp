@@ -108,9 +108,16 @@ struct RunArgs {
   std::vector<std::string> plugin_path;
   std::string stats_csv;
   bool quiet = false;
-  std::string render, snapshot, video, frames;
+  std::string render, physics, snapshot, video, frames;
   std::string save_state, load_state;
 };
+
+// "ode, bullet"
+std::string joined(const std::vector<std::string>& names) {
+  std::string out;
+  for (const auto& n : names) out += (out.empty() ? "" : ", ") + n;
+  return out;
+}
 
 std::vector<std::byte> readFile(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
@@ -145,6 +152,7 @@ int commandRun(const RunArgs& args, bool realtime_given) {
   if (args.threads >= 0) options.threads = args.threads;
   if (args.seed >= 0) options.seed = static_cast<std::uint64_t>(args.seed);
   if (!args.render.empty()) options.render_engine = args.render;
+  if (!args.physics.empty()) options.physics_engine = args.physics;
   options.snapshot = args.snapshot;
   options.video = args.video;
   options.frames_dir = args.frames;
@@ -261,14 +269,17 @@ int commandRun(const RunArgs& args, bool realtime_given) {
   return status;
 }
 
-int commandValidate(const std::string& file, const std::vector<std::string>& plugin_path) {
+int commandValidate(const std::string& file, const std::vector<std::string>& plugin_path, const std::string& physics) {
   ssx::SceneOptions options;
   options.plugin_path = pluginPath(plugin_path);
+  if (!physics.empty()) options.physics_engine = physics;
   try {
     const ssx::Scene scene = ssx::loadScene(file, options);
     printWarnings(scene);
     std::cout << file << ": ok: " << scene.environment->artifactCount() << " artifacts, " << scene.warnings.size()
-              << " warning(s)\n";
+              << " warning(s); physics engine " << scene.environment->settings().physics.engine << " (available: "
+              << joined(ssx::physicEngineNames()) << "), render engine " << scene.environment->settings().render.engine
+              << " (available: " << joined(ssx::renderEngineNames()) << ")\n";
     return 0;
   } catch (const ssx::SceneError& e) {
     std::cerr << e.what() << '\n';
@@ -389,6 +400,8 @@ int commandPlugins(const std::vector<std::string>& plugin_path, const std::strin
     return kExitBadInput;
   }
   int bad = 0;
+  std::cout << "physics engines: " << joined(ssx::physicEngineNames()) << '\n'
+            << "render engines: " << joined(ssx::renderEngineNames()) << '\n';
   for (const auto& dir : loader.searchPath()) std::cout << "search: " << dir.string() << '\n';
   for (const auto& f : files) {
     const Child c = runSelf({"plugins", "--inspect", f.string()}, kTimeout);
@@ -481,6 +494,8 @@ int main(int argc, char** argv) {
   run_cmd->add_option("--stats-csv", run.stats_csv, "write per-step timing samples to FILE");
   run_cmd->add_flag("--quiet", run.quiet, "no progress, no summary");
   run_cmd->add_option("--render", run.render, "render engine (overrides the scene's): null or osmesa");
+  run_cmd->add_option("--physics", run.physics, "physics engine (overrides the scene's): ode or bullet")
+      ->check(CLI::IsMember(ssx::physicEngineNames()));
   run_cmd->add_option("--snapshot", run.snapshot, "write the first camera's last frame as PNG to FILE");
   run_cmd->add_option("--video", run.video, "write the first camera's frames as MP4 to FILE (needs ffmpeg)");
   run_cmd->add_option("--frames", run.frames, "write the first camera's frames as PNG files into DIR");
@@ -494,6 +509,9 @@ int main(int argc, char** argv) {
   CLI::App* validate_cmd = app.add_subcommand("validate", "check a scene and its plugins; run nothing");
   validate_cmd->add_option("scene", validate_file, "scene file")->required()->check(CLI::ExistingFile);
   validate_cmd->add_option("--plugin-path", validate_path, "plugin directory (repeatable)");
+  std::string validate_physics;
+  validate_cmd->add_option("--physics", validate_physics, "check the scene for this physics engine: ode or bullet")
+      ->check(CLI::IsMember(ssx::physicEngineNames()));
 
   std::vector<std::string> plugins_path;
   CLI::App* plugins_cmd = app.add_subcommand("plugins", "list plugin libraries, their classes, and ABI checks");
@@ -528,7 +546,7 @@ int main(int argc, char** argv) {
     if (realtime_given && (realtime->results().empty() || realtime->results().front().empty())) run.realtime = 1.0;
     return commandRun(run, realtime_given);
   }
-  if (*validate_cmd) return commandValidate(validate_file, validate_path);
+  if (*validate_cmd) return commandValidate(validate_file, validate_path, validate_physics);
   if (*sweep_cmd) return commandSweep(sweep);
   if (*plugins_cmd && !inspect_file.empty()) return inspectOne(inspect_file, params_of);
   if (*plugins_cmd) return commandPlugins(plugins_path, params_of);

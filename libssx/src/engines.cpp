@@ -1,4 +1,5 @@
 // Engine factories and the abstract bases' out-of-line members.
+#include "bullet/bullet_engine.hpp"
 #include "ode/ode_engine.hpp"
 #ifdef SSX_HAVE_OSMESA
 #include "render/osmesa_engine.hpp"
@@ -28,9 +29,12 @@ PhysicEngine::~PhysicEngine() = default;
 TaskRunner::~TaskRunner() = default;
 RenderEngine::~RenderEngine() = default;
 
+std::vector<std::string> physicEngineNames() { return {"ode", "bullet"}; }
+
 std::unique_ptr<PhysicEngine> createPhysicEngine(const PhysicsSettings& settings) {
   if (settings.engine == "ode") return std::make_unique<detail::OdeEngine>(settings);
-  throw ConfigError({}, "unknown physics engine '" + settings.engine + "' (available: ode)");
+  if (settings.engine == "bullet") return std::make_unique<detail::BulletEngine>(settings);
+  throw ConfigError({}, "unknown physics engine '" + settings.engine + "' (available: ode, bullet)");
 }
 
 std::vector<std::string> renderEngineNames() {

@@ -27,9 +27,13 @@ void checkSettings(const EnvironmentSettings& s) {
   if (s.timestep <= 0) bad("timestep must be positive");
   if (s.timestep > toNanoseconds(kMaxTimestepSeconds)) bad("timestep must be at most 1 s");
   if (s.threads < 0) bad("threads must be 0 (one per core), 1 (inline) or more");
+  const auto engines = physicEngineNames();
+  if (std::find(engines.begin(), engines.end(), s.physics.engine) == engines.end())
+    bad("unknown physics engine '" + s.physics.engine + "' (available: ode, bullet)");
   if (s.physics.substeps < 1) bad("physics substeps must be at least 1");
-  if (s.physics.iterations < 1) bad("physics iterations must be at least 1");
-  if (s.physics.max_contacts < 1) bad("physics max_contacts must be at least 1");
+  if (s.physics.ode.iterations < 1 || s.physics.bullet.iterations < 1) bad("physics iterations must be at least 1");
+  if (s.physics.ode.max_contacts < 1) bad("physics max_contacts must be at least 1");
+  if (s.physics.ode.partitions < 1) bad("physics partitions must be at least 1");
   if (!s.physics.gravity.allFinite()) bad("gravity must be finite");
   if (s.render.period_steps < 0) bad("render period must be 0 (never) or positive");
   if (!(s.render.rate_hz == 0 || (s.render.rate_hz >= kMinRateHz && std::isfinite(s.render.rate_hz))))

@@ -21,9 +21,9 @@ const fs::path kArtifacts = fs::path(SSX_EXAMPLES_DIR) / "artifacts";
 
 // quadrotors with noisy IMUs take off from the ground and fly the formation around a pillar,
 // while boxes fall on the ground and on each other: contacts, noise, neighbours, obstacles
-std::string sceneXml(int threads, const std::string& log = "") {
+std::string sceneXml(int threads, const std::string& log = "", const std::string& engine = "ode") {
   return "<scene><environment timestep=\"0.002\" seed=\"11\" threads=\"" + std::to_string(threads) +
-         "\"/>"
+         "\"/><physics engine=\"" + engine + "\"/>"
          "<type name=\"quad\" file=\"" + (kArtifacts / "mk_quad_formation.xml").string() +
          "\"/><type name=\"box\" file=\"" + (kArtifacts / "box.xml").string() + "\"/><ground/>"
          "<obstacle name=\"pillar\" xyz=\"2.5 0 2\"><cylinder radius=\"0.25\" length=\"4\"/></obstacle>"
@@ -36,8 +36,8 @@ std::string sceneXml(int threads, const std::string& log = "") {
          "</scene>";
 }
 
-Scene load(int threads, const std::string& log = "") {
-  return loadSceneFromString(sceneXml(threads, log), "state.xml", kArtifacts);
+Scene load(int threads, const std::string& log = "", const std::string& engine = "ode") {
+  return loadSceneFromString(sceneXml(threads, log, engine), "state.xml", kArtifacts);
 }
 
 std::vector<std::uint64_t> hashes(Environment& env, int steps, std::size_t* contacts = nullptr) {
@@ -62,8 +62,11 @@ int runCli(const std::string& args) {
 
 }  // namespace
 
-TEST_CASE("a restored world continues bitwise as the uninterrupted run, on 1, 2 and 4 threads", "[state]") {
-  Scene original = load(1);
+TEST_CASE("a restored world continues bitwise as the uninterrupted run, on 1, 2 and 4 threads, on either engine",
+          "[state]") {
+  const std::string engine = GENERATE("ode", "bullet");
+  INFO(engine);
+  Scene original = load(1, "", engine);
   Environment& env = *original.environment;
   env.step(300);
   const std::vector<std::byte> saved = env.saveState();
@@ -73,7 +76,7 @@ TEST_CASE("a restored world continues bitwise as the uninterrupted run, on 1, 2 
 
   for (int threads : {1, 2, 4}) {
     INFO(threads << " thread(s), a freshly loaded scene");
-    Scene fresh = load(threads);
+    Scene fresh = load(threads, "", engine);
     fresh.environment->restoreState(saved);
     CHECK(fresh.environment->stepCount() == 300);
     CHECK(hashes(*fresh.environment, 300) == reference);

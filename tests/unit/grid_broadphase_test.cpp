@@ -1,6 +1,6 @@
 // The grid broadphase against brute force: every overlapping pair exactly once, in an order that
 // depends only on the boxes.
-#include "ode/grid_broadphase.hpp"
+#include "grid_broadphase.hpp"
 
 #include <catch2/catch.hpp>
 

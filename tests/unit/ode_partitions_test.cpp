@@ -62,7 +62,7 @@ std::unique_ptr<PhysicEngine> headOn(int partitions) {
   PhysicsSettings s;
   s.gravity = Vec3::Zero();
   s.restitution = 0.5;
-  s.partitions = partitions;
+  s.ode.partitions = partitions;
   auto e = createPhysicEngine(s);
   for (int i = 0; i < kBodies; ++i) {
     BodyState state = at(Vec3(0, 10.0 * i, 0), Vec3(0.01 * (i % 7), 0, 0.02), Vec3(0.1, 0.3 * (i % 3), -0.2));
@@ -108,12 +108,15 @@ TEST_CASE("bodies in different partitions collide as in one world, on any number
   }
 }
 
-TEST_CASE("a pile of boxes on the ground by an obstacle: same bits on 1, 2 and 4 threads and after a restore",
+TEST_CASE("a pile of boxes on the ground by an obstacle: same bits on 1, 2 and 4 threads and after a restore, on either engine",
           "[physics][parallel]") {
+  const std::string engine = GENERATE("ode", "bullet");
+  INFO(engine);
   // boxes dropped in touching columns onto the ground next to a static wall: contact groups that
   // span home worlds, resting contacts with the ground in every world
-  auto build = [] {
+  auto build = [&] {
     PhysicsSettings s;
+    s.engine = engine;
     auto e = createPhysicEngine(s);
     e->addStatic({Shape::plane()}, Pose{});
     e->addStatic({Shape::box(Vec3(0.2, 4, 1))}, Pose{Vec3(-0.35, 0, 0.5), Quat::Identity()});

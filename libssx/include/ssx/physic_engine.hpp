@@ -16,23 +16,17 @@
 
 namespace ssx {
 
-/// Settings of the physics engine.
-struct PhysicsSettings {
+/// Settings of the ODE engine (`<physics engine="ode">`).
+struct OdeSettings {
   enum class Solver : std::uint8_t {
     QuickStep,  ///< iterative (ODE's dWorldQuickStep): O(n) in constraints; the default
     Exact,      ///< direct LCP (ODE's dWorldStep): accurate, O(n^3) per island
   };
-  std::string engine = "ode";
-  Vec3 gravity{0.0, 0.0, -9.81};  ///< m/s^2, world frame
   Solver solver = Solver::QuickStep;
   int iterations = 20;  ///< QuickStep iterations
   double sor = 1.3;     ///< QuickStep over-relaxation
-  int substeps = 1;     ///< equal physics steps per environment timestep
   double erp = 0.2;     ///< error reduction parameter
   double cfm = 1e-9;    ///< constraint force mixing
-  // contacts
-  double friction = 1.0;     ///< Coulomb coefficient (pyramid approximation)
-  double restitution = 0.0;  ///< bounce, 0..1
   double contact_soft_cfm = 1e-6;
   double contact_soft_erp = 0.2;
   double contact_surface_layer = 1e-3;  ///< m of allowed penetration, for resting stability
@@ -41,10 +35,33 @@ struct PhysicsSettings {
   /// contact are moved into one). Results do not depend on it when no two bodies touch, and never
   /// on the thread count.
   int partitions = 16;
+};
+
+/// Settings of the Bullet engine (`<physics engine="bullet">`): Bullet's sequential-impulse solver.
+struct BulletSettings {
+  int iterations = 10;                      ///< solver iterations per substep
+  double erp = 0.2;                         ///< error reduction of contacts (Bullet's erp2)
+  double cfm = 0.0;                         ///< constraint force mixing (Bullet's globalCfm)
+  bool split_impulse = true;                ///< penetration recovered without adding momentum
+  double split_impulse_threshold = -0.04;   ///< m: deeper penetrations recover with momentum
+  double linear_slop = 0.0;                 ///< m of penetration allowed at rest
+};
+
+/// Settings of the physics: what every engine takes, and each engine's own.
+struct PhysicsSettings {
+  using Solver = OdeSettings::Solver;
+  std::string engine = "ode";  ///< one of physicEngineNames()
+  Vec3 gravity{0.0, 0.0, -9.81};  ///< m/s^2, world frame
+  int substeps = 1;     ///< equal physics steps per environment timestep
+  // contacts
+  double friction = 1.0;     ///< Coulomb coefficient
+  double restitution = 0.0;  ///< bounce, 0..1
   // divergence guards: a body past these speeds stops the run (StepError) before the engine
   // meets a NaN; far beyond anything a robot does, far below where the arithmetic breaks
   double max_linear_speed = 1e5;   ///< m/s
   double max_angular_speed = 1e6;  ///< rad/s
+  OdeSettings ode;        ///< used when engine == "ode"
+  BulletSettings bullet;  ///< used when engine == "bullet"
 };
 
 /// Force and torque on a body, world frame, torque about the centre of mass.
@@ -100,7 +117,9 @@ class SSX_EXPORT PhysicEngine {
   virtual void restoreState(StateReader& in) = 0;
 };
 
-/// Creates a physics engine by name ("ode"); throws ConfigError for an unknown name.
+/// The physics engines in this build of ssx ("ode", "bullet").
+SSX_EXPORT std::vector<std::string> physicEngineNames();
+/// Creates the engine `settings.engine` names; throws ConfigError for an unknown name.
 SSX_EXPORT std::unique_ptr<PhysicEngine> createPhysicEngine(const PhysicsSettings& settings);
 
 }  // namespace ssx

@@ -49,6 +49,8 @@ struct SceneOptions {
   std::optional<std::uint64_t> seed;         ///< overrides <environment seed>
   std::optional<int> threads;                ///< overrides <environment threads>
   std::optional<std::string> render_engine;  ///< overrides <render engine>
+  /// Overrides <physics engine>; the scene's attributes of another engine are then errors.
+  std::optional<std::string> physics_engine;
   /// Outputs for the first camera (a camera framing the whole scene is added if there is none):
   /// a PNG of the last frame, an MP4, a directory of PNG frames. Empty: as the scene says.
   std::filesystem::path snapshot, video, frames_dir;

@@ -136,16 +136,16 @@ OdeEngine::OdeEngine(const PhysicsSettings& settings) : settings_(settings) {
   try {
     ensureThreadData();
     (void)seedIsPerWorld();  // (checked here, on the caller's thread, once per process)
-    partitions_.resize(static_cast<std::size_t>(std::max(1, settings_.partitions)));
+    partitions_.resize(static_cast<std::size_t>(std::max(1, settings_.ode.partitions)));
     for (Partition& p : partitions_) {
       p.world = dWorldCreate();
       const Vec3& g = settings_.gravity;
       dWorldSetGravity(p.world, g.x(), g.y(), g.z());
-      dWorldSetERP(p.world, settings_.erp);
-      dWorldSetCFM(p.world, settings_.cfm);
-      dWorldSetQuickStepNumIterations(p.world, settings_.iterations);
-      dWorldSetQuickStepW(p.world, settings_.sor);
-      dWorldSetContactSurfaceLayer(p.world, settings_.contact_surface_layer);
+      dWorldSetERP(p.world, settings_.ode.erp);
+      dWorldSetCFM(p.world, settings_.ode.cfm);
+      dWorldSetQuickStepNumIterations(p.world, settings_.ode.iterations);
+      dWorldSetQuickStepW(p.world, settings_.ode.sor);
+      dWorldSetContactSurfaceLayer(p.world, settings_.ode.contact_surface_layer);
       dWorldSetAutoDisableFlag(p.world, 0);
       // each world its own (single-threaded) threading implementation: ODE's default one is
       // shared by every world and not meant for worlds stepped at the same time
@@ -164,7 +164,7 @@ OdeEngine::OdeEngine(const PhysicsSettings& settings) : settings_(settings) {
     throw;
   }
 
-  contacts_per_pair_ = static_cast<std::size_t>(std::max(1, settings_.max_contacts));
+  contacts_per_pair_ = static_cast<std::size_t>(std::max(1, settings_.ode.max_contacts));
 }
 
 OdeEngine::~OdeEngine() {
@@ -404,8 +404,8 @@ void OdeEngine::collidePair(dGeomID a, dGeomID b, std::vector<dContact>& out, st
       continue;
     c.surface.mode = dContactApprox1 | dContactSoftCFM | dContactSoftERP;
     c.surface.mu = s.friction;
-    c.surface.soft_cfm = s.contact_soft_cfm;
-    c.surface.soft_erp = s.contact_soft_erp;
+    c.surface.soft_cfm = s.ode.contact_soft_cfm;
+    c.surface.soft_erp = s.ode.contact_soft_erp;
     if (s.restitution > 0) {
       c.surface.mode |= dContactBounce;
       c.surface.bounce = s.restitution;
@@ -520,7 +520,7 @@ void OdeEngine::stepPartition(Partition& p, double h, std::span<const Wrench> wr
     dBodyAddTorque(b, w.torque.x(), w.torque.y(), w.torque.z());
   }
   auto solve = [&] {
-    if (settings_.solver == PhysicsSettings::Solver::Exact)
+    if (settings_.ode.solver == OdeSettings::Solver::Exact)
       dWorldStep(p.world, h);
     else
       dWorldQuickStep(p.world, h);

@@ -17,7 +17,7 @@
 // bodies however they are laid out, where ODE's sweep-and-prune is quadratic in a grid) and the
 // contacts (dCollide) run in parallel chunks too.
 
-#include "ode/grid_broadphase.hpp"
+#include "grid_broadphase.hpp"
 
 #include <ssx/physic_engine.hpp>
 

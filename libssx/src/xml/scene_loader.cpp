@@ -165,18 +165,43 @@ void SceneLoader::readEnvironment(const Descriptor& d) {
   checkUnknown(d);
 }
 
+namespace {
+// each engine's own attributes of <physics>; the common ones are read for every engine
+const std::vector<std::pair<std::string, std::set<std::string>>>& engineAttributes() {
+  static const std::vector<std::pair<std::string, std::set<std::string>>> table = {
+      {"ode",
+       {"solver", "iterations", "sor", "erp", "cfm", "contact_soft_erp", "contact_soft_cfm", "contact_surface_layer",
+        "max_contacts", "partitions"}},
+      {"bullet",
+       {"iterations", "erp", "cfm", "split_impulse", "split_impulse_threshold", "linear_slop"}},
+  };
+  return table;
+}
+}  // namespace
+
 void SceneLoader::readPhysics(const Descriptor& d) {
   PhysicsSettings& p = settings_.physics;
-  p.engine = readChoice(d, "engine", p.engine, {"ode"});
-  p.solver = readChoice(d, "solver", "quickstep", {"quickstep", "exact"}) == "exact"
-                 ? PhysicsSettings::Solver::Exact
-                 : PhysicsSettings::Solver::QuickStep;
-  p.iterations = static_cast<int>(readCount(d, "iterations", p.iterations, 1, 100'000));
-  p.sor = readPositive(d, "sor", p.sor);
+  p.engine = readChoice(d, "engine", p.engine, {"ode", "bullet"});
+  const bool overridden = options_.physics_engine.has_value();
+  if (overridden) p.engine = *options_.physics_engine;
+  // an attribute that only another engine takes is an error: it would silently do nothing
+  const auto& table = engineAttributes();
+  const auto own = std::find_if(table.begin(), table.end(), [&](const auto& e) { return e.first == p.engine; });
+  if (own != table.end()) {
+    for (const auto& [engine, attributes] : table) {
+      if (engine == p.engine) continue;
+      for (const auto& a : attributes) {
+        const auto* attr = d.find(a);
+        if (attr == nullptr || own->second.contains(a)) continue;
+        attr->used = true;
+        error(attr->where, "<physics>: attribute '" + a + "' is an option of the " + engine + " engine, and the engine is '" +
+                               p.engine + "'" + (overridden ? " (chosen with --physics)" : "") +
+                               ": remove it, or choose engine=\"" + engine + "\"");
+      }
+    }
+  }
   p.substeps = static_cast<int>(readCount(d, "substeps", p.substeps, 1, 10'000));
   p.gravity = read<Vec3>(d, "gravity", p.gravity);
-  p.erp = readPositive(d, "erp", p.erp);
-  p.cfm = readPositive(d, "cfm", p.cfm);
   // ODE's broadphases were replaced by ssx's grid (linear in the bodies, parallel)
   for (const char* gone : {"broadphase", "quadtree_center", "quadtree_extents", "quadtree_depth"})
     if (d.has(gone))
@@ -187,11 +212,38 @@ void SceneLoader::readPhysics(const Descriptor& d) {
   if (p.friction < 0) error(d.where(), "<physics>: friction must not be negative");
   p.restitution = read<double>(d, "restitution", p.restitution);
   if (p.restitution < 0 || p.restitution > 1) error(d.where(), "<physics>: restitution must be in 0..1");
-  p.max_contacts = static_cast<int>(readCount(d, "max_contacts", p.max_contacts, 1, 1024));
-  p.partitions = static_cast<int>(readCount(d, "partitions", p.partitions, 1, 1024));
-  p.contact_surface_layer = read<double>(d, "contact_surface_layer", p.contact_surface_layer);
   p.max_linear_speed = readPositive(d, "max_linear_speed", p.max_linear_speed);
   p.max_angular_speed = readPositive(d, "max_angular_speed", p.max_angular_speed);
+  if (p.engine == "ode") {
+    OdeSettings& o = p.ode;
+    o.solver = readChoice(d, "solver", "quickstep", {"quickstep", "exact"}) == "exact" ? OdeSettings::Solver::Exact
+                                                                                       : OdeSettings::Solver::QuickStep;
+    o.iterations = static_cast<int>(readCount(d, "iterations", o.iterations, 1, 100'000));
+    o.sor = readPositive(d, "sor", o.sor);
+    o.erp = readPositive(d, "erp", o.erp);
+    o.cfm = readPositive(d, "cfm", o.cfm);
+    o.contact_soft_erp = readPositive(d, "contact_soft_erp", o.contact_soft_erp);
+    o.contact_soft_cfm = readPositive(d, "contact_soft_cfm", o.contact_soft_cfm);
+    o.max_contacts = static_cast<int>(readCount(d, "max_contacts", o.max_contacts, 1, 1024));
+    o.partitions = static_cast<int>(readCount(d, "partitions", o.partitions, 1, 1024));
+    o.contact_surface_layer = read<double>(d, "contact_surface_layer", o.contact_surface_layer);
+    if (!(o.contact_surface_layer >= 0 && o.contact_surface_layer < 1))
+      error(d.find("contact_surface_layer")->where, "<physics>: contact_surface_layer must be in [0, 1) m");
+  } else if (p.engine == "bullet") {
+    BulletSettings& b = p.bullet;
+    b.iterations = static_cast<int>(readCount(d, "iterations", b.iterations, 1, 100'000));
+    b.erp = read<double>(d, "erp", b.erp);
+    if (!(b.erp >= 0 && b.erp <= 1)) error(d.find("erp")->where, "<physics>: erp must be in 0..1");
+    b.cfm = read<double>(d, "cfm", b.cfm);
+    if (!(b.cfm >= 0 && b.cfm <= 1)) error(d.find("cfm")->where, "<physics>: cfm must be in 0..1");
+    b.split_impulse = read<bool>(d, "split_impulse", b.split_impulse);
+    b.split_impulse_threshold = read<double>(d, "split_impulse_threshold", b.split_impulse_threshold);
+    if (!(b.split_impulse_threshold <= 0 && b.split_impulse_threshold > -1))
+      error(d.find("split_impulse_threshold")->where,
+            "<physics>: split_impulse_threshold is a penetration depth, in (-1, 0] m");
+    b.linear_slop = read<double>(d, "linear_slop", b.linear_slop);
+    if (!(b.linear_slop >= 0 && b.linear_slop < 1)) error(d.find("linear_slop")->where, "<physics>: linear_slop must be in [0, 1) m");
+  }
   checkUnknown(d);
 }
 
@@ -241,6 +293,7 @@ void SceneLoader::build(Scene& scene) {
   if (options_.seed) settings_.seed = *options_.seed;
   if (options_.threads) settings_.threads = *options_.threads;
   if (options_.render_engine) settings_.render.engine = *options_.render_engine;
+  if (options_.physics_engine) settings_.physics.engine = *options_.physics_engine;
   // outputs asked for on the command line go to the first camera (one framing the scene if none)
   if (!options_.snapshot.empty() || !options_.video.empty() || !options_.frames_dir.empty()) {
     auto& cameras = settings_.render.cameras;

@@ -1,4 +1,4 @@
-#include "ode/grid_broadphase.hpp"
+#include "grid_broadphase.hpp"
 
 #include <algorithm>
 #include <cmath>

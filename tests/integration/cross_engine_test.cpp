@@ -1,0 +1,255 @@
+// The same scenes on both physics engines (ODE and Bullet), against closed forms and each other.
+#include "test_util.hpp"
+
+#include <catch2/catch.hpp>
+
+#include <cmath>
+#include <filesystem>
+#include <numbers>
+
+using namespace ssx;
+using ssx::test::at;
+
+namespace {
+
+const std::filesystem::path kArtifacts = std::filesystem::path(SSX_EXAMPLES_DIR) / "artifacts";
+const std::filesystem::path kScenes = std::filesystem::path(SSX_EXAMPLES_DIR) / "scenes";
+
+EnvironmentSettings settings(const std::string& engine, double dt, bool gravity = true) {
+  EnvironmentSettings s;
+  s.timestep = toNanoseconds(dt);
+  s.threads = 1;
+  s.physics.engine = engine;
+  if (!gravity) s.physics.gravity = Vec3::Zero();
+  return s;
+}
+
+Vec3 bodyRate(const Artifact& a) {
+  const BodyState s = a.state();
+  return s.pose.orientation.conjugate() * s.angular_velocity;
+}
+
+}  // namespace
+
+TEST_CASE("cross_engine: free fall and a projectile follow the closed form of semi-implicit Euler", "[physics][cross_engine]") {
+  const std::string engine = GENERATE("ode", "bullet");
+  INFO(engine);
+  // both engines integrate v += g h, then x += v h: after n steps z = z0 + v0 t - g h^2 n (n + 1) / 2,
+  // the exact parabola plus an O(h) offset of -g t h / 2
+  const double h = 0.001, g = 9.81;
+  Environment env(settings(engine, h));
+  Artifact& drop = env.addArtifact("drop", at(0, 0, 100));
+  drop.addPhysicRoot(test::boxBody(Vec3(0.1, 0.1, 0.1), 1.0));
+  Artifact& thrown = env.addArtifact("thrown", at(5, 0, 100));
+  thrown.addPhysicRoot(test::boxBody(Vec3(0.1, 0.1, 0.1), 1.0));
+  thrown.root().setVelocity(Vec3(3, -1, 4), Vec3::Zero());
+  const int n = 1000;
+  env.step(n);
+  const double t = n * h;
+  const double offset = g * h * h * n * (n + 1) / 2.0;
+  CHECK(drop.pose().position.z() == Approx(100.0 - offset).margin(1e-9));
+  CHECK(drop.state().linear_velocity.z() == Approx(-g * t).margin(1e-9));
+  CHECK(std::abs(drop.pose().position.z() - (100.0 - 0.5 * g * t * t)) == Approx(0.5 * g * t * h).margin(1e-9));
+  CHECK(drop.state().linear_acceleration.isApprox(Vec3(0, 0, -g), 1e-9));
+  const Vec3 p = thrown.pose().position;
+  CHECK(p.x() == Approx(5.0 + 3.0 * t).margin(1e-9));
+  CHECK(p.y() == Approx(-1.0 * t).margin(1e-9));
+  CHECK(p.z() == Approx(100.0 + 4.0 * t - offset).margin(1e-9));
+  CHECK(thrown.state().linear_velocity.isApprox(Vec3(3, -1, 4 - g * t), 1e-9));
+}
+
+TEST_CASE("cross_engine: a torque-free top precesses at (J3 - J1)/J1 w3, keeping its energy and momentum",
+          "[physics][cross_engine]") {
+  const std::string engine = GENERATE("ode", "bullet");
+  INFO(engine);
+  Environment env(settings(engine, 0.001, false));
+  const Vec3 j(0.009, 0.009, 0.018);
+  const Mat3 inertia = j.asDiagonal();
+  Artifact& a = env.addArtifact("top", at(0, 0, 0));
+  a.addPhysicRoot(test::boxBody(Vec3(0.1, 0.1, 0.1), 1.0, &inertia));
+  a.root().setVelocity(Vec3::Zero(), Vec3(0.5, 0, 10));
+  env.start();
+  const double e0 = 0.5 * bodyRate(a).dot(j.cwiseProduct(bodyRate(a)));
+  const Vec3 l0 = a.state().pose.orientation * j.cwiseProduct(bodyRate(a));
+  double angle = 0, last = std::atan2(bodyRate(a).y(), bodyRate(a).x());
+  const int n = 2000;
+  for (int i = 0; i < n; ++i) {
+    env.step();
+    const Vec3 w = bodyRate(a);
+    const double now = std::atan2(w.y(), w.x());
+    double d = now - last;
+    if (d > std::numbers::pi) d -= 2 * std::numbers::pi;
+    if (d < -std::numbers::pi) d += 2 * std::numbers::pi;
+    angle += d;
+    last = now;
+  }
+  CHECK(angle / (n * 0.001) == Approx(10.0).epsilon(0.01));
+  const Vec3 w = bodyRate(a);
+  const double e = 0.5 * w.dot(j.cwiseProduct(w));
+  const Vec3 l = a.state().pose.orientation * j.cwiseProduct(w);
+  const double energy_drift = (e - e0) / e0, momentum_drift = (l - l0).norm() / l0.norm();
+  INFO("energy drift " << energy_drift << ", momentum drift " << momentum_drift);
+  CHECK(std::abs(energy_drift) < 1e-3);
+  CHECK(momentum_drift < 1e-3);
+  WARN(engine << ": torque-free top over 2 s: energy drift " << energy_drift << ", momentum drift " << momentum_drift);
+}
+
+TEST_CASE("cross_engine: spin about the intermediate axis flips, and a tilted inertia turns as the same body",
+          "[physics][cross_engine]") {
+  const std::string engine = GENERATE("ode", "bullet");
+  INFO(engine);
+  // Dzhanibekov: a spin about the intermediate axis reverses
+  {
+    Environment env(settings(engine, 0.001, false));
+    const Mat3 j = Vec3(1e-2, 2e-2, 3e-2).asDiagonal();
+    Artifact& a = env.addArtifact("t", at(0, 0, 0));
+    a.addPhysicRoot(test::boxBody(Vec3(0.1, 0.1, 0.1), 1.0, &j));
+    a.root().setVelocity(Vec3::Zero(), Vec3(0.01, 5.0, 0.01));
+    double min_wy = 5.0, first_flip = -1;
+    for (int i = 0; i < 10000; ++i) {
+      env.step();
+      min_wy = std::min(min_wy, bodyRate(a).y());
+      if (first_flip < 0 && bodyRate(a).y() < 0) first_flip = (i + 1) * 0.001;
+    }
+    INFO("first flip at " << first_flip << " s");
+    CHECK(first_flip == Approx(2.7).margin(0.1));
+    CHECK(min_wy < -4.5);
+  }
+  // the same body described in a frame turned 30 degrees: the inertia is no longer diagonal (Bullet
+  // needs principal axes, ODE takes it as it is); the node turns exactly as the diagonal one
+  {
+    Environment env(settings(engine, 0.001, false));
+    const Quat turn(Eigen::AngleAxisd(std::numbers::pi / 6, Vec3(1, 1, 0).normalized()));
+    const Mat3 diagonal = Vec3(1e-2, 2e-2, 3e-2).asDiagonal();
+    const Mat3 tilted = turn.toRotationMatrix() * diagonal * turn.toRotationMatrix().transpose();
+    Artifact& plain = env.addArtifact("plain", at(0, 0, 0));
+    plain.addPhysicRoot(test::boxBody(Vec3(0.1, 0.1, 0.1), 1.0, &diagonal));
+    plain.root().setVelocity(Vec3::Zero(), Vec3(0.3, 0.2, 5.0));  // about the major axis: stable
+    // the tilted description: its node frame is `turn` away from the principal one
+    Artifact& other = env.addArtifact("tilted", Pose{Vec3(1, 0, 0), turn.conjugate()});
+    other.addPhysicRoot(test::boxBody(Vec3(0.1, 0.1, 0.1), 1.0, &tilted));
+    other.root().setVelocity(Vec3::Zero(), Vec3(0.3, 0.2, 5.0));
+    env.step(3000);
+    const Quat qa = plain.pose().orientation;
+    const Quat qb = other.pose().orientation * turn;  // back to the principal frame
+    INFO("orientations differ by " << qa.angularDistance(qb) << " rad");
+    CHECK(qa.angularDistance(qb) < 1e-6);
+    CHECK((plain.state().angular_velocity - other.state().angular_velocity).norm() < 1e-6);
+  }
+}
+
+TEST_CASE("cross_engine: a box resting on the ground stays put", "[physics][cross_engine]") {
+  const std::string engine = GENERATE("ode", "bullet");
+  INFO(engine);
+  Environment env(settings(engine, 0.001));
+  env.addGround();
+  Artifact& box = env.addArtifact("box", at(0.3, -0.2, 0.1));
+  box.addPhysicRoot(test::boxBody(Vec3(0.2, 0.2, 0.2), 1.0));
+  env.step(5000);
+  const Pose p = box.pose();
+  INFO("at " << p.position.transpose());
+  CHECK((p.position.head<2>() - Vec3(0.3, -0.2, 0).head<2>()).norm() < 1e-4);
+  CHECK(p.position.z() == Approx(0.1).margin(2e-3));
+  CHECK(p.orientation.angularDistance(Quat::Identity()) < 1e-3);
+  CHECK(box.state().linear_velocity.norm() < 1e-3);
+  CHECK(env.physics().contactCount() >= 3);  // it stands on more than one point
+}
+
+TEST_CASE("cross_engine: a box sliding on the ground decelerates at mu g and stops", "[physics][cross_engine]") {
+  const std::string engine = GENERATE("ode", "bullet");
+  INFO(engine);
+  const double mu = 0.5, g = 9.81, v0 = 2.0, h = 0.001;
+  EnvironmentSettings s = settings(engine, h);
+  s.physics.friction = mu;
+  Environment env(s);
+  env.addGround();
+  Artifact& box = env.addArtifact("box", at(0, 0, 0.1));
+  box.addPhysicRoot(test::boxBody(Vec3(0.2, 0.2, 0.2), 1.0));
+  env.step(300);  // settled
+  box.root().setVelocity(Vec3(v0, 0, 0), Vec3::Zero());
+  const double x0 = box.pose().position.x();
+  double v_at_50 = 0, v_at_250 = 0, stopped_at = -1;
+  for (int k = 1; k <= 1000; ++k) {
+    env.step();
+    const double v = box.state().linear_velocity.x();
+    if (k == 50) v_at_50 = v;
+    if (k == 250) v_at_250 = v;
+    if (stopped_at < 0 && v < 1e-3) stopped_at = k * h;
+  }
+  const double deceleration = (v_at_50 - v_at_250) / (200 * h);
+  const double distance = box.pose().position.x() - x0;
+  INFO("deceleration " << deceleration << " m/s^2, stopped after " << stopped_at << " s and " << distance << " m");
+  CHECK(deceleration == Approx(mu * g).epsilon(0.05));
+  CHECK(stopped_at == Approx(v0 / (mu * g)).epsilon(0.05));
+  CHECK(distance == Approx(v0 * v0 / (2 * mu * g)).epsilon(0.05));
+  CHECK(box.pose().orientation.angularDistance(Quat::Identity()) < 0.01);  // it slid, it did not tip
+}
+
+TEST_CASE("cross_engine: an mk_quad hovers still and takes off to its hover point", "[quadrotor][cross_engine]") {
+  const std::string engine = GENERATE("ode", "bullet");
+  INFO(engine);
+  auto scene = [&](const std::string& artifact) {
+    return loadSceneFromString("<scene><environment timestep=\"0.002\" seed=\"4\"/><physics engine=\"" + engine +
+                                   "\"/><type name=\"q\" file=\"mk_quad.xml\"/><ground/>" + artifact + "</scene>",
+                               "quad.xml", kArtifacts);
+  };
+  {
+    Scene s = scene(
+        "<artifact name=\"quad\" type=\"q\" xyz=\"0 0 1\"><sensor index=\"0\" noise=\"false\"/><sensor index=\"1\" "
+        "position_noise=\"0\" velocity_noise=\"0\"/></artifact>");
+    Environment& env = *s.environment;
+    Artifact& quad = *env.findArtifact("quad");
+    env.step(500);
+    const Vec3 start = quad.pose().position;
+    double worst = 0;
+    for (int i = 0; i < 5000; ++i) {
+      env.step();
+      worst = std::max(worst, (quad.pose().position - start).norm());
+    }
+    INFO("hover: largest excursion " << worst << " m");
+    CHECK(worst < 0.01);
+    CHECK((quad.pose().position - Vec3(0, 0, 1)).norm() < 0.01);
+  }
+  {
+    Scene s = scene("<artifact name=\"quad\" type=\"q\" xyz=\"0 0 0.04\"><driver offset=\"0 0 1\"/></artifact>");
+    Environment& env = *s.environment;
+    std::size_t contacts = 0;
+    for (int k = 0; k < 250; ++k) {
+      env.step();
+      contacts += env.physics().contactCount();
+    }
+    CHECK(contacts > 0);  // it stood on the ground
+    env.step(2250);
+    INFO("after take-off at " << env.findArtifact("quad")->pose().position.transpose());
+    CHECK((env.findArtifact("quad")->pose().position - Vec3(0, 0, 1.04)).norm() < 0.05);
+  }
+}
+
+TEST_CASE("cross_engine: the figure-eight tracking errors of the two engines are within 10 % of each other",
+          "[quadrotor][cross_engine]") {
+  for (const char* kind : {"eight_horizontal", "eight_vertical"}) {
+    double mean[2] = {0, 0};
+    for (int e = 0; e < 2; ++e) {
+      SceneOptions options;
+      options.physics_engine = e == 0 ? "ode" : "bullet";
+      Scene s = loadScene(kScenes / (std::string(kind) + ".xml"), options);
+      Environment& env = *s.environment;
+      Artifact& quad = *env.findArtifact("quad");
+      env.start();
+      auto* tracker = dynamic_cast<SetpointInterface*>(quad.driver());
+      REQUIRE(tracker != nullptr);
+      double sum = 0;
+      int n = 0;
+      for (int k = 0; k < 12000; ++k) {
+        env.step();
+        if (k % 10 != 0 || env.time() < toNanoseconds(12.0)) continue;
+        sum += (tracker->currentSetpoint().position - quad.pose().position).norm();
+        ++n;
+      }
+      mean[e] = sum / n;
+    }
+    INFO(kind << ": mean error ode " << mean[0] << " m, bullet " << mean[1] << " m");
+    CHECK(std::abs(mean[1] - mean[0]) / mean[0] < 0.10);
+    WARN(kind << ": mean tracking error ode " << mean[0] << " m, bullet " << mean[1] << " m");
+  }
+}
