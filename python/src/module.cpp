@@ -11,6 +11,7 @@
 #include <pybind11/stl.h>
 #include <pybind11/stl/filesystem.h>
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <cmath>
@@ -371,9 +372,15 @@ class PyEnvironment {
 };
 
 ssx::SceneOptions sceneOptions(std::optional<std::uint64_t> seed, std::optional<int> threads,
-                               const std::vector<fs::path>& plugin_path) {
+                               const std::vector<fs::path>& plugin_path, const std::optional<std::string>& physics) {
   ssx::SceneOptions o;
   o.seed = seed;
+  if (physics) {
+    const auto names = ssx::physicEngineNames();
+    if (std::find(names.begin(), names.end(), *physics) == names.end())
+      throw py::value_error("ssx: unknown physics engine '" + *physics + "' (physics_engines() lists them)");
+    o.physics_engine = physics;
+  }
   if (threads) {
     if (*threads < 0) throw py::value_error("ssx: threads must be >= 0 (0: one per core), got " + std::to_string(*threads));
     o.threads = threads;
@@ -458,8 +465,8 @@ PYBIND11_MODULE(_ssx, m) {
   m.def(
       "load_scene",
       [](const fs::path& path, std::optional<std::uint64_t> seed, std::optional<int> threads,
-         const std::vector<fs::path>& plugin_path) {
-        ssx::SceneOptions options = sceneOptions(seed, threads, plugin_path);
+         const std::vector<fs::path>& plugin_path, const std::optional<std::string>& physics) {
+        ssx::SceneOptions options = sceneOptions(seed, threads, plugin_path, physics);
         std::optional<ssx::Scene> scene;
         {
           py::gil_scoped_release release;
@@ -468,13 +475,14 @@ PYBIND11_MODULE(_ssx, m) {
         return std::make_unique<PyEnvironment>(std::move(*scene));
       },
       py::arg("path"), py::arg("seed") = py::none(), py::arg("threads") = py::none(),
-      py::arg("plugin_path") = std::vector<fs::path>{},
-      "Loads a scene file. Raises SceneError (its text: every `file:line: error:` line) before anything starts.");
+      py::arg("plugin_path") = std::vector<fs::path>{}, py::arg("physics") = py::none(),
+      "Loads a scene file (physics: an engine name overriding the scene's). Raises SceneError (its text: every `file:line: error:` line) before anything starts.");
   m.def(
       "load_scene_string",
       [](const std::string& xml, const fs::path& base_dir, std::optional<std::uint64_t> seed,
-         std::optional<int> threads, const std::string& label, const std::vector<fs::path>& plugin_path) {
-        ssx::SceneOptions options = sceneOptions(seed, threads, plugin_path);
+         std::optional<int> threads, const std::string& label, const std::vector<fs::path>& plugin_path,
+         const std::optional<std::string>& physics) {
+        ssx::SceneOptions options = sceneOptions(seed, threads, plugin_path, physics);
         std::optional<ssx::Scene> scene;
         {
           py::gil_scoped_release release;
@@ -484,8 +492,9 @@ PYBIND11_MODULE(_ssx, m) {
       },
       py::arg("xml"), py::arg("base_dir") = fs::path("."), py::arg("seed") = py::none(),
       py::arg("threads") = py::none(), py::arg("label") = "<string>",
-      py::arg("plugin_path") = std::vector<fs::path>{},
+      py::arg("plugin_path") = std::vector<fs::path>{}, py::arg("physics") = py::none(),
       "Loads a scene from text; relative files resolve against base_dir, messages name `label`.");
+  m.def("physics_engines", &ssx::physicEngineNames, "The physics engines of this build (\"ode\", \"bullet\").");
   m.def("data_directory", &ssx::installedDataDirectory,
         "The installed artifact types (artifacts/) and example scenes (scenes/).");
 }

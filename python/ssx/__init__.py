@@ -18,6 +18,7 @@ from ._ssx import (
     data_directory,
     load_scene,
     load_scene_string,
+    physics_engines,
 )
 
 __all__ = [
@@ -31,4 +32,5 @@ __all__ = [
     "data_directory",
     "load_scene",
     "load_scene_string",
+    "physics_engines",
 ]

@@ -120,6 +120,25 @@ TEST_CASE("ssx validate: 0 for a good scene, 2 with the diagnostics for a broken
   CHECK_THAT(bad.err, Contains("parts/negative_mass.xml:3: error: physic node 'body': mass must be positive"));
 }
 
+TEST_CASE("ssx validate and ssx plugins name the engines; --physics chooses one and checks the scene for it",
+          "[cli][cross_engine]") {
+  CHECK_THAT(run({"plugins"}).out, Contains("physics engines: ode, bullet") && Contains("render engines: null"));
+  const std::string scene = (kExamples / "scenes" / "hover_swarm.xml").string();
+  CHECK_THAT(run({"validate", scene}).out, Contains("physics engine ode (available: ode, bullet)"));
+  CHECK_THAT(run({"validate", scene, "--physics", "bullet"}).out, Contains("physics engine bullet"));
+  CHECK(run({"validate", scene, "--physics", "physx"}).status == 2);
+  // an ODE option in a scene run on Bullet is an error at its line, and nothing runs
+  const std::string ode_only = (kData / "valid" / "ode_options.xml").string();
+  const Result refused = run({"run", ode_only, "--physics", "bullet", "--fast", "--steps", "10"});
+  CHECK(refused.status == 2);
+  CHECK_THAT(refused.err, Contains("ode_options.xml:3: error: <physics>: attribute 'sor' is an option of the ode "
+                                   "engine, and the engine is 'bullet' (chosen with --physics)"));
+  CHECK(run({"run", ode_only, "--fast", "--steps", "10"}).status == 0);
+  const Result bullet = run({"run", scene, "--physics", "bullet", "--fast", "--steps", "100"});
+  CHECK(bullet.status == 0);
+  CHECK_THAT(bullet.out, Contains("steps 100, simulated 0.200 s"));
+}
+
 TEST_CASE("bad arguments exit with 2", "[cli]") {
   CHECK(run({"run", "/no/such/scene.xml"}).status == 2);
   CHECK(run({"run", (kExamples / "scenes" / "hover_swarm.xml").string(), "--fast", "--realtime"}).status == 2);

@@ -109,6 +109,19 @@ def test_same_seed_same_bits_on_any_thread_count():
     assert c.seed == 8 and c.state_hash() != a.state_hash()
 
 
+def test_either_physics_engine_flies_the_swarm():
+    assert ssx.physics_engines() == ["ode", "bullet"]
+    ode, bullet = hover(), hover(physics="bullet")
+    ode.step(1500)
+    bullet.step(1500)
+    # both lift the nine quadrotors to 1 m above their start, to within a centimetre of each other
+    assert np.allclose(ode.positions()[:, 2], 1.05, atol=0.05)
+    assert np.allclose(ode.positions(), bullet.positions(), atol=0.01)
+    assert ode.state_hash() != bullet.state_hash()
+    with pytest.raises(ValueError, match="unknown physics engine 'physx'"):
+        hover(physics="physx")
+
+
 def test_setpoints_fly_the_swarm_there():
     env = hover(threads=2)
     start = env.positions()
