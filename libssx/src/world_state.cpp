@@ -77,6 +77,9 @@ std::uint64_t Environment::sceneFingerprint() const {
   std::uint64_t h = fnv1a("ssx scene", 0xcbf29ce484222325ULL);
   auto mix = [&h](std::string_view s) { h = fnv1a(s, fnv1a("|", h)); };
   mix(std::to_string(settings_.timestep));
+  // the engine's block is the engine's own format (left out for ODE, so that states saved before
+  // there was a second engine still fit)
+  if (settings_.physics.engine != "ode") mix("physics " + settings_.physics.engine);
   for (const auto& a : world_->artifacts) {
     mix(a->name());
     // each dynamic root is one body (known before the engine is built)
@@ -149,8 +152,8 @@ void Environment::checkState(std::span<const std::byte> state) const {
   if (fnv1a(state.data() + kHeaderSize, payload) != checksum)
     throw StateError("restoreState: the saved state is corrupted (checksum mismatch)");
   if (fingerprint != sceneFingerprint())
-    throw StateError("restoreState: the state was saved from a different scene (timestep, bodies, artifacts or "
-                     "their plugins differ): load the scene it was saved from");
+    throw StateError("restoreState: the state was saved from a different scene (timestep, physics engine, bodies, "
+                     "artifacts or their plugins differ): load the scene it was saved from");
 }
 
 void Environment::restoreState(std::span<const std::byte> state) {

@@ -4,6 +4,7 @@
 #include <catch2/catch.hpp>
 
 #include <cmath>
+#include <cstring>
 #include <filesystem>
 #include <numbers>
 
@@ -255,4 +256,45 @@ TEST_CASE("cross_engine: the figure-eight tracking errors of the two engines are
     CHECK(std::abs(mean[1] - mean[0]) / mean[0] < 0.10);
     WARN(kind << ": mean tracking error ode " << mean[0] << " m, bullet " << mean[1] << " m");
   }
+}
+
+TEST_CASE("cross_engine: an engine refuses a saved body state it could not have produced, and keeps its own",
+          "[physics][cross_engine][state]") {
+  const std::string engine = GENERATE("ode", "bullet");
+  INFO(engine);
+  PhysicsSettings s;
+  s.engine = engine;
+  auto e = createPhysicEngine(s);
+  MassProperties m;
+  m.mass = 1;
+  m.inertia = Mat3::Identity() * 0.01;
+  BodyState start;
+  start.pose.position = Vec3(1, 2, 3);
+  start.angular_velocity = Vec3(0, 0, 1);
+  e->addBody(m, {Shape::sphere(0.1)}, start);
+  std::vector<Wrench> none(1);
+  e->step(toNanoseconds(0.001), none);
+  std::vector<std::byte> saved;
+  StateWriter w(saved);
+  e->saveState(w);
+  std::vector<BodyState> before(1), after(1);
+  e->readStates(before);
+  // the last value both engines write is the body's angular velocity about z
+  auto with_last = [&](double v) {
+    std::vector<std::byte> bad = saved;
+    std::memcpy(bad.data() + bad.size() - sizeof v, &v, sizeof v);
+    return bad;
+  };
+  for (const auto& [value, message] : {std::pair{std::nan(""), "NaN or infinite"}, std::pair{1e7, "faster than"}}) {
+    const std::vector<std::byte> bad = with_last(value);
+    StateReader r(bad);
+    CHECK_THROWS_WITH(e->restoreState(r), Catch::Contains(message));
+    e->readStates(after);
+    CHECK(after[0].pose.position == before[0].pose.position);
+    CHECK(after[0].angular_velocity == before[0].angular_velocity);
+  }
+  StateReader good(saved);
+  e->restoreState(good);
+  e->readStates(after);
+  CHECK(after[0].pose.position == before[0].pose.position);
 }

@@ -110,6 +110,9 @@ TEST_CASE("a truncated, corrupted or foreign state is refused and changes nothin
   CHECK_THROWS_WITH(env.restoreState(truncated), Catch::Contains("truncated"));
   CHECK_THROWS_WITH(env.restoreState(corrupted), Catch::Contains("corrupted (checksum mismatch)"));
   CHECK_THROWS_WITH(env.restoreState(foreign), Catch::Contains("saved from a different scene"));
+  // the same scene on the other engine: its physics state is another engine's
+  Scene on_bullet = load(2, "", "bullet");
+  CHECK_THROWS_WITH(on_bullet.environment->restoreState(saved), Catch::Contains("physics engine"));
   CHECK_THROWS_WITH(env.restoreState(std::vector<std::byte>(10)), Catch::Contains("not an ssx saved state"));
   // nothing moved: the world is still at step 150 and goes on as it would have
   CHECK(env.stepCount() == 150);
