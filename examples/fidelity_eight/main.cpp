@@ -10,7 +10,8 @@
 // (ideal, each effect alone, realistic) and prints one line per configuration:
 //   config=NAME horizontal_mean_m=... horizontal_std_m=... vertical_mean_m=... vertical_std_m=...
 //
-// usage: ssx_fidelity_eight [--scenes DIR] [--out DIR] [--seed N] [--profile ideal|realistic] [--ablation]
+// usage: ssx_fidelity_eight [--scenes DIR] [--out DIR] [--seed N] [--profile ideal|realistic]
+//                           [--physics ode|bullet] [--ablation]
 #include <ssx/ssx.hpp>
 
 #include <cmath>
@@ -128,10 +129,12 @@ int main(int argc, char** argv) {
       out = argv[i + 1];
     else if (std::strcmp(argv[i], "--seed") == 0)
       options.seed = std::stoull(argv[i + 1]);
+    else if (std::strcmp(argv[i], "--physics") == 0)
+      options.physics_engine = argv[i + 1];
     else {
       std::fprintf(stderr,
                    "usage: ssx_fidelity_eight [--scenes DIR] [--out DIR] [--seed N] [--profile ideal|realistic] "
-                   "[--ablation]\n");
+                   "[--physics ode|bullet] [--ablation]\n");
       return 2;
     }
   }

@@ -10,6 +10,7 @@
 // median sample over N)
 //
 // usage: ssx_rt_study [--n N]... [--samples K] [--threads T] [--physics-hz H] [--tau S] [--csv FILE]
+//                     [--physics ode|bullet]
 //                     [--fast]
 //   --physics-hz  physics rate (default 1/tau: one physics step per tau, as the paper). When it is
 //                 faster than 1/tau the environment steps at min(H, 500 Hz) with the rest as physics
@@ -36,6 +37,7 @@ struct Options {
   double physics_hz = 0;  // 0: 1/tau
   std::string csv;
   bool fast = false;
+  std::string physics;  // the engine, if not the scene's
 };
 
 // the scene for N robots: the environment steps at the physics rate when it is faster than 1/tau
@@ -91,12 +93,14 @@ int main(int argc, char** argv) {
         o.csv = value();
       else if (a == "--fast")
         o.fast = true;
+      else if (a == "--physics")
+        o.physics = value();
       else
         throw std::runtime_error("unknown option " + a);
     } catch (const std::exception& e) {
       std::fprintf(stderr,
                    "ssx_rt_study: %s\nusage: ssx_rt_study [--n N]... [--samples K] [--threads T] "
-                   "[--physics-hz H] [--tau S] [--csv FILE] [--fast]\n",
+                   "[--physics-hz H] [--tau S] [--csv FILE] [--fast] [--physics ode|bullet]\n",
                    e.what());
       return 2;
     }
@@ -109,8 +113,10 @@ int main(int argc, char** argv) {
   }
   for (int n : o.sizes) {
     try {
-      ssx::Scene scene =
-          ssx::loadSceneFromString(sceneFor(n, o), "rt_study.xml", ssx::installedDataDirectory() / "artifacts");
+      ssx::SceneOptions options;
+      if (!o.physics.empty()) options.physics_engine = o.physics;
+      ssx::Scene scene = ssx::loadSceneFromString(sceneFor(n, o), "rt_study.xml",
+                                                  ssx::installedDataDirectory() / "artifacts", options);
       ssx::Environment& env = *scene.environment;
       env.setLogSink([](ssx::LogLevel, std::string_view) {});  // overruns are counted, not printed
       ssx::RunOptions run;
