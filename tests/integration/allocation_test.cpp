@@ -51,10 +51,13 @@ void operator delete(void* p, std::align_val_t, const std::nothrow_t&) noexcept 
 using namespace ssx;
 namespace fs = std::filesystem;
 
-TEST_CASE("after warm-up a step allocates nothing: quadrotors, formation, contacts, 2 threads", "[allocation]") {
+TEST_CASE("after warm-up a step allocates nothing: quadrotors, formation, contacts, 2 threads, either engine",
+          "[allocation]") {
+  const std::string engine = GENERATE("ode", "bullet");
+  INFO(engine);
   const fs::path artifacts = fs::path(SSX_EXAMPLES_DIR) / "artifacts";
   const std::string xml =
-      "<scene><environment timestep=\"0.002\" seed=\"3\" threads=\"2\"/>"
+      "<scene><environment timestep=\"0.002\" seed=\"3\" threads=\"2\"/><physics engine=\"" + engine + "\"/>"
       "<type name=\"quad\" file=\"" + (artifacts / "mk_quad_formation.xml").string() +
       "\"/><type name=\"box\" file=\"" + (artifacts / "box.xml").string() + "\"/><ground/>"
       "<obstacle name=\"pillar\" xyz=\"2.5 0 2\"><cylinder radius=\"0.25\" length=\"4\"/></obstacle>"

@@ -241,8 +241,17 @@ void BulletEngine::indexGeoms() {
   poses_.resize(proxies_.size());
   for (std::size_t k = dynamic_proxies_; k < proxies_.size(); ++k)
     poses_[k].transform = proxies_[k].object->getWorldTransform();
+  // room for what a substep usually needs, so that steps do not allocate: every body in contact
+  // with a few others
   group_.assign(bodies_.size(), -1);
   touched_.reserve(bodies_.size());
+  members_.reserve(bodies_.size());
+  island_bodies_.reserve(bodies_.size());
+  islands_.reserve(bodies_.size());
+  free_bodies_.reserve(bodies_.size());
+  manifolds_.reserve(4 * bodies_.size() + 64);
+  island_manifolds_.reserve(4 * bodies_.size() + 64);
+  manifold_order_.reserve(4 * bodies_.size() + 64);
 }
 
 void BulletEngine::placeGeoms(std::size_t begin, std::size_t end) {
@@ -297,7 +306,8 @@ void BulletEngine::narrowphase(Context& context, Chunk& chunk, int a, int b, dou
   info.m_timeStep = h;
   info.m_useContinuous = false;
   algorithm->processCollision(&wa, &wb, info, &result);
-  btManifoldArray found;
+  btManifoldArray& found = *chunk.found;
+  found.resize(0);
   algorithm->getAllContactManifolds(found);
   for (int m = 0; m < found.size(); ++m) {
     btPersistentManifold* manifold = found[m];
@@ -336,7 +346,17 @@ void BulletEngine::collide(double h) {
   const std::size_t grid_chunks = grid_.chunkCount();
   const std::size_t plane_chunks =
       planes_.empty() ? 0 : (dynamic_proxies_ + kGeomsPerPlaneChunk - 1) / kGeomsPerPlaneChunk;
-  if (chunks_.size() < grid_chunks + plane_chunks) chunks_.resize(grid_chunks + plane_chunks);
+  if (chunks_.size() < grid_chunks + plane_chunks) {
+    const std::size_t had = chunks_.size();
+    chunks_.resize(grid_chunks + plane_chunks);
+    for (std::size_t c = had; c < chunks_.size(); ++c) {
+      chunks_[c].pairs.reserve(256);
+      chunks_[c].algorithms.reserve(c < plane_chunks ? kGeomsPerPlaneChunk : 256);
+      chunks_[c].manifolds.reserve(c < plane_chunks ? kGeomsPerPlaneChunk : 256);
+      chunks_[c].found = std::make_shared<btManifoldArray>();
+      chunks_[c].found->reserve(4);
+    }
+  }
   const double threshold = gContactBreakingThreshold;
   forEach(grid_chunks + plane_chunks, [&](std::size_t c) {
     Chunk& chunk = chunks_[c];
@@ -401,8 +421,8 @@ void BulletEngine::buildIslands() {
     }
   }
   // islands in the order of their lowest body; bodies ascending, manifolds in pair order
-  std::vector<std::pair<int, int>> members;  // (root, body)
-  members.reserve(touched_.size());
+  std::vector<std::pair<int, int>>& members = members_;  // (root, body)
+  members.clear();
   for (const int i : touched_) members.emplace_back(find(i), i);
   std::sort(members.begin(), members.end());
   islands_.clear();
@@ -413,8 +433,8 @@ void BulletEngine::buildIslands() {
     island_bodies_.push_back(bodies_[static_cast<std::size_t>(members[k].second)]->rb.get());
     ++islands_.back().bodies;
   }
-  std::vector<std::pair<int, std::size_t>> order;  // (root, manifold index)
-  order.reserve(manifolds_.size());
+  std::vector<std::pair<int, std::size_t>>& order = manifold_order_;  // (root, manifold index)
+  order.clear();
   for (std::size_t k = 0; k < manifolds_.size(); ++k) order.emplace_back(find(ownerOf(manifolds_[k])), k);
   std::sort(order.begin(), order.end());
   island_manifolds_.clear();

@@ -30,6 +30,8 @@
 #include <mutex>
 #include <vector>
 
+template <typename T>
+class btAlignedObjectArray;
 class btCollisionAlgorithm;
 class btCollisionObject;
 class btCollisionShape;
@@ -69,6 +71,7 @@ class BulletEngine final : public PhysicEngine {
     std::vector<std::pair<int, int>> pairs;
     std::vector<std::pair<btCollisionAlgorithm*, Context*>> algorithms;  // this substep's, and who made them
     std::vector<btPersistentManifold*> manifolds;                        // theirs with contacts
+    std::shared_ptr<btAlignedObjectArray<btPersistentManifold*>> found;  // an algorithm's manifolds, reused
   };
   struct Island {
     int root;  // its lowest body
@@ -116,6 +119,8 @@ class BulletEngine final : public PhysicEngine {
   std::vector<btPersistentManifold*> manifolds_;  // this substep's with contacts, in pair order
   std::vector<int> group_;                         // union-find over bodies (-1: in no contact)
   std::vector<int> touched_;
+  std::vector<std::pair<int, int>> members_;                // (island root, body)
+  std::vector<std::pair<int, std::size_t>> manifold_order_;  // (island root, manifold)
   std::vector<btCollisionObject*> island_bodies_;
   std::vector<btPersistentManifold*> island_manifolds_;
   std::vector<Island> islands_;
