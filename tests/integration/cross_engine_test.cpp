@@ -298,3 +298,60 @@ TEST_CASE("cross_engine: an engine refuses a saved body state it could not have 
   e->readStates(after);
   CHECK(after[0].pose.position == before[0].pose.position);
 }
+
+TEST_CASE("cross_engine: substeps, forces off the centre of mass and restitution", "[physics][cross_engine]") {
+  const std::string engine = GENERATE("ode", "bullet");
+  INFO(engine);
+  const double g = 9.81;
+  {
+    // 4 substeps of a 4 ms step are 4 steps of 1 ms: the closed form at h = 1 ms
+    EnvironmentSettings s = settings(engine, 0.004);
+    s.physics.substeps = 4;
+    Environment env(s);
+    Artifact& a = env.addArtifact("drop", at(0, 0, 100));
+    a.addPhysicRoot(test::boxBody(Vec3(0.1, 0.1, 0.1), 1.0));
+    env.step(250);
+    const int n = 1000;
+    const double h = 0.001;
+    CHECK(a.pose().position.z() == Approx(100.0 - g * h * h * n * (n + 1) / 2.0).margin(1e-9));
+  }
+  {
+    // a force at the end of a bar, in its own frame, pushes and turns it
+    Environment env(settings(engine, 0.001, false));
+    Artifact& a = env.addArtifact("bar", at(0, 0, 0));
+    a.addPhysicRoot(test::boxBody(Vec3(1.0, 0.1, 0.1), 1.0));
+    a.setDriver(std::make_unique<test::LambdaDriver>([](Driver& d, const StepInfo& info) {
+      if (info.step == 0) d.artifact().root().addForce(Vec3(0, 1, 0), Frame::World, Vec3(0.5, 0, 0), Frame::Local);
+    }));
+    env.step(3);
+    const BodyState st = a.state();
+    CHECK(st.linear_velocity.y() == Approx(0.001).margin(1e-12));
+    CHECK(st.angular_velocity.z() == Approx(0.5 * 0.001 / ((1.0 + 0.01) / 12.0)).epsilon(1e-9));
+  }
+  {
+    // a ball dropped from 1 m with restitution 0.5 comes back to about a quarter of the height
+    EnvironmentSettings s = settings(engine, 0.001);
+    s.physics.restitution = 0.5;
+    Environment env(s);
+    env.addGround();
+    PhysicNodeSpec ball;
+    ball.name = "ball";
+    ball.shapes.push_back(Shape::sphere(0.05));
+    ball.mass = 0.1;
+    Artifact& a = env.addArtifact("ball", at(0, 0, 1.05));
+    a.addPhysicRoot(ball);
+    double lowest = 10, apex = 0;
+    bool bounced = false;
+    for (int k = 0; k < 1500; ++k) {
+      env.step();
+      const double z = a.pose().position.z() - 0.05;
+      lowest = std::min(lowest, z);
+      if (!bounced && a.state().linear_velocity.z() > 0) bounced = true;
+      if (bounced) apex = std::max(apex, z);
+    }
+    INFO("rebound to " << apex << " m, lowest " << lowest << " m");
+    CHECK(bounced);
+    CHECK(apex == Approx(0.25).epsilon(0.1));
+    CHECK(lowest > -0.005);  // it did not sink into the ground
+  }
+}

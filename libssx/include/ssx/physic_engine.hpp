@@ -42,8 +42,8 @@ struct BulletSettings {
   int iterations = 10;                      ///< solver iterations per substep
   double erp = 0.2;                         ///< error reduction of contacts (Bullet's erp2)
   double cfm = 0.0;                         ///< constraint force mixing (Bullet's globalCfm)
-  bool split_impulse = true;                ///< penetration recovered without adding momentum
-  double split_impulse_threshold = -0.04;   ///< m: deeper penetrations recover with momentum
+  bool split_impulse = true;               ///< deep penetrations pushed out without adding momentum
+  double split_impulse_threshold = -0.04;  ///< m, <= 0: shallower penetrations are pushed out through the velocity
   double linear_slop = 0.0;                 ///< m of penetration allowed at rest
 };
 

@@ -54,6 +54,13 @@ double diameterOf(const Shape& s) {
   return 0.0;
 }
 
+// the velocity of an object's material point at `world` (a static object: zero)
+btVector3 velocityAt(const btCollisionObject* object, const btVector3& world) {
+  const btRigidBody* rb = btRigidBody::upcast(object);
+  if (rb == nullptr) return btVector3(0, 0, 0);
+  return rb->getVelocityInLocalPoint(world - rb->getCenterOfMassPosition());
+}
+
 // A body's state bit for bit: the rotation matrix Bullet keeps (row by row), the origin, the
 // linear and angular velocity
 constexpr std::size_t kBodyReals = 9 + 3 + 3 + 3;
@@ -311,12 +318,24 @@ void BulletEngine::narrowphase(Context& context, Chunk& chunk, int a, int b, dou
   algorithm->getAllContactManifolds(found);
   for (int m = 0; m < found.size(); ++m) {
     btPersistentManifold* manifold = found[m];
+    // Bullet reports points up to 2 cm apart, which its solver uses speculatively: it lets the gap
+    // close and no more. A body that would reach the surface within this substep is thereby
+    // stopped at it, a substep before the impact, so it never bounces (restitution is lost). Such
+    // a point is made a touching one: the impact, with its restitution, happens now, less than one
+    // substep's travel early. Points the body does not reach within the substep stay speculative.
     const int n = manifold->getNumContacts();
     if (n == 0) continue;
     for (int k = 0; k < n; ++k) {
       btManifoldPoint& p = manifold->getContactPoint(k);
+      bool touching = p.getDistance() <= 0;
+      if (!touching) {
+        const btVector3 closing = velocityAt(manifold->getBody1(), p.getPositionWorldOnB()) -
+                                  velocityAt(manifold->getBody0(), p.getPositionWorldOnA());
+        touching = closing.dot(p.m_normalWorldOnB) * h >= p.getDistance();
+        if (touching) p.setDistance(0);
+      }
       p.m_combinedFriction = settings_.friction;
-      p.m_combinedRestitution = settings_.restitution;
+      p.m_combinedRestitution = touching ? settings_.restitution : 0.0;  // (a speculative point only stops)
       p.m_combinedRollingFriction = 0;
       p.m_combinedSpinningFriction = 0;
     }
