@@ -7,7 +7,9 @@
 //   n=1000 frames=100 width=640 height=480 median_ms=3.10 p95_ms=3.40
 // LP_NUM_THREADS (llvmpipe's rasteriser threads) is 0 unless set in the environment.
 //
-// usage: ssx_bench_render [--n N]... [--frames K] [--width W] [--height H]
+// --png DIR writes each N's last frame to DIR/render_N.png (to look at what the level of detail does).
+//
+// usage: ssx_bench_render [--n N]... [--frames K] [--width W] [--height H] [--png DIR]
 #include <ssx/ssx.hpp>
 
 #include <algorithm>
@@ -21,15 +23,20 @@
 int main(int argc, char** argv) {
   std::vector<int> sizes;
   int frames = 100, width = 640, height = 480;
+  std::string png_dir;
   for (int i = 1; i + 1 < argc; i += 2) {
     const std::string a = argv[i];
+    if (a == "--png") {
+      png_dir = argv[i + 1];
+      continue;
+    }
     const int v = std::stoi(argv[i + 1]);
     if (a == "--n") sizes.push_back(v);
     else if (a == "--frames") frames = v;
     else if (a == "--width") width = v;
     else if (a == "--height") height = v;
     else {
-      std::fprintf(stderr, "usage: ssx_bench_render [--n N]... [--frames K] [--width W] [--height H]\n");
+      std::fprintf(stderr, "usage: ssx_bench_render [--n N]... [--frames K] [--width W] [--height H] [--png DIR]\n");
       return 2;
     }
   }
@@ -70,6 +77,7 @@ int main(int argc, char** argv) {
         const std::chrono::duration<double, std::milli> dt = std::chrono::steady_clock::now() - t0;
         if (f > 0) ms.push_back(dt.count());  // the first frame compiles the shaders
       }
+      if (!png_dir.empty()) ssx::writePng(png_dir + "/render_" + std::to_string(n) + ".png", image);
       std::sort(ms.begin(), ms.end());
       std::printf("n=%d frames=%zu width=%d height=%d median_ms=%.2f p95_ms=%.2f\n", n, ms.size(), width, height,
                   ms[ms.size() / 2], ms[ms.size() * 95 / 100]);

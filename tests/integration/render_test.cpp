@@ -10,6 +10,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <numbers>
 #include <string>
 
 using namespace ssx;
@@ -220,4 +221,58 @@ TEST_CASE("render: an ffmpeg that fails makes stopping fail with the video's nam
   }
   CHECK(reported);
   CHECK_THAT(slurpText("out.mp4.ffmpeg.log"), Catch::Contains("no encoder here"));
+}
+
+TEST_CASE("render: levels of detail keep a primitive's size in the image, and what is partly in view is drawn",
+          "[render]") {
+  REQUIRE(haveOsmesa());
+  RenderSettings settings;
+  settings.engine = "osmesa";
+  auto engine = createRenderEngine(settings);
+  CameraView view;  // at the origin, looking along +x, 640 x 480, 60 degrees
+  view.far = 500;
+  const double pixels_per_metre = 480 / (2 * std::tan(std::numbers::pi / 6) * 480 / 640);  // at 1 m
+  auto redPixels = [](const Image& im, int column = -1) {
+    int count = 0;
+    for (int y = 0; y < im.height; ++y)
+      for (int x = 0; x < im.width; ++x) {
+        if (column >= 0 && x != column) continue;
+        const std::uint8_t* p = im.pixel(x, y);
+        count += p[0] > 30 && p[1] < 30 && p[2] < 30 ? 1 : 0;  // red, however dimly lit
+      }
+    return count;
+  };
+  Image im;
+  // a thin disc (a rotor) and a sphere facing the camera, near (full detail) to far (the coarsest
+  // polygon, a disc drawn as its face): the red area stays the true one
+  RenderNodeSpec disc;
+  disc.primitive = RenderNodeSpec::Primitive::Cylinder;
+  disc.radius = 0.5;
+  disc.length = 0.005;
+  disc.color = {1, 0, 0, 1};
+  RenderNodeSpec ball = disc;
+  ball.primitive = RenderNodeSpec::Primitive::Sphere;
+  const Quat facing(Eigen::AngleAxisd(std::numbers::pi / 2, Vec3::UnitY()));  // the disc's axis along x
+  for (const RenderNodeSpec* spec : {&disc, &ball})
+    for (double d : {8.0, 30.0, 60.0, 100.0}) {
+      const double r = 0.5 / d * pixels_per_metre;
+      engine->renderView(view, {RenderNode{spec, nullptr, Pose{Vec3(d, 0, 0), facing}}}, {0.2f, 0.4f, 0.6f, 1}, im);
+      const double area = std::numbers::pi * r * r;
+      INFO((spec == &disc ? "disc" : "sphere") << " at " << d << " m: radius " << r << " px, " << redPixels(im)
+                                               << " red pixels for " << area);
+      CHECK(redPixels(im) == Approx(area).epsilon(r > 5 ? 0.05 : 0.15));
+    }
+  // a box mostly left of the image is still drawn at the image's left edge
+  RenderNodeSpec box = disc;
+  box.primitive = RenderNodeSpec::Primitive::Box;
+  box.size = Vec3(1, 1, 1);
+  const double edge = 10 * std::tan(std::numbers::pi / 6);  // the image's left edge at 10 m
+  engine->renderView(view, {RenderNode{&box, nullptr, Pose{Vec3(10, edge + 0.4, 0), Quat::Identity()}}},
+                     {0.2f, 0.4f, 0.6f, 1}, im);
+  CHECK(redPixels(im, 0) > 10);
+  // one far beyond the far plane, or behind the camera, is not
+  for (const Vec3& at : {Vec3(600, 0, 0), Vec3(-5, 0, 0)}) {
+    engine->renderView(view, {RenderNode{&box, nullptr, Pose{at, Quat::Identity()}}}, {0.2f, 0.4f, 0.6f, 1}, im);
+    CHECK(redPixels(im) == 0);
+  }
 }

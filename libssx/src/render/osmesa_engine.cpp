@@ -1,10 +1,12 @@
 // The osmesa render engine: Mesa's software OpenGL (llvmpipe) into a memory buffer, no display.
 //
 // One OpenGL 3.3 core context, created on the first draw, on the thread that draws (the thread
-// calling Environment::step). Every primitive kind is one unit mesh; each frame uploads one
-// instance record per visible primitive (position, orientation, scale, colour) and draws each mesh
-// with a single instanced call, so a frame costs a handful of draw calls whatever the number of
-// robots. Lighting: a sun from above plus a light at the eye, and a 1 m grid on ground planes.
+// calling Environment::step). Every primitive kind is a unit mesh, spheres and cylinders in four
+// levels of detail; each frame uploads one instance record per visible primitive (position,
+// orientation, scale, colour) and draws each mesh with a single instanced call, so a frame costs a
+// handful of draw calls whatever the number of robots. Primitives outside the view or smaller than
+// a quarter pixel are left out; the coarser a polygon, the larger it is made, so that what a
+// person sees covers the true area; boxes and cylinders thinner than a pixel are drawn as one face. Lighting: a sun from above plus a light at the eye, and a 1 m grid on ground planes.
 #include "render/osmesa_engine.hpp"
 
 #define GL_GLEXT_PROTOTYPES 1
@@ -93,7 +95,16 @@ struct Instance {
   float grid;
 };
 
-enum Mesh { kBox, kSphere, kCylinder, kPlane, kMeshCount };
+// spheres and cylinders in four levels of detail, chosen by the size they appear in the image
+enum Mesh {
+  kBox,
+  kSphere, kSphereMid, kSphereLow, kSphereTiny,
+  kCylinder, kCylinderMid, kCylinderLow, kCylinderTiny,
+  kDisc, kDiscMid, kDiscLow, kDiscTiny,  // a cylinder thinner than a pixel: one face, seen from both sides
+  kPlane,  // also a box thinner than a pixel: its largest face
+  kMeshCount
+};
+constexpr bool twoSided(int mesh) { return mesh == kPlane || (mesh >= kDisc && mesh <= kDiscTiny); }
 
 void addQuad(std::vector<Vertex>& v, std::vector<unsigned>& idx, const std::array<float, 3>& n,
              const std::array<std::array<float, 3>, 4>& corners) {
@@ -113,16 +124,22 @@ void boxMesh(std::vector<Vertex>& v, std::vector<unsigned>& idx) {
   addQuad(v, idx, {0, 0, -1}, {{{-h, h, -h}, {h, h, -h}, {h, -h, -h}, {-h, -h, -h}}});
 }
 
-// a unit sphere (radius 1)
-void sphereMesh(std::vector<Vertex>& v, std::vector<unsigned>& idx) {
-  constexpr int stacks = 12, slices = 20;
-  const float pi = std::numbers::pi_v<float>;
+// the radius of a regular polygon of `sides` with the area of the unit circle: a coarse disc or
+// cylinder looks as large as the round one it stands for
+float equalAreaRadius(int sides) {
+  const double pi = std::numbers::pi;
+  return static_cast<float>(std::sqrt(2 * pi / (sides * std::sin(2 * pi / sides))));
+}
+
+// a unit sphere (radius 1; a coarse one a little larger, so that its outline has the circle's area)
+void sphereMesh(std::vector<Vertex>& v, std::vector<unsigned>& idx, int stacks, int slices) {
+  const float pi = std::numbers::pi_v<float>, r = equalAreaRadius(slices);
   for (int i = 0; i <= stacks; ++i) {
     const float theta = pi * static_cast<float>(i) / stacks;
     for (int j = 0; j <= slices; ++j) {
       const float phi = 2 * pi * static_cast<float>(j) / slices;
       const float x = std::sin(theta) * std::cos(phi), y = std::sin(theta) * std::sin(phi), z = std::cos(theta);
-      v.push_back({{x, y, z}, {x, y, z}});
+      v.push_back({{r * x, r * y, r * z}, {x, y, z}});
     }
   }
   for (int i = 0; i < stacks; ++i)
@@ -132,15 +149,14 @@ void sphereMesh(std::vector<Vertex>& v, std::vector<unsigned>& idx) {
     }
 }
 
-// a cylinder of radius 1 and length 1 along z, centred, with caps
-void cylinderMesh(std::vector<Vertex>& v, std::vector<unsigned>& idx) {
-  constexpr int slices = 20;
-  const float pi = std::numbers::pi_v<float>;
+// a cylinder of radius 1 (a prism of equal cross-section) and length 1 along z, centred, with caps
+void cylinderMesh(std::vector<Vertex>& v, std::vector<unsigned>& idx, int slices) {
+  const float pi = std::numbers::pi_v<float>, r = equalAreaRadius(slices);
   const auto side = static_cast<unsigned>(v.size());
   for (int j = 0; j <= slices; ++j) {
     const float phi = 2 * pi * static_cast<float>(j) / slices, c = std::cos(phi), s = std::sin(phi);
-    v.push_back({{c, s, -0.5f}, {c, s, 0}});
-    v.push_back({{c, s, 0.5f}, {c, s, 0}});
+    v.push_back({{r * c, r * s, -0.5f}, {c, s, 0}});
+    v.push_back({{r * c, r * s, 0.5f}, {c, s, 0}});
   }
   for (int j = 0; j < slices; ++j) {
     const auto a = side + static_cast<unsigned>(2 * j);
@@ -151,7 +167,7 @@ void cylinderMesh(std::vector<Vertex>& v, std::vector<unsigned>& idx) {
     v.push_back({{0, 0, z}, {0, 0, z > 0 ? 1.0f : -1.0f}});
     for (int j = 0; j <= slices; ++j) {
       const float phi = 2 * pi * static_cast<float>(j) / slices;
-      v.push_back({{std::cos(phi), std::sin(phi), z}, {0, 0, z > 0 ? 1.0f : -1.0f}});
+      v.push_back({{r * std::cos(phi), r * std::sin(phi), z}, {0, 0, z > 0 ? 1.0f : -1.0f}});
     }
     for (int j = 0; j < slices; ++j) {
       const auto a = centre + 1 + static_cast<unsigned>(j);
@@ -161,6 +177,17 @@ void cylinderMesh(std::vector<Vertex>& v, std::vector<unsigned>& idx) {
         for (unsigned k : {centre, a + 1, a}) idx.push_back(k);
     }
   }
+}
+
+// a disc of radius 1 (a polygon of equal area) in the xy plane, facing +z
+void discMesh(std::vector<Vertex>& v, std::vector<unsigned>& idx, int slices) {
+  const float pi = std::numbers::pi_v<float>, r = equalAreaRadius(slices);
+  for (int j = 0; j < slices; ++j) {
+    const float phi = 2 * pi * static_cast<float>(j) / slices;
+    v.push_back({{r * std::cos(phi), r * std::sin(phi), 0}, {0, 0, 1}});
+  }
+  for (int j = 1; j + 1 < slices; ++j)
+    for (unsigned k : {0u, static_cast<unsigned>(j), static_cast<unsigned>(j + 1)}) idx.push_back(k);
 }
 
 // a unit square in the xy plane, facing +z
@@ -271,8 +298,18 @@ void OsmesaRenderEngine::setup() {
     std::vector<unsigned> indices;
     switch (m) {
       case kBox: boxMesh(vertices, indices); break;
-      case kSphere: sphereMesh(vertices, indices); break;
-      case kCylinder: cylinderMesh(vertices, indices); break;
+      case kSphere: sphereMesh(vertices, indices, 12, 20); break;
+      case kSphereMid: sphereMesh(vertices, indices, 6, 10); break;
+      case kSphereLow: sphereMesh(vertices, indices, 4, 6); break;
+      case kSphereTiny: sphereMesh(vertices, indices, 2, 4); break;
+      case kCylinder: cylinderMesh(vertices, indices, 20); break;
+      case kCylinderMid: cylinderMesh(vertices, indices, 10); break;
+      case kCylinderLow: cylinderMesh(vertices, indices, 6); break;
+      case kCylinderTiny: cylinderMesh(vertices, indices, 4); break;
+      case kDisc: discMesh(vertices, indices, 20); break;
+      case kDiscMid: discMesh(vertices, indices, 10); break;
+      case kDiscLow: discMesh(vertices, indices, 6); break;
+      case kDiscTiny: discMesh(vertices, indices, 4); break;
       default: planeMesh(vertices, indices); break;
     }
     g.index_count[m] = static_cast<GLsizei>(indices.size());
@@ -316,40 +353,6 @@ void OsmesaRenderEngine::renderView(const CameraView& view, const std::vector<Re
   makeCurrent(view.width, view.height);
   Gl& g = *gl_;
 
-  // instances, by mesh
-  for (auto& list : g.instances) list.clear();
-  auto add = [&](Mesh mesh, const Pose& pose, const Vec3& scale, const RenderNodeSpec& spec) {
-    Instance in;
-    for (int k = 0; k < 3; ++k) {
-      in.position[k] = static_cast<float>(pose.position[k]);
-      in.scale[k] = static_cast<float>(std::max(scale[k], 1e-6));
-    }
-    const Quat& q = pose.orientation;
-    in.rotation[0] = static_cast<float>(q.x());
-    in.rotation[1] = static_cast<float>(q.y());
-    in.rotation[2] = static_cast<float>(q.z());
-    in.rotation[3] = static_cast<float>(q.w());
-    for (int k = 0; k < 4; ++k) in.color[k] = spec.color[static_cast<std::size_t>(k)];
-    in.grid = spec.grid ? 1.0f : 0.0f;
-    g.instances[mesh].push_back(in);
-  };
-  using P = RenderNodeSpec::Primitive;
-  for (const RenderNode& n : nodes) {
-    const RenderNodeSpec& s = *n.spec;
-    switch (s.primitive) {
-      case P::None: break;
-      case P::Box: add(kBox, n.world, s.size, s); break;
-      case P::Sphere: add(kSphere, n.world, Vec3::Constant(s.radius), s); break;
-      case P::Cylinder: add(kCylinder, n.world, Vec3(s.radius, s.radius, s.length), s); break;
-      case P::Capsule:
-        add(kCylinder, n.world, Vec3(s.radius, s.radius, s.length), s);
-        for (double end : {-0.5, 0.5})
-          add(kSphere, n.world * Pose{Vec3(0, 0, end * s.length), Quat::Identity()}, Vec3::Constant(s.radius), s);
-        break;
-      case P::Plane: add(kPlane, n.world, Vec3(s.size.x(), s.size.y(), 1.0), s); break;
-    }
-  }
-
   // view: the camera looks along its +x with +z up; OpenGL's eye looks along -z with +y up
   const Eigen::Matrix3d r = view.pose.orientation.toRotationMatrix();
   const Vec3 forward = r.col(0), left = r.col(1), up = r.col(2), eye = view.pose.position;
@@ -375,6 +378,83 @@ void OsmesaRenderEngine::renderView(const CameraView& view, const std::vector<Re
   p[14] = static_cast<float>(-2 * f * n / (f - n));
   const std::array<float, 16> vp = multiply(p, v);
 
+  // instances, by mesh: what the camera cannot see is left out, and spheres and cylinders are
+  // drawn with fewer triangles the smaller they appear (a robot 20 pixels wide does not need 20
+  // slices per rotor); what would cover less than a quarter of a pixel is not drawn at all
+  for (auto& list : g.instances) list.clear();
+  const double pixels_per_unit = view.height / (2.0 * ty);  // at distance 1
+  const double side_x = std::sqrt(1 + tx * tx), side_y = std::sqrt(1 + ty * ty);
+  constexpr double kMinPixels = 0.25, kLowFrom = 3.0, kMidFrom = 8.0, kFullFrom = 24.0;
+  // the level of detail of a primitive of bounding radius r at `position` (-1: not drawn)
+  auto detail = [&](const Vec3& position, double r) {
+    const Vec3 rel = position - eye;
+    const double d = forward.dot(rel);
+    if (d + r < n || d - r > f) return -1;
+    if (std::abs(right.dot(rel)) - d * tx > r * side_x || std::abs(up.dot(rel)) - d * ty > r * side_y) return -1;
+    const double pixels = r / std::max(d, n) * pixels_per_unit;
+    if (pixels < kMinPixels) return -1;
+    return pixels >= kFullFrom ? 0 : pixels >= kMidFrom ? 1 : pixels >= kLowFrom ? 2 : 3;
+  };
+  auto add = [&](Mesh mesh, const Pose& pose, const Vec3& scale, const RenderNodeSpec& spec) {
+    Instance in;
+    for (int k = 0; k < 3; ++k) {
+      in.position[k] = static_cast<float>(pose.position[k]);
+      in.scale[k] = static_cast<float>(std::max(scale[k], 1e-6));
+    }
+    const Quat& q = pose.orientation;
+    in.rotation[0] = static_cast<float>(q.x());
+    in.rotation[1] = static_cast<float>(q.y());
+    in.rotation[2] = static_cast<float>(q.z());
+    in.rotation[3] = static_cast<float>(q.w());
+    for (int k = 0; k < 4; ++k) in.color[k] = spec.color[static_cast<std::size_t>(k)];
+    in.grid = spec.grid ? 1.0f : 0.0f;
+    g.instances[mesh].push_back(in);
+  };
+  auto sphere = [&](const Pose& pose, double radius, const RenderNodeSpec& spec) {
+    const int level = detail(pose.position, radius);
+    if (level >= 0) add(static_cast<Mesh>(kSphere + level), pose, Vec3::Constant(radius), spec);
+  };
+  using P = RenderNodeSpec::Primitive;
+  for (const RenderNode& node : nodes) {
+    const RenderNodeSpec& s = *node.spec;
+    switch (s.primitive) {
+      case P::None: break;
+      case P::Box: {
+        const int level = detail(node.world.position, s.size.norm() / 2);
+        if (level < 0) break;
+        // a box thinner than a pixel is drawn as its largest face
+        Eigen::Index thin;
+        const double smallest = s.size.minCoeff(&thin);
+        if (level > 0 && smallest / std::max(forward.dot(node.world.position - eye), n) * pixels_per_unit < 1.0) {
+          // the face: the plane mesh (xy) turned so that its normal is the thin axis
+          const Quat turn = thin == 2 ? Quat::Identity()
+                                      : Quat(Eigen::AngleAxisd(std::numbers::pi / 2, thin == 0 ? Vec3::UnitY() : Vec3::UnitX()));
+          const Vec3 face = turn.conjugate() * s.size;
+          add(kPlane, node.world * Pose{Vec3::Zero(), turn}, Vec3(std::abs(face.x()), std::abs(face.y()), 1.0), s);
+        } else {
+          add(kBox, node.world, s.size, s);
+        }
+        break;
+      }
+      case P::Sphere: sphere(node.world, s.radius, s); break;
+      case P::Cylinder:
+      case P::Capsule: {
+        const int level = detail(node.world.position, std::hypot(s.radius, s.length / 2));
+        // a cylinder thinner than a pixel (a rotor disc, seen from afar) is drawn as its one face
+        const double thickness = s.length / std::max(forward.dot(node.world.position - eye), n) * pixels_per_unit;
+        if (level > 0 && s.primitive == P::Cylinder && thickness < 1.0)
+          add(static_cast<Mesh>(kDisc + level), node.world, Vec3(s.radius, s.radius, 1.0), s);
+        else if (level >= 0)
+          add(static_cast<Mesh>(kCylinder + level), node.world, Vec3(s.radius, s.radius, s.length), s);
+        if (s.primitive == P::Capsule)
+          for (double end : {-0.5, 0.5})
+            sphere(node.world * Pose{Vec3(0, 0, end * s.length), Quat::Identity()}, s.radius, s);
+        break;
+      }
+      case P::Plane: add(kPlane, node.world, Vec3(s.size.x(), s.size.y(), 1.0), s); break;
+    }
+  }
+
   glViewport(0, 0, view.width, view.height);
   glClearColor(background[0], background[1], background[2], background[3]);
   glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
@@ -386,8 +466,8 @@ void OsmesaRenderEngine::renderView(const CameraView& view, const std::vector<Re
   for (int m = 0; m < kMeshCount; ++m) {
     const auto& list = g.instances[m];
     if (list.empty()) continue;
-    // planes are seen from both sides
-    if (m == kPlane) glDisable(GL_CULL_FACE);
+    // planes and discs are seen from both sides
+    if (twoSided(m)) glDisable(GL_CULL_FACE);
     glBindVertexArray(g.vao[m]);
     glBindBuffer(GL_ARRAY_BUFFER, g.instance_buffer[m]);
     // grow the buffer only when needed, else rewrite it in place
@@ -398,7 +478,7 @@ void OsmesaRenderEngine::renderView(const CameraView& view, const std::vector<Re
     }
     glBufferSubData(GL_ARRAY_BUFFER, 0, static_cast<GLsizeiptr>(bytes), list.data());
     glDrawElementsInstanced(GL_TRIANGLES, g.index_count[m], GL_UNSIGNED_INT, nullptr, static_cast<GLsizei>(list.size()));
-    if (m == kPlane) glEnable(GL_CULL_FACE);
+    if (twoSided(m)) glEnable(GL_CULL_FACE);
   }
   glBindVertexArray(0);
   if (view.depth) {
