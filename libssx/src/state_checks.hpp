@@ -6,6 +6,9 @@
 
 #include <Eigen/Eigenvalues>
 
+#include <cmath>
+#include <span>
+
 namespace ssx::detail {
 
 inline bool finite(const BodyState& s) {
@@ -32,6 +35,20 @@ inline WrenchLimit wrenchLimit(const MassProperties& mass, const PhysicsSettings
 
 inline bool withinLimit(const Wrench& w, const WrenchLimit& limit) {
   return w.force.norm() <= limit.force && w.torque.norm() <= limit.torque;
+}
+
+/// Why a body's state read back from a saved state is not one an engine could have produced, in
+/// the parts every engine keeps: a NaN or infinite value (of all its `values`), a position more
+/// than 1e9 m from the origin, speeds beyond the guards; null when none. (Anything else could make
+/// the engine fail inside its step, where it cannot be recovered.) The engine checks its rotation.
+inline const char* savedBodyProblem(std::span<const double> values, const Vec3& position, const Vec3& linear,
+                                    const Vec3& angular, const PhysicsSettings& physics) {
+  for (const double v : values)
+    if (!std::isfinite(v)) return "has a NaN or infinite value";
+  if (position.cwiseAbs().maxCoeff() > 1e9) return "is more than 1e9 m from the origin";
+  if (linear.norm() > physics.max_linear_speed || angular.norm() > physics.max_angular_speed)
+    return "is faster than max_linear_speed or max_angular_speed";
+  return nullptr;
 }
 
 }  // namespace ssx::detail

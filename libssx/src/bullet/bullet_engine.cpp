@@ -1,4 +1,5 @@
 #include "bullet/bullet_engine.hpp"
+#include "state_checks.hpp"
 
 #include <ssx/error.hpp>
 
@@ -21,7 +22,6 @@ constexpr std::size_t kParallelFrom = 128;      // bodies: fewer are stepped on 
 constexpr std::size_t kBodiesPerChunk = 256;    // per task when posing geoms and integrating
 constexpr std::size_t kGeomsPerPlaneChunk = 512;
 constexpr std::size_t kFreeBodiesPerBatch = 256;  // bodies in no contact, per solveGroup call
-constexpr double kMaxRestoredPosition = 1e9;      // m
 
 btVector3 toBt(const Vec3& v) { return {v.x(), v.y(), v.z()}; }
 Vec3 fromBt(const btVector3& v) { return {v.x(), v.y(), v.z()}; }
@@ -123,21 +123,31 @@ BulletEngine::BulletEngine(const PhysicsSettings& settings) : settings_(settings
 
 BulletEngine::~BulletEngine() = default;
 
-BulletEngine::Context* BulletEngine::acquireContext() {
-  std::lock_guard lock(contexts_mutex_);
-  if (free_contexts_.empty()) {
-    contexts_.push_back(std::make_unique<Context>());
-    return contexts_.back().get();
+// a context for one task: taken from the free ones (or made) and given back when the task ends
+class BulletEngine::Lease {
+ public:
+  explicit Lease(BulletEngine& engine) : engine_(engine) {
+    std::lock_guard lock(engine_.contexts_mutex_);
+    if (engine_.free_contexts_.empty()) {
+      engine_.contexts_.push_back(std::make_unique<Context>());
+      context_ = engine_.contexts_.back().get();
+    } else {
+      context_ = engine_.free_contexts_.back();
+      engine_.free_contexts_.pop_back();
+    }
   }
-  Context* c = free_contexts_.back();
-  free_contexts_.pop_back();
-  return c;
-}
+  ~Lease() {
+    std::lock_guard lock(engine_.contexts_mutex_);
+    engine_.free_contexts_.push_back(context_);
+  }
+  Lease(const Lease&) = delete;
+  Lease& operator=(const Lease&) = delete;
+  Context& context() const { return *context_; }
 
-void BulletEngine::releaseContext(Context* c) {
-  std::lock_guard lock(contexts_mutex_);
-  free_contexts_.push_back(c);
-}
+ private:
+  BulletEngine& engine_;
+  Context* context_;
+};
 
 template <class F>
 void BulletEngine::forEach(std::size_t n, F&& task) {
@@ -379,12 +389,8 @@ void BulletEngine::collide(double h) {
   const double threshold = gContactBreakingThreshold;
   forEach(grid_chunks + plane_chunks, [&](std::size_t c) {
     Chunk& chunk = chunks_[c];
-    Context* context = acquireContext();
-    struct Release {
-      BulletEngine* engine;
-      Context* context;
-      ~Release() { engine->releaseContext(context); }
-    } release{this, context};
+    const Lease lease(*this);
+    Context& context = lease.context();
     if (c < plane_chunks) {
       const std::size_t begin = c * kGeomsPerPlaneChunk;
       const std::size_t end = std::min(dynamic_proxies_, begin + kGeomsPerPlaneChunk);
@@ -396,14 +402,14 @@ void BulletEngine::collide(double h) {
           const StaticObject& plane = *statics_[static_cast<std::size_t>(planes_[p])];
           const double gap = plane.normal.dot(centre) - plane.normal.cwiseAbs().dot(half) - plane.offset;
           if (gap > threshold) continue;
-          narrowphase(*context, chunk, static_cast<int>(k), -1 - static_cast<int>(p), h);
+          narrowphase(context, chunk, static_cast<int>(k), -1 - static_cast<int>(p), h);
         }
       }
       return;
     }
     chunk.pairs.clear();
     grid_.pairs(c - plane_chunks, chunk.pairs);
-    for (const auto& [a, b] : chunk.pairs) narrowphase(*context, chunk, a, b, h);
+    for (const auto& [a, b] : chunk.pairs) narrowphase(context, chunk, a, b, h);
   });
   manifolds_.clear();
   for (std::size_t c = 0; c < grid_chunks + plane_chunks; ++c)
@@ -486,23 +492,19 @@ void BulletEngine::solve(double h) {
   info.m_solverMode = SOLVER_USE_2_FRICTION_DIRECTIONS | SOLVER_SIMD;
   const std::size_t batches = (free_bodies_.size() + kFreeBodiesPerBatch - 1) / kFreeBodiesPerBatch;
   forEach(islands_.size() + batches, [&](std::size_t t) {
-    Context* context = acquireContext();
-    struct Release {
-      BulletEngine* engine;
-      Context* context;
-      ~Release() { engine->releaseContext(context); }
-    } release{this, context};
+    const Lease lease(*this);
+    Context& context = lease.context();
     if (t < islands_.size()) {
       const Island& island = islands_[t];
-      context->solver.solveGroup(&island_bodies_[island.first_body], static_cast<int>(island.bodies),
+      context.solver.solveGroup(&island_bodies_[island.first_body], static_cast<int>(island.bodies),
                                  island.manifolds == 0 ? nullptr : &island_manifolds_[island.first_manifold],
-                                 static_cast<int>(island.manifolds), nullptr, 0, info, nullptr, &context->dispatcher);
+                                 static_cast<int>(island.manifolds), nullptr, 0, info, nullptr, &context.dispatcher);
       return;
     }
     const std::size_t begin = (t - islands_.size()) * kFreeBodiesPerBatch;
     const std::size_t count = std::min(kFreeBodiesPerBatch, free_bodies_.size() - begin);
-    context->solver.solveGroup(&free_bodies_[begin], static_cast<int>(count), nullptr, 0, nullptr, 0, info, nullptr,
-                               &context->dispatcher);
+    context.solver.solveGroup(&free_bodies_[begin], static_cast<int>(count), nullptr, 0, nullptr, 0, info, nullptr,
+                               &context.dispatcher);
   });
 }
 
@@ -583,18 +585,14 @@ void BulletEngine::restoreState(StateReader& in) {
     auto bad = [&](const std::string& what) {
       return StateError("bullet: body " + std::to_string(i) + " in the saved state " + what);
     };
-    for (std::size_t k = 0; k < kBodyReals; ++k)
-      if (!std::isfinite(v[k])) throw bad("has a NaN or infinite value");
+    if (const char* problem = savedBodyProblem({v, kBodyReals}, Vec3(v[9], v[10], v[11]), Vec3(v[12], v[13], v[14]),
+                                               Vec3(v[15], v[16], v[17]), settings_))
+      throw bad(problem);
     Mat3 r;
     for (int row = 0; row < 3; ++row)
       for (int c = 0; c < 3; ++c) r(row, c) = v[3 * row + c];
     if ((r * r.transpose() - Mat3::Identity()).cwiseAbs().maxCoeff() > 1e-9 || r.determinant() < 0)
       throw bad("has a rotation matrix that is not a rotation");
-    if (Vec3(v[9], v[10], v[11]).cwiseAbs().maxCoeff() > kMaxRestoredPosition)
-      throw bad("is more than 1e9 m from the origin");
-    if (Vec3(v[12], v[13], v[14]).norm() > settings_.max_linear_speed ||
-        Vec3(v[15], v[16], v[17]).norm() > settings_.max_angular_speed)
-      throw bad("is faster than max_linear_speed or max_angular_speed");
   }
   for (std::size_t i = 0; i < bodies_.size(); ++i) writeBits(*bodies_[i]->rb, values.data() + i * kBodyReals);
 }

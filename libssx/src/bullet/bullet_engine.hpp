@@ -78,8 +78,7 @@ class BulletEngine final : public PhysicEngine {
     std::size_t first_body, bodies, first_manifold, manifolds;
   };
 
-  Context* acquireContext();
-  void releaseContext(Context* c);
+  class Lease;  // a context for one task, given back when the task ends
   template <class F>
   void forEach(std::size_t n, F&& task);
   void indexGeoms();

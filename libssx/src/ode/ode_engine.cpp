@@ -1,4 +1,5 @@
 #include "ode/ode_engine.hpp"
+#include "state_checks.hpp"
 
 #include <ssx/error.hpp>
 
@@ -609,10 +610,6 @@ void OdeEngine::setState(int body, const BodyState& s) {
   dBodySetAngularVel(b, s.angular_velocity.x(), s.angular_velocity.y(), s.angular_velocity.z());
 }
 
-namespace {
-constexpr double kMaxRestoredPosition = 1e9;  // m
-}
-
 void OdeEngine::saveState(StateWriter& out) const {
   // per world: its random seed and its bodies in creation order (which decides the order ODE
   // solves its contact groups in); then every body
@@ -659,27 +656,22 @@ void OdeEngine::restoreState(StateReader& in) {
                      std::to_string(bodies_.size()));
   std::vector<dReal> values(bodies_.size() * kOdeBodyReals);
   in.bytes(values.data(), values.size() * sizeof(dReal));
-  // a state ODE could have produced: finite, a unit quaternion with its rotation matrix, within the
-  // speed guards and the positions ODE's collision code handles (anything else could make ODE
-  // fail inside its step, where it cannot be recovered)
+  // a state ODE could have produced: finite, within reach and the speed guards, a unit quaternion
+  // with its rotation matrix
   for (std::size_t i = 0; i < bodies_.size(); ++i) {
     const dReal* v = values.data() + i * kOdeBodyReals;
     auto bad = [&](const std::string& what) {
       return StateError("ode: body " + std::to_string(i) + " in the saved state " + what);
     };
-    for (std::size_t k = 0; k < kOdeBodyReals; ++k)
-      if (!std::isfinite(v[k])) throw bad("has a NaN or infinite value");
-    const Vec3 position(v[0], v[1], v[2]);
-    if (position.cwiseAbs().maxCoeff() > kMaxRestoredPosition) throw bad("is more than 1e9 m from the origin");
+    if (const char* problem = savedBodyProblem({v, kOdeBodyReals}, Vec3(v[0], v[1], v[2]), Vec3(v[19], v[20], v[21]),
+                                               Vec3(v[22], v[23], v[24]), settings_))
+      throw bad(problem);
     const Quat q(v[3], v[4], v[5], v[6]);
     if (std::abs(q.norm() - 1.0) > 1e-9) throw bad("has a quaternion that is not of unit length");
     const Mat3 expected = q.toRotationMatrix();
     for (int r = 0; r < 3; ++r)
       for (int c = 0; c < 3; ++c)
         if (std::abs(v[7 + 4 * r + c] - expected(r, c)) > 1e-9) throw bad("has a rotation matrix that is not its quaternion's");
-    if (Vec3(v[19], v[20], v[21]).norm() > settings_.max_linear_speed ||
-        Vec3(v[22], v[23], v[24]).norm() > settings_.max_angular_speed)
-      throw bad("is faster than max_linear_speed or max_angular_speed");
   }
   ensureThreadData();
   // every body created again in its saved world and order, so that ODE lists them as it did
