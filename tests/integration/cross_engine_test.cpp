@@ -385,3 +385,23 @@ TEST_CASE("cross_engine: node frames offset from the centre of mass are tracked"
   CHECK(a.node("hub")->state().linear_velocity.norm() == Approx(0.0).margin(1e-3));
   CHECK((com - Vec3(0.5, 0.5 * 0.001, 0)).norm() < 1e-6);
 }
+
+TEST_CASE("cross_engine: a sweep's override of physics@engine chooses the engine, and its attributes are checked",
+          "[scene][cross_engine]") {
+  // what `ssx sweep` does with <parameter target="physics@engine">: an override applied before the
+  // scene is read (hover_swarm.xml has a <physics> element; one is added where there is none)
+  for (const char* scene : {"hover_swarm.xml", "quad_hover.xml"}) {
+    INFO(scene);
+    SceneOptions options;
+    options.overrides.push_back({"physics@engine", "bullet", {}});
+    Scene s = loadScene(kScenes / scene, options);
+    CHECK(s.environment->settings().physics.engine == "bullet");
+    s.environment->step(10);
+    CHECK(s.environment->physics().name() == "bullet");
+  }
+  SceneOptions both;
+  both.overrides.push_back({"physics@engine", "bullet", {"sweep.xml", 4}});
+  both.overrides.push_back({"physics@sor", "1.2", {"sweep.xml", 5}});
+  CHECK_THROWS_WITH(loadScene(kScenes / "hover_swarm.xml", both),
+                    Catch::Contains("sweep.xml:5: error: <physics>: attribute 'sor' is an option of the ode engine"));
+}

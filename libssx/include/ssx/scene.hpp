@@ -33,7 +33,8 @@ class SSX_EXPORT SceneError : public Error {
 /// `environment@timestep` or `swarm[name=quad{i}]/driver@formation_gain`. Every step must match
 /// exactly one element of the scene file itself (not of its includes or artifact files), except
 /// that a missing `driver` or `sensor[index=K]` of an <artifact> or <swarm> is added (that is
-/// where a placement sets its type's plugin parameters). A path that does not fit, and the
+/// where a placement sets its type's plugin parameters), and so is a missing <environment>,
+/// <physics> or <render>. A path that does not fit, and the
 /// value's own problems, are reported at `where`.
 struct AttributeOverride {
   std::string target;

@@ -77,10 +77,14 @@ std::optional<std::string> applyOverride(Descriptor& scene, const AttributeOverr
     if (found.size() > 1)
       return "target '" + o.target + "': '" + s.text + "' matches " + std::to_string(found.size()) + " elements in " +
              path + "; pick one with " + s.name + "[k] or " + s.name + "[name=...]";
-    // a placement's plugin element that is not there yet is added
+    // a placement's plugin element, or one of the scene's settings elements, that is not there yet
+    // is added
     const bool placement = node->name() == "artifact" || node->name() == "swarm";
-    const bool addable = i + 1 == steps.size() && placement && s.nth == 0 &&
-                         ((s.name == "driver" && s.key.empty()) || (s.name == "sensor" && s.key == "index"));
+    const bool settings = i == 0 && s.key.empty() &&
+                          (s.name == "environment" || s.name == "physics" || s.name == "render");
+    const bool addable = i + 1 == steps.size() && s.nth == 0 &&
+                         (settings || (placement && ((s.name == "driver" && s.key.empty()) ||
+                                                     (s.name == "sensor" && s.key == "index"))));
     if (!addable)
       return "target '" + o.target + "': no element '" + s.text + "' in " + path + " (" +
              (same_name > 0 ? std::to_string(same_name) + " <" + s.name + "> there, none that fits"
