@@ -385,15 +385,21 @@ void OsmesaRenderEngine::renderView(const CameraView& view, const std::vector<Re
   const double pixels_per_unit = view.height / (2.0 * ty);  // at distance 1
   const double side_x = std::sqrt(1 + tx * tx), side_y = std::sqrt(1 + ty * ty);
   constexpr double kMinPixels = 0.25, kLowFrom = 3.0, kMidFrom = 8.0, kFullFrom = 24.0;
-  // the level of detail of a primitive of bounding radius r at `position` (-1: not drawn)
-  auto detail = [&](const Vec3& position, double r) {
+  // the level of detail of a primitive of bounding radius r at `position` (-1: not drawn), and
+  // how many pixels a metre there covers
+  struct Detail {
+    int level;
+    double pixels_per_metre;
+  };
+  auto detail = [&](const Vec3& position, double r) -> Detail {
     const Vec3 rel = position - eye;
     const double d = forward.dot(rel);
-    if (d + r < n || d - r > f) return -1;
-    if (std::abs(right.dot(rel)) - d * tx > r * side_x || std::abs(up.dot(rel)) - d * ty > r * side_y) return -1;
-    const double pixels = r / std::max(d, n) * pixels_per_unit;
-    if (pixels < kMinPixels) return -1;
-    return pixels >= kFullFrom ? 0 : pixels >= kMidFrom ? 1 : pixels >= kLowFrom ? 2 : 3;
+    if (d + r < n || d - r > f) return {-1, 0};
+    if (std::abs(right.dot(rel)) - d * tx > r * side_x || std::abs(up.dot(rel)) - d * ty > r * side_y) return {-1, 0};
+    const double scale = pixels_per_unit / std::max(d, n);
+    const double pixels = r * scale;
+    if (pixels < kMinPixels) return {-1, scale};
+    return {pixels >= kFullFrom ? 0 : pixels >= kMidFrom ? 1 : pixels >= kLowFrom ? 2 : 3, scale};
   };
   auto add = [&](Mesh mesh, const Pose& pose, const Vec3& scale, const RenderNodeSpec& spec) {
     Instance in;
@@ -411,7 +417,7 @@ void OsmesaRenderEngine::renderView(const CameraView& view, const std::vector<Re
     g.instances[mesh].push_back(in);
   };
   auto sphere = [&](const Pose& pose, double radius, const RenderNodeSpec& spec) {
-    const int level = detail(pose.position, radius);
+    const int level = detail(pose.position, radius).level;
     if (level >= 0) add(static_cast<Mesh>(kSphere + level), pose, Vec3::Constant(radius), spec);
   };
   using P = RenderNodeSpec::Primitive;
@@ -420,12 +426,12 @@ void OsmesaRenderEngine::renderView(const CameraView& view, const std::vector<Re
     switch (s.primitive) {
       case P::None: break;
       case P::Box: {
-        const int level = detail(node.world.position, s.size.norm() / 2);
+        const auto [level, scale] = detail(node.world.position, s.size.norm() / 2);
         if (level < 0) break;
         // a box thinner than a pixel is drawn as its largest face
         Eigen::Index thin;
         const double smallest = s.size.minCoeff(&thin);
-        if (level > 0 && smallest / std::max(forward.dot(node.world.position - eye), n) * pixels_per_unit < 1.0) {
+        if (level > 0 && smallest * scale < 1.0) {
           // the face: the plane mesh (xy) turned so that its normal is the thin axis
           const Quat turn = thin == 2 ? Quat::Identity()
                                       : Quat(Eigen::AngleAxisd(std::numbers::pi / 2, thin == 0 ? Vec3::UnitY() : Vec3::UnitX()));
@@ -439,10 +445,9 @@ void OsmesaRenderEngine::renderView(const CameraView& view, const std::vector<Re
       case P::Sphere: sphere(node.world, s.radius, s); break;
       case P::Cylinder:
       case P::Capsule: {
-        const int level = detail(node.world.position, std::hypot(s.radius, s.length / 2));
+        const auto [level, scale] = detail(node.world.position, std::hypot(s.radius, s.length / 2));
         // a cylinder thinner than a pixel (a rotor disc, seen from afar) is drawn as its one face
-        const double thickness = s.length / std::max(forward.dot(node.world.position - eye), n) * pixels_per_unit;
-        if (level > 0 && s.primitive == P::Cylinder && thickness < 1.0)
+        if (level > 0 && s.primitive == P::Cylinder && s.length * scale < 1.0)
           add(static_cast<Mesh>(kDisc + level), node.world, Vec3(s.radius, s.radius, 1.0), s);
         else if (level >= 0)
           add(static_cast<Mesh>(kCylinder + level), node.world, Vec3(s.radius, s.radius, s.length), s);
