@@ -47,8 +47,9 @@ RotorParams rotorParams(const Descriptor& params) {
 std::vector<Rotor> rotorsOf(const Descriptor& params, const Artifact& a) {
   const auto names = words(params.get<std::string>("rotors"));
   const auto dirs = words(params.get<std::string>("directions"));
-  if (names.size() != dirs.size() || names.size() < 4)
-    throw params.error("'rotors' and 'directions' must name the same number (at least 4) of rotors");
+  if (names.size() != dirs.size() || names.size() < 4 || names.size() > kMaxRotors)
+    throw params.error("'rotors' and 'directions' must name the same number (4 to " + std::to_string(kMaxRotors) +
+                       ") of rotors");
   std::vector<Rotor> rotors;
   for (std::size_t i = 0; i < names.size(); ++i) {
     const PhysicNode* node = a.node(names[i]);
@@ -138,7 +139,7 @@ void QuadrotorDriver::configure(const Descriptor& params, PluginSetup& setup) {
     const Pose world = shape.world * shape.shape.pose;
     if ((world.orientation * Vec3::UnitZ()).z() > 1.0 - 1e-9) ground_z_ = std::max(ground_z_, world.position.z());
   }
-  gains_.assign(rotors.size(), 1.0);
+  gains_.fill(1.0);
   // the air: mean wind, one gust, Dryden turbulence
   wind_ = params.get<Vec3>("wind");
   gust_ = params.get<Vec3>("gust");
@@ -265,11 +266,11 @@ void QuadrotorDriver::configure(const Descriptor& params, PluginSetup& setup) {
   current_ = reference(0.0);
 
   // a vehicle placed in the air starts with its rotors at hover speed
-  commanded_speeds_.assign(rotors.size(), 0.0);
+  commanded_speeds_.fill(0.0);
   if (start.z() > 0.1) {
     const double hover = std::sqrt(mass.mass * ip.gravity / (rotors.size() * rp.thrust_coefficient));
-    rotors_->setSpeeds(std::vector<double>(rotors.size(), hover));
-    commanded_speeds_.assign(rotors.size(), hover);
+    commanded_speeds_.fill(hover);
+    rotors_->setSpeeds(std::span(commanded_speeds_).first(rotors.size()));
     command_.thrust_q16 = static_cast<std::int32_t>(std::llround(mass.mass * ip.gravity * 65536.0));
   }
   // before the first delayed command arrives, the inner loop has the initial one
@@ -358,14 +359,17 @@ void QuadrotorDriver::step(const StepInfo& info) {
   // inner loop: IMU counts to motor commands
   if (run % inner_runs_ == 0 && imu_seen_) {
     // the command as it arrives: command_delay late (the queue holds that many inner-loop ticks)
-    command_queue_[queue_at_] = command_;
-    queue_at_ = (queue_at_ + 1) % command_queue_.size();
+    // (without a delay the command passes straight through: the queue is not touched)
+    if (command_queue_.size() > 1) {
+      command_queue_[queue_at_] = command_;
+      queue_at_ = (queue_at_ + 1) % command_queue_.size();
+    }
     const InnerCommand& arrived = command_queue_.size() == 1 ? command_ : command_queue_[queue_at_];
     const InnerOutput out = inner_->step(imu_->gyroscope_counts, imu_->accelerometer_counts, arrived);
     for (std::size_t i = 0; i < out.motors; ++i) commanded_speeds_[i] = inner_->commandToSpeed(out.motor_commands[i]);
   }
   // motors and aerodynamics, applied at the centre of mass in body axes
-  rotors_->step(period, commanded_speeds_);
+  rotors_->step(period, std::span(commanded_speeds_).first(rotors_->size()));
   const BodyState s = body.state();
   const Quat to_body = s.pose.orientation.conjugate();
   const BodyState& com = artifact().environment().bodyState(body.bodyIndex());
@@ -421,7 +425,7 @@ void QuadrotorDriver::step(const StepInfo& info) {
       gains_[i] = battery_gain * (ground_effect_ ? groundEffectGain(com.pose.transformPoint(rotors[i].position).z() -
                                                                         ground_z_, rp.rotor_radius)
                                                  : 1.0);
-    rotors_->setThrustGains(gains_);
+    rotors_->setThrustGains(std::span(gains_).first(rotors.size()));
   }
   Vec3 force, torque;
   rotors_->wrench(to_body * v_com, to_body * s.angular_velocity, force, torque);
@@ -533,8 +537,11 @@ void load(StateReader& in, Setpoint& s) {
 
 // what changes while it flies: motors, both loops, the reference sources, what it last received
 void QuadrotorDriver::saveState(StateWriter& out) const {
-  out.write(rotors_->speeds());
-  out.write(commanded_speeds_);
+  // (per-rotor arrays as vectors of the rotor count: the format of the saved state)
+  const std::size_t n = rotors_->size();
+  const auto vector = [n](std::span<const double> v) { return std::vector<double>(v.begin(), v.begin() + n); };
+  out.write(vector(rotors_->speeds()));
+  out.write(vector(commanded_speeds_));
   out.write(inner_->estimate());
   out.write(outer_->integral());
   out.write(command_);
@@ -547,9 +554,10 @@ void QuadrotorDriver::saveState(StateWriter& out) const {
   ssx::save(out, seen_);
   out.write(imu_seen_);
   ssx::save(out, pose_);
-  out.write(gains_);
+  out.write(vector(gains_));
   out.write(thrust_ratio_);
-  out.write(command_queue_);
+  // (without a delay the queue is not kept up to date: its one entry is the current command)
+  out.write(command_queue_.size() == 1 ? std::vector<InnerCommand>{command_} : command_queue_);
   out.write(static_cast<std::uint64_t>(queue_at_));
   out.write(battery_ ? battery_->charge() : 0.0);
   out.write(battery_ ? battery_->voltage() : 0.0);
@@ -565,7 +573,10 @@ void QuadrotorDriver::loadState(StateReader& in) {
     throw StateError("quadrotor: saved with " + std::to_string(speeds.size()) + " rotors, this one has " +
                      std::to_string(rotors_->speeds().size()));
   rotors_->setSpeeds(speeds);
-  in.read(commanded_speeds_);
+  std::vector<double> commanded;
+  in.read(commanded);
+  if (commanded.size() != speeds.size()) throw StateError("quadrotor: the saved commanded speeds do not fit this driver");
+  std::copy(commanded.begin(), commanded.end(), commanded_speeds_.begin());
   inner_->reset(in.get<AttitudeEstimate>());
   Vec3 integral;
   in.read(integral);
@@ -587,9 +598,9 @@ void QuadrotorDriver::loadState(StateReader& in) {
   ssx::load(in, pose_);
   std::vector<double> gains;
   in.read(gains);
-  if (gains.size() != gains_.size()) throw StateError("quadrotor: the saved thrust gains do not fit this driver");
-  gains_ = gains;
-  rotors_->setThrustGains(gains_);
+  if (gains.size() != speeds.size()) throw StateError("quadrotor: the saved thrust gains do not fit this driver");
+  std::copy(gains.begin(), gains.end(), gains_.begin());
+  rotors_->setThrustGains(gains);
   in.read(thrust_ratio_);
   std::vector<InnerCommand> queue;
   in.read(queue);

@@ -18,6 +18,7 @@
 
 #include <ssx/ssx.hpp>
 
+#include <array>
 #include <optional>
 
 namespace ssx::quadrotor {
@@ -143,7 +144,7 @@ class QuadrotorDriver final : public Driver, public SetpointInterface, public Me
   std::optional<PositionController> outer_;
   InnerCommand command_;
   AttitudeCommand attitude_;
-  std::vector<double> commanded_speeds_;
+  std::array<double, kMaxRotors> commanded_speeds_{};  // the first rotors_->size() in use
   std::int64_t inner_runs_ = 1, outer_runs_ = 10;  // loop periods in runs of the driver
   double outer_dt_ = 0.02;
   enum class Source { Hover, Eight, External, Formation } source_ = Source::Hover;
@@ -180,7 +181,7 @@ class QuadrotorDriver final : public Driver, public SetpointInterface, public Me
   double downwash_c_[3] = {0, 0, 0}, downwash_range_ = 3, downwash_min_dz_ = 0.1;
   std::vector<SpatialIndex::Hit> above_;  // neighbours, reused
   double ground_z_ = 0;       // the ground plane's height (-inf: none)
-  std::vector<double> gains_;  // per rotor thrust gains, handed to the rotor model
+  std::array<double, kMaxRotors> gains_{};  // per rotor thrust gains, handed to the rotor model
   Setpoint current_;
   const ImuMeasurement* imu_ = nullptr;
   bool imu_seen_ = false;  // a sample has arrived

@@ -52,16 +52,35 @@ Allocation::Allocation(const std::vector<Rotor>& rotors, const RotorParams& p) {
   a_inv_ = a_.completeOrthogonalDecomposition().pseudoInverse();
 }
 
-RotorModel::RotorModel(std::vector<Rotor> rotors, const RotorParams& params)
-    : rotors_(std::move(rotors)), params_(params), speeds_(rotors_.size(), 0.0), gains_(rotors_.size(), 1.0) {}
+RotorModel::RotorModel(const std::vector<Rotor>& rotors, const RotorParams& params)
+    : count_(rotors.size()), params_(params) {
+  if (rotors.size() > kMaxRotors)
+    throw std::invalid_argument("rotor model: at most " + std::to_string(kMaxRotors) + " rotors");
+  std::copy(rotors.begin(), rotors.end(), rotors_.begin());
+  gains_.fill(1.0);
+}
 
-void RotorModel::step(double dt, const std::vector<double>& commanded) {
+void RotorModel::setSpeeds(std::span<const double> w) {
+  if (w.size() != count_)
+    throw std::invalid_argument("rotor model: " + std::to_string(w.size()) + " speeds for " + std::to_string(count_) +
+                                " rotors");
+  std::copy(w.begin(), w.end(), speeds_.begin());
+}
+
+void RotorModel::setThrustGains(std::span<const double> gains) {
+  if (gains.size() != count_)
+    throw std::invalid_argument("rotor model: " + std::to_string(gains.size()) + " thrust gains for " +
+                                std::to_string(count_) + " rotors");
+  std::copy(gains.begin(), gains.end(), gains_.begin());
+}
+
+void RotorModel::step(double dt, std::span<const double> commanded) {
   if (dt != alpha_dt_) {  // the filter factors depend only on dt: compute them once
     alpha_dt_ = dt;
     alpha_up_ = std::exp(-dt / params_.time_constant_up);
     alpha_down_ = std::exp(-dt / params_.time_constant_down);
   }
-  for (std::size_t i = 0; i < speeds_.size(); ++i) {
+  for (std::size_t i = 0; i < count_; ++i) {
     const double target = std::clamp(commanded[i], params_.min_rotor_speed, params_.max_rotor_speed);
     const double alpha = target > speeds_[i] ? alpha_up_ : alpha_down_;
     speeds_[i] = alpha * speeds_[i] + (1.0 - alpha) * target;
@@ -168,7 +187,7 @@ void RotorModel::wrench(const Vec3& v_body, const Vec3& w_body, Vec3& force, Vec
   torque.setZero();
   double spin = 0.0;  // sum of s_i w_i, for the rotors' angular momentum
   const Vec3 z = Vec3::UnitZ();
-  for (std::size_t i = 0; i < rotors_.size(); ++i) {
+  for (std::size_t i = 0; i < count_; ++i) {
     const Rotor& r = rotors_[i];
     const double w = speeds_[i];
     const double thrust = params_.thrust_coefficient * w * w * gains_[i];
@@ -201,7 +220,8 @@ std::int64_t toFixed(double v, double scale) { return std::llround(v * scale); }
 
 }  // namespace
 
-InnerLoopFixed::InnerLoopFixed(const InnerLoopParams& p) : params_(p) {
+InnerLoopFixed::InnerLoopFixed(const InnerLoopParams& p)
+    : min_rotor_speed_(p.min_rotor_speed), max_rotor_speed_(p.max_rotor_speed) {
   if (static_cast<std::size_t>(p.mixer.rows()) > kMaxRotors)
     throw std::invalid_argument("inner loop: at most " + std::to_string(kMaxRotors) + " rotors");
   gyro_to_q16_q16 = toFixed(p.gyro_lsb * kQ16, kQ16);
@@ -228,7 +248,7 @@ InnerLoopFixed::InnerLoopFixed(const InnerLoopParams& p) : params_(p) {
              (j < 3 ? p.max_angular_acceleration * kQ12 : p.max_thrust * kQ16);
     }
     worst = std::max(worst, sum);
-    mixer_q20.push_back(row);
+    mixer_q20[rotor_count++] = row;
   }
   if (worst >= 4.6e18)
     throw std::invalid_argument("inner loop: the mixer would overflow 64 bits: lower max_angular_acceleration");
@@ -238,7 +258,7 @@ InnerLoopFixed::InnerLoopFixed(const InnerLoopParams& p) : params_(p) {
 }
 
 double InnerLoopFixed::commandToSpeed(std::uint8_t command) const {
-  return params_.min_rotor_speed + (params_.max_rotor_speed - params_.min_rotor_speed) * command / 255.0;
+  return min_rotor_speed_ + (max_rotor_speed_ - min_rotor_speed_) * command / 255.0;
 }
 
 InnerOutput InnerLoopFixed::step(const std::array<std::int32_t, 3>& gyro, const std::array<std::int32_t, 3>& accel,
@@ -257,9 +277,10 @@ InnerOutput InnerLoopFixed::evaluate(const AttitudeEstimate& prior, const std::a
 
   // Euler angle rates from body rates: roll' = p + tan(pitch) (q sin roll + r cos roll),
   // pitch' = q cos roll - r sin roll (Q30 trigonometry, Q16 results)
-  std::int64_t sr, cr, sp, cp;
-  fx::sinCosQ30(std::int64_t{prior.roll_q20} << 10, sr, cr);
-  fx::sinCosQ30(std::int64_t{prior.pitch_q20} << 10, sp, cp);
+  // (both angles' rotations in one loop: two independent chains the processor overlaps)
+  std::array<std::int64_t, 2> sines{}, cosines{};
+  fx::sinCosQ30<2>({std::int64_t{prior.roll_q20} << 10, std::int64_t{prior.pitch_q20} << 10}, sines, cosines);
+  const std::int64_t sr = sines[0], cr = cosines[0], sp = sines[1], cp = cosines[1];
   const std::int64_t u = fx::roundShift(rate[1] * sr + rate[2] * cr, 30);       // Q16
   const std::int64_t tan_u = (u * sp + (u * sp >= 0 ? cp / 2 : -cp / 2)) / cp;  // Q16, cp > 0 (|pitch| < 80 deg)
   const std::int64_t roll_rate = rate[0] + tan_u;
@@ -274,13 +295,14 @@ InnerOutput InnerLoopFixed::evaluate(const AttitudeEstimate& prior, const std::a
   const std::int64_t norm2 = ax * ax + ay * ay + az * az;
   const std::int64_t pi_q20 = fx::roundShift(fx::kPiQ30, 10);
   if (norm2 >= accel_gate_low2 && norm2 <= accel_gate_high2) {
-    std::int64_t roll_acc = fx::roundShift(fx::atan2Q30(ay, az), 10);
+    // roll from (ay, az), pitch from (-ax, |(ay, az)|), both rotations in one loop
+    const auto ayz = static_cast<std::int64_t>(fx::isqrtRound(static_cast<std::uint64_t>(ay * ay + az * az)));
+    const auto angles = fx::atan2Q30<2>({ay, -ax}, {az, ayz});
+    std::int64_t roll_acc = fx::roundShift(angles[0], 10);
     // blend the shorter way round: upside down, +179 deg and -179 deg are 2 deg apart
     if (roll_acc - roll > pi_q20) roll_acc -= 2 * pi_q20;
     if (roll_acc - roll < -pi_q20) roll_acc += 2 * pi_q20;
-    const std::int64_t pitch_acc = fx::roundShift(
-        fx::atan2Q30(-ax, static_cast<std::int64_t>(fx::isqrtRound(static_cast<std::uint64_t>(ay * ay + az * az)))),
-        10);
+    const std::int64_t pitch_acc = fx::roundShift(angles[1], 10);
     roll = fx::roundShift(gyro_weight_q15 * roll + (32768 - gyro_weight_q15) * roll_acc, 15);
     pitch = fx::roundShift(gyro_weight_q15 * pitch + (32768 - gyro_weight_q15) * pitch_acc, 15);
   }
@@ -307,7 +329,8 @@ InnerOutput InnerLoopFixed::evaluate(const AttitudeEstimate& prior, const std::a
   const std::int64_t min2 = min_speed_q4 * min_speed_q4, max2 = max_speed_q4 * max_speed_q4;
   const std::int64_t range = max_speed_q4 - min_speed_q4;
   const std::int64_t thrust = fx::clamp(command.thrust_q16, 0, max_thrust_q16);
-  for (const auto& m : mixer_q20) {
+  for (std::size_t r = 0; r < rotor_count; ++r) {
+    const auto& m = mixer_q20[r];
     std::int64_t w2 = fx::roundShift(m[0] * alpha[0], 16) + fx::roundShift(m[1] * alpha[1], 16) +
                       fx::roundShift(m[2] * alpha[2], 16) + fx::roundShift(m[3] * thrust, 28);
     w2 = fx::clamp(w2, min2, max2);

@@ -16,6 +16,7 @@
 #include <array>
 #include <cstdint>
 #include <optional>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -148,29 +149,34 @@ class Allocation {
   Eigen::MatrixXd a_, a_inv_;
 };
 
-/// First-order motors and the aerodynamic forces of the rotors.
+/// First-order motors and the aerodynamic forces of the rotors (at most kMaxRotors). Its state is
+/// held inline, not in separate heap blocks: with thousands of robots a step is bound by memory
+/// latency, and every block is one more cache miss per robot and step.
 class RotorModel {
  public:
-  RotorModel(std::vector<Rotor> rotors, const RotorParams& params);
+  RotorModel(const std::vector<Rotor>& rotors, const RotorParams& params);
   /// Advances the motor speeds by dt towards the commanded speeds (clamped to the limits).
-  void step(double dt, const std::vector<double>& commanded);
-  const std::vector<double>& speeds() const { return speeds_; }
-  void setSpeeds(const std::vector<double>& w) { speeds_ = w; }
+  void step(double dt, std::span<const double> commanded);
+  std::span<const double> speeds() const { return {speeds_.data(), count_}; }
+  /// One speed per rotor (throws std::invalid_argument for another count).
+  void setSpeeds(std::span<const double> w);
   /// Force and torque on the body about its centre of mass, body frame, given the body's
   /// velocity and angular velocity in the body frame (air at rest).
   void wrench(const Vec3& velocity_body, const Vec3& angular_velocity_body, Vec3& force, Vec3& torque) const;
   /// Each rotor's thrust (and its reaction torque) at a given speed is multiplied by its gain
-  /// (default 1): ground effect, battery voltage, downwash.
-  void setThrustGains(const std::vector<double>& gains) { gains_ = gains; }
-  const std::vector<double>& thrustGains() const { return gains_; }
-  const std::vector<Rotor>& rotors() const { return rotors_; }
+  /// (default 1): ground effect, battery voltage, downwash. One gain per rotor.
+  void setThrustGains(std::span<const double> gains);
+  std::span<const double> thrustGains() const { return {gains_.data(), count_}; }
+  std::span<const Rotor> rotors() const { return {rotors_.data(), count_}; }
+  std::size_t size() const { return count_; }
   const RotorParams& params() const { return params_; }
 
  private:
-  std::vector<Rotor> rotors_;
+  std::array<Rotor, kMaxRotors> rotors_{};
+  std::array<double, kMaxRotors> speeds_{};
+  std::array<double, kMaxRotors> gains_{};
+  std::size_t count_ = 0;
   RotorParams params_;
-  std::vector<double> speeds_;
-  std::vector<double> gains_;
   double alpha_dt_ = -1, alpha_up_ = 0, alpha_down_ = 0;  // exp(-dt/tau) for the last dt
 };
 
@@ -244,12 +250,14 @@ class InnerLoopFixed {
   std::int64_t max_alpha_q12 = 0;
   std::int64_t gyro_weight_q15 = 0;
   std::int64_t accel_gate_low2 = 0, accel_gate_high2 = 0;  ///< counts^2
-  std::vector<std::array<std::int64_t, 4>> mixer_q20;      ///< alpha columns Q12, thrust column Q20
+  std::array<std::array<std::int64_t, 4>, kMaxRotors> mixer_q20{};  ///< alpha columns Q12, thrust column Q20
+  std::size_t rotor_count = 0;                                     ///< rows of mixer_q20 in use
   std::int64_t min_speed_q4 = 0, max_speed_q4 = 0;
   std::int64_t max_thrust_q16 = 0;
 
  private:
-  InnerLoopParams params_;
+  // (only what a step needs, held inline; see RotorModel)
+  double min_rotor_speed_ = 0, max_rotor_speed_ = 0;
   AttitudeEstimate estimate_;
 };
 

@@ -79,7 +79,7 @@ TEST_CASE("a single counter-clockwise rotor yaws the body clockwise", "[quadroto
   // one CCW rotor at the centre: its reaction torque alone
   auto model = std::make_shared<RotorModel>(std::vector<Rotor>{{Vec3::Zero(), 1}}, *preset("mk_quad"));
   a.setDriver(std::make_unique<test::LambdaDriver>([model](Driver& d, const StepInfo&) {
-    model->step(0.001, {500.0});
+    model->step(0.001, std::vector<double>{500.0});
     Vec3 f, t;
     model->wrench(Vec3::Zero(), Vec3::Zero(), f, t);
     d.artifact().root().addTorque(t, Frame::Local);
@@ -124,6 +124,45 @@ TEST_CASE("fixed-point helpers: rounding shift, square root, CORDIC", "[quadroto
     fixed::sinCosQ30(std::llround(ang * 1073741824.0), s, c);
     REQUIRE(s / 1073741824.0 == Approx(std::sin(ang)).margin(2e-7));
     REQUIRE(c / 1073741824.0 == Approx(std::cos(ang)).margin(2e-7));
+  }
+}
+
+TEST_CASE("fixed-point helpers: the fast square root is the bitwise one's integer, lanes are independent",
+          "[quadrotor][fixed]") {
+  // every n below 2^20, squares and their neighbours up to 2^64, random n of every magnitude
+  for (std::uint64_t n = 0; n < (1u << 20); ++n) REQUIRE(fixed::isqrtFloor(n) == fixed::isqrtFloorBitwise(n));
+  Random r(11);
+  auto check = [](std::uint64_t n) {
+    INFO("n = " << n);
+    REQUIRE(fixed::isqrtFloor(n) == fixed::isqrtFloorBitwise(n));
+  };
+  for (std::uint64_t k : {std::uint64_t{1} << 26, (std::uint64_t{1} << 26) - 1, (std::uint64_t{1} << 26) + 1,
+                          std::uint64_t{94906265}, (std::uint64_t{1} << 32) - 1})
+    for (std::uint64_t n : {k * k - 1, k * k, k * k + 1}) check(n);
+  for (int i = 0; i < 200000; ++i) {
+    const int bits = 1 + static_cast<int>(r() % 63);
+    const std::uint64_t n = r() >> (64 - bits);
+    check(n);
+    const std::uint64_t k = n >> (bits / 2 + 1);  // a root of about half the bits
+    for (std::uint64_t m : {k * k - 1, k * k, k * k + 1}) check(m);
+  }
+  check(~std::uint64_t{0});
+  // two lanes give what each gives alone
+  for (int i = 0; i < 10000; ++i) {
+    const std::int64_t y0 = static_cast<std::int64_t>(r() % 2000001) - 1000000, x0 = static_cast<std::int64_t>(r() % 2000001) - 1000000;
+    const std::int64_t y1 = i % 7 == 0 ? 0 : static_cast<std::int64_t>(r() % 2000001) - 1000000;
+    const std::int64_t x1 = i % 7 == 0 ? 0 : static_cast<std::int64_t>(r() % 2000001) - 1000000;
+    const auto both = fixed::atan2Q30<2>({y0, y1}, {x0, x1});
+    REQUIRE(both[0] == fixed::atan2Q30(y0, x0));
+    REQUIRE(both[1] == fixed::atan2Q30(y1, x1));
+    const std::int64_t a0 = std::llround(r.uniform(-std::numbers::pi, std::numbers::pi) * 1073741824.0);
+    const std::int64_t a1 = std::llround(r.uniform(-std::numbers::pi, std::numbers::pi) * 1073741824.0);
+    std::array<std::int64_t, 2> s{}, c{};
+    fixed::sinCosQ30<2>({a0, a1}, s, c);
+    std::int64_t s0, c0, s1, c1;
+    fixed::sinCosQ30(a0, s0, c0);
+    fixed::sinCosQ30(a1, s1, c1);
+    REQUIRE((s[0] == s0 && c[0] == c0 && s[1] == s1 && c[1] == c1));
   }
 }
 
@@ -229,7 +268,7 @@ TEST_CASE("ground effect: the thrust gain at three heights is Cheeseman-Bennett'
   const RotorParams p = *preset("mk_quad");
   const double R = p.rotor_radius;
   RotorModel model(plusRotors(0.225), p);
-  model.setSpeeds({400, 410, 420, 430});
+  model.setSpeeds(std::vector<double>{400, 410, 420, 430});
   Vec3 f0, t0;
   model.wrench(Vec3::Zero(), Vec3::Zero(), f0, t0);
   for (double h : {0.1, 0.2, 0.5}) {
@@ -271,7 +310,7 @@ TEST_CASE("battery: thrust at a fixed command follows (U - 7.575 V); the voltage
   BatteryParams bp;
   Battery battery(bp);
   RotorModel model(plusRotors(0.225), *preset("mk_quad"));
-  model.setSpeeds({500, 500, 500, 500});
+  model.setSpeeds(std::vector<double>{500, 500, 500, 500});
   auto thrustAt = [&](double volts) {
     model.setThrustGains(std::vector<double>(4, battery.thrustGain(volts)));
     Vec3 f, t;
