@@ -48,8 +48,9 @@ std::vector<Rotor> rotorsOf(const Descriptor& params, const Artifact& a) {
   const auto names = words(params.get<std::string>("rotors"));
   const auto dirs = words(params.get<std::string>("directions"));
   if (names.size() != dirs.size() || names.size() < 4 || names.size() > kMaxRotors)
-    throw params.error("'rotors' and 'directions' must name the same number (4 to " + std::to_string(kMaxRotors) +
-                       ") of rotors");
+    throw params.errorAt(names.size() != dirs.size() ? "directions" : "rotors",
+                         "'rotors' and 'directions' must name the same number (4 to " + std::to_string(kMaxRotors) +
+                             ") of rotors");
   std::vector<Rotor> rotors;
   for (std::size_t i = 0; i < names.size(); ++i) {
     const PhysicNode* node = a.node(names[i]);

@@ -76,7 +76,7 @@ class QuadrotorDriver final : public Driver, public SetpointInterface, public Me
       param::vec3("controller_inertia", "", "kg m^2", param::positive(),
                   "diagonal inertia the inner loop assumes (default: the model's)"),
       param::real("rotor_inertia", "", "kg m^2", param::nonNegative(), "(default: the preset's)"),
-      param::text("rotors", "rotor0 rotor1 rotor2 rotor3", "physic node names of the rotors (at least 4)"),
+      param::text("rotors", "rotor0 rotor1 rotor2 rotor3", "physic node names of the rotors (4 to 8)"),
       param::text("directions", "1 -1 1 -1", "spin of each rotor: 1 counter-clockwise seen from above, -1 clockwise"),
       param::rate("outer_rate_hz", "50", param::positive(), "position loop rate"),
       param::rate("inner_rate_hz", "500", param::positive(), "attitude loop rate; it reads the IMU's latest sample"),
