@@ -190,7 +190,10 @@ const Pose& PhysicNode::poseInBody() const noexcept { return world_->nodes[index
 
 BodyState PhysicNode::state() const {
   const detail::NodeData& n = world_->nodes[index_];
-  if (n.body >= 0 && world_->started()) return world_->states[static_cast<std::size_t>(n.body)].attached(n.pose_in_body);
+  if (n.body >= 0 && world_->started()) {
+    const BodyState& body = world_->states[static_cast<std::size_t>(n.body)];
+    return n.at_body ? body : body.attached(n.pose_in_body);
+  }
   const detail::NodeSetup& setup = world_->node_setup[index_];
   BodyState s;
   s.pose = setup.pose;
@@ -204,7 +207,8 @@ BodyState PhysicNode::state() const {
 Pose PhysicNode::pose() const {
   const detail::NodeData& n = world_->nodes[index_];
   if (n.body < 0 || !world_->started()) return world_->node_setup[index_].pose;
-  return world_->states[static_cast<std::size_t>(n.body)].pose * n.pose_in_body;
+  const Pose& body = world_->states[static_cast<std::size_t>(n.body)].pose;
+  return n.at_body ? body : body * n.pose_in_body;
 }
 
 void PhysicNode::requireWritable() const {
@@ -226,7 +230,7 @@ void PhysicNode::addForce(const Vec3& force, Frame force_frame, const Vec3& poin
     throw Error("artifact '" + artifact_->name() + "', node '" + name() + "': force or point is NaN or infinite");
   const auto body = static_cast<std::size_t>(n.body);
   const BodyState& b = world_->states[body];
-  const Pose node = b.pose * n.pose_in_body;
+  const Pose node = n.at_body ? b.pose : b.pose * n.pose_in_body;
   const Vec3 f = force_frame == Frame::World ? force : Vec3(node.orientation * force);
   const Vec3 p = point_frame == Frame::Local ? node.transformPoint(point) : point;
   Wrench& w = world_->wrenches[body];

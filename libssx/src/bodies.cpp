@@ -48,7 +48,12 @@ void buildBodies(World& world, PhysicEngine& engine, std::vector<Environment::St
       const Pose root_in_body{-mass.center_of_mass, Quat::Identity()};
       for (std::size_t k = 0; k < tree.size(); ++k) {
         NodeData& n = world.nodes[tree[k]];
-        n.pose_in_body = root_in_body * (root_data.pose.inverse() * world.node_setup[tree[k]].pose);
+        // (the root's frame in the body exactly: its own pose undone and redone would be off by
+        // a rounding, and a root at the centre of mass would cost a transform per query)
+        n.pose_in_body = tree[k] == root.nodeIndex()
+                             ? root_in_body
+                             : root_in_body * (root_data.pose.inverse() * world.node_setup[tree[k]].pose);
+        n.at_body = n.pose_in_body.position == Vec3::Zero() && n.pose_in_body.orientation.coeffs() == Quat::Identity().coeffs();
         for (Shape s : specs[k]->shapes) {
           s.pose = n.pose_in_body * s.pose;
           shapes.push_back(s);

@@ -31,6 +31,7 @@ struct NodeData {
   Pose pose_in_body;  // node frame in the body's centre-of-mass frame
   int body = -1;      // -1: static, or not started
   bool is_static = false;
+  bool at_body = false;  // pose_in_body is exactly the identity: the node's state is its body's
 };
 
 /// One physic node as placed before start (static nodes keep their pose).
