@@ -2,6 +2,7 @@
 
 #include <catch2/catch.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <vector>
 
@@ -46,4 +47,35 @@ TEST_CASE("uniform and normal draws have the right moments", "[random]") {
   const double var = sn2 / n - mean * mean;
   CHECK(mean == Approx(2.0).margin(0.03));
   CHECK(std::sqrt(var) == Approx(3.0).epsilon(0.01));
+}
+
+TEST_CASE("normal draws follow the normal distribution, tails included", "[random]") {
+  // the ziggurat's layers, wedges and tail each cover part of the curve: a mistake in one shows
+  // as a distance between the sample's distribution and the normal one, or as a wrong tail mass
+  ssx::Random r(7);
+  const int n = 1000000;
+  std::vector<double> z(n);
+  double m4 = 0;
+  int beyond_r = 0, beyond_4 = 0;
+  for (double& v : z) {
+    v = r.normal();
+    m4 += v * v * v * v;
+    beyond_r += std::abs(v) > 3.6541528853610088;
+    beyond_4 += std::abs(v) > 4.0;
+  }
+  std::sort(z.begin(), z.end());
+  double ks = 0;  // Kolmogorov-Smirnov distance
+  for (int i = 0; i < n; ++i) {
+    const double cdf = 0.5 * std::erfc(-z[static_cast<std::size_t>(i)] / std::sqrt(2.0));
+    ks = std::max({ks, std::abs(cdf - static_cast<double>(i) / n), std::abs(cdf - static_cast<double>(i + 1) / n)});
+  }
+  // 1.63 / sqrt(n) is the 1 % critical value
+  CHECK(ks < 1.63 / std::sqrt(static_cast<double>(n)));
+  CHECK(m4 / n == Approx(3.0).margin(0.03));
+  // P(|z| > 3.654) = 2.58e-4 (the tail the bottom layer draws), P(|z| > 4) = 6.33e-5: within 5 sigma
+  const double p_r = std::erfc(3.6541528853610088 / std::sqrt(2.0)), p_4 = std::erfc(4.0 / std::sqrt(2.0));
+  CHECK(std::abs(beyond_r - n * p_r) < 5 * std::sqrt(n * p_r));
+  CHECK(std::abs(beyond_4 - n * p_4) < 5 * std::sqrt(n * p_4));
+  CHECK(z.front() < -4.0);
+  CHECK(z.back() > 4.0);
 }
