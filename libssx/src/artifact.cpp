@@ -85,6 +85,7 @@ Plugin& Artifact::attach(Plugin& plugin, std::uint32_t plugin_index, std::int64_
                                         : "sensor" + std::to_string(plugin_index - 1);
   world_->plugins.push_back(std::move(slot));
   world_->randoms.emplace_back(deriveSeed(world_->settings.seed, index_, plugin_index));
+  world_->fresh.push_back(0);
   plugin.bind(*world_, *this, static_cast<std::uint32_t>(world_->plugins.size() - 1), period_steps);
   return plugin;
 }
@@ -120,7 +121,7 @@ Sensor& Artifact::addSensor(Sensor& sensor, Descriptor params, std::int64_t peri
   requireSetup("sensors can be added");
   detail::ArtifactData& data = world_->data(*this);
   attach(sensor, static_cast<std::uint32_t>(data.sensors.size() + 1), period_steps, std::move(class_name), params);
-  data.sensors.push_back({&sensor, period_steps, false});
+  data.sensors.push_back({&sensor, period_steps, static_cast<std::uint32_t>(world_->plugins.size() - 1)});
   detail::ArtifactModel& model = world_->model(*this);
   model.owned_sensors.emplace_back();
   model.sensor_params.push_back(std::move(params));

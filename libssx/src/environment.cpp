@@ -160,7 +160,7 @@ void Environment::subscribe(const Sensor& sensor, Artifact& subscriber,
   std::uint32_t k = 0;
   while (sensors[k].sensor != &sensor) ++k;  // attached there: it is in the list
   w.data(subscriber).inbox.push_back({static_cast<std::uint32_t>(source.index()), k, w.subscription_sequence++,
-                                      std::move(callback)});
+                                      &sensor, sensors[k].plugin, std::move(callback)});
 }
 
 void Environment::setLogSink(LogSink sink) { log_ = std::move(sink); }

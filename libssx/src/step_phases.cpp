@@ -78,7 +78,8 @@ void runSensors(World& world, std::size_t begin, std::size_t end) {
     ArtifactData& a = world.artifact_data[i];
     for (std::size_t k = 0; k < a.sensors.size(); ++k) {
       SensorSlot& slot = a.sensors[k];
-      slot.fresh = false;
+      std::uint8_t& fresh = world.fresh[slot.plugin];
+      fresh = 0;
       Sensor& sensor = *slot.sensor;
       const std::int64_t period = slot.period_steps;
       if (step % period != 0) continue;
@@ -92,7 +93,7 @@ void runSensors(World& world, std::size_t begin, std::size_t end) {
                              "wrote a NaN or infinite value into its measurement"};
           break;
         }
-        slot.fresh = true;
+        fresh = 1;
       } catch (...) {
         world.errors[i] = {"sensor " + std::to_string(k) + " '" + sensor.className() + "'",
                            describe(std::current_exception())};
@@ -114,10 +115,9 @@ void runDrivers(World& world, std::size_t begin, std::size_t end) {
     try {
       PhaseGuard guard(nullptr, "callback");
       for (const auto& sub : a.inbox) {
-        const SensorSlot& slot = world.artifact_data[sub.source].sensors[sub.sensor_index];
-        if (!slot.fresh) continue;
+        if (world.fresh[sub.plugin] == 0) continue;
         current = &sub;
-        sub.callback(slot.sensor->latest());
+        sub.callback(sub.sensor->latest());
       }
     } catch (...) {
       world.errors[i] = {"callback subscribed to sensor '" +

@@ -54,13 +54,17 @@ struct PluginSlot {
 struct SensorSlot {
   Sensor* sensor = nullptr;
   std::int64_t period_steps = 1;  // a copy of its plugin slot's, beside what the phase reads
-  bool fresh = false;             // wrote a measurement in this step
+  std::uint32_t plugin = 0;       // its plugin slot: where World::fresh says whether it measured
 };
 
 struct Subscription {
   std::uint32_t source = 0;        // artifact index
   std::uint32_t sensor_index = 0;  // in that artifact
   std::uint64_t sequence = 0;
+  // the sensor itself and its plugin slot, so that delivering reads neither the source artifact's
+  // data nor its sensor list (with thousands of robots each would be a cache miss)
+  const Sensor* sensor = nullptr;
+  std::uint32_t plugin = 0;
   std::function<void(const Measurement&)> callback;
 };
 
@@ -118,6 +122,9 @@ struct World {
   std::vector<NodeSetup> node_setup;
   std::vector<PluginSlot> plugins;
   std::vector<Random> randoms;
+  // per plugin slot, written by the sensors phase: 1 when that sensor measured in this step (one
+  // byte per sensor in one array, read by the drivers phase for every subscription)
+  std::vector<std::uint8_t> fresh;
 
   // per body, from start on: the snapshot, the velocities before the step, the command buffers
   std::vector<BodyState> states;
