@@ -10,6 +10,7 @@
 #include <ssx/plugin_abi.hpp>
 
 #include <algorithm>
+#include <iterator>
 #include <chrono>
 #include <cmath>
 #include <cstring>
@@ -325,6 +326,21 @@ void Environment::start() {
         if (x.sensor_index != y.sensor_index) return x.sensor_index < y.sensor_index;
         return x.sequence < y.sequence;
       });
+    }
+    // the phases' tables: every artifact's sensor slots and subscriptions in one array each, in
+    // artifact order (a step walks them front to back; separate blocks would be a cache miss per
+    // artifact with thousands of them)
+    w.sensor_slots.clear();
+    w.subscriptions.clear();
+    for (auto& data : w.artifact_data) {
+      data.sensor_begin = static_cast<std::uint32_t>(w.sensor_slots.size());
+      w.sensor_slots.insert(w.sensor_slots.end(), data.sensors.begin(), data.sensors.end());
+      data.sensor_end = static_cast<std::uint32_t>(w.sensor_slots.size());
+      data.inbox_begin = static_cast<std::uint32_t>(w.subscriptions.size());
+      std::move(data.inbox.begin(), data.inbox.end(), std::back_inserter(w.subscriptions));
+      data.inbox_end = static_cast<std::uint32_t>(w.subscriptions.size());
+      data.inbox.clear();
+      data.inbox.shrink_to_fit();
     }
   } catch (...) {
     w.configuring = false;

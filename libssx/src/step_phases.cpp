@@ -54,19 +54,19 @@ namespace detail {
 
 namespace {
 void prefetchArtifact(const World& world, std::size_t i, std::size_t end, bool sensors) {
-  // (the world's node, random-stream and artifact tables are walked in order: the hardware
-  // prefetcher follows them; what is scattered over the heap is what is fetched here)
+  // (the world's node, random-stream, artifact, sensor-slot and subscription tables are walked
+  // in order: the hardware prefetcher follows them; what is scattered over the heap is what is
+  // fetched here)
   if (i + 1 >= end) return;
   const ArtifactData& next = world.artifact_data[i + 1];
   if (sensors) {
-    for (const auto& slot : next.sensors) prefetch(slot.sensor, 256);
+    for (std::uint32_t k = next.sensor_begin; k < next.sensor_end; ++k) prefetch(world.sensor_slots[k].sensor, 256);
     return;
   }
   // a driver's handles and the sensors whose measurements its callbacks get
   if (i + 2 < end) prefetch(world.artifacts[i + 2].get(), sizeof(Artifact));
   if (next.driver != nullptr) prefetch(next.driver, 512);
-  if (!next.inbox.empty()) prefetch(next.inbox.data(), next.inbox.size() * sizeof(next.inbox[0]));
-  for (const auto& slot : next.sensors) prefetch(slot.sensor);
+  for (std::uint32_t k = next.inbox_begin; k < next.inbox_end; ++k) prefetch(world.subscriptions[k].sensor);
 }
 }  // namespace
 
@@ -76,8 +76,9 @@ void runSensors(World& world, std::size_t begin, std::size_t end) {
   for (std::size_t i = begin; i < end; ++i) {
     prefetchArtifact(world, i, end, true);
     ArtifactData& a = world.artifact_data[i];
-    for (std::size_t k = 0; k < a.sensors.size(); ++k) {
-      SensorSlot& slot = a.sensors[k];
+    for (std::uint32_t at = a.sensor_begin; at < a.sensor_end; ++at) {
+      const std::size_t k = at - a.sensor_begin;
+      const SensorSlot& slot = world.sensor_slots[at];
       std::uint8_t& fresh = world.fresh[slot.plugin];
       fresh = 0;
       Sensor& sensor = *slot.sensor;
@@ -114,7 +115,8 @@ void runDrivers(World& world, std::size_t begin, std::size_t end) {
     const Subscription* current = nullptr;
     try {
       PhaseGuard guard(nullptr, "callback");
-      for (const auto& sub : a.inbox) {
+      for (std::uint32_t at = a.inbox_begin; at < a.inbox_end; ++at) {
+        const Subscription& sub = world.subscriptions[at];
         if (world.fresh[sub.plugin] == 0) continue;
         current = &sub;
         sub.callback(sub.sensor->latest());

@@ -81,8 +81,12 @@ struct ArtifactModel {
 struct ArtifactData {
   Driver* driver = nullptr;
   std::int64_t driver_period = 1;  // a copy of its slot's, beside what the drivers phase reads
-  std::vector<SensorSlot> sensors;
-  std::vector<Subscription> inbox;  // sorted (source, sensor, sequence) at start
+  std::vector<SensorSlot> sensors;   // as attached (the phases read World::sensor_slots)
+  std::vector<Subscription> inbox;  // until start; then in World::subscriptions
+  // from start: its sensors in World::sensor_slots and its subscriptions, sorted (source, sensor,
+  // sequence), in World::subscriptions, [begin, end)
+  std::uint32_t sensor_begin = 0, sensor_end = 0;
+  std::uint32_t inbox_begin = 0, inbox_end = 0;
   int body_begin = 0;               // bodies [body_begin, body_end) in the body arrays
   int body_end = 0;
   // where its nodes and plugin slots are in the world's tables, for prefetching: [first, end)
@@ -125,6 +129,8 @@ struct World {
   // per plugin slot, written by the sensors phase: 1 when that sensor measured in this step (one
   // byte per sensor in one array, read by the drivers phase for every subscription)
   std::vector<std::uint8_t> fresh;
+  std::vector<SensorSlot> sensor_slots;      // built at start, see ArtifactData
+  std::vector<Subscription> subscriptions;  // built at start, see ArtifactData
 
   // per body, from start on: the snapshot, the velocities before the step, the command buffers
   std::vector<BodyState> states;
