@@ -418,7 +418,7 @@ void Environment::requireOutsidePhases(const char* what) const {
 
 void Environment::enableNeighborQueries(double cell_size) {
   requireOutsidePhases("enableNeighborQueries");
-  if (neighbors_->enable(cell_size) && world_->state == State::Running) neighbors_->rebuild(world_->artifacts);
+  if (neighbors_->enable(cell_size) && world_->state == State::Running) neighbors_->markStale(world_->artifacts);
 }
 
 bool Environment::neighborQueriesEnabled() const noexcept { return neighbors_->enabled(); }

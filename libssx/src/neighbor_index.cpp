@@ -5,17 +5,17 @@ namespace ssx::detail {
 bool NeighborIndex::enable(double cell_size) {
   if (!(cell_size > 0)) throw Error("enableNeighborQueries: cell size must be positive");
   // positions do not change while plugins are configured: only a new grid needs building
-  const bool fresh = !enabled_ || cell_size < index_.cellSize();
-  if (fresh) index_ = SpatialIndex(cell_size);
+  const bool is_new = !enabled_ || cell_size < index_.cellSize();
+  if (is_new) index_ = SpatialIndex(cell_size);
   enabled_ = true;
-  return fresh;
+  return is_new;
 }
 
-void NeighborIndex::rebuild(const Artifacts& artifacts) {
+void NeighborIndex::rebuild() const {
   // one point per artifact with a dynamic root: its first dynamic root's position
   points_.clear();
   ids_.clear();
-  for (const auto& a : artifacts) {
+  for (const auto& a : *artifacts_) {
     for (std::size_t r = 0; r < a->rootCount(); ++r) {
       const PhysicNode& root = a->root(r);
       if (root.isStatic()) continue;
@@ -27,18 +27,29 @@ void NeighborIndex::rebuild(const Artifacts& artifacts) {
   index_.rebuild(points_, ids_);
 }
 
+const SpatialIndex& NeighborIndex::fresh() const {
+  if (stale_.load(std::memory_order_acquire)) {
+    const std::lock_guard<std::mutex> lock(mutex_);
+    if (stale_.load(std::memory_order_relaxed)) {
+      rebuild();
+      stale_.store(false, std::memory_order_release);
+    }
+  }
+  return index_;
+}
+
 void NeighborIndex::requireEnabled() const {
   if (!enabled_) throw Error("neighbour queries are off: call enableNeighborQueries from configure");
 }
 
 void NeighborIndex::query(const Vec3& point, double radius, std::vector<std::size_t>& out) const {
   requireEnabled();
-  index_.query(point, radius, out);
+  fresh().query(point, radius, out);
 }
 
 void NeighborIndex::query(const Vec3& point, double radius, std::vector<SpatialIndex::Hit>& out) const {
   requireEnabled();
-  index_.query(point, radius, out);
+  fresh().query(point, radius, out);
 }
 
 }  // namespace ssx::detail

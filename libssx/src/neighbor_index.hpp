@@ -1,12 +1,17 @@
 #pragma once
 // The index behind Environment::neighbors: each artifact with a dynamic root, at its first
-// dynamic root's position, rebuilt once per step in the snapshot phase and read by any thread in
-// the parallel phases.
+// dynamic root's position as of the last snapshot. The snapshot marks it stale; the first query
+// after that rebuilds it (once, whichever thread asks first; the others wait), so that steps in
+// which nobody asks (a range sensor at 50 Hz in a 500 Hz step) do not pay for it. The positions do
+// not change between a snapshot and the next physics step, so the index is the same whoever
+// builds it.
 
 #include <ssx/artifact.hpp>
 #include <ssx/spatial_index.hpp>
 
+#include <atomic>
 #include <memory>
+#include <mutex>
 #include <vector>
 
 namespace ssx::detail {
@@ -19,18 +24,26 @@ class NeighborIndex {
   /// Turns queries on with cells of at most `cell_size` m (the smallest asked for wins). Returns
   /// whether the grid is new (and must be rebuilt before the next query).
   bool enable(double cell_size);
-  /// Indexes the artifacts at their snapshot positions.
-  void rebuild(const Artifacts& artifacts);
-  /// See Environment::neighbors. Throws when queries are off.
+  /// The snapshot moved: the artifacts are indexed again at the next query. Not during a query.
+  void markStale(const Artifacts& artifacts) noexcept {
+    artifacts_ = &artifacts;
+    stale_.store(true, std::memory_order_release);
+  }
+  /// See Environment::neighbors. Throws when queries are off. Any thread, any number at once.
   void query(const Vec3& point, double radius, std::vector<std::size_t>& out) const;
   void query(const Vec3& point, double radius, std::vector<SpatialIndex::Hit>& out) const;
 
  private:
   void requireEnabled() const;
+  const SpatialIndex& fresh() const;  // rebuilt first when stale
+  void rebuild() const;
   bool enabled_ = false;
-  SpatialIndex index_;
-  std::vector<Vec3> points_;
-  std::vector<std::size_t> ids_;
+  const Artifacts* artifacts_ = nullptr;
+  mutable std::atomic<bool> stale_{false};
+  mutable std::mutex mutex_;  // the one rebuild after a snapshot
+  mutable SpatialIndex index_;
+  mutable std::vector<Vec3> points_;
+  mutable std::vector<std::size_t> ids_;
 };
 
 }  // namespace ssx::detail

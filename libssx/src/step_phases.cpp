@@ -212,7 +212,7 @@ void Environment::step() {
   detail::clearUndrivenCommands(w);
   ++w.steps;
   detail::publishSnapshot(w, *physics_, false);
-  if (neighbors_->enabled()) neighbors_->rebuild(w.artifacts);
+  if (neighbors_->enabled()) neighbors_->markStale(w.artifacts);
   timing.snapshot = since(t);
   if (cameras_->hasRequests()) {
     t = Clock::now();

@@ -215,7 +215,7 @@ void Environment::applyState(std::span<const std::byte> payload) {
   w.steps = steps;
   w.current_step = steps;
   cameras_->invalidate();
-  if (neighbors_->enabled()) neighbors_->rebuild(w.artifacts);
+  if (neighbors_->enabled()) neighbors_->markStale(w.artifacts);
 }
 
 }  // namespace ssx
