@@ -20,6 +20,7 @@
 
 #include <array>
 #include <optional>
+#include <span>
 
 namespace ssx::quadrotor {
 
@@ -153,7 +154,11 @@ class QuadrotorDriver final : public Driver, public SetpointInterface, public Me
   std::size_t formation_index_ = 0, formation_base_ = 0;
   Vec3 virtual_point_ = Vec3::Zero();
   Vec3 virtual_velocity_ = Vec3::Zero();
-  std::vector<RangeMeasurement::Detection> seen_;
+  const RangeMeasurement* range_ = nullptr;  // the range sensor's latest measurement (formation)
+  std::span<const RangeMeasurement::Detection> seen() const {
+    return range_ != nullptr ? std::span<const RangeMeasurement::Detection>(range_->detections)
+                             : std::span<const RangeMeasurement::Detection>();
+  }
   Vec3 own_target_ = Vec3::Zero();
   std::vector<std::pair<std::size_t, double>> desired_distance_;  // member -> d*, sorted; filled as met
   double desiredDistance(std::size_t member);
