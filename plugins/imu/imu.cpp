@@ -27,6 +27,7 @@ struct Channel {
   double noise_density = 0, bias_random_walk = 0, correlation_time = 1, turn_on = 0, scale = 1, lsb = 1, range = 1;
   // discrete-time terms for the sensor's period
   double white_sigma = 0, bias_phi = 1, bias_sigma = 0;
+  double max_count = 1;  // counts at full scale, each way: floor(range / lsb)
   Vec3 turn_on_bias = Vec3::Zero();
   Vec3 bias = Vec3::Zero();
 
@@ -52,11 +53,11 @@ struct Channel {
     if (noise)
       for (int i = 0; i < 3; ++i) turn_on_bias[i] = rng.normal() * turn_on;
     bias.setZero();
+    max_count = static_cast<double>(static_cast<std::int64_t>(std::floor(range / lsb)));
   }
 
   // one reading: returns the value and writes the counts
   Vec3 measure(const Vec3& truth, Random& rng, std::array<std::int32_t, 3>& counts) {
-    const auto max_count = static_cast<std::int64_t>(std::floor(range / lsb));
     Vec3 out;
     for (int i = 0; i < 3; ++i) {
       double white = 0;
@@ -64,7 +65,7 @@ struct Channel {
       if (white_sigma > 0) white = white_sigma * rng.normal();
       const double m = scale * (truth[i] + turn_on_bias[i] + bias[i] + white);
       // saturated before the conversion: a crash can read far beyond the range
-      const double scaled = std::clamp(m / lsb, -static_cast<double>(max_count), static_cast<double>(max_count));
+      const double scaled = std::clamp(m / lsb, -max_count, max_count);
       const std::int64_t c = std::llround(scaled);
       counts[static_cast<std::size_t>(i)] = static_cast<std::int32_t>(c);
       out[i] = static_cast<double>(c) * lsb;
