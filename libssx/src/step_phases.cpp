@@ -122,9 +122,8 @@ void runDrivers(World& world, std::size_t begin, std::size_t end) {
         sub.callback(sub.sensor->latest());
       }
     } catch (...) {
-      world.errors[i] = {"callback subscribed to sensor '" +
-                             world.artifact_data[current->source].sensors[current->sensor_index].sensor->className() +
-                             "' of artifact '" + world.artifacts[current->source]->name() + "'",
+      world.errors[i] = {"callback subscribed to sensor '" + current->sensor->className() + "' of artifact '" +
+                             world.artifacts[current->source]->name() + "'",
                          describe(std::current_exception())};
       continue;
     }

@@ -150,6 +150,17 @@ TEST_CASE("callbacks see this step's measurement and only from due sensors", "[e
   CHECK(got == std::vector<std::pair<std::int64_t, int>>{{tau, 1}, {4 * tau, 2}, {7 * tau, 3}});
 }
 
+TEST_CASE("a callback that throws fails the step, naming its sensor and that sensor's artifact", "[environment]") {
+  Environment env;
+  Artifact& src = addBall(env, "src");
+  src.addSensor(std::make_unique<CountingSensor>(), {}, 1, "s0");
+  Sensor& second = src.addSensor(std::make_unique<CountingSensor>(), {}, 1, "s1");
+  Artifact& sink = addBall(env, "sink", 2);
+  env.subscribe<Counter>(second, sink, [](const Counter&) { throw std::runtime_error("no room"); });
+  CHECK_THROWS_WITH(env.step(), Catch::Contains("callback subscribed to sensor 's1' of artifact 'src'") &&
+                                    Catch::Contains("no room") && Catch::Contains("sink"));
+}
+
 TEST_CASE("subscribing with the wrong measurement type is refused", "[environment]") {
   struct Other : Measurement {};
   Environment env;
