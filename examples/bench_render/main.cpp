@@ -5,7 +5,9 @@
 // into an image (readback included, PNG encoding excluded). Prints the median and p95 over the
 // frames, e.g.
 //   n=1000 frames=100 width=640 height=480 median_ms=3.10 p95_ms=3.40
-// LP_NUM_THREADS (llvmpipe's rasteriser threads) is 0 unless set in the environment.
+// The process is set up for llvmpipe as the ssx command sets itself up (LP_NUM_THREADS=0 unless set
+// in the environment, glibc's trim threshold at 256 MiB; see cli/main.cpp), so the figures are what
+// `ssx run --video` gets.
 //
 // --png DIR writes each N's last frame to DIR/render_N.png (to look at what the level of detail does).
 //
@@ -14,9 +16,11 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cstdlib>
 #include <cmath>
 #include <memory>
 #include <cstdio>
+#include <malloc.h>
 #include <string>
 #include <vector>
 
@@ -41,6 +45,8 @@ int main(int argc, char** argv) {
     }
   }
   if (sizes.empty()) sizes = {70, 1000, 10000};
+  setenv("LP_NUM_THREADS", "0", 0);
+  mallopt(M_TRIM_THRESHOLD, 256 << 20);
   for (int n : sizes) {
     try {
       char xml[1024];

@@ -276,3 +276,50 @@ TEST_CASE("render: levels of detail keep a primitive's size in the image, and wh
     CHECK(redPixels(im) == 0);
   }
 }
+
+TEST_CASE("render: what appears small (placed and lit per vertex) has the colour it has up close (lit per pixel)",
+          "[render]") {
+  REQUIRE(haveOsmesa());
+  RenderSettings settings;
+  settings.engine = "osmesa";
+  auto engine = createRenderEngine(settings);
+  CameraView view;  // at the origin, looking along +x
+  view.far = 500;
+  // the mean red of the red pixels (none: -1)
+  auto meanRed = [](const Image& im) {
+    double sum = 0;
+    int count = 0;
+    for (int y = 0; y < im.height; ++y)
+      for (int x = 0; x < im.width; ++x) {
+        const std::uint8_t* p = im.pixel(x, y);
+        if (p[0] > 30 && p[1] < 30 && p[2] < 30) {
+          sum += p[0];
+          ++count;
+        }
+      }
+    return count > 0 ? sum / count : -1.0;
+  };
+  // a unit box showing the camera its -x face, and a thin disc (a rotor) seen face on from either
+  // side: lit by the eye light (0.3 + 0.3) and not the sun, which is behind them, at every distance
+  RenderNodeSpec box;
+  box.primitive = RenderNodeSpec::Primitive::Box;
+  box.size = Vec3(1, 1, 1);
+  box.color = {1, 0, 0, 1};
+  RenderNodeSpec disc = box;
+  disc.primitive = RenderNodeSpec::Primitive::Cylinder;
+  disc.radius = 0.5;
+  disc.length = 0.005;
+  const Quat towards(Eigen::AngleAxisd(-std::numbers::pi / 2, Vec3::UnitY())), away = towards.conjugate();
+  Image im;
+  for (double d : {8.0, 40.0, 70.0, 120.0}) {
+    engine->renderView(view, {RenderNode{&box, nullptr, Pose{Vec3(d, 0, 0), Quat::Identity()}}}, {0.2f, 0.4f, 0.6f, 1},
+                       im);
+    INFO("box at " << d << " m");
+    CHECK(meanRed(im) == Approx(0.6 * 255).margin(6));
+    for (const Quat& facing : {towards, away}) {
+      engine->renderView(view, {RenderNode{&disc, nullptr, Pose{Vec3(d, 0, 0), facing}}}, {0.2f, 0.4f, 0.6f, 1}, im);
+      INFO("disc at " << d << " m, facing " << (&facing == &towards ? "the camera" : "away"));
+      CHECK(meanRed(im) == Approx(0.6 * 255).margin(6));
+    }
+  }
+}
