@@ -9,7 +9,7 @@
 // and the resident memory the started environment adds per robot (measured on the first round,
 // from /proc/self/statm, so it includes the allocator's overhead):
 //   robot=full n=100000 load_s=1.20 start_s=0.80 total_s=2.00 load_us_per_robot=12.0 kib_per_robot=9.5
-// usage: ssx_bench_scene [--quick]
+// usage: ssx_bench_scene [--quick] [--robot light|full] [--n N]...   (--robot and --n pick cases)
 #include <ssx/ssx.hpp>
 
 #include <sys/wait.h>
@@ -19,9 +19,11 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <string>
 #include <vector>
 
 namespace fs = std::filesystem;
@@ -79,7 +81,21 @@ fs::path writeFull(const fs::path& dir, int n) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  const bool quick = argc > 1 && std::strcmp(argv[1], "--quick") == 0;
+  bool quick = false;
+  std::string only_robot;
+  std::vector<int> only_sizes;
+  for (int i = 1; i < argc; ++i) {
+    if (std::strcmp(argv[i], "--quick") == 0) {
+      quick = true;
+    } else if (std::strcmp(argv[i], "--robot") == 0 && i + 1 < argc) {
+      only_robot = argv[++i];
+    } else if (std::strcmp(argv[i], "--n") == 0 && i + 1 < argc) {
+      only_sizes.push_back(std::atoi(argv[++i]));
+    } else {
+      std::fprintf(stderr, "usage: ssx_bench_scene [--quick] [--robot light|full] [--n N]...\n");
+      return 2;
+    }
+  }
   char pattern[] = "/tmp/ssx_bench_scene_XXXXXX";
   const fs::path dir = mkdtemp(pattern);
   struct Case {
@@ -91,7 +107,8 @@ int main(int argc, char** argv) {
                                         : std::vector<Case>{{"light", writeLight, {1000, 10000, 30000, 100000}},
                                                             {"full", writeFull, {1000, 10000, 100000}}};
   for (const Case& c : cases) {
-    for (int n : c.sizes) {
+    if (!only_robot.empty() && only_robot != c.robot) continue;
+    for (int n : only_sizes.empty() ? c.sizes : only_sizes) {
       const fs::path scene = c.write(dir, n);
       // each size in a process of its own, so that the memory it reports is its own
       std::fflush(stdout);

@@ -57,11 +57,14 @@ PhysicNode& Artifact::addPhysicRoot(std::shared_ptr<const PhysicNodeSpec> shared
   return *nodes_[first];
 }
 
-void Artifact::addRenderRoot(RenderNodeSpec spec) {
+void Artifact::addRenderRoot(RenderNodeSpec spec) { addRenderRoot(std::make_shared<const RenderNodeSpec>(std::move(spec))); }
+
+void Artifact::addRenderRoot(std::shared_ptr<const RenderNodeSpec> spec) {
   requireSetup("render nodes can be added");
-  if (!spec.follow.empty() && node(spec.follow) == nullptr)
-    throw ConfigError({}, "artifact '" + name_ + "': render node '" + spec.name + "' follows unknown physic node '" +
-                              spec.follow + "'");
+  if (spec == nullptr) throw ConfigError({}, "artifact '" + name_ + "': null render node tree");
+  if (!spec->follow.empty() && node(spec->follow) == nullptr)
+    throw ConfigError({}, "artifact '" + name_ + "': render node '" + spec->name + "' follows unknown physic node '" +
+                              spec->follow + "'");
   render_roots_.push_back(std::move(spec));
 }
 

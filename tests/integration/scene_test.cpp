@@ -243,6 +243,31 @@ TEST_CASE("scenes load from memory with paths relative to a base directory", "[s
                     Catch::StartsWith("memory.xml:1: error: XML syntax"));
 }
 
+TEST_CASE("a swarm's members share their type's physic and render trees: one copy whatever the count", "[scene]") {
+  const std::string xml = R"(<scene>
+    <type name="quad" file="mk_quad.xml"/>
+    <swarm type="quad" count="3" name="q{i}" spacing="2"/>
+    <artifact name="solo" type="quad" xyz="0 -5 0"/>
+  </scene>)";
+  Scene scene = loadSceneFromString(xml, "memory.xml", fs::path(SSX_EXAMPLES_DIR) / "artifacts", testOptions());
+  Environment& env = *scene.environment;
+  const Artifact& a = *env.findArtifact("q0");
+  REQUIRE(a.renderRoots().size() >= 1);
+  for (const char* name : {"q1", "q2", "solo"}) {
+    const Artifact& b = *env.findArtifact(name);
+    REQUIRE(b.renderRoots().size() == a.renderRoots().size());
+    for (std::size_t i = 0; i < a.renderRoots().size(); ++i) CHECK(b.renderRoots()[i].get() == a.renderRoots()[i].get());
+  }
+  // a tree added by value is the artifact's own; a null tree is refused
+  Artifact& extra = env.addArtifact("extra", Pose{});
+  RenderNodeSpec ball;
+  ball.primitive = RenderNodeSpec::Primitive::Sphere;
+  extra.addRenderRoot(ball);
+  REQUIRE(extra.renderRoots().size() == 1);
+  CHECK(extra.renderRoots()[0]->primitive == RenderNodeSpec::Primitive::Sphere);
+  CHECK_THROWS_WITH(extra.addRenderRoot(std::shared_ptr<const RenderNodeSpec>()), Catch::Contains("null render node tree"));
+}
+
 TEST_CASE("counts have upper bounds", "[scene]") {
   const std::string xml = R"(<scene>
     <physics partitions="4000" max_contacts="100000000" broadphase="sap"/>

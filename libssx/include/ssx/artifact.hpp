@@ -53,6 +53,8 @@ class SSX_EXPORT Artifact {
   PhysicNode& addPhysicRoot(std::shared_ptr<const PhysicNodeSpec> spec);
   /// Adds a render node tree.
   void addRenderRoot(RenderNodeSpec spec);
+  /// The same, for a tree shared by many artifacts (a swarm's type): it is not copied.
+  void addRenderRoot(std::shared_ptr<const RenderNodeSpec> spec);
   /// Sets the driver. `class_name` names it in messages; `period_steps` >= 1.
   Driver& setDriver(std::unique_ptr<Driver> driver, Descriptor params = {}, std::int64_t period_steps = 1,
                     std::string class_name = {});
@@ -105,7 +107,8 @@ class SSX_EXPORT Artifact {
   std::size_t nodeCount() const noexcept { return nodes_.size(); }
   PhysicNode& nodeAt(std::size_t i) { return *nodes_.at(i); }
   const PhysicNode& nodeAt(std::size_t i) const { return *nodes_.at(i); }
-  const std::vector<RenderNodeSpec>& renderRoots() const noexcept { return render_roots_; }
+  /// The render node trees, in the order added (trees of a swarm's type are shared by its members).
+  const std::vector<std::shared_ptr<const RenderNodeSpec>>& renderRoots() const noexcept { return render_roots_; }
 
   /// State of the first root node (world frame). Requires a physic root.
   BodyState state() const { return root().state(); }
@@ -125,7 +128,7 @@ class SSX_EXPORT Artifact {
   std::vector<std::shared_ptr<const PhysicNodeSpec>> root_specs_;
   std::vector<std::unique_ptr<PhysicNode>> nodes_;  // every node, trees in order
   std::vector<PhysicNode*> roots_;
-  std::vector<RenderNodeSpec> render_roots_;
+  std::vector<std::shared_ptr<const RenderNodeSpec>> render_roots_;
 };
 
 }  // namespace ssx

@@ -61,7 +61,7 @@ void SceneCameras::start(const RenderSettings& r, Nanoseconds timestep, const Re
   follow_.clear();
   for (const auto& a : artifacts) {
     auto& follow = follow_.emplace_back();
-    for (const auto& root : a->renderRoots()) follow.push_back(root.follow.empty() ? nullptr : a->node(root.follow));
+    for (const auto& root : a->renderRoots()) follow.push_back(root->follow.empty() ? nullptr : a->node(root->follow));
   }
   if (r.cameras.empty()) return;
   if (!renderer.drawsPixels()) {
@@ -127,7 +127,7 @@ void SceneCameras::sync(std::int64_t step, const Artifacts& artifacts) {
     owner = &a;
     for (std::size_t i = 0; i < a.renderRoots().size(); ++i) {
       const PhysicNode* follow = follow_[k][i];
-      add(add, a.renderRoots()[i], follow != nullptr ? follow->pose() : a.placement());
+      add(add, *a.renderRoots()[i], follow != nullptr ? follow->pose() : a.placement());
     }
   }
 }

@@ -121,7 +121,7 @@ ArtifactType SceneLoader::parseArtifact(const Descriptor& root) {
       }
       t.physic.push_back(std::make_shared<const PhysicNodeSpec>(std::move(spec)));
     } else if (c.name() == "render") {
-      t.render.push_back(readRenderNode(c, true));
+      t.render.push_back(std::make_shared<const RenderNodeSpec>(readRenderNode(c, true)));
     } else if (c.name() == "driver") {
       if (t.driver) {
         error(c.where(), "<driver>: an artifact has at most one driver");
@@ -134,7 +134,7 @@ ArtifactType SceneLoader::parseArtifact(const Descriptor& root) {
   }
   // render roots follow physic nodes by name
   for (std::size_t i = 0; i < t.render.size(); ++i) {
-    const std::string& follow = t.render[i].follow;
+    const std::string& follow = t.render[i]->follow;
     if (follow.empty()) continue;
     bool found = false;
     auto search = [&](auto& self, const PhysicNodeSpec& n) -> void {

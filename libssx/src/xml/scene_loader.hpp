@@ -33,7 +33,7 @@ struct PluginDecl {
 struct ArtifactType {
   bool ok = true;
   std::vector<std::shared_ptr<const PhysicNodeSpec>> physic;  // shared by every instance
-  std::vector<RenderNodeSpec> render;
+  std::vector<std::shared_ptr<const RenderNodeSpec>> render;  // shared by every instance
   std::optional<PluginDecl> driver;
   std::vector<PluginDecl> sensors;
 };
