@@ -158,28 +158,39 @@ const char* Descriptor::declaredDefault(std::string_view key) const noexcept {
   return nullptr;
 }
 
+namespace {
+// a plugin's declared default for `key`, parsed
+template <class T>
+T parseDefault(const Descriptor& d, std::string_view key, const char* text) {
+  T value{};
+  if (!parseValue(text, value))
+    throw d.error("the declared default of '" + std::string(key) + "' ('" + text + "') is not " + typeName<T>() +
+                  " (a bug in the plugin's declarations)");
+  return value;
+}
+}  // namespace
+
 template <class T>
 T Descriptor::get(std::string_view key) const {
-  const Attribute* a = find(key);
-  if (a == nullptr) {
-    const char* fallback = declaredDefault(key);
-    if (fallback == nullptr) throw error("missing attribute '" + std::string(key) + "'");
-    T value{};
-    if (!parseValue(fallback, value))
-      throw error("the declared default of '" + std::string(key) + "' ('" + fallback + "') is not " + typeName<T>() +
-                  " (a bug in the plugin's declarations)");
-    return value;
-  }
-  T value{};
-  if (!parseValue(a->value, value))
-    throw error(*a, "attribute '" + a->key + "' must be " + typeName<T>() + ", got '" + a->value + "'");
-  return value;
+  if (const Attribute* a = find(key)) return parse<T>(*a);
+  const char* fallback = declaredDefault(key);
+  if (fallback == nullptr) throw error("missing attribute '" + std::string(key) + "'");
+  return parseDefault<T>(*this, key, fallback);
 }
 
 template <class T>
 T Descriptor::get(std::string_view key, const T& fallback) const {
-  if (find(key) == nullptr && declaredDefault(key) == nullptr) return fallback;
-  return get<T>(key);
+  if (const Attribute* a = find(key)) return parse<T>(*a);
+  const char* declared = declaredDefault(key);
+  return declared != nullptr ? parseDefault<T>(*this, key, declared) : fallback;
+}
+
+template <class T>
+T Descriptor::parse(const Attribute& a) const {
+  T value{};
+  if (!parseValue(a.value, value))
+    throw error(a, "attribute '" + a.key + "' must be " + typeName<T>() + ", got '" + a.value + "'");
+  return value;
 }
 
 double Descriptor::getPositive(std::string_view key, double fallback) const {
@@ -227,7 +238,8 @@ ConfigError Descriptor::errorAt(std::string_view key, const std::string& message
 
 #define SSX_INSTANTIATE_GET(T)                                      \
   template SSX_EXPORT T Descriptor::get<T>(std::string_view) const; \
-  template SSX_EXPORT T Descriptor::get<T>(std::string_view, const T&) const;
+  template SSX_EXPORT T Descriptor::get<T>(std::string_view, const T&) const; \
+  template SSX_EXPORT T Descriptor::parse<T>(const Attribute&) const;
 SSX_INSTANTIATE_GET(std::string)
 SSX_INSTANTIATE_GET(bool)
 SSX_INSTANTIATE_GET(int)

@@ -133,15 +133,15 @@ std::vector<Diagnostic> checkParameters(std::span<const ssx_plugin_param> declar
     try {
       switch (d.type) {
         case SSX_PARAM_BOOL:
-          (void)params.get<bool>(d.name);
+          (void)params.parse<bool>(*a);
           break;
         case SSX_PARAM_INT: {
-          const auto v = params.get<std::int64_t>(d.name);
+          const auto v = params.parse<std::int64_t>(*a);
           if (!inBounds(d, static_cast<double>(v))) outOfBounds(a->value);
           break;
         }
         case SSX_PARAM_REAL: {
-          const double v = params.get<double>(d.name);  // finite: get refuses anything else
+          const double v = params.parse<double>(*a);  // finite: parse refuses anything else
           if (!inBounds(d, v)) {
             outOfBounds(a->value);
             break;
@@ -168,12 +168,12 @@ std::vector<Diagnostic> checkParameters(std::span<const ssx_plugin_param> declar
           break;
         }
         case SSX_PARAM_VEC3: {
-          const Vec3 v = params.get<Vec3>(d.name);
+          const Vec3 v = params.parse<Vec3>(*a);
           if (!inBounds(d, v.x()) || !inBounds(d, v.y()) || !inBounds(d, v.z())) outOfBounds(a->value);
           break;
         }
         case SSX_PARAM_CHOICE: {
-          const std::string v = params.get<std::string>(d.name);
+          const std::string& v = a->value;
           if (!isChoice(d.choices, v)) {
             const auto choices = words(d.choices);
             std::string list;

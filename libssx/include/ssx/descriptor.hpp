@@ -70,6 +70,10 @@ class SSX_EXPORT Descriptor {
   /// malformed.
   template <class T>
   T get(std::string_view key, const T& fallback) const;
+  /// An attribute's value (one of this descriptor's, or a stand-in) parsed as T; throws
+  /// ConfigError naming it if malformed.
+  template <class T>
+  T parse(const Attribute& attribute) const;
   /// Like get, and also checks `value > 0` (throws ConfigError naming the attribute).
   double getPositive(std::string_view key, double fallback) const;
 

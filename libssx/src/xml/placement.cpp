@@ -24,12 +24,22 @@ T* SceneLoader::createPlugin(const PluginDecl& decl, Create create) {
 }
 
 void SceneLoader::checkPlugin(Environment& env, const void* instance, Descriptor& params, const Artifact* artifact,
-                              std::int64_t period_steps, const std::string& what, const SourceLocation& period_from) {
+                              std::int64_t period_steps, const std::string& what, const SourceLocation& period_from,
+                              const PluginDecl* as_declared) {
   const ssx_plugin_class* type = env.classLoader().classOf(instance);
   if (type == nullptr) return;
-  const PluginContext context{&env, artifact, period_steps, env.timestep(), period_from};
-  for (auto& d : checkParameters({type->params, type->param_count}, params, context, what))
-    diagnostics_.push_back(std::move(d));
+  const std::span<const ssx_plugin_param> declarations{type->params, type->param_count};
+  // the declared checks read only the values, the period and the time step: the same inputs give
+  // the same (here: no) findings
+  const auto key = std::make_tuple(static_cast<const void*>(type), as_declared, period_steps);
+  if (as_declared != nullptr && clean_checks_.count(key) != 0) {
+    params.setDeclarations(declarations);
+  } else {
+    const PluginContext context{&env, artifact, period_steps, env.timestep(), period_from};
+    std::vector<Diagnostic> found = checkParameters(declarations, params, context, what);
+    if (as_declared != nullptr && found.empty()) clean_checks_.insert(key);
+    for (auto& d : found) diagnostics_.push_back(std::move(d));
+  }
   // unknown parameters were reported just now: not again when the environment starts
   for (const auto& a : params.attributes()) a.used = true;
 }
@@ -115,7 +125,8 @@ void SceneLoader::place(Environment& env, const std::string& name, const std::st
     if (Driver* d = createPlugin<Driver>(decl, create)) {
       Descriptor params = withOverrides(decl, driver_override, index);
       const std::int64_t period = periodOf(decl, driver_override);
-      checkPlugin(env, d, params, &a, period, "driver '" + decl.class_name + "'", periodFrom(decl, driver_override));
+      checkPlugin(env, d, params, &a, period, "driver '" + decl.class_name + "'", periodFrom(decl, driver_override),
+                  driver_override == nullptr ? &decl : nullptr);
       a.setDriver(*d, std::move(params), period, decl.class_name);
     }
   }
@@ -126,7 +137,7 @@ void SceneLoader::place(Environment& env, const std::string& name, const std::st
       Descriptor params = withOverrides(decl, sensor_overrides[i], index);
       const std::int64_t period = periodOf(decl, sensor_overrides[i]);
       checkPlugin(env, s, params, &a, period, "sensor " + std::to_string(i) + " '" + decl.class_name + "'",
-                  periodFrom(decl, sensor_overrides[i]));
+                  periodFrom(decl, sensor_overrides[i]), sensor_overrides[i] == nullptr ? &decl : nullptr);
       a.addSensor(*s, std::move(params), period, decl.class_name);
     }
   }

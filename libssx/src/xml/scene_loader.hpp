@@ -16,6 +16,7 @@
 #include <set>
 #include <sstream>
 #include <string>
+#include <tuple>
 #include <vector>
 
 namespace ssx::detail {
@@ -215,15 +216,20 @@ class SceneLoader {
   static SourceLocation periodFrom(const PluginDecl& decl, const Descriptor* overrides);
   template <class T, class Create>
   T* createPlugin(const PluginDecl& decl, Create create);
-  // checks a plugin's parameters against its class's declarations (defaults added)
+  // checks a plugin's parameters against its class's declarations (defaults added). `as_declared`:
+  // the parameters are exactly that declaration's (no overrides), so a check of the same class,
+  // declaration and period that found nothing need not run again (a swarm's members)
   void checkPlugin(Environment& env, const void* instance, Descriptor& params, const Artifact* artifact,
-                   std::int64_t period_steps, const std::string& what, const SourceLocation& period_from = {});
+                   std::int64_t period_steps, const std::string& what, const SourceLocation& period_from = {},
+                   const PluginDecl* as_declared = nullptr);
   // runs a class's own validate on a parameter set that passed checkPlugin
   void validatePlugin(Environment& env, const void* instance, const Descriptor& params, const Artifact* artifact,
                       std::int64_t period_steps, const std::string& what);
 
   const SceneOptions& options_;
   std::vector<Diagnostic> diagnostics_;
+  // (class, declaration, period) whose check found nothing, for checkPlugin
+  std::set<std::tuple<const void*, const PluginDecl*, std::int64_t>> clean_checks_;
   std::deque<Descriptor> documents_;  // every file read, kept alive for the pointers below
   EnvironmentSettings settings_;
   RunOptions run_;
