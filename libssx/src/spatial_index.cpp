@@ -39,8 +39,34 @@ void SpatialIndex::rebuild(const std::vector<Vec3>& points, const std::vector<st
   }
   std::sort(entries_.begin(), entries_.end(),
             [](const Entry& a, const Entry& b) { return a.key != b.key ? a.key < b.key : a.id < b.id; });
-  // a hash table of the columns, at most half full
   if (entries_.size() >= std::numeric_limits<std::uint32_t>::max()) throw Error("spatial index: too many points");
+  columns_.clear();
+  dense_start_.clear();
+  if (entries_.empty()) return;
+  // dense when the bounding rectangle of the columns has at most 4 columns per point (or 4,096)
+  std::int64_t x_max = 0, y_max = 0;
+  x_min_ = y_min_ = kAxisMax;
+  for (const Entry& e : entries_) {
+    const auto x = static_cast<std::int64_t>(e.key >> 42), y = static_cast<std::int64_t>((e.key >> 21) & kAxisMax);
+    x_min_ = std::min(x_min_, x);
+    x_max = std::max(x_max, x);
+    y_min_ = std::min(y_min_, y);
+    y_max = std::max(y_max, y);
+  }
+  nx_ = x_max - x_min_ + 1;
+  ny_ = y_max - y_min_ + 1;
+  const auto limit = static_cast<double>(std::max<std::size_t>(4 * entries_.size(), 4096));
+  if (static_cast<double>(nx_) * static_cast<double>(ny_) <= limit) {
+    // counting, then prefix sums: the entries are sorted by column already
+    dense_start_.assign(static_cast<std::size_t>(nx_ * ny_) + 1, 0);
+    for (const Entry& e : entries_) {
+      const auto x = static_cast<std::int64_t>(e.key >> 42), y = static_cast<std::int64_t>((e.key >> 21) & kAxisMax);
+      ++dense_start_[static_cast<std::size_t>((x - x_min_) * ny_ + (y - y_min_)) + 1];
+    }
+    for (std::size_t c = 1; c < dense_start_.size(); ++c) dense_start_[c] += dense_start_[c - 1];
+    return;
+  }
+  // a hash table of the columns, at most half full
   std::size_t slots = 16;
   while (slots < 2 * entries_.size()) slots *= 2;
   columns_.assign(slots, Column{});
@@ -70,6 +96,21 @@ void SpatialIndex::visit(const Vec3& center, double radius, Visit&& found) const
   const std::int64_t x0 = cell(center.x() - radius), x1 = cell(center.x() + radius);
   const std::int64_t y0 = cell(center.y() - radius), y1 = cell(center.y() + radius);
   const std::int64_t z0 = cell(center.z() - radius), z1 = cell(center.z() + radius);
+  if (!dense_start_.empty()) {
+    // the columns y0..y1 of one x are adjacent in the table and their entries one run; in it,
+    // only the cells of z0..z1 are looked at
+    const std::int64_t ya = std::max(y0, y_min_) - y_min_, yb = std::min(y1, y_min_ + ny_ - 1) - y_min_;
+    if (ya > yb) return;
+    for (std::int64_t x = std::max(x0, x_min_); x <= std::min(x1, x_min_ + nx_ - 1); ++x) {
+      const auto row = static_cast<std::size_t>((x - x_min_) * ny_);
+      const Entry* end = entries_.data() + dense_start_[row + static_cast<std::size_t>(yb) + 1];
+      for (const Entry* e = entries_.data() + dense_start_[row + static_cast<std::size_t>(ya)]; e != end; ++e) {
+        const auto z = static_cast<std::int64_t>(e->key & kAxisMax);
+        if (z >= z0 && z <= z1 && (e->point - center).squaredNorm() <= r2) found(*e);
+      }
+    }
+    return;
+  }
   for (std::int64_t x = x0; x <= x1; ++x) {
     for (std::int64_t y = y0; y <= y1; ++y) {
       // one hash lookup per column, then the column's entries in the z range

@@ -2,7 +2,9 @@
 /// @file
 /// A uniform-grid index of points for neighbour queries: rebuilt from scratch each time (cells
 /// sorted by key), queried for everything within a radius. Building is O(n log n) in the points,
-/// a query O(cells probed + points found).
+/// a query O(columns probed + points scanned). When the points' (x, y) columns fill a good part
+/// of their bounding rectangle (a swarm), a dense table of the rectangle's columns finds a query's
+/// columns of one x as one contiguous run of entries; else a hash table finds each column.
 
 #include <ssx/export.hpp>
 #include <ssx/types.hpp>
@@ -32,6 +34,8 @@ class SSX_EXPORT SpatialIndex {
   /// Same, with the points (in ascending id order).
   void query(const Vec3& center, double radius, std::vector<Hit>& out) const;
   std::size_t size() const noexcept { return entries_.size(); }
+  /// Whether the last rebuild chose the dense column table (else the hash table).
+  bool dense() const noexcept { return !dense_start_.empty(); }
 
  private:
   struct Entry {
@@ -53,7 +57,11 @@ class SSX_EXPORT SpatialIndex {
 
   double cell_size_;
   std::vector<Entry> entries_;  // sorted by (key, id)
-  std::vector<Column> columns_;  // open-addressing hash table of the non-empty columns
+  std::vector<Column> columns_;  // open-addressing hash table of the non-empty columns (sparse)
+  // dense: the columns of cells [x_min, x_min + nx) x [y_min, y_min + ny), x-major as the keys are;
+  // column c's entries are [dense_start_[c], dense_start_[c + 1])
+  std::vector<std::uint32_t> dense_start_;
+  std::int64_t x_min_ = 0, y_min_ = 0, nx_ = 0, ny_ = 0;
 };
 
 }  // namespace ssx
