@@ -10,6 +10,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <memory>
 #include <numbers>
 #include <string>
 
@@ -51,6 +52,34 @@ double yellowRow(const Image& im) {
       }
     }
   return count > 0 ? sum / count : -1;
+}
+
+// the osmesa engine alone, outside any scene
+std::unique_ptr<RenderEngine> osmesaEngine() {
+  RenderSettings settings;
+  settings.engine = "osmesa";
+  return createRenderEngine(settings);
+}
+
+// the red pixels (however dimly lit) of an image, or of one of its columns: how many, mean red
+struct Red {
+  int count = 0;
+  double mean = -1;
+};
+Red redPixels(const Image& im, int column = -1) {
+  Red red;
+  double sum = 0;
+  for (int y = 0; y < im.height; ++y)
+    for (int x = 0; x < im.width; ++x) {
+      if (column >= 0 && x != column) continue;
+      const std::uint8_t* p = im.pixel(x, y);
+      if (p[0] > 30 && p[1] < 30 && p[2] < 30) {
+        ++red.count;
+        sum += p[0];
+      }
+    }
+  if (red.count > 0) red.mean = sum / red.count;
+  return red;
 }
 
 }  // namespace
@@ -226,22 +255,10 @@ TEST_CASE("render: an ffmpeg that fails makes stopping fail with the video's nam
 TEST_CASE("render: levels of detail keep a primitive's size in the image, and what is partly in view is drawn",
           "[render]") {
   REQUIRE(haveOsmesa());
-  RenderSettings settings;
-  settings.engine = "osmesa";
-  auto engine = createRenderEngine(settings);
+  auto engine = osmesaEngine();
   CameraView view;  // at the origin, looking along +x, 640 x 480, 60 degrees
   view.far = 500;
   const double pixels_per_metre = 480 / (2 * std::tan(std::numbers::pi / 6) * 480 / 640);  // at 1 m
-  auto redPixels = [](const Image& im, int column = -1) {
-    int count = 0;
-    for (int y = 0; y < im.height; ++y)
-      for (int x = 0; x < im.width; ++x) {
-        if (column >= 0 && x != column) continue;
-        const std::uint8_t* p = im.pixel(x, y);
-        count += p[0] > 30 && p[1] < 30 && p[2] < 30 ? 1 : 0;  // red, however dimly lit
-      }
-    return count;
-  };
   Image im;
   // a thin disc (a rotor) and a sphere facing the camera, near (full detail) to far (the coarsest
   // polygon, a disc drawn as its face): the red area stays the true one
@@ -258,9 +275,9 @@ TEST_CASE("render: levels of detail keep a primitive's size in the image, and wh
       const double r = 0.5 / d * pixels_per_metre;
       engine->renderView(view, {RenderNode{spec, nullptr, Pose{Vec3(d, 0, 0), facing}}}, {0.2f, 0.4f, 0.6f, 1}, im);
       const double area = std::numbers::pi * r * r;
-      INFO((spec == &disc ? "disc" : "sphere") << " at " << d << " m: radius " << r << " px, " << redPixels(im)
-                                               << " red pixels for " << area);
-      CHECK(redPixels(im) == Approx(area).epsilon(r > 5 ? 0.05 : 0.15));
+      INFO((spec == &disc ? "disc" : "sphere") << " at " << d << " m: radius " << r << " px, "
+                                               << redPixels(im).count << " red pixels for " << area);
+      CHECK(redPixels(im).count == Approx(area).epsilon(r > 5 ? 0.05 : 0.15));
     }
   // a box mostly left of the image is still drawn at the image's left edge
   RenderNodeSpec box = disc;
@@ -269,36 +286,20 @@ TEST_CASE("render: levels of detail keep a primitive's size in the image, and wh
   const double edge = 10 * std::tan(std::numbers::pi / 6);  // the image's left edge at 10 m
   engine->renderView(view, {RenderNode{&box, nullptr, Pose{Vec3(10, edge + 0.4, 0), Quat::Identity()}}},
                      {0.2f, 0.4f, 0.6f, 1}, im);
-  CHECK(redPixels(im, 0) > 10);
+  CHECK(redPixels(im, 0).count > 10);
   // one far beyond the far plane, or behind the camera, is not
   for (const Vec3& at : {Vec3(600, 0, 0), Vec3(-5, 0, 0)}) {
     engine->renderView(view, {RenderNode{&box, nullptr, Pose{at, Quat::Identity()}}}, {0.2f, 0.4f, 0.6f, 1}, im);
-    CHECK(redPixels(im) == 0);
+    CHECK(redPixels(im).count == 0);
   }
 }
 
 TEST_CASE("render: what appears small (placed and lit per vertex) has the colour it has up close (lit per pixel)",
           "[render]") {
   REQUIRE(haveOsmesa());
-  RenderSettings settings;
-  settings.engine = "osmesa";
-  auto engine = createRenderEngine(settings);
+  auto engine = osmesaEngine();
   CameraView view;  // at the origin, looking along +x
   view.far = 500;
-  // the mean red of the red pixels (none: -1)
-  auto meanRed = [](const Image& im) {
-    double sum = 0;
-    int count = 0;
-    for (int y = 0; y < im.height; ++y)
-      for (int x = 0; x < im.width; ++x) {
-        const std::uint8_t* p = im.pixel(x, y);
-        if (p[0] > 30 && p[1] < 30 && p[2] < 30) {
-          sum += p[0];
-          ++count;
-        }
-      }
-    return count > 0 ? sum / count : -1.0;
-  };
   // a unit box showing the camera its -x face, and a thin disc (a rotor) seen face on from either
   // side: lit by the eye light (0.3 + 0.3) and not the sun, which is behind them, at every distance
   RenderNodeSpec box;
@@ -315,11 +316,11 @@ TEST_CASE("render: what appears small (placed and lit per vertex) has the colour
     engine->renderView(view, {RenderNode{&box, nullptr, Pose{Vec3(d, 0, 0), Quat::Identity()}}}, {0.2f, 0.4f, 0.6f, 1},
                        im);
     INFO("box at " << d << " m");
-    CHECK(meanRed(im) == Approx(0.6 * 255).margin(6));
+    CHECK(redPixels(im).mean == Approx(0.6 * 255).margin(6));
     for (const Quat& facing : {towards, away}) {
       engine->renderView(view, {RenderNode{&disc, nullptr, Pose{Vec3(d, 0, 0), facing}}}, {0.2f, 0.4f, 0.6f, 1}, im);
       INFO("disc at " << d << " m, facing " << (&facing == &towards ? "the camera" : "away"));
-      CHECK(meanRed(im) == Approx(0.6 * 255).margin(6));
+      CHECK(redPixels(im).mean == Approx(0.6 * 255).margin(6));
     }
   }
 }
