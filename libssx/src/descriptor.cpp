@@ -236,8 +236,8 @@ ConfigError Descriptor::errorAt(std::string_view key, const std::string& message
   return a != nullptr ? error(*a, message) : error(message);
 }
 
-#define SSX_INSTANTIATE_GET(T)                                      \
-  template SSX_EXPORT T Descriptor::get<T>(std::string_view) const; \
+#define SSX_INSTANTIATE_GET(T)                                                \
+  template SSX_EXPORT T Descriptor::get<T>(std::string_view) const;           \
   template SSX_EXPORT T Descriptor::get<T>(std::string_view, const T&) const; \
   template SSX_EXPORT T Descriptor::parse<T>(const Attribute&) const;
 SSX_INSTANTIATE_GET(std::string)

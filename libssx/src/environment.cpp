@@ -10,11 +10,11 @@
 #include <ssx/plugin_abi.hpp>
 
 #include <algorithm>
-#include <iterator>
 #include <chrono>
 #include <cmath>
 #include <cstring>
 #include <iostream>
+#include <iterator>
 #include <numbers>
 #include <set>
 #include <sstream>
