@@ -1,6 +1,8 @@
 #include <ssx/environment.hpp>
 #include <ssx/parameters.hpp>
 
+#include "parameter_checks.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -92,14 +94,22 @@ bool isChoice(const char* choices, std::string_view v) {
 }
 }  // namespace
 
-std::vector<Diagnostic> checkParameters(std::span<const ssx_plugin_param> declarations, Descriptor& params,
-                                        const PluginContext& context, const std::string& what) {
+namespace detail {
+
+std::vector<Diagnostic> checkParametersNamed(std::span<const ssx_plugin_param> declarations, Descriptor& params,
+                                             const PluginContext& context, const std::string& what,
+                                             const std::vector<std::string>* only) {
+  // with `only`, the declarations and attributes of those names (a swarm member's own values)
+  auto selected = [&](std::string_view key) {
+    return only == nullptr || std::find(only->begin(), only->end(), key) != only->end();
+  };
   std::vector<Diagnostic> out;
   auto fail = [&](const SourceLocation& where, const std::string& message) {
     out.push_back({Diagnostic::Severity::Error, where, "<" + params.name() + ">: " + what + ": " + message});
   };
   // every attribute given is declared, or a warning
   for (const auto& a : params.attributes()) {
+    if (!selected(a.key)) continue;
     bool declared = false;
     for (const auto& d : declarations) declared = declared || a.key == d.name;
     if (declared) continue;
@@ -112,6 +122,7 @@ std::vector<Diagnostic> checkParameters(std::span<const ssx_plugin_param> declar
   // absent parameters read as their declared defaults
   params.setDeclarations(declarations);
   for (const auto& d : declarations) {
+    if (!selected(d.name)) continue;
     const Descriptor::Attribute* a = params.find(d.name);
     const bool defaulted = a == nullptr;
     Descriptor::Attribute declared_default;
@@ -191,6 +202,13 @@ std::vector<Diagnostic> checkParameters(std::span<const ssx_plugin_param> declar
     }
   }
   return out;
+}
+
+}  // namespace detail
+
+std::vector<Diagnostic> checkParameters(std::span<const ssx_plugin_param> declarations, Descriptor& params,
+                                        const PluginContext& context, const std::string& what) {
+  return detail::checkParametersNamed(declarations, params, context, what, nullptr);
 }
 
 std::string parameterTable(std::span<const ssx_plugin_param> declarations) {

@@ -5,6 +5,8 @@
 
 #include <ssx/plugin_abi.hpp>
 
+#include "parameter_checks.hpp"
+
 #include <cmath>
 
 namespace ssx::detail {
@@ -25,21 +27,26 @@ T* SceneLoader::createPlugin(const PluginDecl& decl, Create create) {
 
 void SceneLoader::checkPlugin(Environment& env, const void* instance, Descriptor& params, const Artifact* artifact,
                               std::int64_t period_steps, const std::string& what, const SourceLocation& period_from,
-                              const PluginDecl* as_declared) {
+                              const PluginDecl* decl, const Descriptor* overrides) {
   const ssx_plugin_class* type = env.classLoader().classOf(instance);
   if (type == nullptr) return;
   const std::span<const ssx_plugin_param> declarations{type->params, type->param_count};
-  // the declared checks read only the values, the period and the time step: the same inputs give
-  // the same (here: no) findings
-  const auto key = std::make_tuple(static_cast<const void*>(type), as_declared, period_steps);
-  if (as_declared != nullptr && clean_checks_.count(key) != 0) {
-    params.setDeclarations(declarations);
-  } else {
-    const PluginContext context{&env, artifact, period_steps, env.timestep(), period_from};
-    std::vector<Diagnostic> found = checkParameters(declarations, params, context, what);
-    if (as_declared != nullptr && found.empty()) clean_checks_.insert(key);
-    for (auto& d : found) diagnostics_.push_back(std::move(d));
+  // the declared checks read only the values, the period and the time step: once the parameters
+  // of a declaration and a placing element passed, the next member of that swarm differs only in
+  // the values where its index was put ({i}), and only those need checking
+  const auto key = std::make_tuple(static_cast<const void*>(type), decl, overrides, period_steps);
+  const auto clean = decl != nullptr ? clean_checks_.find(key) : clean_checks_.end();
+  const PluginContext context{&env, artifact, period_steps, env.timestep(), period_from};
+  std::vector<Diagnostic> found = detail::checkParametersNamed(
+      declarations, params, context, what, clean != clean_checks_.end() ? &clean->second : nullptr);
+  if (decl != nullptr && clean == clean_checks_.end() && found.empty()) {
+    std::vector<std::string> per_member;
+    if (overrides != nullptr)
+      for (const auto& a : overrides->attributes())
+        if (a.value.find("{i}") != std::string::npos) per_member.push_back(a.key);
+    clean_checks_.emplace(key, std::move(per_member));
   }
+  for (auto& d : found) diagnostics_.push_back(std::move(d));
   // unknown parameters were reported just now: not again when the environment starts
   for (const auto& a : params.attributes()) a.used = true;
 }
@@ -126,7 +133,7 @@ void SceneLoader::place(Environment& env, const std::string& name, const std::st
       Descriptor params = withOverrides(decl, driver_override, index);
       const std::int64_t period = periodOf(decl, driver_override);
       checkPlugin(env, d, params, &a, period, "driver '" + decl.class_name + "'", periodFrom(decl, driver_override),
-                  driver_override == nullptr ? &decl : nullptr);
+                  &decl, driver_override);
       a.setDriver(*d, std::move(params), period, decl.class_name);
     }
   }
@@ -137,7 +144,7 @@ void SceneLoader::place(Environment& env, const std::string& name, const std::st
       Descriptor params = withOverrides(decl, sensor_overrides[i], index);
       const std::int64_t period = periodOf(decl, sensor_overrides[i]);
       checkPlugin(env, s, params, &a, period, "sensor " + std::to_string(i) + " '" + decl.class_name + "'",
-                  periodFrom(decl, sensor_overrides[i]), sensor_overrides[i] == nullptr ? &decl : nullptr);
+                  periodFrom(decl, sensor_overrides[i]), &decl, sensor_overrides[i]);
       a.addSensor(*s, std::move(params), period, decl.class_name);
     }
   }

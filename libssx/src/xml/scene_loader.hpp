@@ -216,20 +216,23 @@ class SceneLoader {
   static SourceLocation periodFrom(const PluginDecl& decl, const Descriptor* overrides);
   template <class T, class Create>
   T* createPlugin(const PluginDecl& decl, Create create);
-  // checks a plugin's parameters against its class's declarations (defaults added). `as_declared`:
-  // the parameters are exactly that declaration's (no overrides), so a check of the same class,
-  // declaration and period that found nothing need not run again (a swarm's members)
+  // checks a plugin's parameters against its class's declarations (defaults added). `decl` and
+  // `overrides`: the parameters are that declaration's with that placing element's on top (its {i}
+  // replaced), so after a check of the same class, declaration, element and period that found
+  // nothing, only the values holding {i} are checked again (a swarm's members)
   void checkPlugin(Environment& env, const void* instance, Descriptor& params, const Artifact* artifact,
                    std::int64_t period_steps, const std::string& what, const SourceLocation& period_from = {},
-                   const PluginDecl* as_declared = nullptr);
+                   const PluginDecl* decl = nullptr, const Descriptor* overrides = nullptr);
   // runs a class's own validate on a parameter set that passed checkPlugin
   void validatePlugin(Environment& env, const void* instance, const Descriptor& params, const Artifact* artifact,
                       std::int64_t period_steps, const std::string& what);
 
   const SceneOptions& options_;
   std::vector<Diagnostic> diagnostics_;
-  // (class, declaration, period) whose check found nothing, for checkPlugin
-  std::set<std::tuple<const void*, const PluginDecl*, std::int64_t>> clean_checks_;
+  // (class, declaration, placing element, period) whose check found nothing -> the parameters
+  // whose values differ between the members (they hold {i}), for checkPlugin
+  std::map<std::tuple<const void*, const PluginDecl*, const Descriptor*, std::int64_t>, std::vector<std::string>>
+      clean_checks_;
   std::deque<Descriptor> documents_;  // every file read, kept alive for the pointers below
   EnvironmentSettings settings_;
   RunOptions run_;
