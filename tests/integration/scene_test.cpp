@@ -268,6 +268,26 @@ TEST_CASE("a swarm's members share their type's physic and render trees: one cop
   CHECK_THROWS_WITH(extra.addRenderRoot(std::shared_ptr<const RenderNodeSpec>()), Catch::Contains("null render node tree"));
 }
 
+TEST_CASE("a node's pose in its body is its type's, to the bit, wherever the artifact was placed", "[scene]") {
+  const std::string xml = R"(<scene>
+    <type name="quad" file="mk_quad.xml"/>
+    <artifact name="here" type="quad"/>
+    <artifact name="there" type="quad" xyz="123.4 -56.7 8.9" rpy="0.3 0.2 1.1"/>
+  </scene>)";
+  Scene scene = loadSceneFromString(xml, "placed.xml", fs::path(SSX_EXAMPLES_DIR) / "artifacts", testOptions());
+  Environment& env = *scene.environment;
+  env.start();
+  for (const char* node : {"rotor0", "rotor1", "rotor2", "rotor3"}) {
+    const Pose& here = env.findArtifact("here")->node(node)->poseInBody();
+    const Pose& there = env.findArtifact("there")->node(node)->poseInBody();
+    INFO(node);
+    CHECK(here.position == there.position);
+    CHECK(here.orientation.coeffs() == there.orientation.coeffs());
+  }
+  // mk_quad's centre of mass is its root's origin: the rotors sit where the file puts them
+  CHECK(env.findArtifact("there")->node("rotor1")->poseInBody().position == Vec3(0, 0.225, 0.02));
+}
+
 TEST_CASE("counts have upper bounds", "[scene]") {
   const std::string xml = R"(<scene>
     <physics partitions="4000" max_contacts="100000000" broadphase="sap"/>
