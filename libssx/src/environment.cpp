@@ -304,16 +304,17 @@ void Environment::start() {
     w.errors.assign(w.artifacts.size(), detail::PendingError{});
     w.state = State::Running;  // configure may subscribe and read the snapshot
     w.configuring = true;
+    PluginSetup::SharedValues shared;  // what the instances of a class compute alike, while they configure
     for (std::size_t i = 0; i < w.artifacts.size(); ++i) {
       const detail::ArtifactData& data = w.artifact_data[i];
       const detail::ArtifactModel& model = w.models[i];
       // sensors first: a driver may read their configuration (rates, resolutions)
       for (std::size_t k = 0; k < data.sensors.size(); ++k) {
-        PluginSetup setup(*this, *data.sensors[k].sensor);
+        PluginSetup setup(*this, *data.sensors[k].sensor, &shared);
         data.sensors[k].sensor->configure(model.sensor_params[k], setup);
       }
       if (data.driver) {
-        PluginSetup setup(*this, *data.driver);
+        PluginSetup setup(*this, *data.driver, &shared);
         data.driver->configure(model.driver_params, setup);
       }
     }

@@ -27,6 +27,11 @@ void PluginSetup::requireMeasurement(const Sensor& sensor, bool matches) const {
 
 void PluginSetup::enableNeighborQueries(double cell_size) { env_->enableNeighborQueries(cell_size); }
 
+std::shared_ptr<const void>* PluginSetup::findShared(const std::type_info& type, std::string_view key) {
+  if (shared_ == nullptr) return nullptr;
+  return &(*shared_)[{std::type_index(type), std::string(key)}];
+}
+
 void PluginSetup::addCameraRequest(std::function<bool(std::int64_t, CameraView&)> due, Image& target) {
   const char* kind = dynamic_cast<const Driver*>(plugin_) != nullptr ? "driver '" : "sensor '";
   env_->addCameraRequest(kind + plugin_->className() + "' of artifact '" + plugin_->artifact().name() + "'",

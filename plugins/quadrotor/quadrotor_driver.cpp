@@ -43,35 +43,6 @@ RotorParams rotorParams(const Descriptor& params) {
   return rp;
 }
 
-// the rotors at their physic nodes, positions relative to the centre of mass
-std::vector<Rotor> rotorsOf(const Descriptor& params, const Artifact& a) {
-  const auto names = words(params.get<std::string>("rotors"));
-  const auto dirs = words(params.get<std::string>("directions"));
-  if (names.size() != dirs.size() || names.size() < 4 || names.size() > kMaxRotors)
-    throw params.errorAt(names.size() != dirs.size() ? "directions" : "rotors",
-                         "'rotors' and 'directions' must name the same number (4 to " + std::to_string(kMaxRotors) +
-                             ") of rotors");
-  std::vector<Rotor> rotors;
-  for (std::size_t i = 0; i < names.size(); ++i) {
-    const PhysicNode* node = a.node(names[i]);
-    if (node == nullptr)
-      throw params.errorAt("rotors", "no physic node '" + names[i] + "' for a rotor in artifact '" + a.name() + "'");
-    if (dirs[i] != "1" && dirs[i] != "-1")
-      throw params.errorAt("directions", "rotor directions are 1 or -1, got '" + dirs[i] + "'");
-    rotors.push_back({node->poseInBody().position, dirs[i] == "1" ? 1 : -1});
-  }
-  return rotors;
-}
-
-template <class M>
-const Sensor* firstSensorOf(const Artifact& a) {
-  for (std::size_t i = 0; i < a.sensorCount(); ++i)
-    if (dynamic_cast<const M*>(&a.sensor(i).latest()) != nullptr) return &a.sensor(i);
-  return nullptr;
-}
-
-
-
 // the battery, its voltages checked against each other
 BatteryParams batteryParams(const Descriptor& params) {
   BatteryParams bp;
@@ -90,15 +61,171 @@ BatteryParams batteryParams(const Descriptor& params) {
   return bp;
 }
 
-// command_delay in inner-loop periods (a whole number of them)
-std::size_t commandDelayTicks(const Descriptor& params, const PluginContext& context) {
+template <class T>
+std::optional<T> given(const Descriptor& params, const char* key) {
+  return params.has(key) ? std::optional<T>(params.get<T>(key)) : std::nullopt;
+}
+
+}  // namespace
+
+// Everything the driver reads from its parameters but the member's own formation_index, parsed
+// and checked against itself once per parameter set: a swarm's members share one.
+struct QuadrotorDriver::Config {
+  RotorParams rotor;
+  std::vector<std::string> rotor_names;
+  std::vector<int> directions;  // 1 or -1 per rotor
+  bool ground_effect = false;
+  Vec3 wind, gust;
+  double gust_start, gust_duration, turbulence_w20, min_airspeed;
+  bool downwash = false;
+  double downwash_c[3], downwash_range, downwash_min_dz;
+  double inner_rate_hz, outer_rate_hz;
+  double attitude_kp, attitude_kd, yaw_rate_kp, max_angular_acceleration, filter_gyro_weight;
+  std::optional<Vec3> controller_inertia;
+  std::optional<double> controller_mass, max_thrust;
+  Vec3 position_kp, position_kd, position_ki;
+  double integral_limit, max_tilt;  // m s, rad
+  bool thrust_estimator = false;
+  double estimator_tau;
+  bool command_link = false;
+  double angle_step, command_delay;  // rad, s
+  std::optional<BatteryParams> battery;
+  std::string reference;
+  std::optional<Vec3> target, center;
+  Vec3 offset, center_offset;
+  double heading_kp, amplitude, eight_period, yaw_rate, start_time;
+  std::size_t formation_size;
+  double formation_radius;
+  Vec3 formation_center;
+  double formation_gain, formation_max_speed, formation_anchor_gain, obstacle_distance, obstacle_saturation;
+
+  explicit Config(const Descriptor& params);
+  // the text a Config is parsed from (every given parameter but formation_index); marks those read
+  static std::string key(const Descriptor& params);
+  // the rotors at the artifact's physic nodes, positions relative to the centre of mass
+  std::vector<Rotor> rotorsOf(const Descriptor& params, const Artifact& a) const;
+  // command_delay in inner-loop periods (a whole number of them)
+  std::size_t commandDelayTicks(const Descriptor& params, const PluginContext& context) const;
+};
+
+QuadrotorDriver::Config::Config(const Descriptor& params) : rotor(rotorParams(params)) {
+  const auto names = words(params.get<std::string>("rotors"));
+  const auto dirs = words(params.get<std::string>("directions"));
+  if (names.size() != dirs.size() || names.size() < 4 || names.size() > kMaxRotors)
+    throw params.errorAt(names.size() != dirs.size() ? "directions" : "rotors",
+                         "'rotors' and 'directions' must name the same number (4 to " + std::to_string(kMaxRotors) +
+                             ") of rotors");
+  for (const auto& d : dirs) {
+    if (d != "1" && d != "-1") throw params.errorAt("directions", "rotor directions are 1 or -1, got '" + d + "'");
+    directions.push_back(d == "1" ? 1 : -1);
+  }
+  rotor_names = names;
+  ground_effect = params.get<bool>("ground_effect");
+  wind = params.get<Vec3>("wind");
+  gust = params.get<Vec3>("gust");
+  gust_start = params.get<double>("gust_start");
+  gust_duration = params.get<double>("gust_duration");
+  turbulence_w20 = params.get<double>("turbulence_w20");
+  min_airspeed = params.get<double>("turbulence_min_airspeed");
+  downwash = params.get<bool>("downwash");
+  downwash_c[0] = params.get<double>("downwash_c1");
+  downwash_c[1] = params.get<double>("downwash_c2");
+  downwash_c[2] = params.get<double>("downwash_c3");
+  downwash_range = params.get<double>("downwash_range");
+  downwash_min_dz = params.get<double>("downwash_min_height");
+  inner_rate_hz = params.get<double>("inner_rate_hz");
+  outer_rate_hz = params.get<double>("outer_rate_hz");
+  attitude_kp = params.get<double>("attitude_kp");
+  attitude_kd = params.get<double>("attitude_kd");
+  yaw_rate_kp = params.get<double>("yaw_rate_kp");
+  max_angular_acceleration = params.get<double>("max_angular_acceleration");
+  filter_gyro_weight = params.get<double>("filter_gyro_weight");
+  controller_inertia = given<Vec3>(params, "controller_inertia");
+  controller_mass = given<double>(params, "controller_mass");
+  max_thrust = given<double>(params, "max_thrust");
+  position_kp = params.get<Vec3>("position_kp");
+  position_kd = params.get<Vec3>("position_kd");
+  position_ki = params.get<Vec3>("position_ki");
+  integral_limit = params.get<double>("integral_limit");
+  max_tilt = params.get<double>("max_tilt_deg") * std::numbers::pi / 180.0;
+  thrust_estimator = params.get<bool>("thrust_estimator");
+  estimator_tau = params.get<double>("thrust_estimator_time_constant");
+  command_link = params.get<bool>("command_link");
+  angle_step = params.get<double>("command_angle_step_deg") * std::numbers::pi / 180.0;
+  command_delay = params.get<double>("command_delay");
+  if (params.get<bool>("battery")) battery = batteryParams(params);
+  reference = params.get<std::string>("reference");
+  target = given<Vec3>(params, "target");
+  center = given<Vec3>(params, "center");
+  offset = params.get<Vec3>("offset");
+  center_offset = params.get<Vec3>("center_offset");
+  heading_kp = params.get<double>("heading_kp");
+  amplitude = params.get<double>("amplitude");
+  eight_period = params.get<double>("eight_period");
+  yaw_rate = params.get<double>("yaw_rate");
+  start_time = params.get<double>("start_time");
+  formation_size = static_cast<std::size_t>(params.get<std::int64_t>("formation_size"));
+  formation_radius = params.get<double>("formation_radius");
+  formation_center = params.get<Vec3>("formation_center");
+  formation_gain = params.get<double>("formation_gain");
+  formation_max_speed = params.get<double>("formation_max_speed");
+  formation_anchor_gain = params.get<double>("formation_anchor_gain");
+  obstacle_distance = params.get<double>("obstacle_distance");
+  obstacle_saturation = params.get<double>("obstacle_saturation");
+}
+
+std::string QuadrotorDriver::Config::key(const Descriptor& params) {
+  std::string key;
+  for (const auto& a : params.attributes()) {
+    if (a.key == "formation_index") continue;
+    // the constructor reads every declared parameter, this member's as well as the first's
+    if (std::any_of(std::begin(kParameters), std::end(kParameters),
+                    [&](const ssx_plugin_param& d) { return a.key == d.name; }))
+      a.used = true;
+    // lengths first: no value can run into the next
+    key += std::to_string(a.key.size()) + ":" + a.key + std::to_string(a.value.size()) + ":" + a.value;
+  }
+  return key;
+}
+
+std::vector<Rotor> QuadrotorDriver::Config::rotorsOf(const Descriptor& params, const Artifact& a) const {
+  std::vector<Rotor> rotors;
+  for (std::size_t i = 0; i < rotor_names.size(); ++i) {
+    const PhysicNode* node = a.node(rotor_names[i]);
+    if (node == nullptr)
+      throw params.errorAt("rotors",
+                           "no physic node '" + rotor_names[i] + "' for a rotor in artifact '" + a.name() + "'");
+    rotors.push_back({node->poseInBody().position, directions[i]});
+  }
+  return rotors;
+}
+
+std::size_t QuadrotorDriver::Config::commandDelayTicks(const Descriptor& params, const PluginContext& context) const {
   const double inner_period =
-      static_cast<double>(runsPerPeriod(params.get<double>("inner_rate_hz"), context)) * toSeconds(context.period());
-  const double ticks = params.get<double>("command_delay") / inner_period;
+      static_cast<double>(runsPerPeriod(inner_rate_hz, context)) * toSeconds(context.period());
+  const double ticks = command_delay / inner_period;
   if (std::abs(ticks - std::round(ticks)) > 1e-6)
     throw params.errorAt("command_delay", "command_delay must be a whole number of inner-loop periods (" +
                                               std::to_string(inner_period * 1e3) + " ms)");
   return static_cast<std::size_t>(std::llround(ticks));
+}
+
+// What the rotors' places make of a Config: shared by the members of one artifact type.
+struct QuadrotorDriver::Airframe {
+  std::vector<Rotor> rotors;
+  MassProperties mass;
+  Mat3 inertia;                // what the inner loop assumes
+  Eigen::MatrixXd mixer;       // InnerLoopParams::mixer
+  double rotor_max_thrust = 0;  // N, all rotors at full speed
+};
+
+namespace {
+
+template <class M>
+const Sensor* firstSensorOf(const Artifact& a) {
+  for (std::size_t i = 0; i < a.sensorCount(); ++i)
+    if (dynamic_cast<const M*>(&a.sensor(i).latest()) != nullptr) return &a.sensor(i);
+  return nullptr;
 }
 
 }  // namespace
@@ -106,18 +233,17 @@ std::size_t commandDelayTicks(const Descriptor& params, const PluginContext& con
 void QuadrotorDriver::validate(const Descriptor& params, const PluginContext& context) {
   const Artifact& a = *context.artifact;
   if (a.rootCount() == 0 || a.root().isStatic()) throw params.error("a quadrotor needs a dynamic physic root");
-  (void)rotorParams(params);
-  (void)rotorsOf(params, a);
+  const Config config(params);
+  (void)config.rotorsOf(params, a);
   // checked while loading, so that `ssx validate` refuses what `ssx run` would
-  (void)commandDelayTicks(params, context);
-  if (params.get<bool>("battery")) (void)batteryParams(params);
+  (void)config.commandDelayTicks(params, context);
   if (firstSensorOf<ImuMeasurement>(a) == nullptr)
     throw params.error("a quadrotor needs an IMU: add <sensor plugin=\"imu\"/> to the artifact");
-  if (params.get<std::string>("reference") == "formation") {
+  if (config.reference == "formation") {
     const auto index = params.get<std::int64_t>("formation_index");
-    if (index >= params.get<std::int64_t>("formation_size") || static_cast<std::size_t>(index) > a.index())
+    if (static_cast<std::size_t>(index) >= config.formation_size || static_cast<std::size_t>(index) > a.index())
       throw params.errorAt("formation_index",
-                         "formation_index must be below formation_size and the members one swarm");
+                           "formation_index must be below formation_size and the members one swarm");
     if (firstSensorOf<RangeMeasurement>(a) == nullptr)
       throw params.error("reference=\"formation\" needs a range sensor on the artifact");
   }
@@ -126,14 +252,30 @@ void QuadrotorDriver::validate(const Descriptor& params, const PluginContext& co
 void QuadrotorDriver::configure(const Descriptor& params, PluginSetup& setup) {
   Artifact& a = artifact();
   const Environment& env = environment();
-  const RotorParams rp = rotorParams(params);
-  const std::vector<Rotor> rotors = rotorsOf(params, a);
-  const MassProperties mass = combinedMass(a.root().spec());
+  // parsed once per parameter set, and worked out once per parameter set and artifact type
+  const auto config = setup.shared<Config>(Config::key(params), [&] { return Config(params); });
+  const Config& c = *config;
+  const RotorParams& rp = c.rotor;
+  std::ostringstream frame_key;
+  frame_key << config.get() << ' ' << &a.root().spec();
+  const auto frame = setup.shared<Airframe>(frame_key.str(), [&] {
+    Airframe f;
+    f.rotors = c.rotorsOf(params, a);
+    f.mass = combinedMass(a.root().spec());
+    f.inertia = c.controller_inertia ? Mat3(c.controller_inertia->asDiagonal()) : f.mass.inertia;
+    const Allocation allocation(f.rotors, rp);
+    Eigen::Matrix4d scale = Eigen::Matrix4d::Identity();
+    scale.topLeftCorner<3, 3>() = f.inertia;
+    f.mixer = allocation.inverse() * scale;
+    f.rotor_max_thrust = allocation.matrix().row(3).sum() * rp.max_rotor_speed * rp.max_rotor_speed;
+    return f;
+  });
+  const std::vector<Rotor>& rotors = frame->rotors;
+  const MassProperties& mass = frame->mass;
   com_in_root_ = -a.root().poseInBody().position;
   rotors_.emplace(rotors, rp);
-  const Allocation allocation(rotors, rp);
   // ground effect: over the highest horizontal ground plane, if there is one
-  ground_effect_ = params.get<bool>("ground_effect");
+  ground_effect_ = c.ground_effect;
   ground_z_ = -std::numeric_limits<double>::infinity();
   for (const auto& shape : env.staticShapes()) {
     if (shape.shape.kind != Shape::Kind::Plane) continue;
@@ -142,25 +284,23 @@ void QuadrotorDriver::configure(const Descriptor& params, PluginSetup& setup) {
   }
   gains_.fill(1.0);
   // the air: mean wind, one gust, Dryden turbulence
-  wind_ = params.get<Vec3>("wind");
-  gust_ = params.get<Vec3>("gust");
-  gust_start_ = params.get<double>("gust_start");
-  gust_duration_ = params.get<double>("gust_duration");
-  turbulence_w20_ = params.get<double>("turbulence_w20");
-  min_airspeed_ = params.get<double>("turbulence_min_airspeed");
-  downwash_ = params.get<bool>("downwash");
-  downwash_c_[0] = params.get<double>("downwash_c1");
-  downwash_c_[1] = params.get<double>("downwash_c2");
-  downwash_c_[2] = params.get<double>("downwash_c3");
-  downwash_range_ = params.get<double>("downwash_range");
-  downwash_min_dz_ = params.get<double>("downwash_min_height");
+  wind_ = c.wind;
+  gust_ = c.gust;
+  gust_start_ = c.gust_start;
+  gust_duration_ = c.gust_duration;
+  turbulence_w20_ = c.turbulence_w20;
+  min_airspeed_ = c.min_airspeed;
+  downwash_ = c.downwash;
+  std::copy(std::begin(c.downwash_c), std::end(c.downwash_c), downwash_c_);
+  downwash_range_ = c.downwash_range;
+  downwash_min_dz_ = c.downwash_min_dz;
   if (downwash_) setup.enableNeighborQueries(downwash_range_);
 
   // the loops run every k runs of the driver (whole numbers: checked while loading)
   const PluginContext context{&env, &a, periodSteps(), env.timestep(), {}};
   const double period = toSeconds(context.period());
-  inner_runs_ = runsPerPeriod(params.get<double>("inner_rate_hz"), context);
-  outer_runs_ = runsPerPeriod(params.get<double>("outer_rate_hz"), context);
+  inner_runs_ = runsPerPeriod(c.inner_rate_hz, context);
+  outer_runs_ = runsPerPeriod(c.outer_rate_hz, context);
   if (inner_runs_ < 1 || outer_runs_ < 1)
     throw params.error("inner_rate_hz and outer_rate_hz must not be faster than the driver runs");
   outer_dt_ = static_cast<double>(outer_runs_) * period;
@@ -178,20 +318,17 @@ void QuadrotorDriver::configure(const Descriptor& params, PluginSetup& setup) {
   // inner loop
   InnerLoopParams ip;
   ip.dt = static_cast<double>(inner_runs_) * period;
-  ip.attitude_kp = params.get<double>("attitude_kp");
-  ip.attitude_kd = params.get<double>("attitude_kd");
-  ip.yaw_rate_kp = params.get<double>("yaw_rate_kp");
-  ip.max_angular_acceleration = params.get<double>("max_angular_acceleration");
-  ip.filter_gyro_weight = params.get<double>("filter_gyro_weight");
+  ip.attitude_kp = c.attitude_kp;
+  ip.attitude_kd = c.attitude_kd;
+  ip.yaw_rate_kp = c.yaw_rate_kp;
+  ip.max_angular_acceleration = c.max_angular_acceleration;
+  ip.filter_gyro_weight = c.filter_gyro_weight;
   ip.gravity = -env.settings().physics.gravity.z();
-  ip.inertia = mass.inertia;
-  if (params.has("controller_inertia")) ip.inertia = params.get<Vec3>("controller_inertia").asDiagonal();
+  ip.inertia = frame->inertia;
   ip.min_rotor_speed = rp.min_rotor_speed;
   ip.max_rotor_speed = rp.max_rotor_speed;
-  Eigen::Matrix4d scale = Eigen::Matrix4d::Identity();
-  scale.topLeftCorner<3, 3>() = ip.inertia;
-  ip.mixer = allocation.inverse() * scale;
-  ip.max_thrust = allocation.matrix().row(3).sum() * rp.max_rotor_speed * rp.max_rotor_speed;
+  ip.mixer = frame->mixer;
+  ip.max_thrust = frame->rotor_max_thrust;
   // the IMU's LSBs are known once it has been configured (it comes first in the artifact)
   ip.gyro_lsb = imu_->gyroscope_lsb > 0 ? imu_->gyroscope_lsb : ip.gyro_lsb;
   ip.accel_lsb = imu_->accelerometer_lsb > 0 ? imu_->accelerometer_lsb : ip.accel_lsb;
@@ -199,58 +336,56 @@ void QuadrotorDriver::configure(const Descriptor& params, PluginSetup& setup) {
 
   // outer loop
   PositionParams pp;
-  pp.mass = params.get<double>("controller_mass", mass.mass);
+  pp.mass = c.controller_mass.value_or(mass.mass);
   pp.gravity = ip.gravity;
-  pp.kp = params.get<Vec3>("position_kp");
-  pp.kd = params.get<Vec3>("position_kd");
-  pp.ki = params.get<Vec3>("position_ki");
-  pp.integral_limit = params.get<double>("integral_limit");
-  pp.max_tilt = params.get<double>("max_tilt_deg") * std::numbers::pi / 180.0;
-  pp.max_thrust = params.get<double>("max_thrust", 0.95 * ip.max_thrust);
+  pp.kp = c.position_kp;
+  pp.kd = c.position_kd;
+  pp.ki = c.position_ki;
+  pp.integral_limit = c.integral_limit;
+  pp.max_tilt = c.max_tilt;
+  pp.max_thrust = c.max_thrust.value_or(0.95 * ip.max_thrust);
   pp.min_thrust = 0.05 * pp.max_thrust;
   outer_.emplace(pp);
   controller_mass_ = pp.mass;
-  thrust_estimator_ = params.get<bool>("thrust_estimator");
-  estimator_tau_ = params.get<double>("thrust_estimator_time_constant");
-  command_link_ = params.get<bool>("command_link");
-  angle_step_ = params.get<double>("command_angle_step_deg") * std::numbers::pi / 180.0;
-  command_queue_.assign(commandDelayTicks(params, context) + 1, InnerCommand{});
-  if (params.get<bool>("battery")) battery_.emplace(batteryParams(params));
+  thrust_estimator_ = c.thrust_estimator;
+  estimator_tau_ = c.estimator_tau;
+  command_link_ = c.command_link;
+  angle_step_ = c.angle_step;
+  command_queue_.assign(c.commandDelayTicks(params, context) + 1, InnerCommand{});
+  if (c.battery) battery_.emplace(*c.battery);
 
   // reference source
   const Vec3 start = a.placement().position;
-  const std::string source = params.get<std::string>("reference");
-  hover_.position = params.get<Vec3>("target", Vec3(start + params.get<Vec3>("offset")));
+  hover_.position = c.target.value_or(Vec3(start + c.offset));
   // an external reference starts at the placed heading, which it holds until a set-point says otherwise
   const Vec3 placed_forward = a.placement().orientation * Vec3::UnitX();
   hover_.yaw = std::atan2(placed_forward.y(), placed_forward.x());
-  heading_kp_ = params.get<double>("heading_kp");
-  eight_.center = params.get<Vec3>("center", Vec3(start + params.get<Vec3>("center_offset")));
-  eight_.amplitude = params.get<double>("amplitude");
-  eight_.period = params.get<double>("eight_period");
-  eight_.yaw_rate = params.get<double>("yaw_rate");
-  start_time_ = params.get<double>("start_time");
-  if (source == "hover") {
+  heading_kp_ = c.heading_kp;
+  eight_.center = c.center.value_or(Vec3(start + c.center_offset));
+  eight_.amplitude = c.amplitude;
+  eight_.period = c.eight_period;
+  eight_.yaw_rate = c.yaw_rate;
+  start_time_ = c.start_time;
+  if (c.reference == "hover") {
     source_ = Source::Hover;
-  } else if (source == "eight_horizontal" || source == "eight_vertical") {
+  } else if (c.reference == "eight_horizontal" || c.reference == "eight_vertical") {
     source_ = Source::Eight;
-    eight_.vertical = source == "eight_vertical";
-  } else if (source == "formation") {
+    eight_.vertical = c.reference == "eight_vertical";
+  } else if (c.reference == "formation") {
     source_ = Source::Formation;
-    formation_.size = static_cast<std::size_t>(params.get<std::int64_t>("formation_size"));
+    formation_.size = c.formation_size;
     const auto index = params.get<std::int64_t>("formation_index");
     if (index < 0 || static_cast<std::size_t>(index) >= formation_.size || static_cast<std::size_t>(index) > a.index())
       throw params.error("formation_index must be in [0, formation_size) and the members one swarm");
     formation_index_ = static_cast<std::size_t>(index);
     formation_base_ = a.index() - formation_index_;
-    own_target_ = formation_.target(formation_index_);
-    formation_.radius = params.get<double>("formation_radius");
-    formation_.center = params.get<Vec3>("formation_center");
-    formation_.gain = params.get<double>("formation_gain");
-    formation_.max_speed = params.get<double>("formation_max_speed");
-    formation_.anchor_gain = params.get<double>("formation_anchor_gain");
-    formation_.obstacle_distance = params.get<double>("obstacle_distance");
-    formation_.obstacle_saturation = params.get<double>("obstacle_saturation");
+    formation_.radius = c.formation_radius;
+    formation_.center = c.formation_center;
+    formation_.gain = c.formation_gain;
+    formation_.max_speed = c.formation_max_speed;
+    formation_.anchor_gain = c.formation_anchor_gain;
+    formation_.obstacle_distance = c.obstacle_distance;
+    formation_.obstacle_saturation = c.obstacle_saturation;
     const Sensor* range = firstSensorOf<RangeMeasurement>(a);
     if (range == nullptr) throw params.error("reference=\"formation\" needs a range sensor on the artifact");
     // read in place, as the IMU: the sensor's measurement changes only when it senses, before
@@ -259,7 +394,7 @@ void QuadrotorDriver::configure(const Descriptor& params, PluginSetup& setup) {
     // room for the neighbours a robot usually has, so that flying allocates nothing; a robot
     // that meets more grows this once, to the most it has met
     desired_distance_.reserve(std::min(kTypicalNeighbours, formation_.size));
-    virtual_point_ = start + params.get<Vec3>("offset");
+    virtual_point_ = start + c.offset;
     own_target_ = formation_.target(formation_index_);
   } else {
     source_ = Source::External;

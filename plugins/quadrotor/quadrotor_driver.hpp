@@ -136,6 +136,8 @@ class QuadrotorDriver final : public Driver, public SetpointInterface, public Me
   const AttitudeCommand& attitudeCommand() const { return attitude_; }
 
  private:
+  struct Config;    // the parameters, parsed: one per parameter set (PluginSetup::shared)
+  struct Airframe;  // what the rotors' places make of them: one per parameter set and artifact type
   Setpoint reference(double t) const;
 
   // held in the driver, not behind pointers: with thousands of robots a step is bound by memory

@@ -3,6 +3,7 @@
 #include <catch2/catch.hpp>
 
 #include <limits>
+#include <memory>
 #include <string>
 #include <type_traits>
 #include <utility>
@@ -108,6 +109,51 @@ TEST_CASE("drivers and sensors find extensions by name", "[environment]") {
   REQUIRE(seen != nullptr);
   CHECK(seen->calls == 3);
   CHECK(env.extension("nope") == nullptr);
+}
+
+TEST_CASE("instances that ask for the same value under the same key while starting share one, made once",
+          "[environment]") {
+  struct Gains {
+    int made;
+  };
+  struct Other {
+    int made;
+  };
+  // asks for a Gains under its key, and an Other under "a"
+  class Asking final : public Driver {
+   public:
+    Asking(std::string key, int& made) : key_(std::move(key)), made_(made) {}
+    void configure(const Descriptor&, PluginSetup& setup) override {
+      gains = setup.shared<Gains>(key_, [&] { return Gains{++made_}; });
+      other = setup.shared<Other>("a", [&] { return std::make_shared<Other>(Other{++made_}); });
+    }
+    void step(const StepInfo&) override {}
+    std::shared_ptr<const Gains> gains;
+    std::shared_ptr<const Other> other;
+
+   private:
+    std::string key_;
+    int& made_;
+  };
+  int made = 0;
+  Environment env;
+  std::vector<Asking*> drivers;
+  for (const char* key : {"a", "a", "b", "a"}) {
+    auto d = std::make_unique<Asking>(key, made);
+    drivers.push_back(d.get());
+    addBall(env, "ball" + std::to_string(drivers.size()), static_cast<double>(drivers.size())).setDriver(std::move(d));
+  }
+  env.start();
+  CHECK(made == 3);  // Gains "a", Other "a", Gains "b"
+  CHECK(drivers[0]->gains == drivers[1]->gains);
+  CHECK(drivers[0]->gains == drivers[3]->gains);
+  CHECK(drivers[2]->gains != drivers[0]->gains);
+  CHECK(drivers[2]->gains->made == 3);
+  CHECK(drivers[3]->other == drivers[0]->other);
+  // once started the environment holds none of them: the instances are the only owners
+  CHECK(drivers[0]->gains.use_count() == 3);
+  CHECK(drivers[2]->gains.use_count() == 1);
+  CHECK(drivers[0]->other.use_count() == 4);
 }
 
 TEST_CASE("callbacks are delivered by source artifact, sensor and subscription, on every thread count",

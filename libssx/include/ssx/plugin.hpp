@@ -12,7 +12,14 @@
 
 #include <cstdint>
 #include <functional>
+#include <map>
+#include <memory>
 #include <string>
+#include <string_view>
+#include <type_traits>
+#include <typeindex>
+#include <typeinfo>
+#include <utility>
 
 namespace ssx {
 
@@ -144,7 +151,11 @@ class SensorOf : public Sensor {
 /// parallel phases read. Handed to Plugin::configure, valid during that call only.
 class SSX_EXPORT PluginSetup {
  public:
-  PluginSetup(Environment& environment, Plugin& plugin) noexcept : env_(&environment), plugin_(&plugin) {}
+  /// What the environment keeps for PluginSetup::shared while it starts.
+  using SharedValues = std::map<std::pair<std::type_index, std::string>, std::shared_ptr<const void>>;
+
+  PluginSetup(Environment& environment, Plugin& plugin, SharedValues* shared = nullptr) noexcept
+      : env_(&environment), plugin_(&plugin), shared_(shared) {}
   PluginSetup(const PluginSetup&) = delete;
   PluginSetup& operator=(const PluginSetup&) = delete;
 
@@ -160,12 +171,36 @@ class SSX_EXPORT PluginSetup {
   void enableNeighborQueries(double cell_size);
   /// Asks for camera images (Environment::addCameraRequest), named after this plugin.
   void addCameraRequest(std::function<bool(std::int64_t step, CameraView& view)> due, Image& target);
+  /// What the instances of a class compute alike, computed once: `make()`'s result (a T, or a
+  /// pointer to one) for the first instance that asks for a T under `key` while the environment
+  /// starts, the same object for every later one (a swarm's members, configured one after
+  /// another). `key` must hold everything the value is computed from: the parameters' text, and
+  /// the artifact's type where it matters. The environment lets go of the values once it has
+  /// started; the instances keep what they hold. Without an environment's table (a PluginSetup
+  /// made in code) every call makes its own.
+  template <class T, class Make>
+  std::shared_ptr<const T> shared(std::string_view key, Make&& make);
 
  private:
   void requireMeasurement(const Sensor& sensor, bool matches) const;
+  std::shared_ptr<const void>* findShared(const std::type_info& type, std::string_view key);
   Environment* env_;
   Plugin* plugin_;
+  SharedValues* shared_;
 };
+
+template <class T, class Make>
+std::shared_ptr<const T> PluginSetup::shared(std::string_view key, Make&& make) {
+  std::shared_ptr<const void>* slot = findShared(typeid(T), key);
+  if (slot != nullptr && *slot) return std::static_pointer_cast<const T>(*slot);
+  std::shared_ptr<const T> value;
+  if constexpr (std::is_convertible_v<std::invoke_result_t<Make>, std::shared_ptr<const T>>)
+    value = make();
+  else
+    value = std::make_shared<const T>(make());
+  if (slot != nullptr) *slot = value;
+  return value;
+}
 
 /// A bridge to the outside world (ROS, a logger, a network link). Runs on the thread that calls
 /// Environment::start/step/stop.

@@ -8,6 +8,8 @@
 
 #include <cmath>
 #include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <numbers>
 #include <string>
 
@@ -550,4 +552,40 @@ TEST_CASE("a command delay off the inner loop's period and inconsistent battery 
   CHECK_THAT(load("battery=\"true\" battery_empty_voltage=\"17\""),
              Catch::Contains("battery: needs battery_zero_thrust_voltage < battery_empty_voltage < battery_full_voltage"));
   CHECK(load("command_delay=\"0.004\" battery=\"true\"") == "loaded");
+}
+
+TEST_CASE("a swarm's drivers share their parsed parameters, yet every type flies with its own mass and every member "
+          "with its own values",
+          "[quadrotor]") {
+  // two types alike but for the body's mass, with the same driver parameters: the drivers parse
+  // those once and work out an airframe per type (PluginSetup::shared)
+  const fs::path dir = "quadrotor_shared_test";
+  fs::create_directories(dir);
+  std::ifstream in(fs::path(SSX_EXAMPLES_DIR) / "artifacts" / "mk_quad.xml");
+  std::string light((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  std::string heavy = light;
+  const auto at = heavy.find("mass=\"0.82\"");
+  REQUIRE(at != std::string::npos);
+  heavy.replace(at, 11, "mass=\"1.20\"");
+  std::ofstream(dir / "light.xml") << light;
+  std::ofstream(dir / "heavy.xml") << heavy;
+  const std::string xml =
+      "<scene><environment timestep=\"0.002\" seed=\"1\"/><type name=\"light\" file=\"light.xml\"/>"
+      "<type name=\"heavy\" file=\"heavy.xml\"/><ground/>"
+      "<artifact name=\"l\" type=\"light\" xyz=\"0 -5 1\"/><artifact name=\"h\" type=\"heavy\" xyz=\"0 5 1\"/>"
+      "<swarm type=\"light\" count=\"3\" name=\"m{i}\" xyz=\"0 0 1\" spacing=\"1\" columns=\"3\"><driver target=\"{i}.5 0 1.5\"/>"
+      "</swarm></scene>";
+  Scene scene = loadSceneFromString(xml, "shared.xml", dir);
+  Environment& env = *scene.environment;
+  env.step(2);  // the driver's first forces act in the second step's physics
+  // each starts with its rotors at its own hover speed: with the light one's airframe the heavy
+  // one would fall at (0.82 - 1.2) / 1.2 g = -3.1 m/s^2
+  CHECK(std::abs(env.findArtifact("l")->state().linear_acceleration.z()) < 0.3);
+  CHECK(std::abs(env.findArtifact("h")->state().linear_acceleration.z()) < 0.3);
+  env.step(2500);  // 5 s
+  for (int i = 0; i < 3; ++i) {
+    const Vec3 p = env.findArtifact("m" + std::to_string(i))->pose().position;
+    INFO("member " << i << " at " << p.transpose());
+    CHECK((p - Vec3(i + 0.5, 0, 1.5)).norm() < 0.05);
+  }
 }
