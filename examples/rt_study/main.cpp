@@ -4,10 +4,10 @@
 // model and both control loops, IMU, pose and range sensors, formation with obstacle avoidance)
 // runs in real time at tau = 0.02 s and records the compute time of every step. The formation's
 // radius grows with sqrt(N) so that the spacing stays about 1.5 m. Prints, last for each N:
-//   n=1000 samples=5000 median_ms=1.23 p95_ms=1.50 p99_ms=1.80 max_ms=4.00 overruns=0 physics_ms=0.3
-//     sensors_ms=0.4 drivers_ms=0.5 other_ms=0.03 us_per_robot=1.23
-// (phase medians per sample; other = snapshot, neighbour index and hooks; us_per_robot = the
-// median sample over N)
+//   n=1000 samples=5000 median_ms=1.23 p95_ms=1.50 p99_ms=1.80 max_ms=4.00 overruns=0 max_late_ms=0
+//     physics_ms=0.3 sensors_ms=0.4 drivers_ms=0.5 other_ms=0.03 us_per_robot=1.23
+// (phase medians per sample; max_late_ms: the most any one step ended past its deadline; other =
+// snapshot, neighbour index and hooks; us_per_robot = the median sample over N)
 //
 // usage: ssx_rt_study [--n N]... [--samples K] [--threads T] [--physics-hz H] [--tau S] [--csv FILE]
 //                     [--physics ode|bullet]
@@ -130,6 +130,7 @@ int main(int argc, char** argv) {
       const auto& steps = env.timing().samples();
       std::vector<double> totals, physics, sensors, drivers, other;
       std::int64_t overruns = 0;
+      ssx::Nanoseconds max_late = 0;  // the most any one step ended past its deadline
       for (std::size_t k = 0; k + per_tau <= steps.size(); k += per_tau) {
         ssx::StepTiming sum;
         for (int j = 0; j < per_tau; ++j) {
@@ -141,6 +142,7 @@ int main(int argc, char** argv) {
           sum.lateness = std::max(sum.lateness, s.lateness);
         }
         overruns += sum.lateness > 0 ? 1 : 0;
+        max_late = std::max(max_late, sum.lateness);
         totals.push_back(static_cast<double>(sum.total) * 1e-6);
         physics.push_back(static_cast<double>(sum.physics) * 1e-6);
         sensors.push_back(static_cast<double>(sum.sensors) * 1e-6);
@@ -163,9 +165,9 @@ int main(int argc, char** argv) {
       // per robot and tau of simulated time, from the median step
       const double us_per_robot = pct(50) * 1e3 / n;
       std::printf("n=%d samples=%zu median_ms=%.3f p95_ms=%.3f p99_ms=%.3f max_ms=%.3f overruns=%lld "
-                  "physics_ms=%.3f sensors_ms=%.3f drivers_ms=%.3f other_ms=%.3f us_per_robot=%.3f\n",
+                  "max_late_ms=%.3f physics_ms=%.3f sensors_ms=%.3f drivers_ms=%.3f other_ms=%.3f us_per_robot=%.3f\n",
                   n, sorted.size(), pct(50), pct(95), pct(99), sorted.back(), static_cast<long long>(overruns),
-                  median(physics), median(sensors), median(drivers), median(other), us_per_robot);
+                  static_cast<double>(max_late) * 1e-6, median(physics), median(sensors), median(drivers), median(other), us_per_robot);
       std::fflush(stdout);
     } catch (const std::exception& e) {
       std::fprintf(stderr, "ssx_rt_study: n=%d: %s\n", n, e.what());

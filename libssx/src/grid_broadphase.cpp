@@ -84,13 +84,13 @@ bool GridBroadphase::overlap(int a, int b) const {
          p.min.z() <= q.max.z() && q.min.z() <= p.max.z();
 }
 
-const GridBroadphase::Band* GridBroadphase::findBand(std::int64_t y, std::int64_t z) const {
-  auto it = std::lower_bound(bands_.begin(), bands_.end(), std::pair{y, z},
-                             [](const Band& b, const std::pair<std::int64_t, std::int64_t>& key) {
-                               return b.y != key.first ? b.y < key.first : b.z < key.second;
-                             });
-  if (it == bands_.end() || it->y != y || it->z != z) return nullptr;
-  return &*it;
+std::size_t GridBroadphase::firstBandFrom(std::int64_t y, std::int64_t z) const {
+  return static_cast<std::size_t>(
+      std::lower_bound(bands_.begin(), bands_.end(), std::pair{y, z},
+                       [](const Band& b, const std::pair<std::int64_t, std::int64_t>& key) {
+                         return b.y != key.first ? b.y < key.first : b.z < key.second;
+                       }) -
+      bands_.begin());
 }
 
 void GridBroadphase::sweepSelf(const Band& band, std::vector<std::pair<int, int>>& out) const {
@@ -122,14 +122,22 @@ void GridBroadphase::pairs(std::size_t chunk, std::vector<std::pair<int, int>>& 
         if (pairable(big_[i], big_[j]) && overlap(big_[i], big_[j])) out.emplace_back(big_[i], big_[j]);
     return;
   }
+  const std::size_t begin = chunk * kBandsPerChunk;
   const std::size_t end = std::min(bands_.size(), (chunk + 1) * kBandsPerChunk);
-  for (std::size_t b = chunk * kBandsPerChunk; b < end; ++b) {
+  // the bands are in (y, z) order, one per key: the neighbours of band b that come after it,
+  // (y, z+1) then (y+1, z-1), (y+1, z), (y+1, z+1), are band b+1 if it is (y, z+1), and a run
+  // that starts at the first band from (y+1, z-1), which only moves forward as b does
+  std::size_t next_row = begin < end ? firstBandFrom(bands_[begin].y + 1, bands_[begin].z - 1) : end;
+  for (std::size_t b = begin; b < end; ++b) {
     const Band& band = bands_[b];
     sweepSelf(band, out);
-    // the neighbours after it in (y, z) order: (y, z+1), (y+1, z-1), (y+1, z), (y+1, z+1)
-    if (const Band* q = findBand(band.y, band.z + 1)) sweep(band, *q, out);
-    for (std::int64_t dz = -1; dz <= 1; ++dz)
-      if (const Band* q = findBand(band.y + 1, band.z + dz)) sweep(band, *q, out);
+    if (b + 1 < bands_.size() && bands_[b + 1].y == band.y && bands_[b + 1].z == band.z + 1)
+      sweep(band, bands_[b + 1], out);
+    while (next_row < bands_.size() && (bands_[next_row].y != band.y + 1 ? bands_[next_row].y < band.y + 1
+                                                                         : bands_[next_row].z < band.z - 1))
+      ++next_row;
+    for (std::size_t q = next_row; q < bands_.size() && bands_[q].y == band.y + 1 && bands_[q].z <= band.z + 1; ++q)
+      sweep(band, bands_[q], out);
     // and every large box
     for (std::uint32_t k = band.begin; k < band.end; ++k)
       for (const int big : big_)

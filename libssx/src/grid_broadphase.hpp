@@ -52,7 +52,8 @@ class GridBroadphase {
   bool overlap(int a, int b) const;
   void sweepSelf(const Band& band, std::vector<std::pair<int, int>>& out) const;
   void sweep(const Band& p, const Band& q, std::vector<std::pair<int, int>>& out) const;
-  const Band* findBand(std::int64_t y, std::int64_t z) const;
+  // the index of the first band at or after (y, z) in (y, z) order
+  std::size_t firstBandFrom(std::int64_t y, std::int64_t z) const;
 
   std::span<const Box> boxes_;
   double cell_ = 1.0;
