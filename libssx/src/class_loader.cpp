@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cstdlib>
 #include <cstring>
+#include <new>
 #include <system_error>
 
 namespace ssx {
@@ -30,6 +31,7 @@ namespace {
 constexpr const char* kManifestSymbol = "ssx_plugin_manifest_v1";
 constexpr std::uint32_t kMaxClasses = 4096;
 constexpr std::uint32_t kMaxParameters = 4096;
+constexpr std::size_t kMaxInstanceBytes = std::size_t{64} << 20;
 
 // dlerror text, with any undefined C++ symbol demangled so the user sees what is missing
 std::string explainDlerror(const char* text) {
@@ -81,6 +83,12 @@ std::string checkManifest(const ssx_plugin_manifest* m, PluginLibraryInfo& info)
     const ssx_plugin_class& c = m->classes[i];
     if (c.name == nullptr || c.create == nullptr || c.destroy == nullptr || !validKind(c.kind))
       return "manifest entry " + std::to_string(i) + " is incomplete (kind, name, create and destroy are required)";
+    if (c.construct != nullptr &&
+        (c.destruct == nullptr || c.instance_size == 0 || c.instance_size > kMaxInstanceBytes ||
+         c.instance_align == 0 || (c.instance_align & (c.instance_align - 1)) != 0 || c.instance_align > 4096))
+      return "class '" + std::string(c.name) +
+             "': construct needs destruct, an instance size (at most 64 MiB) and a power-of-two alignment (at most "
+             "4096)";
     if (c.param_count > kMaxParameters || (c.param_count > 0 && c.params == nullptr))
       return "class '" + std::string(c.name) + "' lists an invalid parameter table";
     for (std::uint32_t k = 0; k < c.param_count; ++k) {
@@ -110,9 +118,33 @@ ClassLoader::ClassLoader() = default;
 ClassLoader::~ClassLoader() { destroyInstances(); }
 
 void ClassLoader::destroyInstances() noexcept {
-  for (auto it = instances_.rbegin(); it != instances_.rend(); ++it) it->type->destroy(it->object);
+  for (auto it = instances_.rbegin(); it != instances_.rend(); ++it)
+    (it->in_pool ? it->type->destruct : it->type->destroy)(it->object);
   instances_.clear();
   types_.clear();
+  for (auto& [type, pool] : pools_)
+    for (const auto& [start, slots] : pool.chunks) ::operator delete(start, std::align_val_t(pool.align));
+  pools_.clear();
+}
+
+void* ClassLoader::slotFor(const ssx_plugin_class& type) {
+  Pool& pool = pools_[&type];
+  if (pool.slot == 0) {
+    // whole cache lines: an instance starts a line, and two threads stepping neighbouring
+    // artifacts do not share one
+    pool.align = std::max<std::size_t>(type.instance_align, 64);
+    pool.slot = (type.instance_size + pool.align - 1) / pool.align * pool.align;
+  }
+  if (pool.chunks.empty() || pool.used == pool.chunks.back().second) {
+    constexpr std::size_t kFirst = 16, kMaxBytes = std::size_t{8} << 20;
+    const std::size_t slots = pool.chunks.empty()
+                                  ? kFirst
+                                  : std::max<std::size_t>(1, std::min(2 * pool.chunks.back().second, kMaxBytes / pool.slot));
+    auto* start = static_cast<std::byte*>(::operator new(slots * pool.slot, std::align_val_t(pool.align)));
+    pool.chunks.emplace_back(start, slots);
+    pool.used = 0;
+  }
+  return pool.chunks.back().first + pool.used * pool.slot;
 }
 
 void ClassLoader::addSearchDirectory(fs::path dir) {
@@ -229,11 +261,14 @@ const ssx_plugin_class* ClassLoader::classOf(const void* instance) const noexcep
 void* ClassLoader::create(std::string_view plugin, std::string_view class_name, PluginKind kind) {
   const ssx_plugin_class* found = &classInfo(plugin, class_name, kind);
   char error[512] = {0};
-  void* object = found->create(error, sizeof error);
+  // in the class's pool when it can be built in place (a slot a failed construct leaves is reused)
+  const bool in_pool = found->construct != nullptr;
+  void* object = in_pool ? found->construct(slotFor(*found), error, sizeof error) : found->create(error, sizeof error);
+  if (in_pool && object != nullptr) ++pools_[found].used;
   if (object == nullptr)
     throw PluginError("plugin '" + std::string(plugin) + "' (" + load(plugin).string() + "): creating '" + std::string(class_name) + "' failed: " +
                       (error[0] != '\0' ? std::string(error) : std::string("the constructor returned null")));
-  instances_.push_back({object, found});
+  instances_.push_back({object, found, in_pool});
   types_.emplace(object, found);
   return object;
 }

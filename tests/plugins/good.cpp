@@ -1,10 +1,11 @@
-// A good plugin library with three classes of three kinds.
+// A good plugin library with classes of three kinds.
 #include <cstdlib>
 #include <ssx/artifact.hpp>
 #include <ssx/measurements.hpp>
 #include <ssx/plugin_abi.hpp>
 
 #include <fstream>
+#include <string>
 #include <stdexcept>
 
 namespace {
@@ -67,7 +68,21 @@ class Marker final : public ssx::SimulationExtension {
   }
 };
 
+// counts its live instances, for tests of how the loader builds and destroys them
+int live_tallies = 0;
+class Tally final : public ssx::Driver {
+ public:
+  Tally() { ++live_tallies; }
+  ~Tally() override { --live_tallies; }
+  void step(const ssx::StepInfo&) override {}
+
+ private:
+  std::string held_ = std::string(100, 'x');  // on the heap: a leak if the destructor never runs
+};
+
 }  // namespace
 
+extern "C" __attribute__((visibility("default"))) int ssx_test_live_tallies() { return live_tallies; }
+
 SSX_PLUGIN(SSX_DRIVER(Spinner, "spinner"), SSX_SENSOR(Counter, "counter"), SSX_EXTENSION(Marker, "marker"),
-           SSX_DRIVER(Bomb, "bomb"));
+           SSX_DRIVER(Bomb, "bomb"), SSX_DRIVER(Tally, "tally"));

@@ -1,8 +1,13 @@
 #include <ssx/ssx.hpp>
 
-#include <catch2/catch.hpp>
+#include <ssx/plugin_abi.hpp>
 
+#include <catch2/catch.hpp>
+#include <dlfcn.h>
+
+#include <cstdint>
 #include <string>
+#include <vector>
 
 using namespace ssx;
 using Catch::Contains;
@@ -35,6 +40,36 @@ TEST_CASE("a good plugin library loads and creates classes of each kind", "[plug
   (void)e;
   // two classes of the same library, one load
   CHECK(loader.load("test_good") == path);
+}
+
+TEST_CASE("a class's instances are built side by side, each on its own cache lines, and each destroyed",
+          "[plugins]") {
+  ClassLoader loader;
+  loader.addSearchDirectory(kDir);
+  const ssx_plugin_class& type = loader.classInfo("test_good", "tally", PluginKind::Driver);
+  REQUIRE(type.construct != nullptr);
+  const auto path = loader.load("test_good");
+  void* library = dlopen(path.c_str(), RTLD_NOW | RTLD_NOLOAD);
+  REQUIRE(library != nullptr);
+  const auto live = reinterpret_cast<int (*)()>(dlsym(library, "ssx_test_live_tallies"));
+  REQUIRE(live != nullptr);
+  std::vector<std::uintptr_t> at;
+  for (int i = 0; i < 40; ++i) {  // more than the first chunk holds
+    at.push_back(reinterpret_cast<std::uintptr_t>(&loader.createDriver("test_good", "tally")));
+    (void)loader.createDriver("test_good", "spinner");  // another class in between: its own pool
+  }
+  CHECK(live() == 40);
+  const std::uintptr_t slot = at[1] - at[0];
+  CHECK(slot >= type.instance_size);
+  CHECK(slot % 64 == 0);
+  for (std::size_t i = 0; i < at.size(); ++i) {
+    INFO("instance " << i);
+    CHECK(at[i] % 64 == 0);
+    if (i > 0 && i < 16) CHECK(at[i] - at[i - 1] == slot);  // the first chunk
+  }
+  loader.destroyInstances();
+  CHECK(live() == 0);
+  dlclose(library);
 }
 
 TEST_CASE("plugin instances drive an environment built in code", "[plugins]") {
@@ -90,7 +125,7 @@ TEST_CASE("class lookup failures say what the library has", "[plugins]") {
   ClassLoader loader;
   loader.addSearchDirectory(kDir);
   CHECK_THROWS_WITH(loader.createDriver("test_good", "rocket"),
-                    Contains("has no class 'rocket'; it has: spinner (driver), counter (sensor), marker (extension), bomb (driver)"));
+                    Contains("has no class 'rocket'; it has: spinner (driver), counter (sensor), marker (extension), bomb (driver), tally (driver)"));
   CHECK_THROWS_WITH(loader.createDriver("test_good", "counter"), Contains("class 'counter' is a sensor, not a driver"));
   CHECK_THROWS_WITH(loader.createExtension("test_good", "spinner"),
                     Contains("class 'spinner' is a driver, not an extension"));
@@ -115,7 +150,7 @@ TEST_CASE("scanning lists every library with its classes and check result", "[pl
     (lib.ok ? ok : bad) += 1;
     if (lib.path.filename() == "libssx_test_good.so") {
       saw_good = true;
-      REQUIRE(lib.classes.size() == 4);
+      REQUIRE(lib.classes.size() == 5);
       CHECK(lib.classes[1].kind == PluginKind::Sensor);
       CHECK(lib.classes[1].name == "counter");
     }

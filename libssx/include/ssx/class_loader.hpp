@@ -6,11 +6,13 @@
 #include <ssx/export.hpp>
 #include <ssx/plugin.hpp>
 
+#include <cstddef>
 #include <filesystem>
 #include <memory>
 #include <string>
 #include <string_view>
 #include <unordered_map>
+#include <utility>
 #include <vector>
 
 extern "C" struct ssx_plugin_class;
@@ -108,9 +110,18 @@ class SSX_EXPORT ClassLoader {
   struct Instance {
     void* object;
     const ssx_plugin_class* type;
+    bool in_pool;  // made by `construct` in a pool below, else by `create`
   };
   std::vector<Instance> instances_;
   std::unordered_map<const void*, const ssx_plugin_class*> types_;
+  // a class's instances side by side: chunks of slots, each chunk twice the last (up to a cap)
+  struct Pool {
+    std::size_t slot = 0, align = 0;  // bytes per instance (whole cache lines) and alignment
+    std::vector<std::pair<std::byte*, std::size_t>> chunks;  // start, slots
+    std::size_t used = 0;             // slots used in the last chunk
+  };
+  std::unordered_map<const ssx_plugin_class*, Pool> pools_;
+  void* slotFor(const ssx_plugin_class& type);
 };
 
 }  // namespace ssx

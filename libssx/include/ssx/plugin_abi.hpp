@@ -34,7 +34,7 @@
 
 /// Incremented whenever the manifest layout, the meaning of its fields or the plugin base classes
 /// (Plugin, Driver, Sensor, SimulationExtension: their virtual functions and members) change.
-#define SSX_PLUGIN_ABI_VERSION 4u
+#define SSX_PLUGIN_ABI_VERSION 5u
 
 #define SSX_PLUGIN_STRINGIFY2(x) #x
 #define SSX_PLUGIN_STRINGIFY(x) SSX_PLUGIN_STRINGIFY2(x)
@@ -73,6 +73,10 @@ enum ssx_plugin_kind : std::uint32_t {
 /// parameter set (an `ssx::Descriptor*`, defaults added) in a context (an `ssx::PluginContext*`)
 /// and appends what is wrong to `diagnostics` (a `std::vector<ssx::Diagnostic>*`); it runs no
 /// instance's code and never throws.
+/// `construct`, when not null, is `create` in memory the library provides: `instance_size` bytes
+/// aligned to `instance_align` (a power of two); `destruct` ends an instance it made without
+/// freeing that memory. The library keeps a class's instances side by side this way, so that a
+/// phase walking thousands of them reads memory in order.
 struct ssx_plugin_class {
   std::uint32_t kind;
   const char* name;
@@ -82,6 +86,10 @@ struct ssx_plugin_class {
   const ssx_plugin_param* params;
   std::uint32_t param_count;
   void (*validate)(const void* params, const void* context, void* diagnostics) noexcept;
+  std::size_t instance_size;
+  std::size_t instance_align;
+  void* (*construct)(void* where, char* error, std::size_t error_size) noexcept;
+  void (*destruct)(void* instance) noexcept;
 };
 
 /// The manifest. `record_size` is sizeof(ssx_plugin_manifest) and `class_size` is
@@ -99,8 +107,9 @@ struct ssx_plugin_manifest {
 
 namespace ssx::detail {
 
-template <class T, class Base>
-void* pluginCreate(char* error, std::size_t error_size) noexcept {
+// runs `make`, turning an exception into null and its message in `error`
+template <class Make>
+void* pluginMake(char* error, std::size_t error_size, Make make) noexcept {
   auto report = [&](const char* what) {
     if (error != nullptr && error_size > 0) {
       std::strncpy(error, what, error_size - 1);
@@ -108,7 +117,7 @@ void* pluginCreate(char* error, std::size_t error_size) noexcept {
     }
   };
   try {
-    return static_cast<void*>(static_cast<Base*>(new T()));
+    return make();
   } catch (const std::exception& e) {
     report(e.what());
   } catch (...) {
@@ -117,9 +126,24 @@ void* pluginCreate(char* error, std::size_t error_size) noexcept {
   return nullptr;
 }
 
+template <class T, class Base>
+void* pluginCreate(char* error, std::size_t error_size) noexcept {
+  return pluginMake(error, error_size, [] { return static_cast<void*>(static_cast<Base*>(new T())); });
+}
+
 template <class Base>
 void pluginDestroy(void* instance) noexcept {
   delete static_cast<Base*>(instance);
+}
+
+template <class T, class Base>
+void* pluginConstruct(void* where, char* error, std::size_t error_size) noexcept {
+  return pluginMake(error, error_size, [where] { return static_cast<void*>(static_cast<Base*>(::new (where) T())); });
+}
+
+template <class Base>
+void pluginDestruct(void* instance) noexcept {
+  static_cast<Base*>(instance)->~Base();  // virtual: the class's own destructor
 }
 
 template <class T>
@@ -140,7 +164,8 @@ void pluginValidate(const void* params, const void* context, void* diagnostics) 
 template <class T, class Base>
 constexpr ssx_plugin_class pluginClass(std::uint32_t kind, const char* name) {
   static_assert(std::is_base_of_v<Base, T>, "SSX_DRIVER / SSX_SENSOR / SSX_EXTENSION: wrong base class");
-  ssx_plugin_class c{kind, name, &pluginCreate<T, Base>, &pluginDestroy<Base>, "", nullptr, 0, nullptr};
+  ssx_plugin_class c{kind,    name,      &pluginCreate<T, Base>, &pluginDestroy<Base>, "", nullptr, 0, nullptr,
+                     sizeof(T), alignof(T), &pluginConstruct<T, Base>, &pluginDestruct<Base>};
   if constexpr (requires { T::kDoc; }) c.doc = T::kDoc;
   if constexpr (requires { T::kParameters; }) {
     c.params = T::kParameters;
