@@ -127,7 +127,7 @@ void ClassLoader::destroyInstances() noexcept {
   pools_.clear();
 }
 
-void* ClassLoader::slotFor(const ssx_plugin_class& type) {
+ClassLoader::Pool& ClassLoader::poolOf(const ssx_plugin_class& type) {
   Pool& pool = pools_[&type];
   if (pool.slot == 0) {
     // whole cache lines: an instance starts a line, and two threads stepping neighbouring
@@ -135,16 +135,18 @@ void* ClassLoader::slotFor(const ssx_plugin_class& type) {
     pool.align = std::max<std::size_t>(type.instance_align, 64);
     pool.slot = (type.instance_size + pool.align - 1) / pool.align * pool.align;
   }
-  if (pool.chunks.empty() || pool.used == pool.chunks.back().second) {
+  return pool;
+}
+
+void* ClassLoader::Pool::next() {
+  if (chunks.empty() || used == chunks.back().second) {
     constexpr std::size_t kFirst = 16, kMaxBytes = std::size_t{8} << 20;
-    const std::size_t slots = pool.chunks.empty()
-                                  ? kFirst
-                                  : std::max<std::size_t>(1, std::min(2 * pool.chunks.back().second, kMaxBytes / pool.slot));
-    auto* start = static_cast<std::byte*>(::operator new(slots * pool.slot, std::align_val_t(pool.align)));
-    pool.chunks.emplace_back(start, slots);
-    pool.used = 0;
+    const std::size_t slots =
+        chunks.empty() ? kFirst : std::max<std::size_t>(1, std::min(2 * chunks.back().second, kMaxBytes / slot));
+    chunks.emplace_back(static_cast<std::byte*>(::operator new(slots * slot, std::align_val_t(align))), slots);
+    used = 0;
   }
-  return pool.chunks.back().first + pool.used * pool.slot;
+  return chunks.back().first + used * slot;
 }
 
 void ClassLoader::addSearchDirectory(fs::path dir) {
@@ -259,16 +261,20 @@ const ssx_plugin_class* ClassLoader::classOf(const void* instance) const noexcep
 }
 
 void* ClassLoader::create(std::string_view plugin, std::string_view class_name, PluginKind kind) {
-  const ssx_plugin_class* found = &classInfo(plugin, class_name, kind);
-  char error[512] = {0};
+  // a swarm creates one class thousands of times in a row: the last lookup is kept
+  if (last_.type == nullptr || last_.kind != kind || last_.plugin != plugin || last_.class_name != class_name)
+    last_ = {std::string(plugin), std::string(class_name), kind, &classInfo(plugin, class_name, kind)};
+  const ssx_plugin_class* found = last_.type;
+  char error[512];
+  error[0] = '\0';
   // in the class's pool when it can be built in place (a slot a failed construct leaves is reused)
-  const bool in_pool = found->construct != nullptr;
-  void* object = in_pool ? found->construct(slotFor(*found), error, sizeof error) : found->create(error, sizeof error);
-  if (in_pool && object != nullptr) ++pools_[found].used;
+  Pool* pool = found->construct != nullptr ? &poolOf(*found) : nullptr;
+  void* object = pool != nullptr ? found->construct(pool->next(), error, sizeof error) : found->create(error, sizeof error);
+  if (pool != nullptr && object != nullptr) ++pool->used;
   if (object == nullptr)
     throw PluginError("plugin '" + std::string(plugin) + "' (" + load(plugin).string() + "): creating '" + std::string(class_name) + "' failed: " +
                       (error[0] != '\0' ? std::string(error) : std::string("the constructor returned null")));
-  instances_.push_back({object, found, in_pool});
+  instances_.push_back({object, found, pool != nullptr});
   types_.emplace(object, found);
   return object;
 }

@@ -119,9 +119,15 @@ class SSX_EXPORT ClassLoader {
     std::size_t slot = 0, align = 0;  // bytes per instance (whole cache lines) and alignment
     std::vector<std::pair<std::byte*, std::size_t>> chunks;  // start, slots
     std::size_t used = 0;             // slots used in the last chunk
+    void* next();                     // the next free slot (a new chunk when the last is full)
   };
   std::unordered_map<const ssx_plugin_class*, Pool> pools_;
-  void* slotFor(const ssx_plugin_class& type);
+  Pool& poolOf(const ssx_plugin_class& type);
+  struct LastClass {
+    std::string plugin, class_name;
+    PluginKind kind{};
+    const ssx_plugin_class* type = nullptr;
+  } last_;  // the class create found last
 };
 
 }  // namespace ssx
