@@ -40,8 +40,9 @@ struct Bridge::Impl {
   };
   std::mutex queue_mutex;
   std::condition_variable queue_changed;
+  std::vector<Outgoing> staged;          // the stepping thread's, until commit hands them over
   std::vector<Outgoing> queue, sending;  // queue_mutex guards queue, busy, stop
-  bool busy = false, stop = false, uncommitted = false;
+  bool busy = false, stop = false;
   std::thread publisher;
   void enqueue(const Outgoing& m);
   void publishLoop();
@@ -118,22 +119,24 @@ Bridge::Bridge(const std::string& master_uri, const std::string& node_name, doub
   d.spinner->start();
   d.queue.reserve(4 * robots.size() + 16);
   d.sending.reserve(4 * robots.size() + 16);
+  d.staged.reserve(4 * robots.size() + 16);
   d.publisher = std::thread([&d] { d.publishLoop(); });
 }
 
-void Bridge::Impl::enqueue(const Outgoing& m) {
-  std::lock_guard<std::mutex> lock(queue_mutex);
-  queue.push_back(m);
-  uncommitted = true;
-}
+void Bridge::Impl::enqueue(const Outgoing& m) { staged.push_back(m); }
 
 void Bridge::commit() {
   Impl& d = *impl_;
+  if (d.staged.empty()) return;  // (most steps publish nothing: no lock, no wake-up)
   {
+    // one lock per step, however many robots: the buffers trade places, so none is allocated
     std::lock_guard<std::mutex> lock(d.queue_mutex);
-    if (!d.uncommitted) return;  // (most steps publish nothing: no wake-up for them)
-    d.uncommitted = false;
+    if (d.queue.empty())
+      d.queue.swap(d.staged);
+    else
+      d.queue.insert(d.queue.end(), d.staged.begin(), d.staged.end());
   }
+  d.staged.clear();
   d.queue_changed.notify_all();
 }
 
@@ -155,6 +158,7 @@ void Bridge::Impl::publishLoop() {
 
 void Bridge::flush() {
   Impl& d = *impl_;
+  commit();
   d.queue_changed.notify_all();
   std::unique_lock<std::mutex> lock(d.queue_mutex);
   d.queue_changed.wait(lock, [&] { return d.queue.empty() && !d.busy; });
@@ -167,6 +171,7 @@ void Bridge::shutdown() {
   if (!d.running) return;
   d.running = false;
   if (d.publisher.joinable()) {
+    commit();
     {
       std::lock_guard<std::mutex> lock(d.queue_mutex);
       d.stop = true;

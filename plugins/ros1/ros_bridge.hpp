@@ -48,9 +48,9 @@ class Bridge {
   Bridge& operator=(const Bridge&) = delete;
 
   // Queue a message for the bridge's publishing thread, which serialises and sends it: the caller
-  // (the stepping thread) only copies a few numbers. commit() hands what is queued to that
-  // thread (one wake-up per step, not per message). Messages go out in the order queued, with the
-  // stamps given (simulated time).
+  // (the stepping thread) only copies a few numbers, taking no lock. commit() hands what is queued
+  // to that thread (one lock and one wake-up per step, not per message). Messages go out in the
+  // order queued, with the stamps given (simulated time).
   void publishClock(double time);
   void publishOdometry(std::size_t robot, const Odometry& odom);
   void publishImu(std::size_t robot, const Imu& imu);
