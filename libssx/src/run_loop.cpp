@@ -1,6 +1,8 @@
 // Environment::run: pacing steps against the monotonic clock.
 #include <ssx/environment.hpp>
 
+#include "worker_pool.hpp"
+
 #include <sys/prctl.h>
 #include <time.h>
 
@@ -29,6 +31,8 @@ void waitUntil(Nanoseconds deadline, Nanoseconds spin) {
   while (monotonicNow() < deadline) {
   }
 }
+
+constexpr Nanoseconds kWakeAhead = 200'000;  // ns before a deadline the workers are woken
 
 }  // namespace
 
@@ -97,6 +101,13 @@ TimingSummary Environment::run(const RunOptions& options) {
           grid_k = 0;
         }
       } else {
+        // the workers fall asleep between steps, and a woken thread can take a millisecond to
+        // run on a virtual machine: they are woken a little ahead, so that the step finds them
+        // running
+        if (pool_ != nullptr && deadline - now > kWakeAhead) {
+          waitUntil(deadline - kWakeAhead, 0);
+          pool_->wake();
+        }
         waitUntil(deadline, options.spin);
       }
     }

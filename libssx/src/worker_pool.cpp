@@ -9,10 +9,17 @@ namespace {
 // phase takes: a thread that has just finished, or the caller waiting for the others, first spins
 // this long on the value it waits for, then sleeps.
 constexpr auto kSpin = std::chrono::microseconds(50);
+// after a job it did not join (woken ahead of one, or it came too late), a worker waits longer
+// before it sleeps: the next job is due soon
+constexpr auto kSpinAhead = std::chrono::microseconds(500);
+
+constexpr std::uint64_t kClosed = std::uint64_t{1} << 32;
+constexpr std::uint64_t kCount = kClosed - 1;
+constexpr int kGenerationShift = 33;
 
 template <class T>
-void spinThenWait(const std::atomic<T>& value, T old) {
-  const auto until = std::chrono::steady_clock::now() + kSpin;
+void spinThenWait(const std::atomic<T>& value, T old, std::chrono::microseconds spin = kSpin) {
+  const auto until = std::chrono::steady_clock::now() + spin;
   for (int k = 0; value.load(std::memory_order_acquire) == old; ++k) {
 #if defined(__x86_64__) || defined(__i386__)
     __builtin_ia32_pause();
@@ -25,13 +32,28 @@ void spinThenWait(const std::atomic<T>& value, T old) {
 }
 }  // namespace
 
-WorkerPool::WorkerPool(unsigned threads) {
+WorkerPool::WorkerPool(unsigned threads, bool held) : released_(!held) {
   const unsigned extra = threads > 1 ? threads - 1 : 0;
   workers_.reserve(extra);
   for (unsigned i = 0; i < extra; ++i) workers_.emplace_back([this] { workerLoop(); });
 }
 
+void WorkerPool::wake() {
+  if (workers_.empty()) return;
+  // a job closed from the start: the workers wake, join nothing and spin for the next one
+  const std::uint64_t generation = (generation_.load(std::memory_order_relaxed) + 1) & (kCount >> 1);
+  job_.store((generation << kGenerationShift) | kClosed, std::memory_order_release);
+  generation_.store(generation, std::memory_order_release);
+  generation_.notify_all();
+}
+
+void WorkerPool::releaseWorkers() {
+  released_.store(true, std::memory_order_release);
+  released_.notify_all();
+}
+
 WorkerPool::~WorkerPool() {
+  releaseWorkers();
   stop_.store(true, std::memory_order_relaxed);
   generation_.fetch_add(1, std::memory_order_release);
   generation_.notify_all();
@@ -53,14 +75,23 @@ void WorkerPool::work() {
 }
 
 void WorkerPool::workerLoop() {
+  released_.wait(false, std::memory_order_acquire);
   std::uint64_t seen = 0;
+  bool joined = true;  // (the last job)
   for (;;) {
-    spinThenWait(generation_, seen);
+    spinThenWait(generation_, seen, joined ? kSpin : kSpinAhead);
     seen = generation_.load(std::memory_order_acquire);
     if (stop_.load(std::memory_order_relaxed)) return;
+    // join the job of this generation, unless the caller has closed it (it finished without us)
+    const std::uint64_t mine = seen << kGenerationShift;
+    std::uint64_t job = job_.load(std::memory_order_acquire);
+    joined = false;
+    while (!joined && (job & ~kCount) == mine)
+      joined = job_.compare_exchange_weak(job, job + 1, std::memory_order_acq_rel, std::memory_order_acquire);
+    if (!joined) continue;
     work();
-    // the last one out wakes the caller
-    if (busy_.fetch_sub(1, std::memory_order_acq_rel) == 1) busy_.notify_one();
+    // leaving: the caller waits for the count to reach 0 once it has closed the job
+    if (((job_.fetch_sub(1, std::memory_order_acq_rel) - 1) & kClosed) != 0) job_.notify_one();
   }
 }
 
@@ -78,16 +109,16 @@ void WorkerPool::run(std::size_t n, std::size_t chunk, Invoke invoke, void* ctx)
   has_error_.store(false, std::memory_order_relaxed);
   error_ = nullptr;
   next_.store(0, std::memory_order_relaxed);
-  const unsigned workers = static_cast<unsigned>(workers_.size());
-  if (workers > 0) {
-    busy_.store(workers, std::memory_order_relaxed);
-    generation_.fetch_add(1, std::memory_order_release);
-    generation_.notify_all();
-  }
+  // open the job (published before the generation that wakes the workers), then wake them
+  const std::uint64_t generation = (generation_.load(std::memory_order_relaxed) + 1) & (kCount >> 1);
+  job_.store(generation << kGenerationShift, std::memory_order_release);
+  generation_.store(generation, std::memory_order_release);
+  generation_.notify_all();
   work();
-  // barrier: wait for every worker to finish its chunks
-  for (unsigned left = busy_.load(std::memory_order_acquire); left != 0; left = busy_.load(std::memory_order_acquire))
-    spinThenWait(busy_, left);
+  // every chunk is taken: close the job to workers not yet in it, and wait for those inside
+  for (std::uint64_t job = job_.fetch_or(kClosed, std::memory_order_acq_rel) | kClosed; (job & kCount) != 0;
+       job = job_.load(std::memory_order_acquire))
+    spinThenWait(job_, job);
   if (has_error_.load(std::memory_order_acquire)) std::rethrow_exception(error_);
 }
 

@@ -1,7 +1,9 @@
 #pragma once
-// A fixed pool of worker threads for the parallel phases. The calling thread takes part; all
-// threads meet at the end of each job (a barrier). Work is handed out in chunks of indices from
-// a shared counter, so a slow artifact does not hold up a whole thread's share.
+// A fixed pool of worker threads for the parallel phases. The calling thread takes part; the
+// workers that joined a job meet it at its end (a barrier). Work is handed out in chunks of
+// indices from a shared counter, so a slow artifact does not hold up a whole thread's share, and a
+// worker that wakes late (a virtual machine can take a millisecond to run a woken thread) finds
+// the job done or closed and is not waited for: the caller has done its share.
 
 #include <ssx/physic_engine.hpp>
 
@@ -16,13 +18,18 @@ namespace ssx::detail {
 
 class WorkerPool final : public TaskRunner {
  public:
-  /// `threads` in total, the caller included (>= 1); threads - 1 are started.
-  explicit WorkerPool(unsigned threads);
+  /// `threads` in total, the caller included (>= 1); threads - 1 are started. With `held`, the
+  /// workers take no job until releaseWorkers (as workers that wake late: for tests).
+  explicit WorkerPool(unsigned threads, bool held = false);
+  void releaseWorkers();
   ~WorkerPool() override;
   WorkerPool(const WorkerPool&) = delete;
   WorkerPool& operator=(const WorkerPool&) = delete;
 
   unsigned size() const noexcept { return static_cast<unsigned>(workers_.size()) + 1; }
+  /// Wakes the workers without a job, so that a job due shortly finds them running rather than
+  /// asleep (from the thread that runs the jobs).
+  void wake();
 
   // TaskRunner, for the physics engine: one task per index
   unsigned threads() const override { return size(); }
@@ -56,9 +63,12 @@ class WorkerPool final : public TaskRunner {
 
   std::vector<std::thread> workers_;
   std::atomic<std::uint64_t> generation_{0};
-  std::atomic<unsigned> busy_{0};
+  // the current job: its generation (bits 33 and up), closed to joiners (bit 32), and how many
+  // workers are inside it (bits 0-31)
+  std::atomic<std::uint64_t> job_{0};
   std::atomic<std::size_t> next_{0};
   std::atomic<bool> stop_{false};
+  std::atomic<bool> released_{true};
   std::size_t n_ = 0;
   std::size_t chunk_ = 1;
   Invoke invoke_ = nullptr;
