@@ -53,9 +53,11 @@ TEST_CASE("the worker pool does not wait for workers that have not joined a job"
   };
   for (int round = 0; round < 3; ++round) pool.parallelFor(hits.size(), 7, fn);
   for (int h : hits) REQUIRE(h == 3);
-  // released, they take part again, and every index is still covered once per job
+  // released, they take part again, and every index is still covered once per job, also right
+  // after they were woken ahead of it (as the real-time run loop does before a deadline)
   pool.releaseWorkers();
   for (int round = 0; round < 50; ++round) {
+    if (round % 2 == 0) pool.wake();
     std::vector<std::atomic<int>> counted(1000);
     auto count = [&](std::size_t b, std::size_t e) {
       for (std::size_t i = b; i < e; ++i) counted[i].fetch_add(1);
