@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <typeinfo>
 
 namespace ssx {
 
@@ -29,7 +30,8 @@ void PluginSetup::enableNeighborQueries(double cell_size) { env_->enableNeighbor
 
 std::shared_ptr<const void>* PluginSetup::findShared(const std::type_info& type, std::string_view key) {
   if (shared_ == nullptr) return nullptr;
-  return &(*shared_)[{std::type_index(type), std::string(key)}];
+  // per plugin class: two classes that happen to share a value type and a key share nothing
+  return &(*shared_)[{std::type_index(typeid(*plugin_)), std::type_index(type), std::string(key)}];
 }
 
 void PluginSetup::addCameraRequest(std::function<bool(std::int64_t, CameraView&)> due, Image& target) {

@@ -111,49 +111,60 @@ TEST_CASE("drivers and sensors find extensions by name", "[environment]") {
   CHECK(env.extension("nope") == nullptr);
 }
 
-TEST_CASE("instances that ask for the same value under the same key while starting share one, made once",
-          "[environment]") {
-  struct Gains {
-    int made;
-  };
-  struct Other {
-    int made;
-  };
-  // asks for a Gains under its key, and an Other under "a"
-  class Asking final : public Driver {
-   public:
-    Asking(std::string key, int& made) : key_(std::move(key)), made_(made) {}
-    void configure(const Descriptor&, PluginSetup& setup) override {
-      gains = setup.shared<Gains>(key_, [&] { return Gains{++made_}; });
-      other = setup.shared<Other>("a", [&] { return std::make_shared<Other>(Other{++made_}); });
-    }
-    void step(const StepInfo&) override {}
-    std::shared_ptr<const Gains> gains;
-    std::shared_ptr<const Other> other;
+namespace {
+struct Gains {
+  int made;
+};
+struct Other {
+  int made;
+};
+// asks for a Gains under its key, and an Other under "a"; classes of two tags are two classes
+template <int Tag>
+class Asking final : public Driver {
+ public:
+  Asking(std::string key, int& made) : key_(std::move(key)), made_(made) {}
+  void configure(const Descriptor&, PluginSetup& setup) override {
+    gains = setup.shared<Gains>(key_, [&] { return Gains{++made_}; });
+    other = setup.shared<Other>("a", [&] { return std::make_shared<Other>(Other{++made_}); });
+  }
+  void step(const StepInfo&) override {}
+  std::shared_ptr<const Gains> gains;
+  std::shared_ptr<const Other> other;
 
-   private:
-    std::string key_;
-    int& made_;
-  };
+ private:
+  std::string key_;
+  int& made_;
+};
+}  // namespace
+
+TEST_CASE("instances of a class that ask for the same value under the same key while starting share one, made once",
+          "[environment]") {
   int made = 0;
   Environment env;
-  std::vector<Asking*> drivers;
+  std::vector<Asking<0>*> drivers;
   for (const char* key : {"a", "a", "b", "a"}) {
-    auto d = std::make_unique<Asking>(key, made);
+    auto d = std::make_unique<Asking<0>>(key, made);
     drivers.push_back(d.get());
     addBall(env, "ball" + std::to_string(drivers.size()), static_cast<double>(drivers.size())).setDriver(std::move(d));
   }
+  // another class asking for the same types under the same keys gets values of its own
+  auto stranger = std::make_unique<Asking<1>>("a", made);
+  Asking<1>* other_class = stranger.get();
+  addBall(env, "stranger", 9.0).setDriver(std::move(stranger));
   env.start();
-  CHECK(made == 3);  // Gains "a", Other "a", Gains "b"
+  CHECK(made == 5);  // Gains "a", Other "a", Gains "b"; the other class's Gains "a" and Other "a"
   CHECK(drivers[0]->gains == drivers[1]->gains);
   CHECK(drivers[0]->gains == drivers[3]->gains);
   CHECK(drivers[2]->gains != drivers[0]->gains);
   CHECK(drivers[2]->gains->made == 3);
   CHECK(drivers[3]->other == drivers[0]->other);
+  CHECK(other_class->gains->made == 4);
+  CHECK(other_class->other->made == 5);
   // once started the environment holds none of them: the instances are the only owners
   CHECK(drivers[0]->gains.use_count() == 3);
   CHECK(drivers[2]->gains.use_count() == 1);
   CHECK(drivers[0]->other.use_count() == 4);
+  CHECK(other_class->gains.use_count() == 1);
 }
 
 TEST_CASE("callbacks are delivered by source artifact, sensor and subscription, on every thread count",

@@ -16,6 +16,7 @@
 #include <memory>
 #include <string>
 #include <string_view>
+#include <tuple>
 #include <type_traits>
 #include <typeindex>
 #include <typeinfo>
@@ -152,7 +153,8 @@ class SensorOf : public Sensor {
 class SSX_EXPORT PluginSetup {
  public:
   /// What the environment keeps for PluginSetup::shared while it starts.
-  using SharedValues = std::map<std::pair<std::type_index, std::string>, std::shared_ptr<const void>>;
+  using SharedValues =
+      std::map<std::tuple<std::type_index, std::type_index, std::string>, std::shared_ptr<const void>>;
 
   PluginSetup(Environment& environment, Plugin& plugin, SharedValues* shared = nullptr) noexcept
       : env_(&environment), plugin_(&plugin), shared_(shared) {}
@@ -172,9 +174,9 @@ class SSX_EXPORT PluginSetup {
   /// Asks for camera images (Environment::addCameraRequest), named after this plugin.
   void addCameraRequest(std::function<bool(std::int64_t step, CameraView& view)> due, Image& target);
   /// What the instances of a class compute alike, computed once: `make()`'s result (a T, or a
-  /// pointer to one) for the first instance that asks for a T under `key` while the environment
-  /// starts, the same object for every later one (a swarm's members, configured one after
-  /// another). `key` must hold everything the value is computed from: the parameters' text, and
+  /// pointer to one) for the first instance of this plugin's class that asks for a T under `key`
+  /// while the environment starts, the same object for every later one (a swarm's members,
+  /// configured one after another). `key` must hold everything the value is computed from: the parameters' text, and
   /// the artifact's type where it matters. The environment lets go of the values once it has
   /// started; the instances keep what they hold. Without an environment's table (a PluginSetup
   /// made in code) every call makes its own.
