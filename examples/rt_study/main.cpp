@@ -167,7 +167,8 @@ int main(int argc, char** argv) {
       std::printf("n=%d samples=%zu median_ms=%.3f p95_ms=%.3f p99_ms=%.3f max_ms=%.3f overruns=%lld "
                   "max_late_ms=%.3f physics_ms=%.3f sensors_ms=%.3f drivers_ms=%.3f other_ms=%.3f us_per_robot=%.3f\n",
                   n, sorted.size(), pct(50), pct(95), pct(99), sorted.back(), static_cast<long long>(overruns),
-                  static_cast<double>(max_late) * 1e-6, median(physics), median(sensors), median(drivers), median(other), us_per_robot);
+                  static_cast<double>(max_late) * 1e-6, median(physics), median(sensors), median(drivers),
+                  median(other), us_per_robot);
       std::fflush(stdout);
     } catch (const std::exception& e) {
       std::fprintf(stderr, "ssx_rt_study: n=%d: %s\n", n, e.what());

@@ -269,7 +269,8 @@ void* ClassLoader::create(std::string_view plugin, std::string_view class_name, 
   error[0] = '\0';
   // in the class's pool when it can be built in place (a slot a failed construct leaves is reused)
   Pool* pool = found->construct != nullptr ? &poolOf(*found) : nullptr;
-  void* object = pool != nullptr ? found->construct(pool->next(), error, sizeof error) : found->create(error, sizeof error);
+  void* object =
+      pool != nullptr ? found->construct(pool->next(), error, sizeof error) : found->create(error, sizeof error);
   if (pool != nullptr && object != nullptr) ++pool->used;
   if (object == nullptr)
     throw PluginError("plugin '" + std::string(plugin) + "' (" + load(plugin).string() + "): creating '" + std::string(class_name) + "' failed: " +

@@ -109,7 +109,8 @@ struct QuadrotorDriver::Config {
 };
 
 QuadrotorDriver::Config::Config(const Descriptor& params) : rotor(rotorParams(params)) {
-  const auto names = words(params.get<std::string>("rotors"));
+  rotor_names = words(params.get<std::string>("rotors"));
+  const auto& names = rotor_names;
   const auto dirs = words(params.get<std::string>("directions"));
   if (names.size() != dirs.size() || names.size() < 4 || names.size() > kMaxRotors)
     throw params.errorAt(names.size() != dirs.size() ? "directions" : "rotors",
@@ -119,7 +120,6 @@ QuadrotorDriver::Config::Config(const Descriptor& params) : rotor(rotorParams(pa
     if (d != "1" && d != "-1") throw params.errorAt("directions", "rotor directions are 1 or -1, got '" + d + "'");
     directions.push_back(d == "1" ? 1 : -1);
   }
-  rotor_names = names;
   ground_effect = params.get<bool>("ground_effect");
   wind = params.get<Vec3>("wind");
   gust = params.get<Vec3>("gust");
