@@ -54,6 +54,25 @@ PhysicNode& Artifact::addPhysicRoot(std::shared_ptr<const PhysicNodeSpec> shared
   root_specs_.push_back(std::move(shared));
   const std::size_t first = nodes_.size();
   buildNodes(nullptr, *root_specs_.back());
+  // each node's pose in its body, known from here on (load-time checks read it: a quadrotor's
+  // rotors), from the tree's own poses: the same in every member of a swarm wherever it was
+  // placed (undoing the placement would leave a rounding of it). The nodes were added parents
+  // first, at consecutive indices.
+  const std::size_t offset = nodes_[first]->nodeIndex();
+  std::vector<Pose> in_root(nodes_.size() - first);  // the root's: identity
+  for (std::size_t k = first + 1; k < nodes_.size(); ++k)
+    in_root[k - first] = in_root[nodes_[k]->parent()->nodeIndex() - offset] * nodes_[k]->spec().pose;
+  // a dynamic tree's body frame is at its centre of mass (the root's frame in it set exactly: its
+  // own pose undone and redone would be off by a rounding, and a root at the centre of mass would
+  // cost a transform per query)
+  const Pose root_in_body =
+      spec.is_static ? Pose{} : Pose{-combinedMass(spec).center_of_mass, Quat::Identity()};
+  for (std::size_t k = first; k < nodes_.size(); ++k) {
+    detail::NodeData& n = world_->nodes[offset + (k - first)];
+    n.pose_in_body = k == first ? root_in_body : root_in_body * in_root[k - first];
+    n.at_body = !spec.is_static && n.pose_in_body.position == Vec3::Zero() &&
+                n.pose_in_body.orientation.coeffs() == Quat::Identity().coeffs();
+  }
   return *nodes_[first];
 }
 

@@ -5,7 +5,6 @@
 
 #include <ssx/environment.hpp>
 
-#include <algorithm>
 #include <cstring>
 
 namespace ssx {
@@ -24,28 +23,18 @@ void buildBodies(World& world, PhysicEngine& engine, std::vector<Environment::St
       std::vector<Shape> shapes;
       std::vector<std::size_t> tree;  // the root and its descendants, in order
       std::vector<const PhysicNodeSpec*> specs;
-      // each node's pose in its root's frame, from the tree's own poses: the same in every member
-      // of a swarm wherever it was placed (undoing the placement would leave a rounding of it)
-      std::vector<Pose> in_root;
+      // (each node's pose in its body was set when the tree was added: Artifact::addPhysicRoot)
       for (std::size_t k = 0; k < artifact->nodeCount(); ++k) {
         const PhysicNode& n = artifact->nodeAt(k);
         const PhysicNode* top = &n;
         while (top->parent() != nullptr) top = top->parent();
         if (top != &root) continue;
-        Pose pose;  // the root's: identity
-        if (n.parent() != nullptr) {
-          // parents come before their children
-          const auto parent = std::find(tree.begin(), tree.end(), n.parent()->nodeIndex()) - tree.begin();
-          pose = in_root[static_cast<std::size_t>(parent)] * n.spec().pose;
-        }
         tree.push_back(n.nodeIndex());
         specs.push_back(&n.spec());
-        in_root.push_back(pose);
       }
       if (spec.is_static) {
         for (std::size_t k = 0; k < tree.size(); ++k) {
-          NodeData& n = world.nodes[tree[k]];
-          n.pose_in_body = in_root[k];
+          const NodeData& n = world.nodes[tree[k]];
           for (Shape s : specs[k]->shapes) {
             s.pose = n.pose_in_body * s.pose;
             shapes.push_back(s);
@@ -56,13 +45,9 @@ void buildBodies(World& world, PhysicEngine& engine, std::vector<Environment::St
         continue;
       }
       const MassProperties mass = combinedMass(spec);
-      const Pose root_in_body{-mass.center_of_mass, Quat::Identity()};
+      const Pose& root_in_body = world.nodes[root.nodeIndex()].pose_in_body;
       for (std::size_t k = 0; k < tree.size(); ++k) {
-        NodeData& n = world.nodes[tree[k]];
-        // (the root's frame in the body exactly: its own pose undone and redone would be off by
-        // a rounding, and a root at the centre of mass would cost a transform per query)
-        n.pose_in_body = tree[k] == root.nodeIndex() ? root_in_body : root_in_body * in_root[k];
-        n.at_body = n.pose_in_body.position == Vec3::Zero() && n.pose_in_body.orientation.coeffs() == Quat::Identity().coeffs();
+        const NodeData& n = world.nodes[tree[k]];
         for (Shape s : specs[k]->shapes) {
           s.pose = n.pose_in_body * s.pose;
           shapes.push_back(s);

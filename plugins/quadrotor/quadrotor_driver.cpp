@@ -217,6 +217,24 @@ struct QuadrotorDriver::Airframe {
   Mat3 inertia;                // what the inner loop assumes
   Eigen::MatrixXd mixer;       // InnerLoopParams::mixer
   double rotor_max_thrust = 0;  // N, all rotors at full speed
+
+  // the airframe of artifact `a`, checked against what the integer inner loop can hold
+  Airframe(const Config& c, const Descriptor& params, const Artifact& a)
+      : rotors(c.rotorsOf(params, a)), mass(combinedMass(a.root().spec())) {
+    inertia = c.controller_inertia ? Mat3(c.controller_inertia->asDiagonal()) : mass.inertia;
+    const Allocation allocation(rotors, c.rotor);
+    Eigen::Matrix4d scale = Eigen::Matrix4d::Identity();
+    scale.topLeftCorner<3, 3>() = inertia;
+    mixer = allocation.inverse() * scale;
+    rotor_max_thrust = allocation.matrix().row(3).sum() * c.rotor.max_rotor_speed * c.rotor.max_rotor_speed;
+    if (!mixerFitsFixedPoint(mixer, c.max_angular_acceleration, rotor_max_thrust))
+      // at the value that was given, if one was
+      throw params.errorAt(params.has("max_angular_acceleration") || !params.has("controller_inertia")
+                               ? "max_angular_acceleration"
+                               : "controller_inertia",
+                           "the integer attitude loop cannot hold the mixer of these rotors and this inertia in 64 "
+                           "bits at this max_angular_acceleration: lower it, or check the rotors' positions");
+  }
 };
 
 namespace {
@@ -234,7 +252,7 @@ void QuadrotorDriver::validate(const Descriptor& params, const PluginContext& co
   const Artifact& a = *context.artifact;
   if (a.rootCount() == 0 || a.root().isStatic()) throw params.error("a quadrotor needs a dynamic physic root");
   const Config config(params);
-  (void)config.rotorsOf(params, a);
+  (void)Airframe(config, params, a);
   // checked while loading, so that `ssx validate` refuses what `ssx run` would
   (void)config.commandDelayTicks(params, context);
   if (firstSensorOf<ImuMeasurement>(a) == nullptr)
@@ -258,18 +276,7 @@ void QuadrotorDriver::configure(const Descriptor& params, PluginSetup& setup) {
   const RotorParams& rp = c.rotor;
   std::ostringstream frame_key;
   frame_key << config.get() << ' ' << &a.root().spec();
-  const auto frame = setup.shared<Airframe>(frame_key.str(), [&] {
-    Airframe f;
-    f.rotors = c.rotorsOf(params, a);
-    f.mass = combinedMass(a.root().spec());
-    f.inertia = c.controller_inertia ? Mat3(c.controller_inertia->asDiagonal()) : f.mass.inertia;
-    const Allocation allocation(f.rotors, rp);
-    Eigen::Matrix4d scale = Eigen::Matrix4d::Identity();
-    scale.topLeftCorner<3, 3>() = f.inertia;
-    f.mixer = allocation.inverse() * scale;
-    f.rotor_max_thrust = allocation.matrix().row(3).sum() * rp.max_rotor_speed * rp.max_rotor_speed;
-    return f;
-  });
+  const auto frame = setup.shared<Airframe>(frame_key.str(), [&] { return Airframe(c, params, a); });
   const std::vector<Rotor>& rotors = frame->rotors;
   const MassProperties& mass = frame->mass;
   com_in_root_ = -a.root().poseInBody().position;

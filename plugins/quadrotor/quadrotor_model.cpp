@@ -220,6 +220,19 @@ std::int64_t toFixed(double v, double scale) { return std::llround(v * scale); }
 
 }  // namespace
 
+bool mixerFitsFixedPoint(const Eigen::MatrixXd& mixer, double max_angular_acceleration, double max_thrust) {
+  // mixer coefficients: Q12 for the angular-acceleration columns, Q20 for the thrust column; with
+  // alpha in Q12 and thrust in Q16 every product and the sum of four stay below 2^62
+  for (Eigen::Index i = 0; i < mixer.rows(); ++i) {
+    double sum = 0;
+    for (int j = 0; j < 4; ++j)
+      sum += std::abs(static_cast<double>(toFixed(mixer(i, j), j < 3 ? kQ12 : kQ20))) *
+             (j < 3 ? max_angular_acceleration * kQ12 : max_thrust * kQ16);
+    if (!(sum < 4.6e18)) return false;
+  }
+  return true;
+}
+
 InnerLoopFixed::InnerLoopFixed(const InnerLoopParams& p)
     : min_rotor_speed_(p.min_rotor_speed), max_rotor_speed_(p.max_rotor_speed) {
   if (static_cast<std::size_t>(p.mixer.rows()) > kMaxRotors)
@@ -236,22 +249,13 @@ InnerLoopFixed::InnerLoopFixed(const InnerLoopParams& p)
   // at most 2^24 counts keep the measured norm far below that)
   accel_gate_low2 = toFixed(std::min(0.25 * g_counts * g_counts, 4e18), 1.0);
   accel_gate_high2 = toFixed(std::min(2.25 * g_counts * g_counts, 4e18), 1.0);
-  // mixer coefficients: Q12 for the angular-acceleration columns, Q20 for the thrust column; with
-  // alpha in Q12 and thrust in Q16 every product and the sum of four stay below 2^62
-  double worst = 0;
+  if (!mixerFitsFixedPoint(p.mixer, p.max_angular_acceleration, p.max_thrust))
+    throw std::invalid_argument("inner loop: the mixer would overflow 64 bits: lower max_angular_acceleration");
   for (Eigen::Index i = 0; i < p.mixer.rows(); ++i) {
     std::array<std::int64_t, 4> row{};
-    double sum = 0;
-    for (int j = 0; j < 4; ++j) {
-      row[static_cast<std::size_t>(j)] = toFixed(p.mixer(i, j), j < 3 ? kQ12 : kQ20);
-      sum += std::abs(static_cast<double>(row[static_cast<std::size_t>(j)])) *
-             (j < 3 ? p.max_angular_acceleration * kQ12 : p.max_thrust * kQ16);
-    }
-    worst = std::max(worst, sum);
+    for (int j = 0; j < 4; ++j) row[static_cast<std::size_t>(j)] = toFixed(p.mixer(i, j), j < 3 ? kQ12 : kQ20);
     mixer_q20[rotor_count++] = row;
   }
-  if (worst >= 4.6e18)
-    throw std::invalid_argument("inner loop: the mixer would overflow 64 bits: lower max_angular_acceleration");
   max_thrust_q16 = toFixed(p.max_thrust, kQ16);
   min_speed_q4 = toFixed(p.min_rotor_speed, 16.0);
   max_speed_q4 = toFixed(p.max_rotor_speed, 16.0);

@@ -229,6 +229,11 @@ struct InnerOutput {
 /// int64 followed by a rounding shift, every stage saturated. Formats: angles Q20 in the filter
 /// state and Q12 at the control law, body rates Q16, gains Q8, angular accelerations Q12, thrust
 /// Q16, rotor speed squared Q8, rotor speed Q4, motor commands 8 bits.
+/// Whether InnerLoopFixed holds this mixer (InnerLoopParams::mixer) in 64 bits with angular
+/// accelerations up to `max_angular_acceleration` and thrust up to `max_thrust` (its constructor
+/// throws otherwise).
+bool mixerFitsFixedPoint(const Eigen::MatrixXd& mixer, double max_angular_acceleration, double max_thrust);
+
 class InnerLoopFixed {
  public:
   explicit InnerLoopFixed(const InnerLoopParams& params);

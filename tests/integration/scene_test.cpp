@@ -276,7 +276,10 @@ TEST_CASE("a node's pose in its body is its type's, to the bit, wherever the art
   </scene>)";
   Scene scene = loadSceneFromString(xml, "placed.xml", fs::path(SSX_EXAMPLES_DIR) / "artifacts", testOptions());
   Environment& env = *scene.environment;
+  // known from loading on (a quadrotor's load-time checks read its rotors'), and the same after start
+  const Vec3 loaded = env.findArtifact("there")->node("rotor1")->poseInBody().position;
   env.start();
+  CHECK(env.findArtifact("there")->node("rotor1")->poseInBody().position == loaded);
   for (const char* node : {"rotor0", "rotor1", "rotor2", "rotor3"}) {
     const Pose& here = env.findArtifact("here")->node(node)->poseInBody();
     const Pose& there = env.findArtifact("there")->node(node)->poseInBody();
