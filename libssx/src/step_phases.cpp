@@ -65,7 +65,7 @@ void prefetchArtifact(const World& world, std::size_t i, std::size_t end, bool s
   }
   // a driver's handles and the sensors whose measurements its callbacks get
   if (i + 2 < end) prefetch(world.artifacts[i + 2].get(), sizeof(Artifact));
-  if (next.driver != nullptr) prefetch(next.driver, 512);
+  if (next.driver != nullptr) prefetch(next.driver, 2688);
   for (std::uint32_t k = next.inbox_begin; k < next.inbox_end; ++k) prefetch(world.subscriptions[k].sensor);
 }
 }  // namespace

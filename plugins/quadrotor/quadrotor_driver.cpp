@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <limits>
 #include <cmath>
+#include <cstdio>
 #include <numbers>
 #include <sstream>
 
@@ -213,6 +214,7 @@ std::size_t QuadrotorDriver::Config::commandDelayTicks(const Descriptor& params,
 // What the rotors' places make of a Config: shared by the members of one artifact type.
 struct QuadrotorDriver::Airframe {
   std::vector<Rotor> rotors;
+  RotorModel rotor_model;  // at rest; each driver copies it (the copies share its constants)
   MassProperties mass;
   Mat3 inertia;                // what the inner loop assumes
   Eigen::MatrixXd mixer;       // InnerLoopParams::mixer
@@ -220,7 +222,7 @@ struct QuadrotorDriver::Airframe {
 
   // the airframe of artifact `a`, checked against what the integer inner loop can hold
   Airframe(const Config& c, const Descriptor& params, const Artifact& a)
-      : rotors(c.rotorsOf(params, a)), mass(combinedMass(a.root().spec())) {
+      : rotors(c.rotorsOf(params, a)), rotor_model(rotors, c.rotor), mass(combinedMass(a.root().spec())) {
     inertia = c.controller_inertia ? Mat3(c.controller_inertia->asDiagonal()) : mass.inertia;
     const Allocation allocation(rotors, c.rotor);
     Eigen::Matrix4d scale = Eigen::Matrix4d::Identity();
@@ -280,7 +282,7 @@ void QuadrotorDriver::configure(const Descriptor& params, PluginSetup& setup) {
   const std::vector<Rotor>& rotors = frame->rotors;
   const MassProperties& mass = frame->mass;
   com_in_root_ = -a.root().poseInBody().position;
-  rotors_.emplace(rotors, rp);
+  rotors_.emplace(frame->rotor_model);
   // ground effect: over the highest horizontal ground plane, if there is one
   ground_effect_ = c.ground_effect;
   ground_z_ = -std::numeric_limits<double>::infinity();
@@ -297,6 +299,7 @@ void QuadrotorDriver::configure(const Descriptor& params, PluginSetup& setup) {
   gust_duration_ = c.gust_duration;
   turbulence_w20_ = c.turbulence_w20;
   min_airspeed_ = c.min_airspeed;
+  wind_or_gust_ = !wind_.isZero() || !gust_.isZero() || turbulence_w20_ > 0;
   downwash_ = c.downwash;
   std::copy(std::begin(c.downwash_c), std::end(c.downwash_c), downwash_c_);
   downwash_range_ = c.downwash_range;
@@ -339,7 +342,11 @@ void QuadrotorDriver::configure(const Descriptor& params, PluginSetup& setup) {
   // the IMU's LSBs are known once it has been configured (it comes first in the artifact)
   ip.gyro_lsb = imu_->gyroscope_lsb > 0 ? imu_->gyroscope_lsb : ip.gyro_lsb;
   ip.accel_lsb = imu_->accelerometer_lsb > 0 ? imu_->accelerometer_lsb : ip.accel_lsb;
-  inner_.emplace(ip);
+  // its integer gains and mixer: one copy for the members alike (the estimate is this driver's)
+  char inner_key[96];
+  std::snprintf(inner_key, sizeof inner_key, " %a %a %a", ip.dt, ip.gyro_lsb, ip.accel_lsb);
+  inner_ = setup.shared<InnerLoopFixed>(frame_key.str() + inner_key, [&] { return InnerLoopFixed(ip); });
+  estimate_ = {};
 
   // outer loop
   PositionParams pp;
@@ -468,8 +475,8 @@ void QuadrotorDriver::step(const StepInfo& info) {
     const Vec3 velocity = have_pose_ ? pose_.linear_velocity : truth.linear_velocity;
     const Vec3 forward = pose.orientation * Vec3::UnitX();
     const double yaw = std::atan2(forward.y(), forward.x());
-    const double roll = inner_->estimate().roll_q20 / 1048576.0;
-    const double pitch = inner_->estimate().pitch_q20 / 1048576.0;
+    const double roll = estimate_.roll_q20 / 1048576.0;
+    const double pitch = estimate_.pitch_q20 / 1048576.0;
     attitude_ = outer_->update(outer_dt_, current_, pose.position, velocity, roll, pitch, yaw);
     // an external set-point's heading is held: its yaw error, wrapped to [-pi, pi], adds a yaw
     // rate (the other references command a yaw rate only, as the TeleKyb controller does)
@@ -509,7 +516,8 @@ void QuadrotorDriver::step(const StepInfo& info) {
       queue_at_ = (queue_at_ + 1) % command_queue_.size();
     }
     const InnerCommand& arrived = command_queue_.size() == 1 ? command_ : command_queue_[queue_at_];
-    const InnerOutput out = inner_->step(imu_->gyroscope_counts, imu_->accelerometer_counts, arrived);
+    const InnerOutput out = inner_->evaluate(estimate_, imu_->gyroscope_counts, imu_->accelerometer_counts, arrived);
+    estimate_ = out.estimate;
     for (std::size_t i = 0; i < out.motors; ++i) commanded_speeds_[i] = inner_->commandToSpeed(out.motor_commands[i]);
   }
   // motors and aerodynamics, applied at the centre of mass in body axes
@@ -519,7 +527,7 @@ void QuadrotorDriver::step(const StepInfo& info) {
   const BodyState& com = artifact().environment().bodyState(body.bodyIndex());
   Vec3 v_com = com.linear_velocity;
   // the body moves relative to the air: mean wind, the gust, the turbulence
-  if (!wind_.isZero() || !gust_.isZero() || turbulence_w20_ > 0) {
+  if (wind_or_gust_) {
     Vec3 air = wind_;
     const double tg = toSeconds(info.time) - gust_start_;
     if (tg >= 0 && tg <= gust_duration_) air += 0.5 * (1.0 - std::cos(2.0 * std::numbers::pi * tg / gust_duration_)) * gust_;
@@ -686,7 +694,7 @@ void QuadrotorDriver::saveState(StateWriter& out) const {
   const auto vector = [n](std::span<const double> v) { return std::vector<double>(v.begin(), v.begin() + n); };
   out.write(vector(rotors_->speeds()));
   out.write(vector(commanded_speeds_));
-  out.write(inner_->estimate());
+  out.write(estimate_);
   out.write(outer_->integral());
   out.write(command_);
   out.write(attitude_);
@@ -723,7 +731,7 @@ void QuadrotorDriver::loadState(StateReader& in) {
   in.read(commanded);
   if (commanded.size() != speeds.size()) throw StateError("quadrotor: the saved commanded speeds do not fit this driver");
   std::copy(commanded.begin(), commanded.end(), commanded_speeds_.begin());
-  inner_->reset(in.get<AttitudeEstimate>());
+  in.read(estimate_);
   Vec3 integral;
   in.read(integral);
   outer_->setIntegral(integral);

@@ -19,6 +19,7 @@
 #include <ssx/ssx.hpp>
 
 #include <array>
+#include <memory>
 #include <optional>
 #include <span>
 
@@ -132,69 +133,78 @@ class QuadrotorDriver final : public Driver, public SetpointInterface, public Me
 
   /// For tests: the rotor model and the controller's pieces.
   const RotorModel& rotors() const { return *rotors_; }
-  const InnerLoopFixed& innerLoop() const { return *inner_; }
+  const InnerLoopFixed& innerLoop() const { return *inner_; }  ///< its gains (the estimate is the driver's)
+  const AttitudeEstimate& attitudeEstimate() const { return estimate_; }
   const AttitudeCommand& attitudeCommand() const { return attitude_; }
 
  private:
   struct Config;    // the parameters, parsed: one per parameter set (PluginSetup::shared)
   struct Airframe;  // what the rotors' places make of them: one per parameter set and artifact type
   Setpoint reference(double t) const;
-
-  // held in the driver, not behind pointers: with thousands of robots a step is bound by memory
-  // latency, and every separate allocation is one more cache miss per robot and step
-  std::optional<RotorModel> rotors_;
-  std::optional<InnerLoopFixed> inner_;
-  std::optional<PositionController> outer_;
-  InnerCommand command_;
-  AttitudeCommand attitude_;
-  std::array<double, kMaxRotors> commanded_speeds_{};  // the first rotors_->size() in use
-  std::int64_t inner_runs_ = 1, outer_runs_ = 10;  // loop periods in runs of the driver
-  double outer_dt_ = 0.02;
-  enum class Source { Hover, Eight, External, Formation } source_ = Source::Hover;
   void formationStep(double dt);
-  Formation formation_;
-  std::size_t formation_index_ = 0, formation_base_ = 0;
-  Vec3 virtual_point_ = Vec3::Zero();
-  Vec3 virtual_velocity_ = Vec3::Zero();
-  const RangeMeasurement* range_ = nullptr;  // the range sensor's latest measurement (formation)
+  double desiredDistance(std::size_t member);
   std::span<const RangeMeasurement::Detection> seen() const {
     return range_ != nullptr ? std::span<const RangeMeasurement::Detection>(range_->detections)
                              : std::span<const RangeMeasurement::Detection>();
   }
+
+  // With thousands of robots a step is bound by memory latency: what every step reads comes
+  // first, held in the driver (not behind pointers of its own), so that it spans few cache lines;
+  // what members of one type share (the inner loop's gains, the rotors' constants) is one object
+  // they all point to, which stays in the cache; what only some features read comes last.
+  // -- read every step
+  enum class Source { Hover, Eight, External, Formation } source_ = Source::Hover;
+  bool imu_seen_ = false;  // a sample has arrived
+  bool have_pose_ = false;
+  bool ground_effect_ = false;
+  bool thrust_estimator_ = false;
+  bool command_link_ = false;
+  bool downwash_ = false;
+  bool wind_or_gust_ = false;  // wind_, gust_ or turbulence_w20_ is not zero
+  std::int64_t inner_runs_ = 1, outer_runs_ = 10;  // loop periods in runs of the driver
+  double outer_dt_ = 0.02;
+  const ImuMeasurement* imu_ = nullptr;
+  std::shared_ptr<const InnerLoopFixed> inner_;  // gains and mixer
+  AttitudeEstimate estimate_;
+  InnerCommand command_;
+  std::vector<InnerCommand> command_queue_;  // a ring: the commands of the last command_delay
+  std::size_t queue_at_ = 0;
+  std::array<double, kMaxRotors> commanded_speeds_{};  // the first rotors_->size() in use
+  std::optional<RotorModel> rotors_;
+  Vec3 com_in_root_ = Vec3::Zero();
+  // -- read every outer-loop run
+  std::optional<PositionController> outer_;
+  AttitudeCommand attitude_;
+  Setpoint current_;
+  PoseMeasurement pose_;
+  Setpoint hover_;
+  double start_time_ = 0;
+  // the formation
+  const RangeMeasurement* range_ = nullptr;  // the range sensor's latest measurement
+  std::size_t formation_index_ = 0, formation_base_ = 0;
+  Vec3 virtual_point_ = Vec3::Zero();
+  Vec3 virtual_velocity_ = Vec3::Zero();
   Vec3 own_target_ = Vec3::Zero();
   std::vector<std::pair<std::size_t, double>> desired_distance_;  // member -> d*, sorted; filled as met
-  double desiredDistance(std::size_t member);
-  Setpoint hover_;
+  Formation formation_;
+  // -- features, read when they are on
   Setpoint external_;
   FigureEight eight_;
-  double start_time_ = 0;
   double heading_kp_ = 2.0;  // 1/s, external set-points' yaw
-  bool ground_effect_ = false;
   std::optional<Battery> battery_;
-  bool thrust_estimator_ = false;
   double estimator_tau_ = 1.0, thrust_ratio_ = 1.0;  // estimated actual / expected thrust per command
   Vec3 last_velocity_ = Vec3::Zero();                 // the estimator's, at the last outer run
   bool have_last_velocity_ = false;
   double controller_mass_ = 0;
-  bool command_link_ = false;
-  double angle_step_ = 0;                   // rad
-  std::vector<InnerCommand> command_queue_;  // a ring: the commands of the last command_delay
-  std::size_t queue_at_ = 0;
+  double angle_step_ = 0;  // rad
   Vec3 wind_ = Vec3::Zero(), gust_ = Vec3::Zero();
   double gust_start_ = 0, gust_duration_ = 1;
   double turbulence_w20_ = 0, min_airspeed_ = 1;
   DrydenTurbulence turbulence_;
-  bool downwash_ = false;
   double downwash_c_[3] = {0, 0, 0}, downwash_range_ = 3, downwash_min_dz_ = 0.1;
   std::vector<SpatialIndex::Hit> above_;  // neighbours, reused
-  double ground_z_ = 0;       // the ground plane's height (-inf: none)
+  double ground_z_ = 0;                   // the ground plane's height (-inf: none)
   std::array<double, kMaxRotors> gains_{};  // per rotor thrust gains, handed to the rotor model
-  Setpoint current_;
-  const ImuMeasurement* imu_ = nullptr;
-  bool imu_seen_ = false;  // a sample has arrived
-  PoseMeasurement pose_;
-  bool have_pose_ = false;
-  Vec3 com_in_root_ = Vec3::Zero();
 };
 
 }  // namespace ssx::quadrotor

@@ -52,11 +52,13 @@ Allocation::Allocation(const std::vector<Rotor>& rotors, const RotorParams& p) {
   a_inv_ = a_.completeOrthogonalDecomposition().pseudoInverse();
 }
 
-RotorModel::RotorModel(const std::vector<Rotor>& rotors, const RotorParams& params)
-    : count_(rotors.size()), params_(params) {
+RotorModel::RotorModel(const std::vector<Rotor>& rotors, const RotorParams& params) : count_(rotors.size()) {
   if (rotors.size() > kMaxRotors)
     throw std::invalid_argument("rotor model: at most " + std::to_string(kMaxRotors) + " rotors");
-  std::copy(rotors.begin(), rotors.end(), rotors_.begin());
+  auto constants = std::make_shared<Constants>();
+  std::copy(rotors.begin(), rotors.end(), constants->rotors.begin());
+  constants->params = params;
+  constants_ = std::move(constants);
   gains_.fill(1.0);
 }
 
@@ -75,13 +77,14 @@ void RotorModel::setThrustGains(std::span<const double> gains) {
 }
 
 void RotorModel::step(double dt, std::span<const double> commanded) {
+  const RotorParams& params = constants_->params;
   if (dt != alpha_dt_) {  // the filter factors depend only on dt: compute them once
     alpha_dt_ = dt;
-    alpha_up_ = std::exp(-dt / params_.time_constant_up);
-    alpha_down_ = std::exp(-dt / params_.time_constant_down);
+    alpha_up_ = std::exp(-dt / params.time_constant_up);
+    alpha_down_ = std::exp(-dt / params.time_constant_down);
   }
   for (std::size_t i = 0; i < count_; ++i) {
-    const double target = std::clamp(commanded[i], params_.min_rotor_speed, params_.max_rotor_speed);
+    const double target = std::clamp(commanded[i], params.min_rotor_speed, params.max_rotor_speed);
     const double alpha = target > speeds_[i] ? alpha_up_ : alpha_down_;
     speeds_[i] = alpha * speeds_[i] + (1.0 - alpha) * target;
   }
@@ -187,24 +190,25 @@ void RotorModel::wrench(const Vec3& v_body, const Vec3& w_body, Vec3& force, Vec
   torque.setZero();
   double spin = 0.0;  // sum of s_i w_i, for the rotors' angular momentum
   const Vec3 z = Vec3::UnitZ();
+  const RotorParams& p = constants_->params;
   for (std::size_t i = 0; i < count_; ++i) {
-    const Rotor& r = rotors_[i];
+    const Rotor& r = constants_->rotors[i];
     const double w = speeds_[i];
-    const double thrust = params_.thrust_coefficient * w * w * gains_[i];
+    const double thrust = p.thrust_coefficient * w * w * gains_[i];
     // thrust and reaction torque
     const Vec3 f = thrust * z;
-    torque += r.position.cross(f) + Vec3(0, 0, -r.direction * params_.moment_constant * thrust);
+    torque += r.position.cross(f) + Vec3(0, 0, -r.direction * p.moment_constant * thrust);
     force += f;
     // rotor drag and rolling moment from the air-relative velocity in the rotor plane
     const Vec3 v = v_body + w_body.cross(r.position);
     const Vec3 v_perp = v - v.dot(z) * z;
-    const Vec3 drag = -std::abs(w) * params_.rotor_drag_coefficient * v_perp;
+    const Vec3 drag = -std::abs(w) * p.rotor_drag_coefficient * v_perp;
     force += drag;
-    torque += r.position.cross(drag) - std::abs(w) * params_.rolling_moment_coefficient * v_perp;
+    torque += r.position.cross(drag) - std::abs(w) * p.rolling_moment_coefficient * v_perp;
     spin += r.direction * w;
   }
   // turning spinning rotors takes a torque: the body feels -w x h, h = J_r sum(s_i w_i) z
-  if (params_.rotor_inertia > 0) torque += -w_body.cross(params_.rotor_inertia * spin * z);
+  if (p.rotor_inertia > 0) torque += -w_body.cross(p.rotor_inertia * spin * z);
 }
 
 // --- inner loop, fixed point --------------------------------------------------------------------

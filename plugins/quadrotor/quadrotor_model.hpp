@@ -15,6 +15,7 @@
 
 #include <array>
 #include <cstdint>
+#include <memory>
 #include <optional>
 #include <span>
 #include <string>
@@ -149,9 +150,10 @@ class Allocation {
   Eigen::MatrixXd a_, a_inv_;
 };
 
-/// First-order motors and the aerodynamic forces of the rotors (at most kMaxRotors). Its state is
-/// held inline, not in separate heap blocks: with thousands of robots a step is bound by memory
-/// latency, and every block is one more cache miss per robot and step.
+/// First-order motors and the aerodynamic forces of the rotors (at most kMaxRotors). Its state
+/// (speeds, gains) is held inline; the rotors' places and constants in one block that copies share:
+/// with thousands of robots a step is bound by memory latency, and a swarm's robots of one type
+/// then read one copy of them, which stays in the cache, instead of one each.
 class RotorModel {
  public:
   RotorModel(const std::vector<Rotor>& rotors, const RotorParams& params);
@@ -167,16 +169,19 @@ class RotorModel {
   /// (default 1): ground effect, battery voltage, downwash. One gain per rotor.
   void setThrustGains(std::span<const double> gains);
   std::span<const double> thrustGains() const { return {gains_.data(), count_}; }
-  std::span<const Rotor> rotors() const { return {rotors_.data(), count_}; }
+  std::span<const Rotor> rotors() const { return {constants_->rotors.data(), count_}; }
   std::size_t size() const { return count_; }
-  const RotorParams& params() const { return params_; }
+  const RotorParams& params() const { return constants_->params; }
 
  private:
-  std::array<Rotor, kMaxRotors> rotors_{};
+  struct Constants {
+    std::array<Rotor, kMaxRotors> rotors{};
+    RotorParams params;
+  };
+  std::shared_ptr<const Constants> constants_;  // shared by copies
   std::array<double, kMaxRotors> speeds_{};
   std::array<double, kMaxRotors> gains_{};
   std::size_t count_ = 0;
-  RotorParams params_;
   double alpha_dt_ = -1, alpha_up_ = 0, alpha_down_ = 0;  // exp(-dt/tau) for the last dt
 };
 
