@@ -30,8 +30,8 @@ void Artifact::buildNodes(PhysicNode* parent, const PhysicNodeSpec& spec) {
   data.is_static = parent != nullptr ? parent->isStatic() : spec.is_static;
   world_->nodes.push_back(data);
   world_->node_setup.push_back({(parent != nullptr ? parent->pose() : placement_) * spec.pose});
-  nodes_.push_back(std::make_unique<PhysicNode>(*world_, *this, spec, parent, index));
-  PhysicNode* node = nodes_.back().get();
+  PhysicNode* node = &world_->node_handles.emplace_back(*world_, *this, spec, parent, index);
+  nodes_.push_back(node);
   if (parent == nullptr) roots_.push_back(node);
   for (const auto& child : spec.children) buildNodes(node, child);
 }
@@ -160,7 +160,7 @@ const Descriptor& Artifact::sensorParameters(std::size_t i) const { return world
 
 PhysicNode* Artifact::node(std::string_view name) {
   for (const auto& n : nodes_)
-    if (n->name() == name) return n.get();
+    if (n->name() == name) return n;
   return nullptr;
 }
 

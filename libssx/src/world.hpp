@@ -21,6 +21,7 @@
 #include <memory>
 #include <string>
 #include <unordered_map>
+#include <deque>
 #include <vector>
 
 namespace ssx::detail {
@@ -124,6 +125,10 @@ struct World {
   // per node and per plugin slot
   std::vector<NodeData> nodes;
   std::vector<NodeSetup> node_setup;
+  // the handles (PhysicNode) of `nodes`, side by side at stable addresses: what a sensor or
+  // driver reads its node's state through is then one run of memory for a swarm, not one heap
+  // block per node (the artifacts point into it)
+  std::deque<PhysicNode> node_handles;
   std::vector<PluginSlot> plugins;
   std::vector<Random> randoms;
   // per plugin slot, written by the sensors phase: 1 when that sensor measured in this step (one

@@ -126,7 +126,7 @@ class SSX_EXPORT Artifact {
   std::size_t index_;
   Pose placement_;
   std::vector<std::shared_ptr<const PhysicNodeSpec>> root_specs_;
-  std::vector<std::unique_ptr<PhysicNode>> nodes_;  // every node, trees in order
+  std::vector<PhysicNode*> nodes_;  // every node, trees in order (held by the world)
   std::vector<PhysicNode*> roots_;
   std::vector<std::shared_ptr<const RenderNodeSpec>> render_roots_;
 };
