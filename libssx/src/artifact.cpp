@@ -33,6 +33,7 @@ void Artifact::buildNodes(PhysicNode* parent, const PhysicNodeSpec& spec) {
   PhysicNode* node = &world_->node_handles.emplace_back(*world_, *this, spec, parent, index);
   nodes_.push_back(node);
   if (parent == nullptr) roots_.push_back(node);
+  first_root_ = roots_.front();
   for (const auto& child : spec.children) buildNodes(node, child);
 }
 

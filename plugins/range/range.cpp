@@ -12,7 +12,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <memory>
 #include <numbers>
+#include <vector>
 
 namespace ssx::plugins {
 
@@ -81,12 +83,18 @@ class RangeSensor final : public SensorOf<RangeMeasurement> {
 
     const Environment& env = environment();
     setup.enableNeighborQueries(range_);
+    // the environment's obstacles, listed once for every range sensor (a block each would be one
+    // more cache miss per robot and step)
     if (params.get<bool>("obstacles"))
-      for (const ObstacleShape& o : env.staticShapes())
-        if (o.shape.kind != Shape::Kind::Plane) obstacles_.push_back(&o);
+      obstacles_ = setup.shared<Obstacles>("obstacles", [&env] {
+        Obstacles list;
+        for (const ObstacleShape& o : env.staticShapes())
+          if (o.shape.kind != Shape::Kind::Plane) list.push_back(&o);
+        return list;
+      });
     // room for what a robot usually sees, so that sensing allocates nothing; a robot that sees
     // more grows these once, to the most it has seen
-    const std::size_t typical = std::min<std::size_t>(16, env.artifactCount() + obstacles_.size());
+    const std::size_t typical = std::min<std::size_t>(16, env.artifactCount() + obstacles().size());
     found_.reserve(typical);
     output().detections.reserve(typical);
   }
@@ -114,7 +122,7 @@ class RangeSensor final : public SensorOf<RangeMeasurement> {
       if (visible(rel)) m.detections.push_back({rel, rel.norm(), j, false});
     }
     // obstacles, at their nearest point
-    for (const ObstacleShape* o : obstacles_) {
+    for (const ObstacleShape* o : obstacles()) {
       const Vec3 rel = nearestPoint(*o, self.position) - self.position;
       const double d = rel.norm();
       if (d <= range_ && visible(rel)) m.detections.push_back({rel, d, o->artifact, true});
@@ -134,7 +142,12 @@ class RangeSensor final : public SensorOf<RangeMeasurement> {
  private:
   double range_ = 2.5, noise_ = 0, cos_half_fov_ = -2;
   std::size_t max_count_ = 0;
-  std::vector<const ObstacleShape*> obstacles_;  // owned by the environment
+  using Obstacles = std::vector<const ObstacleShape*>;  // owned by the environment
+  std::shared_ptr<const Obstacles> obstacles_;         // none when obstacles="false"
+  const Obstacles& obstacles() const {
+    static const Obstacles none;
+    return obstacles_ != nullptr ? *obstacles_ : none;
+  }
   std::vector<SpatialIndex::Hit> found_;
 };
 

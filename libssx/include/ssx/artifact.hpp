@@ -94,8 +94,10 @@ class SSX_EXPORT Artifact {
   }
 
   std::size_t rootCount() const noexcept { return roots_.size(); }
-  PhysicNode& root(std::size_t i = 0) { return *roots_.at(i); }
-  const PhysicNode& root(std::size_t i = 0) const { return *roots_.at(i); }
+  PhysicNode& root(std::size_t i = 0) { return i == 0 && first_root_ != nullptr ? *first_root_ : *roots_.at(i); }
+  const PhysicNode& root(std::size_t i = 0) const {
+    return i == 0 && first_root_ != nullptr ? *first_root_ : *roots_.at(i);
+  }
   /// Node by name, searching every tree; nullptr if none.
   PhysicNode* node(std::string_view name);
   const PhysicNode* node(std::string_view name) const;
@@ -121,6 +123,8 @@ class SSX_EXPORT Artifact {
                  const Descriptor& params);
 
   detail::World* world_;
+  // root 0, the node plugins read every step, held here too: root() then reads no other block
+  PhysicNode* first_root_ = nullptr;
   const Environment* env_;
   std::string name_;
   std::size_t index_;

@@ -32,9 +32,10 @@
 #include <type_traits>
 #include <vector>
 
-/// Incremented whenever the manifest layout, the meaning of its fields or the plugin base classes
-/// (Plugin, Driver, Sensor, SimulationExtension: their virtual functions and members) change.
-#define SSX_PLUGIN_ABI_VERSION 5u
+/// Incremented whenever the manifest layout, the meaning of its fields, the plugin base classes
+/// (Plugin, Driver, Sensor, SimulationExtension: their virtual functions and members) or the
+/// members of the classes whose inline accessors plugins compile in (Artifact) change.
+#define SSX_PLUGIN_ABI_VERSION 6u
 
 #define SSX_PLUGIN_STRINGIFY2(x) #x
 #define SSX_PLUGIN_STRINGIFY(x) SSX_PLUGIN_STRINGIFY2(x)
