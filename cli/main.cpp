@@ -110,6 +110,7 @@ struct RunArgs {
   bool quiet = false;
   std::string render, physics, snapshot, video, frames;
   std::string save_state, load_state;
+  int rt_priority = 0;
 };
 
 // "ode, bullet"
@@ -147,6 +148,14 @@ void writeFileAtomically(const std::string& path, const std::vector<std::byte>& 
 }
 
 int commandRun(const RunArgs& args, bool realtime_given) {
+  // a real-time priority this process may not take is refused before anything is loaded or opened
+  if (args.rt_priority > 0) {
+    const std::string problem = ssx::realtimePriorityProblem(args.rt_priority);
+    if (!problem.empty()) {
+      std::cerr << "ssx: error: --rt-priority " << args.rt_priority << ": " << problem << '\n';
+      return kExitBadInput;
+    }
+  }
   ssx::SceneOptions options;
   options.plugin_path = pluginPath(args.plugin_path);
   if (args.threads >= 0) options.threads = args.threads;
@@ -179,6 +188,7 @@ int commandRun(const RunArgs& args, bool realtime_given) {
   ssx::RunOptions run = scene.run;
   run.mode = args.fast ? ssx::RunOptions::Mode::Fast : ssx::RunOptions::Mode::RealTime;
   if (realtime_given) run.realtime_factor = args.realtime;
+  run.realtime_priority = args.rt_priority;
   if (args.steps >= 0) {
     run.steps = args.steps;
   } else {
@@ -487,7 +497,13 @@ int main(int argc, char** argv) {
       run_cmd->add_option("--realtime", run.realtime, "pace against the wall clock, optionally FACTOR times faster")
           ->expected(0, 1)
           ->check(CLI::Range(ssx::kMinRealtimeFactor, ssx::kMaxRealtimeFactor));
-  run_cmd->add_flag("--fast", run.fast, "run as fast as possible")->excludes(realtime);
+  auto* fast = run_cmd->add_flag("--fast", run.fast, "run as fast as possible")->excludes(realtime);
+  run_cmd
+      ->add_option("--rt-priority", run.rt_priority,
+                   "step at this SCHED_FIFO priority (1-99; needs root or CAP_SYS_NICE): steps are not woken late "
+                   "while other processes run")
+      ->check(CLI::Range(ssx::kMinRealtimePriority, ssx::kMaxRealtimePriority))
+      ->excludes(fast);
   run_cmd->add_option("--threads", run.threads, "worker threads (0: one per core)")->check(CLI::NonNegativeNumber);
   run_cmd->add_option("--seed", run.seed, "scene seed")->check(CLI::NonNegativeNumber);
   run_cmd->add_option("--plugin-path", run.plugin_path, "plugin directory (repeatable)");

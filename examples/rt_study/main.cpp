@@ -10,13 +10,15 @@
 // snapshot, neighbour index and hooks; us_per_robot = the median sample over N)
 //
 // usage: ssx_rt_study [--n N]... [--samples K] [--threads T] [--physics-hz H] [--tau S] [--csv FILE]
-//                     [--physics ode|bullet]
+//                     [--physics ode|bullet] [--rt-priority P]
 //                     [--fast]
 //   --physics-hz  physics rate (default 1/tau: one physics step per tau, as the paper). When it is
 //                 faster than 1/tau the environment steps at min(H, 500 Hz) with the rest as physics
 //                 substeps, the inner loop runs at that step rate, and one sample is the compute
 //                 time of the steps of one tau
 //   --fast        do not pace against the wall clock (for tests; overruns are then not measured)
+//   --rt-priority step at SCHED_FIFO priority P (1-99; RunOptions::realtime_priority): needs root
+//                 or CAP_SYS_NICE
 #include <ssx/ssx.hpp>
 
 #include <algorithm>
@@ -37,6 +39,7 @@ struct Options {
   double physics_hz = 0;  // 0: 1/tau
   std::string csv;
   bool fast = false;
+  int rt_priority = 0;
   std::string physics;  // the engine, if not the scene's
 };
 
@@ -93,6 +96,8 @@ int main(int argc, char** argv) {
         o.csv = value();
       else if (a == "--fast")
         o.fast = true;
+      else if (a == "--rt-priority")
+        o.rt_priority = std::stoi(value());
       else if (a == "--physics")
         o.physics = value();
       else
@@ -100,8 +105,15 @@ int main(int argc, char** argv) {
     } catch (const std::exception& e) {
       std::fprintf(stderr,
                    "ssx_rt_study: %s\nusage: ssx_rt_study [--n N]... [--samples K] [--threads T] "
-                   "[--physics-hz H] [--tau S] [--csv FILE] [--fast] [--physics ode|bullet]\n",
+                   "[--physics-hz H] [--tau S] [--csv FILE] [--fast] [--physics ode|bullet] [--rt-priority P]\n",
                    e.what());
+      return 2;
+    }
+  }
+  if (o.rt_priority != 0) {
+    const std::string problem = ssx::realtimePriorityProblem(o.rt_priority);
+    if (!problem.empty()) {
+      std::fprintf(stderr, "ssx_rt_study: --rt-priority %d: %s\n", o.rt_priority, problem.c_str());
       return 2;
     }
   }
@@ -121,6 +133,7 @@ int main(int argc, char** argv) {
       env.setLogSink([](ssx::LogLevel, std::string_view) {});  // overruns are counted, not printed
       ssx::RunOptions run;
       run.mode = o.fast ? ssx::RunOptions::Mode::Fast : ssx::RunOptions::Mode::RealTime;
+      run.realtime_priority = o.rt_priority;
       // the step at the physics rate; a sample is the compute time of one tau of simulated time
       const int per_tau = std::max(1, static_cast<int>(std::lround(o.tau / ssx::toSeconds(env.timestep()))));
       run.steps = static_cast<std::int64_t>(o.samples) * per_tau;

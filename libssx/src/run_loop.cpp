@@ -3,12 +3,19 @@
 
 #include "worker_pool.hpp"
 
+#include <pthread.h>
+#include <sched.h>
 #include <sys/prctl.h>
 #include <time.h>
 
 #include <cerrno>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
+#include <optional>
+#include <string>
+#include <thread>
+#include <vector>
 
 namespace ssx {
 
@@ -34,14 +41,77 @@ void waitUntil(Nanoseconds deadline, Nanoseconds spin) {
 
 constexpr Nanoseconds kWakeAhead = 200'000;  // ns before a deadline the workers are woken
 
+std::string describeSchedError(int error, int priority) {
+  if (error == EPERM)
+    return "SCHED_FIFO priority " + std::to_string(priority) +
+           " is not permitted here: run as root, give the program CAP_SYS_NICE, or raise its real-time "
+           "priority limit (ulimit -r; /etc/security/limits.conf)";
+  return "SCHED_FIFO priority " + std::to_string(priority) + ": " + std::strerror(error);
+}
+
+// The threads of a run at a SCHED_FIFO priority, each put back to its own policy at the end,
+// however the run ends.
+class FifoScheduling {
+ public:
+  FifoScheduling(const std::vector<pthread_t>& threads, int priority) {
+    for (pthread_t t : threads) {
+      Saved saved{t, 0, {}};
+      int error = pthread_getschedparam(t, &saved.policy, &saved.param);
+      if (error == 0) {
+        sched_param fifo{};
+        fifo.sched_priority = priority;
+        error = pthread_setschedparam(t, SCHED_FIFO, &fifo);
+      }
+      if (error != 0) {
+        restore();
+        throw Error("real-time priority: " + describeSchedError(error, priority));
+      }
+      saved_.push_back(saved);
+    }
+  }
+  ~FifoScheduling() { restore(); }
+  FifoScheduling(const FifoScheduling&) = delete;
+  FifoScheduling& operator=(const FifoScheduling&) = delete;
+
+ private:
+  struct Saved {
+    pthread_t thread;
+    int policy;
+    sched_param param;
+  };
+  void restore() noexcept {
+    for (const Saved& s : saved_) pthread_setschedparam(s.thread, s.policy, &s.param);
+    saved_.clear();
+  }
+  std::vector<Saved> saved_;
+};
+
 }  // namespace
+
+std::string realtimePriorityProblem(int priority) {
+  if (priority < kMinRealtimePriority || priority > kMaxRealtimePriority)
+    return "the real-time priority must be from " + std::to_string(kMinRealtimePriority) + " to " +
+           std::to_string(kMaxRealtimePriority);
+  int error = 0;
+  std::thread probe([&error, priority] {
+    sched_param fifo{};
+    fifo.sched_priority = priority;
+    error = pthread_setschedparam(pthread_self(), SCHED_FIFO, &fifo);
+  });
+  probe.join();
+  return error == 0 ? std::string() : describeSchedError(error, priority);
+}
 
 TimingSummary Environment::run(const RunOptions& options) {
   if (options.mode == RunOptions::Mode::RealTime &&
       !(options.realtime_factor >= kMinRealtimeFactor && options.realtime_factor <= kMaxRealtimeFactor))
     throw ConfigError({}, "real-time factor must be from 0.001 to 1e6");
-  if (state() == State::Setup) start();
   const bool realtime = options.mode == RunOptions::Mode::RealTime;
+  if (realtime && options.realtime_priority != 0 &&
+      (options.realtime_priority < kMinRealtimePriority || options.realtime_priority > kMaxRealtimePriority))
+    throw ConfigError({}, "real-time priority must be from " + std::to_string(kMinRealtimePriority) + " to " +
+                              std::to_string(kMaxRealtimePriority) + " (0: off)");
+  if (state() == State::Setup) start();
   // wake within 1 ns of the deadline, not the default 50 us; the slack is the calling thread's,
   // so it is put back when the run ends, however it ends
   struct TimerSlack {
@@ -57,6 +127,14 @@ TimingSummary Environment::run(const RunOptions& options) {
     TimerSlack(const TimerSlack&) = delete;
     TimerSlack& operator=(const TimerSlack&) = delete;
   } slack(realtime);
+  // the stepping thread and the workers at a real-time priority, if asked
+  std::optional<FifoScheduling> fifo;
+  if (realtime && options.realtime_priority > 0) {
+    std::vector<pthread_t> threads{pthread_self()};
+    if (pool_ != nullptr)
+      for (pthread_t t : pool_->nativeHandles()) threads.push_back(t);
+    fifo.emplace(threads, options.realtime_priority);
+  }
 
   const double period = static_cast<double>(settings_.timestep) / (realtime ? options.realtime_factor : 1.0);
   const std::int64_t first_sample = timing_.recorded();

@@ -38,6 +38,12 @@ WorkerPool::WorkerPool(unsigned threads, bool held) : released_(!held) {
   for (unsigned i = 0; i < extra; ++i) workers_.emplace_back([this] { workerLoop(); });
 }
 
+std::vector<std::thread::native_handle_type> WorkerPool::nativeHandles() {
+  std::vector<std::thread::native_handle_type> out;
+  for (auto& t : workers_) out.push_back(t.native_handle());
+  return out;
+}
+
 void WorkerPool::wake() {
   if (workers_.empty()) return;
   // a job closed from the start: the workers wake, join nothing and spin for the next one

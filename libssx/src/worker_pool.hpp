@@ -27,6 +27,8 @@ class WorkerPool final : public TaskRunner {
   WorkerPool& operator=(const WorkerPool&) = delete;
 
   unsigned size() const noexcept { return static_cast<unsigned>(workers_.size()) + 1; }
+  /// The workers' threads (for their scheduling policy).
+  std::vector<std::thread::native_handle_type> nativeHandles();
   /// Wakes the workers without a job, so that a job due shortly finds them running rather than
   /// asleep (from the thread that runs the jobs).
   void wake();

@@ -233,6 +233,28 @@ TEST_CASE("ssx run: a log file that cannot be written fails the run with status 
   CHECK_FALSE(Contains("step time ms").match(r.out));  // no summary of a failed run
 }
 
+TEST_CASE("ssx run --rt-priority: out of range or with --fast refused; refused before anything is written "
+          "where it is not permitted, else used", "[cli]") {
+  const std::string scene = (kExamples / "scenes" / "hover_swarm.xml").string();
+  CHECK(run({"run", scene, "--rt-priority", "0", "--steps", "5"}).status == 2);
+  CHECK(run({"run", scene, "--rt-priority", "100", "--steps", "5"}).status == 2);
+  CHECK(run({"run", scene, "--rt-priority", "5", "--fast", "--steps", "5"}).status == 2);
+  const fs::path dir = "cli_rt_priority";
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  const fs::path csv = dir / "stats.csv";
+  const Result r = run({"run", scene, "--rt-priority", "5", "--steps", "20", "--stats-csv", csv.string()});
+  if (ssx::realtimePriorityProblem(5).empty()) {
+    CHECK(r.status == 0);
+    CHECK_THAT(r.out, Contains("steps 20"));
+  } else {
+    CHECK(r.status == 2);
+    CHECK_THAT(r.err, Contains("--rt-priority 5: SCHED_FIFO priority 5 is not permitted here"));
+    CHECK_FALSE(fs::exists(csv));
+  }
+  fs::remove_all(dir);
+}
+
 TEST_CASE("ssx run: a bare --realtime means factor 1, a given factor is used", "[cli]") {
   const std::string scene = (kExamples / "scenes" / "hover_swarm.xml").string();
   const Result plain = run({"run", scene, "--realtime", "--steps", "50"});

@@ -2,10 +2,14 @@
 
 #include <catch2/catch.hpp>
 
+#include <pthread.h>
+#include <sched.h>
 #include <sys/prctl.h>
 
 #include <chrono>
 #include <limits>
+#include <map>
+#include <mutex>
 #include <stdexcept>
 
 using namespace ssx;
@@ -173,4 +177,68 @@ TEST_CASE("times that do not fit 64-bit nanoseconds are refused, not wrapped", "
   for (const double bad : {1e300, -1e300, 9.3e9, std::numeric_limits<double>::quiet_NaN(),
                            std::numeric_limits<double>::infinity()})
     CHECK_THROWS_AS(toNanoseconds(bad), std::out_of_range);
+}
+
+TEST_CASE("a real-time run at a real-time priority steps every thread at it and puts each back", "[run]") {
+  auto policyOf = [](pthread_t t) {
+    int policy = -1;
+    sched_param param{};
+    REQUIRE(pthread_getschedparam(t, &policy, &param) == 0);
+    return std::pair(policy, param.sched_priority);
+  };
+  const auto before = policyOf(pthread_self());
+  REQUIRE(before.first != SCHED_FIFO);
+  EnvironmentSettings s;
+  s.timestep = toNanoseconds(0.005);
+  s.threads = 2;
+  Environment env(s);
+  // drivers slow enough that both threads take chunks; each records the policy of its thread
+  std::mutex mutex;
+  std::map<pthread_t, std::pair<int, int>> seen;
+  for (int i = 0; i < 16; ++i)
+    env.addArtifact("ball" + std::to_string(i), test::at(i, 0, 1))
+        .addPhysicRoot(test::boxBody(Vec3(0.1, 0.1, 0.1), 1.0))
+        .artifact()
+        .setDriver(std::make_unique<test::LambdaDriver>([&](Driver&, const StepInfo&) {
+          burn(std::chrono::microseconds(100));
+          int policy = -1;
+          sched_param param{};
+          pthread_getschedparam(pthread_self(), &policy, &param);
+          const std::lock_guard<std::mutex> lock(mutex);
+          seen[pthread_self()] = {policy, param.sched_priority};
+        }));
+  RunOptions o;
+  o.steps = 40;
+  o.realtime_priority = 7;
+  std::pair<int, int> during{-1, -1};
+  o.on_step = [&](const Environment&) { during = policyOf(pthread_self()); };
+  const std::string problem = realtimePriorityProblem(7);
+  if (!problem.empty()) {
+    // not permitted here (no root, no CAP_SYS_NICE): refused with the reason, nothing changed
+    INFO(problem);
+    CHECK_THROWS_WITH(env.run(o), Catch::Contains("not permitted") || Catch::Contains("SCHED_FIFO"));
+    CHECK(env.stepCount() == 0);
+  } else {
+    env.run(o);
+    CHECK(during == std::pair(SCHED_FIFO, 7));
+    REQUIRE(seen.size() == 2);  // the caller and the worker
+    for (const auto& [thread, policy] : seen) CHECK(policy == std::pair(SCHED_FIFO, 7));
+    // a fast run and a run without it leave the policies alone
+    seen.clear();
+    o.mode = RunOptions::Mode::Fast;
+    env.run(o);
+    CHECK(during == before);
+    for (const auto& [thread, policy] : seen) CHECK(policy.first != SCHED_FIFO);
+  }
+  CHECK(policyOf(pthread_self()) == before);
+  // out of range: refused before anything runs
+  o.mode = RunOptions::Mode::RealTime;
+  const std::int64_t steps = env.stepCount();
+  for (const int bad : {-1, 100, 1000}) {
+    o.realtime_priority = bad;
+    CHECK_THROWS_AS(env.run(o), ConfigError);
+  }
+  CHECK(env.stepCount() == steps);
+  CHECK_FALSE(realtimePriorityProblem(0).empty());
+  CHECK_FALSE(realtimePriorityProblem(100).empty());
 }

@@ -86,7 +86,24 @@ struct RunOptions {
   Nanoseconds warn_interval = 1'000'000'000;        ///< at most one overrun warning per this wall time
   const std::atomic<bool>* stop = nullptr;          ///< set to true (from anywhere) to end the run
   std::function<void(const Environment&)> on_step;  ///< after every step, calling thread
+  /// 1-99: a real-time run steps on the calling thread and the worker threads at this SCHED_FIFO
+  /// priority, each put back to its own policy when the run returns; 0: their policies as they
+  /// are. Under the default policy a thread that sleeps until a deadline can be woken milliseconds
+  /// late while other work runs (this README's machine: up to 5 ms); a FIFO thread is run at once.
+  /// Needs permission (root, CAP_SYS_NICE or an RLIMIT_RTPRIO; see realtimePriorityProblem): run
+  /// throws before the first step without it. Meant for as many threads as cores, and for scenes
+  /// that keep up: while it is late, a run at this priority leaves the cores it uses to nothing
+  /// else (the kernel's real-time throttling keeps 5 % for the rest). Ignored when Fast.
+  int realtime_priority = 0;
 };
+
+inline constexpr int kMinRealtimePriority = 1;   ///< RunOptions::realtime_priority, when on
+inline constexpr int kMaxRealtimePriority = 99;
+
+/// Why this process cannot run threads at SCHED_FIFO `priority` (1-99), or "" when it can: tried
+/// on a thread of its own that ends at once, so nothing of the process changes. For a program to
+/// check RunOptions::realtime_priority before it loads or opens anything.
+SSX_EXPORT std::string realtimePriorityProblem(int priority);
 
 enum class LogLevel : std::uint8_t { Info, Warning, Error };
 using LogSink = std::function<void(LogLevel, std::string_view)>;
