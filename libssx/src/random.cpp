@@ -14,8 +14,6 @@ std::uint64_t splitmix64(std::uint64_t& state) {
   return z ^ (z >> 31);
 }
 
-std::uint64_t rotl(std::uint64_t x, int k) { return (x << k) | (x >> (64 - k)); }
-
 }  // namespace
 
 std::uint64_t deriveSeed(std::uint64_t seed, std::uint64_t a, std::uint64_t b) {
@@ -34,29 +32,7 @@ void Random::reseed(std::uint64_t seed) {
   has_spare_ = false;
 }
 
-Random::result_type Random::operator()() {
-  // xoshiro256++ (Blackman and Vigna)
-  const std::uint64_t result = rotl(s_[0] + s_[3], 23) + s_[0];
-  const std::uint64_t t = s_[1] << 17;
-  s_[2] ^= s_[0];
-  s_[3] ^= s_[1];
-  s_[1] ^= s_[2];
-  s_[0] ^= s_[3];
-  s_[2] ^= t;
-  s_[3] = rotl(s_[3], 45);
-  return result;
-}
-
-double Random::uniform() {
-  // 53 random bits into [0, 1)
-  return static_cast<double>((*this)() >> 11) * 0x1.0p-53;
-}
-
-double Random::normal() {
-  if (has_spare_) {
-    has_spare_ = false;
-    return spare_;
-  }
+double Random::normalPair() {
   double u, v, s;
   do {
     u = 2.0 * uniform() - 1.0;

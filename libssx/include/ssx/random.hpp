@@ -27,13 +27,31 @@ class SSX_EXPORT Random {
   static constexpr result_type min() { return 0; }
   static constexpr result_type max() { return ~result_type{0}; }
   /// The next raw 64-bit number.
-  result_type operator()();
-  /// Uniform in [0, 1).
-  double uniform();
+  result_type operator()() {
+    // xoshiro256++ (Blackman and Vigna); inline, as uniform and normal's second number: a sensor
+    // draws a dozen numbers per sample, thousands of times per step
+    const std::uint64_t result = rotl(s_[0] + s_[3], 23) + s_[0];
+    const std::uint64_t t = s_[1] << 17;
+    s_[2] ^= s_[0];
+    s_[3] ^= s_[1];
+    s_[1] ^= s_[2];
+    s_[0] ^= s_[3];
+    s_[2] ^= t;
+    s_[3] = rotl(s_[3], 45);
+    return result;
+  }
+  /// Uniform in [0, 1): 53 random bits.
+  double uniform() { return static_cast<double>((*this)() >> 11) * 0x1.0p-53; }
   /// Uniform in [lo, hi).
   double uniform(double lo, double hi) { return lo + (hi - lo) * uniform(); }
-  /// Standard normal (Marsaglia's polar method).
-  double normal();
+  /// Standard normal (Marsaglia's polar method: numbers come in pairs, the second is kept).
+  double normal() {
+    if (has_spare_) {
+      has_spare_ = false;
+      return spare_;
+    }
+    return normalPair();
+  }
   /// Normal with mean and standard deviation.
   double normal(double mean, double stddev) { return mean + stddev * normal(); }
 
@@ -42,6 +60,8 @@ class SSX_EXPORT Random {
   void load(StateReader& in);
 
  private:
+  static std::uint64_t rotl(std::uint64_t x, int k) { return (x << k) | (x >> (64 - k)); }
+  double normalPair();  // draws a pair: returns the first, keeps the second
   std::uint64_t s_[4]{};
   double spare_ = 0.0;
   bool has_spare_ = false;
