@@ -307,10 +307,17 @@ class PyEnvironment {
   // Paces steps for `seconds` of simulated time (the scene's duration when None). Ctrl-C (any
   // Python signal handler that raises) ends the run between two steps and raises here; the
   // environment stays usable.
-  py::dict run(std::optional<double> seconds, bool realtime, std::optional<double> realtime_factor) {
+  py::dict run(std::optional<double> seconds, bool realtime, std::optional<double> realtime_factor,
+               std::optional<int> realtime_priority) {
     InUse use(busy_);
     ssx::RunOptions run = scene_.run;
     run.mode = realtime ? ssx::RunOptions::Mode::RealTime : ssx::RunOptions::Mode::Fast;
+    if (realtime_priority) {
+      // refused before a step: out of range, or not permitted to this process
+      if (const std::string problem = ssx::realtimePriorityProblem(*realtime_priority); !problem.empty())
+        throw py::value_error("ssx: realtime_priority " + std::to_string(*realtime_priority) + ": " + problem);
+      run.realtime_priority = *realtime_priority;
+    }
     if (realtime_factor) {
       if (!(*realtime_factor >= ssx::kMinRealtimeFactor && *realtime_factor <= ssx::kMaxRealtimeFactor))
         throw py::value_error("ssx: realtime_factor must be in [1e-3, 1e6], got " + std::to_string(*realtime_factor));
@@ -454,9 +461,10 @@ PYBIND11_MODULE(_ssx, m) {
       .def("restore_state", &PyEnvironment::restoreState, py::arg("state"),
            "Continues from save_state() bytes: the next steps are bitwise those of the saving run.")
       .def("run", &PyEnvironment::run, py::arg("seconds") = py::none(), py::arg("realtime") = true,
-           py::arg("realtime_factor") = py::none(),
+           py::arg("realtime_factor") = py::none(), py::arg("realtime_priority") = py::none(),
            "Runs `seconds` of simulated time (default: the scene's duration), paced to the wall clock "
-           "unless realtime=False; returns the timing summary. Ctrl-C stops it between two steps.")
+           "unless realtime=False; returns the timing summary. Ctrl-C stops it between two steps. "
+           "realtime_priority (1-99) steps at that SCHED_FIFO priority (needs root or CAP_SYS_NICE).")
       .def("close", &PyEnvironment::close, "Stops the environment: plugins destroyed, files and videos finished.")
       .def("__enter__", [](py::object self) { return self; })
       .def("__exit__", [](PyEnvironment& e, const py::args&) { e.close(); })

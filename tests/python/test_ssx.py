@@ -211,6 +211,43 @@ def test_run_returns_the_timing_summary():
         ssx.load_scene_string(PAIR, base_dir=artifacts_dir()).run()
 
 
+def test_a_real_time_priority_is_checked_before_a_step():
+    env = hover(threads=2)
+    for bad in (0, 100, -3):
+        with pytest.raises(ValueError, match="priority must be from 1 to 99"):
+            env.run(0.05, realtime=True, realtime_priority=bad)
+    assert env.step_count == 0
+    try:
+        permitted = os.sched_getscheduler(0) is not None and _fifo_permitted()
+    except OSError:
+        permitted = False
+    if permitted:
+        s = env.run(0.05, realtime=True, realtime_priority=5)
+        assert s["steps"] == 25
+        assert os.sched_getscheduler(0) == os.SCHED_OTHER  # put back after the run
+    else:
+        with pytest.raises(ValueError, match="not permitted"):
+            env.run(0.05, realtime=True, realtime_priority=5)
+        assert env.step_count == 0
+
+
+def _fifo_permitted():
+    # as the library checks it: on a thread of its own, which ends
+    result = []
+
+    def probe():
+        try:
+            os.sched_setscheduler(0, os.SCHED_FIFO, os.sched_param(5))
+            result.append(True)
+        except PermissionError:
+            result.append(False)
+
+    t = threading.Thread(target=probe)
+    t.start()
+    t.join()
+    return result[0]
+
+
 def test_ctrl_c_stops_a_run_between_steps():
     env = hover(threads=1)
     # a real SIGINT, sent from another thread while the main thread is inside run()
