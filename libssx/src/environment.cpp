@@ -432,6 +432,10 @@ void Environment::neighbors(const Vec3& point, double radius, std::vector<Spatia
   neighbors_->query(point, radius, out);
 }
 
+void Environment::forEachNeighbor(const Vec3& point, double radius, SpatialIndex::Visitor visit, void* context) const {
+  neighbors_->forEach(point, radius, visit, context);
+}
+
 std::vector<CameraSpec> Environment::cameras() const { return cameras_->specs(); }
 
 const std::vector<RenderNode>& Environment::renderNodes() const noexcept { return cameras_->renderNodes(); }

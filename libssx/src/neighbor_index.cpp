@@ -52,4 +52,9 @@ void NeighborIndex::query(const Vec3& point, double radius, std::vector<SpatialI
   fresh().query(point, radius, out);
 }
 
+void NeighborIndex::forEach(const Vec3& point, double radius, SpatialIndex::Visitor visit, void* context) const {
+  requireEnabled();
+  fresh().forEach(point, radius, visit, context);
+}
+
 }  // namespace ssx::detail

@@ -32,6 +32,7 @@ class NeighborIndex {
   /// See Environment::neighbors. Throws when queries are off. Any thread, any number at once.
   void query(const Vec3& point, double radius, std::vector<std::size_t>& out) const;
   void query(const Vec3& point, double radius, std::vector<SpatialIndex::Hit>& out) const;
+  void forEach(const Vec3& point, double radius, SpatialIndex::Visitor visit, void* context) const;
 
  private:
   void requireEnabled() const;

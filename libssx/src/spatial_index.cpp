@@ -124,6 +124,10 @@ void SpatialIndex::visit(const Vec3& center, double radius, Visit&& found) const
   }
 }
 
+void SpatialIndex::forEach(const Vec3& center, double radius, Visitor visit_one, void* context) const {
+  visit(center, radius, [&](const Entry& e) { visit_one(context, e.id, e.point); });
+}
+
 void SpatialIndex::query(const Vec3& center, double radius, std::vector<std::size_t>& out) const {
   const std::size_t first = out.size();
   visit(center, radius, [&](const Entry& e) { out.push_back(e.id); });

@@ -95,7 +95,6 @@ class RangeSensor final : public SensorOf<RangeMeasurement> {
     // room for what a robot usually sees, so that sensing allocates nothing; a robot that sees
     // more grows these once, to the most it has seen
     const std::size_t typical = std::min<std::size_t>(16, env.artifactCount() + obstacles().size());
-    found_.reserve(typical);
     output().detections.reserve(typical);
   }
 
@@ -113,22 +112,25 @@ class RangeSensor final : public SensorOf<RangeMeasurement> {
       const double d = rel.norm();
       return d > 0 && (to_body * rel).x() / d >= cos_half_fov_;
     };
-    // robots
-    found_.clear();
-    environment().neighbors(self.position, range_, found_);
-    for (const auto& [j, position] : found_) {
-      if (j == artifact().index()) continue;
+    // robots, in the index's order (the sort below orders them)
+    const std::size_t own = artifact().index();
+    environment().forEachNeighbor(self.position, range_, [&](std::size_t j, const Vec3& position) {
+      if (j == own) return;
       const Vec3 rel = position - self.position;
       if (visible(rel)) m.detections.push_back({rel, rel.norm(), j, false});
-    }
+    });
     // obstacles, at their nearest point
     for (const ObstacleShape* o : obstacles()) {
       const Vec3 rel = nearestPoint(*o, self.position) - self.position;
       const double d = rel.norm();
       if (d <= range_ && visible(rel)) m.detections.push_back({rel, d, o->artifact, true});
     }
+    // nearest first; ties by artifact, then (two shapes of one obstacle) by where: a total order,
+    // so the result does not depend on the order the index visited the robots in
     std::sort(m.detections.begin(), m.detections.end(), [](const auto& a, const auto& b) {
-      return a.distance != b.distance ? a.distance < b.distance : a.artifact < b.artifact;
+      if (a.distance != b.distance) return a.distance < b.distance;
+      if (a.artifact != b.artifact) return a.artifact < b.artifact;
+      return std::lexicographical_compare(a.relative.begin(), a.relative.end(), b.relative.begin(), b.relative.end());
     });
     if (max_count_ > 0 && m.detections.size() > max_count_) m.detections.resize(max_count_);
     // frame and noise, drawn in a fixed order
@@ -148,7 +150,6 @@ class RangeSensor final : public SensorOf<RangeMeasurement> {
     static const Obstacles none;
     return obstacles_ != nullptr ? *obstacles_ : none;
   }
-  std::vector<SpatialIndex::Hit> found_;
 };
 
 }  // namespace ssx::plugins

@@ -3,6 +3,7 @@
 
 #include <catch2/catch.hpp>
 
+#include <algorithm>
 #include <vector>
 
 using namespace ssx;
@@ -35,6 +36,25 @@ TEST_CASE("neighbour queries return exactly what a brute-force search returns", 
         for (std::size_t i = 0; i < points.size(); ++i)
           if ((points[i] - c).squaredNorm() <= radius * radius) expected.push_back(ids[i]);
         REQUIRE(got == expected);
+        // the visitor sees the same points, each once, with their indexed positions
+        std::vector<SpatialIndex::Hit> visited;
+        index.forEach(
+            c, radius,
+            [](void* out, std::size_t id, const Vec3& p) { static_cast<std::vector<SpatialIndex::Hit>*>(out)->push_back({id, p}); },
+            &visited);
+        std::vector<SpatialIndex::Hit> hits;
+        index.query(c, radius, hits);
+        std::sort(visited.begin(), visited.end(), [](const auto& a, const auto& b) {
+          return a.id != b.id ? a.id < b.id : std::lexicographical_compare(a.point.begin(), a.point.end(), b.point.begin(), b.point.end());
+        });
+        std::sort(hits.begin(), hits.end(), [](const auto& a, const auto& b) {
+          return a.id != b.id ? a.id < b.id : std::lexicographical_compare(a.point.begin(), a.point.end(), b.point.begin(), b.point.end());
+        });
+        REQUIRE(visited.size() == hits.size());
+        for (std::size_t k = 0; k < hits.size(); ++k) {
+          REQUIRE(visited[k].id == hits[k].id);
+          REQUIRE(visited[k].point == hits[k].point);
+        }
       }
     }
   }

@@ -37,6 +37,7 @@
 #include <span>
 #include <string>
 #include <string_view>
+#include <type_traits>
 #include <unordered_map>
 #include <vector>
 
@@ -235,6 +236,17 @@ class SSX_EXPORT Environment {
   void neighbors(const Vec3& point, double radius, std::vector<std::size_t>& out) const;
   /// Same, with each artifact's indexed position (as of the snapshot), in ascending artifact order.
   void neighbors(const Vec3& point, double radius, std::vector<SpatialIndex::Hit>& out) const;
+  /// Calls visit(artifact index, indexed position) for the same artifacts, in no particular order
+  /// (the index's; the same in every run): for a plugin that orders what it keeps itself, as a
+  /// range sensor sorting by distance, without a list to fill and sort first.
+  template <class Visit>
+  void forEachNeighbor(const Vec3& point, double radius, Visit&& visit) const {
+    forEachNeighbor(
+        point, radius,
+        [](void* context, std::size_t id, const Vec3& p) { (*static_cast<std::remove_reference_t<Visit>*>(context))(id, p); },
+        static_cast<void*>(&visit));
+  }
+  void forEachNeighbor(const Vec3& point, double radius, SpatialIndex::Visitor visit, void* context) const;
 
   /// A shape of a static artifact, posed in the world.
   struct StaticShape {

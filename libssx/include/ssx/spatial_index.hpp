@@ -33,6 +33,10 @@ class SSX_EXPORT SpatialIndex {
   };
   /// Same, with the points (in ascending id order).
   void query(const Vec3& center, double radius, std::vector<Hit>& out) const;
+  /// Calls visit(context, id, point) for each point within `radius` of `center`, in the index's
+  /// order (no particular one): for a caller that orders what it keeps itself, without a list.
+  using Visitor = void (*)(void* context, std::size_t id, const Vec3& point);
+  void forEach(const Vec3& center, double radius, Visitor visit, void* context) const;
   std::size_t size() const noexcept { return entries_.size(); }
   /// Whether the last rebuild chose the dense column table (else the hash table).
   bool dense() const noexcept { return !dense_start_.empty(); }
