@@ -17,11 +17,11 @@
 #include "state_checks.hpp"
 
 #include <cstdint>
+#include <deque>
 #include <functional>
 #include <memory>
 #include <string>
 #include <unordered_map>
-#include <deque>
 #include <vector>
 
 namespace ssx::detail {
