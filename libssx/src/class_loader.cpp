@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cstdlib>
 #include <cstring>
+#include <iterator>
 #include <new>
 #include <system_error>
 
@@ -121,7 +122,8 @@ void ClassLoader::destroyInstances() noexcept {
   for (auto it = instances_.rbegin(); it != instances_.rend(); ++it)
     (it->in_pool ? it->type->destruct : it->type->destroy)(it->object);
   instances_.clear();
-  types_.clear();
+  unpooled_.clear();
+  chunks_by_address_.clear();
   for (auto& [type, pool] : pools_)
     for (const auto& [start, slots] : pool.chunks) ::operator delete(start, std::align_val_t(pool.align));
   pools_.clear();
@@ -256,8 +258,23 @@ const ssx_plugin_class& ClassLoader::classInfo(std::string_view plugin, std::str
 }
 
 const ssx_plugin_class* ClassLoader::classOf(const void* instance) const noexcept {
-  const auto it = types_.find(instance);
-  return it == types_.end() ? nullptr : it->second;
+  // in a pool: the chunk that starts last at or before the address, if the address is where an
+  // instance of a used slot of it is
+  const auto address = static_cast<const std::byte*>(instance);
+  auto it = std::upper_bound(chunks_by_address_.begin(), chunks_by_address_.end(), address,
+                             [](const std::byte* a, const ChunkOf& c) { return a < c.start; });
+  if (it != chunks_by_address_.begin()) {
+    const ChunkOf& c = *std::prev(it);
+    const Pool& pool = *c.pool;
+    const auto [start, slots] = pool.chunks[c.chunk];
+    const std::size_t used = c.chunk + 1 == pool.chunks.size() ? pool.used : slots;
+    const std::ptrdiff_t from_start = address - start - pool.offset;
+    if (pool.offset >= 0 && from_start >= 0 && static_cast<std::size_t>(from_start) % pool.slot == 0 &&
+        static_cast<std::size_t>(from_start) / pool.slot < used)
+      return c.type;
+  }
+  const auto found = unpooled_.find(instance);
+  return found == unpooled_.end() ? nullptr : found->second;
 }
 
 void* ClassLoader::create(std::string_view plugin, std::string_view class_name, PluginKind kind) {
@@ -269,14 +286,26 @@ void* ClassLoader::create(std::string_view plugin, std::string_view class_name, 
   error[0] = '\0';
   // in the class's pool when it can be built in place (a slot a failed construct leaves is reused)
   Pool* pool = found->construct != nullptr ? &poolOf(*found) : nullptr;
-  void* object =
-      pool != nullptr ? found->construct(pool->next(), error, sizeof error) : found->create(error, sizeof error);
-  if (pool != nullptr && object != nullptr) ++pool->used;
+  const std::size_t chunks_before = pool != nullptr ? pool->chunks.size() : 0;
+  void* const slot = pool != nullptr ? pool->next() : nullptr;
+  if (pool != nullptr && pool->chunks.size() != chunks_before) {
+    // a new chunk: into the address table, in order
+    const ChunkOf entry{pool->chunks.back().first, pool->chunks.size() - 1, pool, found};
+    chunks_by_address_.insert(std::upper_bound(chunks_by_address_.begin(), chunks_by_address_.end(), entry,
+                                               [](const ChunkOf& a, const ChunkOf& b) { return a.start < b.start; }),
+                              entry);
+  }
+  void* object = pool != nullptr ? found->construct(slot, error, sizeof error) : found->create(error, sizeof error);
   if (object == nullptr)
     throw PluginError("plugin '" + std::string(plugin) + "' (" + load(plugin).string() + "): creating '" + std::string(class_name) + "' failed: " +
                       (error[0] != '\0' ? std::string(error) : std::string("the constructor returned null")));
+  if (pool != nullptr) {
+    ++pool->used;
+    pool->offset = static_cast<std::byte*>(object) - static_cast<std::byte*>(slot);  // the same for every instance
+  } else {
+    unpooled_.emplace(object, found);
+  }
   instances_.push_back({object, found, pool != nullptr});
-  types_.emplace(object, found);
   return object;
 }
 

@@ -67,8 +67,21 @@ TEST_CASE("a class's instances are built side by side, each on its own cache lin
     CHECK(at[i] % 64 == 0);
     if (i > 0 && i < 16) CHECK(at[i] - at[i - 1] == slot);  // the first chunk
   }
+  // each instance is known as its class's, and nothing else is: not an address inside one, not
+  // a slot no instance holds yet, not an object made elsewhere
+  const ssx_plugin_class& spinner = loader.classInfo("test_good", "spinner", PluginKind::Driver);
+  for (const std::uintptr_t a : at) {
+    CHECK(loader.classOf(reinterpret_cast<const void*>(a)) == &type);
+    CHECK(loader.classOf(reinterpret_cast<const void*>(a + 8)) == nullptr);
+  }
+  CHECK(loader.classOf(reinterpret_cast<const void*>(at.back() + slot)) == nullptr);
+  const Driver& last_spinner = loader.createDriver("test_good", "spinner");
+  CHECK(loader.classOf(&last_spinner) == &spinner);
+  const int elsewhere = 0;
+  CHECK(loader.classOf(&elsewhere) == nullptr);
   loader.destroyInstances();
   CHECK(live() == 0);
+  CHECK(loader.classOf(reinterpret_cast<const void*>(at[0])) == nullptr);
   dlclose(library);
 }
 

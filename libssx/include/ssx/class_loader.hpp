@@ -113,16 +113,26 @@ class SSX_EXPORT ClassLoader {
     bool in_pool;  // made by `construct` in a pool below, else by `create`
   };
   std::vector<Instance> instances_;
-  std::unordered_map<const void*, const ssx_plugin_class*> types_;
   // a class's instances side by side: chunks of slots, each chunk twice the last (up to a cap)
   struct Pool {
     std::size_t slot = 0, align = 0;  // bytes per instance (whole cache lines) and alignment
+    std::ptrdiff_t offset = -1;       // from a slot to the instance's address (its base class), once known
     std::vector<std::pair<std::byte*, std::size_t>> chunks;  // start, slots
     std::size_t used = 0;             // slots used in the last chunk
     void* next();                     // the next free slot (a new chunk when the last is full)
   };
   std::unordered_map<const ssx_plugin_class*, Pool> pools_;
   Pool& poolOf(const ssx_plugin_class& type);
+  // classOf's tables: every pool's chunks by address (a swarm's instances need no entry each),
+  // and the instances `create` made outside a pool
+  struct ChunkOf {
+    const std::byte* start;
+    std::size_t chunk;  // its index in the pool
+    const Pool* pool;
+    const ssx_plugin_class* type;
+  };
+  std::vector<ChunkOf> chunks_by_address_;
+  std::unordered_map<const void*, const ssx_plugin_class*> unpooled_;
   struct LastClass {
     std::string plugin, class_name;
     PluginKind kind{};
