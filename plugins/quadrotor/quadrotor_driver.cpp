@@ -253,8 +253,12 @@ const Sensor* firstSensorOf(const Artifact& a) {
 void QuadrotorDriver::validate(const Descriptor& params, const PluginContext& context) {
   const Artifact& a = *context.artifact;
   if (a.rootCount() == 0 || a.root().isStatic()) throw params.error("a quadrotor needs a dynamic physic root");
-  const Config config(params);
-  (void)Airframe(config, params, a);
+  // parsed and checked once per parameter set and artifact type (a swarm's members share them)
+  const auto shared_config = context.shared<Config>(Config::key(params), [&] { return Config(params); });
+  const Config& config = *shared_config;
+  std::ostringstream frame_key;
+  frame_key << shared_config.get() << ' ' << &a.root().spec();
+  (void)context.shared<Airframe>(frame_key.str(), [&] { return Airframe(config, params, a); });
   // checked while loading, so that `ssx validate` refuses what `ssx run` would
   (void)config.commandDelayTicks(params, context);
   if (firstSensorOf<ImuMeasurement>(a) == nullptr)

@@ -3,6 +3,7 @@
 #include <ssx/ssx.hpp>
 
 #include <catch2/catch.hpp>
+#include <dlfcn.h>
 
 #include <filesystem>
 #include <fstream>
@@ -241,6 +242,32 @@ TEST_CASE("scenes load from memory with paths relative to a base directory", "[s
   CHECK((p.orientation * Vec3::UnitX()).isApprox(Vec3::UnitY(), 1e-12));
   CHECK_THROWS_WITH(loadSceneFromString("<scene><artifact/>", "memory.xml", ".", testOptions()),
                     Catch::StartsWith("memory.xml:1: error: XML syntax"));
+}
+
+TEST_CASE("a plugin's validate works out what a swarm's members share once per scene load", "[scene][plugins]") {
+  // the test plugin's spinner counts how often its validate makes its shared value (per torque)
+  void* library = dlopen((fs::path(SSX_TEST_PLUGIN_DIR) / "libssx_test_good.so").c_str(), RTLD_NOW);
+  REQUIRE(library != nullptr);
+  const auto made = reinterpret_cast<int (*)()>(dlsym(library, "ssx_test_spinner_checks"));
+  REQUIRE(made != nullptr);
+  const std::string xml = R"(<scene>
+    <type name="spinner" file="spinner.xml"/>
+    <swarm type="spinner" count="5" name="a{i}" spacing="1"><driver torque="0.2"/></swarm>
+    <swarm type="spinner" count="3" name="b{i}" spacing="1"><driver torque="1.{i}"/></swarm>
+  </scene>)";
+  const int before = made();
+  (void)loadSceneFromString(xml, "memory.xml", kData / "valid", testOptions());
+  CHECK(made() - before == 4);  // 0.2 once for five members, then 1.0, 1.1 and 1.2
+  (void)loadSceneFromString(xml, "memory.xml", kData / "valid", testOptions());
+  CHECK(made() - before == 8);  // each load has its own table
+  // what the shared check refuses is reported where the value was given
+  CHECK_THROWS_WITH(loadSceneFromString(R"(<scene>
+    <type name="spinner" file="spinner.xml"/>
+    <swarm type="spinner" count="3" name="c{i}" spacing="1"><driver torque="2000"/></swarm>
+  </scene>)",
+                                        "memory.xml", kData / "valid", testOptions()),
+                    Contains("memory.xml:3: error: <driver>: driver 'spinner': torque above 1000 N m"));
+  dlclose(library);
 }
 
 TEST_CASE("a swarm's members share their type's physic and render trees: one copy whatever the count", "[scene]") {

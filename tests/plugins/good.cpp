@@ -16,12 +16,26 @@ class Spinner final : public ssx::Driver {
   static constexpr ssx_plugin_param kParameters[] = {
       ssx::param::real("torque", "0.1", "N m", ssx::param::any(), "torque about z"),
   };
+  // works its torque out once per torque in a scene (PluginContext::shared), counting how often;
+  // a torque above 1000 N m is refused there
+  static void validate(const ssx::Descriptor& params, const ssx::PluginContext& context);
   void configure(const ssx::Descriptor& params, ssx::PluginSetup& /*setup*/) override { torque_ = params.get<double>("torque", 0.1); }
   void step(const ssx::StepInfo&) override { artifact().root().addTorque(ssx::Vec3(0, 0, torque_)); }
 
  private:
   double torque_ = 0;
 };
+
+int spinner_checks_made = 0;
+void Spinner::validate(const ssx::Descriptor& params, const ssx::PluginContext& context) {
+  const std::string text = params.get<std::string>("torque");
+  (void)context.shared<double>(text, [&] {
+    ++spinner_checks_made;
+    const double torque = params.get<double>("torque");
+    if (torque > 1000) throw params.errorAt("torque", "torque above 1000 N m");
+    return torque;
+  });
+}
 
 class Counter final : public ssx::SensorOf<ssx::ClockMeasurement> {
  public:
@@ -83,6 +97,7 @@ class Tally final : public ssx::Driver {
 }  // namespace
 
 extern "C" __attribute__((visibility("default"))) int ssx_test_live_tallies() { return live_tallies; }
+extern "C" __attribute__((visibility("default"))) int ssx_test_spinner_checks() { return spinner_checks_made; }
 
 SSX_PLUGIN(SSX_DRIVER(Spinner, "spinner"), SSX_SENSOR(Counter, "counter"), SSX_EXTENSION(Marker, "marker"),
            SSX_DRIVER(Bomb, "bomb"), SSX_DRIVER(Tally, "tally"));

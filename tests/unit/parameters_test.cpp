@@ -10,6 +10,7 @@
 #include <map>
 #include <regex>
 #include <sstream>
+#include <stdexcept>
 
 using namespace ssx;
 
@@ -179,4 +180,24 @@ TEST_CASE("one plugin instance belongs to one artifact", "[parameters]") {
   a.setDriver(driver, {}, 1, "lambda");
   CHECK_THROWS_WITH(b.setDriver(driver, {}, 1, "lambda"),
                     Catch::Contains("belongs to artifact 'a' already; create one instance per artifact"));
+}
+
+TEST_CASE("PluginContext::shared makes a value once per type and key; a failing make leaves nothing", "[parameters]") {
+  PluginContext::SharedValues table;
+  PluginContext context;
+  context.shared_values = &table;
+  int made = 0;
+  auto make = [&] { return ++made; };
+  const auto a = context.shared<int>("k", make);
+  const auto b = context.shared<int>("k", make);
+  CHECK(a.get() == b.get());
+  CHECK(made == 1);
+  CHECK(*context.shared<int>("other", make) == 2);
+  CHECK(*context.shared<double>("k", [] { return 0.5; }) == 0.5);  // another type under the same key
+  CHECK_THROWS_WITH(context.shared<long>("x", []() -> long { throw std::runtime_error("no"); }), "no");
+  CHECK(*context.shared<long>("x", [] { return 7L; }) == 7);
+  // without a table every call makes its own
+  const PluginContext alone;
+  CHECK(alone.shared<int>("k", make).get() != alone.shared<int>("k", make).get());
+  CHECK(made == 4);
 }

@@ -27,8 +27,15 @@
 
 #include <cstdint>
 #include <limits>
+#include <map>
+#include <memory>
 #include <span>
 #include <string>
+#include <string_view>
+#include <type_traits>
+#include <typeindex>
+#include <typeinfo>
+#include <utility>
 #include <vector>
 
 extern "C" {
@@ -93,8 +100,29 @@ struct PluginContext {
   std::int64_t period_steps = 1;             ///< the plugin's period, in steps
   Nanoseconds timestep = 0;                  ///< the environment's timestep
   SourceLocation period_from;                ///< where the period was set, if in a file
+  /// What the scene loader keeps for `shared` while it loads: one table per plugin class.
+  using SharedValues = std::map<std::pair<std::type_index, std::string>, std::shared_ptr<const void>>;
+  SharedValues* shared_values = nullptr;  ///< this plugin class's table, or null (then nothing is shared)
   /// The plugin's period in nanoseconds.
   Nanoseconds period() const { return period_steps * timestep; }
+  /// What `validate` works out alike for many instances of a class, worked out once while the
+  /// scene loads (as PluginSetup::shared while the environment starts): `make()`'s result (a T,
+  /// or a pointer to one) for the first instance that asks for a T under `key`, the same object
+  /// for every later one. `key` must hold everything the value is computed from. A `make` that
+  /// throws leaves nothing behind (the next instance tries again).
+  template <class T, class Make>
+  std::shared_ptr<const T> shared(std::string_view key, Make&& make) const {
+    std::shared_ptr<const void>* slot =
+        shared_values != nullptr ? &(*shared_values)[{std::type_index(typeid(T)), std::string(key)}] : nullptr;
+    if (slot != nullptr && *slot) return std::static_pointer_cast<const T>(*slot);
+    std::shared_ptr<const T> value;
+    if constexpr (std::is_convertible_v<std::invoke_result_t<Make>, std::shared_ptr<const T>>)
+      value = make();
+    else
+      value = std::make_shared<const T>(make());
+    if (slot != nullptr) *slot = value;
+    return value;
+  }
 };
 
 /// Checks `params` against `declarations`: types, ranges, choices, required parameters, rates

@@ -34,8 +34,9 @@
 
 /// Incremented whenever the manifest layout, the meaning of its fields, the plugin base classes
 /// (Plugin, Driver, Sensor, SimulationExtension: their virtual functions and members) or the
-/// members of the classes whose inline accessors plugins compile in (Artifact) change.
-#define SSX_PLUGIN_ABI_VERSION 6u
+/// members of the classes whose inline accessors plugins compile in (Artifact) or the structs
+/// handed to them (PluginContext) change.
+#define SSX_PLUGIN_ABI_VERSION 7u
 
 #define SSX_PLUGIN_STRINGIFY2(x) #x
 #define SSX_PLUGIN_STRINGIFY(x) SSX_PLUGIN_STRINGIFY2(x)

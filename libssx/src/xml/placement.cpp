@@ -55,7 +55,7 @@ void SceneLoader::validatePlugin(Environment& env, const void* instance, const D
                                  const Artifact* artifact, std::int64_t period_steps, const std::string& what) {
   const ssx_plugin_class* type = env.classLoader().classOf(instance);
   if (type == nullptr || type->validate == nullptr) return;
-  const PluginContext context{&env, artifact, period_steps, env.timestep(), {}};
+  const PluginContext context{&env, artifact, period_steps, env.timestep(), {}, &validate_shared_[type]};
   std::vector<Diagnostic> found;
   type->validate(&params, &context, &found);
   for (auto& d : found) {

@@ -233,6 +233,8 @@ class SceneLoader {
   // whose values differ between the members (they hold {i}), for checkPlugin
   std::map<std::tuple<const void*, const PluginDecl*, const Descriptor*, std::int64_t>, std::vector<std::string>>
       clean_checks_;
+  // what each class's validate shares between its instances (PluginContext::shared)
+  std::map<const void*, PluginContext::SharedValues> validate_shared_;
   std::deque<Descriptor> documents_;  // every file read, kept alive for the pointers below
   EnvironmentSettings settings_;
   RunOptions run_;
