@@ -5,17 +5,20 @@
 // runs in real time at tau = 0.02 s and records the compute time of every step. The formation's
 // radius grows with sqrt(N) so that the spacing stays about 1.5 m. Prints, last for each N:
 //   n=1000 samples=5000 median_ms=1.23 p95_ms=1.50 p99_ms=1.80 max_ms=4.00 overruns=0 max_late_ms=0
-//     physics_ms=0.3 sensors_ms=0.4 drivers_ms=0.5 other_ms=0.03 us_per_robot=1.23
-// (phase medians per sample; max_late_ms: the most any one step ended past its deadline; other =
+//     late_steps=0 long_steps=0 began_late=0 physics_ms=0.3 sensors_ms=0.4 drivers_ms=0.5
+//     other_ms=0.03 us_per_robot=1.23
+// (overruns: samples with a late step; max_late_ms: the most any one step ended past its deadline;
+// late_steps, long_steps, began_late: steps, as TimingSummary counts them (late; of those, longer
+// than a step; of the others, begun late after an on-time step); phase medians per sample; other =
 // snapshot, neighbour index and hooks; us_per_robot = the median sample over N)
 //
 // usage: ssx_rt_study [--n N]... [--samples K] [--threads T] [--physics-hz H] [--tau S] [--csv FILE]
-//                     [--physics ode|bullet] [--rt-priority P]
-//                     [--fast]
+//                     [--steps-csv FILE] [--physics ode|bullet] [--rt-priority P] [--fast]
 //   --physics-hz  physics rate (default 1/tau: one physics step per tau, as the paper). When it is
 //                 faster than 1/tau the environment steps at min(H, 500 Hz) with the rest as physics
 //                 substeps, the inner loop runs at that step rate, and one sample is the compute
 //                 time of the steps of one tau
+//   --steps-csv   every step's timing (phases, lateness) of the last N, as `ssx run --stats-csv`
 //   --fast        do not pace against the wall clock (for tests; overruns are then not measured)
 //   --rt-priority step at SCHED_FIFO priority P (1-99; RunOptions::realtime_priority): needs root
 //                 or CAP_SYS_NICE
@@ -38,6 +41,7 @@ struct Options {
   double tau = 0.02;
   double physics_hz = 0;  // 0: 1/tau
   std::string csv;
+  std::string steps_csv;  // every step's timing, for the last N (TimingRecorder::writeCsv)
   bool fast = false;
   int rt_priority = 0;
   std::string physics;  // the engine, if not the scene's
@@ -94,6 +98,8 @@ int main(int argc, char** argv) {
         o.tau = std::stod(value());
       else if (a == "--csv")
         o.csv = value();
+      else if (a == "--steps-csv")
+        o.steps_csv = value();
       else if (a == "--fast")
         o.fast = true;
       else if (a == "--rt-priority")
@@ -105,7 +111,8 @@ int main(int argc, char** argv) {
     } catch (const std::exception& e) {
       std::fprintf(stderr,
                    "ssx_rt_study: %s\nusage: ssx_rt_study [--n N]... [--samples K] [--threads T] "
-                   "[--physics-hz H] [--tau S] [--csv FILE] [--fast] [--physics ode|bullet] [--rt-priority P]\n",
+                   "[--physics-hz H] [--tau S] [--csv FILE] [--steps-csv FILE] [--fast] [--physics ode|bullet] "
+                   "[--rt-priority P]\n",
                    e.what());
       return 2;
     }
@@ -138,7 +145,8 @@ int main(int argc, char** argv) {
       const int per_tau = std::max(1, static_cast<int>(std::lround(o.tau / ssx::toSeconds(env.timestep()))));
       run.steps = static_cast<std::int64_t>(o.samples) * per_tau;
       env.start();
-      env.run(run);
+      const ssx::TimingSummary summary = env.run(run);
+      if (!o.steps_csv.empty()) env.timing().writeCsv(o.steps_csv);
       // fold the steps of each tau into one sample
       const auto& steps = env.timing().samples();
       std::vector<double> totals, physics, sensors, drivers, other;
@@ -178,10 +186,12 @@ int main(int argc, char** argv) {
       // per robot and tau of simulated time, from the median step
       const double us_per_robot = pct(50) * 1e3 / n;
       std::printf("n=%d samples=%zu median_ms=%.3f p95_ms=%.3f p99_ms=%.3f max_ms=%.3f overruns=%lld "
-                  "max_late_ms=%.3f physics_ms=%.3f sensors_ms=%.3f drivers_ms=%.3f other_ms=%.3f us_per_robot=%.3f\n",
+                  "max_late_ms=%.3f late_steps=%lld long_steps=%lld began_late=%lld physics_ms=%.3f sensors_ms=%.3f "
+                  "drivers_ms=%.3f other_ms=%.3f us_per_robot=%.3f\n",
                   n, sorted.size(), pct(50), pct(95), pct(99), sorted.back(), static_cast<long long>(overruns),
-                  static_cast<double>(max_late) * 1e-6, median(physics), median(sensors), median(drivers),
-                  median(other), us_per_robot);
+                  static_cast<double>(max_late) * 1e-6, static_cast<long long>(summary.overruns),
+                  static_cast<long long>(summary.overruns_long), static_cast<long long>(summary.overruns_began_late),
+                  median(physics), median(sensors), median(drivers), median(other), us_per_robot);
       std::fflush(stdout);
     } catch (const std::exception& e) {
       std::fprintf(stderr, "ssx_rt_study: n=%d: %s\n", n, e.what());

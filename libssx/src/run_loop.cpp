@@ -144,6 +144,9 @@ TimingSummary Environment::run(const RunOptions& options) {
   std::int64_t grid_k = 0;
   std::int64_t done = 0;
   std::int64_t overruns = 0, unreported = 0;
+  std::int64_t overruns_long = 0, overruns_began_late = 0;
+  bool previous_late = false;  // the step before ended past its deadline (and the grid was kept)
+  Nanoseconds max_late = 0;
   Nanoseconds last_warning = wall_start - options.warn_interval;
   Nanoseconds worst_unreported = 0;
 
@@ -158,7 +161,15 @@ TimingSummary Environment::run(const RunOptions& options) {
       if (now > deadline) {
         // overrun: record it, warn at most once per interval, and go on at once
         const Nanoseconds late = now - deadline;
-        if (StepTiming* last = timing_.last()) last->lateness = late;
+        StepTiming* last = timing_.last();
+        if (last != nullptr) last->lateness = late;
+        max_late = std::max(max_late, late);
+        // why: it took longer than a step, or it began late though the step before was on time
+        if (last != nullptr && static_cast<double>(last->total) > period)
+          ++overruns_long;
+        else if (!previous_late)
+          ++overruns_began_late;
+        previous_late = options.overrun != RunOptions::Overrun::Resync;  // (a resync starts a new grid)
         ++overruns;
         ++unreported;
         worst_unreported = std::max(worst_unreported, late);
@@ -179,6 +190,7 @@ TimingSummary Environment::run(const RunOptions& options) {
           grid_k = 0;
         }
       } else {
+        previous_late = false;
         // the workers fall asleep between steps, and a woken thread can take a millisecond to
         // run on a virtual machine: they are woken a little ahead, so that the step finds them
         // running
@@ -191,7 +203,13 @@ TimingSummary Environment::run(const RunOptions& options) {
     }
     if (options.on_step) options.on_step(*this);
   }
-  return timing_.summary(monotonicNow() - wall_start, time() - sim_start, first_sample);
+  // (the timing ring holds the newest steps; the overruns are counted over the whole run)
+  TimingSummary summary = timing_.summary(monotonicNow() - wall_start, time() - sim_start, first_sample);
+  summary.overruns = overruns;
+  summary.max_lateness_ms = static_cast<double>(max_late) * 1e-6;
+  summary.overruns_long = overruns_long;
+  summary.overruns_began_late = overruns_began_late;
+  return summary;
 }
 
 }  // namespace ssx

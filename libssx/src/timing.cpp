@@ -89,14 +89,20 @@ TimingSummary TimingRecorder::summary(Nanoseconds wall, Nanoseconds simulated, s
 
 std::string TimingSummary::str() const {
   char buf[768];
-  std::snprintf(buf, sizeof buf,
-                "steps %lld, simulated %.3f s in %.3f s wall (real-time factor %.3f)\n"
-                "step time ms: median %.4f  p95 %.4f  p99 %.4f  max %.4f  mean %.4f\n"
-                "phase medians ms: physics %.4f  sensors %.4f  drivers %.4f  render %.4f\n"
-                "overruns %lld (max lateness %.3f ms)",
-                static_cast<long long>(steps), simulated_s, wall_s, realtime_factor, median_ms, p95_ms, p99_ms, max_ms,
-                mean_ms, physics_median_ms, sensors_median_ms, drivers_median_ms, render_median_ms,
-                static_cast<long long>(overruns), max_lateness_ms);
+  int used = std::snprintf(buf, sizeof buf,
+                           "steps %lld, simulated %.3f s in %.3f s wall (real-time factor %.3f)\n"
+                           "step time ms: median %.4f  p95 %.4f  p99 %.4f  max %.4f  mean %.4f\n"
+                           "phase medians ms: physics %.4f  sensors %.4f  drivers %.4f  render %.4f\n"
+                           "overruns %lld (max lateness %.3f ms)",
+                           static_cast<long long>(steps), simulated_s, wall_s, realtime_factor, median_ms, p95_ms,
+                           p99_ms, max_ms, mean_ms, physics_median_ms, sensors_median_ms, drivers_median_ms,
+                           render_median_ms, static_cast<long long>(overruns), max_lateness_ms);
+  if (overruns > 0 && used > 0 && static_cast<std::size_t>(used) < sizeof buf)
+    std::snprintf(buf + used, sizeof buf - static_cast<std::size_t>(used),
+                  ": %lld took longer than a step, %lld began late after an on-time step (woken late or held up "
+                  "between steps), %lld followed a late step",
+                  static_cast<long long>(overruns_long), static_cast<long long>(overruns_began_late),
+                  static_cast<long long>(overruns - overruns_long - overruns_began_late));
   return buf;
 }
 

@@ -80,6 +80,8 @@ py::dict summaryDict(const ssx::TimingSummary& s) {
   d["drivers_median_ms"] = s.drivers_median_ms;
   d["render_median_ms"] = s.render_median_ms;
   d["overruns"] = s.overruns;
+  d["overruns_long"] = s.overruns_long;
+  d["overruns_began_late"] = s.overruns_began_late;
   d["max_lateness_ms"] = s.max_lateness_ms;
   d["wall_s"] = s.wall_s;
   d["simulated_s"] = s.simulated_s;

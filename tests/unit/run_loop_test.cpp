@@ -92,15 +92,40 @@ TEST_CASE("overruns are counted and reported", "[run]") {
   const TimingSummary summary = env.run(o);
   CHECK(summary.overruns >= 4);
   CHECK(summary.max_lateness_ms >= 1.5);
+  // the 3 ms steps are the long ones (a step after one catches up: late, but not long)
+  CHECK(summary.overruns_long >= 4);
+  CHECK(summary.overruns_long + summary.overruns_began_late <= summary.overruns);
+  CHECK_THAT(summary.str(), Catch::Contains(std::to_string(summary.overruns_long) + " took longer than a step"));
   // rate-limited: one warning in well under a second of run
   REQUIRE(warnings.size() == 1);
   CHECK_THAT(warnings[0], Catch::Contains("real time missed"));
 }
 
+TEST_CASE("a step that begins late after an on-time step is told from a long one", "[run]") {
+  // steps of 5 ms that compute in microseconds; the program holds the loop up for 7 ms once,
+  // between two steps: the next step begins 2 ms late (as after a late wake-up) and ends late,
+  // and the one after it begins 3 ms before its deadline: on time again
+  EnvironmentSettings s;
+  s.timestep = toNanoseconds(0.005);
+  s.threads = 1;
+  Environment env(s);
+  withBall(env);
+  env.setLogSink([](LogLevel, std::string_view) {});
+  RunOptions o;
+  o.steps = 10;
+  o.on_step = [](const Environment& e) {
+    if (e.stepCount() == 4) burn(std::chrono::microseconds(7000));
+  };
+  const TimingSummary summary = env.run(o);
+  CHECK(summary.overruns_began_late >= 1);
+  CHECK(summary.overruns - summary.overruns_long - summary.overruns_began_late == 0);  // none followed a late one
+  CHECK_THAT(summary.str(), Catch::Contains("began late after an on-time step"));
+}
+
 TEST_CASE("catch-up keeps the original grid, resync restarts it", "[run]") {
   // one 30 ms step at the start of 20 steps of 2 ms: catch-up runs the next steps back to back
   // (40 ms in all), resync moves the grid and takes about 30 + 19 * 2 ms
-  auto wallFor = [](RunOptions::Overrun policy, std::int64_t& overruns) {
+  auto wallFor = [](RunOptions::Overrun policy, TimingSummary& summary) {
     EnvironmentSettings s;
     s.timestep = toNanoseconds(0.002);
     s.threads = 1;
@@ -114,16 +139,20 @@ TEST_CASE("catch-up keeps the original grid, resync restarts it", "[run]") {
     o.steps = 20;
     o.overrun = policy;
     double wall = 0;
-    wall = secondsOf([&] { overruns = env.run(o).overruns; });
+    wall = secondsOf([&] { summary = env.run(o); });
     return wall;
   };
-  std::int64_t catchup_overruns = 0, resync_overruns = 0;
-  const double catchup = wallFor(RunOptions::Overrun::CatchUp, catchup_overruns);
-  const double resync = wallFor(RunOptions::Overrun::Resync, resync_overruns);
+  TimingSummary catchup_summary, resync_summary;
+  const double catchup = wallFor(RunOptions::Overrun::CatchUp, catchup_summary);
+  const double resync = wallFor(RunOptions::Overrun::Resync, resync_summary);
   CHECK(catchup >= 0.040);
   CHECK(resync >= 0.030 + 19 * 0.002);
-  CHECK(catchup_overruns > resync_overruns);  // catch-up steps are late until the grid is reached
-  CHECK(resync_overruns >= 1);
+  // catch-up steps are late until the grid is reached: late for following a late step
+  CHECK(catchup_summary.overruns > resync_summary.overruns);
+  CHECK(catchup_summary.overruns_long >= 1);
+  CHECK(catchup_summary.overruns - catchup_summary.overruns_long - catchup_summary.overruns_began_late >= 10);
+  CHECK(resync_summary.overruns >= 1);
+  CHECK(resync_summary.overruns_long >= 1);
 }
 
 TEST_CASE("a stop flag ends the run", "[run]") {
