@@ -205,8 +205,12 @@ def test_run_returns_the_timing_summary():
     assert s["steps"] == 250 and env.step_count == 250
     assert s["simulated_s"] == pytest.approx(0.5)
     assert 0 < s["median_ms"] <= s["p99_ms"] <= s["max_ms"]
+    # late steps, told apart (none unpaced); paced, the kinds never add up to more than the late
+    assert (s["overruns"], s["overruns_long"], s["overruns_began_late"]) == (0, 0, 0)
+    paced = env.run(0.05, realtime=True)
+    assert paced["overruns_long"] + paced["overruns_began_late"] <= paced["overruns"]
     s = env.run(realtime=False)  # the scene's duration, 3 s
-    assert env.step_count == 250 + 1500
+    assert env.step_count == 250 + 25 + 1500
     with pytest.raises(ValueError, match="needs seconds"):
         ssx.load_scene_string(PAIR, base_dir=artifacts_dir()).run()
 
