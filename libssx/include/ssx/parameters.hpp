@@ -23,6 +23,7 @@
 
 #include <ssx/descriptor.hpp>
 #include <ssx/export.hpp>
+#include <ssx/shared_value.hpp>
 #include <ssx/types.hpp>
 
 #include <cstdint>
@@ -32,7 +33,6 @@
 #include <span>
 #include <string>
 #include <string_view>
-#include <type_traits>
 #include <typeindex>
 #include <typeinfo>
 #include <utility>
@@ -112,16 +112,9 @@ struct PluginContext {
   /// throws leaves nothing behind (the next instance tries again).
   template <class T, class Make>
   std::shared_ptr<const T> shared(std::string_view key, Make&& make) const {
-    std::shared_ptr<const void>* slot =
-        shared_values != nullptr ? &(*shared_values)[{std::type_index(typeid(T)), std::string(key)}] : nullptr;
-    if (slot != nullptr && *slot) return std::static_pointer_cast<const T>(*slot);
-    std::shared_ptr<const T> value;
-    if constexpr (std::is_convertible_v<std::invoke_result_t<Make>, std::shared_ptr<const T>>)
-      value = make();
-    else
-      value = std::make_shared<const T>(make());
-    if (slot != nullptr) *slot = value;
-    return value;
+    return detail::sharedValue<T>(
+        shared_values != nullptr ? &(*shared_values)[{std::type_index(typeid(T)), std::string(key)}] : nullptr,
+        std::forward<Make>(make));
   }
 };
 

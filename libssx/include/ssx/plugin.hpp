@@ -7,6 +7,7 @@
 #include <ssx/descriptor.hpp>
 #include <ssx/export.hpp>
 #include <ssx/random.hpp>
+#include <ssx/shared_value.hpp>
 #include <ssx/state.hpp>
 #include <ssx/types.hpp>
 
@@ -193,15 +194,7 @@ class SSX_EXPORT PluginSetup {
 
 template <class T, class Make>
 std::shared_ptr<const T> PluginSetup::shared(std::string_view key, Make&& make) {
-  std::shared_ptr<const void>* slot = findShared(typeid(T), key);
-  if (slot != nullptr && *slot) return std::static_pointer_cast<const T>(*slot);
-  std::shared_ptr<const T> value;
-  if constexpr (std::is_convertible_v<std::invoke_result_t<Make>, std::shared_ptr<const T>>)
-    value = make();
-  else
-    value = std::make_shared<const T>(make());
-  if (slot != nullptr) *slot = value;
-  return value;
+  return detail::sharedValue<T>(findShared(typeid(T), key), std::forward<Make>(make));
 }
 
 /// A bridge to the outside world (ROS, a logger, a network link). Runs on the thread that calls
