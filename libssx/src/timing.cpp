@@ -97,7 +97,10 @@ std::string TimingSummary::str() const {
                            static_cast<long long>(steps), simulated_s, wall_s, realtime_factor, median_ms, p95_ms,
                            p99_ms, max_ms, mean_ms, physics_median_ms, sensors_median_ms, drivers_median_ms,
                            render_median_ms, static_cast<long long>(overruns), max_lateness_ms);
-  if (overruns > 0 && used > 0 && static_cast<std::size_t>(used) < sizeof buf)
+  // (known only for a run's summary: the first late step of a run took long or began late, so a
+  // summary without either kind is one made from the samples alone)
+  const bool told_apart = overruns_long + overruns_began_late > 0;
+  if (told_apart && used > 0 && static_cast<std::size_t>(used) < sizeof buf)
     std::snprintf(buf + used, sizeof buf - static_cast<std::size_t>(used),
                   ": %lld took longer than a step, %lld began late after an on-time step (woken late or held up "
                   "between steps), %lld followed a late step",

@@ -26,6 +26,10 @@ TEST_CASE("timing summary percentiles use nearest rank", "[timing]") {
   CHECK(s.mean_ms == Approx(50.5));
   CHECK(s.physics_median_ms == Approx(0.5));
   CHECK(s.overruns == 3);
+  // the recorder alone cannot tell why a step was late: the summary does not pretend to
+  CHECK(s.overruns_long == 0);
+  CHECK(s.overruns_began_late == 0);
+  CHECK_THAT(s.str(), Catch::EndsWith("overruns 3 (max lateness 0.001 ms)"));
   CHECK(s.realtime_factor == Approx(0.5));
   CHECK(r.summary(0, 0, 90).steps == 10);
   CHECK(r.summary(0, 0, 90).median_ms == Approx(95));

@@ -30,7 +30,8 @@ struct SSX_EXPORT TimingSummary {
   double median_ms = 0, p95_ms = 0, p99_ms = 0, max_ms = 0, mean_ms = 0;  ///< step compute time
   double physics_median_ms = 0, sensors_median_ms = 0, drivers_median_ms = 0, render_median_ms = 0;
   std::int64_t overruns = 0;  ///< steps that ended after their deadline (real-time runs)
-  /// Of the overruns (Environment::run): steps that took longer than a step's period of wall time
+  /// Of the overruns, as Environment::run tells them apart (a summary made by TimingRecorder
+  /// alone leaves both 0): steps that took longer than a step's period of wall time
   /// (the step too slow for real time, or its thread taken off the core while stepping) ...
   std::int64_t overruns_long = 0;
   /// ... and steps that took less but began late, after a step that was on time: the thread woken
