@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <numbers>
 #include <sstream>
+#include <stdexcept>
 
 namespace ssx::quadrotor {
 
@@ -13,6 +14,8 @@ namespace {
 
 // room for the neighbours a formation robot senses at once, reserved at start
 constexpr std::size_t kTypicalNeighbours = 16;
+// m per axis: how far the velocity level's reference point may lead the vehicle
+constexpr double kVelocityLeash = 0.3;
 
 std::vector<std::string> words(const std::string& text) {
   std::istringstream in(text);
@@ -459,58 +462,108 @@ Setpoint QuadrotorDriver::reference(double t) const {
   return hover_;
 }
 
-void QuadrotorDriver::setSetpoint(const Setpoint& setpoint) {
-  external_ = setpoint;
+void QuadrotorDriver::setCommand(const Command& command) {
+  if (const std::string why = refusal(command); !why.empty()) throw std::invalid_argument("quadrotor: " + why);
+  const CommandLevel previous = level_;
   source_ = Source::External;
+  level_ = command.level;
+  switch (command.level) {
+    case CommandLevel::Position:
+      external_ = command.setpoint;
+      break;
+    case CommandLevel::Velocity:
+      // the reference point starts where the vehicle is, and moves on from there while the level holds
+      if (previous != CommandLevel::Velocity) velocity_point_ = artifact().state().pose.position;
+      command_velocity_ = command.velocity;
+      command_yaw_rate_ = command.yaw_rate;
+      break;
+    case CommandLevel::Attitude:
+      attitude_ = overLink({command.roll, command.pitch, command.yaw_rate, command.thrust});
+      command_ = toInner(attitude_);
+      break;
+    case CommandLevel::Rates:
+      // (no serial link quantisation: the link carries angles)
+      command_.roll_q12 = static_cast<std::int32_t>(std::llround(command.body_rates.x() * 4096.0));
+      command_.pitch_q12 = static_cast<std::int32_t>(std::llround(command.body_rates.y() * 4096.0));
+      command_.yaw_rate_q12 = static_cast<std::int32_t>(std::llround(command.body_rates.z() * 4096.0));
+      command_.thrust_q16 = static_cast<std::int32_t>(std::llround(command.thrust * 65536.0));
+      break;
+    case CommandLevel::Rotors:
+      std::copy(command.rotor_speeds.begin(), command.rotor_speeds.end(), commanded_speeds_.begin());
+      break;
+  }
+  // the position loop's integral starts afresh when it takes over again
+  if (previous > CommandLevel::Velocity && level_ <= CommandLevel::Velocity) outer_->reset();
+}
+
+AttitudeCommand QuadrotorDriver::overLink(const AttitudeCommand& c) const {
+  // the serial link: thrust in 8 bits of m g / 128 (255: 2 m g), angles in whole steps
+  return command_link_ ? linkCommand(c, controller_mass_, -environment().settings().physics.gravity.z(), angle_step_)
+                       : c;
+}
+
+InnerCommand QuadrotorDriver::toInner(const AttitudeCommand& c) {
+  InnerCommand out;
+  out.roll_q12 = static_cast<std::int32_t>(std::llround(c.roll * 4096.0));
+  out.pitch_q12 = static_cast<std::int32_t>(std::llround(c.pitch * 4096.0));
+  out.yaw_rate_q12 = static_cast<std::int32_t>(std::llround(c.yaw_rate * 4096.0));
+  out.thrust_q16 = static_cast<std::int32_t>(std::llround(c.thrust * 65536.0));
+  return out;
+}
+
+// the position loop: position (motion capture or ground truth) to attitude and thrust
+void QuadrotorDriver::outerLoop(const StepInfo& info) {
+  // the formation starts after start_time; until then the vehicle climbs to its start + offset
+  if (source_ == Source::Formation && toSeconds(info.time) >= start_time_) formationStep(outer_dt_);
+  current_ = reference(toSeconds(info.time));
+  BodyState truth;
+  if (!have_pose_) truth = artifact().state();
+  const Pose& pose = have_pose_ ? pose_.pose : truth.pose;
+  const Vec3 velocity = have_pose_ ? pose_.linear_velocity : truth.linear_velocity;
+  const Vec3 forward = pose.orientation * Vec3::UnitX();
+  const double yaw = std::atan2(forward.y(), forward.x());
+  const double roll = estimate_.roll_q20 / 1048576.0;
+  const double pitch = estimate_.pitch_q20 / 1048576.0;
+  if (level_ == CommandLevel::Velocity) {
+    // a point moving at the commanded velocity, never more than kVelocityLeash from the vehicle
+    // per axis: the velocity error acts through kd, the point's lead through kp and ki
+    velocity_point_ += command_velocity_ * outer_dt_;
+    velocity_point_ = pose.position + (velocity_point_ - pose.position).cwiseMin(kVelocityLeash).cwiseMax(-kVelocityLeash);
+    current_ = Setpoint{velocity_point_, command_velocity_, Vec3::Zero(), yaw, command_yaw_rate_};
+  }
+  attitude_ = outer_->update(outer_dt_, current_, pose.position, velocity, roll, pitch, yaw);
+  // an external set-point's heading is held: its yaw error, wrapped to [-pi, pi], adds a yaw
+  // rate (the other references command a yaw rate only, as the TeleKyb controller does)
+  if (source_ == Source::External && level_ == CommandLevel::Position)
+    attitude_.yaw_rate += heading_kp_ * std::remainder(current_.yaw - yaw, 2.0 * std::numbers::pi);
+  // the online thrust estimator: the specific force along the body's z axis, from the position
+  // source's velocity (motion capture: no accelerometer bias), against what the commanded thrust
+  // should give the mass the controller believes; the command is divided by their ratio
+  if (thrust_estimator_) {
+    const double g = -environment().settings().physics.gravity.z();
+    const double expected = static_cast<double>(command_.thrust_q16) / 65536.0 / controller_mass_;
+    if (have_last_velocity_ && expected > 0.2 * g) {
+      const Vec3 specific = (velocity - last_velocity_) / outer_dt_ + Vec3(0, 0, g);
+      const double along = specific.dot(pose.orientation * Vec3::UnitZ());
+      thrust_ratio_ += outer_dt_ / estimator_tau_ * (along / expected - thrust_ratio_);
+      thrust_ratio_ = std::clamp(thrust_ratio_, 0.5, 2.0);
+    }
+    last_velocity_ = velocity;
+    have_last_velocity_ = true;
+    attitude_.thrust /= thrust_ratio_;
+  }
+  // handed to the inner loop as integers (over the serial link, if there is one)
+  attitude_ = overLink(attitude_);
+  command_ = toInner(attitude_);
 }
 
 void QuadrotorDriver::step(const StepInfo& info) {
   const double period = info.periodSeconds();
   const std::int64_t run = info.step / periodSteps();
   PhysicNode& body = artifact().root();
-  // outer loop: position (motion capture or ground truth) to attitude and thrust
-  if (run % outer_runs_ == 0) {
-    // the formation starts after start_time; until then the vehicle climbs to its start + offset
-    if (source_ == Source::Formation && toSeconds(info.time) >= start_time_) formationStep(outer_dt_);
-    current_ = reference(toSeconds(info.time));
-    BodyState truth;
-    if (!have_pose_) truth = artifact().state();
-    const Pose& pose = have_pose_ ? pose_.pose : truth.pose;
-    const Vec3 velocity = have_pose_ ? pose_.linear_velocity : truth.linear_velocity;
-    const Vec3 forward = pose.orientation * Vec3::UnitX();
-    const double yaw = std::atan2(forward.y(), forward.x());
-    const double roll = estimate_.roll_q20 / 1048576.0;
-    const double pitch = estimate_.pitch_q20 / 1048576.0;
-    attitude_ = outer_->update(outer_dt_, current_, pose.position, velocity, roll, pitch, yaw);
-    // an external set-point's heading is held: its yaw error, wrapped to [-pi, pi], adds a yaw
-    // rate (the other references command a yaw rate only, as the TeleKyb controller does)
-    if (source_ == Source::External)
-      attitude_.yaw_rate += heading_kp_ * std::remainder(current_.yaw - yaw, 2.0 * std::numbers::pi);
-    // the online thrust estimator: the specific force along the body's z axis, from the position
-    // source's velocity (motion capture: no accelerometer bias), against what the commanded thrust
-    // should give the mass the controller believes; the command is divided by their ratio
-    if (thrust_estimator_) {
-      const double g = -environment().settings().physics.gravity.z();
-      const double expected = static_cast<double>(command_.thrust_q16) / 65536.0 / controller_mass_;
-      if (have_last_velocity_ && expected > 0.2 * g) {
-        const Vec3 specific = (velocity - last_velocity_) / outer_dt_ + Vec3(0, 0, g);
-        const double along = specific.dot(pose.orientation * Vec3::UnitZ());
-        thrust_ratio_ += outer_dt_ / estimator_tau_ * (along / expected - thrust_ratio_);
-        thrust_ratio_ = std::clamp(thrust_ratio_, 0.5, 2.0);
-      }
-      last_velocity_ = velocity;
-      have_last_velocity_ = true;
-      attitude_.thrust /= thrust_ratio_;
-    }
-    // the serial link: thrust in 8 bits of m g / 128 (255: 2 m g), angles in whole steps
-    if (command_link_)
-      attitude_ = linkCommand(attitude_, controller_mass_, -environment().settings().physics.gravity.z(), angle_step_);
-    // handed to the inner loop as integers
-    command_.roll_q12 = static_cast<std::int32_t>(std::llround(attitude_.roll * 4096.0));
-    command_.pitch_q12 = static_cast<std::int32_t>(std::llround(attitude_.pitch * 4096.0));
-    command_.yaw_rate_q12 = static_cast<std::int32_t>(std::llround(attitude_.yaw_rate * 4096.0));
-    command_.thrust_q16 = static_cast<std::int32_t>(std::llround(attitude_.thrust * 65536.0));
-  }
+  // the position loop acts at the position and velocity levels; below them the commands go to the
+  // inner loop (attitude, rates) or the motors (rotors) as they were set
+  if (run % outer_runs_ == 0 && level_ <= CommandLevel::Velocity) outerLoop(info);
   // inner loop: IMU counts to motor commands
   if (run % inner_runs_ == 0 && imu_seen_) {
     // the command as it arrives: command_delay late (the queue holds that many inner-loop ticks)
@@ -520,9 +573,13 @@ void QuadrotorDriver::step(const StepInfo& info) {
       queue_at_ = (queue_at_ + 1) % command_queue_.size();
     }
     const InnerCommand& arrived = command_queue_.size() == 1 ? command_ : command_queue_[queue_at_];
-    const InnerOutput out = inner_->evaluate(estimate_, imu_->gyroscope_counts, imu_->accelerometer_counts, arrived);
+    const InnerOutput out =
+        inner_->evaluate(estimate_, imu_->gyroscope_counts, imu_->accelerometer_counts, arrived,
+                         level_ == CommandLevel::Rates ? InnerMode::Rates : InnerMode::Attitude);
     estimate_ = out.estimate;
-    for (std::size_t i = 0; i < out.motors; ++i) commanded_speeds_[i] = inner_->commandToSpeed(out.motor_commands[i]);
+    // (at the rotors level the estimate goes on, the motors take the command's speeds)
+    if (level_ != CommandLevel::Rotors)
+      for (std::size_t i = 0; i < out.motors; ++i) commanded_speeds_[i] = inner_->commandToSpeed(out.motor_commands[i]);
   }
   // motors and aerodynamics, applied at the centre of mass in body axes
   rotors_->step(period, std::span(commanded_speeds_).first(rotors_->size()));
@@ -722,6 +779,10 @@ void QuadrotorDriver::saveState(StateWriter& out) const {
   out.write(turbulence_.state());
   out.write(last_velocity_);
   out.write(have_last_velocity_);
+  out.write(level_);
+  out.write(command_velocity_);
+  out.write(command_yaw_rate_);
+  out.write(velocity_point_);
 }
 
 void QuadrotorDriver::loadState(StateReader& in) {
@@ -773,6 +834,15 @@ void QuadrotorDriver::loadState(StateReader& in) {
   turbulence_.setState(in.get<std::array<double, 5>>());
   in.read(last_velocity_);
   in.read(have_last_velocity_);
+  CommandLevel level = CommandLevel::Position;
+  in.read(level);
+  if (static_cast<std::size_t>(level) >= std::size(kCommandLevels) ||
+      (level != CommandLevel::Position && source_ != Source::External))
+    throw StateError("quadrotor: the saved command level does not fit this driver (corrupted, or another scene)");
+  level_ = level;
+  in.read(command_velocity_);
+  in.read(command_yaw_rate_);
+  in.read(velocity_point_);
 }
 
 }  // namespace ssx::quadrotor

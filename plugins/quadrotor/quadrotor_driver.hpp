@@ -25,7 +25,7 @@
 
 namespace ssx::quadrotor {
 
-class QuadrotorDriver final : public Driver, public SetpointInterface, public MetricSource {
+class QuadrotorDriver final : public Driver, public CommandInterface, public MetricSource {
  public:
   static constexpr const char* kDoc =
       "rotor model, integer attitude loop on IMU counts, position loop, reference sources";
@@ -123,7 +123,12 @@ class QuadrotorDriver final : public Driver, public SetpointInterface, public Me
   void step(const StepInfo& info) override;
   void saveState(StateWriter& out) const override;
   void loadState(StateReader& in) override;
-  void setSetpoint(const Setpoint& setpoint) override;
+  /// Every level: position and velocity through the position loop, attitude and rates through the
+  /// inner loop, rotors straight to the motors (the loops above keep their state but do not act).
+  bool acceptsCommand(CommandLevel) const override { return true; }
+  std::size_t rotorCount() const override { return rotors_->size(); }
+  void setCommand(const Command& command) override;
+  CommandLevel commandLevel() const override { return level_; }
   Setpoint currentSetpoint() const override { return current_; }
   /// In formation: `formation_error`, the mean over the members its range sensor sees whose
   /// places on the sphere are within sensing range of its own, of | distance - desired distance |
@@ -141,6 +146,9 @@ class QuadrotorDriver final : public Driver, public SetpointInterface, public Me
   struct Config;    // the parameters, parsed: one per parameter set (PluginSetup::shared)
   struct Airframe;  // what the rotors' places make of them: one per parameter set and artifact type
   Setpoint reference(double t) const;
+  void outerLoop(const StepInfo& info);
+  AttitudeCommand overLink(const AttitudeCommand& command) const;  // as command_link carries it
+  static InnerCommand toInner(const AttitudeCommand& command);
   void formationStep(double dt);
   double desiredDistance(std::size_t member);
   std::span<const RangeMeasurement::Detection> seen() const {
@@ -154,6 +162,7 @@ class QuadrotorDriver final : public Driver, public SetpointInterface, public Me
   // they all point to, which stays in the cache; what only some features read comes last.
   // -- read every step
   enum class Source { Hover, Eight, External, Formation } source_ = Source::Hover;
+  CommandLevel level_ = CommandLevel::Position;  // External at a lower level than position
   bool imu_seen_ = false;  // a sample has arrived
   bool have_pose_ = false;
   bool ground_effect_ = false;
@@ -189,6 +198,9 @@ class QuadrotorDriver final : public Driver, public SetpointInterface, public Me
   Formation formation_;
   // -- features, read when they are on
   Setpoint external_;
+  Vec3 command_velocity_ = Vec3::Zero();  // the velocity level's command
+  double command_yaw_rate_ = 0;
+  Vec3 velocity_point_ = Vec3::Zero();  // the velocity level's reference point, moved at the command
   FigureEight eight_;
   double heading_kp_ = 2.0;  // 1/s, external set-points' yaw
   std::optional<Battery> battery_;

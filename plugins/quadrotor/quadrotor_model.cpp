@@ -270,14 +270,15 @@ double InnerLoopFixed::commandToSpeed(std::uint8_t command) const {
 }
 
 InnerOutput InnerLoopFixed::step(const std::array<std::int32_t, 3>& gyro, const std::array<std::int32_t, 3>& accel,
-                                 const InnerCommand& command) {
-  InnerOutput out = evaluate(estimate_, gyro, accel, command);
+                                 const InnerCommand& command, InnerMode mode) {
+  InnerOutput out = evaluate(estimate_, gyro, accel, command, mode);
   estimate_ = out.estimate;
   return out;
 }
 
 InnerOutput InnerLoopFixed::evaluate(const AttitudeEstimate& prior, const std::array<std::int32_t, 3>& gyro,
-                                     const std::array<std::int32_t, 3>& accel, const InnerCommand& command) const {
+                                     const std::array<std::int32_t, 3>& accel, const InnerCommand& command,
+                                     InnerMode mode) const {
   InnerOutput out;
   // body rates, Q16 rad/s
   std::int64_t rate[3];
@@ -321,13 +322,20 @@ InnerOutput InnerLoopFixed::evaluate(const AttitudeEstimate& prior, const std::a
   pitch = fx::clamp(pitch, -max_pitch, max_pitch);
   out.estimate = {static_cast<std::int32_t>(roll), static_cast<std::int32_t>(pitch)};
 
-  // attitude control: angular accelerations, Q12 rad/s^2, saturated
-  const std::int64_t e_roll = command.roll_q12 - fx::roundShift(roll, 8);
-  const std::int64_t e_pitch = command.pitch_q12 - fx::roundShift(pitch, 8);
+  // attitude control: angular accelerations, Q12 rad/s^2, saturated; in rates mode roll and pitch
+  // carry body rates p and q, held by the rate gain alone
+  std::int64_t alpha_xy[2];
+  if (mode == InnerMode::Attitude) {
+    const std::int64_t e_roll = command.roll_q12 - fx::roundShift(roll, 8);
+    const std::int64_t e_pitch = command.pitch_q12 - fx::roundShift(pitch, 8);
+    alpha_xy[0] = fx::roundShift(kp_q8 * e_roll, 8) - fx::roundShift(kd_q8 * rate[0], 12);
+    alpha_xy[1] = fx::roundShift(kp_q8 * e_pitch, 8) - fx::roundShift(kd_q8 * rate[1], 12);
+  } else {
+    alpha_xy[0] = fx::roundShift(kd_q8 * ((std::int64_t{command.roll_q12} << 4) - rate[0]), 12);
+    alpha_xy[1] = fx::roundShift(kd_q8 * ((std::int64_t{command.pitch_q12} << 4) - rate[1]), 12);
+  }
   const std::int64_t alpha[3] = {
-      fx::clamp(fx::roundShift(kp_q8 * e_roll, 8) - fx::roundShift(kd_q8 * rate[0], 12), -max_alpha_q12, max_alpha_q12),
-      fx::clamp(fx::roundShift(kp_q8 * e_pitch, 8) - fx::roundShift(kd_q8 * rate[1], 12), -max_alpha_q12,
-                max_alpha_q12),
+      fx::clamp(alpha_xy[0], -max_alpha_q12, max_alpha_q12), fx::clamp(alpha_xy[1], -max_alpha_q12, max_alpha_q12),
       fx::clamp(fx::roundShift(kyaw_q8 * ((std::int64_t{command.yaw_rate_q12} << 4) - rate[2]), 12), -max_alpha_q12,
                 max_alpha_q12)};
   for (int i = 0; i < 3; ++i)
@@ -353,7 +361,7 @@ InnerOutput InnerLoopFixed::evaluate(const AttitudeEstimate& prior, const std::a
 
 InnerOutput innerLoopFloat(const InnerLoopParams& p, const AttitudeEstimate& prior,
                            const std::array<std::int32_t, 3>& gyro, const std::array<std::int32_t, 3>& accel,
-                           const InnerCommand& command) {
+                           const InnerCommand& command, InnerMode mode) {
   InnerOutput out;
   const Vec3 rate = Vec3(gyro[0], gyro[1], gyro[2]) * p.gyro_lsb;
   const double roll0 = prior.roll_q20 / kQ20, pitch0 = prior.pitch_q20 / kQ20;
@@ -388,8 +396,12 @@ InnerOutput innerLoopFloat(const InnerLoopParams& p, const AttitudeEstimate& pri
   const double e_roll = command.roll_q12 / kQ12 - roll_q12;
   const double e_pitch = command.pitch_q12 / kQ12 - pitch_q12;
   const double amax = p.max_angular_acceleration;
-  const Vec3 alpha(std::clamp(p.attitude_kp * e_roll - p.attitude_kd * rate.x(), -amax, amax),
-                   std::clamp(p.attitude_kp * e_pitch - p.attitude_kd * rate.y(), -amax, amax),
+  const bool rates = mode == InnerMode::Rates;
+  const double ax_raw = rates ? p.attitude_kd * (command.roll_q12 / kQ12 - rate.x())
+                              : p.attitude_kp * e_roll - p.attitude_kd * rate.x();
+  const double ay_raw = rates ? p.attitude_kd * (command.pitch_q12 / kQ12 - rate.y())
+                              : p.attitude_kp * e_pitch - p.attitude_kd * rate.y();
+  const Vec3 alpha(std::clamp(ax_raw, -amax, amax), std::clamp(ay_raw, -amax, amax),
                    std::clamp(p.yaw_rate_kp * (command.yaw_rate_q12 / kQ12 - rate.z()), -amax, amax));
   for (int i = 0; i < 3; ++i)
     out.angular_acceleration_q12[static_cast<std::size_t>(i)] =

@@ -212,10 +212,15 @@ struct InnerLoopParams {
 
 /// What the outer loop hands the inner loop, as integers (as over a serial link).
 struct InnerCommand {
-  std::int32_t roll_q12 = 0, pitch_q12 = 0;  ///< rad, Q12
+  std::int32_t roll_q12 = 0, pitch_q12 = 0;  ///< rad (rates mode: p and q in rad/s), Q12
   std::int32_t yaw_rate_q12 = 0;             ///< rad/s, Q12
   std::int32_t thrust_q16 = 0;               ///< N, Q16
 };
+
+/// What the inner loop holds: roll and pitch angles (InnerCommand's roll and pitch in rad), or body
+/// rates (its roll and pitch carry p and q in rad/s, held by the rate gain attitude_kd). The yaw
+/// rate and the thrust mean the same in both.
+enum class InnerMode : std::uint8_t { Attitude, Rates };
 
 /// The integer attitude estimate the inner loop keeps.
 struct AttitudeEstimate {
@@ -244,10 +249,11 @@ class InnerLoopFixed {
   explicit InnerLoopFixed(const InnerLoopParams& params);
   /// One step from raw IMU counts; updates and returns the estimate.
   InnerOutput step(const std::array<std::int32_t, 3>& gyro_counts, const std::array<std::int32_t, 3>& accel_counts,
-                   const InnerCommand& command);
+                   const InnerCommand& command, InnerMode mode = InnerMode::Attitude);
   /// The same step from a given estimate, without touching the loop's own state.
   InnerOutput evaluate(const AttitudeEstimate& prior, const std::array<std::int32_t, 3>& gyro_counts,
-                       const std::array<std::int32_t, 3>& accel_counts, const InnerCommand& command) const;
+                       const std::array<std::int32_t, 3>& accel_counts, const InnerCommand& command,
+                       InnerMode mode = InnerMode::Attitude) const;
   const AttitudeEstimate& estimate() const { return estimate_; }
   void reset(const AttitudeEstimate& e) { estimate_ = e; }
   /// Motor command to commanded rotor speed (linear between the speed limits).
@@ -275,7 +281,8 @@ class InnerLoopFixed {
 /// a value on (the estimate to Q20, the motor commands to integers).
 InnerOutput innerLoopFloat(const InnerLoopParams& params, const AttitudeEstimate& prior,
                            const std::array<std::int32_t, 3>& gyro_counts,
-                           const std::array<std::int32_t, 3>& accel_counts, const InnerCommand& command);
+                           const std::array<std::int32_t, 3>& accel_counts, const InnerCommand& command,
+                           InnerMode mode = InnerMode::Attitude);
 
 /// Outer loop gains and limits.
 struct PositionParams {

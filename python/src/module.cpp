@@ -4,6 +4,8 @@
 // Threads: every call comes in holding the GIL; stepping and running release it. An environment
 // is used by one thread at a time (as in C++): a call made while another thread is stepping the
 // same environment raises RuntimeError instead of racing it.
+#include "commands.hpp"
+
 #include <ssx/ssx.hpp>
 
 #include <pybind11/numpy.h>
@@ -24,7 +26,7 @@ namespace fs = std::filesystem;
 
 namespace {
 
-using Array = py::array_t<double, py::array::c_style | py::array::forcecast>;
+using ssx_python::Array;
 
 // Marks an environment as in use for the length of one call.
 class InUse {
@@ -89,39 +91,10 @@ py::dict summaryDict(const ssx::TimingSummary& s) {
   return d;
 }
 
-// rows x cols of float64, C order, finite; `what` names it in errors
-Array requireRows(const py::handle& value, py::ssize_t rows, py::ssize_t cols, const char* what) {
-  Array a = Array::ensure(value);
-  if (!a) throw py::type_error(std::string("ssx: ") + what + " must be an array of numbers");
-  const bool shape_ok = cols == 0 ? (a.ndim() == 1 && a.shape(0) == rows)
-                                  : (a.ndim() == 2 && a.shape(0) == rows && a.shape(1) == cols);
-  if (!shape_ok) {
-    std::string got = "(";
-    for (py::ssize_t i = 0; i < a.ndim(); ++i) got += (i ? ", " : "") + std::to_string(a.shape(i));
-    got += a.ndim() == 1 ? ",)" : ")";
-    throw py::value_error(std::string("ssx: ") + what + " must have shape (" + std::to_string(rows) +
-                          (cols == 0 ? ",)" : ", " + std::to_string(cols) + ")") + ", one row per set-point driver (" +
-                          "Environment.setpoint_names()), got " + got);
-  }
-  const double* p = a.data();
-  for (py::ssize_t i = 0; i < a.size(); ++i)
-    if (!std::isfinite(p[i]))
-      throw py::value_error(std::string("ssx: ") + what + " holds a NaN or an infinity (row " +
-                            std::to_string(cols == 0 ? i : i / cols) + ")");
-  return a;
-}
-
 class PyEnvironment {
  public:
-  explicit PyEnvironment(ssx::Scene scene) : scene_(std::move(scene)), env_(*scene_.environment) {
+  explicit PyEnvironment(ssx::Scene scene) : scene_(std::move(scene)), env_(*scene_.environment), targets_(env_) {
     for (const ssx::Artifact* a : std::as_const(env_).selectArtifacts("*")) dynamic_.push_back(a);
-    for (std::size_t i = 0; i < env_.artifactCount(); ++i) {
-      ssx::Artifact& a = env_.artifact(i);
-      if (auto* s = dynamic_cast<ssx::SetpointInterface*>(a.driver())) {
-        setpoint_artifacts_.push_back(&a);
-        setpoint_targets_.push_back(s);
-      }
-    }
   }
 
   ssx::Environment& env() { return env_; }
@@ -152,12 +125,7 @@ class PyEnvironment {
     for (const ssx::Artifact* a : dynamic_) names.push_back(a->name());
     return names;
   }
-  std::vector<std::string> setpointNames() const {
-    std::vector<std::string> names;
-    names.reserve(setpoint_artifacts_.size());
-    for (const ssx::Artifact* a : setpoint_artifacts_) names.push_back(a->name());
-    return names;
-  }
+  std::vector<std::string> setpointNames() const { return targets_.names(); }
 
   // N x 3 (or N x 4) of every dynamic artifact's first root, from the published snapshot
   template <int Cols, class Fill>
@@ -196,22 +164,17 @@ class PyEnvironment {
     });
   }
 
-  void setSetpoints(const py::handle& positions, const py::handle& velocities, const py::handle& yaws) {
+  void setSetpoints(const py::handle& positions, const py::handle& velocities, const py::handle& yaws,
+                    const py::handle& accelerations, const py::handle& yaw_rates, const py::handle& robots) {
     InUse use(busy_);
-    const auto n = static_cast<py::ssize_t>(setpoint_targets_.size());
-    if (n == 0) throw std::runtime_error("ssx: no artifact of this scene has a driver that follows set-points");
-    const Array pos = requireRows(positions, n, 3, "positions");
-    std::optional<Array> vel, yaw;
-    if (!velocities.is_none()) vel = requireRows(velocities, n, 3, "velocities");
-    if (!yaws.is_none()) yaw = requireRows(yaws, n, 0, "yaws");
     if (env_.state() == ssx::Environment::State::Setup) env_.start();
-    for (py::ssize_t i = 0; i < n; ++i) {
-      ssx::Setpoint sp;
-      sp.position = ssx::Vec3(pos.at(i, 0), pos.at(i, 1), pos.at(i, 2));
-      if (vel) sp.velocity = ssx::Vec3(vel->at(i, 0), vel->at(i, 1), vel->at(i, 2));
-      if (yaw) sp.yaw = yaw->at(i);
-      setpoint_targets_[static_cast<std::size_t>(i)]->setSetpoint(sp);
-    }
+    targets_.setSetpoints(positions, velocities, yaws, accelerations, yaw_rates, robots);
+  }
+
+  void setCommands(const std::string& level, const py::handle& values, const py::handle& robots) {
+    InUse use(busy_);
+    if (env_.state() == ssx::Environment::State::Setup) env_.start();
+    targets_.setCommands(level, values, robots);
   }
 
   // the latest measurement of type M of an artifact's sensors: the first such sensor, or sensor `index`
@@ -375,8 +338,7 @@ class PyEnvironment {
   ssx::Scene scene_;
   ssx::Environment& env_;
   std::vector<const ssx::Artifact*> dynamic_;
-  std::vector<ssx::Artifact*> setpoint_artifacts_;
-  std::vector<ssx::SetpointInterface*> setpoint_targets_;
+  ssx_python::CommandTargets targets_;
   std::atomic<bool> busy_{false};
 };
 
@@ -450,9 +412,19 @@ PYBIND11_MODULE(_ssx, m) {
       .def("linear_velocities", &PyEnvironment::linearVelocities, "N x 3, m/s, world frame.")
       .def("angular_velocities", &PyEnvironment::angularVelocities, "N x 3, rad/s, world frame.")
       .def("set_setpoints", &PyEnvironment::setSetpoints, py::arg("positions"), py::arg("velocities") = py::none(),
-           py::arg("yaws") = py::none(),
-           "One row per set-point driver (setpoint_names()): positions N x 3 (m), velocities N x 3 (m/s, "
-           "feed-forward), yaws N (rad). Held until the next call.")
+           py::arg("yaws") = py::none(), py::arg("accelerations") = py::none(), py::arg("yaw_rates") = py::none(),
+           py::arg("robots") = py::none(),
+           "One row per robot (setpoint_names(), or the names or indices in `robots`): positions N x 3 (m), "
+           "velocities N x 3 (m/s, feed-forward), accelerations N x 3 (m/s^2, feed-forward), yaws N (rad), "
+           "yaw_rates N (rad/s, feed-forward). Held until the next call. Every row is checked before any robot "
+           "gets one.")
+      .def("set_commands", &PyEnvironment::setCommands, py::arg("level"), py::arg("values"),
+           py::arg("robots") = py::none(),
+           "Commands at a level, one row per robot (setpoint_names(), or the names or indices in `robots`): "
+           "'position' x, y, z, yaw [, vx, vy, vz [, ax, ay, az [, yaw_rate]]]; 'velocity' vx, vy, vz, yaw_rate; "
+           "'attitude' roll, pitch (rad), yaw_rate (rad/s), thrust (N); 'rates' p, q, r (rad/s), thrust (N); "
+           "'rotors' one speed per rotor (rad/s). Held until the next command. Every row is checked (shape, NaN, "
+           "levels and values the robot takes) before any robot gets one.")
       .def("imu", &PyEnvironment::imu, py::arg("artifact"), py::arg("sensor") = py::none(),
            "The latest IMU measurement of an artifact (its first IMU, or sensor index `sensor`), as a dict.")
       .def("pose", &PyEnvironment::pose, py::arg("artifact"), py::arg("sensor") = py::none(),

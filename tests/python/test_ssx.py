@@ -142,6 +142,100 @@ def test_setpoints_fly_the_swarm_there():
         env.set_setpoints(target, yaws=np.zeros(3))
 
 
+def test_set_setpoints_for_chosen_robots_with_feed_forward():
+    env = hover(threads=1)
+    env.step(2500)  # 5 s: settled 1 m above the start
+    start = env.positions()
+    names = env.setpoint_names()
+    # two robots, one by name and one by index; the others keep their own reference
+    target = start[[4, 0]] + np.array([0.0, 0.0, 0.5])
+    env.set_setpoints(target, accelerations=np.zeros((2, 3)), yaw_rates=np.zeros(2), robots=[names[4], 0])
+    env.step(2500)
+    np.testing.assert_allclose(env.positions()[[4, 0]], target, atol=0.05)
+    np.testing.assert_allclose(env.positions()[1], start[1], atol=0.02)
+    with pytest.raises(KeyError, match="no robot named 'nobody'"):
+        env.set_setpoints(target, robots=["nobody", 1])
+    with pytest.raises(IndexError, match="robot index 9 is outside 0..8"):
+        env.set_setpoints(target, robots=[1, 9])
+    with pytest.raises(ValueError, match="named twice"):
+        env.set_setpoints(target, robots=[1, names[1]])
+    with pytest.raises(ValueError, match=r"accelerations must have shape \(2, 3\)"):
+        env.set_setpoints(target, accelerations=np.zeros((9, 3)), robots=[1, 2])
+
+
+def yaw_of(q):
+    w, x, y, z = q
+    return np.arctan2(2 * (w * z + x * y), 1 - 2 * (y * y + z * z))
+
+
+def test_set_commands_at_every_level():
+    env = hover(threads=2)
+    env.step(2500)  # settled
+    m, n = 0.82, 9  # the mk_quad's mass; nine of them
+    start = env.positions()
+    # velocity: the whole swarm moves at 0.5 m/s along y while turning at 0.2 rad/s
+    env.set_commands("velocity", np.tile([0.0, 0.5, 0.0, 0.2], (n, 1)))
+    env.step(1500)  # 3 s
+    np.testing.assert_allclose(env.linear_velocities()[:, 1], 0.5, atol=0.05)
+    np.testing.assert_allclose(env.angular_velocities()[:, 2], 0.2, atol=0.05)
+    env.set_commands("velocity", np.zeros((n, 4)))
+    env.step(1500)
+    before = env.positions()
+    env.set_commands("attitude", [[0.0, 0.0, 0.0, m * G]], robots=[3])
+    env.set_commands("rates", [[0.0, 0.0, 0.0, m * G]], robots=[5])
+    hover_speed = np.sqrt(m * G / 4e-5)
+    env.set_commands("rotors", np.full((1, 4), hover_speed), robots=["q7"])
+    env.step(500)  # 1 s
+    after = env.positions()
+    # open loop, the lower levels keep them upright and near where they were for a second (no
+    # position loop corrects their drift); the others hold their place
+    for row in (3, 5, 7):
+        np.testing.assert_allclose(after[row], before[row], atol=0.3)
+        w, x, y, z = env.orientations()[row]
+        assert 1 - 2 * (x * x + y * y) > np.cos(0.1)  # tilted less than 0.1 rad
+    for row in (0, 1, 2, 4, 6, 8):
+        np.testing.assert_allclose(after[row], before[row], atol=0.02)
+    # position with its yaw, back where they started
+    rows = np.hstack([start, np.full((n, 1), 0.5)])
+    env.set_commands("position", rows)
+    env.step(5000)  # 10 s: 3 m back
+    np.testing.assert_allclose(env.positions(), start, atol=0.05)
+    np.testing.assert_allclose([yaw_of(q) for q in env.orientations()], 0.5, atol=0.03)
+
+
+def test_set_commands_refuses_before_any_robot_gets_a_row():
+    env = hover(threads=1)
+    env.step(500)
+    before = env.save_state()
+    rows = np.tile([0.0, 0.0, 0.0, 8.0], (9, 1))
+    bad = rows.copy()
+    bad[6, 1] = np.nan
+    with pytest.raises(ValueError, match=r"robot 'q6' \(row 6\): an attitude command holds a NaN"):
+        env.set_commands("attitude", bad)
+    bad = rows.copy()
+    bad[2, 3] = -1
+    with pytest.raises(ValueError, match="thrust must not be negative"):
+        env.set_commands("attitude", bad)
+    with pytest.raises(ValueError, match="unknown command level 'thrust'"):
+        env.set_commands("thrust", rows)
+    with pytest.raises(ValueError, match=r"has 4 \(one speed per rotor\) values, got 3"):
+        env.set_commands("rotors", np.full((9, 3), 400.0))
+    with pytest.raises(ValueError, match="4, 7, 10 or 11|got 5"):
+        env.set_commands("position", np.zeros((9, 5)))
+    with pytest.raises(ValueError, match=r"one row per robot commanded \(2\)"):
+        env.set_commands("velocity", rows, robots=[0, 1])
+    with pytest.raises(TypeError, match="list of names or indices"):
+        env.set_commands("velocity", rows[:1], robots="q0")
+    with pytest.raises(TypeError, match="list of names or indices"):
+        env.set_commands("velocity", rows[:1], robots=[True])
+    # nothing was applied: the run goes on as if no call was made
+    env.step(200)
+    expected = env.state_hash()
+    env.restore_state(before)
+    env.step(200)
+    assert env.state_hash() == expected
+
+
 def test_imu_reads_gravity_when_hovering():
     env = hover(threads=1)
     env.step(2500)  # 5 s: settled at 1.05 m

@@ -4,6 +4,7 @@
 
 #include <ssx/artifact.hpp>
 #include <ssx/class_loader.hpp>
+#include <ssx/command.hpp>
 #include <ssx/descriptor.hpp>
 #include <ssx/environment.hpp>
 #include <ssx/error.hpp>

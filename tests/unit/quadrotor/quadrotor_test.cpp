@@ -190,7 +190,7 @@ struct Gaps {
   std::int64_t estimate = 0, command = 0;
 };
 
-Gaps compare(const InnerLoopParams& p, int cases, std::uint64_t seed) {
+Gaps compare(const InnerLoopParams& p, int cases, std::uint64_t seed, InnerMode mode = InnerMode::Attitude) {
   const InnerLoopFixed fixedLoop(p);
   Random r(seed);
   Gaps worst;
@@ -210,8 +210,8 @@ Gaps compare(const InnerLoopParams& p, int cases, std::uint64_t seed) {
     c.pitch_q12 = static_cast<std::int32_t>(std::llround(r.uniform(-0.6, 0.6) * 4096));
     c.yaw_rate_q12 = static_cast<std::int32_t>(std::llround(r.uniform(-10, 10) * 4096));
     c.thrust_q16 = static_cast<std::int32_t>(std::llround(r.uniform(-5, 45) * 65536));  // beyond both limits too
-    const InnerOutput f = fixedLoop.evaluate(prior, gyro, accel, c);
-    const InnerOutput d = innerLoopFloat(p, prior, gyro, accel, c);
+    const InnerOutput f = fixedLoop.evaluate(prior, gyro, accel, c, mode);
+    const InnerOutput d = innerLoopFloat(p, prior, gyro, accel, c, mode);
     worst.estimate =
         std::max({worst.estimate,
                   std::abs(fixed::roundShift(f.estimate.roll_q20, 8) - fixed::roundShift(d.estimate.roll_q20, 8)),
@@ -233,6 +233,36 @@ TEST_CASE("the integer inner loop agrees with its float reference within 1 LSB",
   INFO("worst estimate gap " << g.estimate << " LSB (Q12 rad), worst motor command gap " << g.command);
   CHECK(g.estimate <= 1);
   CHECK(g.command <= 1);
+}
+
+TEST_CASE("in rates mode the integer inner loop agrees with its float reference within 1 LSB", "[quadrotor][fixed]") {
+  // (roll and pitch carry body rates of up to +-0.6 rad/s there)
+  for (const InnerLoopParams& p : {mkInnerParams(200.0, 25.0, 8.0),
+                                   mkInnerParams(InnerLoopLimits::attitude_kp, InnerLoopLimits::attitude_kd,
+                                                 InnerLoopLimits::yaw_rate_kp)}) {
+    const Gaps g = compare(p, 50000, 3, InnerMode::Rates);
+    INFO("kd " << p.attitude_kd << ": worst motor command gap " << g.command);
+    CHECK(g.estimate <= 1);
+    CHECK(g.command <= 1);
+  }
+}
+
+TEST_CASE("in rates mode the inner loop holds body rates, not angles", "[quadrotor][fixed]") {
+  const InnerLoopParams p = mkInnerParams(200.0, 25.0, 8.0);
+  const InnerLoopFixed loop(p);
+  // tilted 0.3 rad in roll, not turning, level command: attitude mode turns it back, rates mode
+  // (a zero rate) leaves it; a rate command turns it whatever its angle
+  const AttitudeEstimate tilted{static_cast<std::int32_t>(0.3 * 1048576), 0};
+  const std::array<std::int32_t, 3> still{}, gravity{0, 0, static_cast<std::int32_t>(9.81 / p.accel_lsb)};
+  InnerCommand level;
+  level.thrust_q16 = 8 << 16;
+  CHECK(loop.evaluate(tilted, still, gravity, level, InnerMode::Attitude).angular_acceleration_q12[0] < 0);
+  CHECK(loop.evaluate(tilted, still, gravity, level, InnerMode::Rates).angular_acceleration_q12[0] == 0);
+  InnerCommand roll_rate = level;
+  roll_rate.roll_q12 = 4096;  // 1 rad/s
+  const auto alpha = loop.evaluate(tilted, still, gravity, roll_rate, InnerMode::Rates).angular_acceleration_q12;
+  CHECK(alpha[0] / 4096.0 == Approx(p.attitude_kd * 1.0).margin(0.01));
+  CHECK(alpha[1] == 0);
 }
 
 TEST_CASE("the attitude filter blends across +-pi the shorter way, in both implementations", "[quadrotor][fixed]") {

@@ -1,0 +1,94 @@
+#pragma once
+/// @file
+/// Command levels: how a program, a bridge or a viewer commands a vehicle, from a position with
+/// feed-forward down to each rotor's speed (as PX4's offboard mode and gym-pybullet-drones do).
+/// Drivers that take commands implement CommandInterface; anyone finds it with
+/// `dynamic_cast<ssx::CommandInterface*>(artifact.driver())`.
+///
+/// | level      | values (the column order of Python's `Environment.set_commands`)               |
+/// |------------|---------------------------------------------------------------------------------|
+/// | `position` | x, y, z (m), yaw (rad); optionally vx, vy, vz (m/s), ax, ay, az (m/s^2), yaw rate (rad/s) |
+/// | `velocity` | vx, vy, vz (m/s, world frame), yaw rate (rad/s)                                  |
+/// | `attitude` | roll, pitch (rad), yaw rate (rad/s), collective thrust (N)                        |
+/// | `rates`    | body rates p, q, r (rad/s), collective thrust (N)                                 |
+/// | `rotors`   | each rotor's speed (rad/s), one column per rotor                                  |
+///
+/// A command holds until the next one (zero-order hold).
+
+#include <ssx/export.hpp>
+#include <ssx/setpoint.hpp>
+#include <ssx/types.hpp>
+
+#include <cstddef>
+#include <cstdint>
+#include <optional>
+#include <span>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace ssx {
+
+enum class CommandLevel : std::uint8_t { Position, Velocity, Attitude, Rates, Rotors };
+
+/// The five levels, from the highest to the lowest.
+inline constexpr CommandLevel kCommandLevels[] = {CommandLevel::Position, CommandLevel::Velocity,
+                                                  CommandLevel::Attitude, CommandLevel::Rates, CommandLevel::Rotors};
+
+/// "position", "velocity", "attitude", "rates" or "rotors".
+SSX_EXPORT const char* commandLevelName(CommandLevel level);
+/// The level of that name; nothing for another name.
+SSX_EXPORT std::optional<CommandLevel> commandLevelFromName(std::string_view name);
+
+/// One command at one level; only the fields of its level are read.
+struct SSX_EXPORT Command {
+  CommandLevel level = CommandLevel::Position;
+  Setpoint setpoint;                ///< position: where, its feed-forward and heading
+  Vec3 velocity = Vec3::Zero();     ///< velocity: m/s, world frame
+  double yaw_rate = 0;              ///< velocity, attitude: rad/s
+  double roll = 0, pitch = 0;       ///< attitude: rad
+  Vec3 body_rates = Vec3::Zero();   ///< rates: p, q, r in rad/s, body frame
+  double thrust = 0;                ///< attitude, rates: collective thrust, N
+  std::vector<double> rotor_speeds;  ///< rotors: rad/s, one per rotor
+
+  static Command position(const Setpoint& setpoint);
+  static Command velocityYawRate(const Vec3& velocity, double yaw_rate = 0);
+  static Command attitude(double roll, double pitch, double yaw_rate, double thrust);
+  static Command rates(const Vec3& body_rates, double thrust);
+  static Command rotors(std::vector<double> speeds);
+
+  /// The numbers of values a row of this level may have: position 4, 7, 10 or 11 (a prefix of
+  /// the columns above, the rest zero), velocity, attitude and rates 4, rotors `rotor_count`.
+  static bool rowSizeFits(CommandLevel level, std::size_t size, std::size_t rotor_count);
+  /// What rowSizeFits accepts, in words ("4, 7, 10 or 11").
+  static std::string rowSizes(CommandLevel level, std::size_t rotor_count);
+  /// A command from one row in the column order above (its size as rowSizeFits accepts).
+  static Command fromRow(CommandLevel level, std::span<const double> row);
+
+  /// What is wrong with it whatever the vehicle (a value not finite, a negative thrust or rotor
+  /// speed, a roll or pitch beyond 80 degrees), or an empty string.
+  std::string problem() const;
+};
+
+/// Implemented by drivers that take commands at one or more levels. Call only between steps, or
+/// from an extension's hooks, never from another artifact's driver or sensor (the parallel phases).
+class SSX_EXPORT CommandInterface : public SetpointInterface {
+ public:
+  ~CommandInterface() override;
+  /// Whether this driver takes commands at `level`.
+  virtual bool acceptsCommand(CommandLevel level) const = 0;
+  /// The rotors a `rotors` command must name (0 for a vehicle without rotors).
+  virtual std::size_t rotorCount() const = 0;
+  /// What is wrong with this command for this driver (a level it does not take, the wrong number
+  /// of rotors, Command::problem()), or an empty string.
+  std::string refusal(const Command& command) const;
+  /// Switches the driver to this command, held until the next one. Throws std::invalid_argument
+  /// with refusal()'s message, leaving the driver as it was, for a command it refuses.
+  virtual void setCommand(const Command& command) = 0;
+  /// The level of the latest command (position while a reference of the scene's drives it).
+  virtual CommandLevel commandLevel() const = 0;
+  /// A set-point is a command at the position level.
+  void setSetpoint(const Setpoint& setpoint) override { setCommand(Command::position(setpoint)); }
+};
+
+}  // namespace ssx

@@ -1,0 +1,163 @@
+#include <ssx/command.hpp>
+
+#include <cmath>
+#include <numbers>
+#include <stdexcept>
+#include <utility>
+
+namespace ssx {
+
+namespace {
+
+constexpr const char* kNames[] = {"position", "velocity", "attitude", "rates", "rotors"};
+// the attitude estimate of a vehicle's inner loop holds pitch within +-80 degrees
+constexpr double kMaxAngle = 80.0 * std::numbers::pi / 180.0;
+
+bool finite(const Vec3& v) { return v.allFinite(); }
+
+std::string number(double v) { return std::to_string(v); }
+
+}  // namespace
+
+const char* commandLevelName(CommandLevel level) { return kNames[static_cast<std::size_t>(level)]; }
+
+std::optional<CommandLevel> commandLevelFromName(std::string_view name) {
+  for (CommandLevel level : kCommandLevels)
+    if (name == kNames[static_cast<std::size_t>(level)]) return level;
+  return std::nullopt;
+}
+
+Command Command::position(const Setpoint& setpoint) {
+  Command c;
+  c.level = CommandLevel::Position;
+  c.setpoint = setpoint;
+  return c;
+}
+
+Command Command::velocityYawRate(const Vec3& velocity, double yaw_rate) {
+  Command c;
+  c.level = CommandLevel::Velocity;
+  c.velocity = velocity;
+  c.yaw_rate = yaw_rate;
+  return c;
+}
+
+Command Command::attitude(double roll, double pitch, double yaw_rate, double thrust) {
+  Command c;
+  c.level = CommandLevel::Attitude;
+  c.roll = roll;
+  c.pitch = pitch;
+  c.yaw_rate = yaw_rate;
+  c.thrust = thrust;
+  return c;
+}
+
+Command Command::rates(const Vec3& body_rates, double thrust) {
+  Command c;
+  c.level = CommandLevel::Rates;
+  c.body_rates = body_rates;
+  c.thrust = thrust;
+  return c;
+}
+
+Command Command::rotors(std::vector<double> speeds) {
+  Command c;
+  c.level = CommandLevel::Rotors;
+  c.rotor_speeds = std::move(speeds);
+  return c;
+}
+
+bool Command::rowSizeFits(CommandLevel level, std::size_t size, std::size_t rotor_count) {
+  switch (level) {
+    case CommandLevel::Position:
+      return size == 4 || size == 7 || size == 10 || size == 11;
+    case CommandLevel::Rotors:
+      return size == rotor_count && size > 0;
+    default:
+      return size == 4;
+  }
+}
+
+std::string Command::rowSizes(CommandLevel level, std::size_t rotor_count) {
+  switch (level) {
+    case CommandLevel::Position:
+      return "4 (x, y, z, yaw), 7 (and vx, vy, vz), 10 (and ax, ay, az) or 11 (and the yaw rate)";
+    case CommandLevel::Velocity:
+      return "4 (vx, vy, vz, yaw rate)";
+    case CommandLevel::Attitude:
+      return "4 (roll, pitch, yaw rate, thrust)";
+    case CommandLevel::Rates:
+      return "4 (p, q, r, thrust)";
+    case CommandLevel::Rotors:
+      return std::to_string(rotor_count) + " (one speed per rotor)";
+  }
+  return {};
+}
+
+Command Command::fromRow(CommandLevel level, std::span<const double> r) {
+  const auto at = [&](std::size_t i) { return i < r.size() ? r[i] : 0.0; };
+  switch (level) {
+    case CommandLevel::Position: {
+      Setpoint s;
+      s.position = Vec3(at(0), at(1), at(2));
+      s.yaw = at(3);
+      s.velocity = Vec3(at(4), at(5), at(6));
+      s.acceleration = Vec3(at(7), at(8), at(9));
+      s.yaw_rate = at(10);
+      return position(s);
+    }
+    case CommandLevel::Velocity:
+      return velocityYawRate(Vec3(at(0), at(1), at(2)), at(3));
+    case CommandLevel::Attitude:
+      return attitude(at(0), at(1), at(2), at(3));
+    case CommandLevel::Rates:
+      return rates(Vec3(at(0), at(1), at(2)), at(3));
+    case CommandLevel::Rotors:
+      return rotors(std::vector<double>(r.begin(), r.end()));
+  }
+  return {};
+}
+
+std::string Command::problem() const {
+  switch (level) {
+    case CommandLevel::Position:
+      if (!finite(setpoint.position) || !finite(setpoint.velocity) || !finite(setpoint.acceleration) ||
+          !std::isfinite(setpoint.yaw) || !std::isfinite(setpoint.yaw_rate))
+        return "a position command holds a NaN or an infinity";
+      return {};
+    case CommandLevel::Velocity:
+      if (!finite(velocity) || !std::isfinite(yaw_rate)) return "a velocity command holds a NaN or an infinity";
+      return {};
+    case CommandLevel::Attitude:
+      if (!std::isfinite(roll) || !std::isfinite(pitch) || !std::isfinite(yaw_rate) || !std::isfinite(thrust))
+        return "an attitude command holds a NaN or an infinity";
+      if (std::abs(roll) > kMaxAngle || std::abs(pitch) > kMaxAngle)
+        return "an attitude command's roll and pitch must be within +-80 degrees (+-1.396 rad), got roll " +
+               number(roll) + ", pitch " + number(pitch);
+      break;
+    case CommandLevel::Rates:
+      if (!finite(body_rates) || !std::isfinite(thrust)) return "a rates command holds a NaN or an infinity";
+      break;
+    case CommandLevel::Rotors:
+      for (double w : rotor_speeds) {
+        if (!std::isfinite(w)) return "a rotors command holds a NaN or an infinity";
+        if (w < 0) return "rotor speeds are magnitudes (the spin direction is the rotor's), got " + number(w);
+      }
+      return {};
+  }
+  if (thrust < 0) return "thrust must not be negative, got " + number(thrust) + " N";
+  return {};
+}
+
+CommandInterface::~CommandInterface() = default;
+
+std::string CommandInterface::refusal(const Command& command) const {
+  if (!acceptsCommand(command.level))
+    return std::string("this driver takes no commands at the ") + commandLevelName(command.level) + " level";
+  if (command.level == CommandLevel::Rotors && command.rotor_speeds.size() != rotorCount())
+    return "a rotors command needs one speed per rotor: " + std::to_string(rotorCount()) + ", got " +
+           std::to_string(command.rotor_speeds.size());
+  return command.problem();
+}
+
+}  // namespace ssx
