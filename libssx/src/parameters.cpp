@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <sstream>
 
 namespace ssx {
@@ -212,8 +213,17 @@ std::vector<Diagnostic> checkParameters(std::span<const ssx_plugin_param> declar
 }
 
 std::string parameterTable(std::span<const ssx_plugin_param> declarations) {
-  std::string out = "| parameter | type | unit | default | allowed | description |\n|---|---|---|---|---|---|\n";
+  constexpr const char* kHeader = "| parameter | type | unit | default | allowed | description |\n|---|---|---|---|---|---|\n";
+  std::string out;
+  const char* group = nullptr;
   for (const auto& d : declarations) {
+    // a class made of parts: a table per part, under its name
+    const bool new_group = out.empty() || (d.group != nullptr && (group == nullptr || std::strcmp(d.group, group) != 0));
+    if (new_group) {
+      if (d.group != nullptr) out += (out.empty() ? "" : "\n") + std::string("**") + d.group + "**\n\n";
+      out += kHeader;
+      group = d.group;
+    }
     std::string allowed = d.type == SSX_PARAM_CHOICE ? std::string(d.choices) : boundsText(d);
     if ((d.flags & SSX_PARAM_RATE) != 0)
       allowed += std::string(allowed.empty() ? "" : "; ") + "period a whole multiple of the plugin's";

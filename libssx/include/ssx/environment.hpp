@@ -59,6 +59,17 @@ inline constexpr double kMinRealtimeFactor = 1e-3;    ///< a thousand times slow
 inline constexpr double kMaxRealtimeFactor = 1e6;
 inline constexpr double kMinRateHz = 1e-6;            ///< a rate (frames, loops) that is not 0: about one per 12 days
 
+/// The scene's wind (`<wind>`): the air every robot whose driver models it flies through, each
+/// robot with its own seeded turbulence. A robot's own wind parameters override it value by value.
+struct WindSettings {
+  Vec3 mean = Vec3::Zero();            ///< m/s, world frame
+  Vec3 gust = Vec3::Zero();            ///< m/s, amplitude of one 1-cosine gust
+  double gust_start = 0;               ///< s
+  double gust_duration = 1;            ///< s
+  double turbulence_w20 = 0;           ///< m/s at 20 ft, Dryden (MIL-F-8785C); 0: none
+  double turbulence_min_airspeed = 1;  ///< m/s
+};
+
 struct EnvironmentSettings {
   Nanoseconds timestep = 1'000'000;  ///< tau, ns (default 1 ms)
   std::uint64_t seed = 0;            ///< root of every random stream
@@ -67,6 +78,7 @@ struct EnvironmentSettings {
   std::size_t timing_samples = TimingRecorder::kDefaultCapacity;
   PhysicsSettings physics;
   RenderSettings render;
+  WindSettings wind;
 };
 
 /// How a run is paced.

@@ -26,7 +26,10 @@
 #include <ssx/shared_value.hpp>
 #include <ssx/types.hpp>
 
+#include <algorithm>
+#include <array>
 #include <cstdint>
+#include <iterator>
 #include <limits>
 #include <map>
 #include <memory>
@@ -74,6 +77,9 @@ struct ssx_plugin_param {
   double max;
   const char* choices;
   const char* doc;
+  /// the part of the class it belongs to ("vehicle", "controller"), or null: the tables of a class
+  /// made of parts are printed part by part (ssx::param::join)
+  const char* group;
 };
 
 }  // extern "C"
@@ -158,7 +164,7 @@ constexpr Bounds operator&(Bounds a, Bounds b) {
 
 constexpr ssx_plugin_param make(const char* name, std::uint32_t type, const char* unit, const char* default_value,
                                 Bounds bounds, const char* choices, const char* doc) {
-  return {name, type, bounds.flags, unit, default_value, bounds.min, bounds.max, choices, doc};
+  return {name, type, bounds.flags, unit, default_value, bounds.min, bounds.max, choices, doc, nullptr};
 }
 constexpr ssx_plugin_param real(const char* name, const char* default_value, const char* unit, Bounds bounds,
                                 const char* doc) {
@@ -192,6 +198,36 @@ constexpr ssx_plugin_param rate(const char* name, const char* default_value, Bou
 constexpr ssx_plugin_param required(ssx_plugin_param p) {
   p.flags |= SSX_PARAM_REQUIRED;
   return p;
+}
+
+/// A part of a class's parameters: its name and its table.
+template <std::size_t N>
+struct Part {
+  const char* name;
+  const ssx_plugin_param (&params)[N];
+};
+template <std::size_t N>
+constexpr Part<N> part(const char* name, const ssx_plugin_param (&params)[N]) {
+  return {name, params};
+}
+
+/// The tables of a class made of parts, in order, each declaration marked with its part's name:
+/// `static constexpr auto kParameters = param::join(param::part("vehicle", kVehicle), ...);`
+/// (`ssx plugins --params` then prints a table per part).
+template <std::size_t... N>
+constexpr std::array<ssx_plugin_param, (N + ...)> join(Part<N>... parts) {
+  std::array<ssx_plugin_param, (N + ...)> out{};
+  std::size_t at = 0;
+  (
+      [&] {
+        for (const ssx_plugin_param& p : parts.params) {
+          out[at] = p;
+          out[at].group = parts.name;
+          ++at;
+        }
+      }(),
+      ...);
+  return out;
 }
 
 }  // namespace param

@@ -28,6 +28,7 @@
 #include <cstdint>
 #include <cstring>
 #include <exception>
+#include <iterator>
 #include <new>
 #include <type_traits>
 #include <vector>
@@ -36,7 +37,7 @@
 /// (Plugin, Driver, Sensor, SimulationExtension: their virtual functions and members) or the
 /// members of the classes whose inline accessors plugins compile in (Artifact) or the structs
 /// handed to them (PluginContext) change.
-#define SSX_PLUGIN_ABI_VERSION 7u
+#define SSX_PLUGIN_ABI_VERSION 8u
 
 #define SSX_PLUGIN_STRINGIFY2(x) #x
 #define SSX_PLUGIN_STRINGIFY(x) SSX_PLUGIN_STRINGIFY2(x)
@@ -170,8 +171,8 @@ constexpr ssx_plugin_class pluginClass(std::uint32_t kind, const char* name) {
                      sizeof(T), alignof(T), &pluginConstruct<T, Base>, &pluginDestruct<Base>};
   if constexpr (requires { T::kDoc; }) c.doc = T::kDoc;
   if constexpr (requires { T::kParameters; }) {
-    c.params = T::kParameters;
-    c.param_count = static_cast<std::uint32_t>(std::extent_v<decltype(T::kParameters)>);
+    c.params = std::data(T::kParameters);  // a C array, or a std::array (ssx::param::join)
+    c.param_count = static_cast<std::uint32_t>(std::size(T::kParameters));
   }
   if constexpr (requires(const Descriptor& d, const PluginContext& ctx) { T::validate(d, ctx); })
     c.validate = &pluginValidate<T>;

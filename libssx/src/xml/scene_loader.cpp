@@ -59,6 +59,8 @@ void SceneLoader::collect(const Descriptor& scene, const fs::path& dir, std::vec
       if (once(d, physics_element_)) readPhysics(d);
     } else if (n == "render") {
       if (once(d, render_element_)) readRender(d);
+    } else if (n == "wind") {
+      if (once(d, wind_element_)) readWind(d);
     } else if (n == "plugin_path") {
       const std::string p = require(d, "dir");
       if (!p.empty()) plugin_dirs_.push_back(resolve(dir, p));
@@ -108,7 +110,7 @@ void SceneLoader::collect(const Descriptor& scene, const fs::path& dir, std::vec
       stack.pop_back();
     }
   }
-  checkUnknown(scene, {"environment", "physics", "render", "plugin_path", "extension", "type", "artifact", "swarm",
+  checkUnknown(scene, {"environment", "physics", "render", "wind", "plugin_path", "extension", "type", "artifact", "swarm",
                        "ground", "obstacle", "include"});
 }
 
@@ -244,6 +246,24 @@ void SceneLoader::readPhysics(const Descriptor& d) {
     b.linear_slop = read<double>(d, "linear_slop", b.linear_slop);
     if (!(b.linear_slop >= 0 && b.linear_slop < 1)) error(d.find("linear_slop")->where, "<physics>: linear_slop must be in [0, 1) m");
   }
+  checkUnknown(d);
+}
+
+void SceneLoader::readWind(const Descriptor& d) {
+  WindSettings& w = settings_.wind;
+  w.mean = read<Vec3>(d, "mean", w.mean);
+  w.gust = read<Vec3>(d, "gust", w.gust);
+  w.gust_start = read<double>(d, "gust_start", w.gust_start);
+  w.gust_duration = read<double>(d, "gust_duration", w.gust_duration);
+  w.turbulence_w20 = read<double>(d, "turbulence_w20", w.turbulence_w20);
+  w.turbulence_min_airspeed = read<double>(d, "turbulence_min_airspeed", w.turbulence_min_airspeed);
+  const auto where = [&](const char* a) { return d.has(a) ? d.find(a)->where : d.where(); };
+  if (!(w.gust_start >= 0)) error(where("gust_start"), "<wind>: gust_start must not be negative (s)");
+  if (!(w.gust_duration > 0)) error(where("gust_duration"), "<wind>: gust_duration must be positive (s)");
+  if (!(w.turbulence_w20 >= 0 && w.turbulence_w20 <= 50))
+    error(where("turbulence_w20"), "<wind>: turbulence_w20 must be in 0..50 m/s (light 7.7, moderate 15.4)");
+  if (!(w.turbulence_min_airspeed > 0))
+    error(where("turbulence_min_airspeed"), "<wind>: turbulence_min_airspeed must be positive (m/s)");
   checkUnknown(d);
 }
 

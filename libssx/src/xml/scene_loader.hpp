@@ -195,6 +195,7 @@ class SceneLoader {
   void readEnvironment(const Descriptor& d);
   void readPhysics(const Descriptor& d);
   void readRender(const Descriptor& d);
+  void readWind(const Descriptor& d);
   bool once(const Descriptor& d, const Descriptor*& slot);
 
   // --- artifact files ---
@@ -241,6 +242,7 @@ class SceneLoader {
   std::optional<Nanoseconds> duration_;
   const Descriptor* environment_element_ = nullptr;
   const Descriptor* physics_element_ = nullptr;
+  const Descriptor* wind_element_ = nullptr;
   const Descriptor* render_element_ = nullptr;
   std::vector<fs::path> plugin_dirs_;
   std::vector<Entity> extensions_;

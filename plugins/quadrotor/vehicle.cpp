@@ -1,0 +1,128 @@
+#include "vehicle.hpp"
+
+#include <sstream>
+
+namespace ssx::quadrotor {
+
+namespace {
+
+std::vector<std::string> words(const std::string& text) {
+  std::istringstream in(text);
+  std::vector<std::string> out;
+  for (std::string w; in >> w;) out.push_back(w);
+  return out;
+}
+
+// the rotor and motor constants: the preset, then any override (values checked while loading)
+RotorParams rotorParams(const Descriptor& params) {
+  RotorParams rp = *preset(params.get<std::string>("preset"));
+  auto override = [&](const char* key, double& value) { value = params.get<double>(key, value); };
+  override("thrust_coefficient", rp.thrust_coefficient);
+  override("moment_constant", rp.moment_constant);
+  override("time_constant_up", rp.time_constant_up);
+  override("time_constant_down", rp.time_constant_down);
+  override("max_rotor_speed", rp.max_rotor_speed);
+  override("min_rotor_speed", rp.min_rotor_speed);
+  override("rotor_drag_coefficient", rp.rotor_drag_coefficient);
+  override("rolling_moment_coefficient", rp.rolling_moment_coefficient);
+  override("rotor_inertia", rp.rotor_inertia);
+  override("rotor_radius", rp.rotor_radius);
+  if (rp.min_rotor_speed >= rp.max_rotor_speed) {
+    std::ostringstream m;
+    m << "min_rotor_speed (" << rp.min_rotor_speed << " rad/s) must be below max_rotor_speed (" << rp.max_rotor_speed
+      << " rad/s)";
+    throw params.error(m.str());
+  }
+  return rp;
+}
+
+// the battery, its voltages checked against each other
+BatteryParams batteryParams(const Descriptor& params) {
+  BatteryParams bp;
+  bp.full_voltage = params.get<double>("battery_full_voltage");
+  bp.empty_voltage = params.get<double>("battery_empty_voltage");
+  bp.capacity = params.get<double>("battery_capacity");
+  bp.resistance = params.get<double>("battery_resistance");
+  bp.efficiency = params.get<double>("battery_efficiency");
+  bp.initial_charge = params.get<double>("battery_initial_charge");
+  bp.nominal_voltage = params.get<double>("battery_nominal_voltage");
+  bp.zero_thrust_voltage = params.get<double>("battery_zero_thrust_voltage");
+  if (!(bp.empty_voltage < bp.full_voltage) || !(bp.nominal_voltage > bp.zero_thrust_voltage) ||
+      !(bp.empty_voltage > bp.zero_thrust_voltage))
+    throw params.error("battery: needs battery_zero_thrust_voltage < battery_empty_voltage < battery_full_voltage "
+                       "and battery_nominal_voltage > battery_zero_thrust_voltage");
+  return bp;
+}
+
+}  // namespace
+
+VehicleParams::VehicleParams(const Descriptor& params) : rotor(rotorParams(params)) {
+  rotor_names = words(params.get<std::string>("rotors"));
+  const auto& names = rotor_names;
+  const auto dirs = words(params.get<std::string>("directions"));
+  if (names.size() != dirs.size() || names.size() < 4 || names.size() > kMaxRotors)
+    throw params.errorAt(names.size() != dirs.size() ? "directions" : "rotors",
+                         "'rotors' and 'directions' must name the same number (4 to " + std::to_string(kMaxRotors) +
+                             ") of rotors");
+  for (const auto& d : dirs) {
+    if (d != "1" && d != "-1") throw params.errorAt("directions", "rotor directions are 1 or -1, got '" + d + "'");
+    directions.push_back(d == "1" ? 1 : -1);
+  }
+  if (params.get<bool>("battery")) battery = batteryParams(params);
+}
+
+std::vector<Rotor> VehicleParams::rotorsOf(const Descriptor& params, const Artifact& a) const {
+  std::vector<Rotor> rotors;
+  for (std::size_t i = 0; i < rotor_names.size(); ++i) {
+    const PhysicNode* node = a.node(rotor_names[i]);
+    if (node == nullptr)
+      throw params.errorAt("rotors",
+                           "no physic node '" + rotor_names[i] + "' for a rotor in artifact '" + a.name() + "'");
+    rotors.push_back({node->poseInBody().position, directions[i]});
+  }
+  return rotors;
+}
+
+void Vehicle::configure(const RotorModel& at_rest, const Vec3& com_in_root, const std::optional<BatteryParams>& battery) {
+  rotors_.emplace(at_rest);
+  com_in_root_ = com_in_root;
+  gains_.fill(1.0);
+  battery_.reset();
+  if (battery) battery_.emplace(*battery);
+}
+
+void Vehicle::applyWrench(PhysicNode& body, const BodyState& s, const BodyState& com, const Vec3& air) const {
+  // motors and aerodynamics, applied at the centre of mass in body axes
+  const Quat to_body = s.pose.orientation.conjugate();
+  const Vec3 v_air = com.linear_velocity - air;
+  Vec3 force, torque;
+  rotors_->wrench(to_body * v_air, to_body * s.angular_velocity, force, torque);
+  body.addForce(force, Frame::Local, com_in_root_, Frame::Local);
+  body.addTorque(torque, Frame::Local);
+}
+
+void Vehicle::saveState(StateWriter& out) const {
+  // (per-rotor arrays as vectors of the rotor count)
+  const std::size_t n = rotors_->size();
+  out.write(std::vector<double>(rotors_->speeds().begin(), rotors_->speeds().end()));
+  out.write(std::vector<double>(gains_.begin(), gains_.begin() + static_cast<std::ptrdiff_t>(n)));
+  out.write(battery_ ? battery_->charge() : 0.0);
+  out.write(battery_ ? battery_->voltage() : 0.0);
+}
+
+void Vehicle::loadState(StateReader& in) {
+  std::vector<double> speeds, gains;
+  in.read(speeds);
+  if (speeds.size() != rotors_->size())
+    throw StateError("quadrotor: saved with " + std::to_string(speeds.size()) + " rotors, this one has " +
+                     std::to_string(rotors_->size()));
+  in.read(gains);
+  if (gains.size() != speeds.size()) throw StateError("quadrotor: the saved thrust gains do not fit this vehicle");
+  rotors_->setSpeeds(speeds);
+  std::copy(gains.begin(), gains.end(), gains_.begin());
+  rotors_->setThrustGains(gains);
+  const double charge = in.get<double>(), voltage = in.get<double>();
+  if (battery_) battery_->setState(charge, voltage);
+}
+
+}  // namespace ssx::quadrotor
