@@ -100,7 +100,7 @@ ReferenceParams::ReferenceParams(const Descriptor& params) {
   if (reference == "trajectory") {
     const auto* file = params.find("trajectory");
     if (file == nullptr || file->value.empty())
-      throw params.error("reference=\"trajectory\" needs trajectory=\"FILE.csv\" (rows t, x, y, z[, yaw])");
+      throw params.errorAt("reference", "reference=\"trajectory\" needs trajectory=\"FILE.csv\" (rows t, x, y, z[, yaw])");
     std::filesystem::path path = file->value;
     if (path.is_relative() && !file->where.file.empty())
       path = std::filesystem::path(file->where.file).parent_path() / path;
