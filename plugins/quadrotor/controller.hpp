@@ -22,6 +22,9 @@ class FlightInputs {
   virtual bool holdsHeading() const = 0;
   /// The vehicle's pose and velocity from its position source (motion capture, else the truth).
   virtual void position(Pose& pose, Vec3& velocity) const = 0;
+  /// The body's angular velocity in its own frame, rad/s (the truth: a controller that models its
+  /// gyroscope reads the IMU instead, as TeleKybController does).
+  virtual Vec3 bodyRates() const = 0;
 };
 
 class FlightController {

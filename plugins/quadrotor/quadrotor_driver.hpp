@@ -68,6 +68,10 @@ class QuadrotorDriver final : public Driver, public CommandInterface, public Met
   Setpoint reference(double t, double dt) override { return references_.at(t, dt); }
   bool holdsHeading() const override { return references_.holdsHeading(); }
   void position(Pose& pose, Vec3& velocity) const override;
+  Vec3 bodyRates() const override {
+    const BodyState s = artifact().state();
+    return s.pose.orientation.conjugate() * s.angular_velocity;
+  }
 
   // With thousands of robots a step is bound by memory latency: what every step reads comes
   // first, held in the driver (not behind pointers of its own), so that it spans few cache lines;
