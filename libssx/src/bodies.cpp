@@ -4,6 +4,7 @@
 #include "state_checks.hpp"
 
 #include <ssx/environment.hpp>
+#include <ssx/hash.hpp>
 
 #include <cstring>
 
@@ -102,15 +103,12 @@ void publishSnapshot(World& world, const PhysicEngine& engine, bool first) {
 
 std::uint64_t Environment::stateHash() const {
   // FNV-1a over the raw bits of every pose and velocity, then the step count
-  std::uint64_t h = 0xcbf29ce484222325ULL;
+  std::uint64_t h = kFnv1aBasis;
   auto mix = [&h](const double* p, std::size_t count) {
     for (std::size_t i = 0; i < count; ++i) {
       std::uint64_t bits;
       std::memcpy(&bits, p + i, sizeof bits);
-      for (int k = 0; k < 8; ++k) {
-        h ^= (bits >> (8 * k)) & 0xffU;
-        h *= 0x100000001b3ULL;
-      }
+      h = fnv1a(bits, h);
     }
   };
   for (const auto& s : world_->states) {

@@ -12,6 +12,7 @@
 #include "world.hpp"
 
 #include <ssx/environment.hpp>
+#include <ssx/hash.hpp>
 
 #include <cstring>
 
@@ -22,18 +23,6 @@ namespace {
 constexpr char kMagic[8] = {'S', 'S', 'X', 'S', 'T', 'A', 'T', 'E'};
 constexpr std::uint32_t kFormatVersion = 3;
 constexpr std::size_t kHeaderSize = 8 + 4 + 4 + 8 + 8 + 8;
-
-std::uint64_t fnv1a(const std::byte* data, std::size_t size, std::uint64_t h = 0xcbf29ce484222325ULL) {
-  for (std::size_t i = 0; i < size; ++i) {
-    h ^= static_cast<std::uint64_t>(data[i]);
-    h *= 0x100000001b3ULL;
-  }
-  return h;
-}
-
-std::uint64_t fnv1a(std::string_view text, std::uint64_t h) {
-  return fnv1a(reinterpret_cast<const std::byte*>(text.data()), text.size(), h);
-}
 
 void writeBody(StateWriter& out, const BodyState& s) {
   out.write(s.pose);
@@ -74,7 +63,7 @@ void readBlock(StateReader& in, const std::string& what, Load load) {
 
 std::uint64_t Environment::sceneFingerprint() const {
   // what a saved state must agree with: the timestep, the bodies, and each artifact's plugins
-  std::uint64_t h = fnv1a("ssx scene", 0xcbf29ce484222325ULL);
+  std::uint64_t h = fnv1a("ssx scene", kFnv1aBasis);
   auto mix = [&h](std::string_view s) { h = fnv1a(s, fnv1a("|", h)); };
   mix(std::to_string(settings_.timestep));
   // the engine's block is the engine's own format (left out for ODE, so that states saved before

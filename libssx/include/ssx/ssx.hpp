@@ -8,6 +8,7 @@
 #include <ssx/descriptor.hpp>
 #include <ssx/environment.hpp>
 #include <ssx/error.hpp>
+#include <ssx/hash.hpp>
 #include <ssx/export.hpp>
 #include <ssx/measurements.hpp>
 #include <ssx/metrics.hpp>
