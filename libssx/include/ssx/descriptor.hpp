@@ -6,6 +6,7 @@
 #include <ssx/export.hpp>
 #include <ssx/types.hpp>
 
+#include <filesystem>
 #include <optional>
 #include <span>
 #include <string>
@@ -120,5 +121,13 @@ extern template SSX_EXPORT int Descriptor::get<int>(std::string_view, const int&
 extern template SSX_EXPORT std::int64_t Descriptor::get<std::int64_t>(std::string_view, const std::int64_t&) const;
 extern template SSX_EXPORT double Descriptor::get<double>(std::string_view, const double&) const;
 extern template SSX_EXPORT Vec3 Descriptor::get<Vec3>(std::string_view, const Vec3&) const;
+
+/// An XML document as a Descriptor tree (its root element), every element and attribute with the
+/// line it is on; `label` names it in messages. Throws ConfigError "label:line: error: ..." on a
+/// syntax error, at the line of the problem. ssx's own files and tools read XML through it.
+SSX_EXPORT Descriptor parseXml(std::string_view text, const std::string& label);
+
+/// Reads and parses a file. Throws ConfigError naming the file (line 0) when it cannot be read.
+SSX_EXPORT Descriptor readXmlFile(const std::filesystem::path& file);
 
 }  // namespace ssx

@@ -166,7 +166,7 @@ const ArtifactType* SceneLoader::artifactType(const std::string& name, const Sou
   }
   ArtifactType& t = types_[name];
   try {
-    documents_.push_back(detail::readXmlFile(decl->second.file));
+    documents_.push_back(readXmlFile(decl->second.file));
     t = parseArtifact(documents_.back());
   } catch (const ConfigError& e) {
     if (e.where().line == 0)

@@ -97,7 +97,7 @@ void SceneLoader::collect(const Descriptor& scene, const fs::path& dir, std::vec
         continue;
       }
       try {
-        documents_.push_back(detail::readXmlFile(path));
+        documents_.push_back(readXmlFile(path));
       } catch (const ConfigError& e) {
         if (e.where().line == 0)
           error(d.where(), "<include>: cannot read '" + path.string() + "' (missing, a directory, or no permission)");
@@ -431,7 +431,7 @@ fs::path installedDataDirectory() {
 Scene loadScene(const fs::path& file, const SceneOptions& options) {
   Descriptor root;
   try {
-    root = detail::readXmlFile(file);
+    root = readXmlFile(file);
   } catch (const ConfigError& e) {
     throw SceneError({{Diagnostic::Severity::Error, e.where(), e.detail()}});
   }
@@ -445,7 +445,7 @@ Scene loadSceneFromString(std::string_view xml, const std::string& label, const 
                           const SceneOptions& options) {
   Descriptor root;
   try {
-    root = detail::parseXml(xml, label);
+    root = parseXml(xml, label);
   } catch (const ConfigError& e) {
     throw SceneError({{Diagnostic::Severity::Error, e.where(), e.detail()}});
   }

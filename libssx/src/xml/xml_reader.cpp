@@ -63,6 +63,13 @@ Descriptor convert(const pugi::xml_node& node, std::string_view text, const Line
 
 }  // namespace
 
+}  // namespace ssx::detail
+
+namespace ssx {
+
+using detail::convert;
+using detail::LineIndex;
+
 Descriptor parseXml(std::string_view text, const std::string& file) {
   pugi::xml_document doc;
   const pugi::xml_parse_result result =
@@ -84,4 +91,4 @@ Descriptor readXmlFile(const std::filesystem::path& file) {
   return parseXml(buffer.str(), file.string());
 }
 
-}  // namespace ssx::detail
+}  // namespace ssx
