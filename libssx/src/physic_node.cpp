@@ -1,3 +1,10 @@
+// PhysicNodeSpec and Shape (what a node is) and PhysicNode (a handle into the world state: reads the
+// snapshot, writes its artifact's command buffer).
+#include "phase_guard.hpp"
+#include "world.hpp"
+
+#include <ssx/artifact.hpp>
+#include <ssx/environment.hpp>
 #include <ssx/physic_node.hpp>
 
 #include <Eigen/Eigenvalues>
@@ -213,6 +220,98 @@ BodyState BodyState::attached(const Pose& relative) const {
   out.linear_acceleration =
       linear_acceleration + angular_acceleration.cross(r) + angular_velocity.cross(angular_velocity.cross(r));
   return out;
+}
+
+// --- PhysicNode: reads the snapshot, writes its artifact's command buffer -------------------------
+
+bool PhysicNode::isStatic() const noexcept { return world_->nodes[index_].is_static; }
+int PhysicNode::bodyIndex() const noexcept { return world_->nodes[index_].body; }
+const Pose& PhysicNode::poseInBody() const noexcept { return world_->nodes[index_].pose_in_body; }
+
+BodyState PhysicNode::state() const {
+  const detail::NodeData& n = world_->nodes[index_];
+  if (n.body >= 0 && world_->started()) {
+    const BodyState& body = world_->states[static_cast<std::size_t>(n.body)];
+    return n.at_body ? body : body.attached(n.pose_in_body);
+  }
+  const detail::NodeSetup& setup = world_->node_setup[index_];
+  BodyState s;
+  s.pose = setup.pose;
+  if (!n.is_static) {
+    s.linear_velocity = setup.initial_linear;
+    s.angular_velocity = setup.initial_angular;
+  }
+  return s;
+}
+
+Pose PhysicNode::pose() const {
+  const detail::NodeData& n = world_->nodes[index_];
+  if (n.body < 0 || !world_->started()) return world_->node_setup[index_].pose;
+  const Pose& body = world_->states[static_cast<std::size_t>(n.body)].pose;
+  return n.at_body ? body : body * n.pose_in_body;
+}
+
+void PhysicNode::requireWritable() const {
+  if (!detail::PhaseGuard::in_phase || detail::PhaseGuard::writer == artifact_) return;
+  const Artifact* w = detail::PhaseGuard::writer;
+  std::string who = w != nullptr ? std::string(detail::PhaseGuard::role) + " of artifact '" + w->name() + "'"
+                                 : std::string("a ") + detail::PhaseGuard::role;
+  throw Error(who + " tried to write to artifact '" + artifact_->name() +
+              "': during a step, only an artifact's own driver writes its forces and torques");
+}
+
+void PhysicNode::addForce(const Vec3& force, Frame force_frame, const Vec3& point, Frame point_frame) {
+  requireWritable();
+  const detail::NodeData& n = world_->nodes[index_];
+  if (n.body < 0 || !world_->started())
+    throw Error("artifact '" + artifact_->name() + "', node '" + name() +
+                "': forces apply to dynamic nodes once the environment has started");
+  if (!force.allFinite() || !point.allFinite())
+    throw Error("artifact '" + artifact_->name() + "', node '" + name() + "': force or point is NaN or infinite");
+  const auto body = static_cast<std::size_t>(n.body);
+  const BodyState& b = world_->states[body];
+  const Pose node = n.at_body ? b.pose : b.pose * n.pose_in_body;
+  const Vec3 f = force_frame == Frame::World ? force : Vec3(node.orientation * force);
+  const Vec3 p = point_frame == Frame::Local ? node.transformPoint(point) : point;
+  Wrench& w = world_->wrenches[body];
+  w.force += f;
+  w.torque += (p - b.pose.position).cross(f);
+}
+
+void PhysicNode::addTorque(const Vec3& torque, Frame frame) {
+  requireWritable();
+  const detail::NodeData& n = world_->nodes[index_];
+  if (n.body < 0 || !world_->started())
+    throw Error("artifact '" + artifact_->name() + "', node '" + name() +
+                "': torques apply to dynamic nodes once the environment has started");
+  if (!torque.allFinite())
+    throw Error("artifact '" + artifact_->name() + "', node '" + name() + "': torque is NaN or infinite");
+  const Pose node = pose();
+  world_->wrenches[static_cast<std::size_t>(n.body)].torque +=
+      frame == Frame::World ? torque : Vec3(node.orientation * torque);
+}
+
+void PhysicNode::setVelocity(const Vec3& linear, const Vec3& angular) {
+  Environment& env = world_->env;
+  if (detail::PhaseGuard::in_phase) throw Error("setVelocity is not allowed during a step");
+  const PhysicsSettings& ps = env.settings().physics;
+  if (!linear.allFinite() || !angular.allFinite() || linear.norm() > ps.max_linear_speed ||
+      angular.norm() > ps.max_angular_speed)
+    throw Error("artifact '" + artifact_->name() + "', node '" + name() +
+                "': velocity must be finite and within max_linear_speed / max_angular_speed");
+  detail::NodeData& n = world_->nodes[index_];
+  if (env.state() == Environment::State::Setup) {
+    world_->node_setup[index_].initial_linear = linear;
+    world_->node_setup[index_].initial_angular = angular;
+    return;
+  }
+  if (n.is_static) throw Error("node '" + name() + "' of artifact '" + artifact_->name() + "' is static");
+  if (env.state() != Environment::State::Running) throw Error("setVelocity: the environment is not running");
+  BodyState b = world_->states[static_cast<std::size_t>(n.body)];
+  const Vec3 r = b.pose.position - pose().position;  // node origin to centre of mass
+  b.linear_velocity = linear + angular.cross(r);
+  b.angular_velocity = angular;
+  env.setBodyState(n.body, b);
 }
 
 }  // namespace ssx

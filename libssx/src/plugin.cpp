@@ -1,3 +1,5 @@
+#include "world.hpp"
+
 #include <ssx/artifact.hpp>
 #include <ssx/measurements.hpp>
 #include <ssx/environment.hpp>
@@ -40,8 +42,6 @@ void PluginSetup::addCameraRequest(std::function<bool(std::int64_t, CameraView&)
                          std::move(due), target);
 }
 
-Measurement::~Measurement() = default;
-bool Measurement::finite() const noexcept { return true; }
 
 SimulationExtension::~SimulationExtension() = default;
 void SimulationExtension::init(Environment&, const Descriptor&) {}
@@ -51,45 +51,24 @@ void SimulationExtension::shutdown(Environment&) {}
 void SimulationExtension::saveState(StateWriter&) const {}
 void SimulationExtension::loadState(StateReader&) {}
 
-}  // namespace ssx
+// --- Plugin: its slot in the world ---------------------------------------------------------------
 
-#include <ssx/measurements.hpp>
-
-namespace ssx {
-ClockMeasurement::~ClockMeasurement() = default;
-bool ClockMeasurement::finite() const noexcept { return std::isfinite(seconds); }
-PoseMeasurement::~PoseMeasurement() = default;
-bool PoseMeasurement::finite() const noexcept {
-  return pose.position.allFinite() && pose.orientation.coeffs().allFinite() && linear_velocity.allFinite() &&
-         angular_velocity.allFinite();
+void Plugin::bind(detail::World& world, Artifact& artifact, std::uint32_t slot, std::int64_t period_steps) noexcept {
+  world_ = &world;
+  artifact_ = &artifact;
+  env_ = &world.env;
+  slot_ = slot;
+  period_steps_ = period_steps;
 }
-}  // namespace ssx
 
-namespace ssx {
-ImuMeasurement::~ImuMeasurement() = default;
-bool ImuMeasurement::finite() const noexcept {
-  return accelerometer.allFinite() && gyroscope.allFinite() && std::isfinite(accelerometer_lsb) &&
-         std::isfinite(gyroscope_lsb);
+Random& Plugin::random() {
+  if (world_ == nullptr) throw Error("random(): the plugin is not attached to an artifact yet");
+  return world_->randoms[slot_];
 }
-}  // namespace ssx
 
-#include <ssx/metrics.hpp>
-#include <ssx/setpoint.hpp>
-
-namespace ssx {
-SetpointInterface::~SetpointInterface() = default;
-MetricSource::~MetricSource() = default;
-}  // namespace ssx
-
-namespace ssx {
-RangeMeasurement::~RangeMeasurement() = default;
-bool RangeMeasurement::finite() const noexcept {
-  return std::all_of(detections.begin(), detections.end(),
-                     [](const Detection& d) { return d.relative.allFinite() && std::isfinite(d.distance); });
+const std::string& Plugin::className() const noexcept {
+  static const std::string unattached = "plugin";
+  return world_ != nullptr ? world_->plugins[slot_].class_name : unattached;
 }
-CameraMeasurement::~CameraMeasurement() = default;
-// depth is +infinity where nothing was hit, by design: only the camera's pose is checked
-bool CameraMeasurement::finite() const noexcept {
-  return view.pose.position.allFinite() && view.pose.orientation.coeffs().allFinite();
-}
+
 }  // namespace ssx

@@ -1,0 +1,7 @@
+#include <ssx/metrics.hpp>
+
+namespace ssx {
+
+MetricSource::~MetricSource() = default;
+
+}  // namespace ssx

@@ -1,0 +1,7 @@
+#include <ssx/setpoint.hpp>
+
+namespace ssx {
+
+SetpointInterface::~SetpointInterface() = default;
+
+}  // namespace ssx
