@@ -113,4 +113,23 @@ class OdeEngine final : public PhysicEngine {
   std::size_t contact_count_ = 0;
 };
 
+// every thread that calls into ODE needs its own collision data (ode_engine.cpp)
+void ensureThreadData();
+
+template <class F>
+void OdeEngine::forEach(std::size_t n, F&& task) {
+  constexpr std::size_t kParallelFrom = 2 * kBlock;  // bodies
+  if (runner_ == nullptr || runner_->threads() < 2 || bodies_.size() < kParallelFrom || n < 2) {
+    for (std::size_t i = 0; i < n; ++i) task(i);
+    return;
+  }
+  runner_->forEach(
+      n,
+      [](void* context, std::size_t i) {
+        ensureThreadData();
+        (*static_cast<F*>(context))(i);
+      },
+      &task);
+}
+
 }  // namespace ssx::detail
