@@ -279,12 +279,19 @@ int commandRun(const RunArgs& args, bool realtime_given) {
   return status;
 }
 
-int commandValidate(const std::string& file, const std::vector<std::string>& plugin_path, const std::string& physics) {
+int commandValidate(const std::string& file, const std::vector<std::string>& plugin_path, const std::string& physics,
+                    bool print) {
   ssx::SceneOptions options;
   options.plugin_path = pluginPath(plugin_path);
   if (!physics.empty()) options.physics_engine = physics;
   try {
     const ssx::Scene scene = ssx::loadScene(file, options);
+    if (print) {
+      // the scene as the model holds it, every default filled in (nothing else on standard output)
+      printWarnings(scene);
+      std::cout << ssx::parseScene(file, options).toXml();
+      return 0;
+    }
     printWarnings(scene);
     std::cout << file << ": ok: " << scene.environment->artifactCount() << " artifacts, " << scene.warnings.size()
               << " warning(s); physics engine " << scene.environment->settings().physics.engine << " (available: "
@@ -526,6 +533,9 @@ int main(int argc, char** argv) {
   validate_cmd->add_option("scene", validate_file, "scene file")->required()->check(CLI::ExistingFile);
   validate_cmd->add_option("--plugin-path", validate_path, "plugin directory (repeatable)");
   std::string validate_physics;
+  bool validate_print = false;
+  validate_cmd->add_flag("--print", validate_print,
+                         "print the scene as ssx reads it, every default filled in (scene XML, on standard output)");
   validate_cmd->add_option("--physics", validate_physics, "check the scene for this physics engine: ode or bullet")
       ->check(CLI::IsMember(ssx::physicEngineNames()));
 
@@ -562,7 +572,7 @@ int main(int argc, char** argv) {
     if (realtime_given && (realtime->results().empty() || realtime->results().front().empty())) run.realtime = 1.0;
     return commandRun(run, realtime_given);
   }
-  if (*validate_cmd) return commandValidate(validate_file, validate_path, validate_physics);
+  if (*validate_cmd) return commandValidate(validate_file, validate_path, validate_physics, validate_print);
   if (*sweep_cmd) return commandSweep(sweep);
   if (*plugins_cmd && !inspect_file.empty()) return inspectOne(inspect_file, params_of);
   if (*plugins_cmd) return commandPlugins(plugins_path, params_of);

@@ -3,6 +3,7 @@
 #include "xml/scene_loader.hpp"
 
 #include <ssx/scene.hpp>
+#include <ssx/scene_model.hpp>
 
 #include <dlfcn.h>
 
@@ -41,29 +42,81 @@ fs::path installedDataDirectory() {
   return {};
 }
 
-Scene loadScene(const fs::path& file, const SceneOptions& options) {
-  Descriptor root;
+namespace {
+
+Descriptor rootOf(const fs::path& file) {
   try {
-    root = readXmlFile(file);
+    return readXmlFile(file);
   } catch (const ConfigError& e) {
     throw SceneError({{Diagnostic::Severity::Error, e.where(), e.detail()}});
   }
-  detail::SceneLoader loader(options);
+}
+
+Descriptor rootOf(std::string_view xml, const std::string& label) {
+  try {
+    return parseXml(xml, label);
+  } catch (const ConfigError& e) {
+    throw SceneError({{Diagnostic::Severity::Error, e.where(), e.detail()}});
+  }
+}
+
+fs::path directoryOf(const fs::path& file) {
   fs::path dir = file.parent_path();
-  if (dir.empty()) dir = ".";
-  return loader.load(std::move(root), file, dir);
+  return dir.empty() ? fs::path(".") : dir;
+}
+
+SceneModel parseWith(detail::SceneLoader& loader, Descriptor root, const fs::path& file, const fs::path& dir) {
+  SceneModel model = loader.parse(std::move(root), file, dir);
+  const bool failed = loader.hasErrors();
+  std::vector<Diagnostic> found = loader.takeDiagnostics();
+  if (failed) throw SceneError(std::move(found));
+  model.warnings = std::move(found);
+  return model;
+}
+
+// parsed and built in one go: the problems of both together, even when parsing found errors
+Scene load(const SceneOptions& options, Descriptor root, const fs::path& file, const fs::path& dir) {
+  detail::SceneLoader loader(options);
+  const SceneModel model = loader.parse(std::move(root), file, dir);
+  Scene scene = loader.build(model, false);
+  const bool failed = loader.hasErrors();
+  std::vector<Diagnostic> found = loader.takeDiagnostics();
+  if (failed) throw SceneError(std::move(found));
+  scene.warnings = std::move(found);
+  return scene;
+}
+
+}  // namespace
+
+SceneModel parseScene(const fs::path& file, const SceneOptions& options) {
+  detail::SceneLoader loader(options);
+  return parseWith(loader, rootOf(file), file, directoryOf(file));
+}
+
+SceneModel parseSceneString(std::string_view xml, const std::string& label, const fs::path& base_dir,
+                            const SceneOptions& options) {
+  detail::SceneLoader loader(options);
+  return parseWith(loader, rootOf(xml, label), label, base_dir);
+}
+
+Scene buildScene(const SceneModel& model, const SceneOptions& options) {
+  detail::SceneLoader loader(options);
+  Scene scene = loader.build(model, true);
+  const bool failed = loader.hasErrors();
+  std::vector<Diagnostic> found = model.warnings;
+  for (auto& d : loader.takeDiagnostics()) found.push_back(std::move(d));
+  if (failed) throw SceneError(std::move(found));
+  scene.warnings = std::move(found);
+  return scene;
+}
+
+Scene loadScene(const fs::path& file, const SceneOptions& options) {
+  return load(options, rootOf(file), file, directoryOf(file));
 }
 
 Scene loadSceneFromString(std::string_view xml, const std::string& label, const fs::path& base_dir,
                           const SceneOptions& options) {
-  Descriptor root;
-  try {
-    root = parseXml(xml, label);
-  } catch (const ConfigError& e) {
-    throw SceneError({{Diagnostic::Severity::Error, e.where(), e.detail()}});
-  }
-  detail::SceneLoader loader(options);
-  return loader.load(std::move(root), label, base_dir);
+  return load(options, rootOf(xml, label), label, base_dir);
 }
 
 }  // namespace ssx

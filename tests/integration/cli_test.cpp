@@ -120,6 +120,18 @@ TEST_CASE("ssx validate: 0 for a good scene, 2 with the diagnostics for a broken
   CHECK_THAT(bad.err, Contains("parts/negative_mass.xml:3: error: physic node 'body': mass must be positive"));
 }
 
+TEST_CASE("ssx validate --print: the scene with every default, which validates and prints the same again", "[cli]") {
+  const Result printed = run({"validate", (kExamples / "scenes" / "hover_swarm.xml").string(), "--print"});
+  REQUIRE(printed.status == 0);
+  CHECK_THAT(printed.out, Contains("<physics engine=\"ode\" gravity=\"0 0 -9.81\" substeps=\"1\"") &&
+                              Contains("<swarm type=") && Contains("layout=\"grid\" xyz="));
+  const fs::path copy = fs::temp_directory_path() / "ssx_cli_printed_scene.xml";
+  std::ofstream(copy) << printed.out;
+  const Result again = run({"validate", copy.string(), "--print"});
+  CHECK(again.status == 0);
+  CHECK(again.out == printed.out);
+}
+
 TEST_CASE("ssx validate and ssx plugins name the engines; --physics chooses one and checks the scene for it",
           "[cli][cross_engine]") {
   CHECK_THAT(run({"plugins"}).out, Contains("physics engines: ode, bullet") && Contains("render engines: null"));

@@ -13,6 +13,7 @@
 /// Both are drawn on the thread that calls Environment::step, one at a time.
 
 #include <ssx/export.hpp>
+#include <ssx/error.hpp>
 #include <ssx/types.hpp>
 
 #include <array>
@@ -77,6 +78,7 @@ struct CameraSpec {
   Vec3 position{8, -8, 6};
   Vec3 look_at = Vec3::Zero();
   std::string follow;  ///< artifact name; empty: fixed
+  SourceLocation follow_from;  ///< where `follow` was given (a camera of a scene file)
   bool frame_scene = false;  ///< set position and look_at at start so that every artifact is in view
   double fov_deg = 60.0;
   std::filesystem::path frames_dir;  ///< PNG per frame (frame_000000.png, ...); empty: none

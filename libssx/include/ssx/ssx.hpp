@@ -20,6 +20,7 @@
 #include <ssx/random.hpp>
 #include <ssx/render.hpp>
 #include <ssx/scene.hpp>
+#include <ssx/scene_model.hpp>
 #include <ssx/setpoint.hpp>
 #include <ssx/state.hpp>
 #include <ssx/timing.hpp>

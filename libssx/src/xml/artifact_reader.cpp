@@ -168,6 +168,9 @@ const ArtifactType* SceneLoader::artifactType(const std::string& name, const Sou
   try {
     documents_.push_back(readXmlFile(decl->second.file));
     t = parseArtifact(documents_.back());
+    t.name = name;
+    t.file = decl->second.file;
+    t.where = decl->second.where;
   } catch (const ConfigError& e) {
     if (e.where().line == 0)
       error(decl->second.where, "<type>: cannot read artifact file '" + decl->second.file.string() +

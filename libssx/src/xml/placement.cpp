@@ -1,5 +1,6 @@
-// Pass 2: artifacts placed one by one, as obstacles or as swarms, with their plugins created and
-// every parameter checked against its class's declarations.
+// Placements: read from the scene into the model (<artifact>, <swarm> with its layout, <ground>,
+// <obstacle>), then built: artifacts placed one by one, with their plugins created and every
+// parameter checked against its class's declarations.
 #include "xml/layouts.hpp"
 #include "xml/scene_loader.hpp"
 
@@ -46,7 +47,7 @@ void SceneLoader::checkPlugin(Environment& env, const void* instance, Descriptor
         if (a.value.find("{i}") != std::string::npos) per_member.push_back(a.key);
     clean_checks_.emplace(key, std::move(per_member));
   }
-  for (auto& d : found) diagnostics_.push_back(std::move(d));
+  for (auto& d : found) add(std::move(d));
   // unknown parameters were reported just now: not again when the environment starts
   for (const auto& a : params.attributes()) a.used = true;
 }
@@ -63,7 +64,7 @@ void SceneLoader::validatePlugin(Environment& env, const void* instance, const D
     const std::string element = "<" + params.name() + ">: ";
     if (d.message.rfind(element, 0) == 0) d.message.erase(0, element.size());
     d.message = element + what + ": " + d.message;
-    diagnostics_.push_back(std::move(d));
+    add(std::move(d));
   }
 }
 
@@ -95,40 +96,143 @@ SourceLocation SceneLoader::periodFrom(const PluginDecl& decl, const Descriptor*
   return decl.period_from;
 }
 
-void SceneLoader::place(Environment& env, const std::string& name, const std::string& type_name, const Pose& pose,
-                        const Descriptor& element, const std::string& index) {
-  const SourceLocation& where = element.where();
-  const ArtifactType* type = artifactType(type_name, where);
-  if (env.findArtifact(name) != nullptr) {
-    error(where, "duplicate artifact name '" + name + "'");
-    return;
+// --- reading ---------------------------------------------------------------------------------
+
+void SceneLoader::readPlacements() {
+  std::size_t swarm_index = 0;
+  for (std::size_t k = 0; k < entities_.size(); ++k) {
+    stage_ = stage(2, 2 * static_cast<std::int64_t>(k));
+    const Descriptor& d = *entities_[k].element;
+    PlacementModel p;
+    p.where = d.where();
+    bool ok = true;
+    if (d.name() == "artifact") {
+      p.kind = PlacementModel::Kind::Artifact;
+      p.name = require(d, "name");
+      p.type = require(d, "type");
+      p.xyz = read<Vec3>(d, "xyz", Vec3::Zero());
+      p.rpy = read<Vec3>(d, "rpy", Vec3::Zero());
+      checkUnknown(d, {"driver", "sensor"});
+      ok = !p.name.empty() && !p.type.empty() && readOverrides(d, p);
+    } else if (d.name() == "swarm") {
+      p.kind = PlacementModel::Kind::Swarm;
+      ok = readSwarm(d, p, swarm_index++);
+    } else if (d.name() == "ground") {
+      p.kind = PlacementModel::Kind::Ground;
+      p.name = "ground";
+      p.xyz.z() = read<double>(d, "z", 0.0);
+      checkUnknown(d);
+    } else {
+      p.kind = PlacementModel::Kind::Obstacle;
+      ok = readObstacle(d, p);
+    }
+    if (!ok) continue;
+    model_.placements.push_back(std::move(p));
+    placement_stage_.push_back(stage_);
   }
-  if (type == nullptr) return;
-  // parameter overrides: <driver .../> and <sensor index="i" .../> inside the placing element
-  const Descriptor* driver_override = element.child("driver");
-  std::vector<const Descriptor*> sensor_overrides(type->sensors.size(), nullptr);
-  for (const Descriptor* o : element.childrenNamed("sensor")) {
+}
+
+// the type (read now, if it was not yet) and the parameters the placing element sets on its plugins
+bool SceneLoader::readOverrides(const Descriptor& d, PlacementModel& p) {
+  const ArtifactType* type = artifactType(p.type, d.where());
+  if (const Descriptor* o = d.child("driver")) p.driver = std::make_shared<const Descriptor>(*o);
+  if (type == nullptr) return true;  // reported; built as far as it goes (its name is still taken)
+  p.sensors.assign(type->sensors.size(), nullptr);
+  for (const Descriptor* o : d.childrenNamed("sensor")) {
     const std::int64_t i = read<std::int64_t>(*o, "index", 0);
     if (i < 0 || i >= static_cast<std::int64_t>(type->sensors.size())) {
-      error(o->where(), "<sensor>: index " + std::to_string(i) + " does not name a sensor of type '" + type_name +
+      error(o->where(), "<sensor>: index " + std::to_string(i) + " does not name a sensor of type '" + p.type +
                             "' (it has " + std::to_string(type->sensors.size()) + ")");
       continue;
     }
-    sensor_overrides[static_cast<std::size_t>(i)] = o;
+    p.sensors[static_cast<std::size_t>(i)] = std::make_shared<const Descriptor>(*o);
   }
-  if (driver_override != nullptr && !type->driver)
-    error(driver_override->where(), "<driver>: artifact type '" + type_name + "' has no driver to set parameters of");
+  if (p.driver != nullptr && !type->driver)
+    error(p.driver->where(), "<driver>: artifact type '" + p.type + "' has no driver to set parameters of");
+  return true;
+}
 
+bool SceneLoader::readSwarm(const Descriptor& d, PlacementModel& p, std::size_t swarm_index) {
+  const std::size_t errors_before = errorCount();
+  p.type = require(d, "type");
+  p.count = readCount(d, "count", 1, 1);
+  p.name = read<std::string>(d, "name", p.type + "{i}");
+  p.first_index = readCount(d, "first_index", 0, 0);
+  p.layout = readChoice(d, "layout", "grid", {"grid", "random", "sphere"});
+  p.xyz = read<Vec3>(d, "xyz", Vec3::Zero());
+  p.rpy = read<Vec3>(d, "rpy", Vec3::Zero());
+  const std::int64_t count = p.count;
+  if (p.layout == "grid") {
+    p.spacing = readPositive(d, "spacing", 1.0);
+    p.columns = readCount(d, "columns", static_cast<std::int64_t>(std::ceil(std::sqrt(static_cast<double>(count)))), 1);
+    p.rows = readCount(d, "rows", (count + p.columns - 1) / p.columns, 1);
+    p.positions = detail::gridLayout(count, p.spacing, p.columns, p.rows);
+  } else if (p.layout == "random") {
+    p.min = read<Vec3>(d, "min", p.min);
+    p.max = read<Vec3>(d, "max", p.max);
+    if (!(p.min.array() <= p.max.array()).all()) error(d.where(), "<swarm>: every component of 'min' must be <= 'max'");
+    p.min_distance = read<double>(d, "min_distance", 0.0);
+    // a stream of its own, from the scene seed and the swarm's position among the swarms
+    Random rng(deriveSeed(settings_.seed, 0xa11ce5ULL, swarm_index));
+    p.positions = detail::randomLayout(count, p.min, p.max, p.min_distance, rng);
+    if (static_cast<std::int64_t>(p.positions.size()) < count) {
+      error(d.where(), "<swarm>: could not place " + std::to_string(count) + " members " +
+                           std::to_string(p.min_distance) + " m apart in the box: enlarge it or lower min_distance");
+      p.positions.resize(static_cast<std::size_t>(count), Vec3::Zero());
+    }
+  } else {
+    p.radius = readPositive(d, "radius", 1.0);
+    p.positions = detail::sphereLayout(count, p.radius);
+  }
+  checkUnknown(d, {"driver", "sensor"});
+  if (count > 1 && p.name.find("{i}") == std::string::npos)
+    error(d.where(), "<swarm>: the name pattern '" + p.name + "' needs {i} to give " + std::to_string(count) +
+                         " artifacts different names");
+  if (p.type.empty() || errorCount() != errors_before) return false;
+  readOverrides(d, p);
+  return errorCount() == errors_before && types_.at(p.type).ok;
+}
+
+bool SceneLoader::readObstacle(const Descriptor& d, PlacementModel& p) {
+  const std::size_t errors_before = errorCount();
+  p.name = require(d, "name");
+  p.xyz = read<Vec3>(d, "xyz", Vec3::Zero());
+  p.rpy = read<Vec3>(d, "rpy", Vec3::Zero());
+  (void)readColor(d, {0.55f, 0.55f, 0.6f, 1.0f});
+  bool shapes = false;
+  for (const Descriptor& c : d.children()) {
+    if (!kShapeElements.contains(c.name())) continue;
+    (void)readShape(c);
+    shapes = true;
+  }
+  checkUnknown(d, kShapeElements);
+  if (!shapes) error(d.where(), "<obstacle>: needs at least one shape (box, sphere, cylinder, capsule)");
+  if (p.name.empty() || errorCount() != errors_before) return false;
+  p.obstacle = std::make_shared<const Descriptor>(d);
+  return true;
+}
+
+// --- building ------------------------------------------------------------------------------------
+
+bool SceneLoader::place(Environment& env, const std::string& name, const PlacementModel& p,
+                        const ArtifactTypeModel& type, const Pose& pose, const std::string& index) {
+  const SourceLocation& where = p.where;
+  if (env.findArtifact(name) != nullptr) {
+    error(where, "duplicate artifact name '" + name + "'");
+    return false;
+  }
+  const Descriptor* driver_override = p.driver.get();
+  const auto sensor_override = [&](std::size_t i) { return i < p.sensors.size() ? p.sensors[i].get() : nullptr; };
   Artifact& a = env.addArtifact(name, pose);
   const std::size_t errors_before = errorCount();
-  for (const auto& p : type->physic) a.addPhysicRoot(p);
-  for (const auto& r : type->render) a.addRenderRoot(r);
+  for (const auto& r : type.physic) a.addPhysicRoot(r);
+  for (const auto& r : type.render) a.addRenderRoot(r);
   ClassLoader& loader = env.classLoader();
   // each plugin's parameters are checked against its declarations as it is attached, then each
   // class's own checks run on the whole artifact (a driver may need a sensor of some kind)
-  if (type->driver) {
-    const PluginDecl& decl = *type->driver;
-    auto create = [&](std::string_view p, std::string_view c) -> Driver& { return loader.createDriver(p, c); };
+  if (type.driver) {
+    const PluginDecl& decl = *type.driver;
+    auto create = [&](std::string_view pl, std::string_view c) -> Driver& { return loader.createDriver(pl, c); };
     if (Driver* d = createPlugin<Driver>(decl, create)) {
       Descriptor params = withOverrides(decl, driver_override, index);
       const std::int64_t period = periodOf(decl, driver_override);
@@ -137,37 +241,38 @@ void SceneLoader::place(Environment& env, const std::string& name, const std::st
       a.setDriver(*d, std::move(params), period, decl.class_name);
     }
   }
-  for (std::size_t i = 0; i < type->sensors.size(); ++i) {
-    const PluginDecl& decl = type->sensors[i];
-    auto create = [&](std::string_view p, std::string_view c) -> Sensor& { return loader.createSensor(p, c); };
+  for (std::size_t i = 0; i < type.sensors.size(); ++i) {
+    const PluginDecl& decl = type.sensors[i];
+    auto create = [&](std::string_view pl, std::string_view c) -> Sensor& { return loader.createSensor(pl, c); };
     if (Sensor* s = createPlugin<Sensor>(decl, create)) {
-      Descriptor params = withOverrides(decl, sensor_overrides[i], index);
-      const std::int64_t period = periodOf(decl, sensor_overrides[i]);
+      Descriptor params = withOverrides(decl, sensor_override(i), index);
+      const std::int64_t period = periodOf(decl, sensor_override(i));
       checkPlugin(env, s, params, &a, period, "sensor " + std::to_string(i) + " '" + decl.class_name + "'",
-                  periodFrom(decl, sensor_overrides[i]), &decl, sensor_overrides[i]);
+                  periodFrom(decl, sensor_override(i)), &decl, sensor_override(i));
       a.addSensor(*s, std::move(params), period, decl.class_name);
     }
   }
-  if (errorCount() != errors_before) return;  // the class checks assume values of the declared types
+  if (errorCount() != errors_before) return false;  // the class checks assume values of the declared types
   for (std::size_t i = 0; i < a.sensorCount(); ++i)
     validatePlugin(env, &a.sensor(i), a.sensorParameters(i), &a, a.sensor(i).periodSteps(),
                    "sensor " + std::to_string(i) + " '" + a.sensor(i).className() + "'");
   if (a.driver() != nullptr)
     validatePlugin(env, a.driver(), a.driverParameters(), &a, a.driver()->periodSteps(),
                    "driver '" + a.driver()->className() + "'");
+  return errorCount() == errors_before;
 }
 
-void SceneLoader::buildObstacle(Environment& env, const Descriptor& d) {
-  const std::size_t errors_before = errorCount();
-  const std::string name = require(d, "name");
-  const Pose pose = readPose(d);
+void SceneLoader::buildObstacle(Environment& env, const PlacementModel& p) {
+  const Descriptor& d = *p.obstacle;
+  // (read and checked when parsed: what reading it again says was said then)
+  const std::size_t said = diagnostics_.size();
   const auto color = readColor(d, {0.55f, 0.55f, 0.6f, 1.0f});
   PhysicNodeSpec spec;
-  spec.name = name;
+  spec.name = p.name;
   spec.where = d.where();
   spec.is_static = true;
   RenderNodeSpec render;
-  render.name = name;
+  render.name = p.name;
   for (const Descriptor& c : d.children()) {
     if (!kShapeElements.contains(c.name())) continue;
     spec.shapes.push_back(readShape(c));
@@ -175,63 +280,26 @@ void SceneLoader::buildObstacle(Environment& env, const Descriptor& d) {
     r.color = color;
     render.children.push_back(std::move(r));
   }
-  checkUnknown(d, kShapeElements);
-  if (spec.shapes.empty()) error(d.where(), "<obstacle>: needs at least one shape (box, sphere, cylinder, capsule)");
-  if (name.empty() || errorCount() != errors_before) return;
-  if (env.findArtifact(name) != nullptr) {
-    error(d.where(), "duplicate artifact name '" + name + "'");
+  if (parsed_) {
+    diagnostics_.resize(said);
+    stamps_.resize(said);
+  }
+  if (env.findArtifact(p.name) != nullptr) {
+    error(d.where(), "duplicate artifact name '" + p.name + "'");
     return;
   }
-  Artifact& a = env.addArtifact(name, pose);
+  Artifact& a = env.addArtifact(p.name, p.pose());
   a.addPhysicRoot(std::move(spec));
   a.addRenderRoot(std::move(render));
 }
 
-void SceneLoader::buildSwarm(Environment& env, const Descriptor& d, std::size_t swarm_index) {
-  const std::size_t errors_before = errorCount();
-  const std::string type = require(d, "type");
-  const std::int64_t count = readCount(d, "count", 1, 1);
-  const std::string pattern = read<std::string>(d, "name", type + "{i}");
-  const std::int64_t first = readCount(d, "first_index", 0, 0);
-  const std::string layout = readChoice(d, "layout", "grid", {"grid", "random", "sphere"});
-  const Pose origin = readPose(d);
-  std::vector<Vec3> positions;
-  if (layout == "grid") {
-    const double spacing = readPositive(d, "spacing", 1.0);
-    const auto columns =
-        readCount(d, "columns", static_cast<std::int64_t>(std::ceil(std::sqrt(static_cast<double>(count)))), 1);
-    const auto rows = readCount(d, "rows", (count + columns - 1) / columns, 1);
-    positions = detail::gridLayout(count, spacing, columns, rows);
-  } else if (layout == "random") {
-    const Vec3 lo = read<Vec3>(d, "min", Vec3(-1, -1, 0));
-    const Vec3 hi = read<Vec3>(d, "max", Vec3(1, 1, 1));
-    if (!(lo.array() <= hi.array()).all()) error(d.where(), "<swarm>: every component of 'min' must be <= 'max'");
-    const double min_distance = read<double>(d, "min_distance", 0.0);
-    // a stream of its own, from the scene seed and the swarm's position among the swarms
-    Random rng(deriveSeed(settings_.seed, 0xa11ce5ULL, swarm_index));
-    positions = detail::randomLayout(count, lo, hi, min_distance, rng);
-    if (static_cast<std::int64_t>(positions.size()) < count) {
-      error(d.where(), "<swarm>: could not place " + std::to_string(count) + " members " +
-                           std::to_string(min_distance) + " m apart in the box: enlarge it or lower min_distance");
-      positions.resize(static_cast<std::size_t>(count), Vec3::Zero());
-    }
-  } else {
-    positions = detail::sphereLayout(count, readPositive(d, "radius", 1.0));
-  }
-  checkUnknown(d, {"driver", "sensor"});
-  if (count > 1 && pattern.find("{i}") == std::string::npos)
-    error(d.where(), "<swarm>: the name pattern '" + pattern + "' needs {i} to give " + std::to_string(count) +
-                         " artifacts different names");
-  if (type.empty() || errorCount() != errors_before) return;
-  for (std::int64_t i = 0; i < count; ++i) {
-    std::string name = pattern;
-    const std::string index = std::to_string(first + i);
-    for (auto at = name.find("{i}"); at != std::string::npos; at = name.find("{i}", at + index.size()))
-      name.replace(at, 3, index);
+void SceneLoader::buildSwarm(Environment& env, const PlacementModel& p, const ArtifactTypeModel& type) {
+  const Pose origin = p.pose();
+  for (std::int64_t i = 0; i < p.count && static_cast<std::size_t>(i) < p.positions.size(); ++i) {
     Pose pose = origin;
-    pose.position = origin.transformPoint(positions[static_cast<std::size_t>(i)]);
-    place(env, name, type, pose, d, index);
-    if (errorCount() != errors_before) return;  // one report per swarm, not one per robot
+    pose.position = origin.transformPoint(p.positions[static_cast<std::size_t>(i)]);
+    if (!place(env, p.memberName(i), p, type, pose, std::to_string(p.first_index + i)))
+      return;  // one report per swarm, not one per robot
   }
 }
 

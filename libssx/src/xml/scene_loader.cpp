@@ -276,7 +276,7 @@ void SceneLoader::readRender(const Descriptor& d) {
     cam.position = read<Vec3>(*c, "xyz", cam.position);
     cam.look_at = read<Vec3>(*c, "look_at", cam.look_at);
     cam.follow = read<std::string>(*c, "follow", "");
-    if (!cam.follow.empty()) camera_follows_.push_back({cam.follow, c->find("follow")->where});
+    if (!cam.follow.empty()) cam.follow_from = c->find("follow")->where;
     cam.fov_deg = read<double>(*c, "fov_deg", cam.fov_deg);
     if (!validFieldOfView(cam.fov_deg)) {
       error(c->find("fov_deg")->where, "<camera>: fov_deg must be in (0, 180)");
@@ -291,7 +291,7 @@ void SceneLoader::readRender(const Descriptor& d) {
   checkUnknown(d, {"camera"});
 }
 
-void SceneLoader::build(Scene& scene) {
+void SceneLoader::applyOptions() {
   if (options_.seed) settings_.seed = *options_.seed;
   if (options_.threads) settings_.threads = *options_.threads;
   if (options_.render_engine) settings_.render.engine = *options_.render_engine;
@@ -308,75 +308,24 @@ void SceneLoader::build(Scene& scene) {
     if (!options_.video.empty()) cameras.front().video = options_.video;
     if (!options_.frames_dir.empty()) cameras.front().frames_dir = options_.frames_dir;
   }
-  try {
-    scene.environment = std::make_unique<Environment>(settings_);
-  } catch (const ConfigError& e) {
-    error(environment_element_ != nullptr ? environment_element_->where() : SourceLocation{scene.file.string(), 0},
-          e.detail());
-    // go on with defaults, so that the artifacts are checked too
-    scene.environment = std::make_unique<Environment>(EnvironmentSettings{});
-  }
-  Environment& env = *scene.environment;
-  // search order: the scene's directories, the caller's, then the installation's
-  for (const auto& dir : plugin_dirs_) env.classLoader().addSearchDirectory(dir);
-  for (const auto& dir : options_.plugin_path) env.classLoader().addSearchDirectory(dir);
-  if (options_.search_installed_plugins) env.classLoader().addSearchDirectory(ClassLoader::installedPluginDirectory());
+}
 
-  for (const Entity& e : extensions_) {
-    const Descriptor& d = *e.element;
+void SceneLoader::readExtensions() {
+  for (std::size_t j = 0; j < extensions_.size(); ++j) {
+    stage_ = stage(1, 2 * static_cast<std::int64_t>(j));
+    const Descriptor& d = *extensions_[j].element;
     const std::string name = require(d, "name");
     std::optional<PluginDecl> decl = readPluginDecl(d);
     if (name.empty() || !decl) continue;
     decl->params.erase("name");  // the extension's name, read here
-    try {
-      SimulationExtension& ext = env.classLoader().createExtension(decl->plugin, decl->class_name);
-      const std::size_t errors_before = errorCount();
-      checkPlugin(env, &ext, decl->params, nullptr, 1, "extension '" + decl->class_name + "'");
-      env.addExtension(name, ext, decl->params);
-      // its own checks run once every artifact exists, if its parameters are of the declared types
-      if (errorCount() == errors_before)
-        extension_checks_.push_back({&ext, decl->params, "extension '" + decl->class_name + "'"});
-    } catch (const PluginError& err) {
-      error(d.where(), "<extension>: " + std::string(err.what()));
-    } catch (const ConfigError& err) {
-      error(d.where(), "<extension>: " + err.detail());
-    }
-  }
-
-  std::size_t swarm_index = 0;
-  for (const Entity& e : entities_) {
-    const Descriptor& d = *e.element;
-    if (d.name() == "artifact") {
-      const std::string name = require(d, "name");
-      const std::string type = require(d, "type");
-      const Pose pose = readPose(d);
-      checkUnknown(d, {"driver", "sensor"});
-      if (!name.empty() && !type.empty()) place(env, name, type, pose, d);
-    } else if (d.name() == "swarm") {
-      buildSwarm(env, d, swarm_index++);
-    } else if (d.name() == "ground") {
-      const double z = read<double>(d, "z", 0.0);
-      checkUnknown(d);
-      if (env.findArtifact("ground") != nullptr)
-        error(d.where(), "<ground>: an artifact named 'ground' exists already");
-      else
-        env.addGround(z);
-    } else if (d.name() == "obstacle") {
-      buildObstacle(env, d);
-    }
-  }
-  // extensions check what they refer to (artifacts by name) once every artifact exists
-  for (const auto& c : extension_checks_) validatePlugin(env, c.extension, c.params, nullptr, 1, c.what);
-  for (const auto& [name, where] : camera_follows_) {
-    const Artifact* a = env.findArtifact(name);
-    if (a == nullptr || a->rootCount() == 0)
-      error(where, "<camera>: follows '" + name + "', which is no artifact with a physic root in this scene");
+    model_.extensions.push_back({name, std::move(*decl)});
   }
 }
 
-Scene SceneLoader::load(Descriptor root, const fs::path& file, const fs::path& dir) {
-  Scene scene;
-  scene.file = file;
+SceneModel SceneLoader::parse(Descriptor root, const fs::path& file, const fs::path& dir) {
+  model_.file = file;
+  parsed_ = true;
+  stage_ = stage(0);
   // an override that does not fit is reported with the rest (the scene is read without it)
   for (const auto& o : options_.overrides)
     if (auto problem = applyOverride(root, o)) error(o.where, *problem);
@@ -384,14 +333,108 @@ Scene SceneLoader::load(Descriptor root, const fs::path& file, const fs::path& d
   std::error_code ec;
   std::vector<fs::path> stack{fs::weakly_canonical(file, ec)};
   collect(documents_.front(), dir, stack);
-  // build even after errors, to report the problems of artifacts and plugins in the same go
-  build(scene);
-  if (hasErrors()) throw SceneError(std::move(diagnostics_));
-  scene.run.realtime_factor = run_.realtime_factor;
-  scene.run.overrun = run_.overrun;
-  scene.duration = duration_;
-  scene.warnings = std::move(diagnostics_);
+  applyOptions();
+  readExtensions();
+  readPlacements();
+  for (const auto& [name, type] : types_)
+    if (type.ok) model_.types.emplace(name, static_cast<const ArtifactTypeModel&>(type));
+  return std::move(model_);
+}
+
+void SceneLoader::buildExtensions(Environment& env, const SceneModel& model) {
+  for (std::size_t j = 0; j < model.extensions.size(); ++j) {
+    stage_ = stage(1, 2 * static_cast<std::int64_t>(j) + 1);
+    const ExtensionModel& e = model.extensions[j];
+    Descriptor params = e.plugin.params;
+    try {
+      SimulationExtension& ext = env.classLoader().createExtension(e.plugin.plugin, e.plugin.class_name);
+      const std::size_t errors_before = errorCount();
+      checkPlugin(env, &ext, params, nullptr, 1, "extension '" + e.plugin.class_name + "'");
+      env.addExtension(e.name, ext, params);
+      // its own checks run once every artifact exists, if its parameters are of the declared types
+      if (errorCount() == errors_before)
+        extension_checks_.push_back({&ext, params, "extension '" + e.plugin.class_name + "'"});
+    } catch (const PluginError& err) {
+      error(params.where(), "<extension>: " + std::string(err.what()));
+    } catch (const ConfigError& err) {
+      error(params.where(), "<extension>: " + err.detail());
+    }
+  }
+}
+
+Scene SceneLoader::build(const SceneModel& model, bool report_missing_types) {
+  Scene scene;
+  scene.file = model.file;
+  scene.run.realtime_factor = model.run.realtime_factor;
+  scene.run.overrun = model.run.overrun;
+  scene.duration = model.duration;
+  try {
+    scene.environment = std::make_unique<Environment>(model.settings);
+  } catch (const ConfigError& e) {
+    error(environment_element_ != nullptr ? environment_element_->where() : SourceLocation{model.file.string(), 0},
+          e.detail());
+    // go on with defaults, so that the artifacts are checked too
+    scene.environment = std::make_unique<Environment>(EnvironmentSettings{});
+  }
+  Environment& env = *scene.environment;
+  // search order: the scene's directories, the caller's, then the installation's
+  for (const auto& dir : model.plugin_dirs) env.classLoader().addSearchDirectory(dir);
+  for (const auto& dir : options_.plugin_path) env.classLoader().addSearchDirectory(dir);
+  if (options_.search_installed_plugins) env.classLoader().addSearchDirectory(ClassLoader::installedPluginDirectory());
+  buildExtensions(env, model);
+
+  for (std::size_t k = 0; k < model.placements.size(); ++k) {
+    const PlacementModel& p = model.placements[k];
+    stage_ = (k < placement_stage_.size() ? placement_stage_[k] : stage(2, 2 * static_cast<std::int64_t>(k))) + 1;
+    switch (p.kind) {
+      case PlacementModel::Kind::Artifact:
+      case PlacementModel::Kind::Swarm: {
+        const auto type = model.types.find(p.type);
+        if (type == model.types.end()) {
+          if (report_missing_types) error(p.where, "unknown artifact type '" + p.type + "' (the model has none of that name)");
+          if (p.kind == PlacementModel::Kind::Artifact && env.findArtifact(p.name) != nullptr)
+            error(p.where, "duplicate artifact name '" + p.name + "'");
+          break;
+        }
+        if (p.kind == PlacementModel::Kind::Artifact)
+          place(env, p.name, p, type->second, p.pose());
+        else
+          buildSwarm(env, p, type->second);
+        break;
+      }
+      case PlacementModel::Kind::Ground:
+        if (env.findArtifact("ground") != nullptr)
+          error(p.where, "<ground>: an artifact named 'ground' exists already");
+        else
+          env.addGround(p.xyz.z());
+        break;
+      case PlacementModel::Kind::Obstacle:
+        buildObstacle(env, p);
+        break;
+    }
+  }
+  stage_ = stage(3);
+  // extensions check what they refer to (artifacts by name) once every artifact exists
+  for (const auto& c : extension_checks_) validatePlugin(env, c.extension, c.params, nullptr, 1, c.what);
+  for (const CameraSpec& cam : model.settings.render.cameras) {
+    if (cam.follow.empty()) continue;
+    const Artifact* a = env.findArtifact(cam.follow);
+    if (a == nullptr || a->rootCount() == 0)
+      error(cam.follow_from, "<camera>: follows '" + cam.follow + "', which is no artifact with a physic root in this scene");
+  }
   return scene;
+}
+
+std::vector<Diagnostic> SceneLoader::takeDiagnostics() {
+  std::vector<std::size_t> order(diagnostics_.size());
+  for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
+  std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return stamps_[a] < stamps_[b]; });
+  std::vector<Diagnostic> sorted;
+  sorted.reserve(order.size());
+  for (std::size_t i : order) sorted.push_back(std::move(diagnostics_[i]));
+  diagnostics_.clear();
+  stamps_.clear();
+  return sorted;
 }
 
 }  // namespace detail

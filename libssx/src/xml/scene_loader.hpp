@@ -1,12 +1,15 @@
 #pragma once
-// The scene loader: scene and artifact files into an Environment, in two passes. Pass 1 collects
-// every element of the scene and its includes (scene_loader.cpp) and reads artifact files when a
-// type is first used (artifact_reader.cpp); pass 2 places artifacts, creates their plugins and
+// The scene loader: scene and artifact files into a SceneModel (parse), and a SceneModel into an
+// Environment (build). Parsing collects every element of the scene and its includes and reads the
+// settings (scene_loader.cpp), reads artifact files when a type is first used (artifact_reader.cpp)
+// and reads every placement (placement.cpp); building places artifacts, creates their plugins and
 // checks every parameter against its class's declarations (placement.cpp). Every problem is
-// collected; any error stops the load before anything starts.
+// collected, and reported in document order (each element's parse problems, then its build
+// problems); any error stops the load before anything starts.
 
 #include <cstdio>
 #include <ssx/scene.hpp>
+#include <ssx/scene_model.hpp>
 
 #include <array>
 #include <deque>
@@ -23,20 +26,11 @@ namespace ssx::detail {
 
 namespace fs = std::filesystem;
 
-struct PluginDecl {
-  std::string plugin;
-  std::string class_name;
-  std::int64_t period = 1;
-  SourceLocation period_from;  // where `period` was given, if it was
-  Descriptor params;
-};
+using PluginDecl = PluginDeclaration;
 
-struct ArtifactType {
+// an artifact type as the loader keeps it: the model, and whether its file was read without errors
+struct ArtifactType : ArtifactTypeModel {
   bool ok = true;
-  std::vector<std::shared_ptr<const PhysicNodeSpec>> physic;  // shared by every instance
-  std::vector<std::shared_ptr<const RenderNodeSpec>> render;  // shared by every instance
-  std::optional<PluginDecl> driver;
-  std::vector<PluginDecl> sensors;
 };
 
 // one element of the scene that makes artifacts, in document order
@@ -59,23 +53,36 @@ class SceneLoader {
  public:
   explicit SceneLoader(const SceneOptions& options) : options_(options) {}
 
-  Scene load(Descriptor root, const fs::path& file, const fs::path& dir);
+  // the files into a model (what could not be read is left out of it and reported)
+  SceneModel parse(Descriptor root, const fs::path& file, const fs::path& dir);
+  // a model into an environment (placements of types the model lacks are reported when
+  // `report_missing_types`; a model this loader parsed has reported them already)
+  Scene build(const SceneModel& model, bool report_missing_types);
+  bool hasErrors() const { return errorCount() > 0; }
+  // every problem found so far, in document order
+  std::vector<Diagnostic> takeDiagnostics();
 
  private:
-  // --- diagnostics ---
+  // --- diagnostics, each stamped with where in the document it belongs (see takeDiagnostics) ---
+  void add(Diagnostic d) {
+    diagnostics_.push_back(std::move(d));
+    stamps_.push_back(stage_);
+  }
   void error(const SourceLocation& where, std::string message) {
-    diagnostics_.push_back({Diagnostic::Severity::Error, where, std::move(message)});
+    add({Diagnostic::Severity::Error, where, std::move(message)});
   }
   void warning(const SourceLocation& where, std::string message) {
-    diagnostics_.push_back({Diagnostic::Severity::Warning, where, std::move(message)});
+    add({Diagnostic::Severity::Warning, where, std::move(message)});
   }
+  // stages, in document order: pass 1; extension j (parse, then build); entity k (parse, then
+  // build); the checks at the end
+  static std::int64_t stage(std::int64_t major, std::int64_t minor = 0) { return (major << 40) + minor; }
   void record(const ConfigError& e) { error(e.where(), e.detail()); }
   std::size_t errorCount() const {
     std::size_t n = 0;
     for (const auto& d : diagnostics_) n += d.severity == Diagnostic::Severity::Error ? 1 : 0;
     return n;
   }
-  bool hasErrors() const { return errorCount() > 0; }
 
   // --- typed reads that record errors and fall back ---
   template <class T>
@@ -149,13 +156,7 @@ class SceneLoader {
     return fallback;
   }
   Pose readPose(const Descriptor& d) {
-    Pose p;
-    p.position = read<Vec3>(d, "xyz", Vec3::Zero());
-    const Vec3 rpy = read<Vec3>(d, "rpy", Vec3::Zero());
-    // fixed-axis roll, pitch, yaw (as URDF): R = Rz(yaw) Ry(pitch) Rx(roll)
-    p.orientation = Quat(Eigen::AngleAxisd(rpy.z(), Vec3::UnitZ()) * Eigen::AngleAxisd(rpy.y(), Vec3::UnitY()) *
-                         Eigen::AngleAxisd(rpy.x(), Vec3::UnitX()));
-    return p;
+    return poseFromXyzRpy(read<Vec3>(d, "xyz", Vec3::Zero()), read<Vec3>(d, "rpy", Vec3::Zero()));
   }
   std::array<float, 4> readColor(const Descriptor& d, std::array<float, 4> fallback, const char* key = "color") {
     const auto* a = d.find(key);
@@ -206,12 +207,21 @@ class SceneLoader {
   RenderNodeSpec readRenderNode(const Descriptor& d, bool is_root);
   std::optional<PluginDecl> readPluginDecl(const Descriptor& d);
 
-  // --- pass 2: build ---
-  void build(Scene& scene);
-  void buildObstacle(Environment& env, const Descriptor& d);
-  void buildSwarm(Environment& env, const Descriptor& d, std::size_t swarm_index);
-  void place(Environment& env, const std::string& name, const std::string& type, const Pose& pose,
-             const Descriptor& element, const std::string& index = {});
+  // --- the rest of parsing: options, extensions, placements ---
+  void applyOptions();
+  void readExtensions();
+  void readPlacements();
+  bool readOverrides(const Descriptor& d, PlacementModel& p);
+  bool readSwarm(const Descriptor& d, PlacementModel& p, std::size_t swarm_index);
+  bool readObstacle(const Descriptor& d, PlacementModel& p);
+
+  // --- build ---
+  void buildExtensions(Environment& env, const SceneModel& model);
+  void buildObstacle(Environment& env, const PlacementModel& p);
+  void buildSwarm(Environment& env, const PlacementModel& p, const ArtifactTypeModel& type);
+  // returns false when it reported an error
+  bool place(Environment& env, const std::string& name, const PlacementModel& p, const ArtifactTypeModel& type,
+             const Pose& pose, const std::string& index = {});
   Descriptor withOverrides(const PluginDecl& decl, const Descriptor* overrides, const std::string& index);
   std::int64_t periodOf(const PluginDecl& decl, const Descriptor* overrides);
   static SourceLocation periodFrom(const PluginDecl& decl, const Descriptor* overrides);
@@ -230,6 +240,10 @@ class SceneLoader {
 
   const SceneOptions& options_;
   std::vector<Diagnostic> diagnostics_;
+  std::vector<std::int64_t> stamps_;  // per diagnostic: its stage
+  std::int64_t stage_ = 0;
+  bool parsed_ = false;  // this loader parsed the model it builds (its problems were reported then)
+  std::vector<std::int64_t> placement_stage_;  // per placement of the model parsed: its entity's parse stage
   // (class, declaration, placing element, period) whose check found nothing -> the parameters
   // whose values differ between the members (they hold {i}), for checkPlugin
   std::map<std::tuple<const void*, const PluginDecl*, const Descriptor*, std::int64_t>, std::vector<std::string>>
@@ -237,14 +251,15 @@ class SceneLoader {
   // what each class's validate shares between its instances (PluginContext::shared)
   std::map<const void*, PluginContext::SharedValues> validate_shared_;
   std::deque<Descriptor> documents_;  // every file read, kept alive for the pointers below
-  EnvironmentSettings settings_;
-  RunOptions run_;
-  std::optional<Nanoseconds> duration_;
+  SceneModel model_;  // what parse fills in
+  EnvironmentSettings& settings_ = model_.settings;
+  RunOptions& run_ = model_.run;
+  std::optional<Nanoseconds>& duration_ = model_.duration;
   const Descriptor* environment_element_ = nullptr;
   const Descriptor* physics_element_ = nullptr;
   const Descriptor* wind_element_ = nullptr;
   const Descriptor* render_element_ = nullptr;
-  std::vector<fs::path> plugin_dirs_;
+  std::vector<fs::path>& plugin_dirs_ = model_.plugin_dirs;
   std::vector<Entity> extensions_;
   std::vector<Entity> entities_;
   struct TypeDecl {
@@ -254,7 +269,6 @@ class SceneLoader {
   std::map<std::string, TypeDecl> type_decls_;
   std::map<std::string, ArtifactType> types_;          // by type name, parsed on first use
   std::map<std::string, std::string> failed_plugins_;  // "plugin/class" -> already reported
-  std::vector<std::pair<std::string, SourceLocation>> camera_follows_;  // checked once artifacts exist
   struct ExtensionCheck {
     const SimulationExtension* extension;
     Descriptor params;

@@ -1,0 +1,123 @@
+#pragma once
+/// @file
+/// A scene as a plain value, between the file and the world: what a scene file and its includes
+/// and artifact files say, parsed and checked, with every default filled in, before any plugin is
+/// loaded or any artifact made. Loading is two steps: parseScene() (the files into a SceneModel)
+/// and buildScene() (a SceneModel into an Environment: plugins loaded, their parameters checked
+/// against their declarations and by their own validate, artifacts made). loadScene() does both,
+/// reporting the problems of both together. A model prints back to scene XML (toXml(), what
+/// `ssx validate --print` shows), and two models compare equal when they print the same.
+
+#include <ssx/descriptor.hpp>
+#include <ssx/environment.hpp>
+#include <ssx/export.hpp>
+#include <ssx/parameters.hpp>
+#include <ssx/physic_node.hpp>
+#include <ssx/render.hpp>
+
+#include <cstdint>
+#include <filesystem>
+#include <map>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace ssx {
+
+struct SceneOptions;
+struct Scene;
+
+/// A pose from a position and fixed-axis roll, pitch and yaw in rad (as URDF: R = Rz(yaw) Ry(pitch)
+/// Rx(roll)), as scene and artifact files write poses (`xyz`, `rpy`).
+SSX_EXPORT Pose poseFromXyzRpy(const Vec3& xyz, const Vec3& rpy);
+
+/// A plugin as a file declares it: `<driver plugin="..." class="..." period="..." .../>`.
+struct PluginDeclaration {
+  std::string plugin;          ///< the library (libssx_<plugin>.so)
+  std::string class_name;      ///< the class in it (default: the library's name)
+  std::int64_t period = 1;     ///< steps between two runs
+  SourceLocation period_from;  ///< where `period` was given, if it was
+  Descriptor params;           ///< its parameters as written (checked against its class when built)
+};
+
+/// An artifact file, parsed: its node trees and the plugins it declares.
+struct ArtifactTypeModel {
+  std::string name;            ///< as <type name> declares it
+  std::filesystem::path file;  ///< the artifact file
+  SourceLocation where;        ///< of the <type>
+  std::vector<std::shared_ptr<const PhysicNodeSpec>> physic;  ///< shared by every instance
+  std::vector<std::shared_ptr<const RenderNodeSpec>> render;
+  std::optional<PluginDeclaration> driver;
+  std::vector<PluginDeclaration> sensors;
+};
+
+/// One element of the scene that makes artifacts, in document order: an <artifact>, a <swarm>
+/// (its members' places worked out), the <ground> or an <obstacle>.
+struct SSX_EXPORT PlacementModel {
+  enum class Kind : std::uint8_t { Artifact, Swarm, Ground, Obstacle };
+  Kind kind = Kind::Artifact;
+  SourceLocation where;
+  std::string name;  ///< the artifact's or obstacle's name; a swarm's name pattern (with {i})
+  std::string type;  ///< the artifact type (artifacts, swarms)
+  Vec3 xyz = Vec3::Zero(), rpy = Vec3::Zero();  ///< as written: position, fixed-axis roll pitch yaw (rad)
+  Pose pose() const;                            ///< from xyz and rpy
+  /// Parameters the placing element sets on its type's plugins: <driver .../> and <sensor
+  /// index="k" .../> inside it (null: none). A swarm's members share them; {i} in a value is the
+  /// member's index.
+  std::shared_ptr<const Descriptor> driver;
+  std::vector<std::shared_ptr<const Descriptor>> sensors;  ///< by sensor index of the type
+  // a swarm
+  std::int64_t count = 1, first_index = 0;
+  std::string layout = "grid";  ///< grid, random or sphere
+  double spacing = 1.0;         ///< grid
+  std::int64_t columns = 0, rows = 0;  ///< grid
+  Vec3 min = Vec3(-1, -1, 0), max = Vec3(1, 1, 1);  ///< random: the box
+  double min_distance = 0;                            ///< random
+  double radius = 1.0;                                ///< sphere
+  std::vector<Vec3> positions;  ///< the members' places in the swarm's frame (xyz, rpy)
+  std::string memberName(std::int64_t k) const;  ///< member k's name (the pattern with {i} = first_index + k)
+  // the ground: its height is xyz.z(); an obstacle: its element as written (shapes and colour)
+  std::shared_ptr<const Descriptor> obstacle;
+};
+
+/// An <extension>: its name and its plugin.
+struct ExtensionModel {
+  std::string name;
+  PluginDeclaration plugin;
+};
+
+struct SSX_EXPORT SceneModel {
+  std::filesystem::path file;  ///< the scene file, or the label of a scene in memory
+  EnvironmentSettings settings;
+  RunOptions run;                          ///< realtime_factor and overrun, as the file says
+  std::optional<Nanoseconds> duration;     ///< <environment duration>
+  std::vector<std::filesystem::path> plugin_dirs;  ///< <plugin_path>s, resolved
+  std::vector<ExtensionModel> extensions;
+  std::map<std::string, ArtifactTypeModel> types;  ///< the types the placements use, by name
+  std::vector<PlacementModel> placements;          ///< in document order
+  std::vector<Diagnostic> warnings;                ///< unknown elements and attributes, and the like
+
+  /// The scene as scene XML with every setting's default filled in: plugin directories, artifact
+  /// files and paths absolute; swarms with every layout attribute; plugin parameters and
+  /// obstacles as written. Parsing it gives an equal model.
+  std::string toXml() const;
+};
+
+/// The same scene, as printed (toXml()); where each value came from does not count.
+SSX_EXPORT bool operator==(const SceneModel& a, const SceneModel& b);
+
+/// Reads a scene file, its includes and the artifact files its placements use into a model,
+/// applying `options`' overrides (seed, threads, engines, attribute overrides, outputs). Loads no
+/// plugin. Throws SceneError listing every problem found.
+SSX_EXPORT SceneModel parseScene(const std::filesystem::path& file, const SceneOptions& options);
+/// Same, from text in memory; relative paths resolve against `base_dir`, messages say `label`.
+SSX_EXPORT SceneModel parseSceneString(std::string_view xml, const std::string& label,
+                                       const std::filesystem::path& base_dir, const SceneOptions& options);
+/// Builds the environment of a model: loads its plugins (search path: the model's plugin
+/// directories, `options.plugin_path`, then the installed plugin directory), checks every
+/// parameter against its class's declarations and by the class's own validate, makes every
+/// artifact. Starts nothing. Throws SceneError listing every problem found.
+SSX_EXPORT Scene buildScene(const SceneModel& model, const SceneOptions& options);
+
+}  // namespace ssx

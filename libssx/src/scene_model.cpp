@@ -1,0 +1,244 @@
+// The scene model as a value: poses from what files write, swarm members' names, and the model
+// printed back to scene XML (which is also how two models compare).
+#include <ssx/scene_model.hpp>
+
+#include <algorithm>
+#include <cstdio>
+#include <cstdlib>
+#include <sstream>
+
+namespace ssx {
+
+namespace fs = std::filesystem;
+
+Pose poseFromXyzRpy(const Vec3& xyz, const Vec3& rpy) {
+  Pose p;
+  p.position = xyz;
+  p.orientation = Quat(Eigen::AngleAxisd(rpy.z(), Vec3::UnitZ()) * Eigen::AngleAxisd(rpy.y(), Vec3::UnitY()) *
+                       Eigen::AngleAxisd(rpy.x(), Vec3::UnitX()));
+  return p;
+}
+
+Pose PlacementModel::pose() const { return poseFromXyzRpy(xyz, rpy); }
+
+std::string PlacementModel::memberName(std::int64_t k) const {
+  std::string out = name;
+  const std::string index = std::to_string(first_index + k);
+  for (auto at = out.find("{i}"); at != std::string::npos; at = out.find("{i}", at + index.size()))
+    out.replace(at, 3, index);
+  return out;
+}
+
+namespace {
+
+// numbers in the fewest digits that read back bit for bit
+std::string num(double v) {
+  char text[40];
+  for (int digits = 6; digits <= 17; ++digits) {
+    std::snprintf(text, sizeof text, "%.*g", digits, v);
+    if (std::strtod(text, nullptr) == v) break;
+  }
+  return text;
+}
+std::string num(float v) {
+  char text[40];
+  for (int digits = 6; digits <= 9; ++digits) {
+    std::snprintf(text, sizeof text, "%.*g", digits, static_cast<double>(v));
+    if (std::strtof(text, nullptr) == v) break;
+  }
+  return text;
+}
+std::string num(std::int64_t v) { return std::to_string(v); }
+std::string vec(const Vec3& v) { return num(v.x()) + " " + num(v.y()) + " " + num(v.z()); }
+std::string color(const Color& c) { return num(c[0]) + " " + num(c[1]) + " " + num(c[2]) + " " + num(c[3]); }
+std::string seconds(Nanoseconds ns) { return num(toSeconds(ns)); }
+std::string path(const fs::path& p) {
+  std::error_code ec;
+  const fs::path absolute = fs::absolute(p, ec);
+  return (ec ? p : absolute).lexically_normal().string();
+}
+
+std::string escaped(const std::string& s) {
+  std::string out;
+  for (char c : s) {
+    switch (c) {
+      case '&': out += "&amp;"; break;
+      case '<': out += "&lt;"; break;
+      case '>': out += "&gt;"; break;
+      case '"': out += "&quot;"; break;
+      default: out += c;
+    }
+  }
+  return out;
+}
+
+// one element: <name a="v" ...> children </name>, or <name .../> without children
+class Element {
+ public:
+  Element(std::ostringstream& out, std::string name, int depth) : out_(out), name_(std::move(name)), depth_(depth) {
+    out_ << std::string(2 * static_cast<std::size_t>(depth_), ' ') << '<' << name_;
+  }
+  Element& operator()(const std::string& key, const std::string& value) {
+    out_ << ' ' << key << "=\"" << escaped(value) << '"';
+    return *this;
+  }
+  void attributes(const Descriptor& d) {
+    for (const auto& a : d.attributes()) (*this)(a.key, a.value);
+  }
+  // ends the start tag; the children come next, then close()
+  void open() { out_ << ">\n"; }
+  void close() { out_ << std::string(2 * static_cast<std::size_t>(depth_), ' ') << "</" << name_ << ">\n"; }
+  void end() { out_ << "/>\n"; }
+
+ private:
+  std::ostringstream& out_;
+  std::string name_;
+  int depth_;
+};
+
+// a Descriptor as written
+void verbatim(std::ostringstream& out, const Descriptor& d, int depth) {
+  Element e(out, d.name(), depth);
+  e.attributes(d);
+  if (d.children().empty()) {
+    e.end();
+    return;
+  }
+  e.open();
+  for (const Descriptor& c : d.children()) verbatim(out, c, depth + 1);
+  e.close();
+}
+
+void plugin(Element& e, const PluginDeclaration& p) {
+  e("plugin", p.plugin)("class", p.class_name)("period", num(p.period));
+  e.attributes(p.params);
+}
+
+void overrides(std::ostringstream& out, const PlacementModel& p, Element& e) {
+  const bool any = p.driver != nullptr || std::any_of(p.sensors.begin(), p.sensors.end(), [](const auto& s) { return s != nullptr; });
+  if (!any) {
+    e.end();
+    return;
+  }
+  e.open();
+  if (p.driver != nullptr) verbatim(out, *p.driver, 2);
+  for (const auto& s : p.sensors)
+    if (s != nullptr) verbatim(out, *s, 2);
+  e.close();
+}
+
+void environment(std::ostringstream& out, const SceneModel& m) {
+  const EnvironmentSettings& s = m.settings;
+  Element e(out, "environment", 1);
+  e("timestep", seconds(s.timestep))("seed", std::to_string(s.seed))(
+      "threads", s.threads == 0 ? std::string("auto") : std::to_string(s.threads))(
+      "realtime_factor", num(m.run.realtime_factor))(
+      "overrun", m.run.overrun == RunOptions::Overrun::Resync ? "resync" : "catchup");
+  if (m.duration) e("duration", seconds(*m.duration));
+  e.end();
+}
+
+void physics(std::ostringstream& out, const PhysicsSettings& p) {
+  Element e(out, "physics", 1);
+  e("engine", p.engine)("gravity", vec(p.gravity))("substeps", num(std::int64_t{p.substeps}))(
+      "friction", num(p.friction))("restitution", num(p.restitution))("max_linear_speed", num(p.max_linear_speed))(
+      "max_angular_speed", num(p.max_angular_speed));
+  if (p.engine == "ode") {
+    const OdeSettings& o = p.ode;
+    e("solver", o.solver == OdeSettings::Solver::Exact ? "exact" : "quickstep")(
+        "iterations", num(std::int64_t{o.iterations}))("sor", num(o.sor))("erp", num(o.erp))("cfm", num(o.cfm))(
+        "contact_soft_erp", num(o.contact_soft_erp))("contact_soft_cfm", num(o.contact_soft_cfm))(
+        "max_contacts", num(std::int64_t{o.max_contacts}))("partitions", num(std::int64_t{o.partitions}))(
+        "contact_surface_layer", num(o.contact_surface_layer));
+  } else if (p.engine == "bullet") {
+    const BulletSettings& b = p.bullet;
+    e("iterations", num(std::int64_t{b.iterations}))("erp", num(b.erp))("cfm", num(b.cfm))(
+        "split_impulse", b.split_impulse ? "true" : "false")("split_impulse_threshold", num(b.split_impulse_threshold))(
+        "linear_slop", num(b.linear_slop));
+  }
+  e.end();
+}
+
+void render(std::ostringstream& out, const RenderSettings& r) {
+  Element e(out, "render", 1);
+  e("engine", r.engine)("rate_hz", num(r.rate_hz))("period", num(r.period_steps))(
+      "width", num(std::int64_t{r.width}))("height", num(std::int64_t{r.height}))("background", color(r.background));
+  if (r.cameras.empty()) {
+    e.end();
+    return;
+  }
+  e.open();
+  for (const CameraSpec& c : r.cameras) {
+    Element cam(out, "camera", 2);
+    cam("name", c.name);
+    if (!c.frame_scene) cam("xyz", vec(c.position));
+    cam("look_at", vec(c.look_at));
+    if (!c.follow.empty()) cam("follow", c.follow);
+    cam("fov_deg", num(c.fov_deg));
+    if (!c.frames_dir.empty()) cam("frames", c.frames_dir.string());
+    if (!c.video.empty()) cam("video", c.video.string());
+    if (!c.snapshot.empty()) cam("snapshot", c.snapshot.string());
+    cam.end();
+  }
+  e.close();
+}
+
+void wind(std::ostringstream& out, const WindSettings& w) {
+  Element e(out, "wind", 1);
+  e("mean", vec(w.mean))("gust", vec(w.gust))("gust_start", num(w.gust_start))("gust_duration", num(w.gust_duration))(
+      "turbulence_w20", num(w.turbulence_w20))("turbulence_min_airspeed", num(w.turbulence_min_airspeed));
+  e.end();
+}
+
+void placement(std::ostringstream& out, const PlacementModel& p) {
+  switch (p.kind) {
+    case PlacementModel::Kind::Artifact: {
+      Element e(out, "artifact", 1);
+      e("name", p.name)("type", p.type)("xyz", vec(p.xyz))("rpy", vec(p.rpy));
+      overrides(out, p, e);
+      break;
+    }
+    case PlacementModel::Kind::Swarm: {
+      Element e(out, "swarm", 1);
+      e("type", p.type)("count", num(p.count))("name", p.name)("first_index", num(p.first_index))(
+          "layout", p.layout)("xyz", vec(p.xyz))("rpy", vec(p.rpy));
+      if (p.layout == "grid") e("spacing", num(p.spacing))("columns", num(p.columns))("rows", num(p.rows));
+      if (p.layout == "random") e("min", vec(p.min))("max", vec(p.max))("min_distance", num(p.min_distance));
+      if (p.layout == "sphere") e("radius", num(p.radius));
+      overrides(out, p, e);
+      break;
+    }
+    case PlacementModel::Kind::Ground:
+      Element(out, "ground", 1)("z", num(p.xyz.z())).end();
+      break;
+    case PlacementModel::Kind::Obstacle:
+      if (p.obstacle != nullptr) verbatim(out, *p.obstacle, 1);
+      break;
+  }
+}
+
+}  // namespace
+
+std::string SceneModel::toXml() const {
+  std::ostringstream out;
+  out << "<scene>\n";
+  environment(out, *this);
+  physics(out, settings.physics);
+  render(out, settings.render);
+  wind(out, settings.wind);
+  for (const fs::path& dir : plugin_dirs) Element(out, "plugin_path", 1)("dir", path(dir)).end();
+  for (const ExtensionModel& x : extensions) {
+    Element e(out, "extension", 1);
+    e("name", x.name);
+    plugin(e, x.plugin);
+    e.end();
+  }
+  for (const auto& [name, type] : types) Element(out, "type", 1)("name", name)("file", path(type.file)).end();
+  for (const PlacementModel& p : placements) placement(out, p);
+  out << "</scene>\n";
+  return out.str();
+}
+
+bool operator==(const SceneModel& a, const SceneModel& b) { return a.toXml() == b.toXml(); }
+
+}  // namespace ssx
