@@ -11,6 +11,7 @@
 
 #include <ssx/random.hpp>
 #include <ssx/setpoint.hpp>
+#include <ssx/state.hpp>
 #include <ssx/types.hpp>
 
 #include <array>
@@ -283,6 +284,22 @@ InnerOutput innerLoopFloat(const InnerLoopParams& params, const AttitudeEstimate
                            const std::array<std::int32_t, 3>& gyro_counts,
                            const std::array<std::int32_t, 3>& accel_counts, const InnerCommand& command,
                            InnerMode mode = InnerMode::Attitude);
+
+/// A set-point into and out of a saved state (the parts that keep one: controller, references).
+inline void saveSetpoint(StateWriter& out, const Setpoint& s) {
+  out.write(s.position);
+  out.write(s.velocity);
+  out.write(s.acceleration);
+  out.write(s.yaw);
+  out.write(s.yaw_rate);
+}
+inline void loadSetpoint(StateReader& in, Setpoint& s) {
+  in.read(s.position);
+  in.read(s.velocity);
+  in.read(s.acceleration);
+  in.read(s.yaw);
+  in.read(s.yaw_rate);
+}
 
 /// Outer loop gains and limits.
 struct PositionParams {

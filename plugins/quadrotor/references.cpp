@@ -280,11 +280,7 @@ void References::formationStep(double dt) {
 
 void References::saveState(StateWriter& out) const {
   out.write(source_);
-  out.write(external_.position);
-  out.write(external_.velocity);
-  out.write(external_.acceleration);
-  out.write(external_.yaw);
-  out.write(external_.yaw_rate);
+  saveSetpoint(out, external_);
   out.write(virtual_point_);
   out.write(virtual_velocity_);
 }
@@ -296,11 +292,7 @@ void References::loadState(StateReader& in) {
   if (source != configured_ && source != Source::External)
     throw StateError("quadrotor: the saved reference source does not fit this driver (corrupted, or another scene)");
   source_ = source;
-  in.read(external_.position);
-  in.read(external_.velocity);
-  in.read(external_.acceleration);
-  in.read(external_.yaw);
-  in.read(external_.yaw_rate);
+  loadSetpoint(in, external_);
   in.read(virtual_point_);
   in.read(virtual_velocity_);
 }

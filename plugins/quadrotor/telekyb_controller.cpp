@@ -239,11 +239,7 @@ void TeleKybController::saveState(StateWriter& out) const {
   out.write(outer_->integral());
   out.write(command_);
   out.write(attitude_);
-  out.write(current_.position);
-  out.write(current_.velocity);
-  out.write(current_.acceleration);
-  out.write(current_.yaw);
-  out.write(current_.yaw_rate);
+  saveSetpoint(out, current_);
   out.write(imu_seen_);
   out.write(thrust_ratio_);
   // (without a delay the queue is not kept up to date: its one entry is the current command)
@@ -265,11 +261,7 @@ void TeleKybController::loadState(StateReader& in) {
   outer_->setIntegral(integral);
   in.read(command_);
   in.read(attitude_);
-  in.read(current_.position);
-  in.read(current_.velocity);
-  in.read(current_.acceleration);
-  in.read(current_.yaw);
-  in.read(current_.yaw_rate);
+  loadSetpoint(in, current_);
   in.read(imu_seen_);
   in.read(thrust_ratio_);
   std::vector<InnerCommand> queue;
