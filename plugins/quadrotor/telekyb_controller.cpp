@@ -157,15 +157,6 @@ AttitudeCommand TeleKybController::overLink(const AttitudeCommand& c) const {
   return command_link_ ? linkCommand(c, controller_mass_, gravity_, angle_step_) : c;
 }
 
-InnerCommand TeleKybController::toInner(const AttitudeCommand& c) {
-  InnerCommand out;
-  out.roll_q12 = static_cast<std::int32_t>(std::llround(c.roll * 4096.0));
-  out.pitch_q12 = static_cast<std::int32_t>(std::llround(c.pitch * 4096.0));
-  out.yaw_rate_q12 = static_cast<std::int32_t>(std::llround(c.yaw_rate * 4096.0));
-  out.thrust_q16 = static_cast<std::int32_t>(std::llround(c.thrust * 65536.0));
-  return out;
-}
-
 // the position loop: position (motion capture or ground truth) to attitude and thrust
 void TeleKybController::outerLoop(double t, FlightInputs& in) {
   current_ = in.reference(t, outer_dt_);

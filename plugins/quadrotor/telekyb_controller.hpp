@@ -9,6 +9,7 @@
 #include "quadrotor_model.hpp"
 
 #include <array>
+#include <cmath>
 #include <memory>
 #include <optional>
 #include <vector>
@@ -99,7 +100,14 @@ class TeleKybController final : public FlightController {
  private:
   void outerLoop(double t, FlightInputs& in);
   AttitudeCommand overLink(const AttitudeCommand& command) const;  // as command_link carries it
-  static InnerCommand toInner(const AttitudeCommand& command);
+  static InnerCommand toInner(const AttitudeCommand& c) {
+    InnerCommand out;
+    out.roll_q12 = static_cast<std::int32_t>(std::llround(c.roll * 4096.0));
+    out.pitch_q12 = static_cast<std::int32_t>(std::llround(c.pitch * 4096.0));
+    out.yaw_rate_q12 = static_cast<std::int32_t>(std::llround(c.yaw_rate * 4096.0));
+    out.thrust_q16 = static_cast<std::int32_t>(std::llround(c.thrust * 65536.0));
+    return out;
+  }
 
   // (what every step reads first; see the driver)
   CommandLevel level_ = CommandLevel::Position;

@@ -91,16 +91,6 @@ void Vehicle::configure(const RotorModel& at_rest, const Vec3& com_in_root, cons
   if (battery) battery_.emplace(*battery);
 }
 
-void Vehicle::applyWrench(PhysicNode& body, const BodyState& s, const BodyState& com, const Vec3& air) const {
-  // motors and aerodynamics, applied at the centre of mass in body axes
-  const Quat to_body = s.pose.orientation.conjugate();
-  const Vec3 v_air = com.linear_velocity - air;
-  Vec3 force, torque;
-  rotors_->wrench(to_body * v_air, to_body * s.angular_velocity, force, torque);
-  body.addForce(force, Frame::Local, com_in_root_, Frame::Local);
-  body.addTorque(torque, Frame::Local);
-}
-
 void Vehicle::saveState(StateWriter& out) const {
   // (per-rotor arrays as vectors of the rotor count)
   const std::size_t n = rotors_->size();

@@ -72,7 +72,15 @@ class Vehicle {
   void updateGains(double dt, GroundGain ground_gain);
   /// The rotors' wrench on the body for its state `s` (root) and `com` (centre of mass) in air
   /// moving at `air` (world frame).
-  void applyWrench(PhysicNode& body, const BodyState& s, const BodyState& com, const Vec3& air) const;
+  void applyWrench(PhysicNode& body, const BodyState& s, const BodyState& com, const Vec3& air) const {
+    // motors and aerodynamics, applied at the centre of mass in body axes
+    const Quat to_body = s.pose.orientation.conjugate();
+    const Vec3 v_air = com.linear_velocity - air;
+    Vec3 force, torque;
+    rotors_->wrench(to_body * v_air, to_body * s.angular_velocity, force, torque);
+    body.addForce(force, Frame::Local, com_in_root_, Frame::Local);
+    body.addTorque(torque, Frame::Local);
+  }
   /// Adds a world-frame force at the centre of mass.
   void push(PhysicNode& body, const Vec3& force) const { body.addForce(force, Frame::World, com_in_root_, Frame::Local); }
 
