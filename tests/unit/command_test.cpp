@@ -1,0 +1,35 @@
+// Commands at the five levels (ssx/command.hpp): names, rows, and what is wrong with a command
+// whatever the vehicle. Vehicles taking them: tests/unit/quadrotor/telekyb_controller_test.cpp.
+#include <ssx/command.hpp>
+
+#include <catch2/catch.hpp>
+
+#include <cmath>
+#include <string>
+
+using namespace ssx;
+
+TEST_CASE("command levels have names and rows of known sizes", "[command]") {
+  for (CommandLevel level : kCommandLevels) CHECK(commandLevelFromName(commandLevelName(level)) == level);
+  CHECK_FALSE(commandLevelFromName("thrust").has_value());
+  CHECK(Command::rowSizeFits(CommandLevel::Position, 4, 4));
+  CHECK(Command::rowSizeFits(CommandLevel::Position, 11, 4));
+  CHECK_FALSE(Command::rowSizeFits(CommandLevel::Position, 5, 4));
+  CHECK_FALSE(Command::rowSizeFits(CommandLevel::Velocity, 3, 4));
+  CHECK(Command::rowSizeFits(CommandLevel::Rotors, 6, 6));
+  CHECK_FALSE(Command::rowSizeFits(CommandLevel::Rotors, 4, 6));
+  const double row[] = {1, 2, 3, 0.5, 4, 5, 6};
+  const Command c = Command::fromRow(CommandLevel::Position, row);
+  CHECK(c.setpoint.position == Vec3(1, 2, 3));
+  CHECK(c.setpoint.yaw == 0.5);
+  CHECK(c.setpoint.velocity == Vec3(4, 5, 6));
+  CHECK(c.setpoint.acceleration == Vec3::Zero());
+  const double att[] = {0.1, -0.2, 0.3, 7};
+  const Command a = Command::fromRow(CommandLevel::Attitude, att);
+  CHECK((a.roll == 0.1 && a.pitch == -0.2 && a.yaw_rate == 0.3 && a.thrust == 7));
+  CHECK(Command::attitude(0, 0, 0, -1).problem().find("negative") != std::string::npos);
+  CHECK(Command::attitude(1.5, 0, 0, 1).problem().find("80 degrees") != std::string::npos);
+  CHECK(Command::rates(Vec3(0, NAN, 0), 1).problem().find("NaN") != std::string::npos);
+  CHECK(Command::rotors({400, -1, 400, 400}).problem().find("magnitudes") != std::string::npos);
+  CHECK(Command::velocityYawRate(Vec3(1, 0, 0), 0.1).problem().empty());
+}
