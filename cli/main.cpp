@@ -21,6 +21,7 @@
 #include <cstdio>
 #include <cerrno>
 #include <cstdlib>
+#include <cmath>
 #include <cstring>
 #include <fstream>
 #include <iostream>
@@ -42,7 +43,11 @@ constexpr int kExitBadInput = 2;
 
 std::atomic<bool> g_stop{false};
 
-void onSignal(int) { g_stop = true; }
+std::atomic<int> g_signal{0};  // the signal that stopped the run, if one did
+void onSignal(int sig) {
+  g_signal = sig;
+  g_stop = true;
+}
 
 // --plugin-path first, then SSX_PLUGIN_PATH (colon-separated), read here and nowhere else
 std::vector<fs::path> pluginPath(const std::vector<std::string>& from_args) {
@@ -110,6 +115,8 @@ struct RunArgs {
   bool quiet = false;
   std::string render, physics, snapshot, video, frames;
   std::string save_state, load_state;
+  bool allow_special_outputs = false;
+  bool duration_given = false;
   int rt_priority = 0;
 };
 
@@ -165,6 +172,7 @@ int commandRun(const RunArgs& args, bool realtime_given) {
   options.snapshot = args.snapshot;
   options.video = args.video;
   options.frames_dir = args.frames;
+  options.allow_special_outputs = args.allow_special_outputs;
   // settings of this process for drawing with Mesa's llvmpipe (the library leaves the process
   // alone; a program that embeds it chooses these itself, see the README):
   // - llvmpipe's own rasteriser threads cost more than they give at these image sizes and would
@@ -184,6 +192,18 @@ int commandRun(const RunArgs& args, bool realtime_given) {
   }
   printWarnings(scene);
   ssx::Environment& env = *scene.environment;
+  // this command's own files, with the scene's: nothing is written over what the run reads or
+  // writes already, before anything starts
+  {
+    if (!args.load_state.empty()) scene.files.addInput(args.load_state);
+    std::string problem;
+    if (!args.save_state.empty()) problem = scene.files.claimOutput(args.save_state, "--save-state", true);
+    if (problem.empty() && !args.stats_csv.empty()) problem = scene.files.claimOutput(args.stats_csv, "--stats-csv");
+    if (!problem.empty()) {
+      std::cerr << "ssx: error: " << problem << '\n';
+      return kExitBadInput;
+    }
+  }
 
   ssx::RunOptions run = scene.run;
   run.mode = args.fast ? ssx::RunOptions::Mode::Fast : ssx::RunOptions::Mode::RealTime;
@@ -192,8 +212,13 @@ int commandRun(const RunArgs& args, bool realtime_given) {
   if (args.steps >= 0) {
     run.steps = args.steps;
   } else {
+    if (args.duration_given && (!std::isfinite(args.duration) || !(ssx::toNanoseconds(args.duration) > 0))) {
+      std::cerr << "ssx: error: --duration " << args.duration
+                << ": not a number of seconds of at least a nanosecond (the run would have no end)\n";
+      return kExitBadInput;
+    }
     const ssx::Nanoseconds duration =
-        args.duration > 0 ? ssx::toNanoseconds(args.duration) : scene.duration.value_or(-1);
+        args.duration_given ? ssx::toNanoseconds(args.duration) : scene.duration.value_or(-1);
     if (duration > 0) run.steps = (duration + env.timestep() - 1) / env.timestep();
   }
   run.stop = &g_stop;
@@ -276,6 +301,9 @@ int commandRun(const RunArgs& args, bool realtime_given) {
       status = kExitRunFailure;
     }
   }
+  // stopped by SIGINT or SIGTERM: as a shell reports a process those signals ended (130, 143),
+  // after everything above was done (the state saved, files closed)
+  if (status == 0 && g_signal != 0) return 128 + g_signal;
   return status;
 }
 
@@ -523,6 +551,8 @@ int main(int argc, char** argv) {
   run_cmd->add_option("--video", run.video, "write the first camera's frames as MP4 to FILE (needs ffmpeg)");
   run_cmd->add_option("--frames", run.frames, "write the first camera's frames as PNG files into DIR");
   run_cmd->add_option("--save-state", run.save_state, "write the world's state to FILE at the end (ssx run --load-state)");
+  run_cmd->add_flag("--allow-special-outputs", run.allow_special_outputs,
+                    "let outputs written as streams (a logger's file, --stats-csv) be FIFOs or devices");
   run_cmd->add_option("--load-state", run.load_state,
                       "continue from a state saved from this scene (--steps and --duration count from there)")
       ->check(CLI::ExistingFile);
@@ -569,6 +599,7 @@ int main(int argc, char** argv) {
   if (*run_cmd) {
     // --realtime alone means factor 1
     const bool realtime_given = realtime->count() > 0;
+    run.duration_given = duration->count() > 0;
     if (realtime_given && (realtime->results().empty() || realtime->results().front().empty())) run.realtime = 1.0;
     return commandRun(run, realtime_given);
   }

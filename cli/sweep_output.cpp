@@ -48,6 +48,26 @@ void check(std::FILE* f, const fs::path& file) {
 
 Output::Output(const Spec& spec, fs::path file, fs::path robots_file)
     : spec_(spec), file_(std::move(file)), robots_file_(std::move(robots_file)) {
+  // the sweep's outputs are none of its inputs (the sweep file, the scene and every file the scene
+  // reads) nor each other, before any is opened
+  {
+    RunFiles files;
+    files.addInput(spec.file);
+    files.addInput(spec.scene);
+    try {
+      SceneOptions options;
+      options.plugin_path = spec.plugin_path;
+      for (const fs::path& f : parseScene(spec.scene, options).files) files.addInput(f);
+    } catch (const SceneError&) {
+      // (the runs report the scene's problems, each in its row)
+    }
+    fs::path summary = file_;
+    summary.replace_extension(".summary.csv");
+    std::string problem = files.claimOutput(file_, "--out");
+    if (problem.empty() && !robots_file_.empty()) problem = files.claimOutput(robots_file_, "--robots");
+    if (problem.empty()) problem = files.claimOutput(summary, "the summary", true);
+    if (!problem.empty()) throw std::runtime_error(problem);
+  }
   done_.assign(static_cast<std::size_t>(spec.runCount()), false);
   const std::string fingerprint = "# ssx sweep " + spec.fingerprint + " runs " + std::to_string(spec.runCount());
   const std::string header = join(spec.columns());

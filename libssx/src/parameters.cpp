@@ -225,6 +225,8 @@ std::string parameterTable(std::span<const ssx_plugin_param> declarations) {
       group = d.group;
     }
     std::string allowed = d.type == SSX_PARAM_CHOICE ? std::string(d.choices) : boundsText(d);
+    if ((d.flags & SSX_PARAM_OUTPUT) != 0)
+      allowed += std::string(allowed.empty() ? "" : "; ") + "a file it writes: not one the run reads or writes already";
     if ((d.flags & SSX_PARAM_RATE) != 0)
       allowed += std::string(allowed.empty() ? "" : "; ") + "period a whole multiple of the plugin's";
     std::string def = d.default_value != nullptr ? d.default_value : "";

@@ -20,7 +20,7 @@ class CsvLogger final : public SimulationExtension {
  public:
   static constexpr const char* kDoc = "writes poses and velocities of chosen artifacts to a CSV file";
   static constexpr ssx_plugin_param kParameters[] = {
-      param::required(param::text("file", "", "path of the CSV file (relative: to the working directory)")),
+      param::required(param::output("file", "", "path of the CSV file (relative: to the working directory)")),
       param::text("artifacts", "*", "artifact names separated by spaces, or * for every artifact with a dynamic root"),
       param::real("rate_hz", "0", "Hz", param::nonNegative(),
                   "rows per artifact per simulated second; 0 writes one every step"),
@@ -30,12 +30,8 @@ class CsvLogger final : public SimulationExtension {
 
   // what is logged exists before anything is opened
   static void validate(const Descriptor& params, const PluginContext& context) {
+    // (the file itself is checked by the loader, with the run's other files: SSX_PARAM_OUTPUT)
     (void)context.environment->selectArtifacts(params, "artifacts", "log");
-    const std::filesystem::path file = params.get<std::string>("file");
-    const std::filesystem::path dir = file.has_parent_path() ? file.parent_path() : ".";
-    std::error_code ec;
-    if (!std::filesystem::is_directory(dir, ec))
-      throw params.errorAt("file", "the directory of '" + file.string() + "' does not exist");
   }
 
   ~CsvLogger() override { close(); }

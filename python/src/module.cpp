@@ -102,8 +102,17 @@ class PyEnvironment {
   void step(std::int64_t n) {
     if (n < 0) throw py::value_error("ssx: step(n) needs n >= 0, got " + std::to_string(n));
     InUse use(busy_);
-    py::gil_scoped_release release;
-    env_.step(n);
+    // in slices, between which Ctrl-C (a pending signal) stops it: the steps are the same either way
+    constexpr std::int64_t kSlice = 256;
+    for (std::int64_t done = 0; done < n;) {
+      const std::int64_t k = std::min(kSlice, n - done);
+      {
+        py::gil_scoped_release release;
+        env_.step(k);
+      }
+      done += k;
+      if (done < n && PyErr_CheckSignals() != 0) throw py::error_already_set();
+    }
   }
 
   double time() const { return ssx::toSeconds(env_.time()); }

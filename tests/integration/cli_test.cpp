@@ -132,6 +132,46 @@ TEST_CASE("ssx validate --print: the scene with every default, which validates a
   CHECK(again.out == printed.out);
 }
 
+TEST_CASE("ssx run never writes its inputs, nor two outputs onto one file, and checks before anything is written",
+          "[cli][outputs]") {
+  const fs::path dir = fs::absolute("outputs_case");
+  fs::remove_all(dir);
+  fs::create_directories(dir / "sub");
+  const fs::path scene = dir / "s.xml";
+  std::ofstream(scene) << R"(<scene><environment timestep="0.01"/>
+    <type name="ball" file=")" << (kData / "valid" / "ball.xml").string() << R"("/>
+    <artifact name="b" type="ball" xyz="0 0 1"/>
+    <extension name="log" plugin="csv_logger" file=")" << (dir / "log.csv").string() << R"("/></scene>)";
+  const auto text = [](const fs::path& p) {
+    std::ifstream in(p);
+    return std::string((std::istreambuf_iterator<char>(in)), {});
+  };
+  const std::string before = text(scene);
+  // the state over the scene itself, by another spelling: refused, the scene untouched, no log begun
+  const Result over = run({"run", scene.string(), "--fast", "--steps", "5", "--save-state",
+                           (dir / "sub" / ".." / "s.xml").string()});
+  CHECK(over.status == 2);
+  CHECK_THAT(over.err, Contains("--save-state") && Contains("which this run reads"));
+  CHECK(text(scene) == before);
+  CHECK_FALSE(fs::exists(dir / "log.csv"));
+  // over the artifact file the scene reads, and onto the logger's file: refused too
+  CHECK(run({"run", scene.string(), "--fast", "--steps", "5", "--save-state", (kData / "valid" / "ball.xml").string()})
+            .status == 2);
+  const Result twice = run({"run", scene.string(), "--fast", "--steps", "5", "--stats-csv", (dir / "log.csv").string()});
+  CHECK(twice.status == 2);
+  CHECK_THAT(twice.err, Contains("which this run writes already"));
+  // a symbolic link is not replaced: it is refused and stays a link
+  fs::create_symlink(dir / "target.state", dir / "link.state");
+  const Result link = run({"run", scene.string(), "--fast", "--steps", "5", "--save-state", (dir / "link.state").string()});
+  CHECK(link.status == 2);
+  CHECK(fs::is_symlink(dir / "link.state"));
+  // a good run writes both
+  CHECK(run({"run", scene.string(), "--fast", "--steps", "5", "--save-state", (dir / "ok.state").string()}).status == 0);
+  CHECK(fs::exists(dir / "ok.state"));
+  CHECK(fs::exists(dir / "log.csv"));
+  fs::remove_all(dir);
+}
+
 TEST_CASE("ssx validate and ssx plugins name the engines; --physics chooses one and checks the scene for it",
           "[cli][cross_engine]") {
   CHECK_THAT(run({"plugins"}).out, Contains("physics engines: ode, bullet") && Contains("render engines: null"));
@@ -224,7 +264,7 @@ TEST_CASE("Ctrl-C stops a real-time run cleanly: summary printed, files closed",
                          }
                        });
   REQUIRE(sent);
-  CHECK(r.status == 0);
+  CHECK(r.status == 130);  // 128 + SIGINT, as a shell reports it
   CHECK_THAT(r.err, Contains("ssx: interrupted at t = "));
   CHECK_THAT(r.out, Contains("step time ms"));
   // the logger's file was flushed and closed by its shutdown: complete lines only
@@ -234,12 +274,43 @@ TEST_CASE("Ctrl-C stops a real-time run cleanly: summary printed, files closed",
   CHECK(content.back() == '\n');
 }
 
+TEST_CASE("ssx run: SIGTERM stops a run cleanly with 143, and the state asked for is saved", "[cli]") {
+  bool sent = false;
+  const fs::path state = fs::absolute("sigterm.state");
+  fs::remove(state);
+  const Result r = run({"run", (kExamples / "scenes" / "hover_swarm.xml").string(), "--duration", "1000",
+                        "--save-state", state.string()},
+                       {}, [&sent](pid_t pid, const std::string& err) {
+                         if (!sent && err.find("artifacts,") != std::string::npos) {
+                           kill(pid, SIGTERM);
+                           sent = true;
+                         }
+                       });
+  REQUIRE(sent);
+  CHECK(r.status == 143);
+  CHECK(fs::exists(state));
+}
+
+TEST_CASE("ssx run: a duration below a nanosecond or not a number is refused, not run without end", "[cli]") {
+  const std::string scene = (kExamples / "scenes" / "hover_swarm.xml").string();
+  for (const char* d : {"1e-12", "nan"}) {
+    INFO(d);
+    const Result r = run({"run", scene, "--fast", "--duration", d});
+    CHECK(r.status == 2);
+  }
+}
+
 TEST_CASE("ssx run: a log file that cannot be written fails the run with status 1 naming the file", "[cli][csv]") {
   std::ofstream("full.xml") << R"(<scene duration="0.2"><environment timestep="0.01"/>
     <type name="ball" file=")" << (kData / "valid" / "ball.xml").string() << R"("/>
     <artifact name="b" type="ball" xyz="0 0 1"/>
     <extension name="log" plugin="csv_logger" file="/dev/full" flush_s="0.05"/></scene>)";
-  const Result r = run({"run", "full.xml", "--fast"});
+  // a device is refused as an output unless streams into one are allowed
+  const Result refused = run({"run", "full.xml", "--fast"});
+  CHECK(refused.status == 2);
+  CHECK_THAT(refused.err, Contains("parameter 'file' '/dev/full' is not a regular file") &&
+                              Contains("--allow-special-outputs"));
+  const Result r = run({"run", "full.xml", "--fast", "--allow-special-outputs"});
   CHECK(r.status == 1);
   CHECK_THAT(r.err, Contains("cannot write '/dev/full'") && Contains("No space left on device"));
   CHECK_FALSE(Contains("step time ms").match(r.out));  // no summary of a failed run

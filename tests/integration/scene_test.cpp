@@ -211,7 +211,9 @@ TEST_CASE("csv_logger flushes at its simulated interval and when the run stops",
 TEST_CASE("csv_logger: a write that fails stops the run naming the file", "[scene][csv]") {
   REQUIRE(fs::exists("/dev/full"));  // writes there fail with ENOSPC, as on a full disk
   SECTION("at a flush while running") {
-    Scene scene = loadSceneFromString(loggerScene("/dev/full", "0.05"), "memory.xml", kData / "valid");
+    SceneOptions streams;
+    streams.allow_special_outputs = true;  // a device, written as a stream
+    Scene scene = loadSceneFromString(loggerScene("/dev/full", "0.05"), "memory.xml", kData / "valid", streams);
     try {
       scene.environment->step(10);
       FAIL("no StepError");
@@ -223,7 +225,9 @@ TEST_CASE("csv_logger: a write that fails stops the run naming the file", "[scen
     CHECK_NOTHROW(scene.environment->stop());
   }
   SECTION("at the end of the run") {
-    Scene scene = loadSceneFromString(loggerScene("/dev/full", "100"), "memory.xml", kData / "valid");
+    SceneOptions streams;
+    streams.allow_special_outputs = true;
+    Scene scene = loadSceneFromString(loggerScene("/dev/full", "100"), "memory.xml", kData / "valid", streams);
     scene.environment->step(10);
     CHECK_THROWS_WITH(scene.environment->stop(),
                       Contains("extension 'log'") && Contains("cannot write '/dev/full'") &&

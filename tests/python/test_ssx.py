@@ -358,6 +358,27 @@ def test_ctrl_c_stops_a_run_between_steps():
     assert env.step_count == stopped + 5
 
 
+def test_ctrl_c_stops_step_n_between_steps_and_the_steps_are_the_same():
+    env = hover(threads=1)
+    timer = threading.Timer(0.3, lambda: os.kill(os.getpid(), signal.SIGINT))
+    began = time.monotonic()
+    timer.start()
+    with pytest.raises(KeyboardInterrupt):
+        env.step(10**12)
+    timer.join()
+    assert time.monotonic() - began < 10
+    stopped = env.step_count
+    assert stopped > 0
+    env.step(5)  # still usable
+    assert env.step_count == stopped + 5
+    # stepping n at once gives the bits of stepping one at a time
+    a, b = hover(threads=1), hover(threads=1)
+    a.step(600)
+    for _ in range(600):
+        b.step(1)
+    assert a.state_hash() == b.state_hash()
+
+
 def test_stepping_releases_the_gil():
     env = hover(threads=1)
     done = threading.Event()

@@ -50,6 +50,19 @@ grep -q "broken.xml:5: error: metric 'no_such_metric': no plugin of this scene p
 "$ssx" sweep "$here/../../examples/sweeps/realistic_guesses.xml" --check | grep -q "27 point(s) x 1 seed(s) = 27 runs" \
   || fail "the realistic guesses sweep"
 
+# --- no output over an input: the scene (copied here, named by --robots) is left as it was ---
+cp "$data/small.xml" own.xml
+sed -i "s|scene=\"\([^/\"]*\)\"|scene=\"$data/\\1\"|" own.xml
+scene_file=$(sed -n 's/.*scene="\([^"]*\)".*/\1/p' own.xml | head -1)
+cp "$scene_file" own_scene_copy.xml
+status=0
+"$ssx" sweep own.xml --plugin-path "$plugins" --out own.csv --robots "$scene_file" > own.out 2>&1 || status=$?
+cat own.out
+[ "$status" -eq 2 ] || fail "--robots naming the scene: exit $status, expected 2"
+grep -q "which this run reads" own.out || fail "--robots naming the scene: no reason given"
+cmp -s "$scene_file" own_scene_copy.xml || fail "--robots naming the scene changed the scene"
+[ ! -e own.csv ] || fail "a refused sweep created its output"
+
 # --- one process, two processes: the same rows ---
 "$ssx" sweep "$data/small.xml" --plugin-path "$plugins" --out one.csv --robots one_robots.csv --jobs 1
 "$ssx" sweep "$data/small.xml" --plugin-path "$plugins" --out two.csv --jobs 2

@@ -63,6 +63,10 @@ enum ssx_param_flag : std::uint32_t {
   /// a rate in Hz of a loop inside the plugin: unless 0, its period must be a whole multiple of
   /// the plugin's own period (the plugin runs its loop every k of its runs)
   SSX_PARAM_RATE = 32u,
+  /// a file the plugin writes (a text parameter, relative to the working directory): the loader
+  /// checks it with the run's other files before anything runs (ssx/run_files.hpp): not a file the
+  /// run reads, not another output, a regular or a new file
+  SSX_PARAM_OUTPUT = 64u,
 };
 
 /// One declared parameter. `default_value` is text in the parameter's own syntax, or "" when the
@@ -178,6 +182,12 @@ constexpr ssx_plugin_param flag(const char* name, const char* default_value, con
 }
 constexpr ssx_plugin_param text(const char* name, const char* default_value, const char* doc) {
   return make(name, SSX_PARAM_TEXT, "", default_value, {}, "", doc);
+}
+/// A file the plugin writes (SSX_PARAM_OUTPUT).
+constexpr ssx_plugin_param output(const char* name, const char* default_value, const char* doc) {
+  ssx_plugin_param p = text(name, default_value, doc);
+  p.flags |= SSX_PARAM_OUTPUT;
+  return p;
 }
 constexpr ssx_plugin_param vec3(const char* name, const char* default_value, const char* unit, Bounds bounds,
                                 const char* doc) {

@@ -6,6 +6,7 @@
 #include <ssx/error.hpp>
 #include <ssx/export.hpp>
 #include <ssx/parameters.hpp>
+#include <ssx/run_files.hpp>
 
 #include <cstdint>
 #include <filesystem>
@@ -65,6 +66,8 @@ struct SceneOptions {
   /// false: the scene's <extension> elements are left out (headless batch runs: no logger writes,
   /// no bridge connects).
   bool extensions = true;
+  /// Outputs written as streams (a logger's file) may be FIFOs or character devices (RunFiles).
+  bool allow_special_outputs = false;
 };
 
 /// A loaded scene: an environment ready to start, and how the file asks to run it.
@@ -74,6 +77,9 @@ struct Scene {
   RunOptions run;                       ///< real-time factor and overrun policy from the file
   std::optional<Nanoseconds> duration;  ///< <environment duration>, if given
   std::vector<Diagnostic> warnings;     ///< unknown elements and attributes, and the like
+  /// The files the scene was read from, and the outputs its plugins and cameras write, checked
+  /// against each other; claim the program's own outputs here before anything runs.
+  RunFiles files;
 };
 
 /// Where the installed artifact types (`artifacts/`) and example scenes (`scenes/`) are: the

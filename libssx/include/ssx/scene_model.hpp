@@ -97,6 +97,8 @@ struct SSX_EXPORT SceneModel {
   std::map<std::string, ArtifactTypeModel> types;  ///< the types the placements use, by name
   std::vector<PlacementModel> placements;          ///< in document order
   std::vector<Diagnostic> warnings;                ///< unknown elements and attributes, and the like
+  /// Every file read: the scene file, its includes, the artifact files (the run's inputs).
+  std::vector<std::filesystem::path> files;
 
   /// The scene as scene XML with every setting's default filled in: plugin directories, artifact
   /// files and paths absolute; swarms with every layout attribute; plugin parameters and

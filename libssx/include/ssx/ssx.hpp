@@ -19,6 +19,7 @@
 #include <ssx/plugin_abi.hpp>
 #include <ssx/random.hpp>
 #include <ssx/render.hpp>
+#include <ssx/run_files.hpp>
 #include <ssx/scene.hpp>
 #include <ssx/scene_model.hpp>
 #include <ssx/setpoint.hpp>

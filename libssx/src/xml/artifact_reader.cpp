@@ -166,6 +166,7 @@ const ArtifactType* SceneLoader::artifactType(const std::string& name, const Sou
   }
   ArtifactType& t = types_[name];
   try {
+    model_.files.push_back(decl->second.file);
     documents_.push_back(readXmlFile(decl->second.file));
     t = parseArtifact(documents_.back());
     t.name = name;

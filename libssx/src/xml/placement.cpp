@@ -47,6 +47,15 @@ void SceneLoader::checkPlugin(Environment& env, const void* instance, Descriptor
         if (a.value.find("{i}") != std::string::npos) per_member.push_back(a.key);
     clean_checks_.emplace(key, std::move(per_member));
   }
+  // the files it writes, with the run's others (only when its values are of the declared types)
+  if (found.empty())
+    for (const ssx_plugin_param& p : declarations) {
+      if ((p.flags & SSX_PARAM_OUTPUT) == 0) continue;
+      const auto* a = params.find(p.name);
+      if (a == nullptr || a->value.empty()) continue;
+      if (auto problem = files_.claimOutput(a->value, "parameter '" + std::string(p.name) + "'"); !problem.empty())
+        found.push_back({Diagnostic::Severity::Error, a->where, "<" + params.name() + ">: " + what + ": " + problem});
+    }
   for (auto& d : found) add(std::move(d));
   // unknown parameters were reported just now: not again when the environment starts
   for (const auto& a : params.attributes()) a.used = true;

@@ -79,6 +79,7 @@ void SceneLoader::collect(const Descriptor& scene, const fs::path& dir, std::vec
         continue;
       }
       try {
+        model_.files.push_back(path);
         documents_.push_back(readXmlFile(path));
       } catch (const ConfigError& e) {
         if (e.where().line == 0)
@@ -144,8 +145,13 @@ void SceneLoader::readEnvironment(const Descriptor& d) {
                                                    d.find("realtime_factor")->value + "'"));
   run_.overrun = readChoice(d, "overrun", "catchup", {"catchup", "resync"}) == "resync" ? RunOptions::Overrun::Resync
                                                                                         : RunOptions::Overrun::CatchUp;
-  if (d.has("duration"))
+  if (d.has("duration")) {
     duration_ = toNanoseconds(readPositiveAtMost(d, "duration", 1.0, kMaxDurationSeconds, "about 31 years of simulated time"));
+    if (*duration_ <= 0) {
+      error(d.find("duration")->where, "<environment>: duration is shorter than a nanosecond (the run would have no end)");
+      duration_ = toNanoseconds(1.0);  // reported once, here
+    }
+  }
   checkUnknown(d);
 }
 
@@ -325,6 +331,8 @@ void SceneLoader::readExtensions() {
 SceneModel SceneLoader::parse(Descriptor root, const fs::path& file, const fs::path& dir) {
   model_.file = file;
   parsed_ = true;
+  std::error_code file_ec;
+  if (fs::is_regular_file(file, file_ec)) model_.files.push_back(file);  // (a scene in memory is no file)
   stage_ = stage(0);
   // an override that does not fit is reported with the rest (the scene is read without it)
   for (const auto& o : options_.overrides)
@@ -365,6 +373,8 @@ void SceneLoader::buildExtensions(Environment& env, const SceneModel& model) {
 Scene SceneLoader::build(const SceneModel& model, bool report_missing_types) {
   Scene scene;
   scene.file = model.file;
+  files_.allowSpecialOutputs(options_.allow_special_outputs);
+  for (const fs::path& f : model.files) files_.addInput(f);
   scene.run.realtime_factor = model.run.realtime_factor;
   scene.run.overrun = model.run.overrun;
   scene.duration = model.duration;
@@ -414,6 +424,18 @@ Scene SceneLoader::build(const SceneModel& model, bool report_missing_types) {
     }
   }
   stage_ = stage(3);
+  // what the cameras write, with the plugins' outputs
+  for (const CameraSpec& cam : model.settings.render.cameras) {
+    const SourceLocation where{model.file.string(), 0};
+    const std::string who = "camera '" + cam.name + "': ";
+    if (!cam.snapshot.empty())
+      if (auto problem = files_.claimOutput(cam.snapshot, who + "snapshot", false, true); !problem.empty()) error(where, problem);
+    if (!cam.video.empty())
+      if (auto problem = files_.claimOutput(cam.video, who + "video", false, true); !problem.empty()) error(where, problem);
+    if (!cam.frames_dir.empty())
+      if (auto problem = files_.claimOutputDirectory(cam.frames_dir, who + "frames"); !problem.empty())
+        error(where, problem);
+  }
   // extensions check what they refer to (artifacts by name) once every artifact exists
   for (const auto& c : extension_checks_) validatePlugin(env, c.extension, c.params, nullptr, 1, c.what);
   for (const CameraSpec& cam : model.settings.render.cameras) {
@@ -422,6 +444,7 @@ Scene SceneLoader::build(const SceneModel& model, bool report_missing_types) {
     if (a == nullptr || a->rootCount() == 0)
       error(cam.follow_from, "<camera>: follows '" + cam.follow + "', which is no artifact with a physic root in this scene");
   }
+  scene.files = files_;
   return scene;
 }
 

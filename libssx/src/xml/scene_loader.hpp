@@ -242,7 +242,8 @@ class SceneLoader {
   std::vector<Diagnostic> diagnostics_;
   std::vector<std::int64_t> stamps_;  // per diagnostic: its stage
   std::int64_t stage_ = 0;
-  bool parsed_ = false;  // this loader parsed the model it builds (its problems were reported then)
+  bool parsed_ = false;
+  RunFiles files_;  // the inputs, and the outputs claimed so far (build)  // this loader parsed the model it builds (its problems were reported then)
   std::vector<std::int64_t> placement_stage_;  // per placement of the model parsed: its entity's parse stage
   // (class, declaration, placing element, period) whose check found nothing -> the parameters
   // whose values differ between the members (they hold {i}), for checkPlugin

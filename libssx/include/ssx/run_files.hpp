@@ -1,0 +1,53 @@
+#pragma once
+/// @file
+/// The files a run reads and writes, checked before anything is opened: no output may be a file the
+/// run reads or another of its outputs (compared by identity: the same file under another spelling,
+/// a hard link or a symbolic link is the same file), and an output must be a regular file or a new
+/// one in an existing directory. A FIFO, a device, a directory or a symbolic link as an output is
+/// refused: a run replaces its outputs, and would replace those instead of writing through them.
+/// The scene loader fills in the scene's inputs and the outputs its plugins declare
+/// (SSX_PARAM_OUTPUT); the CLI, Python and programs add theirs (a state to save, timing samples).
+
+#include <ssx/export.hpp>
+
+#include <cstdint>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+namespace ssx {
+
+class SSX_EXPORT RunFiles {
+ public:
+  /// Outputs written as a stream (a logger's file, timing samples) may then be a FIFO or a
+  /// character device (a pipe to another program, /dev/null): SceneOptions::allow_special_outputs,
+  /// `ssx run --allow-special-outputs`. Outputs a run replaces (a saved state) never may.
+  void allowSpecialOutputs(bool allow) { allow_special_ = allow; }
+  /// A file the run reads (a scene, an included or artifact file, a state to load).
+  void addInput(const std::filesystem::path& file);
+  /// Claims `path` as an output of the run (`replaced`: written beside it and renamed over it, as a
+  /// saved state is, so never a special file). Returns what is wrong with it ("" when nothing is, and
+  /// then it is recorded); `what` names it in the message ("--save-state", "parameter 'file'").
+  /// (`makes_directory`: its writer creates the directory it goes in, so that need not exist yet.)
+  std::string claimOutput(const std::filesystem::path& path, const std::string& what, bool replaced = false,
+                          bool makes_directory = false);
+  /// Claims a directory the run writes files into (PNG frames): it may exist or be new, and must
+  /// hold no input of the run. Returns what is wrong ("" when nothing is).
+  std::string claimOutputDirectory(const std::filesystem::path& dir, const std::string& what);
+  const std::vector<std::filesystem::path>& inputs() const { return inputs_; }
+  const std::vector<std::filesystem::path>& outputs() const { return outputs_; }
+
+ private:
+  struct Identity {
+    bool exists = false;
+    std::uintmax_t device = 0, inode = 0;
+    std::string path;  // absolute and normal (for a file that does not exist yet)
+    bool operator==(const Identity& o) const;
+  };
+  static Identity identify(const std::filesystem::path& file);
+  std::vector<std::filesystem::path> inputs_, outputs_;
+  std::vector<Identity> input_ids_, output_ids_;
+  bool allow_special_ = false;
+};
+
+}  // namespace ssx

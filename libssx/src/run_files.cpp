@@ -1,0 +1,85 @@
+#include <ssx/run_files.hpp>
+
+#include <sys/stat.h>
+
+namespace ssx {
+
+namespace fs = std::filesystem;
+
+bool RunFiles::Identity::operator==(const Identity& o) const {
+  if (exists && o.exists) return device == o.device && inode == o.inode;
+  return path == o.path;
+}
+
+RunFiles::Identity RunFiles::identify(const fs::path& file) {
+  Identity id;
+  std::error_code ec;
+  id.path = fs::weakly_canonical(fs::absolute(file, ec), ec).lexically_normal().string();
+  struct stat st {};
+  if (::stat(file.c_str(), &st) == 0) {  // (follows links: a link names the file it points to)
+    id.exists = true;
+    id.device = static_cast<std::uintmax_t>(st.st_dev);
+    id.inode = static_cast<std::uintmax_t>(st.st_ino);
+  }
+  return id;
+}
+
+void RunFiles::addInput(const fs::path& file) {
+  const Identity id = identify(file);
+  for (const Identity& known : input_ids_)
+    if (known == id) return;
+  inputs_.push_back(file);
+  input_ids_.push_back(id);
+}
+
+std::string RunFiles::claimOutput(const fs::path& path, const std::string& what, bool replaced,
+                                  bool makes_directory) {
+  const std::string named = what + " '" + path.string() + "'";
+  if (path.empty()) return what + ": an empty path";
+  std::error_code ec;
+  const fs::file_status link = fs::symlink_status(path, ec);
+  const fs::file_status target = fs::status(path, ec);
+  const bool special = fs::is_fifo(target) || fs::is_character_file(target);
+  const bool streamed = !replaced && allow_special_ && special;
+  if (fs::is_symlink(link) && !streamed)
+    return named + " is a symbolic link: a run replaces its outputs, and would replace the link; give the file "
+                   "it points to";
+  if (fs::exists(link) && !streamed) {
+    if (fs::is_directory(target)) return named + " is a directory: give a file name";
+    if (!fs::is_regular_file(link))
+      return named + " is not a regular file (a FIFO, a device or a socket): " +
+             (replaced || !special ? std::string("a run replaces this output")
+                                   : std::string("to write a stream into it, allow special outputs "
+                                                 "(ssx run --allow-special-outputs)"));
+  } else if (!fs::exists(link) && !makes_directory) {
+    const fs::path dir = path.has_parent_path() ? path.parent_path() : fs::path(".");
+    if (!fs::is_directory(dir, ec)) return named + ": the directory '" + dir.string() + "' does not exist";
+  }
+  const Identity id = identify(path);
+  for (std::size_t i = 0; i < input_ids_.size(); ++i)
+    if (input_ids_[i] == id)
+      return named + " is '" + inputs_[i].string() + "', which this run reads: a run never writes its own inputs";
+  for (std::size_t i = 0; i < output_ids_.size(); ++i)
+    if (output_ids_[i] == id)
+      return named + " is '" + outputs_[i].string() + "', which this run writes already: give each output a file "
+                     "of its own";
+  outputs_.push_back(path);
+  output_ids_.push_back(id);
+  return {};
+}
+
+std::string RunFiles::claimOutputDirectory(const fs::path& dir, const std::string& what) {
+  const std::string named = what + " '" + dir.string() + "'";
+  std::error_code ec;
+  const fs::file_status link = fs::symlink_status(dir, ec);
+  if (fs::exists(link) && !fs::is_directory(fs::status(dir, ec))) return named + " is not a directory";
+  const Identity id = identify(dir);
+  const std::string prefix = id.path + "/";
+  for (std::size_t i = 0; i < input_ids_.size(); ++i)
+    if (input_ids_[i].path.rfind(prefix, 0) == 0)
+      return named + " holds '" + inputs_[i].string() + "', which this run reads: write frames into a directory "
+                     "of their own";
+  return {};
+}
+
+}  // namespace ssx

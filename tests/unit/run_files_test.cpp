@@ -1,0 +1,80 @@
+// A run's files (ssx/run_files.hpp): outputs are never inputs nor each other, by identity, and are
+// regular or new files.
+#include <ssx/run_files.hpp>
+
+#include <catch2/catch.hpp>
+
+#include <sys/stat.h>
+
+#include <filesystem>
+#include <fstream>
+
+using namespace ssx;
+namespace fs = std::filesystem;
+
+namespace {
+
+struct Dir {
+  fs::path path = fs::temp_directory_path() / "ssx_run_files_test";
+  Dir() {
+    fs::remove_all(path);
+    fs::create_directories(path / "sub");
+  }
+  ~Dir() { fs::remove_all(path); }
+  fs::path file(const std::string& name, const std::string& text = "x") const {
+    std::ofstream(path / name) << text;
+    return path / name;
+  }
+};
+
+}  // namespace
+
+TEST_CASE("an output that is an input of the run, by any spelling or link, is refused", "[run_files]") {
+  Dir d;
+  const fs::path scene = d.file("scene.xml");
+  RunFiles files;
+  files.addInput(scene);
+  CHECK_THAT(files.claimOutput(scene, "--save-state"), Catch::Contains("which this run reads"));
+  CHECK_THAT(files.claimOutput(d.path / "sub" / ".." / "scene.xml", "--save-state"), Catch::Contains("which this run reads"));
+  fs::create_hard_link(scene, d.path / "hard.xml");
+  CHECK_THAT(files.claimOutput(d.path / "hard.xml", "--stats-csv"), Catch::Contains("which this run reads"));
+  fs::create_symlink(scene, d.path / "link.xml");
+  CHECK_THAT(files.claimOutput(d.path / "link.xml", "--stats-csv"), Catch::Contains("symbolic link"));
+  CHECK(files.outputs().empty());
+  CHECK(fs::file_size(scene) == 1);  // (nothing was opened)
+}
+
+TEST_CASE("two outputs onto one file are refused, however the second is spelled", "[run_files]") {
+  Dir d;
+  RunFiles files;
+  CHECK(files.claimOutput(d.path / "dup.csv", "parameter 'file'").empty());
+  CHECK_THAT(files.claimOutput(d.path / "sub" / ".." / "dup.csv", "parameter 'file'"),
+             Catch::Contains("which this run writes already"));
+  const fs::path existing = d.file("old.csv");
+  CHECK(files.claimOutput(existing, "--stats-csv").empty());  // an existing regular file is replaced
+  CHECK_THAT(files.claimOutput(existing, "--out"), Catch::Contains("writes already"));
+}
+
+TEST_CASE("outputs must be regular or new files in an existing directory; streams may be special when allowed",
+          "[run_files]") {
+  Dir d;
+  RunFiles files;
+  CHECK_THAT(files.claimOutput(d.path / "none" / "x.csv", "--stats-csv"), Catch::Contains("does not exist"));
+  CHECK(files.claimOutput(d.path / "none" / "x.png", "camera 'c': snapshot", false, true).empty());  // its writer makes it
+  CHECK_THAT(files.claimOutput(d.path / "sub", "--stats-csv"), Catch::Contains("is a directory"));
+  REQUIRE(::mkfifo((d.path / "fifo").c_str(), 0600) == 0);
+  CHECK_THAT(files.claimOutput(d.path / "fifo", "--save-state", true), Catch::Contains("not a regular file"));
+  CHECK_THAT(files.claimOutput(d.path / "fifo", "parameter 'file'"), Catch::Contains("--allow-special-outputs"));
+  files.allowSpecialOutputs(true);
+  CHECK(files.claimOutput(d.path / "fifo", "parameter 'file'").empty());  // a stream into a pipe
+  CHECK_THAT(files.claimOutput("/dev/null", "--save-state", true), Catch::Contains("not a regular file"));
+  CHECK(fs::is_fifo(d.path / "fifo"));
+}
+
+TEST_CASE("a frames directory may not hold an input of the run", "[run_files]") {
+  Dir d;
+  RunFiles files;
+  files.addInput(d.file("scene.xml"));
+  CHECK_THAT(files.claimOutputDirectory(d.path, "camera 'c': frames"), Catch::Contains("holds"));
+  CHECK(files.claimOutputDirectory(d.path / "frames", "camera 'c': frames").empty());
+}
