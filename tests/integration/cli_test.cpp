@@ -291,6 +291,15 @@ TEST_CASE("ssx run: SIGTERM stops a run cleanly with 143, and the state asked fo
   CHECK(fs::exists(state));
 }
 
+TEST_CASE("ssx run: an unknown render engine is refused before the scene's logger opens its file", "[cli]") {
+  fs::remove("hover_swarm_poses.csv");
+  const Result r = run({"run", (kExamples / "scenes" / "hover_swarm.xml").string(), "--render", "foo", "--fast",
+                        "--steps", "5"});
+  CHECK(r.status == 2);
+  CHECK_THAT(r.err, Contains("render engine 'foo'") && Contains("available: null"));
+  CHECK_FALSE(fs::exists("hover_swarm_poses.csv"));
+}
+
 TEST_CASE("ssx run: a duration below a nanosecond or not a number is refused, not run without end", "[cli]") {
   const std::string scene = (kExamples / "scenes" / "hover_swarm.xml").string();
   for (const char* d : {"1e-12", "nan"}) {

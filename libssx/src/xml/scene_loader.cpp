@@ -5,6 +5,7 @@
 
 #include <ssx/scene.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <deque>
 #include <map>
@@ -300,7 +301,18 @@ void SceneLoader::readRender(const Descriptor& d) {
 void SceneLoader::applyOptions() {
   if (options_.seed) settings_.seed = *options_.seed;
   if (options_.threads) settings_.threads = *options_.threads;
-  if (options_.render_engine) settings_.render.engine = *options_.render_engine;
+  if (options_.render_engine) {
+    // checked with the scene's own values, before anything is made or opened
+    const auto names = renderEngineNames();
+    if (std::find(names.begin(), names.end(), *options_.render_engine) == names.end()) {
+      std::string list;
+      for (const auto& n : names) list += (list.empty() ? "" : ", ") + n;
+      error({model_.file.string(), 0}, "render engine '" + *options_.render_engine + "' (asked for besides the scene) "
+                                       "is not in this build of ssx (available: " + list + ")");
+    } else {
+      settings_.render.engine = *options_.render_engine;
+    }
+  }
   if (options_.physics_engine) settings_.physics.engine = *options_.physics_engine;
   // outputs asked for on the command line go to the first camera (one framing the scene if none)
   if (!options_.snapshot.empty() || !options_.video.empty() || !options_.frames_dir.empty()) {
