@@ -67,7 +67,7 @@ class CsvLogger final : public SimulationExtension {
       const Vec3& v = s.linear_velocity;
       const Vec3& w = s.angular_velocity;
       const int written = std::fprintf(file_, "%.9g,%s,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g\n", t,
-                   a->name().c_str(), p.x(), p.y(), p.z(), q.w(), q.x(), q.y(), q.z(), v.x(), v.y(), v.z(), w.x(),
+                   field(a->name()).c_str(), p.x(), p.y(), p.z(), q.w(), q.x(), q.y(), q.z(), v.x(), v.y(), v.z(), w.x(),
                    w.y(), w.z());
       check(written > 0);
     }
@@ -95,6 +95,14 @@ class CsvLogger final : public SimulationExtension {
 
  private:
   // every artifact exists when extensions are initialised
+  // a CSV field: quoted when it holds a comma, a quote or a line break (RFC 4180)
+  static std::string field(const std::string& text) {
+    if (text.find_first_of(",\"\r\n") == std::string::npos) return text;
+    std::string out = "\"";
+    for (char c : text) out += c == '"' ? std::string("\"\"") : std::string(1, c);
+    return out + "\"";
+  }
+
   void resolve(Environment& env, const Descriptor& params) {
     for (const Artifact* a : env.selectArtifacts(params, "artifacts", "log")) artifacts_.push_back(a);
   }

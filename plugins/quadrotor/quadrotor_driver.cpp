@@ -62,6 +62,11 @@ struct QuadrotorDriver::Airframe {
     controller.mixer = allocation.inverse() * scale;
     const double w_max = c.vehicle.rotor.max_rotor_speed;
     controller.rotor_max_thrust = allocation.matrix().row(3).sum() * w_max * w_max;
+    // a thrust the rotors cannot give would be commanded and never reached (it saturated silently)
+    if (c.controller.max_thrust && *c.controller.max_thrust > controller.rotor_max_thrust)
+      throw params.errorAt("max_thrust", "max_thrust " + std::to_string(*c.controller.max_thrust) +
+                                             " N is more than these rotors give at full speed (" +
+                                             std::to_string(controller.rotor_max_thrust) + " N)");
     if (!mixerFitsFixedPoint(controller.mixer, c.controller.max_angular_acceleration, controller.rotor_max_thrust))
       // at the value that was given, if one was
       throw params.errorAt(params.has("max_angular_acceleration") || !params.has("controller_inertia")

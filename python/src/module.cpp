@@ -98,6 +98,12 @@ class PyEnvironment {
   }
 
   ssx::Environment& env() { return env_; }
+  // `read()` while no other thread steps this environment (RuntimeError otherwise)
+  template <class Read>
+  auto guarded(Read read) {
+    InUse use(busy_);
+    return read();
+  }
 
   void step(std::int64_t n) {
     if (n < 0) throw py::value_error("ssx: step(n) needs n >= 0, got " + std::to_string(n));
@@ -115,7 +121,10 @@ class PyEnvironment {
     }
   }
 
-  double time() const { return ssx::toSeconds(env_.time()); }
+  double time() const {
+    InUse use(busy_);
+    return ssx::toSeconds(env_.time());
+  }
   double timestep() const { return ssx::toSeconds(env_.timestep()); }
   std::optional<double> duration() const {
     if (!scene_.duration) return std::nullopt;
@@ -123,6 +132,7 @@ class PyEnvironment {
   }
 
   std::vector<std::string> artifactNames() const {
+    InUse use(busy_);
     std::vector<std::string> names;
     names.reserve(env_.artifactCount());
     for (std::size_t i = 0; i < env_.artifactCount(); ++i) names.push_back(std::as_const(env_).artifact(i).name());
@@ -348,7 +358,7 @@ class PyEnvironment {
   ssx::Environment& env_;
   std::vector<const ssx::Artifact*> dynamic_;
   ssx_python::CommandTargets targets_;
-  std::atomic<bool> busy_{false};
+  mutable std::atomic<bool> busy_{false};  // (reads guard it too: InUse)
 };
 
 ssx::SceneOptions sceneOptions(std::optional<std::uint64_t> seed, std::optional<int> threads,
@@ -402,9 +412,10 @@ PYBIND11_MODULE(_ssx, m) {
       .def("step", &PyEnvironment::step, py::arg("n") = 1,
            "Advances n timesteps (starting the environment first if needed). Releases the GIL.")
       .def_property_readonly("time", &PyEnvironment::time, "Simulated time, s.")
-      .def_property_readonly("time_ns", [](PyEnvironment& e) { return e.env().time(); }, "Simulated time, ns.")
+      .def_property_readonly("time_ns", [](PyEnvironment& e) { return e.guarded([&] { return e.env().time(); }); },
+                             "Simulated time, ns.")
       .def_property_readonly("timestep", &PyEnvironment::timestep, "Physics timestep, s.")
-      .def_property_readonly("step_count", [](PyEnvironment& e) { return e.env().stepCount(); })
+      .def_property_readonly("step_count", [](PyEnvironment& e) { return e.guarded([&] { return e.env().stepCount(); }); })
       .def_property_readonly("duration", &PyEnvironment::duration, "<environment duration> in s, or None.")
       .def_property_readonly("seed", [](PyEnvironment& e) { return e.env().settings().seed; })
       .def_property_readonly("threads", [](PyEnvironment& e) { return e.env().threadCount(); },
@@ -414,7 +425,7 @@ PYBIND11_MODULE(_ssx, m) {
            "The artifacts with a dynamic root: the rows of positions() and the other state arrays.")
       .def("setpoint_names", &PyEnvironment::setpointNames,
            "The artifacts whose driver follows set-points: the rows of set_setpoints().")
-      .def("state_hash", [](PyEnvironment& e) { return e.env().stateHash(); },
+      .def("state_hash", [](PyEnvironment& e) { return e.guarded([&] { return e.env().stateHash(); }); },
            "64-bit hash of every body's pose and velocities, bit for bit, and the time.")
       .def("positions", &PyEnvironment::positions, "N x 3 positions (m, world) of the dynamic artifacts' first roots.")
       .def("orientations", &PyEnvironment::orientations, "N x 4 orientations as quaternions (w, x, y, z).")

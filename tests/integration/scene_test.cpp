@@ -208,6 +208,19 @@ TEST_CASE("csv_logger flushes at its simulated interval and when the run stops",
   CHECK(rows.back().rfind("0.12,b,", 0) == 0);
 }
 
+TEST_CASE("csv_logger quotes names that hold a comma, a quote or a line break", "[scene][csv]") {
+  Scene scene = loadSceneFromString(R"(<scene><environment timestep="0.01"/><type name="ball" file="ball.xml"/>
+    <artifact name="a,&quot;b&quot;" type="ball" xyz="0 0 1"/>
+    <extension name="log" plugin="csv_logger" file="quoted.csv" rate_hz="100"/></scene>)",
+                                    "memory.xml", kData / "valid");
+  scene.environment->step(2);
+  scene.environment->stop();
+  const auto rows = lines("quoted.csv");
+  REQUIRE(rows.size() == 3);
+  CHECK(rows[1].rfind("0.01,\"a,\"\"b\"\"\",", 0) == 0);
+  CHECK(std::count(rows[1].begin(), rows[1].end(), ',') == 15);  // 14 separators + the one in the name
+}
+
 TEST_CASE("csv_logger: a write that fails stops the run naming the file", "[scene][csv]") {
   REQUIRE(fs::exists("/dev/full"));  // writes there fail with ENOSPC, as on a full disk
   SECTION("at a flush while running") {

@@ -403,6 +403,30 @@ def test_stepping_releases_the_gil():
     assert env.step_count == 20000
 
 
+def test_reads_while_another_thread_steps_are_refused_not_torn():
+    env = hover(threads=1)
+    done = threading.Event()
+
+    def long_step():
+        env.step(20000)
+        done.set()
+
+    t = threading.Thread(target=long_step)
+    t.start()
+    refused = {name: 0 for name in ("state_hash", "time", "step_count", "artifact_names")}
+    reads = {"state_hash": lambda: env.state_hash(), "time": lambda: env.time,
+             "step_count": lambda: env.step_count, "artifact_names": lambda: env.artifact_names()}
+    while not done.is_set():
+        for name, read in reads.items():
+            try:
+                read()
+            except RuntimeError as e:
+                assert "in use by another thread" in str(e)
+                refused[name] += 1
+    t.join()
+    assert all(n > 0 for n in refused.values()), refused
+
+
 def test_close_finishes_the_run(tmp_path):
     log = tmp_path / "log.csv"
     scene = HOVER.replace("<ground/>", f'<ground/><extension name="log" plugin="csv_logger" file="{log}" rate_hz="10"/>')

@@ -115,6 +115,10 @@ void SceneLoader::readPlacements() {
     PlacementModel p;
     p.where = d.where();
     bool ok = true;
+    // a name given empty would make an artifact nobody can name: an error, not a silent drop
+    for (const char* key : {"name", "type"})
+      if (const auto* a = d.find(key); a != nullptr && a->value.empty())
+        error(a->where, "<" + d.name() + ">: attribute '" + key + "' is empty; give it a value");
     if (d.name() == "artifact") {
       p.kind = PlacementModel::Kind::Artifact;
       p.name = require(d, "name");
