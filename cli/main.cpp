@@ -1,17 +1,15 @@
-// ssx: the command-line client. run, validate, plugins.
+// ssx: the command-line client. run, validate, sweep; plugins in plugins_command.cpp.
 //
 // Exit status: 0 success, 2 bad input (scene, arguments, plugins), 1 failure while running.
+#include "common.hpp"
+#include "plugins_command.hpp"
 #include "sweep.hpp"
 
 #include <ssx/ssx.hpp>
 
 #include <CLI/CLI.hpp>
 
-#include <fcntl.h>
 #include <malloc.h>
-#include <poll.h>
-#include <spawn.h>
-#include <sys/wait.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -32,14 +30,12 @@
 #include <thread>
 #include <vector>
 
-extern char** environ;
-
 namespace {
+
+using namespace ssx::cli;
 
 namespace fs = std::filesystem;
 
-constexpr int kExitRunFailure = 1;
-constexpr int kExitBadInput = 2;
 
 std::atomic<bool> g_stop{false};
 
@@ -49,17 +45,6 @@ void onSignal(int sig) {
   g_stop = true;
 }
 
-// --plugin-path first, then SSX_PLUGIN_PATH (colon-separated), read here and nowhere else
-std::vector<fs::path> pluginPath(const std::vector<std::string>& from_args) {
-  std::vector<fs::path> out(from_args.begin(), from_args.end());
-  if (const char* env = std::getenv("SSX_PLUGIN_PATH")) {
-    std::stringstream in(env);
-    std::string dir;
-    while (std::getline(in, dir, ':'))
-      if (!dir.empty()) out.emplace_back(dir);
-  }
-  return out;
-}
 
 void printWarnings(const ssx::Scene& scene) {
   for (const auto& w : scene.warnings) std::cerr << w.str() << '\n';
@@ -121,11 +106,6 @@ struct RunArgs {
 };
 
 // "ode, bullet"
-std::string joined(const std::vector<std::string>& names) {
-  std::string out;
-  for (const auto& n : names) out += (out.empty() ? "" : ", ") + n;
-  return out;
-}
 
 std::vector<std::byte> readFile(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
@@ -332,136 +312,6 @@ int commandValidate(const std::string& file, const std::vector<std::string>& plu
   }
 }
 
-// What one library reports, printed by a child process (`ssx plugins --inspect FILE`): with
-// `params_of`, that class's parameter table (exit 0, or 4 when the library has no such class);
-// else the library's lines of the listing (exit 0 when it passes its checks, 3 when not).
-constexpr int kExitNoSuchClass = 4, kExitLibraryFails = 3;
-
-int inspectOne(const std::string& file, const std::string& params_of) {
-  const ssx::PluginLibraryInfo lib = ssx::ClassLoader::inspect(file);
-  if (!params_of.empty()) {
-    for (const auto& c : lib.classes) {
-      if (!lib.ok || c.name != params_of) continue;
-      std::cout << ssx::toString(c.kind) << " '" << c.name << "' (" << lib.path.string() << ")"
-                << (c.doc.empty() ? "" : ": " + c.doc) << "\n\n"
-                << c.parameter_table;
-      return 0;
-    }
-    return kExitNoSuchClass;
-  }
-  std::cout << lib.path.string() << ": " << (lib.ok ? "ok" : "FAILS: " + lib.problem) << '\n';
-  for (const auto& c : lib.classes)
-    std::cout << "  " << ssx::toString(c.kind) << ' ' << c.name << (c.doc.empty() ? "" : ": " + c.doc) << '\n';
-  return lib.ok ? 0 : kExitLibraryFails;
-}
-
-struct Child {
-  int status = -1;  ///< exit status, or -signal
-  bool timed_out = false;
-  std::string out;
-};
-
-// runs this program again with `args`, collecting its standard output; killed after `timeout_s`
-Child runSelf(const std::vector<std::string>& args, double timeout_s) {
-  Child c;
-  int fds[2];
-  if (pipe2(fds, O_CLOEXEC) != 0) throw std::runtime_error(std::string("pipe: ") + std::strerror(errno));
-  std::vector<std::string> argv_strings = {"/proc/self/exe"};
-  argv_strings.insert(argv_strings.end(), args.begin(), args.end());
-  std::vector<char*> argv;
-  for (auto& a : argv_strings) argv.push_back(a.data());
-  argv.push_back(nullptr);
-  posix_spawn_file_actions_t actions;
-  posix_spawn_file_actions_init(&actions);
-  posix_spawn_file_actions_adddup2(&actions, fds[1], STDOUT_FILENO);
-  pid_t pid = -1;
-  const int failed = posix_spawn(&pid, "/proc/self/exe", &actions, nullptr, argv.data(), environ);
-  posix_spawn_file_actions_destroy(&actions);
-  close(fds[1]);
-  if (failed != 0) {
-    close(fds[0]);
-    throw std::runtime_error(std::string("cannot start a child to inspect a plugin: ") + std::strerror(failed));
-  }
-  const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(timeout_s);
-  char buffer[4096];
-  for (;;) {
-    const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(deadline - std::chrono::steady_clock::now());
-    if (left.count() <= 0) {
-      kill(pid, SIGKILL);
-      c.timed_out = true;
-      break;
-    }
-    pollfd p{fds[0], POLLIN, 0};
-    const int ready = poll(&p, 1, static_cast<int>(left.count()));
-    if (ready < 0 && errno == EINTR) continue;
-    if (ready <= 0) continue;
-    const ssize_t n = read(fds[0], buffer, sizeof buffer);
-    if (n < 0 && errno == EINTR) continue;
-    if (n <= 0) break;
-    c.out.append(buffer, static_cast<std::size_t>(n));
-  }
-  close(fds[0]);
-  int status = 0;
-  while (waitpid(pid, &status, 0) < 0 && errno == EINTR) {
-  }
-  c.status = WIFEXITED(status) ? WEXITSTATUS(status) : WIFSIGNALED(status) ? -WTERMSIG(status) : -1;
-  return c;
-}
-
-// why a child that inspected `file` did not report
-std::string childProblem(const Child& c) {
-  if (c.timed_out) return "FAILS: did not finish loading within 10 s (a static initialiser that waits or loops?)";
-  if (c.status < 0)
-    return "FAILS: crashed while being loaded (signal " + std::to_string(-c.status) + ", " + strsignal(-c.status) +
-           "): in a static initialiser of the library or of one it pulls in";
-  return "FAILS: its inspection ended with status " + std::to_string(c.status);
-}
-
-// Each library is opened in a child process of its own: one that crashes or hangs while loading
-// (static initialisers run before any check can) is reported, and this process loads none.
-int commandPlugins(const std::vector<std::string>& plugin_path, const std::string& params_of) {
-  ssx::ClassLoader loader;
-  for (const auto& dir : pluginPath(plugin_path)) loader.addSearchDirectory(dir);
-  loader.addSearchDirectory(ssx::ClassLoader::installedPluginDirectory());
-  std::vector<fs::path> files;
-  for (const auto& dir : loader.searchPath()) {
-    std::error_code ec;
-    std::vector<fs::path> here;
-    for (const auto& e : fs::directory_iterator(dir, ec))
-      if (e.path().extension() == ".so") here.push_back(e.path());
-    std::sort(here.begin(), here.end());
-    files.insert(files.end(), here.begin(), here.end());
-  }
-  constexpr double kTimeout = 10.0;
-  if (!params_of.empty()) {
-    // one class's declared parameters, as the Markdown table the docs hold
-    for (const auto& f : files) {
-      const Child c = runSelf({"plugins", "--inspect", f.string(), "--params", params_of}, kTimeout);
-      if (c.status != 0) continue;
-      std::cout << c.out;
-      return 0;
-    }
-    std::cerr << "ssx: error: no plugin class '" << params_of << "' on the search path (ssx plugins lists them)\n";
-    return kExitBadInput;
-  }
-  int bad = 0;
-  std::cout << "physics engines: " << joined(ssx::physicEngineNames()) << '\n'
-            << "render engines: " << joined(ssx::renderEngineNames()) << '\n';
-  for (const auto& dir : loader.searchPath()) std::cout << "search: " << dir.string() << '\n';
-  for (const auto& f : files) {
-    const Child c = runSelf({"plugins", "--inspect", f.string()}, kTimeout);
-    if (c.status == 0 || c.status == kExitLibraryFails) {
-      std::cout << c.out;
-      bad += c.status == 0 ? 0 : 1;
-    } else {
-      std::cout << f.string() << ": " << childProblem(c) << '\n';
-      ++bad;
-    }
-    std::cout.flush();
-  }
-  return bad == 0 ? 0 : kExitBadInput;
-}
-
 struct SweepArgs {
   std::string file, out, robots;
   std::vector<std::string> plugin_path;
@@ -605,7 +455,7 @@ int main(int argc, char** argv) {
   }
   if (*validate_cmd) return commandValidate(validate_file, validate_path, validate_physics, validate_print);
   if (*sweep_cmd) return commandSweep(sweep);
-  if (*plugins_cmd && !inspect_file.empty()) return inspectOne(inspect_file, params_of);
-  if (*plugins_cmd) return commandPlugins(plugins_path, params_of);
+  if (*plugins_cmd && !inspect_file.empty()) return ssx::cli::inspectOne(inspect_file, params_of);
+  if (*plugins_cmd) return ssx::cli::commandPlugins(plugins_path, params_of);
   return kExitBadInput;
 }
