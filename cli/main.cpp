@@ -276,6 +276,10 @@ int commandRun(const RunArgs& args, bool realtime_given) {
   if (!args.stats_csv.empty()) {
     try {
       env.timing().writeCsv(args.stats_csv);
+      if (summary.timed_steps < summary.steps)
+        std::cerr << "ssx: warning: --stats-csv " << args.stats_csv << " holds the newest " << summary.timed_steps
+                  << " of " << summary.steps << " steps (the timing ring keeps " << env.timing().capacity()
+                  << "; EnvironmentSettings::timing_samples sets it)\n";
     } catch (const std::exception& e) {
       std::cerr << "ssx: error: " << e.what() << '\n';
       status = kExitRunFailure;

@@ -53,7 +53,8 @@ TimingSummary TimingRecorder::summary(Nanoseconds wall, Nanoseconds simulated, s
   const std::int64_t oldest = recorded_ - static_cast<std::int64_t>(size_);
   const std::size_t first = static_cast<std::size_t>(std::clamp<std::int64_t>(since - oldest, 0, static_cast<std::int64_t>(size_)));
   const std::size_t n = size_ - first;
-  s.steps = static_cast<std::int64_t>(n);
+  s.steps = std::max<std::int64_t>(0, recorded_ - std::max<std::int64_t>(since, 0));
+  s.timed_steps = static_cast<std::int64_t>(n);
   s.wall_s = toSeconds(wall);
   s.simulated_s = toSeconds(simulated);
   s.realtime_factor = wall > 0 ? s.simulated_s / s.wall_s : 0.0;
@@ -88,13 +89,16 @@ TimingSummary TimingRecorder::summary(Nanoseconds wall, Nanoseconds simulated, s
 }
 
 std::string TimingSummary::str() const {
-  char buf[768];
+  // the ring keeps the newest steps' times: say so when the run made more
+  const std::string timed_note =
+      timed_steps < steps ? " (of the newest " + std::to_string(timed_steps) + " steps)" : std::string();
+  char buf[896];
   int used = std::snprintf(buf, sizeof buf,
                            "steps %lld, simulated %.3f s in %.3f s wall (real-time factor %.3f)\n"
-                           "step time ms: median %.4f  p95 %.4f  p99 %.4f  max %.4f  mean %.4f\n"
+                           "step time ms%s: median %.4f  p95 %.4f  p99 %.4f  max %.4f  mean %.4f\n"
                            "phase medians ms: physics %.4f  sensors %.4f  drivers %.4f  render %.4f\n"
                            "overruns %lld (max lateness %.3f ms)",
-                           static_cast<long long>(steps), simulated_s, wall_s, realtime_factor, median_ms, p95_ms,
+                           static_cast<long long>(steps), simulated_s, wall_s, realtime_factor, timed_note.c_str(), median_ms, p95_ms,
                            p99_ms, max_ms, mean_ms, physics_median_ms, sensors_median_ms, drivers_median_ms,
                            render_median_ms, static_cast<long long>(overruns), max_lateness_ms);
   // (known only for a run's summary: the first late step of a run took long or began late, so a

@@ -72,6 +72,7 @@ py::array_t<std::int32_t> counts(const std::array<std::int32_t, N>& c) {
 py::dict summaryDict(const ssx::TimingSummary& s) {
   py::dict d;
   d["steps"] = s.steps;
+  d["timed_steps"] = s.timed_steps;
   d["median_ms"] = s.median_ms;
   d["p95_ms"] = s.p95_ms;
   d["p99_ms"] = s.p99_ms;

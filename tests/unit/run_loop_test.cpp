@@ -271,3 +271,19 @@ TEST_CASE("a real-time run at a real-time priority steps every thread at it and 
   CHECK_FALSE(realtimePriorityProblem(0).empty());
   CHECK_FALSE(realtimePriorityProblem(100).empty());
 }
+
+TEST_CASE("a run's summary counts every step even when the timing ring keeps only the newest", "[run]") {
+  EnvironmentSettings s;
+  s.timestep = toNanoseconds(0.001);
+  s.timing_samples = 16;
+  Environment env(s);
+  withBall(env);
+  RunOptions o;
+  o.mode = RunOptions::Mode::Fast;
+  o.steps = 100;
+  const TimingSummary summary = env.run(o);
+  CHECK(summary.steps == 100);
+  CHECK(summary.timed_steps == 16);
+  CHECK_THAT(summary.str(), Catch::Contains("steps 100,") && Catch::Contains("(of the newest 16 steps)"));
+  CHECK(env.timing().samples().size() == 16);
+}

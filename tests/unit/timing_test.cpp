@@ -60,7 +60,12 @@ TEST_CASE("the recorder keeps the newest samples in a ring of fixed capacity", "
   // a mark taken before a run covers that run's samples only
   CHECK(r.summary(0, 0, 20).steps == 5);
   CHECK(r.summary(0, 0, 20).max_ms == Approx(25));
-  CHECK(r.summary(0, 0, 3).steps == 10);  // older than the ring holds: what is kept
+  // a mark older than the ring holds: every step is counted, the times are the kept ones
+  CHECK(r.summary(0, 0, 3).steps == 22);
+  CHECK(r.summary(0, 0, 3).timed_steps == 10);
+  CHECK(r.summary().steps == 25);
+  CHECK_THAT(r.summary().str(), Catch::Contains("steps 25,") && Catch::Contains("step time ms (of the newest 10 steps)"));
+  CHECK(r.summary(0, 0, 20).timed_steps == 5);
   r.clear();
   CHECK(r.size() == 0);
   CHECK(r.last() == nullptr);

@@ -26,7 +26,8 @@ struct StepTiming {
 
 /// Summary of a series of steps.
 struct SSX_EXPORT TimingSummary {
-  std::int64_t steps = 0;
+  std::int64_t steps = 0;        ///< every step summarised (of a run: every step it made)
+  std::int64_t timed_steps = 0;  ///< the newest of them whose times the ring kept: what the times below cover
   double median_ms = 0, p95_ms = 0, p99_ms = 0, max_ms = 0, mean_ms = 0;  ///< step compute time
   double physics_median_ms = 0, sensors_median_ms = 0, drivers_median_ms = 0, render_median_ms = 0;
   std::int64_t overruns = 0;  ///< steps that ended after their deadline (real-time runs)
@@ -67,9 +68,9 @@ class SSX_EXPORT TimingRecorder {
   const StepTiming& operator[](std::size_t i) const noexcept { return ring_[(head_ + ring_.size() - size_ + i) % ring_.size()]; }
   /// A copy of the kept samples, oldest first.
   std::vector<StepTiming> samples() const;
-  /// Summary over the kept samples recorded at or after the mark `since` (a recorded() value;
-  /// 0: all kept); `wall` and `simulated` fill the rate fields; `overruns` counts samples with
-  /// lateness > 0.
+  /// Summary of the steps recorded at or after the mark `since` (a recorded() value; 0: all):
+  /// `steps` counts all of them, the times cover those still kept (`timed_steps`); `wall` and
+  /// `simulated` fill the rate fields; `overruns` counts kept samples with lateness > 0.
   TimingSummary summary(Nanoseconds wall = 0, Nanoseconds simulated = 0, std::int64_t since = 0) const;
   /// The newest sample, for the run loop to fill in lateness; nullptr when empty.
   StepTiming* last() noexcept { return size_ == 0 ? nullptr : &ring_[(head_ + ring_.size() - 1) % ring_.size()]; }
