@@ -8,7 +8,6 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
-#include <regex>
 #include <sstream>
 #include <stdexcept>
 
@@ -48,9 +47,18 @@ std::map<std::string, std::string> docTables() {
   text << in.rdbuf();
   const std::string s = text.str();
   std::map<std::string, std::string> out;
-  const std::regex block("<!-- parameters:(\\w+) -->\n([^]*?)<!-- end parameters:\\1 -->");
-  for (auto it = std::sregex_iterator(s.begin(), s.end(), block); it != std::sregex_iterator(); ++it)
-    out[(*it)[1]] = (*it)[2];
+  // (found by plain search: std::regex over a whole document recurses per character and overflows
+  // the stack under AddressSanitizer)
+  const std::string open = "<!-- parameters:", close = " -->\n";
+  for (std::size_t at = s.find(open); at != std::string::npos; at = s.find(open, at + 1)) {
+    const std::size_t name_end = s.find(close, at);
+    if (name_end == std::string::npos) break;
+    const std::string name = s.substr(at + open.size(), name_end - at - open.size());
+    const std::size_t body = name_end + close.size();
+    const std::size_t end = s.find("<!-- end parameters:" + name + " -->", body);
+    if (end == std::string::npos) break;
+    out[name] = s.substr(body, end - body);
+  }
   return out;
 }
 
