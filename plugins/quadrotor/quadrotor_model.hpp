@@ -9,6 +9,7 @@
 //   PositionController  the outer loop in floating point (TeleKyb form)
 //   FigureEight     reference trajectories of the fidelity study
 
+#include <ssx/descriptor.hpp>
 #include <ssx/random.hpp>
 #include <ssx/setpoint.hpp>
 #include <ssx/state.hpp>
@@ -284,6 +285,12 @@ InnerOutput innerLoopFloat(const InnerLoopParams& params, const AttitudeEstimate
                            const std::array<std::int32_t, 3>& gyro_counts,
                            const std::array<std::int32_t, 3>& accel_counts, const InnerCommand& command,
                            InnerMode mode = InnerMode::Attitude);
+
+/// A parameter's value if it was given, else nothing (for defaults worked out from others).
+template <class T>
+std::optional<T> given(const Descriptor& params, const char* key) {
+  return params.has(key) ? std::optional<T>(params.get<T>(key)) : std::nullopt;
+}
 
 /// A set-point into and out of a saved state (the parts that keep one: controller, references).
 inline void saveSetpoint(StateWriter& out, const Setpoint& s) {

@@ -13,11 +13,6 @@ namespace {
 // room for the neighbours a formation robot senses at once, reserved at start
 constexpr std::size_t kTypicalNeighbours = 16;
 
-template <class T>
-std::optional<T> given(const Descriptor& params, const char* key) {
-  return params.has(key) ? std::optional<T>(params.get<T>(key)) : std::nullopt;
-}
-
 // the cells of one CSV line, trimmed
 std::vector<std::string> cells(const std::string& line) {
   std::vector<std::string> out;

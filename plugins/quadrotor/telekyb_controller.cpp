@@ -12,11 +12,6 @@ namespace {
 // m per axis: how far the velocity level's reference point may lead the vehicle
 constexpr double kVelocityLeash = 0.3;
 
-template <class T>
-std::optional<T> given(const Descriptor& params, const char* key) {
-  return params.has(key) ? std::optional<T>(params.get<T>(key)) : std::nullopt;
-}
-
 }  // namespace
 
 TeleKybParams::TeleKybParams(const Descriptor& params) {

@@ -379,43 +379,18 @@ def test_ctrl_c_stops_step_n_between_steps_and_the_steps_are_the_same():
     assert a.state_hash() == b.state_hash()
 
 
-def test_stepping_releases_the_gil():
-    env = hover(threads=1)
+def refusals_while_stepping(env, reads, steps=20000):
+    """Calls each of `reads` over and over while another thread steps `env`; how often each was
+    refused with RuntimeError (any other outcome of a read fails the test)."""
     done = threading.Event()
 
     def long_step():
-        env.step(20000)
+        env.step(steps)
         done.set()
 
     t = threading.Thread(target=long_step)
     t.start()
-    refused = 0
-    # while the other thread is inside step(), this thread runs Python (so the GIL is free) and the
-    # environment refuses a second user instead of racing it
-    while not done.is_set():
-        try:
-            env.positions()
-        except RuntimeError as e:
-            assert "in use by another thread" in str(e)
-            refused += 1
-    t.join()
-    assert refused > 0
-    assert env.step_count == 20000
-
-
-def test_reads_while_another_thread_steps_are_refused_not_torn():
-    env = hover(threads=1)
-    done = threading.Event()
-
-    def long_step():
-        env.step(20000)
-        done.set()
-
-    t = threading.Thread(target=long_step)
-    t.start()
-    refused = {name: 0 for name in ("state_hash", "time", "step_count", "artifact_names")}
-    reads = {"state_hash": lambda: env.state_hash(), "time": lambda: env.time,
-             "step_count": lambda: env.step_count, "artifact_names": lambda: env.artifact_names()}
+    refused = {name: 0 for name in reads}
     while not done.is_set():
         for name, read in reads.items():
             try:
@@ -424,6 +399,23 @@ def test_reads_while_another_thread_steps_are_refused_not_torn():
                 assert "in use by another thread" in str(e)
                 refused[name] += 1
     t.join()
+    return refused
+
+
+def test_stepping_releases_the_gil():
+    env = hover(threads=1)
+    # while the other thread is inside step(), this thread runs Python (so the GIL is free) and the
+    # environment refuses a second user instead of racing it
+    refused = refusals_while_stepping(env, {"positions": lambda: env.positions()})
+    assert refused["positions"] > 0
+    assert env.step_count == 20000
+
+
+def test_reads_while_another_thread_steps_are_refused_not_torn():
+    env = hover(threads=1)
+    refused = refusals_while_stepping(env, {"state_hash": lambda: env.state_hash(), "time": lambda: env.time,
+                                            "step_count": lambda: env.step_count,
+                                            "artifact_names": lambda: env.artifact_names()})
     assert all(n > 0 for n in refused.values()), refused
 
 
