@@ -1,0 +1,79 @@
+// csv_logger: rows at its rate, flushed at its simulated interval, names quoted, failed writes stop the run.
+#include <ssx/ssx.hpp>
+
+#include "scene_util.hpp"
+
+#include <catch2/catch.hpp>
+
+#include <algorithm>
+
+using namespace ssx;
+using ssx::test::kData;
+using Catch::Contains;
+namespace fs = std::filesystem;
+
+using ssx::test::fileLines;
+
+namespace {
+std::string loggerScene(const std::string& file, const std::string& flush_s) {
+  return R"(<scene><environment timestep="0.01"/><type name="ball" file="ball.xml"/>
+    <artifact name="b" type="ball" xyz="0 0 1"/>
+    <extension name="log" plugin="csv_logger" file=")" +
+         file + R"(" rate_hz="100" flush_s=")" + flush_s + R"("/></scene>)";
+}
+}  // namespace
+
+TEST_CASE("csv_logger flushes at its simulated interval and when the run stops", "[scene][csv]") {
+  Scene scene = loadSceneFromString(loggerScene("log.csv", "0.1"), "memory.xml", kData / "valid");
+  Environment& env = *scene.environment;
+  env.step(5);  // t = 0.05 s: nothing flushed yet
+  CHECK(fs::file_size("log.csv") == 0);
+  env.step(7);  // t = 0.12 s: flushed at 0.1 s, before that step's row: the header and 0.01 ... 0.09 s
+  std::vector<std::string> rows = fileLines("log.csv");
+  REQUIRE(rows.size() == 1 + 9);
+  CHECK(rows.back().rfind("0.09,b,", 0) == 0);
+  env.stop();
+  rows = fileLines("log.csv");
+  REQUIRE(rows.size() == 1 + 12);
+  CHECK(rows.back().rfind("0.12,b,", 0) == 0);
+}
+
+TEST_CASE("csv_logger quotes names that hold a comma, a quote or a line break", "[scene][csv]") {
+  Scene scene = loadSceneFromString(R"(<scene><environment timestep="0.01"/><type name="ball" file="ball.xml"/>
+    <artifact name="a,&quot;b&quot;" type="ball" xyz="0 0 1"/>
+    <extension name="log" plugin="csv_logger" file="quoted.csv" rate_hz="100"/></scene>)",
+                                    "memory.xml", kData / "valid");
+  scene.environment->step(2);
+  scene.environment->stop();
+  const auto rows = fileLines("quoted.csv");
+  REQUIRE(rows.size() == 3);
+  CHECK(rows[1].rfind("0.01,\"a,\"\"b\"\"\",", 0) == 0);
+  CHECK(std::count(rows[1].begin(), rows[1].end(), ',') == 15);  // 14 separators + the one in the name
+}
+
+TEST_CASE("csv_logger: a write that fails stops the run naming the file", "[scene][csv]") {
+  REQUIRE(fs::exists("/dev/full"));  // writes there fail with ENOSPC, as on a full disk
+  SECTION("at a flush while running") {
+    SceneOptions streams;
+    streams.allow_special_outputs = true;  // a device, written as a stream
+    Scene scene = loadSceneFromString(loggerScene("/dev/full", "0.05"), "memory.xml", kData / "valid", streams);
+    try {
+      scene.environment->step(10);
+      FAIL("no StepError");
+    } catch (const StepError& e) {
+      CHECK(e.step() == 4);  // the step that ends at t = 0.05 s
+      CHECK_THAT(e.what(), Contains("cannot write '/dev/full'") && Contains("No space left on device"));
+    }
+    // reported once: the file is closed, stopping has nothing more to say
+    CHECK_NOTHROW(scene.environment->stop());
+  }
+  SECTION("at the end of the run") {
+    SceneOptions streams;
+    streams.allow_special_outputs = true;
+    Scene scene = loadSceneFromString(loggerScene("/dev/full", "100"), "memory.xml", kData / "valid", streams);
+    scene.environment->step(10);
+    CHECK_THROWS_WITH(scene.environment->stop(),
+                      Contains("extension 'log'") && Contains("cannot write '/dev/full'") &&
+                          Contains("No space left on device"));
+  }
+}

@@ -1,0 +1,152 @@
+// The osmesa engine: pixel facts on known scenes, levels of detail and lighting.
+// Headless (OSMesa); every test name contains "render".
+#include <ssx/ssx.hpp>
+
+#include "render_util.hpp"
+
+#include <catch2/catch.hpp>
+
+#include <cmath>
+#include <cstdlib>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <numbers>
+#include <string>
+
+using namespace ssx;
+using namespace ssx::test;
+namespace fs = std::filesystem;
+
+TEST_CASE("render: a red box in front of the camera fills the centre, at its known depth", "[render]") {
+  REQUIRE(haveOsmesa());  // dev.sh installs libosmesa6-dev
+  Scene s = loadRenderScene(R"(<render engine="osmesa" background="0.2 0.4 0.6"/>
+    <type name="post" file="camera_post.xml"/>
+    <artifact name="eye" type="post" xyz="0 0 1"/>
+    <obstacle name="box" xyz="5 0 1" color="1 0 0"><box size="1 1 1"/></obstacle>)");
+  Environment& env = *s.environment;
+  env.step();
+  const CameraMeasurement& m = image(env);
+  REQUIRE(m.image.width == 64);
+  REQUIRE(m.image.height == 48);
+  const std::uint8_t* c = m.image.pixel(32, 24);
+  INFO("centre pixel " << int(c[0]) << " " << int(c[1]) << " " << int(c[2]));
+  CHECK(c[0] > 150);
+  CHECK(c[1] < 40);
+  CHECK(c[2] < 40);
+  // the box's near face is at x = 4.5, the camera at x = 0.2
+  CHECK(m.image.depthAt(32, 24) == Approx(4.3).epsilon(0.01));
+  // a corner pixel misses the box: background colour, depth infinite
+  const std::uint8_t* corner = m.image.pixel(0, 0);
+  CHECK(std::abs(corner[0] - 51) <= 1);
+  CHECK(std::abs(corner[2] - 153) <= 1);
+  CHECK(std::isinf(m.image.depthAt(0, 0)));
+  CHECK(m.view.pose.position.isApprox(Vec3(0.2, 0, 1)));
+}
+
+TEST_CASE("render: an empty scene is all background", "[render]") {
+  REQUIRE(haveOsmesa());  // dev.sh installs libosmesa6-dev
+  Scene s = loadRenderScene(R"(<render engine="osmesa" background="0.2 0.4 0.6"/>
+    <type name="post" file="camera_post.xml"/><artifact name="eye" type="post" xyz="0 0 1"/>)");
+  Environment& env = *s.environment;
+  env.step();
+  const Image& im = image(env).image;
+  int off = 0;
+  for (int y = 0; y < im.height; ++y)
+    for (int x = 0; x < im.width; ++x) {
+      const std::uint8_t* p = im.pixel(x, y);
+      off += (std::abs(p[0] - 51) > 1 || std::abs(p[1] - 102) > 1 || std::abs(p[2] - 153) > 1) ? 1 : 0;
+    }
+  CHECK(off == 0);
+}
+
+TEST_CASE("render: a falling robot moves down in a fixed camera's image", "[render]") {
+  REQUIRE(haveOsmesa());  // dev.sh installs libosmesa6-dev
+  Scene s = loadRenderScene(R"(<render engine="osmesa"/>
+    <type name="post" file="camera_post.xml"/><type name="ball" file="yellow_ball.xml"/>
+    <artifact name="eye" type="post" xyz="0 0 1"/>
+    <artifact name="ball" type="ball" xyz="6 0 2"/>)");
+  Environment& env = *s.environment;
+  env.step();
+  const double row_before = yellowRow(image(env).image);
+  env.step(250);  // 0.5 s: 1.2 m lower
+  const double row_after = yellowRow(image(env).image);
+  INFO("rows " << row_before << " -> " << row_after);
+  REQUIRE(row_before >= 0);
+  REQUIRE(row_after >= 0);
+  CHECK(row_before < 24);        // above the optical axis at first
+  CHECK(row_after > row_before + 5);  // then lower in the picture (rows grow downwards)
+}
+
+TEST_CASE("render: levels of detail keep a primitive's size in the image, and what is partly in view is drawn",
+          "[render]") {
+  REQUIRE(haveOsmesa());
+  auto engine = osmesaEngine();
+  CameraView view;  // at the origin, looking along +x, 640 x 480, 60 degrees
+  view.far = 500;
+  const double pixels_per_metre = 480 / (2 * std::tan(std::numbers::pi / 6) * 480 / 640);  // at 1 m
+  Image im;
+  // a thin disc (a rotor) and a sphere facing the camera, near (full detail) to far (the coarsest
+  // polygon, a disc drawn as its face): the red area stays the true one
+  RenderNodeSpec disc;
+  disc.primitive = RenderNodeSpec::Primitive::Cylinder;
+  disc.radius = 0.5;
+  disc.length = 0.005;
+  disc.color = {1, 0, 0, 1};
+  RenderNodeSpec ball = disc;
+  ball.primitive = RenderNodeSpec::Primitive::Sphere;
+  const Quat facing(Eigen::AngleAxisd(std::numbers::pi / 2, Vec3::UnitY()));  // the disc's axis along x
+  for (const RenderNodeSpec* spec : {&disc, &ball})
+    for (double d : {8.0, 30.0, 60.0, 100.0}) {
+      const double r = 0.5 / d * pixels_per_metre;
+      engine->renderView(view, {RenderNode{spec, nullptr, Pose{Vec3(d, 0, 0), facing}}}, {0.2f, 0.4f, 0.6f, 1}, im);
+      const double area = std::numbers::pi * r * r;
+      INFO((spec == &disc ? "disc" : "sphere") << " at " << d << " m: radius " << r << " px, "
+                                               << redPixels(im).count << " red pixels for " << area);
+      CHECK(redPixels(im).count == Approx(area).epsilon(r > 5 ? 0.05 : 0.15));
+    }
+  // a box mostly left of the image is still drawn at the image's left edge
+  RenderNodeSpec box = disc;
+  box.primitive = RenderNodeSpec::Primitive::Box;
+  box.size = Vec3(1, 1, 1);
+  const double edge = 10 * std::tan(std::numbers::pi / 6);  // the image's left edge at 10 m
+  engine->renderView(view, {RenderNode{&box, nullptr, Pose{Vec3(10, edge + 0.4, 0), Quat::Identity()}}},
+                     {0.2f, 0.4f, 0.6f, 1}, im);
+  CHECK(redPixels(im, 0).count > 10);
+  // one far beyond the far plane, or behind the camera, is not
+  for (const Vec3& at : {Vec3(600, 0, 0), Vec3(-5, 0, 0)}) {
+    engine->renderView(view, {RenderNode{&box, nullptr, Pose{at, Quat::Identity()}}}, {0.2f, 0.4f, 0.6f, 1}, im);
+    CHECK(redPixels(im).count == 0);
+  }
+}
+
+TEST_CASE("render: what appears small (placed and lit per vertex) has the colour it has up close (lit per pixel)",
+          "[render]") {
+  REQUIRE(haveOsmesa());
+  auto engine = osmesaEngine();
+  CameraView view;  // at the origin, looking along +x
+  view.far = 500;
+  // a unit box showing the camera its -x face, and a thin disc (a rotor) seen face on from either
+  // side: lit by the eye light (0.3 + 0.3) and not the sun, which is behind them, at every distance
+  RenderNodeSpec box;
+  box.primitive = RenderNodeSpec::Primitive::Box;
+  box.size = Vec3(1, 1, 1);
+  box.color = {1, 0, 0, 1};
+  RenderNodeSpec disc = box;
+  disc.primitive = RenderNodeSpec::Primitive::Cylinder;
+  disc.radius = 0.5;
+  disc.length = 0.005;
+  const Quat towards(Eigen::AngleAxisd(-std::numbers::pi / 2, Vec3::UnitY())), away = towards.conjugate();
+  Image im;
+  for (double d : {8.0, 40.0, 70.0, 120.0}) {
+    engine->renderView(view, {RenderNode{&box, nullptr, Pose{Vec3(d, 0, 0), Quat::Identity()}}}, {0.2f, 0.4f, 0.6f, 1},
+                       im);
+    INFO("box at " << d << " m");
+    CHECK(redPixels(im).mean == Approx(0.6 * 255).margin(6));
+    for (const Quat& facing : {towards, away}) {
+      engine->renderView(view, {RenderNode{&disc, nullptr, Pose{Vec3(d, 0, 0), facing}}}, {0.2f, 0.4f, 0.6f, 1}, im);
+      INFO("disc at " << d << " m, facing " << (&facing == &towards ? "the camera" : "away"));
+      CHECK(redPixels(im).mean == Approx(0.6 * 255).margin(6));
+    }
+  }
+}

@@ -1,0 +1,119 @@
+// Saved states (world_state.cpp): what does not fit the world is refused and changes nothing.
+#include <ssx/ssx.hpp>
+
+#include "scene_util.hpp"
+#include "test_util.hpp"
+
+#include <catch2/catch.hpp>
+
+#include <string>
+#include <vector>
+
+using namespace ssx;
+
+namespace {
+
+using ssx::test::kArtifacts;
+
+// quadrotors with noisy IMUs take off from the ground and fly the formation around a pillar,
+// while boxes fall on the ground and on each other: contacts, noise, neighbours, obstacles
+std::string sceneXml(int threads, const std::string& log = "", const std::string& engine = "ode") {
+  return "<scene><environment timestep=\"0.002\" seed=\"11\" threads=\"" + std::to_string(threads) +
+         "\"/><physics engine=\"" + engine + "\"/>"
+         "<type name=\"quad\" file=\"" + (kArtifacts / "mk_quad_formation.xml").string() +
+         "\"/><type name=\"box\" file=\"" + (kArtifacts / "box.xml").string() + "\"/><ground/>"
+         "<obstacle name=\"pillar\" xyz=\"2.5 0 2\"><cylinder radius=\"0.25\" length=\"4\"/></obstacle>"
+         "<swarm type=\"quad\" count=\"12\" layout=\"random\" min=\"-2 -2 0.05\" max=\"2 2 0.05\" "
+         "min_distance=\"1.0\"><driver formation_index=\"{i}\" formation_size=\"12\" formation_radius=\"1.5\" "
+         "formation_center=\"0 0 2.5\" offset=\"0 0 1\" start_time=\"0.3\"/></swarm>"
+         "<swarm type=\"box\" name=\"box{i}\" count=\"12\" layout=\"random\" min=\"4 -0.3 0.2\" max=\"4.6 0.3 2.5\" "
+         "min_distance=\"0.3\"/>" +
+         (log.empty() ? std::string() : "<extension name=\"log\" plugin=\"csv_logger\" file=\"" + log + "\" rate_hz=\"20\"/>") +
+         "</scene>";
+}
+
+Scene load(int threads, const std::string& log = "", const std::string& engine = "ode") {
+  return loadSceneFromString(sceneXml(threads, log, engine), "state.xml", kArtifacts);
+}
+
+}  // namespace
+
+TEST_CASE("a truncated, corrupted or foreign state is refused and changes nothing", "[state]") {
+  Scene scene = load(2);
+  Environment& env = *scene.environment;
+  env.step(100);
+  const std::vector<std::byte> saved = env.saveState();
+  env.step(50);
+  const std::vector<std::byte> at150 = env.saveState();
+  const std::uint64_t before = env.stateHash();
+
+  std::vector<std::byte> truncated(saved.begin(), saved.end() - 1);
+  std::vector<std::byte> corrupted = saved;
+  corrupted[corrupted.size() / 2] ^= std::byte{0x10};
+  Scene other = loadSceneFromString(
+      "<scene><type name=\"box\" file=\"box.xml\"/><artifact name=\"b\" type=\"box\"/></scene>", "other.xml", kArtifacts);
+  other.environment->step(3);
+  const std::vector<std::byte> foreign = other.environment->saveState();
+
+  CHECK_THROWS_AS(env.restoreState(truncated), StateError);
+  CHECK_THROWS_WITH(env.restoreState(truncated), Catch::Contains("truncated"));
+  CHECK_THROWS_WITH(env.restoreState(corrupted), Catch::Contains("corrupted (checksum mismatch)"));
+  CHECK_THROWS_WITH(env.restoreState(foreign), Catch::Contains("saved from a different scene"));
+  // the same scene on the other engine: its physics state is another engine's
+  Scene on_bullet = load(2, "", "bullet");
+  CHECK_THROWS_WITH(on_bullet.environment->restoreState(saved), Catch::Contains("physics engine"));
+  CHECK_THROWS_WITH(env.restoreState(std::vector<std::byte>(10)), Catch::Contains("not an ssx saved state"));
+  // nothing moved: the world is still at step 150 and goes on as it would have
+  CHECK(env.stepCount() == 150);
+  CHECK(env.stateHash() == before);
+  CHECK(env.saveState() == at150);
+}
+
+TEST_CASE("the scene's physics partitions are part of the state: a restore needs the same count", "[state]") {
+  auto scene = [](const std::string& physics) {
+    return loadSceneFromString("<scene>" + physics + "<ground/><type name=\"box\" file=\"box.xml\"/>"
+                               "<swarm type=\"box\" count=\"150\" name=\"b{i}\" spacing=\"1\" xyz=\"0 0 0.5\"/></scene>",
+                               "partitions.xml", kArtifacts);
+  };
+  Scene three = scene("<physics partitions=\"3\"/>");
+  three.environment->step(20);
+  const std::vector<std::byte> saved = three.environment->saveState();
+  Scene again = scene("<physics partitions=\"3\"/>");
+  again.environment->start();
+  again.environment->restoreState(saved);
+  CHECK(again.environment->stateHash() == three.environment->stateHash());
+  Scene sixteen = scene("");  // the default, 16
+  sixteen.environment->start();
+  CHECK_THROWS_AS(sixteen.environment->restoreState(saved), StateError);
+}
+
+namespace {
+
+// a driver whose loadState reads less than its saveState wrote
+class ForgetfulDriver final : public Driver {
+ public:
+  void step(const StepInfo&) override { ++runs_; }
+  void saveState(StateWriter& out) const override {
+    out.write(runs_);
+    out.write(runs_);
+  }
+  void loadState(StateReader& in) override { in.read(runs_); }
+  std::int64_t runs_ = 0;
+};
+
+}  // namespace
+
+TEST_CASE("a plugin that reads back less than it saved fails the restore, which changes nothing", "[state]") {
+  Environment env;
+  Artifact& a = env.addArtifact("body", test::at(0, 0, 1));
+  a.addPhysicRoot(test::boxBody(Vec3(0.1, 0.1, 0.1), 1.0));
+  auto& driver = static_cast<ForgetfulDriver&>(a.setDriver(std::make_unique<ForgetfulDriver>()));
+  env.step(10);
+  const auto saved = env.saveState();
+  env.step(5);
+  const auto hash = env.stateHash();
+  CHECK_THROWS_WITH(env.restoreState(saved), Catch::Contains("driver 'driver' of artifact 'body' left 8 bytes"));
+  CHECK(env.stepCount() == 15);
+  CHECK(env.stateHash() == hash);
+  CHECK(driver.runs_ == 15);
+}
