@@ -121,7 +121,10 @@ void TeleKybController::setCommand(const Command& command, const Vec3& position)
   level_ = command.level;
   switch (command.level) {
     case CommandLevel::Position:
-      break;  // the references hold its set-point
+      // the references hold its set-point; it is the one tracked from now on (currentSetpoint
+      // says so at once, not only after the next position loop)
+      current_ = command.setpoint;
+      break;
     case CommandLevel::Velocity:
       // the reference point starts where the vehicle is, and moves on from there while the level holds
       if (previous != CommandLevel::Velocity) velocity_point_ = position;
