@@ -88,6 +88,10 @@ TEST_CASE("the model holds every default and what the file says, with where it s
   CHECK(m.settings.timestep == 2'000'000);
   CHECK(m.settings.physics.engine == "ode");
   CHECK(m.settings.physics.ode.iterations == 20);
+  // where each setting was written; a default has no place
+  REQUIRE(m.settings_from.count("environment@timestep") == 1);
+  CHECK(m.settings_from.at("environment@timestep").str() == "mem.xml:2");
+  CHECK(m.settings_from.count("physics@engine") == 0);
   REQUIRE(m.placements.size() == 3);
   const PlacementModel& swarm = m.placements[0];
   CHECK(swarm.kind == PlacementModel::Kind::Swarm);
@@ -153,4 +157,18 @@ TEST_CASE("a model made in code builds; a placement of a type it lacks is report
   Scene scene = buildScene(model, testOptions());
   REQUIRE(scene.environment->findArtifact("stray") != nullptr);
   CHECK(scene.environment->findArtifact("stray")->placement().position == Vec3(0, 0, 20));
+}
+
+TEST_CASE("a setting an override changed is placed where the override was given", "[scene][model]") {
+  SceneOptions options = testOptions();
+  options.overrides = {{"environment@seed", "9", {"sweep.xml", 4}},
+                       {"render/camera[name=top]@xyz", "1 2 3", {"sweep.xml", 5}}};
+  const SceneModel m = parseSceneString("<scene>\n<environment timestep=\"0.002\" seed=\"1\"/>\n"
+                                        "<render><camera name=\"top\" xyz=\"0 0 9\"/></render>\n</scene>",
+                                        "mem.xml", kData / "valid", options);
+  CHECK(m.settings.seed == 9);
+  CHECK(m.settings_from.at("environment@seed").str() == "sweep.xml:4");
+  CHECK(m.settings_from.at("environment@timestep").str() == "mem.xml:2");
+  CHECK(m.settings_from.at("render/camera[name=top]@xyz").str() == "sweep.xml:5");
+  CHECK(m.settings_from.at("render/camera[name=top]@name").str() == "mem.xml:3");
 }

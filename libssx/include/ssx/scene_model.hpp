@@ -97,8 +97,13 @@ struct SSX_EXPORT SceneModel {
   std::map<std::string, ArtifactTypeModel> types;  ///< the types the placements use, by name
   std::vector<PlacementModel> placements;          ///< in document order
   std::vector<Diagnostic> warnings;                ///< unknown elements and attributes, and the like
+  /// Where each setting the file gives was written (the settings above hold the values, defaults
+  /// included), keyed element@attribute as sweep overrides spell them: "environment@timestep",
+  /// "physics@engine", "wind@speed", "render@rate_hz", "render/camera[name=top]@xyz". A setting
+  /// the file leaves out has no entry (its value is the default).
   /// Every file read: the scene file, its includes, the artifact files (the run's inputs).
   std::vector<std::filesystem::path> files;
+  std::map<std::string, SourceLocation> settings_from;
 
   /// The scene as scene XML with every setting's default filled in: plugin directories, artifact
   /// files and paths absolute; swarms with every layout attribute; plugin parameters and

@@ -29,6 +29,10 @@ bool SceneLoader::once(const Descriptor& d, const Descriptor*& slot) {
   return true;
 }
 
+void SceneLoader::noteSettings(const Descriptor& d, const std::string& path) {
+  for (const auto& a : d.attributes()) model_.settings_from[path + "@" + a.key] = a.where;
+}
+
 void SceneLoader::collect(const Descriptor& scene, const fs::path& dir, std::vector<fs::path>& stack) {
   if (scene.name() != "scene") {
     error(scene.where(), "the root element of a scene file must be <scene>, got <" + scene.name() + ">");
@@ -37,13 +41,25 @@ void SceneLoader::collect(const Descriptor& scene, const fs::path& dir, std::vec
   for (const Descriptor& d : scene.children()) {
     const std::string& n = d.name();
     if (n == "environment") {
-      if (once(d, environment_element_)) readEnvironment(d);
+      if (once(d, environment_element_)) {
+        readEnvironment(d);
+        noteSettings(d, n);
+      }
     } else if (n == "physics") {
-      if (once(d, physics_element_)) readPhysics(d);
+      if (once(d, physics_element_)) {
+        readPhysics(d);
+        noteSettings(d, n);
+      }
     } else if (n == "render") {
-      if (once(d, render_element_)) readRender(d);
+      if (once(d, render_element_)) {
+        readRender(d);
+        noteSettings(d, n);
+      }
     } else if (n == "wind") {
-      if (once(d, wind_element_)) readWind(d);
+      if (once(d, wind_element_)) {
+        readWind(d);
+        noteSettings(d, n);
+      }
     } else if (n == "plugin_path") {
       const std::string p = require(d, "dir");
       if (!p.empty()) plugin_dirs_.push_back(resolve(dir, p));
@@ -293,6 +309,7 @@ void SceneLoader::readRender(const Descriptor& d) {
     cam.video = read<std::string>(*c, "video", "");
     cam.snapshot = read<std::string>(*c, "snapshot", "");
     checkUnknown(*c);
+    noteSettings(*c, "render/camera[name=" + cam.name + "]");
     r.cameras.push_back(std::move(cam));
   }
   checkUnknown(d, {"camera"});

@@ -193,6 +193,8 @@ class SceneLoader {
   // an installed artifact type by name (options_.artifact_path, then the installed directory);
   // records the error and returns empty when there is none
   fs::path findArtifactType(const Descriptor& d, const std::string& name);
+  // records where each attribute of a settings element was written, under path@attribute
+  void noteSettings(const Descriptor& d, const std::string& path);
   void readEnvironment(const Descriptor& d);
   void readPhysics(const Descriptor& d);
   void readRender(const Descriptor& d);
