@@ -1,5 +1,6 @@
 #pragma once
 // What the ssx command's subcommands share: exit statuses, the plugin search path, lists.
+#include <cstdint>
 #include <cstdlib>
 #include <filesystem>
 #include <sstream>
@@ -22,6 +23,11 @@ inline std::vector<std::filesystem::path> pluginPath(const std::vector<std::stri
   }
   return out;
 }
+
+// --max-input-mb: the largest file a command reads as input, in MiB (default: the library's 64)
+constexpr double kDefaultMaxInputMb = 64.0;
+constexpr double kMostMaxInputMb = 1 << 20;  // 1 TiB: beyond it, a file is no scene
+inline std::uintmax_t maxInputBytes(double mb) { return static_cast<std::uintmax_t>(mb * (1 << 20)); }
 
 inline std::string joined(const std::vector<std::string>& names) {
   std::string out;

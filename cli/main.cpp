@@ -98,6 +98,7 @@ struct RunArgs {
   std::vector<std::string> plugin_path;
   std::string stats_csv;
   bool quiet = false;
+  double max_input_mb = kDefaultMaxInputMb;
   std::string render, physics, snapshot, video, frames;
   std::string save_state, load_state;
   bool allow_special_outputs = false;
@@ -107,14 +108,23 @@ struct RunArgs {
 
 // "ode, bullet"
 
-std::vector<std::byte> readFile(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw std::runtime_error("cannot read '" + path + "'");
-  std::vector<char> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  if (in.bad()) throw std::runtime_error("error while reading '" + path + "'");
-  std::vector<std::byte> out(bytes.size());
-  std::memcpy(out.data(), bytes.data(), bytes.size());
+// a saved state: a regular file of at most max_bytes (ssx::readInputFile)
+std::vector<std::byte> readFile(const std::string& path, std::uintmax_t max_bytes) {
+  std::string text;
+  try {
+    text = ssx::readInputFile(path, max_bytes);
+  } catch (const ssx::ConfigError& e) {
+    throw std::runtime_error(e.detail());
+  }
+  std::vector<std::byte> out(text.size());
+  std::memcpy(out.data(), text.data(), text.size());
   return out;
+}
+
+void addMaxInputOption(CLI::App* command, double& mb) {
+  command->add_option("--max-input-mb", mb, "largest input file read (scene, include, artifact, sweep, state), MiB")
+      ->check(CLI::Range(1.0 / 1024, kMostMaxInputMb))
+      ->default_val(kDefaultMaxInputMb);
 }
 
 // written beside the target and renamed over it: a failed write never leaves a short file
@@ -153,6 +163,7 @@ int commandRun(const RunArgs& args, bool realtime_given) {
   options.video = args.video;
   options.frames_dir = args.frames;
   options.allow_special_outputs = args.allow_special_outputs;
+  options.max_input_bytes = maxInputBytes(args.max_input_mb);
   // settings of this process for drawing with Mesa's llvmpipe (the library leaves the process
   // alone; a program that embeds it chooses these itself, see the README):
   // - llvmpipe's own rasteriser threads cost more than they give at these image sizes and would
@@ -213,7 +224,7 @@ int commandRun(const RunArgs& args, bool realtime_given) {
   std::vector<std::byte> loaded;
   if (!args.load_state.empty()) {
     try {
-      loaded = readFile(args.load_state);
+      loaded = readFile(args.load_state, maxInputBytes(args.max_input_mb));
       env.checkState(loaded);
     } catch (const std::exception& e) {
       std::cerr << "ssx: error: --load-state " << args.load_state << ": " << e.what() << '\n';
@@ -292,9 +303,10 @@ int commandRun(const RunArgs& args, bool realtime_given) {
 }
 
 int commandValidate(const std::string& file, const std::vector<std::string>& plugin_path, const std::string& physics,
-                    bool print) {
+                    bool print, double max_input_mb) {
   ssx::SceneOptions options;
   options.plugin_path = pluginPath(plugin_path);
+  options.max_input_bytes = maxInputBytes(max_input_mb);
   if (!physics.empty()) options.physics_engine = physics;
   try {
     const ssx::Scene scene = ssx::loadScene(file, options);
@@ -321,16 +333,18 @@ struct SweepArgs {
   std::vector<std::string> plugin_path;
   int jobs = 0;
   bool check = false, quiet = false;
+  double max_input_mb = kDefaultMaxInputMb;
 };
 
 int commandSweep(const SweepArgs& args) {
   namespace sw = ssx::sweep;
   const fs::path out = args.out.empty() ? fs::path(fs::path(args.file).stem().string() + ".csv") : fs::path(args.out);
   const auto plugin_path = pluginPath(args.plugin_path);
-  if (sw::underMpi()) return sw::runMpi(args.file, plugin_path, out, args.robots, args.check);
+  const std::uintmax_t max_input = maxInputBytes(args.max_input_mb);
+  if (sw::underMpi()) return sw::runMpi(args.file, plugin_path, out, args.robots, args.check, max_input);
   std::optional<sw::Spec> spec;
   try {
-    spec = sw::readSpec(args.file, plugin_path);
+    spec = sw::readSpec(args.file, plugin_path, max_input);
     sw::check(*spec);
   } catch (const ssx::SceneError& e) {
     std::cerr << e.what() << '\n';
@@ -410,6 +424,7 @@ int main(int argc, char** argv) {
   run_cmd->add_option("--load-state", run.load_state,
                       "continue from a state saved from this scene (--steps and --duration count from there)")
       ->check(CLI::ExistingFile);
+  addMaxInputOption(run_cmd, run.max_input_mb);
 
   std::string validate_file;
   std::vector<std::string> validate_path;
@@ -422,6 +437,8 @@ int main(int argc, char** argv) {
                          "print the scene as ssx reads it, every default filled in (scene XML, on standard output)");
   validate_cmd->add_option("--physics", validate_physics, "check the scene for this physics engine: ode or bullet")
       ->check(CLI::IsMember(ssx::physicEngineNames()));
+  double validate_max_input_mb = kDefaultMaxInputMb;
+  addMaxInputOption(validate_cmd, validate_max_input_mb);
 
   std::vector<std::string> plugins_path;
   CLI::App* plugins_cmd = app.add_subcommand("plugins", "list plugin libraries, their classes, and ABI checks");
@@ -443,6 +460,7 @@ int main(int argc, char** argv) {
   sweep_cmd->add_option("--plugin-path", sweep.plugin_path, "plugin directory (repeatable)");
   sweep_cmd->add_flag("--check", sweep.check, "check the sweep and every point's scene; run nothing");
   sweep_cmd->add_flag("--quiet", sweep.quiet, "no progress");
+  addMaxInputOption(sweep_cmd, sweep.max_input_mb);
 
   try {
     app.parse(argc, argv);
@@ -457,7 +475,7 @@ int main(int argc, char** argv) {
     if (realtime_given && (realtime->results().empty() || realtime->results().front().empty())) run.realtime = 1.0;
     return commandRun(run, realtime_given);
   }
-  if (*validate_cmd) return commandValidate(validate_file, validate_path, validate_physics, validate_print);
+  if (*validate_cmd) return commandValidate(validate_file, validate_path, validate_physics, validate_print, validate_max_input_mb);
   if (*sweep_cmd) return commandSweep(sweep);
   if (*plugins_cmd && !inspect_file.empty()) return ssx::cli::inspectOne(inspect_file, params_of);
   if (*plugins_cmd) return ssx::cli::commandPlugins(plugins_path, params_of);

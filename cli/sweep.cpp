@@ -25,6 +25,7 @@ SceneOptions sceneOptions(const Spec& spec, std::size_t point) {
   o.threads = spec.threads;
   o.render_engine = "null";
   o.extensions = spec.extensions;
+  o.max_input_bytes = spec.max_input_bytes;
   for (std::size_t i = 0; i < spec.parameters.size(); ++i)
     o.overrides.push_back({spec.parameters[i].target, spec.points[point][i], spec.parameters[i].where});
   return o;

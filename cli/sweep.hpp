@@ -50,6 +50,7 @@ struct Spec {
   std::vector<std::vector<std::string>> points;  // one value per parameter
   std::vector<MetricSpec> metrics;
   std::string fingerprint;  // of the sweep file and the scene file's text
+  std::uintmax_t max_input_bytes = kDefaultMaxInputBytes;  // of every file read (--max-input-mb)
 
   std::int64_t runCount() const { return static_cast<std::int64_t>(points.size()) * seeds; }
   std::size_t pointOf(std::int64_t run) const { return static_cast<std::size_t>(run / seeds); }
@@ -61,7 +62,8 @@ struct Spec {
 };
 
 /// Reads a sweep file; throws SceneError with every problem (file:line).
-Spec readSpec(const fs::path& file, const std::vector<fs::path>& plugin_path);
+Spec readSpec(const fs::path& file, const std::vector<fs::path>& plugin_path,
+              std::uintmax_t max_input_bytes = kDefaultMaxInputBytes);
 
 /// Loads the scene at every point (each value checked by its plugin's declarations) and starts
 /// the first point once to learn the metrics its plugins publish. Throws SceneError.
@@ -124,7 +126,7 @@ bool underMpi();
 /// The sweep under MPI: rank 0 checks, hands out runs as ranks free up and writes; the others
 /// run. Returns the exit status.
 int runMpi(const fs::path& file, const std::vector<fs::path>& plugin_path, const fs::path& out_file,
-           const fs::path& robots_file, bool check_only);
+           const fs::path& robots_file, bool check_only, std::uintmax_t max_input_bytes);
 
 /// Prints the sweep's rate and its cost per run (load, start, run, write).
 void printStats(const Stats& stats, const Output& out, double wall_s, int processes, const fs::path& summary);

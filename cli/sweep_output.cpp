@@ -57,6 +57,7 @@ Output::Output(const Spec& spec, fs::path file, fs::path robots_file)
     try {
       SceneOptions options;
       options.plugin_path = spec.plugin_path;
+      options.max_input_bytes = spec.max_input_bytes;
       for (const fs::path& f : parseScene(spec.scene, options).files) files.addInput(f);
     } catch (const SceneError&) {
       // (the runs report the scene's problems, each in its row)

@@ -230,7 +230,7 @@ constexpr int kTagResult = 1, kTagWork = 2;
 }
 
 int runMpi(const fs::path& file, const std::vector<fs::path>& plugin_path, const fs::path& out_file,
-           const fs::path& robots_file, bool check_only) {
+           const fs::path& robots_file, bool check_only, std::uintmax_t max_input_bytes) {
   MPI_Init(nullptr, nullptr);
   int rank = 0, size = 1;
   MPI_Comm_rank(MPI_COMM_WORLD, &rank);
@@ -241,7 +241,7 @@ int runMpi(const fs::path& file, const std::vector<fs::path>& plugin_path, const
   std::string problem;
   int status = 0;
   try {
-    spec = readSpec(file, plugin_path);
+    spec = readSpec(file, plugin_path, max_input_bytes);
     if (rank == 0) check(*spec);
   } catch (const SceneError& e) {
     problem = e.what();
@@ -318,7 +318,7 @@ int runMpi(const fs::path& file, const std::vector<fs::path>& plugin_path, const
   return 0;
 }
 #else
-int runMpi(const fs::path&, const std::vector<fs::path>&, const fs::path&, const fs::path&, bool) {
+int runMpi(const fs::path&, const std::vector<fs::path>&, const fs::path&, const fs::path&, bool, std::uintmax_t) {
   std::cerr << "ssx: error: this ssx was built without MPI (apt-get install libopenmpi-dev, then rebuild)\n";
   return 2;
 }

@@ -19,13 +19,6 @@ namespace {
 
 constexpr std::int64_t kMaxRuns = 10'000'000;
 
-std::string readText(const fs::path& file) {
-  std::ifstream in(file, std::ios::binary);
-  if (!in) return {};
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
 
 // (a basis of its own since the first sweeps: the fingerprints of files already written stay)
 constexpr std::uint64_t kFingerprintBasis = 1469598103934665603ull;
@@ -148,12 +141,11 @@ std::vector<std::string> Spec::columns() const {
   return c;
 }
 
-Spec readSpec(const fs::path& file, const std::vector<fs::path>& plugin_path) {
-  const std::string text = readText(file);
-  if (text.empty() && !fs::is_regular_file(file))
-    throw SceneError({{Diagnostic::Severity::Error, {file.string(), 0}, "cannot read the sweep file (missing, a directory, or no permission)"}});
+Spec readSpec(const fs::path& file, const std::vector<fs::path>& plugin_path, std::uintmax_t max_input_bytes) {
+  std::string text;
   Descriptor root;
   try {
+    text = readInputFile(file, max_input_bytes);
     root = parseXml(text, file.string());
   } catch (const ConfigError& e) {
     throw SceneError({{Diagnostic::Severity::Error, e.where(), e.detail()}});
@@ -162,6 +154,7 @@ Spec readSpec(const fs::path& file, const std::vector<fs::path>& plugin_path) {
   Spec spec;
   spec.file = file;
   spec.plugin_path = plugin_path;
+  spec.max_input_bytes = max_input_bytes;
   if (root.name() != "sweep") {
     r.error(r.at(root), "the root element of a sweep file must be <sweep>, got <" + root.name() + ">");
     throw SceneError(r.diagnostics);
@@ -169,13 +162,17 @@ Spec readSpec(const fs::path& file, const std::vector<fs::path>& plugin_path) {
   r.allow(root, {"scene", "seed", "seeds", "duration", "threads", "sample_hz", "extensions"});
   const SourceLocation root_at = r.at(root);
   spec.where = root_at;
+  std::string scene_text;
   if (Reader::text(root, "scene").empty()) {
     r.error(root_at, "<sweep>: missing attribute 'scene' (the scene file to vary, relative to this file)");
   } else {
     spec.scene = fs::path(Reader::text(root, "scene"));
     if (spec.scene.is_relative()) spec.scene = file.parent_path() / spec.scene;
-    if (!fs::is_regular_file(spec.scene))
-      r.error(root_at, "<sweep>: cannot read scene '" + spec.scene.string() + "' (missing, a directory, or no permission)");
+    try {
+      scene_text = readInputFile(spec.scene, max_input_bytes);
+    } catch (const ConfigError& e) {
+      r.error(root_at, "<sweep>: scene '" + spec.scene.string() + "': " + e.detail());
+    }
   }
   spec.seed = static_cast<std::uint64_t>(r.integer(root, "seed", 0, std::numeric_limits<std::int64_t>::max()).value_or(0));
   spec.seeds = r.integer(root, "seeds", 1, 1'000'000).value_or(1);
@@ -357,7 +354,7 @@ Spec readSpec(const fs::path& file, const std::vector<fs::path>& plugin_path) {
   }
   if (!r.diagnostics.empty()) throw SceneError(r.diagnostics);
   char fp[17];
-  std::snprintf(fp, sizeof fp, "%016" PRIx64, fnv1a(readText(spec.scene), fnv1a(text, kFingerprintBasis)));
+  std::snprintf(fp, sizeof fp, "%016" PRIx64, fnv1a(scene_text, fnv1a(text, kFingerprintBasis)));
   spec.fingerprint = fp;
   return spec;
 }

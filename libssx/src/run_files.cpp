@@ -1,10 +1,47 @@
+#include <ssx/error.hpp>
 #include <ssx/run_files.hpp>
 
 #include <sys/stat.h>
 
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
+#include <memory>
+
 namespace ssx {
 
 namespace fs = std::filesystem;
+
+std::string readInputFile(const fs::path& file, std::uintmax_t max_bytes) {
+  const SourceLocation where{file.string(), 0};
+  struct stat st {};
+  if (::stat(file.c_str(), &st) != 0)
+    throw ConfigError(where, std::string("cannot read it: ") + std::strerror(errno));
+  if (S_ISDIR(st.st_mode)) throw ConfigError(where, "cannot read it: a directory, not a file");
+  if (!S_ISREG(st.st_mode))
+    throw ConfigError(where, "cannot read it: not a regular file (a FIFO, a device or a socket has no end or no fixed "
+                            "content); give a file");
+  const auto too_large = [&](std::uintmax_t size) {
+    char text[160];
+    std::snprintf(text, sizeof text, "cannot read it: larger than the limit on input files (%.3g MiB; it has at least %.3g MiB)",
+                  static_cast<double>(max_bytes) / (1 << 20), static_cast<double>(size) / (1 << 20));
+    return ConfigError(where, std::string(text) + ": raise it with --max-input-mb (SceneOptions::max_input_bytes)");
+  };
+  if (static_cast<std::uintmax_t>(st.st_size) > max_bytes) throw too_large(static_cast<std::uintmax_t>(st.st_size));
+  const std::unique_ptr<std::FILE, int (*)(std::FILE*)> f(std::fopen(file.c_str(), "rb"), &std::fclose);
+  if (!f) throw ConfigError(where, std::string("cannot read it: ") + std::strerror(errno));
+  // read at most one byte beyond the limit: a file that grows while it is read is caught too
+  std::string text;
+  char buffer[65536];
+  for (;;) {
+    const std::size_t n = std::fread(buffer, 1, sizeof buffer, f.get());
+    text.append(buffer, n);
+    if (text.size() > max_bytes) throw too_large(text.size());
+    if (n < sizeof buffer) break;
+  }
+  if (std::ferror(f.get()) != 0) throw ConfigError(where, std::string("cannot read it: ") + std::strerror(errno));
+  return text;
+}
 
 bool RunFiles::Identity::operator==(const Identity& o) const {
   if (exists && o.exists) return device == o.device && inode == o.inode;

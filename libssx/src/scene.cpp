@@ -44,9 +44,9 @@ fs::path installedDataDirectory() {
 
 namespace {
 
-Descriptor rootOf(const fs::path& file) {
+Descriptor rootOf(const fs::path& file, std::uintmax_t max_bytes) {
   try {
-    return readXmlFile(file);
+    return readXmlFile(file, max_bytes);
   } catch (const ConfigError& e) {
     throw SceneError({{Diagnostic::Severity::Error, e.where(), e.detail()}});
   }
@@ -90,7 +90,7 @@ Scene load(const SceneOptions& options, Descriptor root, const fs::path& file, c
 
 SceneModel parseScene(const fs::path& file, const SceneOptions& options) {
   detail::SceneLoader loader(options);
-  return parseWith(loader, rootOf(file), file, directoryOf(file));
+  return parseWith(loader, rootOf(file, options.max_input_bytes), file, directoryOf(file));
 }
 
 SceneModel parseSceneString(std::string_view xml, const std::string& label, const fs::path& base_dir,
@@ -111,7 +111,7 @@ Scene buildScene(const SceneModel& model, const SceneOptions& options) {
 }
 
 Scene loadScene(const fs::path& file, const SceneOptions& options) {
-  return load(options, rootOf(file), file, directoryOf(file));
+  return load(options, rootOf(file, options.max_input_bytes), file, directoryOf(file));
 }
 
 Scene loadSceneFromString(std::string_view xml, const std::string& label, const fs::path& base_dir,

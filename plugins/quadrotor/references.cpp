@@ -35,9 +35,12 @@ bool number(const std::string& text, double& value) {
 }  // namespace
 
 Trajectory Trajectory::read(const std::filesystem::path& file) {
-  std::ifstream in(file);
-  if (!in)
-    throw ConfigError({file.string(), 0}, "cannot read the trajectory file (missing, a directory, or no permission)");
+  std::istringstream in;
+  try {
+    in.str(readInputFile(file));
+  } catch (const ConfigError& e) {
+    throw ConfigError(e.where(), "cannot read the trajectory file: " + e.detail());
+  }
   Trajectory t;
   std::size_t columns = 0;
   int line_number = 0;

@@ -120,6 +120,24 @@ TEST_CASE("ssx validate: 0 for a good scene, 2 with the diagnostics for a broken
   CHECK_THAT(bad.err, Contains("parts/negative_mass.xml:3: error: physic node 'body': mass must be positive"));
 }
 
+TEST_CASE("ssx validate, run and sweep: inputs beyond --max-input-mb are refused with exit 2, naming the file",
+          "[cli]") {
+  // a scene of 4 KiB (a long comment), its artifact file beside the examples'
+  const std::string scene = (fs::current_path() / "padded_scene.xml").string();
+  std::ofstream(scene) << "<scene><!--" << std::string(4096, '-') << "--><type name=\"b\" file=\""
+                       << (kExamples / "artifacts" / "box.xml").string() << "\"/><artifact name=\"b\" type=\"b\"/></scene>\n";
+  const Result small = run({"validate", scene, "--max-input-mb", "0.002"});
+  CHECK(small.status == 2);
+  CHECK_THAT(small.err, Contains("padded_scene.xml: error: cannot read it: larger than the limit on input files (0.002 MiB; it has at least 0.00"));
+  CHECK(run({"validate", scene, "--max-input-mb", "1"}).status == 0);
+  CHECK(run({"run", scene, "--steps", "1", "--quiet", "--max-input-mb", "0.002"}).status == 2);
+  CHECK(run({"validate", scene, "--max-input-mb", "0"}).status == 2);  // no limit below a KiB
+  // a state to load is an input too
+  const Result state = run({"run", scene, "--steps", "1", "--quiet", "--load-state", "/dev/zero"});
+  CHECK(state.status == 2);
+  CHECK_THAT(state.err, Contains("--load-state /dev/zero: cannot read it: not a regular file"));
+}
+
 TEST_CASE("ssx validate --print: the scene with every default, which validates and prints the same again", "[cli]") {
   const Result printed = run({"validate", (kExamples / "scenes" / "hover_swarm.xml").string(), "--print"});
   REQUIRE(printed.status == 0);

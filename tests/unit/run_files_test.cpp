@@ -78,3 +78,24 @@ TEST_CASE("a frames directory may not hold an input of the run", "[run_files]") 
   CHECK_THAT(files.claimOutputDirectory(d.path, "camera 'c': frames"), Catch::Contains("holds"));
   CHECK(files.claimOutputDirectory(d.path / "frames", "camera 'c': frames").empty());
 }
+
+TEST_CASE("input files: regular files up to the limit are read whole; anything else is refused saying why",
+          "[run_files]") {
+  const Dir dir;
+  const fs::path small = dir.file("small.xml", std::string(1000, 'a'));
+  CHECK(readInputFile(small) == std::string(1000, 'a'));
+  CHECK(readInputFile(small, 1000).size() == 1000);  // the limit itself is allowed
+  CHECK_THROWS_WITH(readInputFile(small, 999), Catch::Contains("small.xml: error: cannot read it: larger than the "
+                                                               "limit on input files") &&
+                                                   Catch::Contains("--max-input-mb"));
+  // a device with no end, a FIFO, a directory, a missing file: errors, never a read without bound
+  CHECK_THROWS_WITH(readInputFile("/dev/zero"), Catch::Contains("/dev/zero: error: cannot read it: not a regular file"));
+  const fs::path fifo = dir.path / "pipe";
+  REQUIRE(mkfifo(fifo.c_str(), 0600) == 0);
+  CHECK_THROWS_WITH(readInputFile(fifo), Catch::Contains("not a regular file"));  // (opening it would block)
+  CHECK_THROWS_WITH(readInputFile(dir.path / "sub"), Catch::Contains("a directory, not a file"));
+  CHECK_THROWS_WITH(readInputFile(dir.path / "none.xml"), Catch::Contains("none.xml: error: cannot read it: No such file"));
+  // a link to a file reads the file
+  fs::create_symlink(small, dir.path / "link.xml");
+  CHECK(readInputFile(dir.path / "link.xml").size() == 1000);
+}

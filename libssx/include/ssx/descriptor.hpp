@@ -4,6 +4,7 @@
 
 #include <ssx/error.hpp>
 #include <ssx/export.hpp>
+#include <ssx/run_files.hpp>
 #include <ssx/types.hpp>
 
 #include <filesystem>
@@ -127,7 +128,8 @@ extern template SSX_EXPORT Vec3 Descriptor::get<Vec3>(std::string_view, const Ve
 /// syntax error, at the line of the problem. ssx's own files and tools read XML through it.
 SSX_EXPORT Descriptor parseXml(std::string_view text, const std::string& label);
 
-/// Reads and parses a file. Throws ConfigError naming the file (line 0) when it cannot be read.
-SSX_EXPORT Descriptor readXmlFile(const std::filesystem::path& file);
+/// Reads (readInputFile: a regular file of at most `max_bytes`) and parses a file. Throws
+/// ConfigError naming the file (line 0) when it cannot be read.
+SSX_EXPORT Descriptor readXmlFile(const std::filesystem::path& file, std::uintmax_t max_bytes = kDefaultMaxInputBytes);
 
 }  // namespace ssx

@@ -17,6 +17,16 @@
 
 namespace ssx {
 
+/// The largest file a run reads as input unless told otherwise (SceneOptions::max_input_bytes,
+/// `ssx run|validate|sweep --max-input-mb`): 64 MiB, far beyond any scene, artifact, sweep, saved
+/// state or trajectory of a swarm of 100,000 robots.
+inline constexpr std::uintmax_t kDefaultMaxInputBytes = std::uintmax_t{64} << 20;
+
+/// Reads a whole input file of the run. It must be a regular file (a FIFO, a device such as
+/// /dev/zero, or a directory is refused: they have no end or no content) of at most `max_bytes`.
+/// Throws ConfigError at the file (line 0) saying what is wrong and what to do.
+SSX_EXPORT std::string readInputFile(const std::filesystem::path& file, std::uintmax_t max_bytes = kDefaultMaxInputBytes);
+
 class SSX_EXPORT RunFiles {
  public:
   /// Outputs written as a stream (a logger's file, timing samples) may then be a FIFO or a

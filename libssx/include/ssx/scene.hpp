@@ -68,6 +68,8 @@ struct SceneOptions {
   bool extensions = true;
   /// Outputs written as streams (a logger's file) may be FIFOs or character devices (RunFiles).
   bool allow_special_outputs = false;
+  /// The largest scene, include or artifact file read (readInputFile); `--max-input-mb`.
+  std::uintmax_t max_input_bytes = kDefaultMaxInputBytes;
 };
 
 /// A loaded scene: an environment ready to start, and how the file asks to run it.

@@ -167,15 +167,14 @@ const ArtifactType* SceneLoader::artifactType(const std::string& name, const Sou
   ArtifactType& t = types_[name];
   try {
     model_.files.push_back(decl->second.file);
-    documents_.push_back(readXmlFile(decl->second.file));
+    documents_.push_back(readXmlFile(decl->second.file, options_.max_input_bytes));
     t = parseArtifact(documents_.back());
     t.name = name;
     t.file = decl->second.file;
     t.where = decl->second.where;
   } catch (const ConfigError& e) {
     if (e.where().line == 0)
-      error(decl->second.where, "<type>: cannot read artifact file '" + decl->second.file.string() +
-                                    "' (missing, a directory, or no permission)");
+      error(decl->second.where, "<type>: artifact file '" + decl->second.file.string() + "': " + e.detail());
     else
       record(e);
     t.ok = false;

@@ -97,10 +97,10 @@ void SceneLoader::collect(const Descriptor& scene, const fs::path& dir, std::vec
       }
       try {
         model_.files.push_back(path);
-        documents_.push_back(readXmlFile(path));
+        documents_.push_back(readXmlFile(path, options_.max_input_bytes));
       } catch (const ConfigError& e) {
         if (e.where().line == 0)
-          error(d.where(), "<include>: cannot read '" + path.string() + "' (missing, a directory, or no permission)");
+          error(d.where(), "<include>: '" + file + "': " + e.detail());
         else
           record(e);
         continue;

@@ -4,8 +4,6 @@
 
 #include <algorithm>
 #include <cctype>
-#include <fstream>
-#include <sstream>
 #include <vector>
 
 namespace ssx::detail {
@@ -16,8 +14,10 @@ namespace {
 class LineIndex {
  public:
   explicit LineIndex(std::string_view text) {
+    // a line ends at LF, CRLF or a lone CR (old Mac files): each ends one line
     for (std::size_t i = 0; i < text.size(); ++i)
-      if (text[i] == '\n') newlines_.push_back(i);
+      if (text[i] == '\n' || (text[i] == '\r' && (i + 1 == text.size() || text[i + 1] != '\n')))
+        newlines_.push_back(i);
   }
   int line(std::ptrdiff_t offset) const {
     if (offset < 0) return 0;
@@ -81,14 +81,8 @@ Descriptor parseXml(std::string_view text, const std::string& file) {
   return convert(root, text, lines, file);
 }
 
-Descriptor readXmlFile(const std::filesystem::path& file) {
-  std::ifstream in(file, std::ios::binary);
-  std::error_code ec;
-  if (!in || std::filesystem::is_directory(file, ec))
-    throw ConfigError({file.string(), 0}, "cannot read file (missing, a directory, or no permission)");
-  std::ostringstream buffer;
-  buffer << in.rdbuf();
-  return parseXml(buffer.str(), file.string());
+Descriptor readXmlFile(const std::filesystem::path& file, std::uintmax_t max_bytes) {
+  return parseXml(readInputFile(file, max_bytes), file.string());
 }
 
 }  // namespace ssx

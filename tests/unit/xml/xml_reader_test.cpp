@@ -4,6 +4,7 @@
 #include <catch2/catch.hpp>
 
 #include <filesystem>
+#include <fstream>
 #include <string>
 
 using namespace ssx;
@@ -38,4 +39,33 @@ TEST_CASE("XML errors say where: a syntax error at its line, a file that cannot 
   for (int i = 0; i < 70; ++i) deep += "<e>";
   for (int i = 0; i < 70; ++i) deep += "</e>";
   CHECK_THROWS_WITH(parseXml(deep, "deep.xml"), Catch::Contains("nested more than 64 levels deep"));
+}
+
+TEST_CASE("lines are counted the same whether they end in LF, CRLF or a lone CR", "[xml]") {
+  for (const char* eol : {"\n", "\r\n", "\r"}) {
+    const std::string e = eol;
+    const Descriptor root = parseXml("<scene>" + e + "<a/>" + e + e + "<b x=\"1\"/>" + e + "</scene>", "eol.xml");
+    INFO("line end " << (e == "\n" ? "LF" : e == "\r\n" ? "CRLF" : "CR"));
+    CHECK(root.children().at(0).where().line == 2);
+    CHECK(root.children().at(1).where().line == 4);
+    CHECK(root.children().at(1).find("x")->where.line == 4);
+    try {
+      (void)parseXml("<scene>" + e + e + "<a>" + e + "</scene>", "eol.xml");
+      FAIL("parsed");
+    } catch (const ConfigError& err) {
+      CHECK(err.where().line >= 3);
+    }
+  }
+}
+
+TEST_CASE("an XML file is read as an input file: bounded, and regular", "[xml]") {
+  CHECK_THROWS_WITH(readXmlFile("/dev/zero"), Catch::Contains("not a regular file"));
+  const auto file = std::filesystem::temp_directory_path() / "ssx_xml_limit.xml";
+  {
+    std::ofstream out(file);
+    out << "<scene>" << std::string(4096, ' ') << "</scene>";
+  }
+  CHECK(readXmlFile(file).name() == "scene");
+  CHECK_THROWS_WITH(readXmlFile(file, 1024), Catch::Contains("larger than the limit on input files"));
+  std::filesystem::remove(file);
 }
