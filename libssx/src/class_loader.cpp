@@ -1,6 +1,8 @@
 #include <ssx/class_loader.hpp>
 #include <ssx/plugin_abi.hpp>
 
+#include "elf_check.hpp"
+
 #include <cxxabi.h>
 #include <dlfcn.h>
 
@@ -169,6 +171,7 @@ fs::path ClassLoader::installedPluginDirectory() {
 PluginLibraryInfo ClassLoader::inspect(const fs::path& file) {
   PluginLibraryInfo info;
   info.path = file;
+  if (info.problem = detail::sharedLibraryProblem(file); !info.problem.empty()) return info;
   void* handle = dlopen(file.c_str(), RTLD_NOW | RTLD_LOCAL);
   if (handle == nullptr) {
     info.problem = explainDlerror(dlerror());
@@ -212,6 +215,11 @@ fs::path ClassLoader::load(std::string_view plugin) {
     auto lib = std::make_unique<Library>();
     lib->path = canonical;
     lib->info.path = canonical;
+    // a broken file is an error message here, not a signal inside dlopen
+    if (const std::string problem = detail::sharedLibraryProblem(canonical); !problem.empty()) {
+      tried += "\n  " + candidate.string() + ": " + problem;
+      continue;
+    }
     lib->handle = dlopen(canonical.c_str(), RTLD_NOW | RTLD_LOCAL);
     if (lib->handle == nullptr) {
       tried += "\n  " + candidate.string() + ": " + explainDlerror(dlerror());

@@ -6,6 +6,9 @@
 #include <dlfcn.h>
 
 #include <cstdint>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <string>
 #include <vector>
 
@@ -131,7 +134,23 @@ TEST_CASE("plugin load failures name the plugin, every path tried and the reason
     CHECK_THAT(e, Contains("undefined symbol: _ZN7missing12solveRiccatiEi"));
     CHECK_THAT(e, Contains("(missing::solveRiccati(int))"));
   }
-  SECTION("not a library") { CHECK_THAT(loadError(loader, "test_garbage"), Contains("libssx_test_garbage.so: ")); }
+  SECTION("not a library") {
+    CHECK_THAT(loadError(loader, "test_garbage"), Contains("libssx_test_garbage.so: not a shared library (no ELF header"));
+  }
+  SECTION("a truncated copy: a message, not SIGBUS inside dlopen") {
+    const std::filesystem::path dir = std::filesystem::current_path() / "truncated_plugin";
+    std::filesystem::create_directories(dir);
+    std::ifstream in(kDir + "/libssx_test_good.so", std::ios::binary);
+    std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    std::ofstream(dir / "libssx_test_cut.so", std::ios::binary) << bytes.substr(0, bytes.size() * 3 / 4);
+    ClassLoader cut;
+    cut.addSearchDirectory(dir);
+    CHECK_THAT(loadError(cut, "test_cut"), Contains("libssx_test_cut.so: truncated: its section table ends at byte"));
+    const auto listed = cut.scan();
+    REQUIRE(listed.size() == 1);
+    CHECK_FALSE(listed[0].ok);
+    CHECK_THAT(listed[0].problem, Contains("truncated"));
+  }
 }
 
 TEST_CASE("class lookup failures say what the library has", "[plugins]") {
