@@ -26,6 +26,7 @@
 #include <sstream>
 #include <stdexcept>
 #include <optional>
+#include <new>
 #include <string>
 #include <thread>
 #include <vector>
@@ -468,16 +469,26 @@ int main(int argc, char** argv) {
     const int code = app.exit(e);
     return code == 0 ? 0 : kExitBadInput;
   }
-  if (*run_cmd) {
-    // --realtime alone means factor 1
-    const bool realtime_given = realtime->count() > 0;
-    run.duration_given = duration->count() > 0;
-    if (realtime_given && (realtime->results().empty() || realtime->results().front().empty())) run.realtime = 1.0;
-    return commandRun(run, realtime_given);
+  auto dispatch = [&]() -> int {
+    if (*run_cmd) {
+      // --realtime alone means factor 1
+      const bool realtime_given = realtime->count() > 0;
+      run.duration_given = duration->count() > 0;
+      if (realtime_given && (realtime->results().empty() || realtime->results().front().empty())) run.realtime = 1.0;
+      return commandRun(run, realtime_given);
+    }
+    if (*validate_cmd) return commandValidate(validate_file, validate_path, validate_physics, validate_print, validate_max_input_mb);
+    if (*sweep_cmd) return commandSweep(sweep);
+    if (*plugins_cmd && !inspect_file.empty()) return ssx::cli::inspectOne(inspect_file, params_of);
+    if (*plugins_cmd) return ssx::cli::commandPlugins(plugins_path, params_of);
+    return kExitBadInput;
+  };
+  // memory running out anywhere (a scene larger than the estimate foresaw): a message and status 1,
+  // not an abort
+  try {
+    return dispatch();
+  } catch (const std::bad_alloc&) {
+    std::cerr << "ssx: error: out of memory (the scene needs more than this machine has: make its swarms smaller)\n";
+    return kExitRunFailure;
   }
-  if (*validate_cmd) return commandValidate(validate_file, validate_path, validate_physics, validate_print, validate_max_input_mb);
-  if (*sweep_cmd) return commandSweep(sweep);
-  if (*plugins_cmd && !inspect_file.empty()) return ssx::cli::inspectOne(inspect_file, params_of);
-  if (*plugins_cmd) return ssx::cli::commandPlugins(plugins_path, params_of);
-  return kExitBadInput;
 }

@@ -42,7 +42,8 @@ struct Result {
   std::string out, err;
 };
 
-// runs ssx with `args`; `extra_env` entries are added to the child's environment only;
+// runs ssx with `args` (or the program args[0] names by an absolute path); `extra_env` entries are
+// added to the child's environment only;
 // `on_err` sees stderr as it grows and may signal the child
 Result run(std::vector<std::string> args, std::vector<std::string> extra_env = {},
            const std::function<void(pid_t, const std::string&)>& on_err = {}) {
@@ -55,7 +56,7 @@ Result run(std::vector<std::string> args, std::vector<std::string> extra_env = {
     if (s.rfind("SSX_PLUGIN_PATH=", 0) != 0) env_strings.push_back(s);
   }
   for (auto& e : extra_env) env_strings.push_back(e);
-  args.insert(args.begin(), kCli);
+  if (args.empty() || args[0].front() != '/') args.insert(args.begin(), kCli);  // (or a program by its path)
   std::vector<char*> argv, envp;
   for (auto& a : args) argv.push_back(a.data());
   argv.push_back(nullptr);
@@ -69,7 +70,7 @@ Result run(std::vector<std::string> args, std::vector<std::string> extra_env = {
     dup2(err_pipe[1], 2);
     close(out_pipe[0]);
     close(err_pipe[0]);
-    execve(kCli.c_str(), argv.data(), envp.data());
+    execve(argv[0], argv.data(), envp.data());
     _exit(127);
   }
   close(out_pipe[1]);
@@ -136,6 +137,16 @@ TEST_CASE("ssx validate, run and sweep: inputs beyond --max-input-mb are refused
   const Result state = run({"run", scene, "--steps", "1", "--quiet", "--load-state", "/dev/zero"});
   CHECK(state.status == 2);
   CHECK_THAT(state.err, Contains("--load-state /dev/zero: cannot read it: not a regular file"));
+}
+
+TEST_CASE("ssx: memory running out while loading is a message and status 1, not an abort", "[cli]") {
+  // a million boxes fit the estimate of any machine this runs on, not an address space of 600 MB
+  const fs::path scene = fs::current_path() / "million_boxes.xml";
+  std::ofstream(scene) << "<scene><type name=\"b\" file=\"" << (kExamples / "artifacts" / "box.xml").string()
+                       << "\"/><swarm type=\"b\" count=\"1000000\" name=\"b{i}\"/></scene>\n";
+  const Result r = run({"/bin/sh", "-c", "ulimit -v 600000 && exec \"$0\" validate \"$1\"", kCli, scene.string()});
+  CHECK(r.status == 1);
+  CHECK_THAT(r.err, Contains("ssx: error: out of memory"));
 }
 
 TEST_CASE("ssx validate --print: the scene with every default, which validates and prints the same again", "[cli]") {

@@ -70,6 +70,10 @@ struct SceneOptions {
   bool allow_special_outputs = false;
   /// The largest scene, include or artifact file read (readInputFile); `--max-input-mb`.
   std::uintmax_t max_input_bytes = kDefaultMaxInputBytes;
+  /// The memory the scene's artifacts may need, estimated from the swarms' counts while parsing
+  /// (0: this machine's physical memory). A swarm beyond it is an error at its line, not an abort
+  /// when memory runs out.
+  std::uintmax_t max_memory_bytes = 0;
 };
 
 /// A loaded scene: an environment ready to start, and how the file asks to run it.

@@ -215,6 +215,8 @@ class SceneLoader {
   void readPlacements();
   bool readOverrides(const Descriptor& d, PlacementModel& p);
   bool readSwarm(const Descriptor& d, PlacementModel& p, std::size_t swarm_index);
+  // refuses a swarm whose members, with the scene's artifacts before it, cannot fit in memory
+  void checkMemory(const Descriptor& d, const PlacementModel& p);
   bool readObstacle(const Descriptor& d, PlacementModel& p);
 
   // --- build ---
@@ -271,6 +273,7 @@ class SceneLoader {
   };
   std::map<std::string, TypeDecl> type_decls_;
   std::map<std::string, ArtifactType> types_;          // by type name, parsed on first use
+  double placed_bytes_ = 0;                            // estimated memory of the artifacts so far
   std::map<std::string, std::string> failed_plugins_;  // "plugin/class" -> already reported
   struct ExtensionCheck {
     const SimulationExtension* extension;
