@@ -2,6 +2,7 @@
 //
 // Exit status: 0 success, 2 bad input (scene, arguments, plugins), 1 failure while running.
 #include "common.hpp"
+#include "number_options.hpp"
 #include "plugins_command.hpp"
 #include "sweep.hpp"
 
@@ -26,6 +27,7 @@
 #include <sstream>
 #include <stdexcept>
 #include <optional>
+#include <limits>
 #include <new>
 #include <string>
 #include <thread>
@@ -95,7 +97,7 @@ struct RunArgs {
   double realtime = 1.0;
   bool fast = false;
   int threads = -1;
-  std::int64_t seed = -1;
+  std::optional<std::uint64_t> seed;
   std::vector<std::string> plugin_path;
   std::string stats_csv;
   bool quiet = false;
@@ -124,7 +126,7 @@ std::vector<std::byte> readFile(const std::string& path, std::uintmax_t max_byte
 
 void addMaxInputOption(CLI::App* command, double& mb) {
   command->add_option("--max-input-mb", mb, "largest input file read (scene, include, artifact, sweep, state), MiB")
-      ->check(CLI::Range(1.0 / 1024, kMostMaxInputMb))
+      ->check(realNumber(1.0 / 1024, kMostMaxInputMb))
       ->default_val(kDefaultMaxInputMb);
 }
 
@@ -157,7 +159,7 @@ int commandRun(const RunArgs& args, bool realtime_given) {
   ssx::SceneOptions options;
   options.plugin_path = pluginPath(args.plugin_path);
   if (args.threads >= 0) options.threads = args.threads;
-  if (args.seed >= 0) options.seed = static_cast<std::uint64_t>(args.seed);
+  options.seed = args.seed;
   if (!args.render.empty()) options.render_engine = args.render;
   if (!args.physics.empty()) options.physics_engine = args.physics;
   options.snapshot = args.snapshot;
@@ -395,21 +397,21 @@ int main(int argc, char** argv) {
   run_cmd->add_option("scene", run.scene, "scene file")->required()->check(CLI::ExistingFile);
   auto* duration =
       run_cmd->add_option("--duration", run.duration, "simulated seconds to run")
-          ->check(CLI::PositiveNumber & CLI::Range(0.0, ssx::kMaxDurationSeconds));
-  run_cmd->add_option("--steps", run.steps, "steps to run")->check(CLI::NonNegativeNumber)->excludes(duration);
+          ->check(realNumber(0.0, ssx::kMaxDurationSeconds, true));
+  run_cmd->add_option("--steps", run.steps, "steps to run")->check(wholeNumber(0, std::numeric_limits<std::int64_t>::max()))->excludes(duration);
   auto* realtime =
       run_cmd->add_option("--realtime", run.realtime, "pace against the wall clock, optionally FACTOR times faster")
           ->expected(0, 1)
-          ->check(CLI::Range(ssx::kMinRealtimeFactor, ssx::kMaxRealtimeFactor));
+          ->check(realNumber(ssx::kMinRealtimeFactor, ssx::kMaxRealtimeFactor));
   auto* fast = run_cmd->add_flag("--fast", run.fast, "run as fast as possible")->excludes(realtime);
   run_cmd
       ->add_option("--rt-priority", run.rt_priority,
                    "step at this SCHED_FIFO priority (1-99; needs root or CAP_SYS_NICE): steps are not woken late "
                    "while other processes run")
-      ->check(CLI::Range(ssx::kMinRealtimePriority, ssx::kMaxRealtimePriority))
+      ->check(wholeNumber(ssx::kMinRealtimePriority, ssx::kMaxRealtimePriority))
       ->excludes(fast);
-  run_cmd->add_option("--threads", run.threads, "worker threads (0: one per core)")->check(CLI::NonNegativeNumber);
-  run_cmd->add_option("--seed", run.seed, "scene seed")->check(CLI::NonNegativeNumber);
+  run_cmd->add_option("--threads", run.threads, "worker threads (0: one per core)")->check(wholeNumber(0, 1024));
+  run_cmd->add_option("--seed", run.seed, "scene seed")->check(seedNumber());
   run_cmd->add_option("--plugin-path", run.plugin_path, "plugin directory (repeatable)");
   run_cmd->add_option("--stats-csv", run.stats_csv, "write per-step timing samples to FILE");
   run_cmd->add_flag("--quiet", run.quiet, "no progress, no summary");
@@ -457,7 +459,7 @@ int main(int argc, char** argv) {
   sweep_cmd->add_option("--out", sweep.out, "results CSV (default: SWEEP's name .csv); an existing one is resumed");
   sweep_cmd->add_option("--robots", sweep.robots, "also write per-robot metrics to this CSV");
   sweep_cmd->add_option("--jobs", sweep.jobs, "worker processes (default: one per core; under mpirun: the ranks)")
-      ->check(CLI::Range(1, 4096));
+      ->check(wholeNumber(1, 4096));
   sweep_cmd->add_option("--plugin-path", sweep.plugin_path, "plugin directory (repeatable)");
   sweep_cmd->add_flag("--check", sweep.check, "check the sweep and every point's scene; run nothing");
   sweep_cmd->add_flag("--quiet", sweep.quiet, "no progress");

@@ -174,7 +174,13 @@ Spec readSpec(const fs::path& file, const std::vector<fs::path>& plugin_path, st
       r.error(root_at, "<sweep>: scene '" + spec.scene.string() + "': " + e.detail());
     }
   }
-  spec.seed = static_cast<std::uint64_t>(r.integer(root, "seed", 0, std::numeric_limits<std::int64_t>::max()).value_or(0));
+  if (const auto* given = root.find("seed")) {
+    if (const auto seed = parseSeed(given->value))
+      spec.seed = *seed;
+    else
+      r.error(given->where, "<sweep>: attribute 'seed' must be a whole number from 0 to " + std::to_string(kMaxSeed) +
+                                ", got '" + given->value + "'");
+  }
   spec.seeds = r.integer(root, "seeds", 1, 1'000'000).value_or(1);
   spec.threads = static_cast<int>(r.integer(root, "threads", 0, 1024).value_or(1));
   if (const auto d = r.real(root, "duration")) {

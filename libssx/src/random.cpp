@@ -1,6 +1,7 @@
 #include <ssx/random.hpp>
 #include <ssx/state.hpp>
 
+#include <charconv>
 #include <cmath>
 
 namespace ssx {
@@ -15,6 +16,14 @@ std::uint64_t splitmix64(std::uint64_t& state) {
 }
 
 }  // namespace
+
+std::optional<std::uint64_t> parseSeed(std::string_view text) {
+  if (text.empty() || text.front() < '0' || text.front() > '9') return std::nullopt;
+  std::uint64_t v = 0;
+  const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), v);
+  if (ec != std::errc() || end != text.data() + text.size()) return std::nullopt;
+  return v;
+}
 
 std::uint64_t deriveSeed(std::uint64_t seed, std::uint64_t a, std::uint64_t b) {
   // chain the three values through SplitMix64 so that nearby indices give unrelated seeds

@@ -149,6 +149,32 @@ TEST_CASE("ssx: memory running out while loading is a message and status 1, not 
   CHECK_THAT(r.err, Contains("ssx: error: out of memory"));
 }
 
+TEST_CASE("ssx run: numbers are decimal and in range, with the range said plainly; one seed range everywhere",
+          "[cli]") {
+  const std::string scene = (kExamples / "scenes" / "hover_swarm.xml").string();
+  const auto err = [&](const std::string& option, const std::string& value) {
+    const Result r = run({"run", scene, "--fast", "--quiet", option, value});
+    CHECK(r.status == 2);
+    return r.err;
+  };
+  // seeds beyond 2^64 - 1 were taken as 2^64 - 1, so different seeds gave one run
+  CHECK_THAT(err("--seed", "18446744073709551616"),
+             Contains("--seed: must be a whole number in decimal from 0 to 18446744073709551615, got '18446744073709551616'"));
+  CHECK_THAT(err("--seed", "99999999999999999999999"), Contains("from 0 to 18446744073709551615"));
+  CHECK_THAT(err("--seed", "-1"), Contains("got '-1'"));
+  CHECK_THAT(err("--steps", "0x10"), Contains("--steps: must be a whole number in decimal"));
+  CHECK_THAT(err("--steps", "1e3"), Contains("got '1e3'"));
+  CHECK_THAT(err("--threads", "5000"), Contains("--threads: must be from 0 to 1024, got 5000"));
+  // bounds as a person writes them (they were printed with 300 digits)
+  const std::string duration = err("--duration", "1e10");
+  CHECK_THAT(duration, Contains("--duration: must be above 0 and at most 1e+09, got 1e10"));
+  CHECK(duration.size() < 200);
+  CHECK_THAT(err("--duration", "nan"), Contains("must be a decimal number above 0"));
+  CHECK_THAT(err("--realtime", "1e9"), Contains("--realtime: must be from 0.001 to 1e+06"));
+  CHECK(run({"run", scene, "--steps", "1", "--quiet", "--seed", "18446744073709551615"}).status == 0);
+  fs::remove("hover_swarm_poses.csv");
+}
+
 TEST_CASE("ssx validate --print: the scene with every default, which validates and prints the same again", "[cli]") {
   const Result printed = run({"validate", (kExamples / "scenes" / "hover_swarm.xml").string(), "--print"});
   REQUIRE(printed.status == 0);

@@ -109,6 +109,13 @@ def test_same_seed_same_bits_on_any_thread_count():
     assert c.seed == 8 and c.state_hash() != a.state_hash()
 
 
+def test_seeds_have_one_range_everywhere():
+    assert hover(seed=2**64 - 1).seed == 2**64 - 1
+    for bad in (2**64, -1):
+        with pytest.raises(TypeError):
+            hover(seed=bad)
+
+
 def test_either_physics_engine_flies_the_swarm():
     assert ssx.physics_engines() == ["ode", "bullet"]
     ode, bullet = hover(), hover(physics="bullet")

@@ -5,11 +5,21 @@
 #include <ssx/export.hpp>
 
 #include <cstdint>
+#include <optional>
+#include <string_view>
 
 namespace ssx {
 
 class StateWriter;
 class StateReader;
+
+/// Seeds are whole numbers from 0 to 2^64 - 1 everywhere one is given (scene `seed`, `ssx run
+/// --seed`, Python's `seed=`, sweep files, and the runs a sweep derives).
+inline constexpr std::uint64_t kMaxSeed = 18'446'744'073'709'551'615ULL;
+
+/// A seed written in decimal (digits only: no sign, no hex, no exponent, nothing after), or
+/// nothing when the text is not one or is beyond kMaxSeed.
+SSX_EXPORT std::optional<std::uint64_t> parseSeed(std::string_view text);
 
 /// Mixes a seed with stream indices into an independent 64-bit seed (SplitMix64 finaliser).
 /// Every stream in ssx is derived from (scene seed, artifact index, plugin index).

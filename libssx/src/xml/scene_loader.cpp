@@ -138,9 +138,25 @@ void SceneLoader::readEnvironment(const Descriptor& d) {
   if (settings_.timestep <= 0) {
     error(d.where(), "<environment>: timestep is below one nanosecond");
     settings_.timestep = EnvironmentSettings{}.timestep;  // reported once, here
+  } else if (const auto* given = d.find("timestep")) {
+    // time is counted in whole nanoseconds: say what a finer timestep became
+    double asked = static_cast<double>(settings_.timestep);
+    try {
+      asked = d.get<double>("timestep") * 1e9;
+    } catch (const ConfigError&) {
+      // (reported above)
+    }
+    if (std::abs(asked - static_cast<double>(settings_.timestep)) > 1e-3)
+      warning(given->where, "<environment>: timestep " + given->value + " s is " + std::to_string(settings_.timestep) +
+                                " ns (time is counted in whole nanoseconds)");
   }
-  const std::int64_t seed = readCount(d, "seed", 0, 0);
-  settings_.seed = static_cast<std::uint64_t>(seed);
+  if (const auto* given = d.find("seed")) {
+    if (const auto seed = parseSeed(given->value))
+      settings_.seed = *seed;
+    else
+      error(given->where, "<environment>: attribute 'seed' must be a whole number from 0 to " + std::to_string(kMaxSeed) +
+                              ", got '" + given->value + "'");
+  }
   const std::string threads = read<std::string>(d, "threads", "auto");
   if (threads != "auto") {
     std::int64_t n = 0;

@@ -74,7 +74,7 @@ TEST_CASE("all problems of a scene are reported together, in document order", "[
       if (d.severity == Diagnostic::Severity::Error) errors.push_back(std::to_string(d.where.line) + " " + d.message);
     REQUIRE(errors.size() == 3);
     CHECK_THAT(errors[0], Catch::StartsWith("2 <environment>: attribute 'timestep' must be positive"));
-    CHECK_THAT(errors[1], Catch::StartsWith("2 <environment>: attribute 'seed' must be an integer"));
+    CHECK_THAT(errors[1], Catch::StartsWith("2 <environment>: attribute 'seed' must be a whole number from 0 to 18446744073709551615, got 'x'"));
     CHECK_THAT(errors[2], Catch::StartsWith("5 <swarm>: attribute 'layout' must be one of"));
   }
 }
@@ -188,4 +188,21 @@ TEST_CASE("a type named without a file is the installed artifact type; a given f
     CHECK_THAT(e.what(), Contains("m.xml:2: error: <type>: attribute 'file' is empty"));
   }
   fs::remove_all(dir);
+}
+
+TEST_CASE("a timestep finer than a nanosecond is a warning saying what it became; seeds are 0 to 2^64 - 1", "[scene]") {
+  Scene scene = loadSceneFromString(R"(<scene>
+    <environment timestep="1.5e-9" seed="18446744073709551615"/></scene>)", "t.xml", kData);
+  REQUIRE(scene.warnings.size() == 1);
+  CHECK(scene.warnings[0].str() == "t.xml:2: warning: <environment>: timestep 1.5e-9 s is 2 ns (time is counted in whole nanoseconds)");
+  CHECK(scene.environment->timestep() == 2);
+  CHECK(scene.environment->settings().seed == kMaxSeed);
+  CHECK(loadSceneFromString(R"(<scene><environment timestep="0.002"/></scene>)", "t.xml", kData).warnings.empty());
+  // the scene took seeds up to 1e7 only, while the command line, Python and sweeps took any
+  CHECK(loadSceneFromString(R"(<scene><environment seed="12345678901234"/></scene>)", "t.xml", kData)
+            .environment->settings().seed == 12345678901234u);
+  for (const char* bad : {"18446744073709551616", "-1", "0x10", "1e3", "7 "})
+    CHECK_THROWS_WITH(loadSceneFromString(std::string("<scene><environment seed=\"") + bad + "\"/></scene>", "t.xml", kData),
+                      Contains("t.xml:1: error: <environment>: attribute 'seed' must be a whole number from 0 to "
+                               "18446744073709551615, got '" + std::string(bad) + "'"));
 }
