@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cerrno>
+#include <charconv>
 #include <chrono>
 #include <cmath>
 #include <cstring>
@@ -37,6 +38,14 @@ std::vector<std::string> completeLines(const fs::path& file, std::uintmax_t& kee
     b = e + 1;
   }
   return lines;
+}
+
+// a run's number as a row writes it (decimal digits), or nothing
+std::optional<std::int64_t> runNumber(const std::string& text) {
+  std::int64_t v = 0;
+  const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), v);
+  if (text.empty() || ec != std::errc() || end != text.data() + text.size() || v < 0) return std::nullopt;
+  return v;
 }
 
 void check(std::FILE* f, const fs::path& file) {
@@ -82,11 +91,20 @@ Output::Output(const Spec& spec, fs::path file, fs::path robots_file)
                                "' holds the results of another sweep (or this sweep file or its scene changed since); "
                                "give another --out, or remove it to start again");
     fs::resize_file(file_, keep);  // a row cut short is run again
+    const std::size_t columns = spec.columns().size();
     for (std::size_t i = 2; i < lines.size(); ++i) {
+      if (lines[i].find_first_not_of(" \t\r") == std::string::npos) continue;  // a blank line (an editor's)
       auto fields = csvSplit(lines[i]);
-      const std::int64_t run = std::stoll(fields.at(0));
-      if (run < 0 || run >= spec.runCount() || done_[static_cast<std::size_t>(run)]) continue;
-      done_[static_cast<std::size_t>(run)] = true;
+      const auto run = runNumber(fields.at(0));
+      if (!run || fields.size() != columns)
+        throw std::runtime_error("'" + file_.string() + "' line " + std::to_string(i + 1) +
+                                 " is no row of this sweep (" +
+                                 (!run ? "its first field '" + fields.at(0) + "' is no run number"
+                                       : std::to_string(fields.size()) + " fields, the header has " +
+                                             std::to_string(columns)) +
+                                 "): mend or remove that line, or give another --out");
+      if (*run >= spec.runCount() || done_[static_cast<std::size_t>(*run)]) continue;
+      done_[static_cast<std::size_t>(*run)] = true;
       rows_.push_back(std::move(fields));
     }
   }
@@ -103,9 +121,9 @@ Output::Output(const Spec& spec, fs::path file, fs::path robots_file)
       std::uintmax_t keep = 0;
       for (const auto& line : completeLines(robots_file_, keep)) {
         if (line == kRobotHeader) continue;
-        const auto comma = line.find(',');
-        const std::int64_t run = std::stoll(line.substr(0, comma));
-        if (run >= 0 && run < spec.runCount() && done_[static_cast<std::size_t>(run)]) kept.push_back(line);
+        // (a line that is no row of a run the results hold is dropped: those runs are run again)
+        const auto run = runNumber(line.substr(0, line.find(',')));
+        if (run && *run < spec.runCount() && done_[static_cast<std::size_t>(*run)]) kept.push_back(line);
       }
     }
     robots_ = std::fopen(robots_file_.c_str(), "wb");

@@ -303,10 +303,18 @@ Spec readSpec(const fs::path& file, const std::vector<fs::path>& plugin_path, st
     for (const char* k : {"tracking_error", "min_distance", "contacts", "state_hash"})
       spec.metrics.push_back({k, "", 0, "", root_at});
   {
-    std::set<std::string> seen;
+    // every column once: a metric's column may be neither a column of every row nor a parameter's
+    std::set<std::string> seen(kFixedColumns.begin(), kFixedColumns.end());
     for (const auto& p : spec.parameters) seen.insert(p.name);
-    for (const auto& c : spec.metricColumns())
-      if (!seen.insert(c).second) r.error(root_at, "<sweep>: column '" + c + "' would appear twice");
+    for (const auto& m : spec.metrics) {
+      Spec one;
+      one.metrics = {m};
+      for (const auto& c : one.metricColumns())
+        if (!seen.insert(c).second)
+          r.error(m.where, "<metrics>: column '" + c + "' would appear twice in the results (" +
+                               (kFixedColumns.count(c) != 0 ? "every row has it" : "another column has this name") +
+                               "): choose another name");
+    }
   }
 
   // the points

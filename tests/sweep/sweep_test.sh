@@ -44,6 +44,26 @@ refused broken.xml broken.csv broken.out
 grep -q "broken.xml:5: error: metric 'no_such_metric': no plugin of this scene publishes it (published: formation_error, tracking_error)" broken.out \
   || fail "unknown metric"
 
+# one attribute targeted twice (however spelled) and a metric column that every row has are refused
+cat > twice.xml <<'XML'
+<sweep scene="SCENE">
+  <grid>
+    <parameter name="g1" target="swarm/driver@formation_gain" values="0.1 0.2"/>
+    <parameter name="g2" target="swarm[name=q{i}]/driver@formation_gain" values="0.3"/>
+  </grid>
+  <metrics><settle_time of="tracking_error" below="0.5" column="run"/></metrics>
+</sweep>
+XML
+sed -i "s|SCENE|$data/scene.xml|" twice.xml
+refused twice.xml twice.csv twice.out
+grep -q "twice.xml:6: error: <metrics>: column 'run' would appear twice in the results (every row has it)" twice.out \
+  || fail "reserved column"
+sed -i 's/column="run"/column="settled"/' twice.xml
+refused twice.xml twice.csv twice.out
+grep -q "twice.xml:4: error: target 'swarm\[name=q{i}\]/driver@formation_gain' sets the attribute that target 'swarm/driver@formation_gain' (.*twice.xml:3) sets" twice.out \
+  || fail "one attribute twice"
+[ ! -e twice.csv ] || fail "a refused sweep created its output"
+
 # --- the example sweep passes its checks ---
 "$ssx" sweep "$here/../../examples/sweeps/formation_gains.xml" --check | grep -q "5 point(s) x 10 seed(s) = 50 runs" \
   || fail "the example sweep"
@@ -102,6 +122,12 @@ grep -q "resuming: 5 of 12 runs are in resumed.csv" resumed.out || fail "resume 
 grep -q "ssx sweep: 7 run(s)" resumed.out || fail "resume ran 7"
 diff <(rows one.csv) <(rows resumed.csv) || fail "resumed rows differ"
 "$ssx" sweep "$data/small.xml" --plugin-path "$plugins" --out resumed.csv | grep -q "nothing to do" || fail "all done"
+# a blank line in the results (an editor's) is no row; a line that is no row is refused, naming it
+{ head -n 4 one.csv; echo; tail -n +5 one.csv; } > blank.csv
+"$ssx" sweep "$data/small.xml" --plugin-path "$plugins" --out blank.csv | grep -q "nothing to do" || fail "blank line"
+{ head -n 4 one.csv; echo "x,1,2"; } > edited.csv
+refused "$data/small.xml" edited.csv edited.out
+grep -q "'edited.csv' line 5 is no row of this sweep (its first field 'x' is no run number)" edited.out || fail "edited row"
 # another sweep's results file is refused and left alone
 sed 's/seed="5"/seed="6"/' "$data/small.xml" > other.xml
 sed -i "s|scene=\"scene.xml\"|scene=\"$data/scene.xml\"|" other.xml

@@ -43,7 +43,7 @@ bool matches(const Descriptor& d, const Step& s) {
 
 }  // namespace
 
-std::optional<std::string> applyOverride(Descriptor& scene, const AttributeOverride& o) {
+std::optional<std::string> applyOverride(Descriptor& scene, const AttributeOverride& o, std::string* identity) {
   const std::string syntax = "target '" + o.target +
                              "' is not a path like swarm[name=quad{i}]/driver@formation_gain (steps name, "
                              "name[k] or name[attribute=value] separated by '/', then @attribute)";
@@ -60,6 +60,7 @@ std::optional<std::string> applyOverride(Descriptor& scene, const AttributeOverr
   }
   Descriptor* node = &scene;
   std::string path = "<scene>";
+  std::string indices;  // the element by its child indices: the same element however the target spells it
   for (std::size_t i = 0; i < steps.size(); ++i) {
     const Step& s = steps[i];
     std::vector<Descriptor*> found;
@@ -70,6 +71,7 @@ std::optional<std::string> applyOverride(Descriptor& scene, const AttributeOverr
       if (s.nth == 0 || same_name == s.nth) found.push_back(&c);
     }
     if (found.size() == 1) {
+      indices += std::to_string(found.front() - node->children().data()) + "/";
       node = found.front();
       path += " <" + s.text + ">";
       continue;
@@ -92,10 +94,12 @@ std::optional<std::string> applyOverride(Descriptor& scene, const AttributeOverr
              ")";
     Descriptor added(s.name, o.where);
     if (!s.key.empty()) added.set(s.key, s.value, o.where);
+    indices += std::to_string(node->children().size()) + "/";
     node = &node->addChild(std::move(added));
     path += " <" + s.text + ">";
   }
   node->set(attribute, o.value, o.where);
+  if (identity != nullptr) *identity = indices + "@" + attribute;
   return std::nullopt;
 }
 

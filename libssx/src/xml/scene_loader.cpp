@@ -380,8 +380,17 @@ SceneModel SceneLoader::parse(Descriptor root, const fs::path& file, const fs::p
   if (fs::is_regular_file(file, file_ec)) model_.files.push_back(file);  // (a scene in memory is no file)
   stage_ = stage(0);
   // an override that does not fit is reported with the rest (the scene is read without it)
-  for (const auto& o : options_.overrides)
-    if (auto problem = applyOverride(root, o)) error(o.where, *problem);
+  // two overrides of one attribute, however spelled, would apply one and report both: refused
+  std::map<std::string, const AttributeOverride*> applied;
+  for (const auto& o : options_.overrides) {
+    std::string identity;
+    if (auto problem = applyOverride(root, o, &identity)) {
+      error(o.where, *problem);
+    } else if (const auto [it, fresh] = applied.emplace(identity, &o); !fresh) {
+      error(o.where, "target '" + o.target + "' sets the attribute that target '" + it->second->target + "' (" +
+                         it->second->where.str() + ") sets: give each attribute one override");
+    }
+  }
   documents_.push_back(std::move(root));
   std::error_code ec;
   std::vector<fs::path> stack{fs::weakly_canonical(file, ec)};

@@ -47,7 +47,9 @@ inline const std::set<std::string> kShapeElements{"box", "sphere", "cylinder", "
 
 // Sets the attribute an override names in the tree of a scene file (see AttributeOverride);
 // returns what is wrong with its target, if anything.
-std::optional<std::string> applyOverride(Descriptor& scene, const AttributeOverride& o);
+/// (`identity`: set to the attribute's identity in the document, the same for every spelling of
+/// its target)
+std::optional<std::string> applyOverride(Descriptor& scene, const AttributeOverride& o, std::string* identity = nullptr);
 
 class SceneLoader {
  public:
