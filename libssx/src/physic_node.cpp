@@ -10,6 +10,7 @@
 #include <Eigen/Eigenvalues>
 
 #include <cmath>
+#include <cstdio>
 #include <numbers>
 #include <set>
 
@@ -189,6 +190,11 @@ PhysicNodeSpec& PhysicNodeSpec::addChild(PhysicNodeSpec child) {
   return children.back();
 }
 
+namespace {
+constexpr double kMinBodyMass = 1e-9, kMaxBodyMass = 1e9;           // kg: a microgram's thousandth, a million tonnes
+constexpr double kMinBodyInertia = 1e-18, kMaxBodyInertia = 1e18;   // kg m^2
+}  // namespace
+
 void validatePhysicTree(const PhysicNodeSpec& root) {
   std::set<std::string> names;
   validateNode(root, true, root.is_static, names);
@@ -201,6 +207,19 @@ void validatePhysicTree(const PhysicNodeSpec& root) {
       throw ConfigError(
           root.where,
           nodeLabel(root) + ": the body's combined inertia is singular: give an inertia or shapes with volume");
+    // what the engines step: beyond these, their arithmetic loses the body (ODE asserts at step 0
+    // for 1e308 kg); far beyond any robot or obstacle
+    const auto beyond = [&](const std::string& what, double value, double lo, double hi, const char* unit) {
+      char text[200];
+      std::snprintf(text, sizeof text, ": the body's %s %.3g %s is beyond what the engines step (%.0e to %.0e %s)",
+                    what.c_str(), value, unit, lo, hi, unit);
+      return ConfigError(root.where, nodeLabel(root) + text);
+    };
+    if (m.mass < kMinBodyMass || m.mass > kMaxBodyMass) throw beyond("mass", m.mass, kMinBodyMass, kMaxBodyMass, "kg");
+    if (eig.minCoeff() < kMinBodyInertia || eig.maxCoeff() > kMaxBodyInertia) {
+      const double worst = eig.minCoeff() < kMinBodyInertia ? eig.minCoeff() : eig.maxCoeff();
+      throw beyond("principal moment of inertia", worst, kMinBodyInertia, kMaxBodyInertia, "kg m^2");
+    }
   }
 }
 

@@ -126,3 +126,26 @@ TEST_CASE("attached frames follow rigid-body kinematics", "[physic_node]") {
   // centripetal acceleration w^2 r towards the axis
   CHECK(a.linear_acceleration.isApprox(Vec3(-2.0, 0, 0)));
 }
+
+TEST_CASE("masses and inertias beyond what the engines step are refused naming the node", "[physic_node]") {
+  // ODE asserted at step 0 for 1e308 kg, naming no attribute
+  PhysicNodeSpec n;
+  n.name = "hull";
+  n.shapes.push_back(Shape::box(Vec3(1, 1, 1)));
+  for (double mass : {1e308, 1e10, 1e-10, 1e-300}) {
+    n.mass = mass;
+    INFO(mass);
+    CHECK_THROWS_WITH(validatePhysicTree(n), Catch::Contains("physic node 'hull': the body's mass") &&
+                                                 Catch::Contains("is beyond what the engines step (1e-09 to 1e+09 kg)"));
+  }
+  n.mass = 1;
+  n.inertia = Mat3::Identity() * 1e300;
+  CHECK_THROWS_WITH(validatePhysicTree(n), Catch::Contains("principal moment of inertia 1e+300 kg m^2"));
+  // the ends of the ranges are steppable: a million tonnes, a microgram's thousandth
+  n.inertia.reset();
+  n.mass = 1e9;
+  CHECK_NOTHROW(validatePhysicTree(n));
+  n.shapes[0] = Shape::box(Vec3(1e-3, 1e-3, 1e-3));
+  n.mass = 1e-9;
+  CHECK_NOTHROW(validatePhysicTree(n));
+}
