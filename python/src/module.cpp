@@ -139,6 +139,7 @@ class PyEnvironment {
     for (std::size_t i = 0; i < env_.artifactCount(); ++i) names.push_back(std::as_const(env_).artifact(i).name());
     return names;
   }
+  // (fixed from loading on, as setpointNames, timestep, duration and seed: readable at any time)
   std::vector<std::string> dynamicNames() const {
     std::vector<std::string> names;
     names.reserve(dynamic_.size());
@@ -349,9 +350,15 @@ class PyEnvironment {
     if (env_.state() == ssx::Environment::State::Running) env_.stop();
   }
 
+  // (never raises: a debugger or a log shows it while another thread steps)
   std::string repr() const {
-    return "<ssx.Environment " + scene_.file.string() + ": " + std::to_string(env_.artifactCount()) +
-           " artifacts, t = " + std::to_string(time()) + " s>";
+    std::string t = "stepping in another thread";
+    if (!busy_.exchange(true)) {
+      t = "t = " + std::to_string(ssx::toSeconds(env_.time())) + " s";
+      busy_.store(false);
+    }
+    return "<ssx.Environment " + scene_.file.string() + ": " + std::to_string(env_.artifactCount()) + " artifacts, " +
+           t + ">";
   }
 
  private:
@@ -419,7 +426,7 @@ PYBIND11_MODULE(_ssx, m) {
       .def_property_readonly("step_count", [](PyEnvironment& e) { return e.guarded([&] { return e.env().stepCount(); }); })
       .def_property_readonly("duration", &PyEnvironment::duration, "<environment duration> in s, or None.")
       .def_property_readonly("seed", [](PyEnvironment& e) { return e.env().settings().seed; })
-      .def_property_readonly("threads", [](PyEnvironment& e) { return e.env().threadCount(); },
+      .def_property_readonly("threads", [](PyEnvironment& e) { return e.guarded([&] { return e.env().threadCount(); }); },
                              "Worker threads of the parallel phases (known once started).")
       .def("artifact_names", &PyEnvironment::artifactNames, "Every artifact, in artifact order.")
       .def("dynamic_names", &PyEnvironment::dynamicNames,

@@ -422,8 +422,23 @@ def test_reads_while_another_thread_steps_are_refused_not_torn():
     env = hover(threads=1)
     refused = refusals_while_stepping(env, {"state_hash": lambda: env.state_hash(), "time": lambda: env.time,
                                             "step_count": lambda: env.step_count,
-                                            "artifact_names": lambda: env.artifact_names()})
+                                            "artifact_names": lambda: env.artifact_names(),
+                                            "threads": lambda: env.threads, "pose": lambda: env.pose("q0"),
+                                            "save_state": lambda: env.save_state()})
     assert all(n > 0 for n in refused.values()), refused
+
+
+def test_what_is_fixed_from_loading_on_reads_while_stepping_and_repr_never_raises():
+    env = hover(threads=1)
+    names, setpoints = env.dynamic_names(), env.setpoint_names()
+    seen = []
+    refused = refusals_while_stepping(env, {"fixed": lambda: seen.append(
+        (env.dynamic_names() == names, env.setpoint_names() == setpoints, env.timestep, env.seed)),
+        "repr": lambda: seen.append(repr(env))})
+    assert refused == {"fixed": 0, "repr": 0}
+    assert all(s[0] and s[1] for s in seen if isinstance(s, tuple))
+    assert any("stepping in another thread" in s for s in seen if isinstance(s, str))
+    assert "t = 40.000000 s" in repr(env)
 
 
 def test_close_finishes_the_run(tmp_path):
