@@ -2,7 +2,7 @@
 //
 // Exit status: 0 success, 2 bad input (scene, arguments, plugins), 1 failure while running.
 #include "common.hpp"
-#include "number_options.hpp"
+#include "command_line.hpp"
 #include "plugins_command.hpp"
 #include "sweep.hpp"
 
@@ -90,24 +90,6 @@ std::string formatFactor(double f) {
   return buf;
 }
 
-struct RunArgs {
-  std::string scene;
-  double duration = 0;
-  std::int64_t steps = -1;
-  double realtime = 1.0;
-  bool fast = false;
-  int threads = -1;
-  std::optional<std::uint64_t> seed;
-  std::vector<std::string> plugin_path;
-  std::string stats_csv;
-  bool quiet = false;
-  double max_input_mb = kDefaultMaxInputMb;
-  std::string render, physics, snapshot, video, frames;
-  std::string save_state, load_state;
-  bool allow_special_outputs = false;
-  bool duration_given = false;
-  int rt_priority = 0;
-};
 
 // "ode, bullet"
 
@@ -124,11 +106,6 @@ std::vector<std::byte> readFile(const std::string& path, std::uintmax_t max_byte
   return out;
 }
 
-void addMaxInputOption(CLI::App* command, double& mb) {
-  command->add_option("--max-input-mb", mb, "largest input file read (scene, include, artifact, sweep, state), MiB")
-      ->check(realNumber(1.0 / 1024, kMostMaxInputMb))
-      ->default_val(kDefaultMaxInputMb);
-}
 
 // written beside the target and renamed over it: a failed write never leaves a short file
 void writeFileAtomically(const std::string& path, const std::vector<std::byte>& bytes) {
@@ -331,13 +308,6 @@ int commandValidate(const std::string& file, const std::vector<std::string>& plu
   }
 }
 
-struct SweepArgs {
-  std::string file, out, robots;
-  std::vector<std::string> plugin_path;
-  int jobs = 0;
-  bool check = false, quiet = false;
-  double max_input_mb = kDefaultMaxInputMb;
-};
 
 int commandSweep(const SweepArgs& args) {
   namespace sw = ssx::sweep;
@@ -388,109 +358,24 @@ int commandSweep(const SweepArgs& args) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  CLI::App app{"ssx: real-time simulation of robot swarms"};
-  app.set_version_flag("--version", std::string("ssx ") + SSX_VERSION_STRING);
-  app.require_subcommand(1);
-
-  RunArgs run;
-  CLI::App* run_cmd = app.add_subcommand("run", "run a scene");
-  run_cmd->add_option("scene", run.scene, "scene file")->required()->check(CLI::ExistingFile);
-  auto* duration =
-      run_cmd->add_option("--duration", run.duration, "simulated seconds to run")
-          ->check(realNumber(0.0, ssx::kMaxDurationSeconds, true));
-  run_cmd->add_option("--steps", run.steps, "steps to run")->check(wholeNumber(0, std::numeric_limits<std::int64_t>::max()))->excludes(duration);
-  auto* realtime =
-      run_cmd->add_option("--realtime", run.realtime, "pace against the wall clock, optionally FACTOR times faster")
-          ->expected(0, 1)
-          ->check(realNumber(ssx::kMinRealtimeFactor, ssx::kMaxRealtimeFactor));
-  auto* fast = run_cmd->add_flag("--fast", run.fast, "run as fast as possible")->excludes(realtime);
-  run_cmd
-      ->add_option("--rt-priority", run.rt_priority,
-                   "step at this SCHED_FIFO priority (1-99; needs root or CAP_SYS_NICE): steps are not woken late "
-                   "while other processes run")
-      ->check(wholeNumber(ssx::kMinRealtimePriority, ssx::kMaxRealtimePriority))
-      ->excludes(fast);
-  run_cmd->add_option("--threads", run.threads, "worker threads (0: one per core)")->check(wholeNumber(0, 1024));
-  run_cmd->add_option("--seed", run.seed, "scene seed")->check(seedNumber());
-  run_cmd->add_option("--plugin-path", run.plugin_path, "plugin directory (repeatable)");
-  run_cmd->add_option("--stats-csv", run.stats_csv, "write per-step timing samples to FILE");
-  run_cmd->add_flag("--quiet", run.quiet, "no progress, no summary");
-  run_cmd->add_option("--render", run.render, "render engine (overrides the scene's): null or osmesa");
-  run_cmd->add_option("--physics", run.physics, "physics engine (overrides the scene's): ode or bullet")
-      ->check(CLI::IsMember(ssx::physicEngineNames()));
-  run_cmd->add_option("--snapshot", run.snapshot, "write the first camera's last frame as PNG to FILE");
-  run_cmd->add_option("--video", run.video, "write the first camera's frames as MP4 to FILE (needs ffmpeg)");
-  run_cmd->add_option("--frames", run.frames, "write the first camera's frames as PNG files into DIR");
-  run_cmd->add_option("--save-state", run.save_state, "write the world's state to FILE at the end (ssx run --load-state)");
-  run_cmd->add_flag("--allow-special-outputs", run.allow_special_outputs,
-                    "let outputs written as streams (a logger's file, --stats-csv) be FIFOs or devices");
-  run_cmd->add_option("--load-state", run.load_state,
-                      "continue from a state saved from this scene (--steps and --duration count from there)")
-      ->check(CLI::ExistingFile);
-  addMaxInputOption(run_cmd, run.max_input_mb);
-
-  std::string validate_file;
-  std::vector<std::string> validate_path;
-  CLI::App* validate_cmd = app.add_subcommand("validate", "check a scene and its plugins; run nothing");
-  validate_cmd->add_option("scene", validate_file, "scene file")->required()->check(CLI::ExistingFile);
-  validate_cmd->add_option("--plugin-path", validate_path, "plugin directory (repeatable)");
-  std::string validate_physics;
-  bool validate_print = false;
-  validate_cmd->add_flag("--print", validate_print,
-                         "print the scene as ssx reads it, every default filled in (scene XML, on standard output)");
-  validate_cmd->add_option("--physics", validate_physics, "check the scene for this physics engine: ode or bullet")
-      ->check(CLI::IsMember(ssx::physicEngineNames()));
-  double validate_max_input_mb = kDefaultMaxInputMb;
-  addMaxInputOption(validate_cmd, validate_max_input_mb);
-
-  std::vector<std::string> plugins_path;
-  CLI::App* plugins_cmd = app.add_subcommand("plugins", "list plugin libraries, their classes, and ABI checks");
-  plugins_cmd->add_option("--plugin-path", plugins_path, "plugin directory (repeatable)");
-  std::string params_of;
-  plugins_cmd->add_option("--params", params_of, "print the declared parameters of class NAME (a Markdown table)");
-  std::string inspect_file;
-  plugins_cmd->add_option("--inspect", inspect_file, "(internal) report one library from a child process")
-      ->group("");
-
-  SweepArgs sweep;
-  CLI::App* sweep_cmd =
-      app.add_subcommand("sweep", "run a scene many times over varied attributes and seeds (docs/sweep-format.md)");
-  sweep_cmd->add_option("sweep", sweep.file, "sweep file")->required()->check(CLI::ExistingFile);
-  sweep_cmd->add_option("--out", sweep.out, "results CSV (default: SWEEP's name .csv); an existing one is resumed");
-  sweep_cmd->add_option("--robots", sweep.robots, "also write per-robot metrics to this CSV");
-  sweep_cmd->add_option("--jobs", sweep.jobs, "worker processes (default: one per core; under mpirun: the ranks)")
-      ->check(wholeNumber(1, 4096));
-  sweep_cmd->add_option("--plugin-path", sweep.plugin_path, "plugin directory (repeatable)");
-  sweep_cmd->add_flag("--check", sweep.check, "check the sweep and every point's scene; run nothing");
-  sweep_cmd->add_flag("--quiet", sweep.quiet, "no progress");
-  addMaxInputOption(sweep_cmd, sweep.max_input_mb);
-
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::ParseError& e) {
-    const int code = app.exit(e);
-    return code == 0 ? 0 : kExitBadInput;
-  }
-  auto dispatch = [&]() -> int {
-    if (*run_cmd) {
-      // --realtime alone means factor 1
-      const bool realtime_given = realtime->count() > 0;
-      run.duration_given = duration->count() > 0;
-      if (realtime_given && (realtime->results().empty() || realtime->results().front().empty())) run.realtime = 1.0;
-      return commandRun(run, realtime_given);
-    }
-    if (*validate_cmd) return commandValidate(validate_file, validate_path, validate_physics, validate_print, validate_max_input_mb);
-    if (*sweep_cmd) return commandSweep(sweep);
-    if (*plugins_cmd && !inspect_file.empty()) return ssx::cli::inspectOne(inspect_file, params_of);
-    if (*plugins_cmd) return ssx::cli::commandPlugins(plugins_path, params_of);
-    return kExitBadInput;
-  };
+  const CommandLine c = parseCommandLine(argc, argv, std::cout, std::cerr);
+  if (c.exit_status) return *c.exit_status;
   // memory running out anywhere (a scene larger than the estimate foresaw): a message and status 1,
   // not an abort
   try {
-    return dispatch();
+    switch (c.command) {
+      case CommandLine::Command::Run: return commandRun(c.run, c.realtime_given);
+      case CommandLine::Command::Validate:
+        return commandValidate(c.validate.scene, c.validate.plugin_path, c.validate.physics, c.validate.print,
+                               c.validate.max_input_mb);
+      case CommandLine::Command::Sweep: return commandSweep(c.sweep);
+      case CommandLine::Command::Plugins:
+        if (!c.plugins.inspect_file.empty()) return ssx::cli::inspectOne(c.plugins.inspect_file, c.plugins.params_of);
+        return ssx::cli::commandPlugins(c.plugins.plugin_path, c.plugins.params_of);
+    }
   } catch (const std::bad_alloc&) {
     std::cerr << "ssx: error: out of memory (the scene needs more than this machine has: make its swarms smaller)\n";
     return kExitRunFailure;
   }
+  return kExitBadInput;
 }

@@ -1,6 +1,8 @@
 // What the fuzz targets do with one input (see fuzz_inputs.hpp).
 #include "fuzz_inputs.hpp"
 
+#include "command_line.hpp"
+
 #include <ssx/ssx.hpp>
 
 #include <unistd.h>
@@ -10,6 +12,9 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <limits>
+#include <sstream>
+#include <stdexcept>
 #include <memory>
 #include <string>
 #include <string_view>
@@ -198,6 +203,39 @@ void stateInput(std::span<const std::uint8_t> data) {
   } catch (const Error& error) {
     expected(error);
   }
+}
+
+void commandLineInput(std::span<const std::uint8_t> data) {
+  std::vector<std::string> args{"ssx"};
+  const std::string_view all = text(data);
+  for (std::size_t begin = 0; begin <= all.size() && args.size() <= 64;) {
+    const std::size_t end = std::min(all.find('\0', begin), all.size());
+    args.emplace_back(all.substr(begin, end - begin));
+    begin = end + 1;
+  }
+  std::vector<const char*> argv;
+  for (const auto& a : args) argv.push_back(a.c_str());
+  std::ostringstream out, err;
+  const cli::CommandLine c = cli::parseCommandLine(static_cast<int>(argv.size()), argv.data(), out, err);
+  const auto require = [](bool ok, const char* what) {
+    if (!ok) throw std::logic_error(std::string("the command line accepted ") + what);
+  };
+  if (c.exit_status) {
+    require(*c.exit_status == 0 || *c.exit_status == cli::kExitBadInput, "an exit status other than 0 and 2");
+    require(*c.exit_status == 0 || !err.str().empty(), "nothing said about refused arguments");
+    return;
+  }
+  const cli::RunArgs& r = c.run;
+  require(!r.duration_given || (r.duration > 0 && r.duration <= kMaxDurationSeconds), "a duration out of range");
+  require(r.steps >= -1, "a negative step count");
+  require(r.threads >= -1 && r.threads <= 1024, "a thread count out of range");
+  require(!c.realtime_given || (r.realtime >= kMinRealtimeFactor && r.realtime <= kMaxRealtimeFactor),
+          "a real-time factor out of range");
+  require(r.rt_priority == 0 || (r.rt_priority >= kMinRealtimePriority && r.rt_priority <= kMaxRealtimePriority),
+          "a priority out of range");
+  for (double mb : {r.max_input_mb, c.validate.max_input_mb, c.sweep.max_input_mb})
+    require(mb >= 1.0 / 1024 && mb <= cli::kMostMaxInputMb, "an input limit out of range");
+  require(c.sweep.jobs == 0 || (c.sweep.jobs >= 1 && c.sweep.jobs <= 4096), "a job count out of range");
 }
 
 }  // namespace ssx::fuzz

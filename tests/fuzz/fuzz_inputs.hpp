@@ -27,4 +27,9 @@ void parameterInput(std::span<const std::uint8_t> data);
 /// (so that the fuzzer reaches past the checksum). After a restore that is accepted, 20 steps.
 void stateInput(std::span<const std::uint8_t> data);
 
+/// The ssx command's arguments, separated by NUL bytes (at most 64), parsed as the command parses
+/// them and nothing run. What parsing accepts must be in the ranges the options promise (a
+/// std::logic_error otherwise: a finding); what it refuses gets exit status 2.
+void commandLineInput(std::span<const std::uint8_t> data);
+
 }  // namespace ssx::fuzz

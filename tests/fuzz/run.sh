@@ -16,9 +16,10 @@ declare -A seeds=(
   [artifact]="examples/artifacts tests/data/fuzz/artifact"
   [parameter]="tests/data/fuzz/parameter"
   [state]="tests/data/fuzz/state"
+  [command_line]="tests/data/fuzz/command_line"
 )
 status=0
-for target in scene artifact parameter state; do
+for target in scene artifact parameter state command_line; do
   corpus=$work/corpus_$target
   mkdir -p "$corpus"
   # shellcheck disable=SC2086

@@ -45,3 +45,7 @@ TEST_CASE("inputs the fuzzers found or started from are refused or run cleanly: 
 TEST_CASE("inputs the fuzzers found or started from are refused or run cleanly: saved states", "[fuzz]") {
   CHECK(replay("state", ssx::fuzz::stateInput) >= 1);
 }
+
+TEST_CASE("inputs the fuzzers found or started from are refused or run cleanly: command lines", "[fuzz]") {
+  CHECK(replay("command_line", ssx::fuzz::commandLineInput) >= 1);
+}

@@ -1,0 +1,118 @@
+#include "command_line.hpp"
+
+#include "number_options.hpp"
+
+#include <ssx/ssx.hpp>
+
+#include <CLI/CLI.hpp>
+
+#include <limits>
+#include <ostream>
+
+namespace ssx::cli {
+
+namespace {
+
+void addMaxInputOption(CLI::App* command, double& mb) {
+  command->add_option("--max-input-mb", mb, "largest input file read (scene, include, artifact, sweep, state), MiB")
+      ->check(realNumber(1.0 / 1024, kMostMaxInputMb))
+      ->default_val(kDefaultMaxInputMb);
+}
+
+}  // namespace
+
+CommandLine parseCommandLine(int argc, const char* const* argv, std::ostream& out, std::ostream& err) {
+  CommandLine c;
+  CLI::App app{"ssx: real-time simulation of robot swarms"};
+  app.set_version_flag("--version", std::string("ssx ") + SSX_VERSION_STRING);
+  app.require_subcommand(1);
+
+  CLI::App* run_cmd = app.add_subcommand("run", "run a scene");
+  run_cmd->add_option("scene", c.run.scene, "scene file")->required()->check(CLI::ExistingFile);
+  auto* duration =
+      run_cmd->add_option("--duration", c.run.duration, "simulated seconds to run")
+          ->check(realNumber(0.0, ssx::kMaxDurationSeconds, true));
+  run_cmd->add_option("--steps", c.run.steps, "steps to run")->check(wholeNumber(0, std::numeric_limits<std::int64_t>::max()))->excludes(duration);
+  auto* realtime =
+      run_cmd->add_option("--realtime", c.run.realtime, "pace against the wall clock, optionally FACTOR times faster")
+          ->expected(0, 1)
+          ->check(realNumber(ssx::kMinRealtimeFactor, ssx::kMaxRealtimeFactor));
+  auto* fast = run_cmd->add_flag("--fast", c.run.fast, "run as fast as possible")->excludes(realtime);
+  run_cmd
+      ->add_option("--rt-priority", c.run.rt_priority,
+                   "step at this SCHED_FIFO priority (1-99; needs root or CAP_SYS_NICE): steps are not woken late "
+                   "while other processes run")
+      ->check(wholeNumber(ssx::kMinRealtimePriority, ssx::kMaxRealtimePriority))
+      ->excludes(fast);
+  run_cmd->add_option("--threads", c.run.threads, "worker threads (0: one per core)")->check(wholeNumber(0, 1024));
+  run_cmd->add_option("--seed", c.run.seed, "scene seed")->check(seedNumber());
+  run_cmd->add_option("--plugin-path", c.run.plugin_path, "plugin directory (repeatable)");
+  run_cmd->add_option("--stats-csv", c.run.stats_csv, "write per-step timing samples to FILE");
+  run_cmd->add_flag("--quiet", c.run.quiet, "no progress, no summary");
+  run_cmd->add_option("--render", c.run.render, "render engine (overrides the scene's): null or osmesa");
+  run_cmd->add_option("--physics", c.run.physics, "physics engine (overrides the scene's): ode or bullet")
+      ->check(CLI::IsMember(ssx::physicEngineNames()));
+  run_cmd->add_option("--snapshot", c.run.snapshot, "write the first camera's last frame as PNG to FILE");
+  run_cmd->add_option("--video", c.run.video, "write the first camera's frames as MP4 to FILE (needs ffmpeg)");
+  run_cmd->add_option("--frames", c.run.frames, "write the first camera's frames as PNG files into DIR");
+  run_cmd->add_option("--save-state", c.run.save_state, "write the world's state to FILE at the end (ssx run --load-state)");
+  run_cmd->add_flag("--allow-special-outputs", c.run.allow_special_outputs,
+                    "let outputs written as streams (a logger's file, --stats-csv) be FIFOs or devices");
+  run_cmd->add_option("--load-state", c.run.load_state,
+                      "continue from a state saved from this scene (--steps and --duration count from there)")
+      ->check(CLI::ExistingFile);
+  addMaxInputOption(run_cmd, c.run.max_input_mb);
+
+  CLI::App* validate_cmd = app.add_subcommand("validate", "check a scene and its plugins; run nothing");
+  validate_cmd->add_option("scene", c.validate.scene, "scene file")->required()->check(CLI::ExistingFile);
+  validate_cmd->add_option("--plugin-path", c.validate.plugin_path, "plugin directory (repeatable)");
+  validate_cmd->add_flag("--print", c.validate.print,
+                         "print the scene as ssx reads it, every default filled in (scene XML, on standard output)");
+  validate_cmd->add_option("--physics", c.validate.physics, "check the scene for this physics engine: ode or bullet")
+      ->check(CLI::IsMember(ssx::physicEngineNames()));
+  addMaxInputOption(validate_cmd, c.validate.max_input_mb);
+
+  CLI::App* plugins_cmd = app.add_subcommand("plugins", "list plugin libraries, their classes, and ABI checks");
+  plugins_cmd->add_option("--plugin-path", c.plugins.plugin_path, "plugin directory (repeatable)");
+  plugins_cmd->add_option("--params", c.plugins.params_of, "print the declared parameters of class NAME (a Markdown table)");
+  plugins_cmd->add_option("--inspect", c.plugins.inspect_file, "(internal) report one library from a child process")
+      ->group("");
+
+  CLI::App* sweep_cmd =
+      app.add_subcommand("sweep", "run a scene many times over varied attributes and seeds (docs/sweep-format.md)");
+  sweep_cmd->add_option("sweep", c.sweep.file, "sweep file")->required()->check(CLI::ExistingFile);
+  sweep_cmd->add_option("--out", c.sweep.out, "results CSV (default: SWEEP's name .csv); an existing one is resumed");
+  sweep_cmd->add_option("--robots", c.sweep.robots, "also write per-robot metrics to this CSV");
+  sweep_cmd->add_option("--jobs", c.sweep.jobs, "worker processes (default: one per core; under mpirun: the ranks)")
+      ->check(wholeNumber(1, 4096));
+  sweep_cmd->add_option("--plugin-path", c.sweep.plugin_path, "plugin directory (repeatable)");
+  sweep_cmd->add_flag("--check", c.sweep.check, "check the sweep and every point's scene; run nothing");
+  sweep_cmd->add_flag("--quiet", c.sweep.quiet, "no progress");
+  addMaxInputOption(sweep_cmd, c.sweep.max_input_mb);
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    const int code = app.exit(e, out, err);
+    c.exit_status = code == 0 ? 0 : kExitBadInput;
+    return c;
+  }
+  if (*run_cmd) {
+    c.command = CommandLine::Command::Run;
+    // --realtime alone means factor 1
+    c.realtime_given = realtime->count() > 0;
+    c.run.duration_given = duration->count() > 0;
+    if (c.realtime_given && (realtime->results().empty() || realtime->results().front().empty())) c.run.realtime = 1.0;
+  } else if (*validate_cmd) {
+    c.command = CommandLine::Command::Validate;
+  } else if (*sweep_cmd) {
+    c.command = CommandLine::Command::Sweep;
+  } else if (*plugins_cmd) {
+    c.command = CommandLine::Command::Plugins;
+  } else {
+    c.exit_status = kExitBadInput;
+  }
+  return c;
+}
+
+}  // namespace ssx::cli

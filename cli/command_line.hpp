@@ -1,0 +1,72 @@
+#pragma once
+// The ssx command's command line: its subcommands and options, parsed and checked (numbers by
+// cli/number_options.hpp) without running anything. main.cpp runs what it asks for; the fuzz
+// target tests/fuzz/command_line_fuzz.cpp feeds it arbitrary arguments.
+#include "common.hpp"
+
+#include <cstdint>
+#include <iosfwd>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace ssx::cli {
+
+struct RunArgs {
+  std::string scene;
+  double duration = 0;
+  std::int64_t steps = -1;
+  double realtime = 1.0;
+  bool fast = false;
+  int threads = -1;
+  std::optional<std::uint64_t> seed;
+  std::vector<std::string> plugin_path;
+  std::string stats_csv;
+  bool quiet = false;
+  double max_input_mb = kDefaultMaxInputMb;
+  std::string render, physics, snapshot, video, frames;
+  std::string save_state, load_state;
+  bool allow_special_outputs = false;
+  bool duration_given = false;
+  int rt_priority = 0;
+};
+
+struct ValidateArgs {
+  std::string scene;
+  std::vector<std::string> plugin_path;
+  std::string physics;
+  bool print = false;
+  double max_input_mb = kDefaultMaxInputMb;
+};
+
+struct SweepArgs {
+  std::string file, out, robots;
+  std::vector<std::string> plugin_path;
+  int jobs = 0;
+  bool check = false, quiet = false;
+  double max_input_mb = kDefaultMaxInputMb;
+};
+
+struct PluginsArgs {
+  std::vector<std::string> plugin_path;
+  std::string params_of;
+  std::string inspect_file;  // (internal) one library, reported from a child process
+};
+
+struct CommandLine {
+  enum class Command { Run, Validate, Sweep, Plugins };
+  /// Set when parsing ended the command: --help or --version (0), bad arguments (kExitBadInput);
+  /// what CLI11 had to say went to the streams given.
+  std::optional<int> exit_status;
+  Command command = Command::Run;
+  RunArgs run;
+  bool realtime_given = false;  // --realtime, with or without a factor
+  ValidateArgs validate;
+  SweepArgs sweep;
+  PluginsArgs plugins;
+};
+
+/// Parses argv (argv[0] the program). Never throws for bad arguments.
+CommandLine parseCommandLine(int argc, const char* const* argv, std::ostream& out, std::ostream& err);
+
+}  // namespace ssx::cli
