@@ -64,6 +64,11 @@ VehicleParams::VehicleParams(const Descriptor& params) : rotor(rotorParams(param
     throw params.errorAt(names.size() != dirs.size() ? "directions" : "rotors",
                          "'rotors' and 'directions' must name the same number (4 to " + std::to_string(kMaxRotors) +
                              ") of rotors");
+  // one rotor named twice would be pushed twice and leave another out
+  for (std::size_t i = 0; i < names.size(); ++i)
+    for (std::size_t j = 0; j < i; ++j)
+      if (names[i] == names[j])
+        throw params.errorAt("rotors", "rotor '" + names[i] + "' is named twice: name each rotor node once");
   for (const auto& d : dirs) {
     if (d != "1" && d != "-1") throw params.errorAt("directions", "rotor directions are 1 or -1, got '" + d + "'");
     directions.push_back(d == "1" ? 1 : -1);
