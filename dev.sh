@@ -75,8 +75,10 @@ case "${1:-}" in
       -DSSX_WARNINGS_AS_ERRORS="${SSX_WARNINGS_AS_ERRORS:-OFF}" "${launcher[@]}" >/dev/null
     cmake --build build-asan -j "$jobs"
     # install_and_consume builds a plain consumer against the library, which an instrumented
-    # libssx cannot link into; the plain build (./dev.sh test) runs it
-    ctest --test-dir build-asan -j "$jobs" --output-on-failure -E '^install_and_consume$'
+    # libssx cannot link into; the out-of-memory test limits the address space (ulimit -v), in which
+    # ASan cannot reserve its shadow memory, and ASan's operator new reports instead of throwing;
+    # the plain build (./dev.sh test) runs both
+    ctest --test-dir build-asan -j "$jobs" --output-on-failure -E '^install_and_consume$|memory running out while loading'
     tests/fuzz/run.sh build-asan "${FUZZ_SECONDS:-60}"
     cmake -S . -B build-tsan -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DSSX_SANITIZE=thread \
       -DSSX_BUILD_EXAMPLES=OFF -DSSX_WITH_ROS1=OFF -DSSX_WARNINGS_AS_ERRORS="${SSX_WARNINGS_AS_ERRORS:-OFF}" \

@@ -145,7 +145,7 @@ int commandRun(const RunArgs& args, bool realtime_given) {
   options.allow_special_outputs = args.allow_special_outputs;
   options.max_input_bytes = maxInputBytes(args.max_input_mb);
   // settings of this process for drawing with Mesa's llvmpipe (the library leaves the process
-  // alone; a program that embeds it chooses these itself, see the README):
+  // alone; a program that embeds it chooses these itself, see docs/library.md, Rendering):
   // - llvmpipe's own rasteriser threads cost more than they give at these image sizes and would
   //   compete with the simulation's workers (a user's LP_NUM_THREADS still wins);
   // - llvmpipe allocates and frees large blocks every frame; with glibc's default trim threshold

@@ -5,7 +5,7 @@
   step       overhead_us=... cpp_step_us=... one env.step() called from Python, minus the same step
                                              taken inside one env.step(n) call (a C++ loop)
 
-Targets (issue 16): positions of 10,000 under 1 ms; overhead under 10 us.
+Targets: positions of 10,000 under 1 ms; overhead under 10 us.
     PYTHONPATH=build/python python3 examples/python/bench_python.py
 """
 import argparse

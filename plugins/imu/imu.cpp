@@ -1,5 +1,5 @@
 // imu: accelerometer and gyroscope (ssx::ImuMeasurement) with the error model of
-// shared/specs/quadrotor.md section 3, per axis:
+// docs/quadrotor-reference.md section 3, per axis:
 //   measured = scale * (true + turn-on bias + Gauss-Markov bias + white noise),
 //   then quantised to counts of one LSB and saturated at the range.
 // The accelerometer measures specific force R^T (a - g) at the IMU node (lever-arm terms included

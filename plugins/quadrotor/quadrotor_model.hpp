@@ -1,6 +1,6 @@
 #pragma once
 // The quadrotor model and flight controller, free of the plugin glue so that tests and programs
-// can use each part alone. Reference numbers: shared/specs/quadrotor.md.
+// can use each part alone. Reference numbers: docs/quadrotor-reference.md.
 //
 //   RotorModel      first-order motors, thrust kF w^2, reaction torque, rotor drag, rolling moment
 //   Allocation      maps rotor speeds squared to body torques and thrust, and back

@@ -1,5 +1,5 @@
 // The Python module `ssx._ssx` (imported as `ssx`): scenes, stepping, state as numpy arrays,
-// set-points, measurements, save and restore. See python/ssx/__init__.py and README "Python".
+// set-points, measurements, save and restore. See python/ssx/__init__.py and docs/python.md.
 //
 // Threads: every call comes in holding the GIL; stepping and running release it. An environment
 // is used by one thread at a time (as in C++): a call made while another thread is stepping the

@@ -5,7 +5,7 @@
     env.step(100)
     p = env.positions()          # N x 3 numpy array, one row per env.dynamic_names()
 
-The simulation runs in libssx (C++); stepping releases the GIL. See the README's "Python" section.
+The simulation runs in libssx (C++); stepping releases the GIL. See docs/python.md.
 """
 from ._ssx import (
     ConfigError,

@@ -93,7 +93,7 @@ TEST_CASE("cross_engine: a torque-free top precesses at (J3 - J1)/J1 w3, keeping
   INFO("energy drift " << energy_drift << ", momentum drift " << momentum_drift);
   CHECK(std::abs(energy_drift) < 1e-3);
   CHECK(momentum_drift < 1e-3);
-  // the README's figures, to their last digit
+  // docs/physics.md's figures, to their last digit
   CHECK(energy_drift == Approx(engine == "ode" ? -1.9e-4 : -2.3e-4).margin(0.05e-4));
   CHECK(momentum_drift == Approx(engine == "ode" ? 1.1e-4 : 1.2e-4).margin(0.05e-4));
   WARN(engine << ": torque-free top over 2 s: energy drift " << energy_drift << ", momentum drift " << momentum_drift);
@@ -117,7 +117,7 @@ TEST_CASE("cross_engine: spin about the intermediate axis flips, and a tilted in
       if (first_flip < 0 && bodyRate(a).y() < 0) first_flip = (i + 1) * 0.001;
     }
     INFO("first flip at " << first_flip << " s");
-    CHECK(first_flip == Approx(2.7).margin(0.05));  // the README's figure
+    CHECK(first_flip == Approx(2.7).margin(0.05));  // docs/physics.md's figure
     CHECK(min_wy < -4.5);
   }
   // the same body described in a frame turned 30 degrees: the inertia is no longer diagonal (Bullet

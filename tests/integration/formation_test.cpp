@@ -64,7 +64,7 @@ FormationRun flyFormation(const std::string& engine) {
 }
 
 // the spec's acceptance (section 6): shape within 30 s, no pair closer than 0.7 m, no robot within
-// 0.2 m of an obstacle, throughout; and the README's figures for this engine (formed at `formed_s`,
+// 0.2 m of an obstacle, throughout; and docs/overview.md's figures for this engine (formed at `formed_s`,
 // 0.78 m, 0.31 m) within the tolerances it states
 void checkFormation(const std::string& engine, double formed_s) {
   const auto [error, reached_at, min_pair, min_obstacle] = flyFormation(engine);

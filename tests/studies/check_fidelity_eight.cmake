@@ -1,11 +1,11 @@
-# Runs ssx_fidelity_eight with a profile and checks its last two lines against the README's table,
+# Runs ssx_fidelity_eight with a profile and checks its last two lines against docs/quadrotor.md's table,
 # within 5 %:
 #   cmake -DPROGRAM=... -DOUT=... -DPROFILE=ideal|realistic -P check_fidelity_eight.cmake
 execute_process(COMMAND ${PROGRAM} --out ${OUT} --profile ${PROFILE} OUTPUT_VARIABLE out RESULT_VARIABLE status)
 if(NOT status EQUAL 0)
   message(FATAL_ERROR "ssx_fidelity_eight failed (${status}):\n${out}")
 endif()
-# the README's figures: trajectory, mean, std (m)
+# docs/quadrotor.md's figures: trajectory, mean, std (m)
 if(PROFILE STREQUAL "ideal")
   set(expected "eight_horizontal;0.0308;0.0104;eight_vertical;0.0156;0.0062")
 else()
@@ -39,8 +39,8 @@ foreach(i RANGE 0 ${last} 3)
     endif()
     math(EXPR limit "(${want_um} * 5 + 99) / 100")
     if(diff GREATER limit)
-      message(FATAL_ERROR "${name} ${what}_m = ${got}, the README says ${want} (tolerance 5 %)")
+      message(FATAL_ERROR "${name} ${what}_m = ${got}, docs/quadrotor.md says ${want} (tolerance 5 %)")
     endif()
-    message(STATUS "${name} ${what}_m = ${got} (README ${want}, within 5 %)")
+    message(STATUS "${name} ${what}_m = ${got} (docs/quadrotor.md ${want}, within 5 %)")
   endforeach()
 endforeach()

@@ -102,11 +102,12 @@ TEST_CASE("overruns are counted and reported", "[run]") {
 }
 
 TEST_CASE("a step that begins late after an on-time step is told from a long one", "[run]") {
-  // steps of 5 ms that compute in microseconds; the program holds the loop up for 7 ms once,
-  // between two steps: the next step begins 2 ms late (as after a late wake-up) and ends late,
-  // and the one after it begins 3 ms before its deadline: on time again
+  // steps of 20 ms that compute in microseconds; the program holds the loop up for 25 ms once,
+  // between two steps: the next step begins 5 ms late (as after a late wake-up) and ends late,
+  // and the one after it begins 15 ms before its deadline: on time again (margins wide enough for
+  // a loaded machine: with 5 ms steps a sanitized run in parallel with others saw a second late one)
   EnvironmentSettings s;
-  s.timestep = toNanoseconds(0.005);
+  s.timestep = toNanoseconds(0.020);
   s.threads = 1;
   Environment env(s);
   withBall(env);
@@ -114,7 +115,7 @@ TEST_CASE("a step that begins late after an on-time step is told from a long one
   RunOptions o;
   o.steps = 10;
   o.on_step = [](const Environment& e) {
-    if (e.stepCount() == 4) burn(std::chrono::microseconds(7000));
+    if (e.stepCount() == 4) burn(std::chrono::microseconds(25000));
   };
   const TimingSummary summary = env.run(o);
   CHECK(summary.overruns_began_late >= 1);

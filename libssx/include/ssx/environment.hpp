@@ -102,7 +102,7 @@ struct RunOptions {
   /// 1-99: a real-time run steps on the calling thread and the worker threads at this SCHED_FIFO
   /// priority, each put back to its own policy when the run returns; 0: their policies as they
   /// are. Under the default policy a thread that sleeps until a deadline can be woken milliseconds
-  /// late while other work runs (this README's machine: up to 5 ms); a FIFO thread is run at once.
+  /// late while other work runs (the development machine: up to 5 ms, docs/cli.md); a FIFO thread is run at once.
   /// Needs permission (root, CAP_SYS_NICE or an RLIMIT_RTPRIO; see realtimePriorityProblem): run
   /// throws before the first step without it. Meant for as many threads as cores, and for scenes
   /// that keep up: while it is late, a run at this priority leaves the cores it uses to nothing

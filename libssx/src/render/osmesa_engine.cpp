@@ -223,7 +223,7 @@ void OsmesaRenderEngine::makeCurrent(int width, int height) {
   Gl& g = *gl_;
   if (g.context == nullptr) {
     // (the process settings that make llvmpipe fast, LP_NUM_THREADS=0 and a large malloc trim
-    // threshold, are the program's to choose: the ssx command sets them, see the README)
+    // threshold, are the program's to choose: the ssx command sets them, see docs/library.md, Rendering)
     const int attributes[] = {OSMESA_FORMAT,
                               OSMESA_RGBA,
                               OSMESA_DEPTH_BITS,

@@ -146,7 +146,9 @@ void SceneLoader::readEnvironment(const Descriptor& d) {
     } catch (const ConfigError&) {
       // (reported above)
     }
-    if (std::abs(asked - static_cast<double>(settings_.timestep)) > 1e-3)
+    // (a timestep refused above was reported; it is no rounding)
+    const bool accepted = asked > 0 && asked <= kMaxTimestepSeconds * 1e9;
+    if (accepted && std::abs(asked - static_cast<double>(settings_.timestep)) > 1e-3)
       warning(given->where, "<environment>: timestep " + given->value + " s is " + std::to_string(settings_.timestep) +
                                 " ns (time is counted in whole nanoseconds)");
   }
