@@ -29,7 +29,8 @@ Pose lookAt(const Vec3& position, const Vec3& target) {
 }
 
 // everything placed, static or not (ground planes aside), seen from the south-east above
-void frameScene(CameraSpec& spec, const SceneCameras::Artifacts& artifacts) {
+// the box of the robots' positions (the ground left out)
+Eigen::AlignedBox3d robotsBox(const SceneCameras::Artifacts& artifacts) {
   Eigen::AlignedBox3d box;
   for (const auto& a : artifacts) {
     if (a->rootCount() == 0) {
@@ -43,11 +44,31 @@ void frameScene(CameraSpec& spec, const SceneCameras::Artifacts& artifacts) {
     if (!ground) box.extend(a->root().pose().position);
   }
   if (box.isEmpty()) box.extend(Vec3::Zero());
+  return box;
+}
+
+// a camera seeing the whole box: looking at its centre from the side and above, as close as keeps
+// every corner of the box, grown by 0.5 m, inside the image (both ways)
+void frameBox(CameraSpec& spec, Eigen::AlignedBox3d box, double aspect) {
+  box.min() -= Vec3::Constant(0.5);
+  box.max() += Vec3::Constant(0.5);
   const Vec3 centre = box.center();
-  const double extent = std::max(2.0, box.sizes().norm());
-  const double distance = 0.5 * extent / std::tan(spec.fov_deg * std::numbers::pi / 360.0) + 0.5 * extent;
+  const Vec3 back = Vec3(0.62, -0.62, 0.48).normalized();  // from the centre towards the camera
+  const Vec3 forward = -back;
+  const Vec3 right = forward.cross(Vec3::UnitZ()).normalized();
+  const Vec3 up = right.cross(forward);
+  const double tan_v = std::tan(spec.fov_deg * std::numbers::pi / 360.0);
+  const double tan_h = tan_v * aspect;
+  double distance = 1.0;
+  for (int k = 0; k < 8; ++k) {
+    const Vec3 r = box.corner(static_cast<Eigen::AlignedBox3d::CornerType>(k)) - centre;
+    // the corner's depth from a camera at centre + D back is D + r.forward: far enough that its
+    // offsets across the image fit the half angles
+    distance = std::max({distance, std::abs(r.dot(right)) / tan_h - r.dot(forward),
+                         std::abs(r.dot(up)) / tan_v - r.dot(forward)});
+  }
   spec.look_at = centre;
-  spec.position = centre + distance * Vec3(0.62, -0.62, 0.48).normalized();
+  spec.position = centre + 1.05 * distance * back;
 }
 
 }  // namespace
@@ -81,7 +102,10 @@ void SceneCameras::start(const RenderSettings& r, Nanoseconds timestep, const Re
         throw ConfigError({}, "camera '" + spec.name + "' follows '" + spec.follow +
                                   "', which is no artifact with a physic root");
     }
-    if (spec.frame_scene) frameScene(c.spec, artifacts);
+    if (spec.frame_scene) {
+      c.seen = robotsBox(artifacts);
+      frameBox(c.spec, c.seen, static_cast<double>(r.width) / r.height);
+    }
     cameras_.push_back(std::move(c));
   }
   const double fps = 1.0 / (static_cast<double>(r.period_steps) * toSeconds(timestep));
@@ -163,6 +187,14 @@ void SceneCameras::drawFrame(std::int64_t step, const RenderSettings& settings, 
       const Pose base{root.position, Quat(Eigen::AngleAxisd(std::atan2(forward.y(), forward.x()), Vec3::UnitZ()))};
       view.pose = lookAt(base.transformPoint(c.spec.position), base.transformPoint(c.spec.look_at));
     } else {
+      if (c.spec.frame_scene) {
+        // framing every place the robots have been: it widens as they spread, and never jumps back
+        const Eigen::AlignedBox3d now = robotsBox(artifacts);
+        if (!c.seen.contains(now)) {
+          c.seen.extend(now);
+          frameBox(c.spec, c.seen, static_cast<double>(settings.width) / settings.height);
+        }
+      }
       view.pose = lookAt(c.spec.position, c.spec.look_at);
     }
     views.push_back(view);

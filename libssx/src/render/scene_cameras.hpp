@@ -56,6 +56,7 @@ class SceneCameras {
   struct Camera {
     CameraSpec spec;
     const Artifact* follow = nullptr;
+    Eigen::AlignedBox3d seen;  // a framing camera's: every place the robots have been in a frame
   };
   struct Request {
     std::string owner;

@@ -292,6 +292,7 @@ void SceneLoader::readWind(const Descriptor& d) {
 
 void SceneLoader::readRender(const Descriptor& d) {
   RenderSettings& r = settings_.render;
+  render_engine_named_ = d.has("engine");
   r.engine = readChoice(d, "engine", r.engine, {"null", "osmesa"});
   const auto names = renderEngineNames();
   if (std::find(names.begin(), names.end(), r.engine) == names.end()) {
@@ -360,6 +361,20 @@ void SceneLoader::applyOptions() {
     if (!options_.snapshot.empty()) cameras.front().snapshot = options_.snapshot;
     if (!options_.video.empty()) cameras.front().video = options_.video;
     if (!options_.frames_dir.empty()) cameras.front().frames_dir = options_.frames_dir;
+  }
+  // pictures asked for (a camera's snapshot, video or frames, in the scene or on the command line)
+  // need an engine that draws: when none was named, the osmesa renderer is switched on for them
+  RenderSettings& r = settings_.render;
+  const bool pictures = std::any_of(r.cameras.begin(), r.cameras.end(), [](const CameraSpec& c) {
+    return !c.snapshot.empty() || !c.video.empty() || !c.frames_dir.empty();
+  });
+  if (pictures && r.engine == "null" && !render_engine_named_ && !options_.render_engine) {
+    const auto names = renderEngineNames();
+    if (std::find(names.begin(), names.end(), "osmesa") != names.end())
+      r.engine = "osmesa";
+    else
+      error({model_.file.string(), 0}, "a picture was asked for (snapshot, video or frames), and this build of ssx "
+                                       "draws none: install libosmesa6-dev and rebuild");
   }
 }
 

@@ -266,6 +266,7 @@ class SceneLoader {
   const Descriptor* physics_element_ = nullptr;
   const Descriptor* wind_element_ = nullptr;
   const Descriptor* render_element_ = nullptr;
+  bool render_engine_named_ = false;  // <render engine="..."> given (then outputs do not switch it)
   std::vector<fs::path>& plugin_dirs_ = model_.plugin_dirs;
   std::vector<Entity> extensions_;
   std::vector<Entity> entities_;

@@ -44,3 +44,61 @@ TEST_CASE("render: scene cameras write numbered PNG frames at their rate and a s
   CHECK(((head[16] << 24) | (head[17] << 16) | (head[18] << 8) | head[19]) == 160);
   CHECK(((head[20] << 24) | (head[21] << 16) | (head[22] << 8) | head[23]) == 120);
 }
+
+TEST_CASE("render: a picture asked for switches the osmesa engine on, unless the scene named an engine",
+          "[render]") {
+  REQUIRE(haveOsmesa());
+  const std::string robots = R"(<type name="ball" file="yellow_ball.xml"/><artifact name="ball" type="ball" xyz="0 0 2"/>)";
+  SceneOptions options;
+  options.snapshot = fs::current_path() / "switched_on.png";
+  fs::remove(options.snapshot);
+  Scene s = loadSceneFromString("<scene>" + robots + "</scene>", "r.xml", kRenderData, options);
+  CHECK(s.environment->settings().render.engine == "osmesa");
+  s.environment->step(50);
+  s.environment->stop();
+  CHECK(fs::file_size(options.snapshot) > 1000);
+  // a scene camera's own outputs do the same; a scene that names the null engine keeps it
+  Scene named = loadSceneFromString(R"(<scene><render engine="null"><camera name="c" snapshot="none.png"/></render>)" +
+                                        robots + "</scene>",
+                                    "r.xml", kRenderData);
+  CHECK(named.environment->settings().render.engine == "null");
+  Scene scene_camera = loadSceneFromString(R"(<scene><render><camera name="c" snapshot="mine.png"/></render>)" + robots +
+                                               "</scene>",
+                                           "r.xml", kRenderData);
+  CHECK(scene_camera.environment->settings().render.engine == "osmesa");
+}
+
+TEST_CASE("render: a camera that frames the scene keeps every robot in the image as they fly", "[render]") {
+  REQUIRE(haveOsmesa());
+  // nine quadrotors on a 3 x 3 grid climb 3 m: framed at the start on the ground, they would leave
+  // the image at the top
+  Scene s = loadSceneFromString(R"(<scene><environment timestep="0.002"/>
+    <render engine="osmesa" rate_hz="10"><camera name="auto"/></render><ground/>
+    <type name="q" file=")" + (kData.parent_path().parent_path() / "examples" / "artifacts" / "mk_quad.xml").string() +
+                                    R"("/><swarm type="q" count="9" name="q{i}" spacing="2" xyz="0 0 0.05">
+    <driver offset="0 0 3"/></swarm></scene>)",
+                                "framing.xml", kRenderData);
+  Environment& env = *s.environment;
+  auto inView = [&] {
+    const CameraSpec cam = env.cameras().at(0);
+    const Vec3 forward = (cam.look_at - cam.position).normalized();
+    const Vec3 right = forward.cross(Vec3::UnitZ()).normalized();
+    const Vec3 up = right.cross(forward);
+    const double tan_v = std::tan(cam.fov_deg * std::numbers::pi / 360), tan_h = tan_v * 640.0 / 480.0;
+    int in = 0;
+    for (int i = 0; i < 9; ++i) {
+      const Vec3 r = env.findArtifact("q" + std::to_string(i))->pose().position - cam.position;
+      const double depth = r.dot(forward);
+      in += depth > 0 && std::abs(r.dot(right)) < depth * tan_h && std::abs(r.dot(up)) < depth * tan_v ? 1 : 0;
+    }
+    return in;
+  };
+  env.step(1);
+  CHECK(inView() == 9);
+  const double first_distance = (env.cameras().at(0).position - env.cameras().at(0).look_at).norm();
+  env.step(3000);  // 6 s: at 3 m
+  REQUIRE(env.findArtifact("q4")->pose().position.z() > 2.5);
+  CHECK(inView() == 9);
+  CHECK((env.cameras().at(0).position - env.cameras().at(0).look_at).norm() > first_distance);  // it widened
+  env.stop();
+}
