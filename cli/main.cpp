@@ -84,6 +84,28 @@ class Progress {
   std::chrono::steady_clock::time_point last_{};
 };
 
+// a scene's problems by file (in the order the files were first named) and line within each
+void printSorted(const ssx::SceneError& e) {
+  std::vector<ssx::Diagnostic> d = e.diagnostics();
+  std::vector<std::string> files;
+  const auto rank = [&files](const std::string& file) {
+    const auto it = std::find(files.begin(), files.end(), file);
+    return static_cast<std::size_t>(it - files.begin());
+  };
+  for (const auto& x : d)
+    if (std::find(files.begin(), files.end(), x.where.file) == files.end()) files.push_back(x.where.file);
+  std::stable_sort(d.begin(), d.end(), [&](const ssx::Diagnostic& a, const ssx::Diagnostic& b) {
+    const auto ra = rank(a.where.file), rb = rank(b.where.file);
+    return ra != rb ? ra < rb : a.where.line < b.where.line;
+  });
+  std::size_t errors = 0;
+  for (const auto& x : d) {
+    std::cerr << x.str() << '\n';
+    errors += x.severity == ssx::Diagnostic::Severity::Error ? 1 : 0;
+  }
+  std::cerr << errors << " error(s); nothing was run\n";
+}
+
 std::string formatFactor(double f) {
   char buf[32];
   std::snprintf(buf, sizeof buf, "%g", f);
@@ -158,7 +180,7 @@ int commandRun(const RunArgs& args, bool realtime_given) {
   try {
     scene = ssx::loadScene(args.scene, options);
   } catch (const ssx::SceneError& e) {
-    std::cerr << e.what() << '\n';
+    printSorted(e);
     return kExitBadInput;
   }
   printWarnings(scene);
@@ -303,7 +325,7 @@ int commandValidate(const std::string& file, const std::vector<std::string>& plu
               << " (available: " << joined(ssx::renderEngineNames()) << ")\n";
     return 0;
   } catch (const ssx::SceneError& e) {
-    std::cerr << e.what() << '\n';
+    printSorted(e);
     return kExitBadInput;
   }
 }
@@ -320,7 +342,7 @@ int commandSweep(const SweepArgs& args) {
     spec = sw::readSpec(args.file, plugin_path, max_input);
     sw::check(*spec);
   } catch (const ssx::SceneError& e) {
-    std::cerr << e.what() << '\n';
+    printSorted(e);
     return kExitBadInput;
   }
   if (args.check) {

@@ -238,7 +238,16 @@ fs::path ClassLoader::load(std::string_view plugin) {
     return canonical;
   }
   if (candidates.empty()) tried = "\n  (the search path is empty: add a plugin directory)";
-  throw PluginError("plugin '" + name + "' could not be loaded; tried:" + tried);
+  // a name near one of the plugins there are: a typing slip
+  std::vector<std::string> present;
+  for (const auto& dir : search_path_) {
+    std::error_code ec;
+    for (const auto& entry : fs::directory_iterator(dir, ec)) {
+      const std::string file = entry.path().filename().string();
+      if (file.starts_with("libssx_") && file.ends_with(".so")) present.push_back(file.substr(7, file.size() - 10));
+    }
+  }
+  throw PluginError("plugin '" + name + "' could not be loaded" + didYouMean(name, present) + "; tried:" + tried);
 }
 
 const ssx_plugin_class& ClassLoader::classInfo(std::string_view plugin, std::string_view class_name,
@@ -253,12 +262,14 @@ const ssx_plugin_class& ClassLoader::classInfo(std::string_view plugin, std::str
   const std::string where = "plugin '" + std::string(plugin) + "' (" + path.string() + ")";
   if (found == nullptr) {
     std::string available;
+    std::vector<std::string> names;
     for (std::uint32_t i = 0; i < lib->manifest->class_count; ++i) {
       const ssx_plugin_class& c = lib->manifest->classes[i];
       available += std::string(available.empty() ? "" : ", ") + c.name + " (" + toString(toKind(c.kind)) + ")";
+      names.emplace_back(c.name);
     }
-    throw PluginError(where + " has no class '" + std::string(class_name) +
-                      "'; it has: " + (available.empty() ? std::string("none") : available));
+    throw PluginError(where + " has no class '" + std::string(class_name) + "'" + didYouMean(class_name, names) +
+                      "; it has: " + (available.empty() ? std::string("none") : available));
   }
     throw PluginError(where + ": class '" + std::string(class_name) + "' is " + withArticle(toKind(found->kind)) +
                       ", not " + withArticle(kind));

@@ -115,10 +115,16 @@ std::vector<Diagnostic> checkParametersNamed(std::span<const ssx_plugin_param> d
     for (const auto& d : declarations) declared = declared || a.key == d.name;
     if (declared) continue;
     std::string known;
-    for (const auto& d : declarations) known += std::string(known.empty() ? "" : ", ") + d.name;
+    std::vector<std::string> names;
+    for (const auto& d : declarations) {
+      known += std::string(known.empty() ? "" : ", ") + d.name;
+      names.emplace_back(d.name);
+    }
+    const std::string nearest = nearestName(a.key, names);
     out.push_back({Diagnostic::Severity::Warning, a.where,
-                   "unknown parameter '" + a.key + "' of " + what + " (ignored; it has: " +
-                       (known.empty() ? std::string("none") : known) + ")"});
+                   "unknown parameter '" + a.key + "' of " + what + " (ignored; " +
+                       (nearest.empty() ? std::string() : "did you mean '" + nearest + "'? ") +
+                       "it has: " + (known.empty() ? std::string("none") : known) + ")"});
   }
   // absent parameters read as their declared defaults
   params.setDeclarations(declarations);

@@ -175,6 +175,21 @@ TEST_CASE("ssx run: numbers are decimal and in range, with the range said plainl
   fs::remove("hover_swarm_poses.csv");
 }
 
+TEST_CASE("ssx validate lists a scene's problems by line, whatever order they were found in", "[cli]") {
+  // the environment is read before the swarms: its error was found second and printed first
+  const fs::path scene = fs::current_path() / "unsorted.xml";
+  std::ofstream(scene) << "<scene>\n  <swarm type=\"b\" count=\"2\" layout=\"hexagonal\"/>\n  <type name=\"b\" file=\""
+                       << (kExamples / "artifacts" / "box.xml").string() << "\"/>\n  <environment timestep=\"-1\"/>\n</scene>\n";
+  const Result r = run({"validate", scene.string()});
+  CHECK(r.status == 2);
+  const auto second = r.err.find("unsorted.xml:2: error:");
+  const auto fourth = r.err.find("unsorted.xml:4: error:");
+  REQUIRE(second != std::string::npos);
+  REQUIRE(fourth != std::string::npos);
+  CHECK(second < fourth);
+  CHECK_THAT(r.err, Contains("2 error(s); nothing was run"));
+}
+
 TEST_CASE("ssx validate --print: the scene with every default, which validates and prints the same again", "[cli]") {
   const Result printed = run({"validate", (kExamples / "scenes" / "hover_swarm.xml").string(), "--print"});
   REQUIRE(printed.status == 0);

@@ -4,6 +4,9 @@
 
 #include <catch2/catch.hpp>
 
+#include <string>
+#include <vector>
+
 using namespace ssx;
 
 TEST_CASE("a source location reads file:line, file, or <code>", "[error]") {
@@ -30,4 +33,17 @@ TEST_CASE("a step error names the step, the artifact and the plugin", "[error]")
   CHECK(e.artifact() == "q7");
   CHECK(e.plugin() == "driver quadrotor");
   CHECK(e.step() == 42);
+}
+
+TEST_CASE("did you mean: the nearest name within a typing slip, case aside", "[error]") {
+  const std::vector<std::string> names{"timestep", "threads", "seed", "csv_logger", "quadrotor"};
+  CHECK(didYouMean("timestpe", names) == " (did you mean 'timestep'?)");  // two letters swapped: one edit
+  CHECK(didYouMean("thraeds", names) == " (did you mean 'threads'?)");
+  CHECK(didYouMean("csv_loger", names) == " (did you mean 'csv_logger'?)");
+  CHECK(didYouMean("QuadRotor", names) == " (did you mean 'quadrotor'?)");
+  CHECK(didYouMean("sed", names) == " (did you mean 'seed'?)");           // short names: one edit
+  CHECK(didYouMean("colour", names).empty());
+  CHECK(didYouMean("seed", names).empty());  // the name itself is no suggestion
+  CHECK(nearestName("thread", names) == "threads");
+  CHECK(nearestName("xyz", {}).empty());
 }

@@ -110,7 +110,7 @@ TEST_CASE("each kind of bad parameter is an error at its own line", "[parameters
   Descriptor extra = element({{"file", "f"}, {"gian", "1"}});
   const auto all = checkParameters(kDeclared, extra, context, "driver 'x'");
   REQUIRE(all.size() == 1);
-  CHECK(all[0].str() == "scene.xml:9: warning: unknown parameter 'gian' of driver 'x' (ignored; it has: gain, count, "
+  CHECK(all[0].str() == "scene.xml:9: warning: unknown parameter 'gian' of driver 'x' (ignored; did you mean 'gain'? it has: gain, count, "
                         "mode, file, loop_hz, offset)");
 }
 

@@ -6,6 +6,8 @@
 
 #include <stdexcept>
 #include <string>
+#include <string_view>
+#include <vector>
 
 namespace ssx {
 
@@ -17,6 +19,13 @@ struct SourceLocation {
   /// "file:line", "file", or "<code>".
   SSX_EXPORT std::string str() const;
 };
+
+/// The name among `candidates` nearest to `name` (fewest single-character edits, case ignored), if it
+/// is near enough to be a typing slip (at most a third of its length, and 1 for short names):
+/// " (did you mean 'csv_logger'?)", else an empty string. For messages about unknown names.
+SSX_EXPORT std::string didYouMean(std::string_view name, const std::vector<std::string>& candidates);
+/// The candidate itself, or an empty string.
+SSX_EXPORT std::string nearestName(std::string_view name, const std::vector<std::string>& candidates);
 
 /// Base of every ssx exception.
 class SSX_EXPORT Error : public std::runtime_error {

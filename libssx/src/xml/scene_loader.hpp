@@ -87,8 +87,14 @@ class SceneLoader {
   }
 
   // --- typed reads that record errors and fall back ---
+  // every attribute a read asked for, per element: what an unknown attribute may have meant
+  void asked(const Descriptor& d, std::string_view key) {
+    auto& keys = asked_[&d];
+    if (std::find(keys.begin(), keys.end(), key) == keys.end()) keys.emplace_back(key);
+  }
   template <class T>
   T read(const Descriptor& d, std::string_view key, const T& fallback) {
+    asked(d, key);
     try {
       return d.get<T>(key, fallback);
     } catch (const ConfigError& e) {
@@ -98,6 +104,7 @@ class SceneLoader {
   }
   template <class T>
   std::optional<T> readOptional(const Descriptor& d, std::string_view key) {
+    asked(d, key);
     if (!d.has(key)) return std::nullopt;
     try {
       return d.get<T>(key);
@@ -107,6 +114,7 @@ class SceneLoader {
     }
   }
   std::string require(const Descriptor& d, std::string_view key) {
+    asked(d, key);
     if (!d.has(key)) {
       error(d.where(), "<" + d.name() + ">: missing attribute '" + std::string(key) + "'");
       return {};
@@ -114,6 +122,7 @@ class SceneLoader {
     return d.get<std::string>(key);
   }
   double readPositive(const Descriptor& d, std::string_view key, double fallback) {
+    asked(d, key);
     try {
       return d.getPositive(key, fallback);
     } catch (const ConfigError& e) {
@@ -178,12 +187,19 @@ class SceneLoader {
             static_cast<float>(v.size() == 4 ? v[3] : 1.0)};
   }
   // unknown attributes (those nobody read) and unknown child elements are warnings
+  // (with the nearest name it asked for or allows, when one is near: a typing slip)
   void checkUnknown(const Descriptor& d, const std::set<std::string>& children = {}) {
+    const auto it = asked_.find(&d);
+    const std::vector<std::string> none;
     for (const auto& a : d.attributes())
-      if (!a.used) warning(a.where, "unknown attribute '" + a.key + "' of <" + d.name() + "> (ignored)");
+      if (!a.used)
+        warning(a.where, "unknown attribute '" + a.key + "' of <" + d.name() + "> (ignored)" +
+                             didYouMean(a.key, it != asked_.end() ? it->second : none));
+    const std::vector<std::string> allowed(children.begin(), children.end());
     for (const auto& c : d.children())
       if (!children.contains(c.name()))
-        warning(c.where(), "unknown element <" + c.name() + "> in <" + d.name() + "> (ignored)");
+        warning(c.where(), "unknown element <" + c.name() + "> in <" + d.name() + "> (ignored)" +
+                               didYouMean(c.name(), allowed));
   }
   fs::path resolve(const fs::path& dir, const std::string& file) const {
     const fs::path p(file);
@@ -276,7 +292,8 @@ class SceneLoader {
   };
   std::map<std::string, TypeDecl> type_decls_;
   std::map<std::string, ArtifactType> types_;          // by type name, parsed on first use
-  double placed_bytes_ = 0;                            // estimated memory of the artifacts so far
+  double placed_bytes_ = 0;
+  std::map<const Descriptor*, std::vector<std::string>> asked_;  // see asked()                            // estimated memory of the artifacts so far
   std::map<std::string, std::string> failed_plugins_;  // "plugin/class" -> already reported
   struct ExtensionCheck {
     const SimulationExtension* extension;
