@@ -106,6 +106,11 @@ def main(argv=None):
     print(f"robots={args.n} simulated_s={times[-1]:.2f} "
           f"mean_error_m={error[turning].mean():.4f} max_error_m={error[turning].max():.4f}")
     if args.out:
+        try:
+            import matplotlib  # noqa: F401 (optional: only the plot needs it)
+        except ImportError:
+            print("no plot: matplotlib is not installed (apt-get install python3-matplotlib)")
+            return 0
         plot(times, flown, wanted, args.out)
         print(f"wrote {args.out}")
     return 0
