@@ -1,0 +1,96 @@
+"""Type stubs of the compiled module ssx._ssx (what an editor completes for `import ssx`).
+
+tests/python/test_stubs.py checks that these name exactly what the module has."""
+import os
+from typing import Any, Dict, List, Optional, Sequence, Union
+
+import numpy as np
+import numpy.typing as npt
+
+__version__: str
+
+_Path = Union[str, "os.PathLike[str]"]
+_Rows = npt.ArrayLike
+_Robots = Optional[Sequence[Union[str, int]]]
+
+class Error(RuntimeError): ...
+class ConfigError(Error): ...
+class SceneError(Error): ...
+class StepError(Error): ...
+class StateError(Error): ...
+
+class Environment:
+    """A loaded scene: step it, read its state as numpy arrays, command it (load_scene, load_scene_string)."""
+
+    def step(self, n: int = 1) -> None:
+        """Advances n timesteps (starting the environment first if needed); releases the GIL."""
+    @property
+    def time(self) -> float:
+        """Simulated time, s."""
+    @property
+    def time_ns(self) -> int:
+        """Simulated time, ns."""
+    @property
+    def timestep(self) -> float:
+        """Physics timestep, s."""
+    @property
+    def step_count(self) -> int: ...
+    @property
+    def duration(self) -> Optional[float]:
+        """<environment duration> in s, or None."""
+    @property
+    def seed(self) -> int: ...
+    @property
+    def threads(self) -> int:
+        """Worker threads of the parallel phases (known once started)."""
+    def artifact_names(self) -> List[str]:
+        """Every artifact, in artifact order."""
+    def dynamic_names(self) -> List[str]:
+        """The artifacts with a dynamic root: the rows of positions() and the other state arrays."""
+    def setpoint_names(self) -> List[str]:
+        """The artifacts whose driver follows set-points: the rows of set_setpoints()."""
+    def state_hash(self) -> int:
+        """64-bit hash of every body's pose and velocities, bit for bit, and the time."""
+    def positions(self) -> npt.NDArray[np.float64]:
+        """N x 3 positions (m, world) of the dynamic artifacts' first roots."""
+    def orientations(self) -> npt.NDArray[np.float64]:
+        """N x 4 orientations as quaternions (w, x, y, z)."""
+    def linear_velocities(self) -> npt.NDArray[np.float64]:
+        """N x 3, m/s, world frame."""
+    def angular_velocities(self) -> npt.NDArray[np.float64]:
+        """N x 3, rad/s, world frame."""
+    def set_setpoints(self, positions: _Rows, velocities: Optional[_Rows] = None, yaws: Optional[_Rows] = None,
+                      accelerations: Optional[_Rows] = None, yaw_rates: Optional[_Rows] = None,
+                      robots: _Robots = None) -> None:
+        """One row per robot (setpoint_names(), or `robots`); held until the next call; every row checked first."""
+    def set_commands(self, level: str, values: _Rows, robots: _Robots = None) -> None:
+        """Commands at a level ('position', 'velocity', 'attitude', 'rates', 'rotors'), one row per robot."""
+    def imu(self, artifact: str, sensor: Optional[int] = None) -> Dict[str, Any]:
+        """The latest IMU measurement of an artifact, as a dict of numpy arrays."""
+    def pose(self, artifact: str, sensor: Optional[int] = None) -> Dict[str, Any]:
+        """The latest pose measurement of an artifact, as a dict."""
+    def range(self, artifact: str, sensor: Optional[int] = None) -> Dict[str, Any]:
+        """The latest range measurement of an artifact: detections as arrays, nearest first."""
+    def save_state(self) -> bytes:
+        """Everything that determines the future."""
+    def restore_state(self, state: bytes) -> None:
+        """Continues from save_state() bytes: the next steps are bitwise those of the saving run."""
+    def run(self, seconds: Optional[float] = None, realtime: bool = True, realtime_factor: Optional[float] = None,
+            realtime_priority: Optional[int] = None) -> Dict[str, Any]:
+        """Runs `seconds` of simulated time, paced unless realtime=False; returns the timing summary."""
+    def close(self) -> None:
+        """Stops the environment: plugins destroyed, files and videos finished."""
+    def __enter__(self) -> "Environment": ...
+    def __exit__(self, *args: Any) -> None: ...
+
+def load_scene(path: _Path, seed: Optional[int] = None, threads: Optional[int] = None,
+               plugin_path: Sequence[_Path] = ..., physics: Optional[str] = None) -> Environment:
+    """Loads a scene file; raises SceneError (every file:line: error: line) before anything starts."""
+def load_scene_string(xml: str, base_dir: _Path = ..., seed: Optional[int] = None, threads: Optional[int] = None,
+                      label: str = "<string>", plugin_path: Sequence[_Path] = ...,
+                      physics: Optional[str] = None) -> Environment:
+    """Loads a scene from text; relative files resolve against base_dir, messages name `label`."""
+def physics_engines() -> List[str]:
+    """The physics engines of this build ("ode", "bullet")."""
+def data_directory() -> "os.PathLike[str]":
+    """Where the installed artifact types (artifacts/) and example scenes (scenes/) are."""
