@@ -1,6 +1,7 @@
 // Saving and restoring a world: continuing after a restore is the run that was never interrupted.
 #include <ssx/ssx.hpp>
 
+#include "state_scene.hpp"
 #include "test_util.hpp"
 
 #include <catch2/catch.hpp>
@@ -13,32 +14,11 @@
 #include <iterator>
 
 using namespace ssx;
+using ssx::test::loadStateScene;
+using ssx::test::stateSceneXml;
 namespace fs = std::filesystem;
 
 namespace {
-
-const fs::path kArtifacts = fs::path(SSX_EXAMPLES_DIR) / "artifacts";
-
-// quadrotors with noisy IMUs take off from the ground and fly the formation around a pillar,
-// while boxes fall on the ground and on each other: contacts, noise, neighbours, obstacles
-std::string sceneXml(int threads, const std::string& log = "", const std::string& engine = "ode") {
-  return "<scene><environment timestep=\"0.002\" seed=\"11\" threads=\"" + std::to_string(threads) +
-         "\"/><physics engine=\"" + engine + "\"/>"
-         "<type name=\"quad\" file=\"" + (kArtifacts / "mk_quad_formation.xml").string() +
-         "\"/><type name=\"box\" file=\"" + (kArtifacts / "box.xml").string() + "\"/><ground/>"
-         "<obstacle name=\"pillar\" xyz=\"2.5 0 2\"><cylinder radius=\"0.25\" length=\"4\"/></obstacle>"
-         "<swarm type=\"quad\" count=\"12\" layout=\"random\" min=\"-2 -2 0.05\" max=\"2 2 0.05\" "
-         "min_distance=\"1.0\"><driver formation_index=\"{i}\" formation_size=\"12\" formation_radius=\"1.5\" "
-         "formation_center=\"0 0 2.5\" offset=\"0 0 1\" start_time=\"0.3\"/></swarm>"
-         "<swarm type=\"box\" name=\"box{i}\" count=\"12\" layout=\"random\" min=\"4 -0.3 0.2\" max=\"4.6 0.3 2.5\" "
-         "min_distance=\"0.3\"/>" +
-         (log.empty() ? std::string() : "<extension name=\"log\" plugin=\"csv_logger\" file=\"" + log + "\" rate_hz=\"20\"/>") +
-         "</scene>";
-}
-
-Scene load(int threads, const std::string& log = "", const std::string& engine = "ode") {
-  return loadSceneFromString(sceneXml(threads, log, engine), "state.xml", kArtifacts);
-}
 
 std::vector<std::uint64_t> hashes(Environment& env, int steps, std::size_t* contacts = nullptr) {
   std::vector<std::uint64_t> out;
@@ -66,7 +46,7 @@ TEST_CASE("a restored world continues bitwise as the uninterrupted run, on 1, 2 
           "[state]") {
   const std::string engine = GENERATE("ode", "bullet");
   INFO(engine);
-  Scene original = load(1, "", engine);
+  Scene original = loadStateScene(1, "", engine);
   Environment& env = *original.environment;
   env.step(300);
   const std::vector<std::byte> saved = env.saveState();
@@ -76,7 +56,7 @@ TEST_CASE("a restored world continues bitwise as the uninterrupted run, on 1, 2 
 
   for (int threads : {1, 2, 4}) {
     INFO(threads << " thread(s), a freshly loaded scene");
-    Scene fresh = load(threads, "", engine);
+    Scene fresh = loadStateScene(threads, "", engine);
     fresh.environment->restoreState(saved);
     CHECK(fresh.environment->stepCount() == 300);
     CHECK(hashes(*fresh.environment, 300) == reference);
@@ -93,7 +73,7 @@ TEST_CASE("ssx run --save-state and --load-state continue a run in another proce
   const fs::path dir = fs::current_path() / "state_cli";
   fs::create_directories(dir);
   const fs::path scene = dir / "scene.xml";
-  std::ofstream(scene) << sceneXml(2, (dir / "poses.csv").string());
+  std::ofstream(scene) << stateSceneXml(2, (dir / "poses.csv").string());
   const std::string sceneArg = "run " + scene.string() + " --fast --quiet ";
 
   REQUIRE(runCli(sceneArg + "--steps 400 --save-state " + (dir / "whole.bin").string()) == 0);

@@ -2,6 +2,7 @@
 #include <ssx/ssx.hpp>
 
 #include "scene_util.hpp"
+#include "state_scene.hpp"
 #include "test_util.hpp"
 
 #include <catch2/catch.hpp>
@@ -11,35 +12,11 @@
 
 using namespace ssx;
 
-namespace {
-
 using ssx::test::kArtifacts;
-
-// quadrotors with noisy IMUs take off from the ground and fly the formation around a pillar,
-// while boxes fall on the ground and on each other: contacts, noise, neighbours, obstacles
-std::string sceneXml(int threads, const std::string& log = "", const std::string& engine = "ode") {
-  return "<scene><environment timestep=\"0.002\" seed=\"11\" threads=\"" + std::to_string(threads) +
-         "\"/><physics engine=\"" + engine + "\"/>"
-         "<type name=\"quad\" file=\"" + (kArtifacts / "mk_quad_formation.xml").string() +
-         "\"/><type name=\"box\" file=\"" + (kArtifacts / "box.xml").string() + "\"/><ground/>"
-         "<obstacle name=\"pillar\" xyz=\"2.5 0 2\"><cylinder radius=\"0.25\" length=\"4\"/></obstacle>"
-         "<swarm type=\"quad\" count=\"12\" layout=\"random\" min=\"-2 -2 0.05\" max=\"2 2 0.05\" "
-         "min_distance=\"1.0\"><driver formation_index=\"{i}\" formation_size=\"12\" formation_radius=\"1.5\" "
-         "formation_center=\"0 0 2.5\" offset=\"0 0 1\" start_time=\"0.3\"/></swarm>"
-         "<swarm type=\"box\" name=\"box{i}\" count=\"12\" layout=\"random\" min=\"4 -0.3 0.2\" max=\"4.6 0.3 2.5\" "
-         "min_distance=\"0.3\"/>" +
-         (log.empty() ? std::string() : "<extension name=\"log\" plugin=\"csv_logger\" file=\"" + log + "\" rate_hz=\"20\"/>") +
-         "</scene>";
-}
-
-Scene load(int threads, const std::string& log = "", const std::string& engine = "ode") {
-  return loadSceneFromString(sceneXml(threads, log, engine), "state.xml", kArtifacts);
-}
-
-}  // namespace
+using ssx::test::loadStateScene;
 
 TEST_CASE("a truncated, corrupted or foreign state is refused and changes nothing", "[state]") {
-  Scene scene = load(2);
+  Scene scene = loadStateScene(2);
   Environment& env = *scene.environment;
   env.step(100);
   const std::vector<std::byte> saved = env.saveState();
@@ -60,7 +37,7 @@ TEST_CASE("a truncated, corrupted or foreign state is refused and changes nothin
   CHECK_THROWS_WITH(env.restoreState(corrupted), Catch::Contains("corrupted (checksum mismatch)"));
   CHECK_THROWS_WITH(env.restoreState(foreign), Catch::Contains("saved from a different scene"));
   // the same scene on the other engine: its physics state is another engine's
-  Scene on_bullet = load(2, "", "bullet");
+  Scene on_bullet = loadStateScene(2, "", "bullet");
   CHECK_THROWS_WITH(on_bullet.environment->restoreState(saved), Catch::Contains("physics engine"));
   CHECK_THROWS_WITH(env.restoreState(std::vector<std::byte>(10)), Catch::Contains("not an ssx saved state"));
   // nothing moved: the world is still at step 150 and goes on as it would have
