@@ -92,10 +92,29 @@ py::dict summaryDict(const ssx::TimingSummary& s) {
   return d;
 }
 
+// The library's messages go to Python's logging (logger "ssx"), from whichever thread writes them
+// (the GIL is taken for it; a step runs without it). Before Python is up or after it is gone: stderr.
+void toLogging(ssx::LogLevel level, std::string_view message) {
+  if (Py_IsInitialized() == 0 || _Py_IsFinalizing() != 0) {
+    std::fprintf(stderr, "ssx: %.*s\n", static_cast<int>(message.size()), message.data());
+    return;
+  }
+  py::gil_scoped_acquire gil;
+  try {
+    const char* method = level == ssx::LogLevel::Error ? "error" : level == ssx::LogLevel::Warning ? "warning" : "info";
+    py::module_::import("logging").attr("getLogger")("ssx").attr(method)(std::string(message));
+  } catch (py::error_already_set& e) {
+    e.discard_as_unraisable("ssx logging");
+  }
+}
+
 class PyEnvironment {
  public:
   explicit PyEnvironment(ssx::Scene scene) : scene_(std::move(scene)), env_(*scene_.environment), targets_(env_) {
     for (const ssx::Artifact* a : std::as_const(env_).selectArtifacts("*")) dynamic_.push_back(a);
+    env_.setLogSink(toLogging);
+    // what loading had to say (unknown attributes and the like), as warnings of the same logger
+    for (const auto& w : scene_.warnings) toLogging(ssx::LogLevel::Warning, w.str());
   }
 
   ssx::Environment& env() { return env_; }

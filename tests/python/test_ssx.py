@@ -1,5 +1,6 @@
 """The Python module: loading, stepping, state arrays, set-points, measurements, save and restore,
 run and Ctrl-C, the GIL. Run by ctest (python_tests) with PYTHONPATH=<build>/python."""
+import logging
 import os
 import signal
 import threading
@@ -448,3 +449,16 @@ def test_close_finishes_the_run(tmp_path):
         env.step(500)  # 1 s at 10 Hz
     rows = log.read_text().splitlines()
     assert len(rows) == 1 + 9 * 10
+
+
+def test_the_library_speaks_through_pythons_logging(caplog):
+    caplog.set_level(logging.INFO, logger="ssx")
+    # a warning of loading, and one written while stepping (the GIL released, taken again to log)
+    env = ssx.load_scene_string('<scene><environment timestep="0.002" colour="red"/>'
+                                '<render engine="null"><camera name="c"/></render>'
+                                '<type name="b" file="box.xml"/><artifact name="b" type="b"/></scene>',
+                                ssx.data_directory() / "artifacts")
+    env.step(5)
+    messages = [(r.name, r.levelname, r.getMessage()) for r in caplog.records]
+    assert ("ssx", "WARNING", "<string>:1: warning: unknown attribute 'colour' of <environment> (ignored)") in messages
+    assert any(n == "ssx" and "draws no pixels: camera 'c' gets no frames" in m for n, _, m in messages)
