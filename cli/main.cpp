@@ -216,7 +216,22 @@ int commandRun(const RunArgs& args, bool realtime_given) {
   }
   run.stop = &g_stop;
   Progress progress(!args.quiet && isatty(STDERR_FILENO) == 1, run.steps);
-  run.on_step = [&progress](const ssx::Environment& e) { progress.update(e); };
+  // what happens to the robots, sampled every 10th step; a robot that crashes is said at once
+  ssx::FlightRecorder flights;
+  std::int64_t crashes_said = 0;
+  run.on_step = [&progress, &flights, &crashes_said](const ssx::Environment& e) {
+    progress.update(e);
+    if (e.stepCount() % 10 != 0) return;
+    flights.observe(e);
+    const ssx::FlightSummary now = flights.summary();
+    if (now.crashed > crashes_said) {
+      progress.finish();
+      std::cerr << "ssx: warning: t = " << ssx::toSeconds(e.time()) << " s: " << now.crashed
+                << " robot(s) tilted over (crashed): " << (now.crashed_names.empty() ? "" : now.crashed_names.back())
+                << (now.crashed > 1 ? " and others" : "") << '\n';
+    }
+    crashes_said = now.crashed;
+  };
 
   std::signal(SIGINT, onSignal);
   std::signal(SIGTERM, onSignal);
@@ -265,6 +280,7 @@ int commandRun(const RunArgs& args, bool realtime_given) {
     }
   }
   const std::vector<ssx::CameraSpec> cameras = env.cameras();
+  if (env.state() == ssx::Environment::State::Running) flights.observe(env);  // the end states
   // stop cleanly: plugins destroyed, engines stopped, extensions shut down (files closed)
   try {
     env.stop();
@@ -273,7 +289,7 @@ int commandRun(const RunArgs& args, bool realtime_given) {
     status = kExitRunFailure;
   }
   if (status == 0) {
-    if (!args.quiet) std::cout << summary.str() << '\n';
+    if (!args.quiet) std::cout << summary.str() << '\n' << flights.summary().str() << '\n';
   }
   // where the pictures went
   if (!args.quiet && env.frameCount() > 0) {

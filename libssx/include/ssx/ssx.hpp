@@ -10,6 +10,7 @@
 #include <ssx/error.hpp>
 #include <ssx/hash.hpp>
 #include <ssx/export.hpp>
+#include <ssx/flight_summary.hpp>
 #include <ssx/measurements.hpp>
 #include <ssx/metrics.hpp>
 #include <ssx/physic_engine.hpp>

@@ -1,0 +1,82 @@
+// The flight summary: end states (airborne, landed, crashed), touches between robots counted once
+// per touch with the first one's time and pair, the closest approach and the distance flown.
+#include <ssx/ssx.hpp>
+
+#include "test_util.hpp"
+
+#include <catch2/catch.hpp>
+
+#include <numbers>
+
+using namespace ssx;
+using ssx::test::at;
+using ssx::test::boxBody;
+
+namespace {
+
+Artifact& addBox(Environment& env, const std::string& name, const Pose& pose) {
+  Artifact& a = env.addArtifact(name, pose);
+  a.addPhysicRoot(boxBody(Vec3(0.2, 0.2, 0.2), 1.0));  // reach: half the diagonal, 0.173 m
+  return a;
+}
+
+}  // namespace
+
+TEST_CASE("flight summary: a box on its side crashed, one resting on the ground landed, one high up flies",
+          "[flight_summary]") {
+  Environment env;
+  env.addGround();
+  addBox(env, "resting", at(0, 0, 0.1));
+  addBox(env, "tipped", {Vec3(3, 0, 0.1), Quat(Eigen::AngleAxisd(std::numbers::pi / 2, Vec3::UnitX()))});
+  Artifact& high = addBox(env, "high", at(6, 0, 5));
+  high.setDriver(std::make_unique<test::LambdaDriver>([](Driver& d, const StepInfo&) {
+    d.artifact().root().addForce(Vec3(0, 0, 9.81));  // weightless: it stays up
+  }));
+  FlightRecorder recorder;
+  for (int k = 0; k < 100; ++k) {
+    env.step(10);
+    recorder.observe(env);
+  }
+  const FlightSummary s = recorder.summary();
+  CHECK(s.robots == 3);
+  CHECK(s.landed == 1);
+  CHECK(s.crashed == 1);
+  CHECK(s.airborne == 1);
+  CHECK(s.crashed_names == std::vector<std::string>{"tipped"});
+  CHECK(s.collisions == 0);
+  CHECK(s.closest_approach_m == Approx(3.0).margin(0.01));
+  CHECK(s.samples == 100);
+  CHECK_THAT(s.str(), Catch::StartsWith("robots 3: airborne 1, landed 1, crashed 1 (tipped); collisions 0; closest "
+                                        "approach 3.00 m (resting and tipped)"));
+}
+
+TEST_CASE("flight summary: robots that come within reach of each other touch, once per touch", "[flight_summary]") {
+  EnvironmentSettings settings;
+  settings.physics.gravity = Vec3::Zero();
+  Environment env(settings);
+  // two boxes moving towards each other at 1 m/s each, from 2 m apart: they meet after about 0.83 s
+  Artifact& a = addBox(env, "a", at(-1, 0, 1));
+  Artifact& b = addBox(env, "b", at(1, 0, 1));
+  addBox(env, "far", at(0, 50, 1));
+  env.step();
+  BodyState s = a.root().state();
+  s.linear_velocity = Vec3(1, 0, 0);
+  env.setBodyState(a.root().bodyIndex(), s);
+  s = b.root().state();
+  s.linear_velocity = Vec3(-1, 0, 0);
+  env.setBodyState(b.root().bodyIndex(), s);
+  FlightRecorder recorder;
+  for (int k = 0; k < 200; ++k) {
+    env.step(10);  // 0.01 s with the default 1 ms step
+    recorder.observe(env);
+  }
+  const FlightSummary f = recorder.summary();
+  CHECK(f.collisions == 1);
+  CHECK(f.first_collision_pair == "a and b");
+  // they touch when the centres are 0.346 m apart: after (2 - 0.346) / 2 s = 0.827 s
+  CHECK(f.first_collision_s == Approx(0.83).margin(0.02));
+  CHECK(f.closest_approach_m < 0.25);
+  CHECK(f.closest_pair == "a and b");
+  CHECK(f.mean_distance_flown_m > 0.5);
+  CHECK_THAT(f.str(), Catch::Contains("collisions 1, first at 0.8") && Catch::Contains("(a and b)"));
+}
