@@ -134,7 +134,14 @@ class PyEnvironment {
       const std::int64_t k = std::min(kSlice, n - done);
       {
         py::gil_scoped_release release;
-        env_.step(k);
+        // the flight summary looks every 10th step, as ssx run's does (looking changes no bit)
+        for (std::int64_t left = k; left > 0;) {
+          const std::int64_t to_tenth = 10 - env_.stepCount() % 10;
+          const std::int64_t now = std::min(left, to_tenth);
+          env_.step(now);
+          left -= now;
+          if (env_.stepCount() % 10 == 0) flights_.observe(env_);
+        }
       }
       done += k;
       if (done < n && PyErr_CheckSignals() != 0) throw py::error_already_set();
@@ -158,6 +165,51 @@ class PyEnvironment {
     for (std::size_t i = 0; i < env_.artifactCount(); ++i) names.push_back(std::as_const(env_).artifact(i).name());
     return names;
   }
+  // what happened to the robots so far (FlightRecorder, every 10th step), as a dict
+  py::dict flightSummary() {
+    InUse use(busy_);
+    ssx::FlightRecorder now = flights_;
+    if (env_.state() == ssx::Environment::State::Running) now.observe(env_);  // the end states as of now
+    const ssx::FlightSummary s = now.summary();
+    py::dict d;
+    d["robots"] = s.robots;
+    d["airborne"] = s.airborne;
+    d["landed"] = s.landed;
+    d["crashed"] = s.crashed;
+    d["crashed_names"] = s.crashed_names;
+    d["collisions"] = s.collisions;
+    d["first_collision_s"] = s.first_collision_s >= 0 ? py::object(py::float_(s.first_collision_s)) : py::object(py::none());
+    d["first_collision_pair"] = s.first_collision_pair;
+    d["closest_approach_m"] = s.closest_approach_m >= 0 ? py::object(py::float_(s.closest_approach_m)) : py::object(py::none());
+    d["closest_pair"] = s.closest_pair;
+    d["mean_distance_flown_m"] = s.mean_distance_flown_m;
+    d["text"] = s.str();
+    return d;
+  }
+  // every metric the plugins publish now (ssx::MetricSource), by artifact: {name: {metric: value}}
+  py::dict metrics() {
+    InUse use(busy_);
+    py::dict out;
+    std::vector<ssx::Metric> values;
+    for (std::size_t i = 0; i < env_.artifactCount(); ++i) {
+      const ssx::Artifact& a = std::as_const(env_).artifact(i);
+      const auto* source = dynamic_cast<const ssx::MetricSource*>(a.driver());
+      if (source == nullptr) continue;
+      values.clear();
+      source->metrics(values);
+      if (values.empty()) continue;
+      py::dict m;
+      for (const auto& v : values) m[py::str(v.name)] = v.value;
+      out[py::str(a.name())] = m;
+    }
+    return out;
+  }
+  // contact points the physics engine found in the last step
+  std::size_t contacts() {
+    InUse use(busy_);
+    return env_.state() == ssx::Environment::State::Running ? env_.physics().contactCount() : 0;
+  }
+
   // (fixed from loading on, as setpointNames, timestep, duration and seed: readable at any time)
   std::vector<std::string> dynamicNames() const {
     std::vector<std::string> names;
@@ -386,6 +438,7 @@ class PyEnvironment {
   std::vector<const ssx::Artifact*> dynamic_;
   ssx_python::CommandTargets targets_;
   mutable std::atomic<bool> busy_{false};  // (reads guard it too: InUse)
+  ssx::FlightRecorder flights_;
 };
 
 ssx::SceneOptions sceneOptions(std::optional<std::uint64_t> seed, std::optional<int> threads,
@@ -478,6 +531,13 @@ PYBIND11_MODULE(_ssx, m) {
            "The latest pose measurement of an artifact, as a dict.")
       .def("range", &PyEnvironment::range, py::arg("artifact"), py::arg("sensor") = py::none(),
            "The latest range measurement of an artifact: detections as arrays, nearest first.")
+      .def("flight_summary", &PyEnvironment::flightSummary,
+           "What happened to the robots so far (every 10th step): airborne, landed, crashed, collisions between "
+           "robots (count, first time and pair), closest approach, mean distance flown; 'text' says it in a line.")
+      .def("metrics", &PyEnvironment::metrics,
+           "Every metric the drivers publish now (ssx::MetricSource, e.g. the formation's formation_error), as "
+           "{artifact: {metric: value}}.")
+      .def("contacts", &PyEnvironment::contacts, "Contact points the physics engine found in the last step.")
       .def("save_state", &PyEnvironment::saveState, "Everything that determines the future, as bytes.")
       .def("restore_state", &PyEnvironment::restoreState, py::arg("state"),
            "Continues from save_state() bytes: the next steps are bitwise those of the saving run.")

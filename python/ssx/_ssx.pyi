@@ -71,6 +71,12 @@ class Environment:
         """The latest pose measurement of an artifact, as a dict."""
     def range(self, artifact: str, sensor: Optional[int] = None) -> Dict[str, Any]:
         """The latest range measurement of an artifact: detections as arrays, nearest first."""
+    def flight_summary(self) -> Dict[str, Any]:
+        """What happened to the robots so far: airborne, landed, crashed, collisions, closest approach, distance flown."""
+    def metrics(self) -> Dict[str, Dict[str, float]]:
+        """Every metric the drivers publish now, as {artifact: {metric: value}}."""
+    def contacts(self) -> int:
+        """Contact points the physics engine found in the last step."""
     def save_state(self) -> bytes:
         """Everything that determines the future."""
     def restore_state(self, state: bytes) -> None:

@@ -462,3 +462,26 @@ def test_the_library_speaks_through_pythons_logging(caplog):
     messages = [(r.name, r.levelname, r.getMessage()) for r in caplog.records]
     assert ("ssx", "WARNING", "<string>:1: warning: unknown attribute 'colour' of <environment> (ignored)") in messages
     assert any(n == "ssx" and "draws no pixels: camera 'c' gets no frames" in m for n, _, m in messages)
+
+
+def test_flight_summary_metrics_and_contacts_say_what_happened_to_the_robots():
+    env = ssx.load_scene(ssx.data_directory() / "scenes" / "quad_hover.xml")
+    assert env.contacts() == 0  # not started
+    env.step(2500)  # 5 s: they took off and hover 1 m up
+    s = env.flight_summary()
+    assert (s["robots"], s["airborne"], s["landed"], s["crashed"], s["collisions"]) == (3, 3, 0, 0, 0)
+    assert s["first_collision_s"] is None
+    assert abs(s["closest_approach_m"] - 1.5) < 0.05 and s["closest_pair"] in ("mk and hb", "hb and cf")
+    assert 0.9 < s["mean_distance_flown_m"] < 1.5
+    assert s["text"].startswith("robots 3: airborne 3, landed 0, crashed 0; collisions 0")
+    assert env.contacts() == 0  # none touches anything in the air
+    box = ssx.load_scene_string('<scene><ground/><type name="b" file="box.xml"/><artifact name="b" type="b" xyz="0 0 0.5"/>'
+                                '</scene>', ssx.data_directory() / "artifacts")
+    box.step(2000)  # fallen and resting on the ground
+    assert box.contacts() > 0
+    # a formation publishes its error per member; hovering quadrotors publish nothing
+    assert env.metrics() == {}
+    formation = ssx.load_scene(ssx.data_directory() / "scenes" / "formation_sphere.xml", threads=1)
+    formation.step(500)
+    m = formation.metrics()
+    assert len(m) == 70 and all(set(v) == {"formation_error"} for v in m.values())
