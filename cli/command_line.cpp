@@ -61,6 +61,9 @@ CommandLine parseCommandLine(int argc, const char* const* argv, std::ostream& ou
   run_cmd->add_option("--load-state", c.run.load_state,
                       "continue from a state saved from this scene (--steps and --duration count from there)")
       ->check(CLI::ExistingFile);
+  run_cmd->add_option("--out", c.run.out,
+                      "directory for the scene's own outputs (its loggers' files, its cameras' pictures) given as "
+                      "relative paths (default: ssx-out/SCENE/; --out . for the working directory)");
   addMaxInputOption(run_cmd, c.run.max_input_mb);
 
   CLI::App* validate_cmd = app.add_subcommand("validate", "check a scene and its plugins; run nothing");

@@ -26,6 +26,7 @@ struct RunArgs {
   double max_input_mb = kDefaultMaxInputMb;
   std::string render, physics, snapshot, video, frames;
   std::string save_state, load_state;
+  std::string out;  // the scene's own outputs (empty: ssx-out/<scene>/)
   bool allow_special_outputs = false;
   bool duration_given = false;
   int rt_priority = 0;

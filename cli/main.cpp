@@ -166,6 +166,9 @@ int commandRun(const RunArgs& args, bool realtime_given) {
   options.frames_dir = args.frames;
   options.allow_special_outputs = args.allow_special_outputs;
   options.max_input_bytes = maxInputBytes(args.max_input_mb);
+  // the scene's own outputs into a directory of this run, never the working directory unasked
+  const fs::path out_dir = args.out.empty() ? fs::path("ssx-out") / fs::path(args.scene).stem() : fs::path(args.out);
+  options.output_directory = out_dir;
   // settings of this process for drawing with Mesa's llvmpipe (the library leaves the process
   // alone; a program that embeds it chooses these itself, see docs/library.md, Rendering):
   // - llvmpipe's own rasteriser threads cost more than they give at these image sizes and would
@@ -245,6 +248,20 @@ int commandRun(const RunArgs& args, bool realtime_given) {
       env.checkState(loaded);
     } catch (const std::exception& e) {
       std::cerr << "ssx: error: --load-state " << args.load_state << ": " << e.what() << '\n';
+      return kExitBadInput;
+    }
+  }
+  // every check passed: the output directory may be made now (when anything goes into it)
+  const bool writes_into_out = std::any_of(scene.files.outputs().begin(), scene.files.outputs().end(),
+                                           [&out_dir](const fs::path& p) {
+                                             const auto rel = p.lexically_relative(out_dir);
+                                             return !rel.empty() && *rel.begin() != "..";
+                                           });
+  if (writes_into_out) {
+    std::error_code ec;
+    fs::create_directories(out_dir, ec);
+    if (ec) {
+      std::cerr << "ssx: error: --out " << out_dir.string() << ": cannot make the directory: " << ec.message() << '\n';
       return kExitBadInput;
     }
   }

@@ -20,7 +20,8 @@ class CsvLogger final : public SimulationExtension {
  public:
   static constexpr const char* kDoc = "writes poses and velocities of chosen artifacts to a CSV file";
   static constexpr ssx_plugin_param kParameters[] = {
-      param::required(param::output("file", "", "path of the CSV file (relative: to the working directory)")),
+      param::required(param::output(
+          "file", "", "path of the CSV file (relative: in the run's output directory, ssx run --out; else the working directory)")),
       param::text("artifacts", "*", "artifact names separated by spaces, or * for every artifact with a dynamic root"),
       param::real("rate_hz", "0", "Hz", param::nonNegative(),
                   "rows per artifact per simulated second; 0 writes one every step"),

@@ -37,7 +37,7 @@ if(NOT last_output MATCHES "steps 2400, simulated 12.000 s")
   message(FATAL_ERROR "the orbit scene did not run its 12 s")
 endif()
 # the logger wrote 20 rows a second for each of the three orbiters, and closed the file
-file(STRINGS ${WORK_DIR}/orbit_poses.csv rows)
+file(STRINGS ${WORK_DIR}/ssx-out/orbit_scene/orbit_poses.csv rows)
 list(LENGTH rows n)
 if(NOT n EQUAL 721)
   message(FATAL_ERROR "orbit_poses.csv has ${n} lines, expected 1 + 3 * 20 * 12 = 721")

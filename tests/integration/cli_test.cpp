@@ -190,6 +190,25 @@ TEST_CASE("ssx validate lists a scene's problems by line, whatever order they we
   CHECK_THAT(r.err, Contains("2 error(s); nothing was run"));
 }
 
+TEST_CASE("ssx run: a scene's own outputs go into ssx-out/<scene>/ or --out DIR, never the working directory unasked",
+          "[cli]") {
+  const std::string logged = (kExamples / "scenes" / "hover_swarm.xml").string();  // a logger, file="hover_swarm_poses.csv"
+  fs::remove_all("ssx-out");
+  fs::remove_all("chosen");
+  fs::remove("hover_swarm_poses.csv");
+  REQUIRE(run({"run", logged, "--steps", "50", "--fast", "--quiet"}).status == 0);
+  CHECK(fs::is_regular_file("ssx-out/hover_swarm/hover_swarm_poses.csv"));
+  REQUIRE(run({"run", logged, "--steps", "50", "--fast", "--quiet", "--out", "chosen"}).status == 0);
+  CHECK(fs::is_regular_file("chosen/hover_swarm_poses.csv"));
+  CHECK_FALSE(fs::exists("hover_swarm_poses.csv"));
+  // a scene that writes nothing makes no directory; the command's own outputs stay where they are named
+  const std::string quiet_scene = (kExamples / "scenes" / "quad_hover.xml").string();
+  fs::remove("own.png");
+  REQUIRE(run({"run", quiet_scene, "--steps", "20", "--fast", "--quiet", "--snapshot", "own.png"}).status == 0);
+  CHECK(fs::is_regular_file("own.png"));
+  CHECK_FALSE(fs::exists("ssx-out/quad_hover"));
+}
+
 TEST_CASE("ssx validate --print: the scene with every default, which validates and prints the same again", "[cli]") {
   const Result printed = run({"validate", (kExamples / "scenes" / "hover_swarm.xml").string(), "--print"});
   REQUIRE(printed.status == 0);
@@ -324,6 +343,7 @@ TEST_CASE("ssx plugins survives a library that crashes while loading, and lists 
 
 TEST_CASE("Ctrl-C stops a real-time run cleanly: summary printed, files closed", "[cli]") {
   fs::remove("hover_swarm_poses.csv");
+  fs::remove_all("ssx-out");
   bool sent = false;
   const Result r = run({"run", (kExamples / "scenes" / "hover_swarm.xml").string(), "--duration", "1000"}, {},
                        [&sent](pid_t pid, const std::string& err) {
@@ -337,8 +357,10 @@ TEST_CASE("Ctrl-C stops a real-time run cleanly: summary printed, files closed",
   CHECK(r.status == 130);  // 128 + SIGINT, as a shell reports it
   CHECK_THAT(r.err, Contains("ssx: interrupted at t = "));
   CHECK_THAT(r.out, Contains("step time ms"));
-  // the logger's file was flushed and closed by its shutdown: complete lines only
-  std::ifstream csv("hover_swarm_poses.csv");
+  // the logger's file, in the run's output directory (not the working directory), was flushed and
+  // closed by its shutdown: complete lines only
+  CHECK_FALSE(fs::exists("hover_swarm_poses.csv"));
+  std::ifstream csv("ssx-out/hover_swarm/hover_swarm_poses.csv");
   std::string content((std::istreambuf_iterator<char>(csv)), std::istreambuf_iterator<char>());
   REQUIRE_FALSE(content.empty());
   CHECK(content.back() == '\n');

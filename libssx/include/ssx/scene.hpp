@@ -74,6 +74,11 @@ struct SceneOptions {
   /// (0: this machine's physical memory). A swarm beyond it is an error at its line, not an abort
   /// when memory runs out.
   std::uintmax_t max_memory_bytes = 0;
+  /// Where the scene's own outputs go when their paths are relative (a logger's file, a scene
+  /// camera's snapshot, video or frames): empty, the working directory; `ssx run` gives
+  /// `ssx-out/<scene>/` unless told `--out DIR`. The directory itself is the program's to make, after
+  /// loading succeeded (the outputs are checked as in a directory about to be made).
+  std::filesystem::path output_directory;
 };
 
 /// A loaded scene: an environment ready to start, and how the file asks to run it.

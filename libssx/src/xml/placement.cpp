@@ -57,8 +57,18 @@ void SceneLoader::checkPlugin(Environment& env, const void* instance, Descriptor
       if ((p.flags & SSX_PARAM_OUTPUT) == 0) continue;
       const auto* a = params.find(p.name);
       if (a == nullptr || a->value.empty()) continue;
-      if (auto problem = files_.claimOutput(a->value, "parameter '" + std::string(p.name) + "'"); !problem.empty())
-        found.push_back({Diagnostic::Severity::Error, a->where, "<" + params.name() + ">: " + what + ": " + problem});
+      const SourceLocation where = a->where;
+      std::string file = a->value;
+      const bool moved = !options_.output_directory.empty() && fs::path(file).is_relative();
+      // (the program makes the output directory after loading; deeper directories must exist)
+      const bool in_made_directory = moved && fs::path(file).parent_path().empty();
+      if (moved) {
+        // into the run's output directory: the plugin opens it there
+        file = (options_.output_directory / file).string();
+        params.set(p.name, file, where);
+      }
+      if (auto problem = files_.claimOutput(file, "parameter '" + std::string(p.name) + "'", false, in_made_directory); !problem.empty())
+        found.push_back({Diagnostic::Severity::Error, where, "<" + params.name() + ">: " + what + ": " + problem});
     }
   for (auto& d : found) add(std::move(d));
   // unknown parameters were reported just now: not again when the environment starts

@@ -327,7 +327,11 @@ void SceneLoader::readRender(const Descriptor& d) {
     cam.frames_dir = read<std::string>(*c, "frames", "");
     cam.video = read<std::string>(*c, "video", "");
     cam.snapshot = read<std::string>(*c, "snapshot", "");
+    // (relative outputs go into the run's output directory, when it has one: see below)
     checkUnknown(*c);
+    if (!options_.output_directory.empty())
+      for (fs::path* out : {&cam.snapshot, &cam.video, &cam.frames_dir})
+        if (!out->empty() && out->is_relative()) *out = options_.output_directory / *out;
     noteSettings(*c, "render/camera[name=" + cam.name + "]");
     r.cameras.push_back(std::move(cam));
   }
