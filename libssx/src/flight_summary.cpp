@@ -69,8 +69,11 @@ void FlightRecorder::observe(const Environment& env) {
     ids.push_back(k);
     largest = std::max(largest, r.radius);
   }
-  // pairs near each other: the closest approach, and touches (a pair that was not touching at the last sample)
-  const double search = std::max(kSearch, 2 * largest);
+  // pairs near each other: the closest approach, and touches (a pair that was not touching at the last
+  // sample). A pair closer than the closest so far is within that distance: after the first sample
+  // the search shrinks to it (or to what a touch needs)
+  const double closest = summary_.closest_approach_m;
+  const double search = std::max(closest >= 0 ? std::min(kSearch, closest) : kSearch, 2 * largest);
   SpatialIndex index(search);
   index.rebuild(points, ids);
   std::vector<std::pair<std::size_t, std::size_t>> touching;
