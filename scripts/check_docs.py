@@ -8,6 +8,8 @@ Each fenced block is preceded by a marker line `<!-- doc-test: KIND -->`:
   run            sh: each command runs (bash -e); python: the block runs; cpp: compiled against the
                  build and run. All in WORK_DIR, where build/, examples/ and tests/ are links to the
                  tree, so outputs land there and never in the repository.
+  run, prints: RE  as run, and what it prints matches the regular expression RE (a figure the text
+                 beside the block quotes)
   output         the block is `$ COMMAND` and then exactly what the command prints (stdout and
                  stderr), run as for `run`
   validate       an XML scene: `ssx validate` accepts it
@@ -111,15 +113,19 @@ class Checker:
                 self.error(where, "a code block without a <!-- doc-test: ... --> line before it (run, output, "
                                   "validate, validate-sweep, fragment, compile, same as PATH, or not run: WHY)")
                 continue
-            if marker == "run":
+            if marker == "run" or marker.startswith("run, prints: "):
+                expected = marker[len("run, prints: "):] if marker != "run" else None
+                r = None
                 if lang == "sh":
-                    self.run(["bash", "-e", "-c", text], where)
+                    r = self.run(["bash", "-e", "-c", text], where)
                 elif lang == "python":
-                    self.run(["/usr/bin/python3", "-c", text], where)
+                    r = self.run(["/usr/bin/python3", "-c", text], where)
                 elif lang == "cpp":
                     self.cpp(text, where, link=True)
                 else:
                     self.error(where, f"'run' takes sh, python or cpp blocks, not '{lang}'")
+                if expected is not None and (r is None or not re.search(expected, r.stdout)):
+                    self.error(where, f"prints no match for '{expected}':\n{r.stdout if r else ''}")
             elif marker == "output":
                 first, _, expected = text.partition("\n")
                 if not first.startswith("$ "):
