@@ -6,6 +6,7 @@
 
 #include <sys/stat.h>
 
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 
@@ -14,10 +15,14 @@ namespace fs = std::filesystem;
 
 namespace {
 
+// a directory of this test's own: ctest runs the cases in parallel processes, and a fixed name had
+// one case remove the directory another was using
 struct Dir {
-  fs::path path = fs::temp_directory_path() / "ssx_run_files_test";
+  fs::path path;
   Dir() {
-    fs::remove_all(path);
+    std::string pattern = (fs::temp_directory_path() / "ssx_run_files_XXXXXX").string();
+    REQUIRE(mkdtemp(pattern.data()) != nullptr);
+    path = pattern;
     fs::create_directories(path / "sub");
   }
   ~Dir() { fs::remove_all(path); }
