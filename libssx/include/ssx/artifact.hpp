@@ -36,6 +36,7 @@ class SSX_EXPORT Artifact {
   Artifact& operator=(const Artifact&) = delete;
   ~Artifact();
 
+  /// The artifact's name, unique in its environment (the scene's `name`, or a swarm's member name).
   const std::string& name() const noexcept { return name_; }
   /// Position in the environment's artifact list; streams and orders derive from it.
   std::size_t index() const noexcept { return index_; }
@@ -64,16 +65,23 @@ class SSX_EXPORT Artifact {
   /// Same, for instances owned elsewhere (by the environment's ClassLoader); they must outlive
   /// the environment's run.
   Driver& setDriver(Driver& driver, Descriptor params, std::int64_t period_steps, std::string class_name);
+  /// Adds a sensor owned elsewhere (by the environment's ClassLoader); it must outlive the
+  /// environment's run. Returns it.
   Sensor& addSensor(Sensor& sensor, Descriptor params, std::int64_t period_steps, std::string class_name);
 
   // --- access -------------------------------------------------------------------------------
   // Through a const Artifact (what plugins see of other artifacts, and sensors of their own)
   // nodes, driver and sensors are const: reading the state, not writing commands.
 
+  /// The driver, or nullptr when the artifact has none (a passive body).
   Driver* driver() noexcept;
+  /// @copydoc driver()
   const Driver* driver() const noexcept;
+  /// How many sensors the artifact has.
   std::size_t sensorCount() const noexcept;
+  /// Sensor i, in the order added (0 <= i < sensorCount(); std::out_of_range otherwise).
   Sensor& sensor(std::size_t i);
+  /// @copydoc sensor(std::size_t)
   const Sensor& sensor(std::size_t i) const;
   /// The parameters the driver is (or will be) configured with.
   const Descriptor& driverParameters() const noexcept;
@@ -86,6 +94,7 @@ class SSX_EXPORT Artifact {
       if (auto* t = dynamic_cast<T*>(&sensor(i))) return t;
     return nullptr;
   }
+  /// @copydoc findSensor()
   template <class T>
   const T* findSensor() const {
     for (std::size_t i = 0; i < sensorCount(); ++i)
@@ -93,27 +102,35 @@ class SSX_EXPORT Artifact {
     return nullptr;
   }
 
+  /// How many physic node trees the artifact has.
   std::size_t rootCount() const noexcept { return roots_.size(); }
+  /// The root node of tree i, in the order added (std::out_of_range when there is none).
   PhysicNode& root(std::size_t i = 0) { return i == 0 && first_root_ != nullptr ? *first_root_ : *roots_.at(i); }
+  /// @copydoc root(std::size_t)
   const PhysicNode& root(std::size_t i = 0) const {
     return i == 0 && first_root_ != nullptr ? *first_root_ : *roots_.at(i);
   }
   /// Node by name, searching every tree; nullptr if none.
   PhysicNode* node(std::string_view name);
+  /// @copydoc node(std::string_view)
   const PhysicNode* node(std::string_view name) const;
   /// The node a plugin parameter names (`key`, default "node"), or the first root when the parameter
   /// is absent or empty; throws the parameter's ConfigError when there is no such node.
   PhysicNode& nodeFromParameter(const Descriptor& params, std::string_view key = "node");
+  /// @copydoc nodeFromParameter(const Descriptor&, std::string_view)
   const PhysicNode& nodeFromParameter(const Descriptor& params, std::string_view key = "node") const;
   /// Every node of every tree, trees in order (node i of nodeCount()).
   std::size_t nodeCount() const noexcept { return nodes_.size(); }
+  /// Node i of every tree's nodes, parents before children (std::out_of_range past nodeCount()).
   PhysicNode& nodeAt(std::size_t i) { return *nodes_.at(i); }
+  /// @copydoc nodeAt(std::size_t)
   const PhysicNode& nodeAt(std::size_t i) const { return *nodes_.at(i); }
   /// The render node trees, in the order added (trees of a swarm's type are shared by its members).
   const std::vector<std::shared_ptr<const RenderNodeSpec>>& renderRoots() const noexcept { return render_roots_; }
 
   /// State of the first root node (world frame). Requires a physic root.
   BodyState state() const { return root().state(); }
+  /// Pose of the first root node (world frame). Requires a physic root.
   Pose pose() const { return root().pose(); }
 
  private:

@@ -19,6 +19,7 @@ extern "C" struct ssx_plugin_class;
 
 namespace ssx {
 
+/// What a plugin class is: a robot's driver, a sensor, or a simulation extension.
 enum class PluginKind : std::uint8_t { Driver, Sensor, Extension };
 /// "driver", "sensor" or "extension".
 SSX_EXPORT const char* toString(PluginKind kind);
@@ -32,17 +33,18 @@ class SSX_EXPORT PluginError : public Error {
 
 /// What a plugin library holds, as read from its manifest.
 struct PluginLibraryInfo {
-  std::filesystem::path path;
+  std::filesystem::path path;  ///< the library file
   bool ok = false;        ///< passes every check
   std::string problem;    ///< why not, when !ok
   std::string build_tag;  ///< as the library reports it
+  /// One class the library offers.
   struct Class {
-    PluginKind kind;
-    std::string name;
+    PluginKind kind;              ///< driver, sensor or extension
+    std::string name;             ///< its class name, as a scene names it (`class="..."`)
     std::string doc;              ///< one line on what it is ("" if the plugin gives none)
     std::string parameter_table;  ///< its declared parameters as a Markdown table (parameterTable)
   };
-  std::vector<Class> classes;
+  std::vector<Class> classes;  ///< in the manifest's order
 };
 
 /// Loads plugin libraries with dlopen(RTLD_NOW | RTLD_LOCAL) and checks their manifest (ABI
@@ -73,6 +75,7 @@ class SSX_EXPORT ClassLoader {
 
   /// Appends a directory to the search path (searched in the order added).
   void addSearchDirectory(std::filesystem::path dir);
+  /// The directories searched for plugin libraries, in order.
   const std::vector<std::filesystem::path>& searchPath() const noexcept { return search_path_; }
   /// The plugin directory of this libssx installation (`<libdir>/ssx/plugins`, found beside the
   /// loaded libssx itself, so it works in a build tree and after install).
@@ -84,7 +87,9 @@ class SSX_EXPORT ClassLoader {
   /// Creates an instance of `class_name` from `plugin`, of the given kind. The loader owns it.
   /// Throws PluginError (unknown class, class of another kind, constructor threw or returned null).
   Driver& createDriver(std::string_view plugin, std::string_view class_name);
+  /// @copydoc createDriver
   Sensor& createSensor(std::string_view plugin, std::string_view class_name);
+  /// @copydoc createDriver
   SimulationExtension& createExtension(std::string_view plugin, std::string_view class_name);
   /// The manifest entry of `class_name` in `plugin` (loading the library), which must be of
   /// `kind`. Valid as long as the loader lives. Throws PluginError.

@@ -29,6 +29,8 @@
 
 namespace ssx {
 
+/// A command level, from the highest (position with feed-forward) to the lowest (rotor speeds);
+/// the table above lists each level's values.
 enum class CommandLevel : std::uint8_t { Position, Velocity, Attitude, Rates, Rotors };
 
 /// The five levels, from the highest to the lowest.
@@ -42,19 +44,25 @@ SSX_EXPORT std::optional<CommandLevel> commandLevelFromName(std::string_view nam
 
 /// One command at one level; only the fields of its level are read.
 struct SSX_EXPORT Command {
-  CommandLevel level = CommandLevel::Position;
+  CommandLevel level = CommandLevel::Position;  ///< which of the fields below are read
   Setpoint setpoint;                ///< position: where, its feed-forward and heading
   Vec3 velocity = Vec3::Zero();     ///< velocity: m/s, world frame
   double yaw_rate = 0;              ///< velocity, attitude: rad/s
-  double roll = 0, pitch = 0;       ///< attitude: rad
+  double roll = 0;                  ///< attitude: rad
+  double pitch = 0;                 ///< attitude: rad
   Vec3 body_rates = Vec3::Zero();   ///< rates: p, q, r in rad/s, body frame
   double thrust = 0;                ///< attitude, rates: collective thrust, N
   std::vector<double> rotor_speeds;  ///< rotors: rad/s, one per rotor
 
+  /// A position command: the set-point's position, feed-forward and heading.
   static Command position(const Setpoint& setpoint);
+  /// A velocity command: m/s in the world frame and a yaw rate in rad/s.
   static Command velocityYawRate(const Vec3& velocity, double yaw_rate = 0);
+  /// An attitude command: roll and pitch in rad, yaw rate in rad/s, collective thrust in N.
   static Command attitude(double roll, double pitch, double yaw_rate, double thrust);
+  /// A body-rate command: p, q, r in rad/s (body frame) and collective thrust in N.
   static Command rates(const Vec3& body_rates, double thrust);
+  /// A rotor command: each rotor's speed in rad/s, in the vehicle's rotor order.
   static Command rotors(std::vector<double> speeds);
 
   /// The numbers of values a row of this level may have: position 4, 7, 10 or 11 (a prefix of

@@ -27,36 +27,47 @@ namespace ssx {
 /// `double`, `Vec3` ("x y z").
 class SSX_EXPORT Descriptor {
  public:
+  /// One attribute: its key, its text as written, where it was written, and whether it was read.
   struct Attribute {
-    std::string key;
-    std::string value;
-    SourceLocation where;
-    mutable bool used = false;
+    std::string key;         ///< the attribute's name
+    std::string value;       ///< its text, unparsed
+    SourceLocation where;    ///< file and line it came from (empty when set by code)
+    mutable bool used = false;  ///< read by a getter (unread ones are reported as unknown)
   };
 
   Descriptor() = default;
+  /// An empty node named `name` (an element name such as "driver"), from `where`.
   explicit Descriptor(std::string name, SourceLocation where = {});
 
+  /// The element name ("driver", "sensor", "artifact", ...).
   const std::string& name() const noexcept { return name_; }
+  /// The file and line the element came from (empty when made by code).
   const SourceLocation& where() const noexcept { return where_; }
 
   /// Sets (or replaces) an attribute; returns *this for chaining.
   Descriptor& set(std::string key, std::string value, SourceLocation where = {});
+  /// Sets an attribute to a number, written so that it reads back to the same double.
   Descriptor& set(std::string key, double value);
+  /// Sets an attribute to an integer.
   Descriptor& set(std::string key, std::int64_t value);
+  /// @copydoc set(std::string, std::int64_t)
   Descriptor& set(std::string key, int value) { return set(std::move(key), std::int64_t{value}); }
+  /// Sets an attribute to "true" or "false".
   Descriptor& set(std::string key, bool value);
+  /// Sets an attribute to a text (not a bool, which a string literal would otherwise pick).
   Descriptor& set(std::string key, const char* value) { return set(std::move(key), std::string(value)); }
+  /// Sets an attribute to a vector, written "x y z".
   Descriptor& set(std::string key, const Vec3& value);
 
-  /// Appends a child node and returns it.
   /// Removes an attribute, if there is one.
   Descriptor& erase(std::string_view key);
+  /// Appends a child node and returns it.
   Descriptor& addChild(Descriptor child);
 
   /// Declared parameters (ssx/parameters.hpp) whose defaults `get` returns for absent
   /// attributes. The declarations must outlive this descriptor (a plugin's manifest does).
   void setDeclarations(std::span<const ssx_plugin_param> declarations) noexcept { declarations_ = declarations; }
+  /// The declared parameters set by setDeclarations (empty when none).
   std::span<const ssx_plugin_param> declarations() const noexcept { return declarations_; }
 
   /// Whether the attribute was given (a declared default does not count).
@@ -79,8 +90,11 @@ class SSX_EXPORT Descriptor {
   /// Like get, and also checks `value > 0` (throws ConfigError naming the attribute).
   double getPositive(std::string_view key, double fallback) const;
 
+  /// Every attribute, in the order given.
   const std::vector<Attribute>& attributes() const noexcept { return attributes_; }
+  /// Every child node, in document order.
   const std::vector<Descriptor>& children() const noexcept { return children_; }
+  /// @copydoc children() const
   std::vector<Descriptor>& children() noexcept { return children_; }
   /// The first child with this element name, or nullptr.
   const Descriptor* child(std::string_view name) const;
@@ -110,6 +124,7 @@ class SSX_EXPORT Descriptor {
 };
 
 // explicit instantiations live in descriptor.cpp
+/// @cond
 extern template SSX_EXPORT std::string Descriptor::get<std::string>(std::string_view) const;
 extern template SSX_EXPORT bool Descriptor::get<bool>(std::string_view) const;
 extern template SSX_EXPORT int Descriptor::get<int>(std::string_view) const;
@@ -122,6 +137,7 @@ extern template SSX_EXPORT int Descriptor::get<int>(std::string_view, const int&
 extern template SSX_EXPORT std::int64_t Descriptor::get<std::int64_t>(std::string_view, const std::int64_t&) const;
 extern template SSX_EXPORT double Descriptor::get<double>(std::string_view, const double&) const;
 extern template SSX_EXPORT Vec3 Descriptor::get<Vec3>(std::string_view, const Vec3&) const;
+/// @endcond
 
 /// An XML document as a Descriptor tree (its root element), every element and attribute with the
 /// line it is on; `label` names it in messages. Throws ConfigError "label:line: error: ..." on a

@@ -56,7 +56,7 @@ class NeighborIndex;
 inline constexpr double kMaxTimestepSeconds = 1.0;    ///< one physics step
 inline constexpr double kMaxDurationSeconds = 1e9;    ///< about 31 years of simulated time
 inline constexpr double kMinRealtimeFactor = 1e-3;    ///< a thousand times slower than real time
-inline constexpr double kMaxRealtimeFactor = 1e6;
+inline constexpr double kMaxRealtimeFactor = 1e6;     ///< a million times faster than real time
 inline constexpr double kMinRateHz = 1e-6;            ///< a rate (frames, loops) that is not 0: about one per 12 days
 
 /// The scene's wind (`<wind>`): the air every robot whose driver models it flies through, each
@@ -70,31 +70,35 @@ struct WindSettings {
   double turbulence_min_airspeed = 1;  ///< m/s
 };
 
+/// What an environment is made with: its clock, seed, threads, engines and wind. Fixed once the
+/// environment exists (settings()).
 struct EnvironmentSettings {
   Nanoseconds timestep = 1'000'000;  ///< tau, ns (default 1 ms)
   std::uint64_t seed = 0;            ///< root of every random stream
   int threads = 0;                   ///< worker threads for the parallel phases; 0: one per core; 1: inline
   /// Steps whose timing is kept (timing()), in a ring allocated when the environment is made.
   std::size_t timing_samples = TimingRecorder::kDefaultCapacity;
-  PhysicsSettings physics;
-  RenderSettings render;
-  WindSettings wind;
+  PhysicsSettings physics;  ///< the physics engine and its parameters
+  RenderSettings render;    ///< the render engine, scene cameras and outputs
+  WindSettings wind;        ///< the scene's wind
 };
 
 /// How a run is paced.
 struct RunOptions {
+  /// Paced against the wall clock, or as fast as the machine goes.
   enum class Mode : std::uint8_t {
     RealTime,  ///< one timestep per timestep/realtime_factor of wall-clock time
     Fast,      ///< as fast as possible
   };
+  /// What a real-time run does after a step that finished past its deadline.
   enum class Overrun : std::uint8_t {
     CatchUp,  ///< deadlines stay on the original grid; late steps run back to back until caught up (the paper's)
     Resync,   ///< after a late step the grid restarts from now: lateness never accumulates
   };
-  Mode mode = Mode::RealTime;
+  Mode mode = Mode::RealTime;    ///< real time (default) or as fast as possible
   double realtime_factor = 1.0;  ///< > 1 runs faster than the wall clock
   std::int64_t steps = -1;       ///< stop after this many steps; -1: until `stop` is set
-  Overrun overrun = Overrun::CatchUp;
+  Overrun overrun = Overrun::CatchUp;  ///< after a late step: catch up (default) or restart the grid
   Nanoseconds spin = 0;                             ///< busy-wait this long before each deadline, for precision
   Nanoseconds warn_interval = 1'000'000'000;        ///< at most one overrun warning per this wall time
   const std::atomic<bool>* stop = nullptr;          ///< set to true (from anywhere) to end the run
@@ -111,22 +115,29 @@ struct RunOptions {
 };
 
 inline constexpr int kMinRealtimePriority = 1;   ///< RunOptions::realtime_priority, when on
-inline constexpr int kMaxRealtimePriority = 99;
+inline constexpr int kMaxRealtimePriority = 99;  ///< the highest SCHED_FIFO priority
 
 /// Why this process cannot run threads at SCHED_FIFO `priority` (1-99), or "" when it can: tried
 /// on a thread of its own that ends at once, so nothing of the process changes. For a program to
 /// check RunOptions::realtime_priority before it loads or opens anything.
 SSX_EXPORT std::string realtimePriorityProblem(int priority);
 
+/// How serious a message is.
 enum class LogLevel : std::uint8_t { Info, Warning, Error };
+/// Receives every message of an environment (Environment::setLogSink): its level and its text,
+/// without a trailing newline. Called on the stepping thread.
 using LogSink = std::function<void(LogLevel, std::string_view)>;
 
 /// A simulated world. Not copyable. All calls come from one thread (the one that steps);
 /// plugin callbacks run on worker threads only inside the parallel phases.
 class SSX_EXPORT Environment {
  public:
+  /// Where an environment is in its life: being set up, running (after start() or the first
+  /// step), stopped (after stop()), or failed (a step threw; only stop() and queries remain).
   enum class State : std::uint8_t { Setup, Running, Stopped, Failed };
 
+  /// An empty environment with these settings (checked: ConfigError for a timestep, thread count,
+  /// engine name or render setting out of range).
   explicit Environment(EnvironmentSettings settings = {});
   Environment(const Environment&) = delete;
   Environment& operator=(const Environment&) = delete;
@@ -155,6 +166,7 @@ class SSX_EXPORT Environment {
   void subscribe(const Sensor& sensor, Artifact& subscriber, std::function<void(const M&)> callback);
   /// Where messages go (default: stderr, "ssx: warning: ...").
   void setLogSink(LogSink sink);
+  /// Sends a message to the log sink (by default: stderr). Plugins log through this.
   void log(LogLevel level, std::string_view message) const;
 
   // --- lifecycle -----------------------------------------------------------------------------
@@ -190,36 +202,47 @@ class SSX_EXPORT Environment {
   /// The checks restoreState makes before it changes anything (format, size, checksum, the scene
   /// it was saved from), without starting the environment. Throws StateError.
   void checkState(std::span<const std::byte> state) const;
+  /// Where the environment is in its life.
   State state() const noexcept;
 
   // --- queries -------------------------------------------------------------------------------
 
+  /// The settings it was made with.
   const EnvironmentSettings& settings() const noexcept { return settings_; }
+  /// The physics timestep tau, ns.
   Nanoseconds timestep() const noexcept { return settings_.timestep; }
   /// Simulated time: steps taken times the timestep.
   Nanoseconds time() const noexcept { return stepCount() * settings_.timestep; }
+  /// Steps taken so far (restoreState sets it to the saved run's).
   std::int64_t stepCount() const noexcept;
   /// Worker threads used by the parallel phases (1: inline).
   unsigned threadCount() const noexcept;
 
+  /// How many artifacts the environment has (the ground included).
   std::size_t artifactCount() const noexcept;
+  /// Artifact `index`, in the order added (std::out_of_range past artifactCount()).
   Artifact& artifact(std::size_t index);
+  /// @copydoc artifact(std::size_t)
   const Artifact& artifact(std::size_t index) const;
   /// Artifact by name, or nullptr.
   Artifact* findArtifact(std::string_view name);
+  /// @copydoc findArtifact(std::string_view)
   const Artifact* findArtifact(std::string_view name) const;
   /// Artifacts chosen by a parameter: "*" is every artifact with a dynamic root, else names
   /// separated by spaces, each of an artifact with a physic root. Throws Error naming the first
   /// name that is not.
   std::vector<Artifact*> selectArtifacts(std::string_view names);
+  /// @copydoc selectArtifacts(std::string_view)
   std::vector<const Artifact*> selectArtifacts(std::string_view names) const;
   /// The same for the names a plugin parameter `key` gives; throws the parameter's ConfigError,
   /// "... to <purpose>", when a name does not fit.
   std::vector<Artifact*> selectArtifacts(const Descriptor& params, std::string_view key, std::string_view purpose);
+  /// @copydoc selectArtifacts(const Descriptor&, std::string_view, std::string_view)
   std::vector<const Artifact*> selectArtifacts(const Descriptor& params, std::string_view key,
                                                std::string_view purpose) const;
   /// Extension by name, or nullptr.
   SimulationExtension* extension(std::string_view name) const;
+  /// Extension by name as a T, or nullptr (no such extension, or one of another type).
   template <class T>
   T* extension(std::string_view name) const {
     return dynamic_cast<T*>(extension(name));
@@ -227,6 +250,7 @@ class SSX_EXPORT Environment {
 
   /// The published state of body `i` (see PhysicNode::bodyIndex).
   const BodyState& bodyState(int i) const;
+  /// How many rigid bodies the world has: one per dynamic physic node tree (static trees have none).
   std::size_t bodyCount() const noexcept;
   /// Sets body `i`'s pose and velocities (centre-of-mass frame, world) between steps: in the
   /// engine and in the snapshot at once (accelerations are kept). To reset or teleport a robot;
@@ -241,6 +265,7 @@ class SSX_EXPORT Environment {
   /// then on the index of every artifact's first dynamic root position is rebuilt once per step,
   /// in the snapshot phase (the smallest cell size asked for wins).
   void enableNeighborQueries(double cell_size);
+  /// Whether a plugin enabled neighbour queries.
   bool neighborQueriesEnabled() const noexcept;
   /// Appends to `out` the indices of the artifacts (with a dynamic root) whose first root is
   /// within `radius` of `point`, in ascending order; reads the snapshot's index, so it is safe in
@@ -258,13 +283,14 @@ class SSX_EXPORT Environment {
         [](void* context, std::size_t id, const Vec3& p) { (*static_cast<std::remove_reference_t<Visit>*>(context))(id, p); },
         static_cast<void*>(&visit));
   }
+  /// The same with a plain function and its context pointer.
   void forEachNeighbor(const Vec3& point, double radius, SpatialIndex::Visitor visit, void* context) const;
 
   /// A shape of a static artifact, posed in the world.
   struct StaticShape {
     Shape shape;  ///< its pose is the shape's pose in its static root's frame
     Pose world;   ///< the shape's frame in the world
-    std::size_t artifact = 0;
+    std::size_t artifact = 0;  ///< index of the static artifact it belongs to
   };
   /// Every shape of every static root (ground planes included), known from start() on.
   const std::vector<StaticShape>& staticShapes() const noexcept { return static_shapes_; }
@@ -286,9 +312,11 @@ class SSX_EXPORT Environment {
   /// The physics engine, read-only (bodies are added by the environment, at start); throws when
   /// the environment is not running.
   const PhysicEngine& physics() const;
+  /// The render engine, read-only; throws when the environment is not running.
   const RenderEngine& renderer() const;
   /// Per-step timing of every step taken so far.
   TimingRecorder& timing() noexcept { return timing_; }
+  /// @copydoc timing()
   const TimingRecorder& timing() const noexcept { return timing_; }
 
  private:

@@ -37,7 +37,10 @@ class SSX_EXPORT Error : public std::runtime_error {
 /// `file:line: error: ...` when the location is known.
 class SSX_EXPORT ConfigError : public Error {
  public:
+  /// An error at `where`; what() is "file:line: error: message" (just the message when `where`
+  /// is empty).
   ConfigError(SourceLocation where, const std::string& message);
+  /// Where the bad input is (empty when not known).
   const SourceLocation& where() const noexcept { return where_; }
   /// The message without the location prefix.
   const std::string& detail() const noexcept { return detail_; }
@@ -51,6 +54,7 @@ class SSX_EXPORT ConfigError : public Error {
 /// The environment is left in the failed state: it refuses further steps.
 class SSX_EXPORT StepError : public Error {
  public:
+  /// The failure `what` of `plugin` of `artifact` in step `step`; what() names all four.
   StepError(std::string artifact, std::string plugin, std::int64_t step, const std::string& what);
   /// Name of the artifact whose plugin or state failed.
   const std::string& artifact() const noexcept { return artifact_; }

@@ -21,10 +21,12 @@ constexpr std::uint64_t fnv1a(const unsigned char* data, std::size_t size, std::
   return h;
 }
 
+/// FNV-1a (64 bits) of `size` bytes, continuing from `h` (kFnv1aBasis for a new hash).
 inline std::uint64_t fnv1a(const std::byte* data, std::size_t size, std::uint64_t h = kFnv1aBasis) {
   return fnv1a(reinterpret_cast<const unsigned char*>(data), size, h);
 }
 
+/// FNV-1a (64 bits) of a text's bytes, continuing from `h` (kFnv1aBasis for a new hash).
 inline std::uint64_t fnv1a(std::string_view text, std::uint64_t h = kFnv1aBasis) {
   return fnv1a(reinterpret_cast<const unsigned char*>(text.data()), text.size(), h);
 }

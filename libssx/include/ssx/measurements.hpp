@@ -18,15 +18,15 @@ namespace ssx {
 
 /// Simulated time, as a clock sensor reports it.
 struct SSX_EXPORT ClockMeasurement : Measurement {
-  std::int64_t step = 0;
-  double seconds = 0.0;
+  std::int64_t step = 0;   ///< steps taken
+  double seconds = 0.0;    ///< simulated time, s
   ~ClockMeasurement() override;
   bool finite() const noexcept override;
 };
 
 /// Pose and twist of a node, world frame, possibly with noise.
 struct SSX_EXPORT PoseMeasurement : Measurement {
-  Pose pose;
+  Pose pose;                             ///< position (m) and orientation, world frame
   Vec3 linear_velocity = Vec3::Zero();   ///< m/s, world frame
   Vec3 angular_velocity = Vec3::Zero();  ///< rad/s, world frame
   ~PoseMeasurement() override;
@@ -48,6 +48,7 @@ struct SSX_EXPORT ImuMeasurement : Measurement {
 
 /// What a range sensor sees: other robots and obstacles within its range, nearest first.
 struct SSX_EXPORT RangeMeasurement : Measurement {
+  /// One robot or obstacle seen.
   struct Detection {
     Vec3 relative = Vec3::Zero();  ///< from the sensor to the robot (or the obstacle's nearest surface point), m
     double distance = 0.0;         ///< |relative| before noise, m
@@ -55,7 +56,7 @@ struct SSX_EXPORT RangeMeasurement : Measurement {
     bool obstacle = false;         ///< a static obstacle rather than a robot
   };
   bool body_frame = false;  ///< `relative` in the sensor's body frame, else the world frame
-  std::vector<Detection> detections;
+  std::vector<Detection> detections;  ///< nearest first
   ~RangeMeasurement() override;
   bool finite() const noexcept override;
 };
@@ -63,7 +64,7 @@ struct SSX_EXPORT RangeMeasurement : Measurement {
 /// A camera image: RGB and, when asked for, depth (m along the optical axis), drawn from the
 /// snapshot of the step it is stamped with.
 struct SSX_EXPORT CameraMeasurement : Measurement {
-  Image image;
+  Image image;      ///< RGB (and depth when asked for), row 0 at the top
   CameraView view;  ///< the camera's pose (x forward, z up) and lens when it was drawn
   ~CameraMeasurement() override;
   bool finite() const noexcept override;
@@ -75,23 +76,27 @@ inline void save(StateWriter& out, const ClockMeasurement& m) {
   out.write(m.step);
   out.write(m.seconds);
 }
+/// Reads what the matching save wrote.
 inline void load(StateReader& in, ClockMeasurement& m) {
   in.read(m.stamp);
   in.read(m.step);
   in.read(m.seconds);
 }
+/// Writes a measurement (or a detection list) into a saved state.
 inline void save(StateWriter& out, const PoseMeasurement& m) {
   out.write(m.stamp);
   out.write(m.pose);
   out.write(m.linear_velocity);
   out.write(m.angular_velocity);
 }
+/// Reads what the matching save wrote.
 inline void load(StateReader& in, PoseMeasurement& m) {
   in.read(m.stamp);
   in.read(m.pose);
   in.read(m.linear_velocity);
   in.read(m.angular_velocity);
 }
+/// Writes a measurement (or a detection list) into a saved state.
 inline void save(StateWriter& out, const ImuMeasurement& m) {
   out.write(m.stamp);
   out.write(m.accelerometer);
@@ -99,6 +104,7 @@ inline void save(StateWriter& out, const ImuMeasurement& m) {
   out.write(m.accelerometer_counts);
   out.write(m.gyroscope_counts);
 }
+/// Reads what the matching save wrote.
 inline void load(StateReader& in, ImuMeasurement& m) {
   in.read(m.stamp);
   in.read(m.accelerometer);
@@ -106,6 +112,7 @@ inline void load(StateReader& in, ImuMeasurement& m) {
   in.read(m.accelerometer_counts);
   in.read(m.gyroscope_counts);
 }
+/// Writes a measurement (or a detection list) into a saved state.
 inline void save(StateWriter& out, const std::vector<RangeMeasurement::Detection>& detections) {
   out.write(static_cast<std::uint64_t>(detections.size()));
   for (const auto& d : detections) {
@@ -115,6 +122,7 @@ inline void save(StateWriter& out, const std::vector<RangeMeasurement::Detection
     out.write(d.obstacle);
   }
 }
+/// Reads what the matching save wrote.
 inline void load(StateReader& in, std::vector<RangeMeasurement::Detection>& detections) {
   detections.resize(in.count(8 * 3 + 8 + 8 + 1));
   for (auto& d : detections) {
@@ -124,10 +132,12 @@ inline void load(StateReader& in, std::vector<RangeMeasurement::Detection>& dete
     in.read(d.obstacle);
   }
 }
+/// Writes a measurement (or a detection list) into a saved state.
 inline void save(StateWriter& out, const RangeMeasurement& m) {
   out.write(m.stamp);
   save(out, m.detections);
 }
+/// Reads what the matching save wrote.
 inline void load(StateReader& in, RangeMeasurement& m) {
   in.read(m.stamp);
   load(in, m.detections);

@@ -14,8 +14,8 @@ namespace ssx {
 
 /// One named value, e.g. a formation error in metres.
 struct Metric {
-  std::string name;
-  double value = 0.0;
+  std::string name;   ///< what it is, with its unit where it has one ("formation_error_m")
+  double value = 0.0;  ///< its value now
 };
 
 /// Implemented by plugins with numbers worth collecting. Called between steps from the thread

@@ -57,9 +57,9 @@ enum ssx_param_type : std::uint32_t {
 enum ssx_param_flag : std::uint32_t {
   SSX_PARAM_REQUIRED = 1u,  ///< must be given
   SSX_PARAM_HAS_MIN = 2u,   ///< value >= min (> min with MIN_OPEN)
-  SSX_PARAM_MIN_OPEN = 4u,
+  SSX_PARAM_MIN_OPEN = 4u,  ///< with HAS_MIN: the minimum itself is excluded
   SSX_PARAM_HAS_MAX = 8u,  ///< value <= max (< max with MAX_OPEN)
-  SSX_PARAM_MAX_OPEN = 16u,
+  SSX_PARAM_MAX_OPEN = 16u,  ///< with HAS_MAX: the maximum itself is excluded
   /// a rate in Hz of a loop inside the plugin: unless 0, its period must be a whole multiple of
   /// the plugin's own period (the plugin runs its loop every k of its runs)
   SSX_PARAM_RATE = 32u,
@@ -72,15 +72,15 @@ enum ssx_param_flag : std::uint32_t {
 /// One declared parameter. `default_value` is text in the parameter's own syntax, or "" when the
 /// default is computed (say so in `doc`); `unit` is "" when there is none.
 struct ssx_plugin_param {
-  const char* name;
-  std::uint32_t type;
-  std::uint32_t flags;
-  const char* unit;
-  const char* default_value;
-  double min;
-  double max;
-  const char* choices;
-  const char* doc;
+  const char* name;           ///< the attribute's name in a scene
+  std::uint32_t type;         ///< an ssx_param_type
+  std::uint32_t flags;        ///< ssx_param_flag values, or'ed
+  const char* unit;           ///< "m", "rad/s", ...; "" when none
+  const char* default_value;  ///< text in the parameter's syntax; "" when computed or required
+  double min;                 ///< lower bound (with SSX_PARAM_HAS_MIN)
+  double max;                 ///< upper bound (with SSX_PARAM_HAS_MAX)
+  const char* choices;        ///< SSX_PARAM_CHOICE: the accepted words, separated by spaces
+  const char* doc;            ///< one line on what it does
   /// the part of the class it belongs to ("vehicle", "controller"), or null: the tables of a class
   /// made of parts are printed part by part (ssx::param::join)
   const char* group;
@@ -95,10 +95,11 @@ class Environment;
 
 /// A message about a scene or a parameter, with where it came from.
 struct SSX_EXPORT Diagnostic {
+  /// A warning lets the run go on; an error stops it before it starts.
   enum class Severity : std::uint8_t { Warning, Error };
-  Severity severity = Severity::Error;
-  SourceLocation where;
-  std::string message;
+  Severity severity = Severity::Error;  ///< warning or error
+  SourceLocation where;                 ///< file and line (empty when not from a file)
+  std::string message;                  ///< what is wrong and what to do, without the location
   /// "file:line: error: message" (or warning).
   std::string str() const;
 };
@@ -147,16 +148,23 @@ namespace param {
 
 /// Bounds of a number (each component of a vector).
 struct Bounds {
-  std::uint32_t flags = 0;
-  double min = 0;
-  double max = 0;
+  std::uint32_t flags = 0;  ///< SSX_PARAM_HAS_MIN, _MIN_OPEN, _HAS_MAX, _MAX_OPEN
+  double min = 0;           ///< lower bound, when HAS_MIN
+  double max = 0;           ///< upper bound, when HAS_MAX
 };
+/// No bounds.
 constexpr Bounds any() { return {}; }
+/// value >= v
 constexpr Bounds atLeast(double v) { return {SSX_PARAM_HAS_MIN, v, 0}; }
+/// value > v
 constexpr Bounds above(double v) { return {SSX_PARAM_HAS_MIN | SSX_PARAM_MIN_OPEN, v, 0}; }
+/// value <= v
 constexpr Bounds atMost(double v) { return {SSX_PARAM_HAS_MAX, 0, v}; }
+/// value < v
 constexpr Bounds below(double v) { return {SSX_PARAM_HAS_MAX | SSX_PARAM_MAX_OPEN, 0, v}; }
+/// value > 0
 constexpr Bounds positive() { return above(0); }
+/// value >= 0
 constexpr Bounds nonNegative() { return atLeast(0); }
 /// [lo, hi]
 constexpr Bounds between(double lo, double hi) { return {SSX_PARAM_HAS_MIN | SSX_PARAM_HAS_MAX, lo, hi}; }
@@ -166,20 +174,25 @@ constexpr Bounds operator&(Bounds a, Bounds b) {
           (b.flags & SSX_PARAM_HAS_MAX) != 0 ? b.max : a.max};
 }
 
+/// A declaration of any type; the builders below fill in its type and flags.
 constexpr ssx_plugin_param make(const char* name, std::uint32_t type, const char* unit, const char* default_value,
                                 Bounds bounds, const char* choices, const char* doc) {
   return {name, type, bounds.flags, unit, default_value, bounds.min, bounds.max, choices, doc, nullptr};
 }
+/// A finite number with a unit ("" for none) and bounds.
 constexpr ssx_plugin_param real(const char* name, const char* default_value, const char* unit, Bounds bounds,
                                 const char* doc) {
   return make(name, SSX_PARAM_REAL, unit, default_value, bounds, "", doc);
 }
+/// A whole number (64 bits) with bounds.
 constexpr ssx_plugin_param integer(const char* name, const char* default_value, Bounds bounds, const char* doc) {
   return make(name, SSX_PARAM_INT, "", default_value, bounds, "", doc);
 }
+/// A yes/no value (true/false/1/0).
 constexpr ssx_plugin_param flag(const char* name, const char* default_value, const char* doc) {
   return make(name, SSX_PARAM_BOOL, "", default_value, {}, "", doc);
 }
+/// Any text (a name, a list of names).
 constexpr ssx_plugin_param text(const char* name, const char* default_value, const char* doc) {
   return make(name, SSX_PARAM_TEXT, "", default_value, {}, "", doc);
 }
@@ -189,6 +202,7 @@ constexpr ssx_plugin_param output(const char* name, const char* default_value, c
   p.flags |= SSX_PARAM_OUTPUT;
   return p;
 }
+/// A vector "x y z" with a unit; the bounds apply to each component.
 constexpr ssx_plugin_param vec3(const char* name, const char* default_value, const char* unit, Bounds bounds,
                                 const char* doc) {
   return make(name, SSX_PARAM_VEC3, unit, default_value, bounds, "", doc);
@@ -213,9 +227,10 @@ constexpr ssx_plugin_param required(ssx_plugin_param p) {
 /// A part of a class's parameters: its name and its table.
 template <std::size_t N>
 struct Part {
-  const char* name;
-  const ssx_plugin_param (&params)[N];
+  const char* name;                     ///< the part's name ("vehicle", "controller")
+  const ssx_plugin_param (&params)[N];  ///< its declarations
 };
+/// A part named `name` with the declarations `params` (for join).
 template <std::size_t N>
 constexpr Part<N> part(const char* name, const ssx_plugin_param (&params)[N]) {
   return {name, params};

@@ -18,17 +18,18 @@ namespace ssx {
 
 /// Settings of the ODE engine (`<physics engine="ode">`).
 struct OdeSettings {
+  /// ODE's two solvers.
   enum class Solver : std::uint8_t {
     QuickStep,  ///< iterative (ODE's dWorldQuickStep): O(n) in constraints; the default
     Exact,      ///< direct LCP (ODE's dWorldStep): accurate, O(n^3) per island
   };
-  Solver solver = Solver::QuickStep;
+  Solver solver = Solver::QuickStep;  ///< QuickStep (default) or the exact LCP solver
   int iterations = 20;  ///< QuickStep iterations
   double sor = 1.3;     ///< QuickStep over-relaxation
   double erp = 0.2;     ///< error reduction parameter
   double cfm = 1e-9;    ///< constraint force mixing
-  double contact_soft_cfm = 1e-6;
-  double contact_soft_erp = 0.2;
+  double contact_soft_cfm = 1e-6;  ///< constraint force mixing of contacts (softness)
+  double contact_soft_erp = 0.2;   ///< error reduction of contacts
   double contact_surface_layer = 1e-3;  ///< m of allowed penetration, for resting stability
   int max_contacts = 8;                 ///< per pair of geoms
   /// Worlds the bodies are spread over, stepped in parallel on the worker pool (bodies in
@@ -49,7 +50,7 @@ struct BulletSettings {
 
 /// Settings of the physics: what every engine takes, and each engine's own.
 struct PhysicsSettings {
-  using Solver = OdeSettings::Solver;
+  using Solver = OdeSettings::Solver;  ///< ODE's solvers, under a shorter name
   std::string engine = "ode";  ///< one of physicEngineNames()
   Vec3 gravity{0.0, 0.0, -9.81};  ///< m/s^2, world frame
   int substeps = 1;     ///< equal physics steps per environment timestep
@@ -66,8 +67,8 @@ struct PhysicsSettings {
 
 /// Force and torque on a body, world frame, torque about the centre of mass.
 struct Wrench {
-  Vec3 force = Vec3::Zero();
-  Vec3 torque = Vec3::Zero();
+  Vec3 force = Vec3::Zero();   ///< N, world frame
+  Vec3 torque = Vec3::Zero();  ///< N m, world frame, about the centre of mass
 };
 
 /// Runs independent tasks on the environment's worker pool, for an engine that can step parts
@@ -75,6 +76,7 @@ struct Wrench {
 class SSX_EXPORT TaskRunner {
  public:
   virtual ~TaskRunner();
+  /// The threads tasks may run on (1: only the caller's).
   virtual unsigned threads() const = 0;
   /// Calls task(context, i) for every i in [0, n), on any of the pool's threads; returns when all
   /// are done. The first exception a task throws is rethrown here.
@@ -88,6 +90,7 @@ class SSX_EXPORT TaskRunner {
 class SSX_EXPORT PhysicEngine {
  public:
   virtual ~PhysicEngine();
+  /// "ode" or "bullet".
   virtual std::string name() const = 0;
 
   /// The pool the engine may run its own parallel work on (null: everything on the caller's
@@ -106,6 +109,7 @@ class SSX_EXPORT PhysicEngine {
   virtual void readStates(std::span<BodyState> out) const = 0;
   /// Overwrites one body's pose and velocities.
   virtual void setState(int body, const BodyState& state) = 0;
+  /// How many dynamic bodies were added.
   virtual std::size_t bodyCount() const = 0;
   /// Contacts generated in the last step.
   virtual std::size_t contactCount() const = 0;

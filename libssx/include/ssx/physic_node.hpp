@@ -22,18 +22,24 @@ struct World;
 /// lie along their local z axis. A plane is the half-space below its local xy-plane (normal +z)
 /// and is allowed only on static nodes.
 struct SSX_EXPORT Shape {
+  /// The shape's geometry.
   enum class Kind : std::uint8_t { Box, Sphere, Cylinder, Capsule, Plane };
-  Kind kind = Kind::Box;
+  Kind kind = Kind::Box;     ///< which geometry; the fields below that it uses
   Vec3 size = Vec3::Ones();  ///< box: full edge lengths, m
   double radius = 0.5;       ///< sphere, cylinder, capsule: m
   double length = 1.0;       ///< cylinder: full height; capsule: length of the cylindrical part, m
   Pose pose;                 ///< relative to the node
   double density = 1000.0;   ///< kg/m^3; used when the node's mass comes from its shapes
 
+  /// A box with full edge lengths `size`, m.
   static Shape box(const Vec3& size, const Pose& pose = {});
+  /// A sphere, m.
   static Shape sphere(double radius, const Pose& pose = {});
+  /// A cylinder along z, `length` its full height, m.
   static Shape cylinder(double radius, double length, const Pose& pose = {});
+  /// A capsule along z, `length` the length of its cylindrical part, m.
   static Shape capsule(double radius, double length, const Pose& pose = {});
+  /// A plane (static nodes only): the half-space below the posed xy-plane.
   static Shape plane(const Pose& pose = {});
 
   /// Volume in m^3 (0 for a plane).
@@ -50,15 +56,15 @@ struct SSX_EXPORT Shape {
 /// shapes' volume times density. A node without shapes and mass is a massless frame (a sensor
 /// mount, say).
 struct SSX_EXPORT PhysicNodeSpec {
-  std::string name;
+  std::string name;  ///< unique within the artifact; plugins name nodes by it
   Pose pose;  ///< relative to the parent node; for a root, relative to the artifact's pose
-  std::vector<Shape> shapes;
+  std::vector<Shape> shapes;  ///< its collision and mass shapes (none: a frame, or mass given)
   std::optional<double> mass;          ///< kg
   std::optional<Mat3> inertia;         ///< kg m^2, about the centre of mass, node axes; needs `mass`
   Vec3 center_of_mass = Vec3::Zero();  ///< node frame; used with an explicit `mass`
   bool is_static = false;              ///< root only: fixed in the world, never moves
   SourceLocation where;                ///< where it was described, for messages
-  std::vector<PhysicNodeSpec> children;
+  std::vector<PhysicNodeSpec> children;  ///< nodes rigidly attached to this one
 
   /// Appends a child and returns it.
   PhysicNodeSpec& addChild(PhysicNodeSpec child);
@@ -66,7 +72,7 @@ struct SSX_EXPORT PhysicNodeSpec {
 
 /// Mass properties of a rigid body: total mass, centre of mass and inertia about it.
 struct MassProperties {
-  double mass = 0.0;
+  double mass = 0.0;  ///< kg
   Vec3 center_of_mass = Vec3::Zero();  ///< in the frame the properties were computed in
   Mat3 inertia = Mat3::Zero();         ///< about the centre of mass, axes of that frame
 };
@@ -94,9 +100,13 @@ class SSX_EXPORT PhysicNode {
   PhysicNode(const PhysicNode&) = delete;
   PhysicNode& operator=(const PhysicNode&) = delete;
 
+  /// The node's name (its spec's).
   const std::string& name() const noexcept { return spec_->name; }
+  /// What the node was made from.
   const PhysicNodeSpec& spec() const noexcept { return *spec_; }
+  /// The artifact the node belongs to.
   Artifact& artifact() noexcept { return *artifact_; }
+  /// @copydoc artifact()
   const Artifact& artifact() const noexcept { return *artifact_; }
   /// The parent node, or nullptr for a root.
   const PhysicNode* parent() const noexcept { return parent_; }
@@ -111,6 +121,7 @@ class SSX_EXPORT PhysicNode {
 
   /// Pose, velocities and accelerations of this node's frame origin, world frame.
   BodyState state() const;
+  /// Pose of this node's frame, world frame (the position and orientation of state()).
   Pose pose() const;
 
   /// Adds a force at a point. `force` is in `force_frame`; `point` in `point_frame` (Local:

@@ -41,6 +41,7 @@ struct StepInfo {
   std::int64_t step = 0;   ///< index of the current step, from 0
   Nanoseconds time = 0;    ///< simulated time after this step's physics
   Nanoseconds period = 0;  ///< time between two runs of this plugin (period_steps * timestep)
+  /// The period in seconds.
   double periodSeconds() const { return toSeconds(period); }
 };
 
@@ -105,6 +106,9 @@ class SSX_EXPORT Plugin {
 /// physics step until its next run (zero-order hold).
 class SSX_EXPORT Driver : public Plugin {
  public:
+  /// Runs the controller once: reads sensors and the snapshot, writes this artifact's forces and
+  /// torques. Called every periodSteps() steps, in the drivers phase. Throw to stop the run (a
+  /// StepError names the artifact and driver).
   virtual void step(const StepInfo& info) = 0;
   /// Its own artifact, writable: its nodes take this driver's forces and torques.
   Artifact& artifact() const noexcept { return const_cast<Artifact&>(Plugin::artifact()); }
@@ -112,7 +116,7 @@ class SSX_EXPORT Driver : public Plugin {
 
 /// Base of every measurement a sensor delivers; `stamp` is the simulated time it was taken.
 struct SSX_EXPORT Measurement {
-  Nanoseconds stamp = 0;
+  Nanoseconds stamp = 0;  ///< simulated time it was taken, ns
   virtual ~Measurement();
   /// Whether every number in it is finite. The core calls this after each `sense`: a NaN or an
   /// infinity stops the step with an error naming the artifact and the sensor, as a driver's NaN
@@ -128,6 +132,8 @@ struct SSX_EXPORT Measurement {
 /// subscriber artifact's thread, in a fixed order.
 class SSX_EXPORT Sensor : public Plugin {
  public:
+  /// Takes one measurement into its buffer. Called every periodSteps() steps, in the sensors
+  /// phase. Throw to stop the run (a StepError names the artifact and sensor).
   virtual void sense(const StepInfo& info) = 0;
   /// The last measurement written by `sense` (never null).
   virtual const Measurement& latest() const = 0;
@@ -137,7 +143,8 @@ class SSX_EXPORT Sensor : public Plugin {
 template <class M>
 class SensorOf : public Sensor {
  public:
-  using MeasurementType = M;
+  using MeasurementType = M;  ///< the type of what it measures
+  /// The last measurement, typed.
   const M& value() const noexcept { return measurement_; }
   const Measurement& latest() const override { return measurement_; }
 
@@ -157,11 +164,14 @@ class SSX_EXPORT PluginSetup {
   using SharedValues =
       std::map<std::tuple<std::type_index, std::type_index, std::string>, std::shared_ptr<const void>>;
 
+  /// Made by the environment for `plugin`'s configure; `shared` is its table of shared values
+  /// (null: nothing is shared).
   PluginSetup(Environment& environment, Plugin& plugin, SharedValues* shared = nullptr) noexcept
       : env_(&environment), plugin_(&plugin), shared_(shared) {}
   PluginSetup(const PluginSetup&) = delete;
   PluginSetup& operator=(const PluginSetup&) = delete;
 
+  /// The environment being started, read-only.
   const Environment& environment() const noexcept { return *env_; }
   /// Delivers `sensor`'s fresh measurements to `callback`, in the drivers phase, on the thread of
   /// this plugin's artifact (which receives them).
@@ -210,14 +220,19 @@ class SSX_EXPORT SimulationExtension {
   SimulationExtension& operator=(const SimulationExtension&) = delete;
   virtual ~SimulationExtension();
 
+  /// Called once as the environment starts, before the engines; `params` are the extension's
+  /// attributes. Throw ConfigError to refuse them (nothing has run yet).
   virtual void init(Environment& env, const Descriptor& params);
   /// Before each step's physics.
   virtual void beforeStep(Environment& env);
   /// After each step (drivers done, frame drawn if due).
   virtual void afterStep(Environment& env);
+  /// Called once as the environment stops, after the engines. Throw Error when something could
+  /// not be finished (a file not written to its end): stop() reports it.
   virtual void shutdown(Environment& env);
   /// As Plugin::saveState / loadState, for what an extension keeps between steps.
   virtual void saveState(StateWriter& out) const;
+  /// @copydoc saveState
   virtual void loadState(StateReader& in);
 };
 

@@ -39,8 +39,12 @@
 /// handed to them (PluginContext) change.
 #define SSX_PLUGIN_ABI_VERSION 8u
 
+/// @cond
 #define SSX_PLUGIN_STRINGIFY2(x) #x
+/// @endcond
+/// The text of a macro's value ("12" for a macro defined as 12).
 #define SSX_PLUGIN_STRINGIFY(x) SSX_PLUGIN_STRINGIFY2(x)
+/// The compiler a plugin (or libssx) was built with and its major version ("gcc 12").
 #if defined(__clang__)
 #define SSX_PLUGIN_COMPILER "clang " SSX_PLUGIN_STRINGIFY(__clang_major__)
 #elif defined(__GNUC__)
@@ -48,6 +52,7 @@
 #else
 #define SSX_PLUGIN_COMPILER "unknown"
 #endif
+/// The C++ standard library and its ABI ("libstdc++ abi1"): plugins must match libssx's.
 #if defined(_GLIBCXX_USE_CXX11_ABI)
 #define SSX_PLUGIN_STDLIB "libstdc++ abi" SSX_PLUGIN_STRINGIFY(_GLIBCXX_USE_CXX11_ABI)
 #elif defined(_LIBCPP_VERSION)
@@ -81,29 +86,31 @@ enum ssx_plugin_kind : std::uint32_t {
 /// freeing that memory. The library keeps a class's instances side by side this way, so that a
 /// phase walking thousands of them reads memory in order.
 struct ssx_plugin_class {
-  std::uint32_t kind;
-  const char* name;
-  void* (*create)(char* error, std::size_t error_size) noexcept;
-  void (*destroy)(void* instance) noexcept;
-  const char* doc;
-  const ssx_plugin_param* params;
-  std::uint32_t param_count;
+  std::uint32_t kind;  ///< an ssx_plugin_kind
+  const char* name;    ///< the class name scenes use
+  void* (*create)(char* error, std::size_t error_size) noexcept;  ///< a new instance, or null and a reason
+  void (*destroy)(void* instance) noexcept;                       ///< deletes what create returned
+  const char* doc;                 ///< one line on what the class is, or null
+  const ssx_plugin_param* params;  ///< its declared parameters (param_count of them)
+  std::uint32_t param_count;       ///< how many declared parameters
+  /// checks parameters in a context before anything runs, or null
   void (*validate)(const void* params, const void* context, void* diagnostics) noexcept;
-  std::size_t instance_size;
-  std::size_t instance_align;
+  std::size_t instance_size;   ///< bytes construct needs (0: no construct)
+  std::size_t instance_align;  ///< their alignment, a power of two
+  /// create in memory the library provides, or null
   void* (*construct)(void* where, char* error, std::size_t error_size) noexcept;
-  void (*destruct)(void* instance) noexcept;
+  void (*destruct)(void* instance) noexcept;  ///< ends what construct made, without freeing
 };
 
 /// The manifest. `record_size` is sizeof(ssx_plugin_manifest) and `class_size` is
 /// sizeof(ssx_plugin_class) as the plugin saw them.
 struct ssx_plugin_manifest {
-  std::uint32_t abi_version;
-  std::uint32_t record_size;
-  std::uint32_t class_size;
-  std::uint32_t class_count;
-  const char* build_tag;
-  const ssx_plugin_class* classes;
+  std::uint32_t abi_version;        ///< SSX_PLUGIN_ABI_VERSION as the plugin was built
+  std::uint32_t record_size;        ///< sizeof(ssx_plugin_manifest) as the plugin saw it
+  std::uint32_t class_size;         ///< sizeof(ssx_plugin_class) as the plugin saw it
+  std::uint32_t class_count;        ///< how many classes
+  const char* build_tag;            ///< SSX_PLUGIN_BUILD_TAG as the plugin was built
+  const ssx_plugin_class* classes;  ///< the classes (class_count of them)
 };
 
 }  // extern "C"
@@ -181,8 +188,11 @@ constexpr ssx_plugin_class pluginClass(std::uint32_t kind, const char* name) {
 
 }  // namespace ssx::detail
 
+/// A manifest entry (for SSX_PLUGIN) for driver class `Type`, named `name` in scenes.
 #define SSX_DRIVER(Type, name) ::ssx::detail::pluginClass<Type, ::ssx::Driver>(SSX_PLUGIN_DRIVER, name)
+/// A manifest entry for sensor class `Type`, named `name` in scenes.
 #define SSX_SENSOR(Type, name) ::ssx::detail::pluginClass<Type, ::ssx::Sensor>(SSX_PLUGIN_SENSOR, name)
+/// A manifest entry for extension class `Type`, named `name` in scenes.
 #define SSX_EXTENSION(Type, name) \
   ::ssx::detail::pluginClass<Type, ::ssx::SimulationExtension>(SSX_PLUGIN_EXTENSION, name)
 

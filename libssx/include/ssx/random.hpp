@@ -30,11 +30,15 @@ SSX_EXPORT std::uint64_t deriveSeed(std::uint64_t seed, std::uint64_t a, std::ui
 /// belongs to one plugin instance.
 class SSX_EXPORT Random {
  public:
-  using result_type = std::uint64_t;
+  using result_type = std::uint64_t;  ///< what operator() returns (a UniformRandomBitGenerator)
+  /// A stream from `seed` (any 64-bit value; expanded with SplitMix64).
   explicit Random(std::uint64_t seed = 0) { reseed(seed); }
+  /// Restarts the stream from `seed`, as a new Random(seed) would.
   void reseed(std::uint64_t seed);
 
+  /// The smallest number operator() returns.
   static constexpr result_type min() { return 0; }
+  /// The largest number operator() returns.
   static constexpr result_type max() { return ~result_type{0}; }
   /// The next raw 64-bit number.
   result_type operator()() {
@@ -67,6 +71,7 @@ class SSX_EXPORT Random {
 
   /// The generator's whole state (for Environment::saveState), and back.
   void save(StateWriter& out) const;
+  /// @copydoc save
   void load(StateReader& in);
 
  private:

@@ -27,6 +27,9 @@ inline constexpr std::uintmax_t kDefaultMaxInputBytes = std::uintmax_t{64} << 20
 /// Throws ConfigError at the file (line 0) saying what is wrong and what to do.
 SSX_EXPORT std::string readInputFile(const std::filesystem::path& file, std::uintmax_t max_bytes = kDefaultMaxInputBytes);
 
+/// The files one run reads and writes, checked against each other before anything is opened:
+/// no output is an input or another output (however spelled: symlinks and `..` resolved), and
+/// no output is a special file unless allowed. The scene loader and the CLI fill one in.
 class SSX_EXPORT RunFiles {
  public:
   /// Outputs written as a stream (a logger's file, timing samples) may then be a FIFO or a
@@ -44,7 +47,9 @@ class SSX_EXPORT RunFiles {
   /// Claims a directory the run writes files into (PNG frames): it may exist or be new, and must
   /// hold no input of the run. Returns what is wrong ("" when nothing is).
   std::string claimOutputDirectory(const std::filesystem::path& dir, const std::string& what);
+  /// The inputs added, as given.
   const std::vector<std::filesystem::path>& inputs() const { return inputs_; }
+  /// The outputs claimed, as given.
   const std::vector<std::filesystem::path>& outputs() const { return outputs_; }
 
  private:

@@ -21,7 +21,9 @@ namespace ssx {
 /// line; nothing was started.
 class SSX_EXPORT SceneError : public Error {
  public:
+  /// An error made of these diagnostics: what() lists them in the order given, then the count of errors.
   explicit SceneError(std::vector<Diagnostic> diagnostics);
+  /// Every error and warning found, each with its file and line.
   const std::vector<Diagnostic>& diagnostics() const noexcept { return diagnostics_; }
 
  private:
@@ -29,33 +31,35 @@ class SSX_EXPORT SceneError : public Error {
 };
 
 /// An attribute of the scene file set before the file is read: how a sweep varies a scene.
-/// `target` is a path from <scene>: steps separated by '/', each `name`, `name[k]` (the k-th child
+/// `target` is a path from `<scene>`: steps separated by '/', each `name`, `name[k]` (the k-th child
 /// of that name, from 1) or `name[attribute=value]`, then `@attribute`; for example
 /// `environment@timestep` or `swarm[name=quad{i}]/driver@formation_gain`. Every step must match
 /// exactly one element of the scene file itself (not of its includes or artifact files), except
-/// that a missing `driver` or `sensor[index=K]` of an <artifact> or <swarm> is added (that is
-/// where a placement sets its type's plugin parameters), and so is a missing <environment>,
-/// <physics> or <render>. A path that does not fit, and the
+/// that a missing `driver` or `sensor[index=K]` of an `<artifact>` or `<swarm>` is added (that is
+/// where a placement sets its type's plugin parameters), and so is a missing `<environment>`,
+/// `<physics>` or `<render>`. A path that does not fit, and the
 /// value's own problems, are reported at `where`.
 struct AttributeOverride {
-  std::string target;
-  std::string value;
-  SourceLocation where;
+  std::string target;    ///< the path described above
+  std::string value;     ///< the attribute's new text
+  SourceLocation where;  ///< where the override was given (a sweep file's line), for messages
 };
 
 /// How to load a scene, beyond what the file says.
 struct SceneOptions {
-  /// Plugin directories searched after the scene's own <plugin_path>s and before the installed
+  /// Plugin directories searched after the scene's own `<plugin_path>`s and before the installed
   /// plugin directory (the CLI puts --plugin-path, then SSX_PLUGIN_PATH, here).
   std::vector<std::filesystem::path> plugin_path;
-  std::optional<std::uint64_t> seed;         ///< overrides <environment seed>
-  std::optional<int> threads;                ///< overrides <environment threads>
-  std::optional<std::string> render_engine;  ///< overrides <render engine>
-  /// Overrides <physics engine>; the scene's attributes of another engine are then errors.
+  std::optional<std::uint64_t> seed;         ///< overrides `<environment seed>`
+  std::optional<int> threads;                ///< overrides `<environment threads>`
+  std::optional<std::string> render_engine;  ///< overrides `<render engine>`
+  /// Overrides `<physics engine>`; the scene's attributes of another engine are then errors.
   std::optional<std::string> physics_engine;
   /// Outputs for the first camera (a camera framing the whole scene is added if there is none):
   /// a PNG of the last frame, an MP4, a directory of PNG frames. Empty: as the scene says.
-  std::filesystem::path snapshot, video, frames_dir;
+  std::filesystem::path snapshot;
+  std::filesystem::path video;       ///< MP4 of the first camera (see snapshot)
+  std::filesystem::path frames_dir;  ///< PNG frames of the first camera (see snapshot)
   bool search_installed_plugins = true;      ///< append ClassLoader::installedPluginDirectory()
   /// Directories where a `<type name="X"/>` without `file` finds `X.xml`, searched before the
   /// installed artifact directory (installedDataDirectory()/artifacts). A `file` always wins.
@@ -63,7 +67,7 @@ struct SceneOptions {
   bool search_installed_artifacts = true;    ///< append installedDataDirectory()/artifacts
   /// Attributes set before the scene file is read (see AttributeOverride), in order.
   std::vector<AttributeOverride> overrides;
-  /// false: the scene's <extension> elements are left out (headless batch runs: no logger writes,
+  /// false: the scene's `<extension>` elements are left out (headless batch runs: no logger writes,
   /// no bridge connects).
   bool extensions = true;
   /// Outputs written as streams (a logger's file) may be FIFOs or character devices (RunFiles).
@@ -83,10 +87,10 @@ struct SceneOptions {
 
 /// A loaded scene: an environment ready to start, and how the file asks to run it.
 struct Scene {
-  std::filesystem::path file;
-  std::unique_ptr<Environment> environment;
+  std::filesystem::path file;                ///< the scene file (or the label of a scene in memory)
+  std::unique_ptr<Environment> environment;  ///< populated, not started
   RunOptions run;                       ///< real-time factor and overrun policy from the file
-  std::optional<Nanoseconds> duration;  ///< <environment duration>, if given
+  std::optional<Nanoseconds> duration;  ///< `<environment duration>`, if given
   std::vector<Diagnostic> warnings;     ///< unknown elements and attributes, and the like
   /// The files the scene was read from, and the outputs its plugins and cameras write, checked
   /// against each other; claim the program's own outputs here before anything runs.
@@ -94,8 +98,8 @@ struct Scene {
 };
 
 /// Where the installed artifact types (`artifacts/`) and example scenes (`scenes/`) are: the
-/// package's data directory (<prefix>/share/ssx), found from the location of this libssx, so it
-/// moves with the installation; in a build tree, <build>/share/ssx. Empty if there is none.
+/// package's data directory (`<prefix>/share/ssx`), found from the location of this libssx, so it
+/// moves with the installation; in a build tree, `<build>/share/ssx`. Empty if there is none.
 SSX_EXPORT std::filesystem::path installedDataDirectory();
 
 /// Parses a scene file and every file it includes, loads every plugin it names and creates every

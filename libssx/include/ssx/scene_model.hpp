@@ -34,7 +34,7 @@ SSX_EXPORT Pose poseFromXyzRpy(const Vec3& xyz, const Vec3& rpy);
 
 /// A plugin as a file declares it: `<driver plugin="..." class="..." period="..." .../>`.
 struct PluginDeclaration {
-  std::string plugin;          ///< the library (libssx_<plugin>.so)
+  std::string plugin;          ///< the library (libssx_`<plugin>`.so)
   std::string class_name;      ///< the class in it (default: the library's name)
   std::int64_t period = 1;     ///< steps between two runs
   SourceLocation period_from;  ///< where `period` was given, if it was
@@ -43,66 +43,74 @@ struct PluginDeclaration {
 
 /// An artifact file, parsed: its node trees and the plugins it declares.
 struct ArtifactTypeModel {
-  std::string name;            ///< as <type name> declares it
+  std::string name;            ///< as `<type name>` declares it
   std::filesystem::path file;  ///< the artifact file
-  SourceLocation where;        ///< of the <type>
+  SourceLocation where;        ///< of the `<type>`
   std::vector<std::shared_ptr<const PhysicNodeSpec>> physic;  ///< shared by every instance
-  std::vector<std::shared_ptr<const RenderNodeSpec>> render;
-  std::optional<PluginDeclaration> driver;
-  std::vector<PluginDeclaration> sensors;
+  std::vector<std::shared_ptr<const RenderNodeSpec>> render;  ///< shared by every instance
+  std::optional<PluginDeclaration> driver;  ///< its driver, if it declares one
+  std::vector<PluginDeclaration> sensors;   ///< its sensors, by index
 };
 
-/// One element of the scene that makes artifacts, in document order: an <artifact>, a <swarm>
-/// (its members' places worked out), the <ground> or an <obstacle>.
+/// One element of the scene that makes artifacts, in document order: an `<artifact>`, a `<swarm>`
+/// (its members' places worked out), the `<ground>` or an `<obstacle>`.
 struct SSX_EXPORT PlacementModel {
+  /// Which element it is.
   enum class Kind : std::uint8_t { Artifact, Swarm, Ground, Obstacle };
-  Kind kind = Kind::Artifact;
-  SourceLocation where;
+  Kind kind = Kind::Artifact;  ///< which element it is
+  SourceLocation where;        ///< of the element
   std::string name;  ///< the artifact's or obstacle's name; a swarm's name pattern (with {i})
   std::string type;  ///< the artifact type (artifacts, swarms)
-  Vec3 xyz = Vec3::Zero(), rpy = Vec3::Zero();  ///< as written: position, fixed-axis roll pitch yaw (rad)
+  Vec3 xyz = Vec3::Zero();  ///< as written: position, m
+  Vec3 rpy = Vec3::Zero();  ///< as written: fixed-axis roll, pitch, yaw, rad
   Pose pose() const;                            ///< from xyz and rpy
-  /// Parameters the placing element sets on its type's plugins: <driver .../> and <sensor
-  /// index="k" .../> inside it (null: none). A swarm's members share them; {i} in a value is the
+  /// Parameters the placing element sets on its type's plugins: `<driver .../>` and
+  /// `<sensor index="k" .../>` inside it (null: none). A swarm's members share them; {i} in a value is the
   /// member's index.
   std::shared_ptr<const Descriptor> driver;
   std::vector<std::shared_ptr<const Descriptor>> sensors;  ///< by sensor index of the type
   // a swarm
-  std::int64_t count = 1, first_index = 0;
+  std::int64_t count = 1;        ///< swarm: how many members
+  std::int64_t first_index = 0;  ///< swarm: the first member's {i}
   std::string layout = "grid";  ///< grid, random or sphere
   double spacing = 1.0;         ///< grid
-  std::int64_t columns = 0, rows = 0;  ///< grid
-  Vec3 min = Vec3(-1, -1, 0), max = Vec3(1, 1, 1);  ///< random: the box
+  std::int64_t columns = 0;     ///< grid: members per row (parsing fills in ceil(sqrt(count)) when not given)
+  std::int64_t rows = 0;        ///< grid: rows (parsing fills in as many as needed)
+  Vec3 min = Vec3(-1, -1, 0);   ///< random: the box's lower corner
+  Vec3 max = Vec3(1, 1, 1);     ///< random: the box's upper corner
   double min_distance = 0;                            ///< random
   double radius = 1.0;                                ///< sphere
   std::vector<Vec3> positions;  ///< the members' places in the swarm's frame (xyz, rpy)
   std::string memberName(std::int64_t k) const;  ///< member k's name (the pattern with {i} = first_index + k)
-  // the ground: its height is xyz.z(); an obstacle: its element as written (shapes and colour)
+  /// An obstacle: its element as written (shapes and colour). (The ground's height is xyz.z().)
   std::shared_ptr<const Descriptor> obstacle;
 };
 
-/// An <extension>: its name and its plugin.
+/// An `<extension>`: its name and its plugin.
 struct ExtensionModel {
-  std::string name;
-  PluginDeclaration plugin;
+  std::string name;          ///< unique among the scene's extensions
+  PluginDeclaration plugin;  ///< its plugin, class and parameters
 };
 
+/// A scene as a value: everything a scene file says, parsed and checked, with no environment
+/// built (parseScene makes one; buildScene turns it into an environment). What `ssx validate`
+/// checks, what a sweep varies and what a recording keeps.
 struct SSX_EXPORT SceneModel {
   std::filesystem::path file;  ///< the scene file, or the label of a scene in memory
-  EnvironmentSettings settings;
+  EnvironmentSettings settings;  ///< timestep, seed, threads, physics, render, wind (defaults filled in)
   RunOptions run;                          ///< realtime_factor and overrun, as the file says
-  std::optional<Nanoseconds> duration;     ///< <environment duration>
-  std::vector<std::filesystem::path> plugin_dirs;  ///< <plugin_path>s, resolved
-  std::vector<ExtensionModel> extensions;
+  std::optional<Nanoseconds> duration;     ///< `<environment duration>`
+  std::vector<std::filesystem::path> plugin_dirs;  ///< `<plugin_path>`s, resolved
+  std::vector<ExtensionModel> extensions;  ///< in document order
   std::map<std::string, ArtifactTypeModel> types;  ///< the types the placements use, by name
   std::vector<PlacementModel> placements;          ///< in document order
   std::vector<Diagnostic> warnings;                ///< unknown elements and attributes, and the like
-  /// Where each setting the file gives was written (the settings above hold the values, defaults
-  /// included), keyed element@attribute as sweep overrides spell them: "environment@timestep",
-  /// "physics@engine", "wind@speed", "render@rate_hz", "render/camera[name=top]@xyz". A setting
-  /// the file leaves out has no entry (its value is the default).
   /// Every file read: the scene file, its includes, the artifact files (the run's inputs).
   std::vector<std::filesystem::path> files;
+  /// Where each setting the file gives was written (the settings above hold the values, defaults
+  /// included), keyed `element@attribute` as sweep overrides spell them: `environment@timestep`,
+  /// `physics@engine`, `wind@speed`, `render@rate_hz`, `render/camera[name=top]@xyz`. A setting
+  /// the file leaves out has no entry (its value is the default).
   std::map<std::string, SourceLocation> settings_from;
 
   /// The scene as scene XML with every setting's default filled in: plugin directories, artifact

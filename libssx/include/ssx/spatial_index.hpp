@@ -15,11 +15,15 @@
 
 namespace ssx {
 
+/// A uniform grid over points with ids, for "who is within r of here" queries: the neighbour
+/// queries of Environment and the range sensors use one. Rebuilt whole each step; queries are
+/// read-only and safe from many threads at once.
 class SSX_EXPORT SpatialIndex {
  public:
   /// `cell_size` in m; queries are cheapest when it is about the typical query radius.
   explicit SpatialIndex(double cell_size = 2.0);
 
+  /// The cell edge length, m.
   double cellSize() const noexcept { return cell_size_; }
   /// Replaces the contents: point i gets the id ids[i] (ids.size() == points.size()).
   void rebuild(const std::vector<Vec3>& points, const std::vector<std::size_t>& ids);
@@ -28,15 +32,17 @@ class SSX_EXPORT SpatialIndex {
   void query(const Vec3& center, double radius, std::vector<std::size_t>& out) const;
   /// A point found by a query: its id and indexed position.
   struct Hit {
-    std::size_t id;
-    Vec3 point;
+    std::size_t id;  ///< the id given to rebuild
+    Vec3 point;      ///< the position indexed
   };
   /// Same, with the points (in ascending id order).
   void query(const Vec3& center, double radius, std::vector<Hit>& out) const;
   /// Calls visit(context, id, point) for each point within `radius` of `center`, in the index's
   /// order (no particular one): for a caller that orders what it keeps itself, without a list.
   using Visitor = void (*)(void* context, std::size_t id, const Vec3& point);
+  /// @copydoc Visitor
   void forEach(const Vec3& center, double radius, Visitor visit, void* context) const;
+  /// How many points the last rebuild indexed.
   std::size_t size() const noexcept { return entries_.size(); }
   /// Whether the last rebuild chose the dense column table (else the hash table).
   bool dense() const noexcept { return !dense_start_.empty(); }

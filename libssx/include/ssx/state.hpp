@@ -34,8 +34,10 @@ class SSX_EXPORT StateError : public Error {
 /// Appends values to a byte buffer.
 class StateWriter {
  public:
+  /// A writer appending to `out`, which must outlive it.
   explicit StateWriter(std::vector<std::byte>& out) : out_(&out) {}
 
+  /// Appends `size` raw bytes.
   void bytes(const void* data, std::size_t size) {
     const auto* p = static_cast<const std::byte*>(data);
     out_->insert(out_->end(), p, p + size);
@@ -46,12 +48,16 @@ class StateWriter {
   void write(const T& value) {
     bytes(&value, sizeof value);
   }
+  /// A vector: x, y, z as doubles.
   void write(const Vec3& v) { bytes(v.data(), 3 * sizeof(double)); }
+  /// A quaternion: x, y, z, w as doubles.
   void write(const Quat& q) { bytes(q.coeffs().data(), 4 * sizeof(double)); }
+  /// A pose: its position, then its orientation.
   void write(const Pose& p) {
     write(p.position);
     write(p.orientation);
   }
+  /// A text: its length (64 bits), then its bytes.
   void write(const std::string& s) {
     write(static_cast<std::uint64_t>(s.size()));
     bytes(s.data(), s.size());
@@ -63,7 +69,9 @@ class StateWriter {
     for (const T& x : v) write(x);
   }
 
+  /// Bytes in the buffer so far (what was there before included).
   std::size_t size() const noexcept { return out_->size(); }
+  /// The buffer written to.
   std::vector<std::byte>& buffer() noexcept { return *out_; }
 
  private:
@@ -74,9 +82,11 @@ class StateWriter {
 class StateReader {
  public:
   StateReader() = default;
+  /// A reader of `data` (which must outlive it); `what` names the data in error messages.
   explicit StateReader(std::span<const std::byte> data, std::string what = "saved state")
       : data_(data), what_(std::move(what)) {}
 
+  /// Reads `size` raw bytes into `out`; throws StateError when fewer are left.
   void bytes(void* out, std::size_t size) {
     if (size > remaining())
       throw StateError(what_ + " ends early: " + std::to_string(size) + " more bytes wanted, " +
@@ -84,6 +94,7 @@ class StateReader {
     std::memcpy(out, data_.data() + at_, size);
     at_ += size;
   }
+  /// A trivially copyable value, as StateWriter::write wrote it.
   template <class T>
     requires std::is_trivially_copyable_v<T>
   void read(T& value) {
@@ -96,16 +107,21 @@ class StateReader {
     if (byte > 1) throw StateError(what_ + ": a flag reads " + std::to_string(byte) + ", not 0 or 1 (corrupted)");
     value = byte == 1;
   }
+  /// A vector: x, y, z as doubles.
   void read(Vec3& v) { bytes(v.data(), 3 * sizeof(double)); }
+  /// A quaternion: x, y, z, w as doubles.
   void read(Quat& q) { bytes(q.coeffs().data(), 4 * sizeof(double)); }
+  /// A pose: its position, then its orientation.
   void read(Pose& p) {
     read(p.position);
     read(p.orientation);
   }
+  /// A text: its length, then its bytes (a length beyond the data is StateError).
   void read(std::string& s) {
     s.resize(count(1));
     bytes(s.data(), s.size());
   }
+  /// A vector: its size, then each element as `read` reads it.
   template <class T>
   void read(std::vector<T>& v) {
     v.resize(count(1));
@@ -133,8 +149,11 @@ class StateReader {
     return r;
   }
 
+  /// Bytes not read yet.
   std::size_t remaining() const noexcept { return data_.size() - at_; }
+  /// Whether every byte was read.
   bool done() const noexcept { return at_ == data_.size(); }
+  /// What the data is called in messages.
   const std::string& what() const noexcept { return what_; }
 
  private:

@@ -14,7 +14,7 @@ namespace ssx {
 
 /// Wall-clock cost of one step, in nanoseconds.
 struct StepTiming {
-  std::int64_t step = 0;
+  std::int64_t step = 0;     ///< index of the step
   Nanoseconds physics = 0;   ///< the engine's own step (collision and integration)
   Nanoseconds snapshot = 0;  ///< publishing the new state, checking it for NaN
   Nanoseconds sensors = 0;   ///< parallel sensors phase
@@ -28,8 +28,15 @@ struct StepTiming {
 struct SSX_EXPORT TimingSummary {
   std::int64_t steps = 0;        ///< every step summarised (of a run: every step it made)
   std::int64_t timed_steps = 0;  ///< the newest of them whose times the ring kept: what the times below cover
-  double median_ms = 0, p95_ms = 0, p99_ms = 0, max_ms = 0, mean_ms = 0;  ///< step compute time
-  double physics_median_ms = 0, sensors_median_ms = 0, drivers_median_ms = 0, render_median_ms = 0;
+  double median_ms = 0;  ///< step compute time: median
+  double p95_ms = 0;     ///< step compute time: 95th percentile
+  double p99_ms = 0;     ///< step compute time: 99th percentile
+  double max_ms = 0;     ///< step compute time: the longest
+  double mean_ms = 0;    ///< step compute time: mean
+  double physics_median_ms = 0;  ///< median of the physics phase
+  double sensors_median_ms = 0;  ///< median of the sensors phase
+  double drivers_median_ms = 0;  ///< median of the drivers phase
+  double render_median_ms = 0;   ///< median of the render phase
   std::int64_t overruns = 0;  ///< steps that ended after their deadline (real-time runs)
   /// Of the overruns, as Environment::run tells them apart (a summary made by TimingRecorder
   /// alone leaves both 0): steps that took longer than a step's period of wall time
@@ -39,7 +46,7 @@ struct SSX_EXPORT TimingSummary {
   /// late from its sleep to the deadline (a real-time priority helps: RunOptions::realtime_priority),
   /// or held up between steps (RunOptions::on_step). The rest followed a late step (catching up).
   std::int64_t overruns_began_late = 0;
-  double max_lateness_ms = 0;
+  double max_lateness_ms = 0;  ///< how far past its deadline the latest step ended
   double wall_s = 0;           ///< wall-clock time of the run
   double simulated_s = 0;      ///< simulated time covered
   double realtime_factor = 0;  ///< simulated_s / wall_s
@@ -56,11 +63,15 @@ class SSX_EXPORT TimingRecorder {
  public:
   /// 262,144 samples (16 MiB): 4.4 minutes at 1 kHz, 87 minutes at 50 Hz.
   static constexpr std::size_t kDefaultCapacity = std::size_t{1} << 18;
+  /// A recorder keeping the newest `capacity` samples (at least 1), allocated now.
   explicit TimingRecorder(std::size_t capacity = kDefaultCapacity);
+  /// Records one step's timing (overwriting the oldest when full). Never allocates.
   void add(const StepTiming& sample) noexcept;
+  /// Forgets every sample (the ring stays allocated).
   void clear() noexcept;
   /// Samples kept (at most capacity()).
   std::size_t size() const noexcept { return size_; }
+  /// Samples the ring holds at most.
   std::size_t capacity() const noexcept { return ring_.size(); }
   /// Samples added since construction or clear(), kept or not: a mark for summary().
   std::int64_t recorded() const noexcept { return recorded_; }

@@ -12,9 +12,9 @@
 
 namespace ssx {
 
-using Vec3 = Eigen::Vector3d;
-using Mat3 = Eigen::Matrix3d;
-using Quat = Eigen::Quaterniond;
+using Vec3 = Eigen::Vector3d;     ///< a 3-vector (positions in m, velocities, forces), Eigen's
+using Mat3 = Eigen::Matrix3d;     ///< a 3x3 matrix (inertia tensors), Eigen's
+using Quat = Eigen::Quaterniond;  ///< a unit quaternion (orientations), Eigen's
 
 /// Simulation time and durations, in integer nanoseconds: time is a step count times the
 /// timestep, so it never drifts.
@@ -33,8 +33,8 @@ constexpr double toSeconds(Nanoseconds ns) { return static_cast<double>(ns) * 1e
 /// A rigid transform. As the pose of a frame F in a frame W, it maps F-coordinates to W:
 /// `p_W = orientation * p_F + position`.
 struct Pose {
-  Vec3 position = Vec3::Zero();
-  Quat orientation = Quat::Identity();
+  Vec3 position = Vec3::Zero();         ///< of F's origin in W, m
+  Quat orientation = Quat::Identity();  ///< of F's axes in W (unit)
 
   /// The identity transform.
   static Pose identity() { return {}; }
@@ -54,7 +54,7 @@ struct Pose {
 /// The kinematic state of a rigid body or of a point fixed on it, all in the world frame.
 /// Velocities and accelerations are those of the frame's origin.
 struct SSX_EXPORT BodyState {
-  Pose pose;
+  Pose pose;                                 ///< the frame's pose in the world
   Vec3 linear_velocity = Vec3::Zero();       ///< m/s, world frame
   Vec3 angular_velocity = Vec3::Zero();      ///< rad/s, world frame
   Vec3 linear_acceleration = Vec3::Zero();   ///< m/s^2, world frame, gravity included
