@@ -5,6 +5,8 @@
 
 #include "scene_util.hpp"
 
+#include <png.h>
+
 #include <algorithm>
 #include <cstdint>
 #include <filesystem>
@@ -12,6 +14,7 @@
 #include <iterator>
 #include <memory>
 #include <string>
+#include <vector>
 
 namespace ssx::test {
 
@@ -43,6 +46,21 @@ inline double yellowRow(const Image& im) {
       }
     }
   return count > 0 ? sum / count : -1;
+}
+
+// a PNG file read back as an RGB image (libpng's simplified API); empty when it cannot be read
+inline Image readPng(const std::filesystem::path& file) {
+  png_image png{};
+  png.version = PNG_IMAGE_VERSION;
+  Image im;
+  if (png_image_begin_read_from_file(&png, file.c_str()) == 0) return im;
+  png.format = PNG_FORMAT_RGB;
+  std::vector<std::uint8_t> rgb(PNG_IMAGE_SIZE(png));
+  if (png_image_finish_read(&png, nullptr, rgb.data(), 0, nullptr) == 0) return im;
+  im.width = static_cast<int>(png.width);
+  im.height = static_cast<int>(png.height);
+  im.rgb = std::move(rgb);
+  return im;
 }
 
 // the osmesa engine alone, outside any scene

@@ -10,8 +10,9 @@
 // `ssx run --video` gets.
 //
 // --png DIR writes each N's last frame to DIR/render_N.png (to look at what the level of detail does).
+// --shadows 1 draws the robots' shadows, as the scene cameras do (RenderSettings::shadows).
 //
-// usage: ssx_bench_render [--n N]... [--frames K] [--width W] [--height H] [--png DIR]
+// usage: ssx_bench_render [--n N]... [--frames K] [--width W] [--height H] [--shadows 0|1] [--png DIR]
 #include <ssx/ssx.hpp>
 
 #include <algorithm>
@@ -26,7 +27,7 @@
 
 int main(int argc, char** argv) {
   std::vector<int> sizes;
-  int frames = 100, width = 640, height = 480;
+  int frames = 100, width = 640, height = 480, shadows = 0;
   std::string png_dir;
   for (int i = 1; i + 1 < argc; i += 2) {
     const std::string a = argv[i];
@@ -39,8 +40,9 @@ int main(int argc, char** argv) {
     else if (a == "--frames") frames = v;
     else if (a == "--width") width = v;
     else if (a == "--height") height = v;
+    else if (a == "--shadows") shadows = v;
     else {
-      std::fprintf(stderr, "usage: ssx_bench_render [--n N]... [--frames K] [--width W] [--height H] [--png DIR]\n");
+      std::fprintf(stderr, "usage: ssx_bench_render [--n N]... [--frames K] [--width W] [--height H] [--shadows 0|1] [--png DIR]\n");
       return 2;
     }
   }
@@ -65,6 +67,7 @@ int main(int argc, char** argv) {
       ssx::CameraView view;
       view.width = width;
       view.height = height;
+      view.shadows = shadows != 0;
       view.pose.position = centre + distance * ssx::Vec3(0.62, -0.62, 0.48).normalized();
       const ssx::Vec3 forward = (centre - view.pose.position).normalized();
       const ssx::Vec3 left = ssx::Vec3::UnitZ().cross(forward).normalized();
@@ -85,7 +88,7 @@ int main(int argc, char** argv) {
       }
       if (!png_dir.empty()) ssx::writePng(png_dir + "/render_" + std::to_string(n) + ".png", image);
       std::sort(ms.begin(), ms.end());
-      std::printf("n=%d frames=%zu width=%d height=%d median_ms=%.2f p95_ms=%.2f\n", n, ms.size(), width, height,
+      std::printf("n=%d frames=%zu width=%d height=%d shadows=%d median_ms=%.2f p95_ms=%.2f\n", n, ms.size(), width, height, shadows,
                   ms[ms.size() / 2], ms[ms.size() * 95 / 100]);
       std::fflush(stdout);
     } catch (const std::exception& e) {

@@ -162,7 +162,8 @@ void physics(std::ostringstream& out, const PhysicsSettings& p) {
 void render(std::ostringstream& out, const RenderSettings& r) {
   Element e(out, "render", 1);
   e("engine", r.engine)("rate_hz", num(r.rate_hz))("period", num(r.period_steps))(
-      "width", num(std::int64_t{r.width}))("height", num(std::int64_t{r.height}))("background", color(r.background));
+      "width", num(std::int64_t{r.width}))("height", num(std::int64_t{r.height}))("background", color(r.background))(
+      "shadows", r.shadows ? "true" : "false")("time_stamp", r.time_stamp ? "true" : "false");
   if (r.cameras.empty()) {
     e.end();
     return;

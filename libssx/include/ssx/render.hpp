@@ -62,6 +62,9 @@ struct CameraView {
   double near = 0.05;     ///< nearest distance drawn, m
   double far = 200.0;     ///< farthest distance drawn, m
   bool depth = false;               ///< also read the depth image
+  /// Draw a shadow on the ground under every robot (an artifact with a dynamic root), as if lit
+  /// from straight above: the scene's cameras do (RenderSettings::shadows), camera sensors not.
+  bool shadows = false;
 };
 
 /// An image: rows top to bottom, RGB 8 bits each; depth (when asked for) in m along the optical
@@ -101,6 +104,8 @@ struct RenderSettings {
   int width = 640;                ///< frame width, pixels
   int height = 480;               ///< frame height, pixels
   Color background{0.62f, 0.72f, 0.85f, 1.0f};  ///< the sky, RGBA 0..1
+  bool shadows = true;     ///< the scene cameras draw each robot's shadow on the ground
+  bool time_stamp = true;  ///< the scene cameras' frames show the simulated time, top left
   std::vector<CameraSpec> cameras;  ///< frames are drawn only when there is a camera
 };
 

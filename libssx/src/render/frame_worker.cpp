@@ -1,4 +1,5 @@
 #include "render/frame_worker.hpp"
+#include "render/time_stamp.hpp"
 
 #include <pthread.h>
 #include <sys/resource.h>
@@ -20,7 +21,7 @@ FrameWorker::~FrameWorker() {
   }
 }
 
-void FrameWorker::submit(const std::vector<RenderNode>& nodes, std::vector<CameraView> views) {
+void FrameWorker::submit(const std::vector<RenderNode>& nodes, std::vector<CameraView> views, Nanoseconds time) {
   std::unique_lock lock(mutex_);
   changed_.wait(lock, [&] { return queue_.size() < depth_ || error_; });
   if (error_) std::rethrow_exception(error_);
@@ -31,6 +32,7 @@ void FrameWorker::submit(const std::vector<RenderNode>& nodes, std::vector<Camer
   }
   job.nodes.assign(nodes.begin(), nodes.end());
   job.views = std::move(views);
+  job.time = time;
   queue_.push_back(std::move(job));
   changed_.notify_all();
 }
@@ -59,6 +61,7 @@ void FrameWorker::loop() {
       if (!engine) engine = createRenderEngine(settings_);  // its context is made on this thread
       for (std::size_t i = 0; i < job.views.size() && i < outputs_.size(); ++i) {
         engine->renderView(job.views[i], job.nodes, settings_.background, image);
+        if (settings_.time_stamp) stampTime(image, job.time);
         outputs_[i]->add(image);
       }
     } catch (...) {

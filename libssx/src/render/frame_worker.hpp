@@ -31,8 +31,9 @@ class FrameWorker {
   FrameWorker(const FrameWorker&) = delete;
   FrameWorker& operator=(const FrameWorker&) = delete;
 
-  /// Queues one frame: views[i] is drawn for outputs[i]. Rethrows the worker's first error.
-  void submit(const std::vector<RenderNode>& nodes, std::vector<CameraView> views);
+  /// Queues one frame of simulated time `time`: views[i] is drawn for outputs[i] (stamped with
+  /// the time when the settings ask for it). Rethrows the worker's first error.
+  void submit(const std::vector<RenderNode>& nodes, std::vector<CameraView> views, Nanoseconds time = 0);
   /// Draws what is queued, ends the thread, finishes the outputs; rethrows the first error.
   void finish();
 
@@ -40,6 +41,7 @@ class FrameWorker {
   struct Job {
     std::vector<RenderNode> nodes;
     std::vector<CameraView> views;
+    Nanoseconds time = 0;
   };
   void loop();
 

@@ -9,7 +9,9 @@
 // was most of a frame). Primitives outside the view or smaller than a quarter pixel are left out;
 // the coarser a polygon, the larger it is made, so that what a person sees covers the true area;
 // boxes and cylinders thinner than a pixel are drawn as one face. Lighting: a sun from above plus a
-// light at the eye, and a 1 m grid on ground planes.
+// light at the eye, and a 1 m grid on ground planes. Shadows (when the view asks): one dark disc
+// per robot on the ground, straight below it, as wide as the robot and fading with its height,
+// blended over the ground last.
 #include "render/osmesa_engine.hpp"
 #include "render/unit_meshes.hpp"
 
@@ -18,7 +20,9 @@
 #include <GL/glext.h>
 #include <GL/osmesa.h>
 
+#include <ssx/artifact.hpp>
 #include <ssx/error.hpp>
+#include <ssx/physic_node.hpp>
 
 #include <algorithm>
 #include <array>
@@ -205,11 +209,12 @@ struct OsmesaRenderEngine::Gl {
   // every mesh's vertices and triangles, for the batches
   std::vector<Vertex> mesh_vertices[kMeshCount];
   std::vector<unsigned> mesh_indices[kMeshCount];
-  // the batches: [0] one-sided, [1] seen from both sides
-  GLuint batch_vao[2] = {}, batch_vertex_buffer[2] = {}, batch_index_buffer[2] = {};
-  std::size_t batch_vertex_capacity[2] = {}, batch_index_capacity[2] = {};
-  std::vector<BatchVertex> batch_vertices[2];
-  std::vector<unsigned> batch_indices[2];
+  // the batches: [0] one-sided, [1] seen from both sides, [2] the shadows (blended, drawn last)
+  static constexpr int kBatches = 3, kShadowBatch = 2;
+  GLuint batch_vao[kBatches] = {}, batch_vertex_buffer[kBatches] = {}, batch_index_buffer[kBatches] = {};
+  std::size_t batch_vertex_capacity[kBatches] = {}, batch_index_capacity[kBatches] = {};
+  std::vector<BatchVertex> batch_vertices[kBatches];
+  std::vector<unsigned> batch_indices[kBatches];
   std::vector<float> depth;
 };
 
@@ -313,10 +318,10 @@ void OsmesaRenderEngine::setup() {
     }
   }
   // the batches: world positions and lit colours
-  glGenVertexArrays(2, g.batch_vao);
-  glGenBuffers(2, g.batch_vertex_buffer);
-  glGenBuffers(2, g.batch_index_buffer);
-  for (int b = 0; b < 2; ++b) {
+  glGenVertexArrays(Gl::kBatches, g.batch_vao);
+  glGenBuffers(Gl::kBatches, g.batch_vertex_buffer);
+  glGenBuffers(Gl::kBatches, g.batch_index_buffer);
+  for (int b = 0; b < Gl::kBatches; ++b) {
     glBindVertexArray(g.batch_vao[b]);
     glBindBuffer(GL_ARRAY_BUFFER, g.batch_vertex_buffer[b]);
     glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, g.batch_index_buffer[b]);
@@ -369,7 +374,7 @@ void OsmesaRenderEngine::renderView(const CameraView& view, const std::vector<Re
   // drawn with fewer triangles the smaller they appear (a robot 20 pixels wide does not need 20
   // slices per rotor); what would cover less than a quarter of a pixel is not drawn at all
   for (auto& list : g.instances) list.clear();
-  for (int b = 0; b < 2; ++b) {
+  for (int b = 0; b < Gl::kBatches; ++b) {
     g.batch_vertices[b].clear();
     g.batch_indices[b].clear();
   }
@@ -500,18 +505,79 @@ void OsmesaRenderEngine::renderView(const CameraView& view, const std::vector<Re
       case P::Plane: add(kPlane, node.world, Vec3(s.size.x(), s.size.y(), 1.0), s); break;
     }
   }
+  // shadows: the ground is the first plane facing up; a robot's nodes (they come artifact by
+  // artifact) give its footprint, a box around them in x and y; its shadow is a disc of the
+  // box's larger half-width at the box's centre, on the ground, darker the nearer the robot is
+  if (view.shadows) {
+    const RenderNode* ground = nullptr;
+    for (const RenderNode& node : nodes)
+      if (node.spec->primitive == P::Plane && (node.world.orientation * Vec3::UnitZ()).z() > 0.99) {
+        ground = &node;
+        break;
+      }
+    auto& vertices = g.batch_vertices[Gl::kShadowBatch];
+    auto& indices = g.batch_indices[Gl::kShadowBatch];
+    auto footprint = [](const RenderNodeSpec& s) {
+      switch (s.primitive) {
+        case P::Box: return 0.5 * std::hypot(s.size.x(), s.size.y());
+        case P::Sphere:
+        case P::Cylinder:
+        case P::Capsule: return s.radius;
+        default: return -1.0;  // casts none
+      }
+    };
+    auto shadow = [&](const Eigen::AlignedBox2d& box, double bottom) {
+      const double ground_z = ground->world.position.z(), height = bottom - ground_z;
+      if (box.isEmpty() || height < -0.05) return;  // nothing drawn, or below the ground
+      const Vec3 centre(box.center().x(), box.center().y(), ground_z);
+      const double radius = 0.5 * box.sizes().maxCoeff();
+      const int level = detail(centre, radius).level;
+      if (level < 0) return;
+      const auto alpha = static_cast<std::uint8_t>(std::lround(255 * 0.45 / (1 + 0.15 * std::max(height, 0.0))));
+      const std::vector<Vertex>& disc = g.mesh_vertices[kDisc + level];
+      const auto base = static_cast<unsigned>(vertices.size());
+      for (const Vertex& v : disc)
+        vertices.push_back({{static_cast<float>(centre.x() + radius * v.position[0]),
+                             static_cast<float>(centre.y() + radius * v.position[1]), static_cast<float>(ground_z)},
+                            {0, 0, 0, alpha}});
+      for (unsigned k : g.mesh_indices[kDisc + level]) indices.push_back(base + k);
+    };
+    if (ground != nullptr) {
+      const Artifact* owner = nullptr;
+      Eigen::AlignedBox2d box;
+      double bottom = 0;
+      for (const RenderNode& node : nodes) {
+        if (node.artifact != owner) {
+          if (owner != nullptr) shadow(box, bottom);
+          owner = node.artifact;
+          box.setEmpty();
+          bottom = std::numeric_limits<double>::infinity();
+          // only robots: artifacts with a dynamic body
+          if (owner != nullptr && (owner->rootCount() == 0 || owner->root().isStatic())) owner = nullptr;
+          if (owner == nullptr) continue;
+        }
+        if (owner == nullptr) continue;
+        const double r = footprint(*node.spec);
+        if (r < 0) continue;
+        const Eigen::Vector2d at = node.world.position.head<2>();
+        box.extend(at - Eigen::Vector2d::Constant(r));
+        box.extend(at + Eigen::Vector2d::Constant(r));
+        bottom = std::min(bottom, node.world.position.z());
+      }
+      if (owner != nullptr) shadow(box, bottom);
+    }
+  }
 
   glViewport(0, 0, view.width, view.height);
   glClearColor(background[0], background[1], background[2], background[3]);
   glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
   // first what appears small: the batches, one call each
-  glUseProgram(g.batch_program);
-  glUniformMatrix4fv(g.batch_view_projection, 1, GL_FALSE, vp.data());
-  for (int b = 0; b < 2; ++b) {
+  auto drawBatch = [&](int b) {
     const auto& vertices = g.batch_vertices[b];
     const auto& indices = g.batch_indices[b];
-    if (indices.empty()) continue;
-    if (b == 1) glDisable(GL_CULL_FACE);
+    if (indices.empty()) return;
+    glUseProgram(g.batch_program);
+    glUniformMatrix4fv(g.batch_view_projection, 1, GL_FALSE, vp.data());
     glBindVertexArray(g.batch_vao[b]);
     glBindBuffer(GL_ARRAY_BUFFER, g.batch_vertex_buffer[b]);
     const std::size_t vertex_bytes = vertices.size() * sizeof(BatchVertex), index_bytes = indices.size() * sizeof(unsigned);
@@ -526,8 +592,11 @@ void OsmesaRenderEngine::renderView(const CameraView& view, const std::vector<Re
     }
     glBufferSubData(GL_ELEMENT_ARRAY_BUFFER, 0, static_cast<GLsizeiptr>(index_bytes), indices.data());
     glDrawElements(GL_TRIANGLES, static_cast<GLsizei>(indices.size()), GL_UNSIGNED_INT, nullptr);
-    if (b == 1) glEnable(GL_CULL_FACE);
-  }
+  };
+  drawBatch(0);
+  glDisable(GL_CULL_FACE);
+  drawBatch(1);
+  glEnable(GL_CULL_FACE);
   // then what appears large, instanced, one call per mesh (the ground last: what stands on it hides
   // part of it, and llvmpipe shades no pixel that fails the depth test)
   for (int f = 0; f < 2; ++f) {
@@ -553,6 +622,21 @@ void OsmesaRenderEngine::renderView(const CameraView& view, const std::vector<Re
     glBufferSubData(GL_ARRAY_BUFFER, 0, static_cast<GLsizeiptr>(bytes), list.data());
     glDrawElementsInstanced(GL_TRIANGLES, g.index_count[m], GL_UNSIGNED_INT, nullptr, static_cast<GLsizei>(list.size()));
     if (twoSided(m)) glEnable(GL_CULL_FACE);
+  }
+  // the shadows, over the ground: blended, pulled towards the eye so that they win against the
+  // ground they lie on, without writing depth (so they never hide each other)
+  if (!g.batch_indices[Gl::kShadowBatch].empty()) {
+    glDisable(GL_CULL_FACE);
+    glEnable(GL_BLEND);
+    glBlendFunc(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA);
+    glDepthMask(GL_FALSE);
+    glEnable(GL_POLYGON_OFFSET_FILL);
+    glPolygonOffset(-2.0f, -4.0f);
+    drawBatch(Gl::kShadowBatch);
+    glDisable(GL_POLYGON_OFFSET_FILL);
+    glDepthMask(GL_TRUE);
+    glDisable(GL_BLEND);
+    glEnable(GL_CULL_FACE);
   }
   glBindVertexArray(0);
   if (view.depth) {

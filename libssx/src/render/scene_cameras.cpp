@@ -78,6 +78,7 @@ SceneCameras::~SceneCameras() = default;
 
 void SceneCameras::start(const RenderSettings& r, Nanoseconds timestep, const RenderEngine& renderer,
                          const Artifacts& artifacts, const Log& warn) {
+  timestep_ = timestep;
   // render roots follow their physic nodes, looked up once
   follow_.clear();
   for (const auto& a : artifacts) {
@@ -180,6 +181,7 @@ void SceneCameras::drawFrame(std::int64_t step, const RenderSettings& settings, 
     view.width = settings.width;
     view.height = settings.height;
     view.fov_deg = c.spec.fov_deg;
+    view.shadows = settings.shadows;
     if (c.follow != nullptr) {
       // in the followed robot's frame, turning with its heading only: the picture stays level
       const Pose root = c.follow->root().pose();
@@ -200,7 +202,7 @@ void SceneCameras::drawFrame(std::int64_t step, const RenderSettings& settings, 
     views.push_back(view);
   }
   try {
-    worker_->submit(items_, std::move(views));
+    worker_->submit(items_, std::move(views), (step + 1) * timestep_);
   } catch (const std::exception& e) {
     throw StepError("", "render", step, std::string("drawing or writing frames: ") + e.what());
   }

@@ -69,6 +69,7 @@ class SceneCameras {
   std::vector<RenderNode> items_;
   std::int64_t items_step_ = -1;  // the step items_ were posed for
   std::unique_ptr<FrameWorker> worker_;
+  Nanoseconds timestep_ = 0;  // for the time a frame shows
   std::int64_t frames_ = 0;
 };
 

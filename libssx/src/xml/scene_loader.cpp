@@ -309,6 +309,8 @@ void SceneLoader::readRender(const Descriptor& d) {
   r.width = static_cast<int>(readCount(d, "width", r.width, 1, kMaxImageSide));
   r.height = static_cast<int>(readCount(d, "height", r.height, 1, kMaxImageSide));
   r.background = readColor(d, r.background, "background");
+  r.shadows = read<bool>(d, "shadows", r.shadows);
+  r.time_stamp = read<bool>(d, "time_stamp", r.time_stamp);
   for (const Descriptor* c : d.childrenNamed("camera")) {
     CameraSpec cam;
     cam.name = read<std::string>(*c, "name", "camera" + std::to_string(r.cameras.size()));

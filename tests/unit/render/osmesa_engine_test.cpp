@@ -106,3 +106,77 @@ TEST_CASE("render: what appears small (placed and lit per vertex) has the colour
     }
   }
 }
+
+namespace {
+
+// pixels of `shaded` darker than the same pixel of `plain` (by more than 6 in the sum of its
+// channels), the mean darkening, and their mean row; and how many pixels are brighter instead
+struct Darker {
+  int count = 0, brighter = 0;
+  double mean = 0, row = -1;
+};
+Darker darker(const Image& plain, const Image& shaded) {
+  Darker d;
+  double sum = 0, rows = 0;
+  for (int y = 0; y < plain.height; ++y)
+    for (int x = 0; x < plain.width; ++x) {
+      const std::uint8_t *a = plain.pixel(x, y), *b = shaded.pixel(x, y);
+      const int drop = (a[0] + a[1] + a[2]) - (b[0] + b[1] + b[2]);
+      if (drop > 6) {
+        ++d.count;
+        sum += drop;
+        rows += y;
+      } else if (drop < -3) {
+        ++d.brighter;
+      }
+    }
+  if (d.count > 0) {
+    d.mean = sum / d.count;
+    d.row = rows / d.count;
+  }
+  return d;
+}
+
+}  // namespace
+
+TEST_CASE("render: a robot casts a shadow on the ground below it, fainter the higher it flies; without ground none",
+          "[render][shadows]") {
+  REQUIRE(haveOsmesa());
+  auto engine = osmesaEngine();
+  for (bool ground : {true, false}) {
+    Scene s = loadRenderScene(std::string(ground ? "<ground/>" : "") + R"(<render engine="osmesa"/>
+      <type name="post" file="camera_post.xml"/><artifact name="eye" type="post" xyz="0 0 1"/>
+      <type name="ball" file="yellow_ball.xml"/><artifact name="ball" type="ball" xyz="6 0 1.5"/>)");
+    Environment& env = *s.environment;
+    env.step();  // the camera sensor poses the render nodes
+    CameraView view;  // from above and behind, looking down at the ball
+    view.pose = Pose{Vec3(0, 0, 5), Quat(Eigen::AngleAxisd(0.6, Vec3::UnitY()))};
+    Image plain, shaded;
+    engine->renderView(view, env.renderNodes(), {0.2f, 0.4f, 0.6f, 1}, plain);
+    view.shadows = true;
+    engine->renderView(view, env.renderNodes(), {0.2f, 0.4f, 0.6f, 1}, shaded);
+    const Darker low = darker(plain, shaded);
+    INFO("ground " << ground << ": " << low.count << " pixels darker by " << low.mean << " on average");
+    CHECK(low.brighter == 0);
+    if (!ground) {
+      CHECK(low.count == 0);
+      continue;
+    }
+    CHECK(low.count > 100);
+    CHECK(low.row > yellowRow(plain));  // below the ball in the picture: on the ground
+    CHECK(yellowRow(shaded) == Approx(yellowRow(plain)).margin(0.5));  // the ball itself is as it was
+    // the same ball 3 m higher: a fainter shadow in the same place on the ground
+    const int body = env.findArtifact("ball")->root().bodyIndex();
+    BodyState high = env.bodyState(body);
+    high.pose.position.z() += 3;
+    env.setBodyState(body, high);
+    env.step();
+    engine->renderView(view, env.renderNodes(), {0.2f, 0.4f, 0.6f, 1}, shaded);
+    view.shadows = false;
+    engine->renderView(view, env.renderNodes(), {0.2f, 0.4f, 0.6f, 1}, plain);
+    const Darker far = darker(plain, shaded);
+    CHECK(far.count > 100);
+    CHECK(far.mean < 0.8 * low.mean);
+    CHECK(far.row == Approx(low.row).margin(3));
+  }
+}

@@ -1,7 +1,9 @@
-// Scene cameras: numbered PNG frames at the render rate and a snapshot at the end.
+// Scene cameras: numbered PNG frames at the render rate and a snapshot at the end, stamped with the
+// simulated time, with the robots' shadows.
 // Headless (OSMesa); every test name contains "render".
 #include <ssx/ssx.hpp>
 
+#include "render/time_stamp.hpp"
 #include "render_util.hpp"
 
 #include <catch2/catch.hpp>
@@ -101,4 +103,47 @@ TEST_CASE("render: a camera that frames the scene keeps every robot in the image
   CHECK(inView() == 9);
   CHECK((env.cameras().at(0).position - env.cameras().at(0).look_at).norm() > first_distance);  // it widened
   env.stop();
+}
+
+TEST_CASE("render: scene camera frames show the simulated time of their step and the robots' shadows; either can be "
+          "turned off", "[render][time_stamp][shadows]") {
+  REQUIRE(haveOsmesa());
+  auto snapshot = [](const std::string& flags, const std::string& name) {
+    const fs::path file = fs::current_path() / name;
+    fs::remove(file);
+    Scene s = loadRenderScene(R"(<render engine="osmesa" rate_hz="10" width="320" height="240" )" + flags + R"(>
+        <camera name="side" xyz="-4 -4 4" look_at="0 0 1" snapshot=")" + file.string() + R"("/>
+      </render><ground/>
+      <type name="ball" file="yellow_ball.xml"/><artifact name="ball" type="ball" xyz="0 0 3"/>)");
+    s.environment->step(250);  // frames at steps 0, 50, ..., 200: the last shows t = 201 * 2 ms
+    s.environment->stop();
+    return readPng(file);
+  };
+  const Image plain = snapshot(R"(shadows="false" time_stamp="false")", "plain.png");
+  const Image both = snapshot("", "both.png");
+  const Image shadow_only = snapshot(R"(time_stamp="false")", "shadow_only.png");
+  REQUIRE(plain.width == 320);
+  REQUIRE(both.width == 320);
+  REQUIRE(shadow_only.width == 320);
+  // the stamp is exactly the plain frame stamped with that time, in the corner; nothing else differs
+  Image stamped = shadow_only;
+  detail::stampTime(stamped, 201 * 2'000'000);
+  CHECK(stamped.rgb == both.rgb);
+  CHECK(shadow_only.rgb != both.rgb);
+  // the shadow: only darker pixels than the plain frame, below the ball in the picture
+  int darker = 0, brighter = 0;
+  double rows = 0;
+  for (int y = 0; y < plain.height; ++y)
+    for (int x = 0; x < plain.width; ++x) {
+      const std::uint8_t *a = plain.pixel(x, y), *b = shadow_only.pixel(x, y);
+      const int drop = (a[0] + a[1] + a[2]) - (b[0] + b[1] + b[2]);
+      if (drop > 6) {
+        ++darker;
+        rows += y;
+      }
+      brighter += drop < -3 ? 1 : 0;
+    }
+  CHECK(darker > 50);
+  CHECK(brighter == 0);
+  CHECK(rows / std::max(darker, 1) > yellowRow(plain));
 }
