@@ -230,7 +230,7 @@ int commandRun(const RunArgs& args, bool realtime_given) {
     if (now.crashed > crashes_said) {
       progress.finish();
       std::cerr << "ssx: warning: t = " << ssx::toSeconds(e.time()) << " s: " << now.crashed
-                << " robot(s) tilted over (crashed): " << (now.crashed_names.empty() ? "" : now.crashed_names.back())
+                << " robot(s) crashed (tilted over, or down after an impact): " << (now.crashed_names.empty() ? "" : now.crashed_names.back())
                 << (now.crashed > 1 ? " and others" : "") << '\n';
     }
     crashes_said = now.crashed;

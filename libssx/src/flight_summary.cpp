@@ -49,22 +49,38 @@ void FlightRecorder::start(const Environment& env) {
       }
       continue;
     }
-    robots_.push_back({i, reach(root.spec(), Pose{}), root.pose().position, 0.0});
+    robots_.push_back({i, reach(root.spec(), Pose{}), root.pose().position, root.state().linear_velocity, 0.0});
   }
   summary_.robots = static_cast<std::int64_t>(robots_.size());
+  last_time_ = toSeconds(env.time());
 }
 
 void FlightRecorder::observe(const Environment& env) {
   if (!started_) start(env);
   ++summary_.samples;
+  const double now = toSeconds(env.time());
+  const double explained = kManoeuvre * std::max(now - last_time_, 0.0);
+  last_time_ = now;
   std::vector<Vec3> points;
   std::vector<std::size_t> ids;
   double largest = 0;
   for (std::size_t k = 0; k < robots_.size(); ++k) {
     Robot& r = robots_[k];
-    const Vec3 p = env.artifact(r.artifact).root().pose().position;
+    const BodyState s = env.artifact(r.artifact).root().state();
+    const Vec3& p = s.pose.position;
     r.flown += (p - r.last).norm();
     r.last = p;
+    // an impact: a change of velocity no thrust explains
+    const double change = (s.linear_velocity - r.last_velocity).norm() - explained;
+    r.last_velocity = s.linear_velocity;
+    const bool hitting = change > kImpactSpeed;
+    if (hitting && !r.hitting) ++summary_.impacts;
+    r.hitting = hitting;
+    r.hit = r.hit || hitting;
+    if (change > summary_.hardest_impact_mps && hitting) {
+      summary_.hardest_impact_mps = change;
+      summary_.hardest_impact_robot = env.artifact(r.artifact).name();
+    }
     points.push_back(p);
     ids.push_back(k);
     largest = std::max(largest, r.radius);
@@ -112,10 +128,11 @@ void FlightRecorder::observe(const Environment& env) {
     const Artifact& a = env.artifact(r.artifact);
     const BodyState s = a.root().state();
     const double up = (s.pose.orientation * Vec3::UnitZ()).z();
-    if (up < kCrashedTilt) {
+    const bool down = has_ground_ && s.pose.position.z() - ground_z_ < r.radius + 0.05;
+    if (up < kCrashedTilt || (down && r.hit)) {
       ++summary_.crashed;
       if (summary_.crashed_names.size() < 10) summary_.crashed_names.push_back(a.name());
-    } else if (has_ground_ && s.pose.position.z() - ground_z_ < r.radius + 0.05 && s.linear_velocity.norm() < 0.1) {
+    } else if (down && s.linear_velocity.norm() < 0.1) {
       ++summary_.landed;
     } else {
       ++summary_.airborne;
@@ -151,6 +168,11 @@ std::string FlightSummary::str() const {
   if (closest_approach_m >= 0) {
     std::snprintf(text, sizeof text, "; closest approach %.2f m (", closest_approach_m);
     out += text + closest_pair + ")";
+  }
+  if (impacts > 0) {
+    std::snprintf(text, sizeof text, "; impacts %lld, hardest %.1f m/s (", static_cast<long long>(impacts),
+                  hardest_impact_mps);
+    out += text + hardest_impact_robot + ")";
   }
   std::snprintf(text, sizeof text, "; mean distance flown %.2f m", mean_distance_flown_m);
   return out + text;

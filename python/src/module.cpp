@@ -177,6 +177,9 @@ class PyEnvironment {
     d["landed"] = s.landed;
     d["crashed"] = s.crashed;
     d["crashed_names"] = s.crashed_names;
+    d["impacts"] = s.impacts;
+    d["hardest_impact_mps"] = s.hardest_impact_mps;
+    d["hardest_impact_robot"] = s.hardest_impact_robot;
     d["collisions"] = s.collisions;
     d["first_collision_s"] = s.first_collision_s >= 0 ? py::object(py::float_(s.first_collision_s)) : py::object(py::none());
     d["first_collision_pair"] = s.first_collision_pair;
@@ -532,7 +535,7 @@ PYBIND11_MODULE(_ssx, m) {
       .def("range", &PyEnvironment::range, py::arg("artifact"), py::arg("sensor") = py::none(),
            "The latest range measurement of an artifact: detections as arrays, nearest first.")
       .def("flight_summary", &PyEnvironment::flightSummary,
-           "What happened to the robots so far (every 10th step): airborne, landed, crashed, collisions between "
+           "What happened to the robots so far (every 10th step): airborne, landed, crashed, impacts, collisions between "
            "robots (count, first time and pair), closest approach, mean distance flown; 'text' says it in a line.")
       .def("metrics", &PyEnvironment::metrics,
            "Every metric the drivers publish now (ssx::MetricSource, e.g. the formation's formation_error), as "

@@ -479,6 +479,10 @@ def test_flight_summary_metrics_and_contacts_say_what_happened_to_the_robots():
                                 '</scene>', ssx.data_directory() / "artifacts")
     box.step(2000)  # fallen and resting on the ground
     assert box.contacts() > 0
+    assert s["impacts"] == 0 and s["hardest_impact_robot"] == ""
+    fallen = box.flight_summary()  # it hit the ground at about 3 m/s: an impact, and down after one
+    assert (fallen["crashed"], fallen["impacts"], fallen["hardest_impact_robot"]) == (1, 1, "b")
+    assert fallen["hardest_impact_mps"] > 1.5
     # a formation publishes its error per member; hovering quadrotors publish nothing
     assert env.metrics() == {}
     formation = ssx.load_scene(ssx.data_directory() / "scenes" / "formation_sphere.xml", threads=1)

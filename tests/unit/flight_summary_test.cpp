@@ -80,3 +80,63 @@ TEST_CASE("flight summary: robots that come within reach of each other touch, on
   CHECK(f.mean_distance_flown_m > 0.5);
   CHECK_THAT(f.str(), Catch::Contains("collisions 1, first at 0.8") && Catch::Contains("(a and b)"));
 }
+
+TEST_CASE("flight summary: a robot dropped onto the ground crashed, one set down gently landed; an impact counts once",
+          "[flight_summary]") {
+  Environment env;
+  env.addGround();
+  // from 2 m: it meets the ground at about 6 m/s and stops within a few steps; from 2 cm above
+  // touching it: 0.6 m/s, less than the 1 m/s an impact takes
+  addBox(env, "dropped", at(0, 0, 2.1));
+  addBox(env, "set_down", at(3, 0, 0.12));
+  FlightRecorder recorder;
+  for (int k = 0; k < 150; ++k) {  // 1.5 s, observed every 10 ms
+    env.step(10);
+    recorder.observe(env);
+  }
+  const FlightSummary s = recorder.summary();
+  CHECK(s.crashed == 1);
+  CHECK(s.crashed_names == std::vector<std::string>{"dropped"});
+  CHECK(s.landed == 1);
+  CHECK(s.impacts == 1);
+  CHECK(s.hardest_impact_robot == "dropped");
+  // at least the speed it fell at less what 4 g explain in 10 ms; more when the contact throws it
+  // back up a little (ODE pushes the sinking box out)
+  const double fall = std::sqrt(2 * 9.81 * 1.9);
+  CHECK(s.hardest_impact_mps > fall - 4 * 9.81 * 0.01 - 0.1);
+  CHECK(s.hardest_impact_mps < 1.5 * fall);
+  CHECK_THAT(s.str(), Catch::Contains("crashed 1 (dropped)") && Catch::Contains("; impacts 1, hardest "));
+}
+
+TEST_CASE("flight summary: a robot that bumps an obstacle in flight and flies on is airborne, with its impact counted",
+          "[flight_summary]") {
+  EnvironmentSettings settings;
+  settings.physics.gravity = Vec3::Zero();
+  Environment env(settings);
+  env.addGround();
+  // a wall; a box flies into it at 3 m/s, 1 m above the ground, and bounces back
+  Artifact& wall = env.addArtifact("wall", at(2, 0, 1));
+  PhysicNodeSpec slab;
+  slab.name = "slab";
+  slab.is_static = true;
+  slab.shapes.push_back(Shape::box(Vec3(0.2, 4, 2)));
+  wall.addPhysicRoot(std::move(slab));
+  Artifact& flyer = addBox(env, "flyer", at(0, 0, 1));
+  env.start();
+  BodyState moving = flyer.root().state();
+  moving.linear_velocity = Vec3(3, 0, 0);
+  env.setBodyState(flyer.root().bodyIndex(), moving);
+  FlightRecorder recorder;
+  recorder.observe(env);
+  for (int k = 0; k < 100; ++k) {
+    env.step(10);
+    recorder.observe(env);
+  }
+  const FlightSummary s = recorder.summary();
+  CHECK(s.robots == 1);
+  CHECK(s.impacts == 1);
+  CHECK(s.hardest_impact_robot == "flyer");
+  CHECK(s.hardest_impact_mps > 1.0);
+  CHECK(s.airborne == 1);  // not on the ground: an impact alone is not a crash
+  CHECK(s.crashed == 0);
+}

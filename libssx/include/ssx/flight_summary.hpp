@@ -20,7 +20,9 @@ class Environment;
 enum class RobotState : std::uint8_t {
   Airborne,  ///< above the ground, upright
   Landed,    ///< at rest on the ground (within 5 cm of touching it), upright
-  Crashed,   ///< tilted more than 60 degrees from upright
+  /// tilted more than 60 degrees from upright, or on the ground after an impact: a change of
+  /// velocity between two observations larger, by more than kImpactSpeed, than 4 g could make
+  Crashed,
 };
 
 /// The summary of a run's robots (FlightRecorder::summary).
@@ -28,8 +30,14 @@ struct SSX_EXPORT FlightSummary {
   std::int64_t robots = 0;    ///< artifacts with a dynamic physic root
   std::int64_t airborne = 0;  ///< of those, flying at the last observation
   std::int64_t landed = 0;    ///< at rest on the ground
-  std::int64_t crashed = 0;   ///< tilted over
+  std::int64_t crashed = 0;   ///< tilted over, or down after an impact
   std::vector<std::string> crashed_names;  ///< the first ten that crashed, by name
+  /// Impacts: a robot's velocity changed between two observations by more than kImpactSpeed
+  /// beyond what 4 g could do (a hit on the ground, an obstacle or another robot), counted once
+  /// per hit.
+  std::int64_t impacts = 0;
+  double hardest_impact_mps = 0;     ///< the largest such change, m/s (0: none)
+  std::string hardest_impact_robot;  ///< whose it was
   /// Robots touching: two robots closer than the sum of their radii (the farthest point of each one's
   /// shapes from its centre), counted once per pair and touch.
   std::int64_t collisions = 0;
@@ -47,6 +55,12 @@ struct SSX_EXPORT FlightSummary {
 /// Collects a FlightSummary over a run. A robot is an artifact with a dynamic physic root.
 class SSX_EXPORT FlightRecorder {
  public:
+  /// A change of velocity between two observations beyond what 4 g explain that counts as an
+  /// impact, m/s: a free fall from 5 cm. A robot that lands at walking pace has none.
+  static constexpr double kImpactSpeed = 1.0;
+  /// The acceleration a robot's own thrust and gravity are granted between observations, m/s^2.
+  static constexpr double kManoeuvre = 4 * 9.81;
+
   /// Looks at the robots of `env` as they are now (call between steps, from the stepping thread).
   void observe(const Environment& env);
   /// The summary so far; the end states are those of the last observation.
@@ -57,7 +71,10 @@ class SSX_EXPORT FlightRecorder {
     std::size_t artifact = 0;
     double radius = 0;
     Vec3 last = Vec3::Zero();
+    Vec3 last_velocity = Vec3::Zero();
     double flown = 0;
+    bool hit = false;       // had an impact
+    bool hitting = false;   // in one at the last observation (counted once per hit)
   };
   void start(const Environment& env);
 
@@ -65,6 +82,7 @@ class SSX_EXPORT FlightRecorder {
   std::vector<Robot> robots_;
   std::vector<std::pair<std::size_t, std::size_t>> touching_;  // pairs (robot indices) in contact at the last sample
   FlightSummary summary_;
+  double last_time_ = 0;
   double ground_z_ = 0;
   bool has_ground_ = false;
 };
