@@ -121,10 +121,13 @@ std::vector<Diagnostic> checkParametersNamed(std::span<const ssx_plugin_param> d
       names.emplace_back(d.name);
     }
     const std::string nearest = nearestName(a.key, names);
+    // a near name is what the user meant, most likely: it alone (a quadrotor has 75 parameters);
+    // with none near, every name it has
     out.push_back({Diagnostic::Severity::Warning, a.where,
                    "unknown parameter '" + a.key + "' of " + what + " (ignored; " +
-                       (nearest.empty() ? std::string() : "did you mean '" + nearest + "'? ") +
-                       "it has: " + (known.empty() ? std::string("none") : known) + ")"});
+                       (!nearest.empty() ? "did you mean '" + nearest + "'?"
+                                         : "it has: " + (known.empty() ? std::string("none") : known)) +
+                       ")"});
   }
   // absent parameters read as their declared defaults
   params.setDeclarations(declarations);

@@ -110,8 +110,13 @@ TEST_CASE("each kind of bad parameter is an error at its own line", "[parameters
   Descriptor extra = element({{"file", "f"}, {"gian", "1"}});
   const auto all = checkParameters(kDeclared, extra, context, "driver 'x'");
   REQUIRE(all.size() == 1);
-  CHECK(all[0].str() == "scene.xml:9: warning: unknown parameter 'gian' of driver 'x' (ignored; did you mean 'gain'? it has: gain, count, "
-                        "mode, file, loop_hz, offset)");
+  CHECK(all[0].str() == "scene.xml:9: warning: unknown parameter 'gian' of driver 'x' (ignored; did you mean 'gain'?)");
+  // with no name near it, every name the plugin has
+  Descriptor far = element({{"file", "f"}, {"zzzzzz", "1"}});
+  const auto listed = checkParameters(kDeclared, far, context, "driver 'x'");
+  REQUIRE(listed.size() == 1);
+  CHECK(listed[0].str() == "scene.xml:9: warning: unknown parameter 'zzzzzz' of driver 'x' (ignored; it has: gain, count, "
+                           "mode, file, loop_hz, offset)");
 }
 
 TEST_CASE("a loop rate fits when its period is a whole multiple of the plugin's", "[parameters]") {

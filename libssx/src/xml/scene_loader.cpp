@@ -180,6 +180,7 @@ void SceneLoader::readEnvironment(const Descriptor& d) {
                                                    d.find("realtime_factor")->value + "'"));
   run_.overrun = readChoice(d, "overrun", "catchup", {"catchup", "resync"}) == "resync" ? RunOptions::Overrun::Resync
                                                                                         : RunOptions::Overrun::CatchUp;
+  asked(d, "duration");  // (read only when given: still a name an unknown attribute may have meant)
   if (d.has("duration")) {
     duration_ = toNanoseconds(readPositiveAtMost(d, "duration", 1.0, kMaxDurationSeconds, "about 31 years of simulated time"));
     if (*duration_ <= 0) {

@@ -191,15 +191,18 @@ class SceneLoader {
   void checkUnknown(const Descriptor& d, const std::set<std::string>& children = {}) {
     const auto it = asked_.find(&d);
     const std::vector<std::string> none;
+    const auto ignored = [](std::string_view name, const std::vector<std::string>& known) {
+      const std::string nearest = nearestName(name, known);
+      return nearest.empty() ? std::string(" (ignored)") : " (ignored; did you mean '" + nearest + "'?)";
+    };
     for (const auto& a : d.attributes())
       if (!a.used)
-        warning(a.where, "unknown attribute '" + a.key + "' of <" + d.name() + "> (ignored)" +
-                             didYouMean(a.key, it != asked_.end() ? it->second : none));
+        warning(a.where, "unknown attribute '" + a.key + "' of <" + d.name() + ">" +
+                             ignored(a.key, it != asked_.end() ? it->second : none));
     const std::vector<std::string> allowed(children.begin(), children.end());
     for (const auto& c : d.children())
       if (!children.contains(c.name()))
-        warning(c.where(), "unknown element <" + c.name() + "> in <" + d.name() + "> (ignored)" +
-                               didYouMean(c.name(), allowed));
+        warning(c.where(), "unknown element <" + c.name() + "> in <" + d.name() + ">" + ignored(c.name(), allowed));
   }
   fs::path resolve(const fs::path& dir, const std::string& file) const {
     const fs::path p(file);

@@ -88,7 +88,7 @@ TEST_CASE("unknown elements, attributes and plugin parameters are warnings with 
         std::vector<std::string>{"warnings.xml:2: warning: unknown attribute 'colour' of <environment> (ignored)",
                                  "warnings.xml:5: warning: unknown element <lights> in <scene> (ignored)",
                                  "spinner.xml:5: warning: unknown parameter 'torqeu' of driver 'spinner' (ignored; "
-                                 "did you mean 'torque'? it has: torque)"});
+                                 "did you mean 'torque'?)"});
   // and are not reported a second time when the environment starts
   std::vector<std::string> logged;
   scene.environment->setLogSink([&](LogLevel, std::string_view m) { logged.emplace_back(m.substr(m.rfind('/') + 1)); });
@@ -209,16 +209,17 @@ TEST_CASE("a timestep finer than a nanosecond is a warning saying what it became
 
 TEST_CASE("an unknown name near a known one asks whether that was meant", "[scene]") {
   Scene scene = loadSceneFromString(R"(<scene>
-    <environment timestpe="0.002"/>
+    <environment timestpe="0.002" duraton="3"/>
     <swram type="ball" count="2"/>
     <type name="ball" file="ball.xml"/><artifact name="b" type="ball" xyz="0 0 1" rpy_="0 0 0"/>
   </scene>)", "m.xml", kData / "valid", testOptions());
   std::vector<std::string> warnings;
   for (const auto& w : scene.warnings) warnings.push_back(w.str());
   CHECK(warnings == std::vector<std::string>{
-                        "m.xml:2: warning: unknown attribute 'timestpe' of <environment> (ignored) (did you mean 'timestep'?)",
-                        "m.xml:3: warning: unknown element <swram> in <scene> (ignored) (did you mean 'swarm'?)",
-                        "m.xml:4: warning: unknown attribute 'rpy_' of <artifact> (ignored) (did you mean 'rpy'?)"});
+                        "m.xml:2: warning: unknown attribute 'timestpe' of <environment> (ignored; did you mean 'timestep'?)",
+                        "m.xml:2: warning: unknown attribute 'duraton' of <environment> (ignored; did you mean 'duration'?)",
+                        "m.xml:3: warning: unknown element <swram> in <scene> (ignored; did you mean 'swarm'?)",
+                        "m.xml:4: warning: unknown attribute 'rpy_' of <artifact> (ignored; did you mean 'rpy'?)"});
   CHECK_THROWS_WITH(loadSceneFromString(R"(<scene><extension name="log" plugin="csv_loger" file="x.csv"/></scene>)", "m.xml",
                                         kData / "valid"),
                     Contains("plugin 'csv_loger' could not be loaded (did you mean 'csv_logger'?); tried:"));
