@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Builds ssx from a fresh Debian 12 machine and runs it. Installs what the build needs first.
 #
-#   ./dev.sh demo   build, then run the default swarm scenario in real time
+#   ./dev.sh demo   build the ssx command and its plugins, then run the default swarm scenario in
+#                   real time (20 s)
 #   ./dev.sh test   build, then run every test (ctest)
 #   ./dev.sh build  build only
 #   ./dev.sh sanitize  the whole suite under ASan+UBSan (clang, build-asan/), each fuzz target for
@@ -40,18 +41,19 @@ install_packages() {
   DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
 }
 
+# build [TARGET]: configures and builds everything, or only TARGET
 build() {
   install_packages
   local launcher=()
   command -v ccache >/dev/null && launcher=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache -DCMAKE_C_COMPILER_LAUNCHER=ccache)
   cmake -S . -B "$build_dir" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo \
     -DSSX_WARNINGS_AS_ERRORS="${SSX_WARNINGS_AS_ERRORS:-OFF}" "${launcher[@]}" >/dev/null
-  cmake --build "$build_dir" -j "$jobs"
+  cmake --build "$build_dir" -j "$jobs" ${1:+--target "$1"}
 }
 
 case "${1:-}" in
   demo)
-    build
+    build ssx_runtime  # the command and its plugins: the tests and examples are `test`'s to build
     "$build_dir/bin/ssx" run examples/scenes/formation_sphere.xml --realtime
     ;;
   test)
