@@ -15,7 +15,7 @@ set -euo pipefail
 cd "$(dirname "$0")"
 
 packages=(build-essential cmake ninja-build pkg-config ccache
-          libode-dev libbullet-dev libeigen3-dev libpugixml-dev libcli11-dev catch2 libpng-dev libosmesa6-dev
+          libode-dev libbullet-dev libeigen3-dev libpugixml-dev libcli11-dev catch2 libpng-dev libosmesa6-dev libzstd-dev
           python3-dev python3-numpy pybind11-dev libopenmpi-dev openmpi-bin)
 # for `test` also pytest and matplotlib (the Python module's tests and examples) and doxygen (the
 # API reference and its check)

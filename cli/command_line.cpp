@@ -56,6 +56,14 @@ CommandLine parseCommandLine(int argc, const char* const* argv, std::ostream& ou
   run_cmd->add_option("--video", c.run.video, "write the first camera's frames as MP4 to FILE (needs ffmpeg)");
   run_cmd->add_option("--frames", c.run.frames, "write the first camera's frames as PNG files into DIR");
   run_cmd->add_option("--save-state", c.run.save_state, "write the world's state to FILE at the end (ssx run --load-state)");
+  run_cmd->add_option("--record", c.run.record,
+                      "record the run into FILE (MCAP: the scene, every body's pose, saved states; ssx inspect, "
+                      "ssx replay, ssx.Recording)");
+  run_cmd->add_option("--record-rate", c.run.record_rate, "pose samples per simulated second in --record (0: every step)")
+      ->check(realNumber(0.0, 1e6));
+  run_cmd->add_option("--record-states", c.run.record_states,
+                      "simulated seconds between saved states in --record (0: only the first)")
+      ->check(realNumber(0.0, ssx::kMaxDurationSeconds));
   run_cmd->add_flag("--allow-special-outputs", c.run.allow_special_outputs,
                     "let outputs written as streams (a logger's file, --stats-csv) be FIFOs or devices");
   run_cmd->add_option("--load-state", c.run.load_state,

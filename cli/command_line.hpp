@@ -26,6 +26,9 @@ struct RunArgs {
   double max_input_mb = kDefaultMaxInputMb;
   std::string render, physics, snapshot, video, frames;
   std::string save_state, load_state;
+  std::string record;          // an MCAP recording of the run (empty: none)
+  double record_rate = 25;     // pose samples per simulated second (0: every step)
+  double record_states = 10;   // simulated seconds between saved states in the recording
   std::string out;  // the scene's own outputs (empty: ssx-out/<scene>/)
   bool allow_special_outputs = false;
   bool duration_given = false;

@@ -24,6 +24,7 @@
 #include <cstring>
 #include <fstream>
 #include <iostream>
+#include <memory>
 #include <sstream>
 #include <stdexcept>
 #include <optional>
@@ -195,6 +196,7 @@ int commandRun(const RunArgs& args, bool realtime_given) {
     std::string problem;
     if (!args.save_state.empty()) problem = scene.files.claimOutput(args.save_state, "--save-state", true);
     if (problem.empty() && !args.stats_csv.empty()) problem = scene.files.claimOutput(args.stats_csv, "--stats-csv");
+    if (problem.empty() && !args.record.empty()) problem = scene.files.claimOutput(args.record, "--record", true);
     if (!problem.empty()) {
       std::cerr << "ssx: error: " << problem << '\n';
       return kExitBadInput;
@@ -267,6 +269,24 @@ int commandRun(const RunArgs& args, bool realtime_given) {
   }
   int status = 0;
   ssx::TimingSummary summary;
+  // the recording: created now that every check passed; a real-time run drops samples rather than
+  // wait for the writer, a fast one waits
+  std::unique_ptr<ssx::Recorder> recorder;
+  if (!args.record.empty()) {
+    try {
+      ssx::RecordOptions record;
+      record.file = args.record;
+      record.rate_hz = args.record_rate;
+      record.state_every_s = args.record_states;
+      record.drop_when_behind = !args.fast;
+      record.scene_xml = scene.model->toXml();
+      record.scene_label = fs::path(args.scene).filename().string();
+      recorder = std::make_unique<ssx::Recorder>(env, std::move(record));
+    } catch (const std::exception& e) {
+      std::cerr << "ssx: error: --record " << args.record << ": " << e.what() << '\n';
+      return kExitBadInput;
+    }
+  }
   try {
     env.start();
     if (!loaded.empty()) env.restoreState(loaded);
@@ -296,6 +316,15 @@ int commandRun(const RunArgs& args, bool realtime_given) {
       status = kExitRunFailure;
     }
   }
+  std::string recorded;
+  if (recorder) {
+    try {
+      recorded = recorder->finish().str(args.record);
+    } catch (const std::exception& e) {
+      std::cerr << "ssx: error: --record: " << e.what() << '\n';
+      status = kExitRunFailure;
+    }
+  }
   const std::vector<ssx::CameraSpec> cameras = env.cameras();
   if (env.state() == ssx::Environment::State::Running) flights.observe(env);  // the end states
   // stop cleanly: plugins destroyed, engines stopped, extensions shut down (files closed)
@@ -307,6 +336,7 @@ int commandRun(const RunArgs& args, bool realtime_given) {
   }
   if (status == 0) {
     if (!args.quiet) std::cout << summary.str() << '\n' << flights.summary().str() << '\n';
+    if (!args.quiet && !recorded.empty()) std::cout << recorded << '\n';
   }
   // where the pictures went
   if (!args.quiet && env.frameCount() > 0) {

@@ -77,12 +77,13 @@ SceneModel parseWith(detail::SceneLoader& loader, Descriptor root, const fs::pat
 // parsed and built in one go: the problems of both together, even when parsing found errors
 Scene load(const SceneOptions& options, Descriptor root, const fs::path& file, const fs::path& dir) {
   detail::SceneLoader loader(options);
-  const SceneModel model = loader.parse(std::move(root), file, dir);
+  SceneModel model = loader.parse(std::move(root), file, dir);
   Scene scene = loader.build(model, false);
   const bool failed = loader.hasErrors();
   std::vector<Diagnostic> found = loader.takeDiagnostics();
   if (failed) throw SceneError(std::move(found));
   scene.warnings = std::move(found);
+  scene.model = std::make_shared<const SceneModel>(std::move(model));
   return scene;
 }
 
@@ -107,6 +108,7 @@ Scene buildScene(const SceneModel& model, const SceneOptions& options) {
   for (auto& d : loader.takeDiagnostics()) found.push_back(std::move(d));
   if (failed) throw SceneError(std::move(found));
   scene.warnings = std::move(found);
+  scene.model = std::make_shared<const SceneModel>(model);
   return scene;
 }
 

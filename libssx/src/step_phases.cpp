@@ -257,6 +257,23 @@ void Environment::step() {
   runExtensionHook(&SimulationExtension::afterStep, "afterStep");
   timing.total = since(t_step);
   timing_.add(timing);
+  for (std::size_t i = 0; i < listeners_.size(); ++i) {
+    try {
+      listeners_[i].second(*this);
+    } catch (const std::exception& e) {
+      fail();
+      throw StepError("", "step listener", world_->current_step, e.what());
+    }
+  }
+}
+
+std::size_t Environment::addStepListener(std::function<void(const Environment&)> listener) {
+  listeners_.emplace_back(next_listener_, std::move(listener));
+  return next_listener_++;
+}
+
+void Environment::removeStepListener(std::size_t id) noexcept {
+  std::erase_if(listeners_, [id](const auto& l) { return l.first == id; });
 }
 
 void Environment::runExtensionHook(void (SimulationExtension::*hook)(Environment&), const char* what) {

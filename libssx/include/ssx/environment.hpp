@@ -39,6 +39,7 @@
 #include <string_view>
 #include <type_traits>
 #include <unordered_map>
+#include <utility>
 #include <vector>
 
 namespace ssx {
@@ -314,6 +315,14 @@ class SSX_EXPORT Environment {
   const PhysicEngine& physics() const;
   /// The render engine, read-only; throws when the environment is not running.
   const RenderEngine& renderer() const;
+  /// Calls `listener` at the end of every step (after the extensions' afterStep), on the stepping
+  /// thread, whether the steps come from step() or run(), until removeStepListener. For observers
+  /// outside the simulated world (a recording): listeners are not part of a saved state. A listener
+  /// that throws fails the step as a plugin does (StepError). Returns the listener's id.
+  std::size_t addStepListener(std::function<void(const Environment&)> listener);
+  /// Removes a listener added by addStepListener (an unknown id is ignored).
+  void removeStepListener(std::size_t id) noexcept;
+
   /// Per-step timing of every step taken so far.
   TimingRecorder& timing() noexcept { return timing_; }
   /// @copydoc timing()
@@ -350,6 +359,9 @@ class SSX_EXPORT Environment {
   std::vector<StaticShape> static_shapes_;
   TimingRecorder timing_{settings_.timing_samples};
   LogSink log_;
+  // step listeners (addStepListener), after the members plugins' inline accessors read
+  std::vector<std::pair<std::size_t, std::function<void(const Environment&)>>> listeners_;
+  std::size_t next_listener_ = 0;
 };
 
 template <class M>

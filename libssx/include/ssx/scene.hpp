@@ -85,6 +85,8 @@ struct SceneOptions {
   std::filesystem::path output_directory;
 };
 
+struct SceneModel;
+
 /// A loaded scene: an environment ready to start, and how the file asks to run it.
 struct Scene {
   std::filesystem::path file;                ///< the scene file (or the label of a scene in memory)
@@ -95,6 +97,8 @@ struct Scene {
   /// The files the scene was read from, and the outputs its plugins and cameras write, checked
   /// against each other; claim the program's own outputs here before anything runs.
   RunFiles files;
+  /// The model the environment was built from (what a recording keeps: model->toXml()).
+  std::shared_ptr<const SceneModel> model;
 };
 
 /// Where the installed artifact types (`artifacts/`) and example scenes (`scenes/`) are: the

@@ -19,6 +19,7 @@
 #include <ssx/plugin.hpp>
 #include <ssx/plugin_abi.hpp>
 #include <ssx/random.hpp>
+#include <ssx/recording.hpp>
 #include <ssx/render.hpp>
 #include <ssx/run_files.hpp>
 #include <ssx/scene.hpp>

@@ -1,0 +1,127 @@
+#pragma once
+/// @file
+/// Recording a run into one MCAP file (https://mcap.dev), and reading it back.
+///
+/// A recording holds:
+/// - metadata `ssx`: the ssx version, the seed, the timestep, the scene's label; attachment
+///   `scene.xml`: the scene model as scene XML (SceneModel::toXml), so that a replay needs no scene file;
+/// - metadata `ssx.bodies`: the recorded bodies' names, one per line (an artifact's name, or
+///   `artifact/node` for an artifact's second and later dynamic roots);
+/// - channel `/ssx/poses` (schema `ssx.Poses`, encoding `ssx.poses.v1`): every body's pose at the
+///   recording rate, compact for whole swarms: a little-endian uint32 body count N, then N float32
+///   x, N float32 y, N float32 z (m, world frame), then N int16 each of the orientation quaternion's
+///   w, x, y, z times 32767 (sign chosen so that w >= 0);
+/// - attachments `state/<nanoseconds>`: saved states (Environment::saveState) at the first sample and
+///   then every `state_every_s` of simulated time, from which a run can be continued bitwise.
+///
+/// The stepping thread copies each sample into a buffer and hands it to a writer thread through a
+/// bounded queue; compression (zstd) and writing happen there. When the queue is full a real-time
+/// run drops the sample (`drop_when_behind`: a step is never held up; the summary counts what was
+/// dropped) and a run as fast as possible waits for the writer (nothing is dropped).
+
+#include <ssx/export.hpp>
+#include <ssx/types.hpp>
+
+#include <cstddef>
+#include <cstdint>
+#include <filesystem>
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace ssx {
+
+class Environment;
+
+/// What to record, and how.
+struct RecordOptions {
+  std::filesystem::path file;       ///< the MCAP file written (created, or replaced)
+  double rate_hz = 25;              ///< pose samples per simulated second; 0: every step
+  double state_every_s = 10;        ///< simulated time between saved states; 0: only the first
+  bool drop_when_behind = false;    ///< a full queue drops samples (real-time runs) instead of waiting
+  std::size_t queue_samples = 64;   ///< samples that may wait for the writer thread, at most
+  std::string scene_xml;            ///< the scene as scene XML (SceneModel::toXml), kept in the file
+  std::string scene_label;          ///< the scene's file name, for messages
+};
+
+/// What a recording wrote (Recorder::finish).
+struct SSX_EXPORT RecordSummary {
+  std::int64_t samples = 0;  ///< pose samples written
+  std::int64_t dropped = 0;  ///< pose samples dropped because the writer was behind
+  std::int64_t states = 0;   ///< saved states written
+  std::uint64_t bytes = 0;   ///< size of the file
+  std::int64_t bodies = 0;   ///< bodies in each sample
+  double simulated_s = 0;    ///< time from the first sample to the last
+  /// "recording run.mcap: 250 samples of 70 bodies (0 dropped), 2 saved states, 1.2 MB"
+  std::string str(const std::filesystem::path& file) const;
+};
+
+/// Records an environment's run into an MCAP file, from the next step on, whether the steps come
+/// from Environment::step or run (a step listener). Make it before the steps to record and keep it
+/// until they are done; finish() (or the destructor) writes the file's end.
+class SSX_EXPORT Recorder {
+ public:
+  /// Checks the options and creates the file (Error if it cannot be: nothing is recorded then).
+  Recorder(Environment& env, RecordOptions options);
+  /// Finishes, if finish() was not called (errors are then lost: call finish()).
+  ~Recorder();
+  Recorder(const Recorder&) = delete;
+  Recorder& operator=(const Recorder&) = delete;
+
+  /// Stops recording, waits for the writer, writes the summary section and closes the file.
+  /// Throws Error when a write failed (a full disk), naming the file. Once only; later calls
+  /// return the same summary.
+  RecordSummary finish();
+  /// The summary so far.
+  RecordSummary summary() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+/// A recording read back (the file's poses in memory): for analysis, replays and re-simulation.
+class SSX_EXPORT Recording {
+ public:
+  /// Reads `file`. Throws Error naming the file and the byte offset when it is not an ssx
+  /// recording or is corrupted; a file cut short (a killed run) is read up to its last complete
+  /// chunk (complete() is then false).
+  explicit Recording(const std::filesystem::path& file);
+  ~Recording();
+  Recording(Recording&&) noexcept;
+  Recording& operator=(Recording&&) noexcept;
+
+  /// The recorded bodies' names.
+  const std::vector<std::string>& names() const noexcept;
+  /// The sample times, ns, ascending.
+  const std::vector<Nanoseconds>& times() const noexcept;
+  /// Sample k's positions: names().size() x 3 floats (x, y, z of each body).
+  std::vector<float> positions(std::size_t k) const;
+  /// Sample k's orientations: names().size() x 4 floats (w, x, y, z of each body, unit).
+  std::vector<float> orientations(std::size_t k) const;
+  /// The scene model as scene XML.
+  const std::string& sceneXml() const noexcept;
+  /// The scene's label (its file name when recorded).
+  const std::string& sceneLabel() const noexcept;
+  /// The ssx version that recorded it.
+  const std::string& version() const noexcept;
+  /// The seed of the recorded run.
+  std::uint64_t seed() const noexcept;
+  /// The times of the saved states, ns, ascending.
+  std::vector<Nanoseconds> stateTimes() const;
+  /// The saved state at or before `time` (its time in `at`), for Environment::restoreState.
+  /// Throws Error when there is none that early.
+  std::vector<std::byte> stateAtOrBefore(Nanoseconds time, Nanoseconds* at = nullptr) const;
+  /// Whether the file ends as a finished recording does (summary and footer).
+  bool complete() const noexcept;
+  /// Every channel's topic and message count, in id order.
+  std::vector<std::pair<std::string, std::uint64_t>> channels() const;
+  /// Bytes in the file.
+  std::uint64_t size() const noexcept;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace ssx

@@ -1,0 +1,76 @@
+#include "record/pose_codec.hpp"
+
+#include <ssx/environment.hpp>
+#include <ssx/error.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <cstring>
+
+namespace ssx::detail {
+
+namespace {
+
+constexpr std::size_t kBytesPerBody = 3 * 4 + 4 * 2;
+
+}  // namespace
+
+void encodePoses(const Environment& env, std::span<const int> bodies, std::vector<std::byte>& out) {
+  const std::size_t n = bodies.size();
+  out.resize(4 + n * kBytesPerBody);
+  const auto count = static_cast<std::uint32_t>(n);
+  std::memcpy(out.data(), &count, 4);  // (little-endian machines only: x86-64 and arm64)
+  std::byte* planes = out.data() + 4;
+  for (std::size_t i = 0; i < n; ++i) {
+    const Pose& p = env.bodyState(bodies[i]).pose;
+    for (int k = 0; k < 3; ++k) {
+      const auto v = static_cast<float>(p.position[k]);
+      std::memcpy(planes + (static_cast<std::size_t>(k) * n + i) * 4, &v, 4);
+    }
+    Quat q = p.orientation.normalized();
+    if (q.w() < 0) q.coeffs() = -q.coeffs();
+    const double c[4] = {q.w(), q.x(), q.y(), q.z()};
+    for (int k = 0; k < 4; ++k) {
+      const auto v = static_cast<std::int16_t>(std::lround(std::clamp(c[k], -1.0, 1.0) * 32767.0));
+      std::memcpy(planes + 12 * n + (static_cast<std::size_t>(k) * n + i) * 2, &v, 2);
+    }
+  }
+}
+
+std::size_t poseCount(std::span<const std::byte> message) {
+  if (message.size() < 4) return 0;
+  std::uint32_t n = 0;
+  std::memcpy(&n, message.data(), 4);
+  return n;
+}
+
+void decodePoses(std::span<const std::byte> message, std::vector<float>* positions, std::vector<float>* orientations) {
+  const std::size_t n = poseCount(message);
+  if (message.size() < 4 || message.size() != 4 + n * kBytesPerBody)
+    throw Error("a pose message of " + std::to_string(message.size()) + " bytes does not hold the " + std::to_string(n) +
+                " bodies it says (corrupted)");
+  const std::byte* planes = message.data() + 4;
+  if (positions != nullptr) {
+    positions->resize(3 * n);
+    for (std::size_t i = 0; i < n; ++i)
+      for (std::size_t k = 0; k < 3; ++k) std::memcpy(&(*positions)[3 * i + k], planes + (k * n + i) * 4, 4);
+  }
+  if (orientations != nullptr) {
+    orientations->resize(4 * n);
+    for (std::size_t i = 0; i < n; ++i) {
+      float q[4];
+      double norm = 0;
+      for (std::size_t k = 0; k < 4; ++k) {
+        std::int16_t v = 0;
+        std::memcpy(&v, planes + 12 * n + (k * n + i) * 2, 2);
+        q[k] = static_cast<float>(v) / 32767.0f;
+        norm += static_cast<double>(q[k]) * q[k];
+      }
+      const float scale = norm > 0 ? static_cast<float>(1 / std::sqrt(norm)) : 0.0f;
+      for (std::size_t k = 0; k < 4; ++k) (*orientations)[4 * i + k] = norm > 0 ? q[k] * scale : (k == 0 ? 1.0f : 0.0f);
+    }
+  }
+}
+
+}  // namespace ssx::detail

@@ -1,0 +1,130 @@
+// A recording read back (ssx/recording.hpp).
+#include "record/mcap_reader.hpp"
+#include "record/pose_codec.hpp"
+
+#include <ssx/error.hpp>
+#include <ssx/recording.hpp>
+
+#include <algorithm>
+#include <charconv>
+
+namespace ssx {
+
+struct Recording::Impl {
+  detail::McapFile file;
+  std::vector<std::string> names;
+  std::vector<Nanoseconds> times;
+  std::vector<std::span<const std::byte>> samples;
+  std::string scene_xml, scene_label, version;
+  std::uint64_t seed = 0;
+  std::vector<std::pair<Nanoseconds, std::span<const std::byte>>> states;
+};
+
+namespace {
+
+[[noreturn]] void notRecording(const std::filesystem::path& file, const std::string& what) {
+  throw Error(file.string() + ": not an ssx recording: " + what);
+}
+
+}  // namespace
+
+Recording::Recording(const std::filesystem::path& path) : impl_(std::make_unique<Impl>()) {
+  Impl& m = *impl_;
+  m.file = detail::readMcap(path);
+  const detail::McapFile& f = m.file;
+  if (f.profile != "ssx") notRecording(path, "its profile is '" + f.profile + "', not 'ssx'");
+  const auto meta = f.metadata.find("ssx");
+  if (meta == f.metadata.end()) notRecording(path, "it has no 'ssx' metadata");
+  auto value = [&](const char* key) {
+    const auto it = meta->second.find(key);
+    return it == meta->second.end() ? std::string() : it->second;
+  };
+  m.version = value("version");
+  m.scene_label = value("scene");
+  const std::string seed = value("seed");
+  std::from_chars(seed.data(), seed.data() + seed.size(), m.seed);
+  if (const auto bodies = f.metadata.find("ssx.bodies"); bodies != f.metadata.end()) {
+    const auto it = bodies->second.find("names");
+    if (it != bodies->second.end()) {
+      std::string_view rest = it->second;
+      while (!rest.empty()) {
+        const auto end = rest.find('\n');
+        m.names.emplace_back(rest.substr(0, end));
+        rest = end == std::string_view::npos ? std::string_view() : rest.substr(end + 1);
+      }
+    }
+  }
+  for (const auto& a : f.attachments) {
+    if (a.name == "scene.xml") {
+      m.scene_xml.assign(reinterpret_cast<const char*>(a.data.data()), a.data.size());
+    } else if (a.name.rfind("state/", 0) == 0) {
+      m.states.emplace_back(a.log_time, a.data);
+    }
+  }
+  std::sort(m.states.begin(), m.states.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+  const int channel = f.channelId("/ssx/poses");
+  if (channel < 0) notRecording(path, "it has no /ssx/poses channel");
+  for (const auto& msg : f.messages) {
+    if (msg.channel != channel) continue;
+    if (detail::poseCount(msg.data) != m.names.size())
+      throw Error(path.string() + ": a pose sample at " + std::to_string(msg.log_time) + " ns holds " +
+                  std::to_string(detail::poseCount(msg.data)) + " bodies, the recording names " +
+                  std::to_string(m.names.size()) + " (corrupted)");
+    m.times.push_back(msg.log_time);
+    m.samples.push_back(msg.data);
+  }
+}
+
+Recording::~Recording() = default;
+Recording::Recording(Recording&&) noexcept = default;
+Recording& Recording::operator=(Recording&&) noexcept = default;
+
+const std::vector<std::string>& Recording::names() const noexcept { return impl_->names; }
+const std::vector<Nanoseconds>& Recording::times() const noexcept { return impl_->times; }
+const std::string& Recording::sceneXml() const noexcept { return impl_->scene_xml; }
+const std::string& Recording::sceneLabel() const noexcept { return impl_->scene_label; }
+const std::string& Recording::version() const noexcept { return impl_->version; }
+std::uint64_t Recording::seed() const noexcept { return impl_->seed; }
+bool Recording::complete() const noexcept { return impl_->file.complete; }
+std::uint64_t Recording::size() const noexcept { return impl_->file.size; }
+
+std::vector<float> Recording::positions(std::size_t k) const {
+  std::vector<float> out;
+  detail::decodePoses(impl_->samples.at(k), &out, nullptr);
+  return out;
+}
+
+std::vector<float> Recording::orientations(std::size_t k) const {
+  std::vector<float> out;
+  detail::decodePoses(impl_->samples.at(k), nullptr, &out);
+  return out;
+}
+
+std::vector<Nanoseconds> Recording::stateTimes() const {
+  std::vector<Nanoseconds> out;
+  for (const auto& s : impl_->states) out.push_back(s.first);
+  return out;
+}
+
+std::vector<std::byte> Recording::stateAtOrBefore(Nanoseconds time, Nanoseconds* at) const {
+  const std::pair<Nanoseconds, std::span<const std::byte>>* best = nullptr;
+  for (const auto& s : impl_->states)
+    if (s.first <= time) best = &s;
+  if (best == nullptr)
+    throw Error(impl_->file.file.string() + ": no saved state at or before " + std::to_string(toSeconds(time)) +
+                " s (the first is at " +
+                (impl_->states.empty() ? std::string("none") : std::to_string(toSeconds(impl_->states.front().first)) + " s") +
+                ")");
+  if (at != nullptr) *at = best->first;
+  return {best->second.begin(), best->second.end()};
+}
+
+std::vector<std::pair<std::string, std::uint64_t>> Recording::channels() const {
+  std::vector<std::pair<std::string, std::uint64_t>> out;
+  std::map<std::uint16_t, std::uint64_t> counts;
+  for (const auto& msg : impl_->file.messages) ++counts[msg.channel];
+  for (const auto& [id, c] : impl_->file.channels) out.emplace_back(c.topic, counts[id]);
+  return out;
+}
+
+}  // namespace ssx

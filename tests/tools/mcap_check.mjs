@@ -1,0 +1,65 @@
+// An independent reader of ssx's recordings: Foxglove's @mcap/core (npm), with fzstd for the zstd
+// chunks. Reads FILE twice, once through its summary and index (McapIndexedReader) and once record
+// by record from the start (McapStreamReader, which checks every CRC), and prints what it found as
+// JSON: channels with their schemas and message counts, the first and last message times,
+// attachments and metadata, and whether the two reads agree.
+//   node mcap_check.mjs FILE
+import { McapIndexedReader, McapStreamReader } from "@mcap/core";
+import { decompress } from "fzstd";
+import { open, readFile } from "node:fs/promises";
+
+const file = process.argv[2];
+const decompressHandlers = { zstd: (data, size) => decompress(data, new Uint8Array(Number(size))) };
+
+const handle = await open(file, "r");
+const readable = {
+  size: async () => BigInt((await handle.stat()).size),
+  read: async (offset, length) => {
+    const buffer = new Uint8Array(Number(length));
+    await handle.read(buffer, 0, Number(length), Number(offset));
+    return buffer;
+  },
+};
+const indexed = await McapIndexedReader.Initialize({ readable, decompressHandlers });
+const channels = {};
+for (const [id, c] of indexed.channelsById) {
+  const schema = indexed.schemasById.get(c.schemaId);
+  channels[c.topic] = { id, messageEncoding: c.messageEncoding, schema: schema ? schema.name : null, count: 0 };
+}
+let first = null, last = null, count = 0;
+for await (const m of indexed.readMessages()) {
+  const topic = indexed.channelsById.get(m.channelId).topic;
+  channels[topic].count++;
+  count++;
+  if (first === null || m.logTime < first) first = m.logTime;
+  if (last === null || m.logTime > last) last = m.logTime;
+}
+const attachments = [];
+for await (const a of indexed.readAttachments()) attachments.push({ name: a.name, mediaType: a.mediaType, size: a.data.length });
+const metadata = [];
+for await (const m of indexed.readMetadata()) metadata.push({ name: m.name, keys: [...m.metadata.keys()].sort() });
+
+// the same file from the start, every record, CRCs checked
+const stream = new McapStreamReader({ decompressHandlers, validateCrcs: true });
+stream.append(await readFile(file));
+let streamed = 0, footer = false;
+for (let r; (r = stream.nextRecord()); ) {
+  if (r.type === "Message") streamed++;
+  if (r.type === "Footer") footer = true;
+}
+console.log(JSON.stringify({
+  profile: indexed.header.profile,
+  library: indexed.header.library,
+  channels,
+  messages: count,
+  streamedMessages: streamed,
+  footer,
+  done: stream.done(),
+  firstTime: first === null ? null : first.toString(),
+  lastTime: last === null ? null : last.toString(),
+  chunks: indexed.chunkIndexes.length,
+  statisticsMessageCount: indexed.statistics ? indexed.statistics.messageCount.toString() : null,
+  attachments,
+  metadata,
+}));
+await handle.close();
