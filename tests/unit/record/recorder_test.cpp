@@ -1,0 +1,98 @@
+// The recorder: every body's pose at the rate asked for and saved states at their interval, written
+// off the stepping thread; nothing dropped when it may wait; a write that fails stops the run.
+#include <ssx/ssx.hpp>
+
+#include "scene_util.hpp"
+
+#include <catch2/catch.hpp>
+
+#include <cstring>
+#include <filesystem>
+
+using namespace ssx;
+using namespace ssx::test;
+namespace fs = std::filesystem;
+
+namespace {
+
+const char* kQuads = R"(<scene><environment timestep="0.002" seed="5" threads="2"/><type name="q" file="mk_quad.xml"/>
+  <ground/><swarm type="q" count="4" name="q{i}" spacing="1.5" xyz="0 0 0.05"><driver offset="0 0 1"/></swarm></scene>)";
+
+RecordOptions options(const fs::path& file, const Scene& scene) {
+  RecordOptions o;
+  o.file = file;
+  o.rate_hz = 25;
+  o.state_every_s = 1;
+  o.scene_xml = scene.model->toXml();
+  o.scene_label = "quads.xml";
+  return o;
+}
+
+}  // namespace
+
+TEST_CASE("recorder: poses of every body at 25 Hz, saved states every second, the scene and its seed",
+          "[record][recorder]") {
+  const fs::path file = fs::current_path() / "recorder_quads.mcap";
+  Scene scene = loadSceneFromString(kQuads, "quads.xml", kArtifacts, testOptions());
+  Environment& env = *scene.environment;
+  Recorder recorder(env, options(file, scene));
+  env.step(1000);  // 2 s
+  const RecordSummary s = recorder.finish();
+  CHECK(s.samples == 50);
+  CHECK(s.dropped == 0);
+  CHECK(s.states == 2);  // at the first sample, 0.04 s, and at 1.04 s
+  CHECK(s.bodies == 4);
+  CHECK(s.bytes == fs::file_size(file));
+  CHECK(s.str(file).find("50 samples of 4 bodies (0 dropped), 2 saved states") != std::string::npos);
+
+  const Recording r(file);
+  CHECK(r.complete());
+  CHECK(r.names() == std::vector<std::string>{"q0", "q1", "q2", "q3"});
+  REQUIRE(r.times().size() == 50);
+  for (std::size_t k = 0; k < 50; ++k) CHECK(r.times()[k] == static_cast<Nanoseconds>(k + 1) * 40'000'000);
+  // the last sample is the world as it is now, to the float
+  const std::vector<float> last = r.positions(49);
+  for (std::size_t i = 0; i < 4; ++i)
+    for (Eigen::Index k = 0; k < 3; ++k)
+      CHECK(last[3 * i + static_cast<std::size_t>(k)] == static_cast<float>(env.findArtifact(r.names()[i])->pose().position[k]));
+  CHECK(last[2] > 0.5f);  // they took off
+  CHECK(r.stateTimes() == std::vector<Nanoseconds>{40'000'000, 1'040'000'000});
+  CHECK(r.sceneXml() == scene.model->toXml());
+  CHECK(r.sceneLabel() == "quads.xml");
+  CHECK(r.seed() == 5);
+  CHECK(r.version() == SSX_VERSION_STRING);
+  CHECK(r.channels() == std::vector<std::pair<std::string, std::uint64_t>>{{"/ssx/poses", 50}});
+  // a second finish is the same summary; steps after it are not recorded
+  CHECK(recorder.finish().samples == 50);
+  env.step(100);
+  CHECK(Recording(file).times().size() == 50);
+}
+
+TEST_CASE("recorder: with a queue of one and no dropping, the stepper waits and every sample is written",
+          "[record][recorder]") {
+  const fs::path file = fs::current_path() / "recorder_wait.mcap";
+  Scene scene = loadSceneFromString(kQuads, "quads.xml", kArtifacts, testOptions());
+  RecordOptions o = options(file, scene);
+  o.queue_samples = 1;
+  o.rate_hz = 0;  // every step
+  Recorder recorder(*scene.environment, o);
+  scene.environment->step(500);
+  const RecordSummary s = recorder.finish();
+  CHECK(s.samples == 500);
+  CHECK(s.dropped == 0);
+  CHECK(Recording(file).times().size() == 500);
+}
+
+TEST_CASE("recorder: a recording that cannot be written stops the run with the file's name", "[record][recorder]") {
+  Scene scene = loadSceneFromString(kQuads, "quads.xml", kArtifacts, testOptions());
+  Environment& env = *scene.environment;
+  Recorder recorder(env, options("/dev/full", scene));  // takes the open, refuses every byte
+  CHECK_THROWS_WITH(env.step(100), Catch::Contains("/dev/full"));
+  CHECK(env.state() == Environment::State::Failed);
+  CHECK_THROWS_WITH(recorder.finish(), Catch::Contains("/dev/full"));
+  // bad options are refused before a file is made
+  RecordOptions bad = options(fs::current_path() / "never.mcap", scene);
+  bad.rate_hz = -1;
+  CHECK_THROWS_WITH(Recorder(env, bad), Catch::Contains("rate_hz"));
+  CHECK_FALSE(fs::exists(bad.file));
+}

@@ -1,0 +1,71 @@
+// A recording read back: from one of its saved states, the recorded scene steps again to the same
+// poses, bit for bit; a file that is not a recording says so.
+#include "record/mcap_writer.hpp"
+
+#include <ssx/ssx.hpp>
+
+#include "scene_util.hpp"
+
+#include <catch2/catch.hpp>
+
+#include <cstring>
+#include <filesystem>
+
+using namespace ssx;
+using namespace ssx::test;
+namespace fs = std::filesystem;
+
+TEST_CASE("recording: the recorded scene, restored from a saved state, steps to the recorded poses bit for bit",
+          "[record][recording]") {
+  const fs::path file = fs::current_path() / "recording_resim.mcap";
+  const std::string xml = R"(<scene><environment timestep="0.002" seed="9" threads="2"/><type name="q" file="mk_quad.xml"/>
+    <type name="box" file="box.xml"/><ground/>
+    <swarm type="q" count="6" name="q{i}" spacing="1.2" xyz="0 0 0.05"><driver offset="0 0 1.5"/></swarm>
+    <swarm type="box" count="3" name="b{i}" layout="random" min="-1 -1 2" max="1 1 3"/></scene>)";
+  {
+    Scene scene = loadSceneFromString(xml, "resim.xml", kArtifacts, testOptions());
+    RecordOptions o;
+    o.file = file;
+    o.state_every_s = 1;
+    o.scene_xml = scene.model->toXml();
+    Recorder recorder(*scene.environment, o);
+    scene.environment->step(1500);  // 3 s: take-off, boxes falling and landing
+    recorder.finish();
+  }
+  const Recording r(file);
+  Nanoseconds at = 0;
+  const std::vector<std::byte> state = r.stateAtOrBefore(1'500'000'000, &at);
+  CHECK(at == 1'040'000'000);
+  // the scene as the recording keeps it, built again, on one thread this time
+  SceneOptions options = testOptions();
+  options.threads = 1;
+  Scene again = buildScene(parseSceneString(r.sceneXml(), "recorded.xml", kArtifacts, options), options);
+  Environment& env = *again.environment;
+  env.restoreState(state);
+  REQUIRE(env.time() == at);
+  std::size_t compared = 0;
+  for (std::size_t k = 0; k < r.times().size(); ++k) {
+    if (r.times()[k] <= at) continue;
+    while (env.time() < r.times()[k]) env.step();
+    std::vector<float> now;
+    for (const std::string& name : r.names())
+      for (Eigen::Index c = 0; c < 3; ++c) now.push_back(static_cast<float>(env.findArtifact(name)->pose().position[c]));
+    const std::vector<float> recorded = r.positions(k);
+    REQUIRE(now.size() == recorded.size());
+    INFO("sample " << k << " at " << toSeconds(r.times()[k]) << " s");
+    CHECK(std::memcmp(now.data(), recorded.data(), now.size() * sizeof(float)) == 0);
+    ++compared;
+  }
+  CHECK(compared == 49);  // 1.08 s to 3.0 s
+  CHECK_THROWS_WITH(r.stateAtOrBefore(0), Catch::Contains("no saved state at or before 0"));
+}
+
+TEST_CASE("recording: an MCAP file that is not an ssx recording is refused, naming the file", "[record][recording]") {
+  const fs::path file = fs::current_path() / "foreign.mcap";
+  {
+    detail::McapWriter w(file, "ros2", "someone else");
+    w.close();
+  }
+  CHECK_THROWS_WITH(Recording(file), Catch::Contains("foreign.mcap: not an ssx recording: its profile is 'ros2'"));
+  CHECK_THROWS_WITH(Recording(fs::current_path() / "missing.mcap"), Catch::Contains("cannot open the recording"));
+}
