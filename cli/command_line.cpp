@@ -101,6 +101,34 @@ CommandLine parseCommandLine(int argc, const char* const* argv, std::ostream& ou
   sweep_cmd->add_flag("--quiet", c.sweep.quiet, "no progress");
   addMaxInputOption(sweep_cmd, c.sweep.max_input_mb);
 
+  CLI::App* inspect_cmd = app.add_subcommand("inspect", "say what a recording (ssx run --record) holds");
+  inspect_cmd->add_option("file", c.inspect.file, "recording (MCAP)")->required()->check(CLI::ExistingFile);
+  inspect_cmd->add_option("--complete", c.inspect.complete,
+                          "write a complete copy to FILE (of a recording cut short: summary and footer added)");
+  inspect_cmd->add_flag("--json", c.inspect.json, "print as JSON");
+
+  CLI::App* replay_cmd =
+      app.add_subcommand("replay", "draw a recording's poses, or re-simulate it from one of its saved states");
+  replay_cmd->add_option("file", c.replay.file, "recording (MCAP)")->required()->check(CLI::ExistingFile);
+  replay_cmd->add_option("--from", c.replay.from, "first simulated second drawn")->check(realNumber(0.0, ssx::kMaxDurationSeconds));
+  replay_cmd->add_option("--to", c.replay.to, "last simulated second drawn")->check(realNumber(0.0, ssx::kMaxDurationSeconds));
+  replay_cmd->add_option("--snapshot", c.replay.snapshot, "write the last frame drawn as PNG to FILE");
+  replay_cmd->add_option("--video", c.replay.video, "write the frames as MP4 to FILE (needs ffmpeg)");
+  replay_cmd->add_option("--frames", c.replay.frames, "write the frames as PNG files into DIR");
+  replay_cmd->add_option("--follow", c.replay.follow, "a camera that follows this robot");
+  replay_cmd->add_option("--plugin-path", c.replay.plugin_path, "plugin directory (repeatable)");
+  replay_cmd
+      ->add_option("--resimulate-from", c.replay.resimulate_from,
+                   "restore the saved state at or before this simulated second and step the recorded scene again, "
+                   "comparing every recorded pose")
+      ->check(realNumber(0.0, ssx::kMaxDurationSeconds));
+  replay_cmd->add_option("--duration", c.replay.duration, "simulated seconds to re-simulate (default: to the end)")
+      ->check(realNumber(0.0, ssx::kMaxDurationSeconds, true));
+  replay_cmd->add_option("--set", c.replay.set,
+                         "PATH=VALUE: an attribute of the recorded scene set for the re-simulation, as a sweep sets it "
+                         "(repeatable)");
+  replay_cmd->add_option("--record", c.replay.record, "record the re-simulation into FILE");
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -118,6 +146,14 @@ CommandLine parseCommandLine(int argc, const char* const* argv, std::ostream& ou
     c.command = CommandLine::Command::Validate;
   } else if (*sweep_cmd) {
     c.command = CommandLine::Command::Sweep;
+  } else if (*inspect_cmd) {
+    c.command = CommandLine::Command::Inspect;
+  } else if (*replay_cmd) {
+    c.command = CommandLine::Command::Replay;
+    if (c.replay.resimulate_from < 0 && (!c.replay.set.empty() || !c.replay.record.empty() || c.replay.duration > 0)) {
+      err << "ssx replay: --set, --record and --duration need --resimulate-from\n";
+      c.exit_status = kExitBadInput;
+    }
   } else if (*plugins_cmd) {
     c.command = CommandLine::Command::Plugins;
   } else {

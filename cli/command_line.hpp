@@ -57,8 +57,25 @@ struct PluginsArgs {
   std::string inspect_file;  // (internal) one library, reported from a child process
 };
 
+struct InspectArgs {
+  std::string file;
+  std::string complete;  // write a complete copy here
+  bool json = false;
+};
+
+struct ReplayArgs {
+  std::string file;
+  double from = 0, to = -1;  // seconds; to < 0: the end
+  std::string snapshot, video, frames, follow;
+  std::vector<std::string> plugin_path;
+  double resimulate_from = -1;  // seconds; < 0: draw the recorded poses only
+  double duration = -1;         // of a re-simulation; < 0: to the recording's end
+  std::vector<std::string> set;  // PATH=VALUE overrides of the recorded scene, for a re-simulation
+  std::string record;           // record the re-simulation
+};
+
 struct CommandLine {
-  enum class Command { Run, Validate, Sweep, Plugins };
+  enum class Command { Run, Validate, Sweep, Plugins, Inspect, Replay };
   /// Set when parsing ended the command: --help or --version (0), bad arguments (kExitBadInput);
   /// what CLI11 had to say went to the streams given.
   std::optional<int> exit_status;
@@ -68,6 +85,8 @@ struct CommandLine {
   ValidateArgs validate;
   SweepArgs sweep;
   PluginsArgs plugins;
+  InspectArgs inspect;
+  ReplayArgs replay;
 };
 
 /// Parses argv (argv[0] the program). Never throws for bad arguments.

@@ -4,6 +4,7 @@
 #include "common.hpp"
 #include "command_line.hpp"
 #include "plugins_command.hpp"
+#include "recording_commands.hpp"
 #include "sweep.hpp"
 
 #include <ssx/ssx.hpp>
@@ -454,6 +455,8 @@ int main(int argc, char** argv) {
         return commandValidate(c.validate.scene, c.validate.plugin_path, c.validate.physics, c.validate.print,
                                c.validate.max_input_mb);
       case CommandLine::Command::Sweep: return commandSweep(c.sweep);
+      case CommandLine::Command::Inspect: return ssx::cli::commandInspect(c.inspect);
+      case CommandLine::Command::Replay: return ssx::cli::commandReplay(c.replay);
       case CommandLine::Command::Plugins:
         if (!c.plugins.inspect_file.empty()) return ssx::cli::inspectOne(c.plugins.inspect_file, c.plugins.params_of);
         return ssx::cli::commandPlugins(c.plugins.plugin_path, c.plugins.params_of);

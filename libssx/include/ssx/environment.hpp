@@ -305,6 +305,11 @@ class SSX_EXPORT Environment {
   /// draws pixels (ConfigError otherwise). `owner` names the requester in messages.
   void addCameraRequest(std::string owner, std::function<bool(std::int64_t step, CameraView& view)> due,
                         Image& target);
+  /// Draws the scene cameras' frame of the world as it is now, stamped with `time`, outside a step:
+  /// for a replay that poses the bodies itself (setBodyState) without stepping. Needs the
+  /// environment running; a camera that follows a robot follows it. Throws StepError when a frame
+  /// cannot be drawn or written.
+  void drawFrame(Nanoseconds time);
   /// Frames drawn for the scene's cameras so far.
   std::int64_t frameCount() const noexcept;
   /// The scene cameras' specs as used (frame_scene cameras placed), from start() on.

@@ -88,7 +88,9 @@ class SSX_EXPORT Recording {
   /// chunk (complete() is then false).
   explicit Recording(const std::filesystem::path& file);
   ~Recording();
+  /// Moves the recording read (its memory) into a new one.
   Recording(Recording&&) noexcept;
+  /// @copydoc Recording(Recording&&)
   Recording& operator=(Recording&&) noexcept;
 
   /// The recorded bodies' names.
@@ -123,5 +125,10 @@ class SSX_EXPORT Recording {
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };
+
+/// Writes a complete copy of a recording that was cut short (a killed run: no summary, no
+/// footer) to `out`: everything up to its last complete chunk, with the summary a finished file has.
+/// Works on complete files too (a plain copy of their contents). Throws Error naming the file.
+SSX_EXPORT void completeRecording(const std::filesystem::path& damaged, const std::filesystem::path& out);
 
 }  // namespace ssx

@@ -94,7 +94,8 @@ void McapWriter::addMessage(std::uint16_t channel, Nanoseconds log_time, std::sp
   last_time_ = std::max(last_time_, time);
   ++messages_;
   ++channel_counts_[channel];
-  if (chunk_.size() >= chunk_bytes_) flushChunk();
+  // full, or holding a second of log time: a killed run loses at most that
+  if (chunk_.size() >= chunk_bytes_ || chunk_end_ - chunk_start_ >= kChunkSpan) flushChunk();
 }
 
 void McapWriter::flushChunk() {

@@ -1,8 +1,8 @@
 #pragma once
 // A writer of MCAP files (https://mcap.dev/spec, major version 0), written from the specification:
 // Debian 12 has no MCAP library. Messages go into zstd-compressed chunks, each followed by its
-// message indexes; a chunk reaches the file as soon as it is full, so a run that is killed leaves a
-// file readable up to its last complete chunk. close() writes the summary section (schemas,
+// message indexes; a chunk reaches the file as soon as it is full or spans a second of log time, so a
+// run that is killed leaves a file readable up to its last complete chunk, a second before its end. close() writes the summary section (schemas,
 // channels, statistics, chunk, attachment and metadata indexes) and the footer.
 //
 // Not thread-safe: one thread writes (the recorder's). Every failed write throws Error naming the file.
@@ -23,6 +23,9 @@ namespace ssx::detail {
 
 class McapWriter {
  public:
+  /// A chunk is written out when it holds this much log time (ns), or chunk_bytes.
+  static constexpr std::uint64_t kChunkSpan = 1'000'000'000;
+
   /// Creates (truncates) `file` and writes the magic and the header (profile, library).
   McapWriter(const std::filesystem::path& file, const std::string& profile, const std::string& library,
              std::size_t chunk_bytes = std::size_t{1} << 20, int zstd_level = 3);

@@ -172,7 +172,8 @@ void SceneCameras::renderRequests(std::int64_t step, RenderEngine& renderer, con
   }
 }
 
-void SceneCameras::drawFrame(std::int64_t step, const RenderSettings& settings, const Artifacts& artifacts) {
+void SceneCameras::drawFrame(std::int64_t step, const RenderSettings& settings, const Artifacts& artifacts,
+                             Nanoseconds time) {
   sync(step + 1, artifacts);  // also without cameras: renderNodes() serves viewers outside ssx
   if (!worker_) return;
   std::vector<CameraView> views;
@@ -202,7 +203,7 @@ void SceneCameras::drawFrame(std::int64_t step, const RenderSettings& settings, 
     views.push_back(view);
   }
   try {
-    worker_->submit(items_, std::move(views), (step + 1) * timestep_);
+    worker_->submit(items_, std::move(views), time >= 0 ? time : (step + 1) * timestep_);
   } catch (const std::exception& e) {
     throw StepError("", "render", step, std::string("drawing or writing frames: ") + e.what());
   }

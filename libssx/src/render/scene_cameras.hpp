@@ -40,8 +40,9 @@ class SceneCameras {
   bool hasRequests() const noexcept { return !requests_.empty(); }
   /// Draws the images of the requests due at `step` from the snapshot. Throws StepError.
   void renderRequests(std::int64_t step, RenderEngine& renderer, const Color& background, const Artifacts& artifacts);
-  /// Hands the scene cameras' views of the snapshot at `step` to the frame thread. Throws StepError.
-  void drawFrame(std::int64_t step, const RenderSettings& settings, const Artifacts& artifacts);
+  /// Hands the scene cameras' views of the snapshot at `step` to the frame thread, stamped with
+  /// `time` (< 0: the time after that step). Throws StepError.
+  void drawFrame(std::int64_t step, const RenderSettings& settings, const Artifacts& artifacts, Nanoseconds time = -1);
   /// Forgets the posed items (after a restore: the snapshot changed under the same step count).
   void invalidate() noexcept { items_step_ = -1; }
 

@@ -1,0 +1,335 @@
+#include "recording_commands.hpp"
+
+#include <ssx/ssx.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <iostream>
+#include <sstream>
+
+namespace ssx::cli {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+std::string seconds(Nanoseconds t) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.3f s", toSeconds(t));
+  return text;
+}
+
+std::string jsonString(const std::string& s) {
+  std::string out = "\"";
+  for (const char c : s) {
+    if (c == '"' || c == '\\') out += '\\';
+    if (static_cast<unsigned char>(c) < 0x20) {
+      char e[8];
+      std::snprintf(e, sizeof e, "\\u%04x", c);
+      out += e;
+      continue;
+    }
+    out += c;
+  }
+  return out + "\"";
+}
+
+// the recorded scene, built to draw or to step: plugins from the recording's plugin directories
+// and the ones given; the scene's own camera outputs left out (a replay writes only what it is
+// asked to). Drawing leaves the extensions out (no logger writes, no bridge connects); a
+// re-simulation keeps them (a saved state holds theirs), their relative outputs going into
+// ssx-out/<scene>-resimulated/ rather than over the recorded run's
+Scene buildRecorded(const Recording& r, const ReplayArgs& args, bool draw, int* status) {
+  SceneOptions options;
+  for (const auto& p : args.plugin_path) options.plugin_path.emplace_back(p);
+  if (const char* env = std::getenv("SSX_PLUGIN_PATH"))
+    for (std::string_view rest = env; !rest.empty();) {
+      const auto colon = rest.find(':');
+      if (colon != 0) options.plugin_path.emplace_back(std::string(rest.substr(0, colon)));
+      rest = colon == std::string_view::npos ? std::string_view() : rest.substr(colon + 1);
+    }
+  options.extensions = !draw;
+  if (!draw) options.output_directory = fs::path("ssx-out") / (fs::path(r.sceneLabel()).stem().string() + "-resimulated");
+  for (const std::string& s : args.set) {
+    // PATH=VALUE, the path's own '=' (name[attribute=value]) before its '@'
+    const auto at = s.find('@');
+    const auto eq = at == std::string::npos ? std::string::npos : s.find('=', at);
+    if (eq == std::string::npos || eq == 0) {
+      std::cerr << "ssx: error: --set " << s << ": write PATH=VALUE (e.g. swarm[name=q{i}]/driver@position_kp=4)\n";
+      *status = kExitBadInput;
+      return {};
+    }
+    options.overrides.push_back({s.substr(0, eq), s.substr(eq + 1), SourceLocation{"--set", 0}});
+  }
+  if (draw) options.render_engine = "osmesa";
+  try {
+    SceneModel model = parseSceneString(r.sceneXml(), r.sceneLabel().empty() ? "recorded scene" : r.sceneLabel(),
+                                        fs::current_path(), options);
+    for (CameraSpec& c : model.settings.render.cameras) {
+      c.snapshot.clear();
+      c.video.clear();
+      c.frames_dir.clear();
+    }
+    // the outputs asked for, on the first camera: the follow camera, the scene's first, or one
+    // framing every robot
+    if (draw && model.settings.render.cameras.empty() && args.follow.empty()) {
+      CameraSpec all;
+      all.name = "replay";
+      all.frame_scene = true;
+      model.settings.render.cameras.push_back(all);
+    }
+    if (draw && !args.follow.empty()) {
+      CameraSpec chase;
+      chase.name = "follow";
+      chase.follow = args.follow;
+      chase.position = Vec3(-3, 0, 1.5);
+      chase.look_at = Vec3::Zero();
+      model.settings.render.cameras.insert(model.settings.render.cameras.begin(), chase);
+    }
+    if (draw) {
+      CameraSpec& first = model.settings.render.cameras.front();
+      first.snapshot = args.snapshot;
+      first.video = args.video;
+      first.frames_dir = args.frames;
+    }
+    // frames at the recording's rate
+    if (draw && r.times().size() > 1) {
+      const Nanoseconds interval = r.times()[1] - r.times()[0];
+      if (interval > 0) model.settings.render.rate_hz = 1.0 / toSeconds(interval);
+    }
+    Scene scene = buildScene(model, options);
+    return scene;
+  } catch (const SceneError& e) {
+    std::cerr << e.what() << "\nssx: error: the recorded scene cannot be built here (recorded by ssx " << r.version()
+              << "; plugins and artifact files must be where they were, or given with --plugin-path)\n";
+    *status = kExitBadInput;
+    return {};
+  }
+}
+
+int draw(const Recording& r, const ReplayArgs& args) {
+  if (args.snapshot.empty() && args.video.empty() && args.frames.empty()) {
+    std::cerr << "ssx: error: ssx replay draws into --snapshot, --video or --frames (or re-simulates: "
+                 "--resimulate-from)\n";
+    return kExitBadInput;
+  }
+  int status = 0;
+  Scene scene = buildRecorded(r, args, true, &status);
+  if (status != 0) return status;
+  Environment& env = *scene.environment;
+  // the recording's bodies in this environment
+  std::vector<int> bodies;
+  env.start();
+  for (const std::string& name : r.names()) {
+    const auto slash = name.find('/');
+    const Artifact* a = env.findArtifact(name.substr(0, slash));
+    const PhysicNode* node = a == nullptr ? nullptr : slash == std::string::npos ? &a->root() : a->node(name.substr(slash + 1));
+    if (node == nullptr || node->bodyIndex() < 0) {
+      std::cerr << "ssx: error: " << r.names().size() << " bodies recorded, but the recorded scene has no body '" << name
+                << "' (a recording of another version?)\n";
+      return kExitBadInput;
+    }
+    bodies.push_back(node->bodyIndex());
+  }
+  const Nanoseconds from = toNanoseconds(args.from);
+  const Nanoseconds to = args.to >= 0 ? toNanoseconds(args.to) : std::numeric_limits<Nanoseconds>::max();
+  std::int64_t drawn = 0;
+  std::vector<CameraSpec> cameras;
+  try {
+    for (std::size_t k = 0; k < r.times().size(); ++k) {
+      const Nanoseconds t = r.times()[k];
+      if (t < from || t > to) continue;
+      const std::vector<float> p = r.positions(k), q = r.orientations(k);
+      for (std::size_t i = 0; i < bodies.size(); ++i) {
+        BodyState s = env.bodyState(bodies[i]);
+        s.pose.position = Vec3(p[3 * i], p[3 * i + 1], p[3 * i + 2]);
+        s.pose.orientation = Quat(q[4 * i], q[4 * i + 1], q[4 * i + 2], q[4 * i + 3]).normalized();
+        s.linear_velocity.setZero();
+        s.angular_velocity.setZero();
+        env.setBodyState(bodies[i], s);
+      }
+      env.drawFrame(t);
+      ++drawn;
+    }
+    cameras = env.cameras();
+    env.stop();
+  } catch (const std::exception& e) {
+    std::cerr << "ssx: error: " << e.what() << '\n';
+    return kExitRunFailure;
+  }
+  std::cout << "replayed " << drawn << " samples of " << bodies.size() << " bodies";
+  if (drawn > 0) std::cout << " (" << seconds(std::max(from, r.times().front())) << " to " << seconds(std::min(to, r.times().back())) << ")";
+  std::cout << '\n';
+  for (const auto& c : cameras) {
+    if (!c.snapshot.empty() && fs::exists(c.snapshot)) std::cout << "camera " << c.name << ": snapshot " << c.snapshot.string() << '\n';
+    if (!c.video.empty() && fs::exists(c.video)) std::cout << "camera " << c.name << ": video " << c.video.string() << '\n';
+    if (!c.frames_dir.empty()) std::cout << "camera " << c.name << ": " << drawn << " frames in " << c.frames_dir.string() << '\n';
+  }
+  return 0;
+}
+
+int resimulate(const Recording& r, const ReplayArgs& args) {
+  int status = 0;
+  Scene scene = buildRecorded(r, args, false, &status);
+  if (status != 0) return status;
+  Environment& env = *scene.environment;
+  if (!args.record.empty()) {
+    scene.files.addInput(args.file);  // the recording replayed is never written over
+    const std::string problem = scene.files.claimOutput(args.record, "--record", true);
+    if (!problem.empty()) {
+      std::cerr << "ssx: error: " << problem << '\n';
+      return kExitBadInput;
+    }
+  }
+  // the scene's own outputs go into ssx-out/<scene>-resimulated/, made now that every check passed
+  const fs::path out_dir = fs::path("ssx-out") / (fs::path(r.sceneLabel()).stem().string() + "-resimulated");
+  for (const fs::path& p : scene.files.outputs()) {
+    const auto rel = p.lexically_relative(out_dir);
+    if (!rel.empty() && *rel.begin() != "..") {
+      std::error_code ec;
+      fs::create_directories(out_dir, ec);
+      break;
+    }
+  }
+  Nanoseconds at = 0;
+  std::unique_ptr<Recorder> recorder;
+  try {
+    const std::vector<std::byte> state = r.stateAtOrBefore(toNanoseconds(args.resimulate_from), &at);
+    env.checkState(state);
+    if (!args.record.empty()) {
+      RecordOptions o;
+      o.file = args.record;
+      o.scene_xml = scene.model->toXml();
+      o.scene_label = r.sceneLabel();
+      recorder = std::make_unique<Recorder>(env, o);
+    }
+    env.start();
+    env.restoreState(state);
+  } catch (const std::exception& e) {
+    std::cerr << "ssx: error: " << args.file << ": " << e.what() << '\n';
+    return kExitBadInput;
+  }
+  const Nanoseconds end = args.duration > 0 ? at + toNanoseconds(args.duration) : r.times().empty() ? at : r.times().back();
+  // step, comparing each recorded sample on the way
+  std::size_t compared = 0, equal = 0;
+  double largest = 0;
+  std::string largest_at, first_difference;
+  try {
+    std::size_t k = 0;
+    while (k < r.times().size() && r.times()[k] <= at) ++k;
+    while (env.time() < end) {
+      env.step();
+      if (k < r.times().size() && r.times()[k] == env.time()) {
+        const std::vector<float> recorded = r.positions(k);
+        bool same = true;
+        for (std::size_t i = 0; i < r.names().size(); ++i) {
+          const std::string& name = r.names()[i];
+          const Artifact* a = env.findArtifact(name.substr(0, name.find('/')));
+          if (a == nullptr) continue;
+          const Vec3 p = a->pose().position;
+          double d = 0;
+          for (int c = 0; c < 3; ++c) {
+            const auto now = static_cast<float>(p[c]);
+            same = same && now == recorded[3 * i + static_cast<std::size_t>(c)];
+            d = std::max(d, std::abs(static_cast<double>(now) - recorded[3 * i + static_cast<std::size_t>(c)]));
+          }
+          if (d > 0 && first_difference.empty()) first_difference = seconds(r.times()[k]) + " (" + name + ")";
+          if (d > largest) {
+            largest = d;
+            largest_at = name + " at " + seconds(r.times()[k]);
+          }
+        }
+        ++compared;
+        equal += same ? 1 : 0;
+        ++k;
+      }
+    }
+    if (recorder) std::cout << recorder->finish().str(args.record) << '\n';
+    env.stop();
+  } catch (const std::exception& e) {
+    std::cerr << "ssx: error: " << e.what() << '\n';
+    return kExitRunFailure;
+  }
+  std::cout << "re-simulated from " << seconds(at) << " (the saved state at or before " << args.resimulate_from
+            << " s) to " << seconds(end) << ": " << compared << " recorded samples compared, ";
+  if (equal == compared)
+    std::cout << "every one equal to the recording bit for bit\n";
+  else
+    std::cout << equal << " equal; the first difference at " << first_difference << ", the largest " << largest
+              << " m (" << largest_at << ")\n";
+  return 0;
+}
+
+}  // namespace
+
+int commandInspect(const InspectArgs& args) {
+  try {
+    const Recording r(args.file);
+    if (!args.complete.empty()) {
+      if (fs::exists(args.complete) && fs::equivalent(args.complete, args.file)) {
+        std::cerr << "ssx: error: --complete " << args.complete << " is the recording itself: name another file\n";
+        return kExitBadInput;
+      }
+      completeRecording(args.file, args.complete);
+    }
+    const auto states = r.stateTimes();
+    if (args.json) {
+      std::ostringstream o;
+      o << "{\"file\":" << jsonString(args.file) << ",\"complete\":" << (r.complete() ? "true" : "false")
+        << ",\"bytes\":" << r.size() << ",\"version\":" << jsonString(r.version()) << ",\"seed\":" << r.seed()
+        << ",\"scene\":" << jsonString(r.sceneLabel()) << ",\"bodies\":" << r.names().size() << ",\"channels\":{";
+      bool first = true;
+      for (const auto& [topic, count] : r.channels()) {
+        o << (first ? "" : ",") << jsonString(topic) << ":" << count;
+        first = false;
+      }
+      o << "},\"first_time_ns\":" << (r.times().empty() ? 0 : r.times().front())
+        << ",\"last_time_ns\":" << (r.times().empty() ? 0 : r.times().back()) << ",\"states_ns\":[";
+      for (std::size_t i = 0; i < states.size(); ++i) o << (i ? "," : "") << states[i];
+      o << "]}";
+      std::cout << o.str() << '\n';
+      return 0;
+    }
+    std::cout << args.file << ": " << (r.complete() ? "complete" : "cut short (no summary: ssx inspect --complete FILE writes a complete copy)")
+              << ", " << r.size() << " bytes, recorded by ssx " << r.version() << ", scene " << r.sceneLabel()
+              << ", seed " << r.seed() << '\n';
+    std::cout << r.names().size() << " bodies, " << r.times().size() << " pose samples";
+    if (!r.times().empty()) std::cout << " from " << seconds(r.times().front()) << " to " << seconds(r.times().back());
+    std::cout << '\n';
+    for (const auto& [topic, count] : r.channels()) std::cout << "channel " << topic << ": " << count << " messages\n";
+    std::cout << "saved states: " << states.size();
+    for (std::size_t i = 0; i < states.size(); ++i) std::cout << (i ? ", " : " at ") << seconds(states[i]);
+    std::cout << '\n';
+    if (!args.complete.empty()) std::cout << "complete copy written to " << args.complete << '\n';
+  } catch (const std::exception& e) {
+    std::cerr << "ssx: error: " << e.what() << '\n';
+    return kExitBadInput;
+  }
+  return 0;
+}
+
+int commandReplay(const ReplayArgs& args) {
+  // never written over: the recording itself
+  const fs::path recording = fs::weakly_canonical(fs::absolute(args.file));
+  for (const auto& [path, what] :
+       {std::pair{args.snapshot, "--snapshot"}, std::pair{args.video, "--video"}, std::pair{args.record, "--record"}}) {
+    if (path.empty()) continue;
+    std::error_code ec;
+    const fs::path out = fs::weakly_canonical(fs::absolute(path), ec);
+    if (!ec && out == recording) {
+      std::cerr << "ssx: error: " << what << " " << path << " would write over the recording being replayed: name another\n";
+      return kExitBadInput;
+    }
+  }
+  try {
+    const Recording r(args.file);
+    return args.resimulate_from >= 0 ? resimulate(r, args) : draw(r, args);
+  } catch (const std::exception& e) {
+    std::cerr << "ssx: error: " << e.what() << '\n';
+    return kExitBadInput;
+  }
+}
+
+}  // namespace ssx::cli
