@@ -41,6 +41,14 @@ install_packages() {
   DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
 }
 
+# the independent MCAP reader the tests use, from the npm registry, pinned by
+# tests/tools/package-lock.json, into DIR/npm (tests only: nothing ssx runs needs Node.js)
+install_npm_tools() {
+  mkdir -p "$1/npm"
+  cp tests/tools/package.json tests/tools/package-lock.json "$1/npm/"
+  npm ci --prefix "$1/npm" --no-audit --no-fund >/dev/null
+}
+
 # build [TARGET]: configures and builds everything, or only TARGET
 build() {
   install_packages
@@ -58,7 +66,10 @@ case "${1:-}" in
     ;;
   test)
     packages+=("${ros_packages[@]}" "${python_test_packages[@]}")
+    # Node.js for the independent MCAP reader (tests only; a Node.js already there is used as it is)
+    command -v node >/dev/null && command -v npm >/dev/null || packages+=(nodejs npm)
     build
+    install_npm_tools "$build_dir"
     ctest --test-dir "$build_dir" -j "$jobs" --output-on-failure
     ;;
   build)
@@ -66,7 +77,9 @@ case "${1:-}" in
     ;;
   sanitize)
     packages+=("${ros_packages[@]}" "${sanitize_packages[@]}")
+    command -v node >/dev/null && command -v npm >/dev/null || packages+=(nodejs npm)
     install_packages
+    install_npm_tools build-asan
     launcher=()
     command -v ccache >/dev/null && launcher=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache -DCMAKE_C_COMPILER_LAUNCHER=ccache)
     # a finding ends the test that found it, with a stack

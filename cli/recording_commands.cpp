@@ -102,8 +102,9 @@ Scene buildRecorded(const Recording& r, const ReplayArgs& args, bool draw, int* 
     Scene scene = buildScene(model, options);
     return scene;
   } catch (const SceneError& e) {
-    std::cerr << e.what() << "\nssx: error: the recorded scene cannot be built here (recorded by ssx " << r.version()
-              << "; plugins and artifact files must be where they were, or given with --plugin-path)\n";
+    std::cerr << e.what() << "\nssx replay: the recorded scene (recorded by ssx " << r.version()
+              << ") was not built: the lines above say why (a recording names its artifact files and plugin "
+                 "directories where they were; --plugin-path adds others)\n";
     *status = kExitBadInput;
     return {};
   }
@@ -196,7 +197,11 @@ int resimulate(const Recording& r, const ReplayArgs& args) {
   Nanoseconds at = 0;
   std::unique_ptr<Recorder> recorder;
   try {
-    const std::vector<std::byte> state = r.stateAtOrBefore(toNanoseconds(args.resimulate_from), &at);
+    // the saved state at or before the time asked for; before the first one, the first
+    const std::vector<Nanoseconds> times = r.stateTimes();
+    const Nanoseconds from = toNanoseconds(args.resimulate_from);
+    const std::vector<std::byte> state =
+        r.stateAtOrBefore(!times.empty() && from < times.front() ? times.front() : from, &at);
     env.checkState(state);
     if (!args.record.empty()) {
       RecordOptions o;
@@ -208,7 +213,7 @@ int resimulate(const Recording& r, const ReplayArgs& args) {
     env.start();
     env.restoreState(state);
   } catch (const std::exception& e) {
-    std::cerr << "ssx: error: " << args.file << ": " << e.what() << '\n';
+    std::cerr << "ssx: error: " << e.what() << '\n';
     return kExitBadInput;
   }
   const Nanoseconds end = args.duration > 0 ? at + toNanoseconds(args.duration) : r.times().empty() ? at : r.times().back();
@@ -252,8 +257,8 @@ int resimulate(const Recording& r, const ReplayArgs& args) {
     std::cerr << "ssx: error: " << e.what() << '\n';
     return kExitRunFailure;
   }
-  std::cout << "re-simulated from " << seconds(at) << " (the saved state at or before " << args.resimulate_from
-            << " s) to " << seconds(end) << ": " << compared << " recorded samples compared, ";
+  std::cout << "re-simulated from the saved state at " << seconds(at) << " (asked for "
+            << seconds(toNanoseconds(args.resimulate_from)) << ") to " << seconds(end) << ": " << compared << " recorded samples compared, ";
   if (equal == compared)
     std::cout << "every one equal to the recording bit for bit\n";
   else

@@ -449,3 +449,42 @@ TEST_CASE("ssx run: a bare --realtime means factor 1, a given factor is used", "
   CHECK_THAT(doubled.err, Contains("real time x4"));
   CHECK_THAT(doubled.out, Contains("steps 50"));
 }
+
+TEST_CASE("ssx run --record, inspect and replay: a run kept, looked at, drawn again and re-simulated bit for bit",
+          "[cli][record]") {
+  const fs::path dir = fs::temp_directory_path() / ("ssx_record_cli_" + std::to_string(getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  const std::string scene = (kExamples / "scenes" / "quad_hover.xml").string();
+  const std::string rec = (dir / "hover.mcap").string();
+  const Result ran = run({"run", scene, "--steps", "1000", "--fast", "--record", rec, "--out", (dir / "out").string()});
+  REQUIRE(ran.status == 0);
+  CHECK_THAT(ran.out, Catch::Contains("recording " + rec + ": 50 samples of 3 bodies (0 dropped), 1 saved states"));
+  const Result inspected = run({"inspect", rec, "--json"});
+  CHECK(inspected.status == 0);
+  CHECK_THAT(inspected.out, Catch::Contains("\"complete\":true") && Catch::Contains("\"/ssx/poses\":50") &&
+                                Catch::Contains("\"first_time_ns\":40000000,\"last_time_ns\":2000000000"));
+  const Result drawn = run({"replay", rec, "--snapshot", (dir / "replay.png").string(), "--from", "1"});
+  CHECK(drawn.status == 0);
+  CHECK_THAT(drawn.out, Catch::Contains("replayed 26 samples of 3 bodies (1.000 s to 2.000 s)"));
+  CHECK(fs::file_size(dir / "replay.png") > 1000);
+  const Result again = run({"replay", rec, "--resimulate-from", "0"});
+  CHECK(again.status == 0);
+  CHECK_THAT(again.out, Catch::Contains("49 recorded samples compared, every one equal to the recording bit for bit"));
+  // a changed gain: the same start, then another flight
+  const Result changed =
+      run({"replay", rec, "--resimulate-from", "0", "--set", "artifact[name=mk]/driver@position_kp=1 1 1"});
+  CHECK(changed.status == 0);
+  CHECK_THAT(changed.out, Catch::Contains("recorded samples compared, ") && Catch::Contains("the first difference at"));
+  // nothing is written over the recording, or over the scene
+  const Result over = run({"replay", rec, "--snapshot", rec});
+  CHECK(over.status == 2);
+  CHECK_THAT(over.err, Catch::Contains("would write over the recording being replayed"));
+  CHECK(run({"run", scene, "--steps", "10", "--fast", "--record", scene}).status == 2);
+  CHECK(run({"inspect", rec}).status == 0);
+  // a file that is not a recording: a message naming it, status 2
+  const Result foreign = run({"inspect", scene});
+  CHECK(foreign.status == 2);
+  CHECK_THAT(foreign.err, Catch::Contains(scene + ": byte 0: not an MCAP file"));
+  fs::remove_all(dir);
+}

@@ -113,8 +113,9 @@ std::vector<std::byte> Recording::stateAtOrBefore(Nanoseconds time, Nanoseconds*
     if (s.first <= time) best = &s;
   if (best == nullptr)
     throw Error(impl_->file.file.string() + ": no saved state at or before " + std::to_string(toSeconds(time)) +
-                " s (the first is at " +
-                (impl_->states.empty() ? std::string("none") : std::to_string(toSeconds(impl_->states.front().first)) + " s") +
+                " s (" +
+                (impl_->states.empty() ? std::string("it has none")
+                                       : "the first is at " + std::to_string(toSeconds(impl_->states.front().first)) + " s") +
                 ")");
   if (at != nullptr) *at = best->first;
   return {best->second.begin(), best->second.end()};
