@@ -2,6 +2,8 @@
 #include "fuzz_inputs.hpp"
 
 #include "command_line.hpp"
+#include "record/mcap_reader.hpp"
+#include "record/pose_codec.hpp"
 
 #include <ssx/ssx.hpp>
 
@@ -236,6 +238,24 @@ void commandLineInput(std::span<const std::uint8_t> data) {
   for (double mb : {r.max_input_mb, c.validate.max_input_mb, c.sweep.max_input_mb})
     require(mb >= 1.0 / 1024 && mb <= cli::kMostMaxInputMb, "an input limit out of range");
   require(c.sweep.jobs == 0 || (c.sweep.jobs >= 1 && c.sweep.jobs <= 4096), "a job count out of range");
+}
+
+void recordingInput(std::span<const std::uint8_t> data) {
+  std::vector<std::byte> bytes(data.size());
+  if (!data.empty()) std::memcpy(bytes.data(), data.data(), data.size());
+  try {
+    const detail::McapFile f = detail::parseMcap(std::move(bytes), "fuzz.mcap");
+    const int poses = f.channelId("/ssx/poses");
+    std::vector<float> p, q;
+    for (const auto& m : f.messages) {
+      if (m.channel != poses) continue;
+      try {
+        detail::decodePoses(m.data, &p, &q);
+      } catch (const Error&) {
+      }
+    }
+  } catch (const Error&) {
+  }
 }
 
 }  // namespace ssx::fuzz

@@ -32,4 +32,8 @@ void stateInput(std::span<const std::uint8_t> data);
 /// std::logic_error otherwise: a finding); what it refuses gets exit status 2.
 void commandLineInput(std::span<const std::uint8_t> data);
 
+/// A recording (MCAP), read as `ssx inspect` and `ssx replay` read one (the MCAP reader), and its
+/// pose messages decoded. A file that is refused is an ssx::Error.
+void recordingInput(std::span<const std::uint8_t> data);
+
 }  // namespace ssx::fuzz

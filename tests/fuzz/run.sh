@@ -17,9 +17,10 @@ declare -A seeds=(
   [parameter]="tests/data/fuzz/parameter"
   [state]="tests/data/fuzz/state"
   [command_line]="tests/data/fuzz/command_line"
+  [recording]="tests/data/fuzz/recording"
 )
 status=0
-for target in scene artifact parameter state command_line; do
+for target in scene artifact parameter state command_line recording; do
   corpus=$work/corpus_$target
   mkdir -p "$corpus"
   # shellcheck disable=SC2086

@@ -46,6 +46,10 @@ TEST_CASE("inputs the fuzzers found or started from are refused or run cleanly: 
   CHECK(replay("state", ssx::fuzz::stateInput) >= 1);
 }
 
+TEST_CASE("inputs the fuzzers found or started from are refused or run cleanly: recordings", "[fuzz]") {
+  CHECK(replay("recording", ssx::fuzz::recordingInput) >= 1);
+}
+
 TEST_CASE("inputs the fuzzers found or started from are refused or run cleanly: command lines", "[fuzz]") {
   CHECK(replay("command_line", ssx::fuzz::commandLineInput) >= 1);
 }
