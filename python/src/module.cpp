@@ -368,7 +368,26 @@ class PyEnvironment {
   // Python signal handler that raises) ends the run between two steps and raises here; the
   // environment stays usable.
   py::dict run(std::optional<double> seconds, bool realtime, std::optional<double> realtime_factor,
-               std::optional<int> realtime_priority) {
+               std::optional<int> realtime_priority, std::optional<fs::path> record) {
+    if (record) {
+      // this run recorded: samples dropped rather than a paced step held up
+      this->record(*record, 25.0, 10.0, realtime);
+      py::dict out;
+      try {
+        out = run(seconds, realtime, realtime_factor, realtime_priority, std::nullopt);
+      } catch (...) {
+        if (recorder_) {
+          std::unique_ptr<ssx::Recorder> recorder = std::move(recorder_);
+          try {
+            recorder->finish();
+          } catch (...) {
+          }
+        }
+        throw;
+      }
+      out["recording"] = stopRecording();
+      return out;
+    }
     InUse use(busy_);
     ssx::RunOptions run = scene_.run;
     run.mode = realtime ? ssx::RunOptions::Mode::RealTime : ssx::RunOptions::Mode::Fast;
@@ -418,9 +437,53 @@ class PyEnvironment {
     return summaryDict(summary);
   }
 
+  // records from the next step on, whether stepped or run, until stop_recording() or close()
+  void record(const fs::path& file, double rate_hz, double state_every_s, bool drop_when_behind) {
+    InUse use(busy_);
+    if (recorder_) throw py::value_error("ssx: already recording to " + recording_file_.string() + ": stop_recording() first");
+    ssx::RecordOptions o;
+    o.file = file;
+    o.rate_hz = rate_hz;
+    o.state_every_s = state_every_s;
+    o.drop_when_behind = drop_when_behind;
+    o.scene_xml = scene_.model ? scene_.model->toXml() : std::string();
+    o.scene_label = scene_.file.filename().string();
+    // never over what the scene reads or writes
+    ssx::RunFiles files = scene_.files;
+    if (const std::string problem = files.claimOutput(file, "record", true); !problem.empty())
+      throw py::value_error("ssx: " + problem);
+    recorder_ = std::make_unique<ssx::Recorder>(env_, std::move(o));
+    recording_file_ = file;
+  }
+
+  py::dict stopRecording() {
+    InUse use(busy_);
+    if (!recorder_) throw py::value_error("ssx: not recording");
+    std::unique_ptr<ssx::Recorder> recorder = std::move(recorder_);
+    ssx::RecordSummary s;
+    {
+      py::gil_scoped_release release;
+      s = recorder->finish();
+    }
+    py::dict d;
+    d["file"] = recording_file_;
+    d["samples"] = s.samples;
+    d["dropped"] = s.dropped;
+    d["states"] = s.states;
+    d["bodies"] = s.bodies;
+    d["bytes"] = s.bytes;
+    d["text"] = s.str(recording_file_);
+    return d;
+  }
+  bool recording() const { return recorder_ != nullptr; }
+
   void close() {
     InUse use(busy_);
     py::gil_scoped_release release;
+    if (recorder_) {
+      std::unique_ptr<ssx::Recorder> recorder = std::move(recorder_);
+      recorder->finish();
+    }
     if (env_.state() == ssx::Environment::State::Running) env_.stop();
   }
 
@@ -442,6 +505,8 @@ class PyEnvironment {
   ssx_python::CommandTargets targets_;
   mutable std::atomic<bool> busy_{false};  // (reads guard it too: InUse)
   ssx::FlightRecorder flights_;
+  std::unique_ptr<ssx::Recorder> recorder_;
+  fs::path recording_file_;
 };
 
 ssx::SceneOptions sceneOptions(std::optional<std::uint64_t> seed, std::optional<int> threads,
@@ -546,13 +611,129 @@ PYBIND11_MODULE(_ssx, m) {
            "Continues from save_state() bytes: the next steps are bitwise those of the saving run.")
       .def("run", &PyEnvironment::run, py::arg("seconds") = py::none(), py::arg("realtime") = true,
            py::arg("realtime_factor") = py::none(), py::arg("realtime_priority") = py::none(),
+           py::arg("record") = py::none(),
            "Runs `seconds` of simulated time (default: the scene's duration), paced to the wall clock "
            "unless realtime=False; returns the timing summary. Ctrl-C stops it between two steps. "
-           "realtime_priority (1-99) steps at that SCHED_FIFO priority (needs root or CAP_SYS_NICE).")
-      .def("close", &PyEnvironment::close, "Stops the environment: plugins destroyed, files and videos finished.")
+           "realtime_priority (1-99) steps at that SCHED_FIFO priority (needs root or CAP_SYS_NICE). record=FILE "
+           "records the run (as record() does; samples dropped rather than a paced step held up), its summary under "
+           "'recording'.")
+      .def("record", &PyEnvironment::record, py::arg("file"), py::arg("rate_hz") = 25.0, py::arg("state_every_s") = 10.0,
+           py::arg("drop_when_behind") = false,
+           "Records the run from the next step on (stepped or run) into an MCAP file: the scene, every body's pose "
+           "at rate_hz, a saved state every state_every_s; read it back with ssx.Recording. Written by a thread of "
+           "its own; drop_when_behind drops samples rather than wait for it.")
+      .def("stop_recording", &PyEnvironment::stopRecording,
+           "Ends the recording (the file complete) and returns what it wrote: samples, dropped, states, bytes.")
+      .def_property_readonly("recording", &PyEnvironment::recording, "Whether a recording is running.")
+      .def("close", &PyEnvironment::close,
+           "Stops the environment: a recording finished, plugins destroyed, files and videos finished.")
       .def("__enter__", [](py::object self) { return self; })
       .def("__exit__", [](PyEnvironment& e, const py::args&) { e.close(); })
       .def("__repr__", &PyEnvironment::repr);
+
+  py::class_<ssx::Recording>(m, "Recording",
+                             "A recording (ssx run --record, Environment.record) read back: names, times, every body's "
+                             "poses as numpy arrays, the scene, and saved states to continue from.")
+      .def(py::init([](const fs::path& file) {
+             py::gil_scoped_release release;
+             return ssx::Recording(file);
+           }),
+           py::arg("file"), "Reads a recording; raises RuntimeError naming the file and the byte offset when it is "
+                            "not one or is corrupted (a file cut short is read up to its last complete chunk).")
+      .def_property_readonly("names", &ssx::Recording::names, "The recorded bodies, in the order of the arrays' rows.")
+      .def_property_readonly(
+          "times",
+          [](const ssx::Recording& r) {
+            py::array_t<double> out(static_cast<py::ssize_t>(r.times().size()));
+            auto w = out.mutable_unchecked<1>();
+            for (std::size_t k = 0; k < r.times().size(); ++k) w(static_cast<py::ssize_t>(k)) = ssx::toSeconds(r.times()[k]);
+            return out;
+          },
+          "Sample times, s (a numpy array).")
+      .def(
+          "positions",
+          [](const ssx::Recording& r) {
+            const auto t = static_cast<py::ssize_t>(r.times().size()), n = static_cast<py::ssize_t>(r.names().size());
+            py::array_t<float> out({t, n, py::ssize_t{3}});
+            float* dst = out.mutable_data();
+            {
+              py::gil_scoped_release release;
+              for (std::size_t k = 0; k < r.times().size(); ++k) {
+                const std::vector<float> p = r.positions(k);
+                std::copy(p.begin(), p.end(), dst + k * p.size());
+              }
+            }
+            return out;
+          },
+          "Every sample's positions: a float32 array of times x bodies x 3 (m, world frame).")
+      .def(
+          "orientations",
+          [](const ssx::Recording& r) {
+            const auto t = static_cast<py::ssize_t>(r.times().size()), n = static_cast<py::ssize_t>(r.names().size());
+            py::array_t<float> out({t, n, py::ssize_t{4}});
+            float* dst = out.mutable_data();
+            {
+              py::gil_scoped_release release;
+              for (std::size_t k = 0; k < r.times().size(); ++k) {
+                const std::vector<float> q = r.orientations(k);
+                std::copy(q.begin(), q.end(), dst + k * q.size());
+              }
+            }
+            return out;
+          },
+          "Every sample's orientations: a float32 array of times x bodies x 4 (w, x, y, z; unit quaternions).")
+      .def(
+          "at",
+          [](const ssx::Recording& r, double t) {
+            const auto& times = r.times();
+            const ssx::Nanoseconds ns = ssx::toNanoseconds(t);
+            auto it = std::upper_bound(times.begin(), times.end(), ns);
+            if (it == times.begin()) throw py::value_error("ssx: no sample at or before " + std::to_string(t) + " s");
+            const auto k = static_cast<std::size_t>(it - times.begin() - 1);
+            const auto n = static_cast<py::ssize_t>(r.names().size());
+            py::array_t<float> p({n, py::ssize_t{3}}), q({n, py::ssize_t{4}});
+            const std::vector<float> pv = r.positions(k), qv = r.orientations(k);
+            std::copy(pv.begin(), pv.end(), p.mutable_data());
+            std::copy(qv.begin(), qv.end(), q.mutable_data());
+            return py::make_tuple(ssx::toSeconds(times[k]), p, q);
+          },
+          py::arg("t"), "The sample at or before t seconds: (its time, positions bodies x 3, orientations bodies x 4).")
+      .def_property_readonly("scene_xml", &ssx::Recording::sceneXml, "The recorded scene as scene XML.")
+      .def_property_readonly("scene", &ssx::Recording::sceneLabel, "The scene's file name when it was recorded.")
+      .def_property_readonly("version", &ssx::Recording::version, "The ssx version that recorded it.")
+      .def_property_readonly("seed", &ssx::Recording::seed, "The recorded run's seed.")
+      .def_property_readonly("complete", &ssx::Recording::complete, "False for a file cut short (a killed run).")
+      .def_property_readonly("size", &ssx::Recording::size, "Bytes in the file.")
+      .def_property_readonly(
+          "state_times",
+          [](const ssx::Recording& r) {
+            std::vector<double> out;
+            for (const ssx::Nanoseconds t : r.stateTimes()) out.push_back(ssx::toSeconds(t));
+            return out;
+          },
+          "Times of the saved states, s.")
+      .def(
+          "snapshot",
+          [](const ssx::Recording& r, double t) {
+            ssx::Nanoseconds at = 0;
+            const std::vector<std::byte> s = r.stateAtOrBefore(ssx::toNanoseconds(t), &at);
+            return py::make_tuple(ssx::toSeconds(at), py::bytes(reinterpret_cast<const char*>(s.data()), s.size()));
+          },
+          py::arg("t"),
+          "The saved state at or before t seconds: (its time, bytes for Environment.restore_state of the recorded "
+          "scene, e.g. load_scene_string(recording.scene_xml)).")
+      .def(
+          "channels", [](const ssx::Recording& r) {
+            py::dict d;
+            for (const auto& [topic, count] : r.channels()) d[py::str(topic)] = count;
+            return d;
+          },
+          "Every channel's topic and message count.")
+      .def("__len__", [](const ssx::Recording& r) { return r.times().size(); })
+      .def("__repr__", [](const ssx::Recording& r) {
+        return "<ssx.Recording " + r.sceneLabel() + ": " + std::to_string(r.names().size()) + " bodies, " +
+               std::to_string(r.times().size()) + " samples>";
+      });
 
   m.def(
       "load_scene",

@@ -82,12 +82,65 @@ class Environment:
     def restore_state(self, state: bytes) -> None:
         """Continues from save_state() bytes: the next steps are bitwise those of the saving run."""
     def run(self, seconds: Optional[float] = None, realtime: bool = True, realtime_factor: Optional[float] = None,
-            realtime_priority: Optional[int] = None) -> Dict[str, Any]:
-        """Runs `seconds` of simulated time, paced unless realtime=False; returns the timing summary."""
+            realtime_priority: Optional[int] = None, record: Optional[_Path] = None) -> Dict[str, Any]:
+        """Runs `seconds` of simulated time, paced unless realtime=False; returns the timing summary.
+        record=FILE records the run (summary under 'recording')."""
+    def record(self, file: _Path, rate_hz: float = 25.0, state_every_s: float = 10.0,
+               drop_when_behind: bool = False) -> None:
+        """Records from the next step on into an MCAP file (read back with Recording)."""
+    def stop_recording(self) -> Dict[str, Any]:
+        """Ends the recording; returns samples, dropped, states, bodies, bytes and a line of text."""
+    @property
+    def recording(self) -> bool:
+        """Whether a recording is running."""
     def close(self) -> None:
-        """Stops the environment: plugins destroyed, files and videos finished."""
+        """Stops the environment: a recording finished, plugins destroyed, files and videos finished."""
     def __enter__(self) -> "Environment": ...
     def __exit__(self, *args: Any) -> None: ...
+
+class Recording:
+    """A recording read back: names, times, every body's poses as numpy arrays, the scene, saved states."""
+
+    def __init__(self, file: _Path) -> None:
+        """Reads a recording; RuntimeError naming the file and the byte offset when it is not one."""
+    @property
+    def names(self) -> List[str]:
+        """The recorded bodies, in the order of the arrays' rows."""
+    @property
+    def times(self) -> npt.NDArray[np.float64]:
+        """Sample times, s."""
+    def positions(self) -> npt.NDArray[np.float32]:
+        """Every sample's positions: times x bodies x 3."""
+    def orientations(self) -> npt.NDArray[np.float32]:
+        """Every sample's orientations: times x bodies x 4 (w, x, y, z)."""
+    def at(self, t: float) -> Any:
+        """The sample at or before t: (time, positions bodies x 3, orientations bodies x 4)."""
+    @property
+    def scene_xml(self) -> str:
+        """The recorded scene as scene XML."""
+    @property
+    def scene(self) -> str:
+        """The scene's file name when it was recorded."""
+    @property
+    def version(self) -> str:
+        """The ssx version that recorded it."""
+    @property
+    def seed(self) -> int:
+        """The recorded run's seed."""
+    @property
+    def complete(self) -> bool:
+        """False for a file cut short (a killed run)."""
+    @property
+    def size(self) -> int:
+        """Bytes in the file."""
+    @property
+    def state_times(self) -> List[float]:
+        """Times of the saved states, s."""
+    def snapshot(self, t: float) -> Any:
+        """The saved state at or before t: (its time, bytes for Environment.restore_state)."""
+    def channels(self) -> Dict[str, int]:
+        """Every channel's topic and message count."""
+    def __len__(self) -> int: ...
 
 def load_scene(path: _Path, seed: Optional[int] = None, threads: Optional[int] = None,
                plugin_path: Sequence[_Path] = ..., physics: Optional[str] = None) -> Environment:

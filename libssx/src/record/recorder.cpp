@@ -66,8 +66,10 @@ void Recorder::Impl::begin() {
   period_steps = options.rate_hz > 0
                      ? std::max<std::int64_t>(1, std::llround(1.0 / (options.rate_hz * toSeconds(tau))))
                      : 1;
-  // the bodies: each artifact's dynamic roots, in artifact order
-  for (std::size_t i = 0; i < env->artifactCount(); ++i) {
+  // the bodies: each artifact's dynamic roots, in artifact order (none known before the start:
+  // a recording finished before any step holds the scene and no samples)
+  const bool running = env->state() == Environment::State::Running;
+  for (std::size_t i = 0; running && i < env->artifactCount(); ++i) {
     const Artifact& a = std::as_const(*env).artifact(i);
     bool first = true;
     for (std::size_t r = 0; r < a.rootCount(); ++r) {
@@ -203,6 +205,7 @@ RecordSummary Recorder::finish() {
   m.finished = true;
   if (m.listening) m.env->removeStepListener(m.listener);
   m.listening = false;
+  if (!m.begun) m.begin();  // no step was taken: the scene and no samples
   {
     std::lock_guard lock(m.mutex);
     m.done = true;

@@ -1,0 +1,57 @@
+"""Recordings from Python: Environment.record and run(record=), read back with ssx.Recording into numpy,
+and a saved state from it continuing the recorded scene to the recorded poses bit for bit."""
+import numpy as np
+import pytest
+
+import ssx
+
+
+def test_a_recording_read_back_into_numpy_and_continued_from_its_state(tmp_path):
+    env = ssx.load_scene(ssx.data_directory() / "scenes" / "quad_hover.xml")
+    env.record(tmp_path / "hover.mcap", rate_hz=50, state_every_s=1)
+    assert env.recording
+    env.step(1500)  # 3 s
+    summary = env.stop_recording()
+    assert not env.recording
+    assert (summary["samples"], summary["dropped"], summary["states"], summary["bodies"]) == (150, 0, 3, 3)
+
+    r = ssx.Recording(tmp_path / "hover.mcap")
+    assert len(r) == 150 and r.names == ["mk", "hb", "cf"] and r.complete
+    assert np.allclose(r.times, 0.02 * np.arange(1, 151))
+    p, q = r.positions(), r.orientations()
+    assert p.shape == (150, 3, 3) and p.dtype == np.float32 and q.shape == (150, 3, 4)
+    assert np.allclose(np.linalg.norm(q, axis=2), 1, atol=1e-6)
+    assert np.array_equal(p[-1], env.positions().astype(np.float32))  # the last sample is the world now
+    assert p[-1, :, 2].min() > 0.8  # they took off
+    t, p_at, _ = r.at(1.011)
+    assert t == pytest.approx(1.0) and np.array_equal(p_at, p[49])
+    assert r.state_times == pytest.approx([0.02, 1.02, 2.02])
+    assert r.channels() == {"/ssx/poses": 150} and r.scene == "quad_hover.xml"
+
+    # the recorded scene from its state at 1.02 s: the recorded poses again, bit for bit
+    at, state = r.snapshot(1.5)
+    assert at == pytest.approx(1.02)
+    again = ssx.load_scene_string(r.scene_xml, threads=1)
+    again.restore_state(state)
+    for k in range(51, 150):
+        again.step(10)
+        assert np.array_equal(again.positions().astype(np.float32), p[k]), f"sample {k}"
+
+
+def test_run_records_and_refuses_what_it_must_not_write(tmp_path):
+    env = ssx.load_scene(ssx.data_directory() / "scenes" / "quad_hover.xml")
+    out = env.run(1, realtime=False, record=tmp_path / "run.mcap")
+    assert out["recording"]["samples"] == 25 and not env.recording
+    assert len(ssx.Recording(tmp_path / "run.mcap")) == 25
+    with pytest.raises(ValueError, match="which this run reads"):
+        env.record(ssx.data_directory() / "scenes" / "quad_hover.xml")
+    with pytest.raises(ValueError, match="not recording"):
+        env.stop_recording()
+    env.record(tmp_path / "two.mcap")
+    with pytest.raises(ValueError, match="already recording"):
+        env.record(tmp_path / "three.mcap")
+    env.close()  # finishes the recording
+    assert ssx.Recording(tmp_path / "two.mcap").complete
+    (tmp_path / "not.mcap").write_text("<scene/>")
+    with pytest.raises(RuntimeError, match=r"not.mcap: byte 0: not an MCAP file"):
+        ssx.Recording(tmp_path / "not.mcap")
