@@ -75,12 +75,19 @@ void readChunk(McapFile& f, In& in) {
   const std::string compression = in.str();
   const std::uint64_t at = in.offset();
   const auto records = in.take(in.num<std::uint64_t>());
-  if (size > (std::uint64_t{1} << 32)) in.fail("a chunk of " + std::to_string(size) + " bytes uncompressed (corrupted)");
+  // writers make chunks of a few MiB (ssx: 1 MiB); a size far beyond is a corrupted one, not memory to give
+  constexpr std::uint64_t kMaxChunk = std::uint64_t{256} << 20;
+  if (size > kMaxChunk)
+    in.fail("a chunk of " + std::to_string(size) + " bytes uncompressed (ssx reads chunks of at most 256 MiB)");
   std::vector<std::byte> data;
   if (compression.empty()) {
     if (records.size() != size) in.fail("an uncompressed chunk whose size disagrees with its length (corrupted)");
     data.assign(records.begin(), records.end());
   } else if (compression == "zstd") {
+    // the frame says what it holds: it must be the chunk's size (before anything is allocated)
+    const unsigned long long content = ZSTD_getFrameContentSize(records.data(), records.size());
+    if (content == ZSTD_CONTENTSIZE_ERROR || (content != ZSTD_CONTENTSIZE_UNKNOWN && content != size))
+      throw Error(f.file.string() + ": byte " + std::to_string(at) + ": a chunk does not decompress (corrupted)");
     data.resize(static_cast<std::size_t>(size));
     const std::size_t got = ZSTD_decompress(data.data(), data.size(), records.data(), records.size());
     if (ZSTD_isError(got) || got != size)
