@@ -8,9 +8,10 @@
 /// - metadata `ssx.bodies`: the recorded bodies' names, one per line (an artifact's name, or
 ///   `artifact/node` for an artifact's second and later dynamic roots);
 /// - channel `/ssx/poses` (schema `ssx.Poses`, encoding `ssx.poses.v1`): every body's pose at the
-///   recording rate, compact for whole swarms: a little-endian uint32 body count N, then N float32
-///   x, N float32 y, N float32 z (m, world frame), then N int16 each of the orientation quaternion's
-///   w, x, y, z times 32767 (sign chosen so that w >= 0);
+///   recording rate, compact for whole swarms: a little-endian uint32 body count N, then the fields
+///   float32 x, y, z (m, world frame) and int16 qw, qx, qy, qz (the orientation quaternion times
+///   32767, sign chosen so that w >= 0), one after another, each as byte planes: byte b of body i's
+///   value at (the field's start) + b * N + i (the schema's text says the same);
 /// - attachments `state/<nanoseconds>`: saved states (Environment::saveState) at the first sample and
 ///   then every `state_every_s` of simulated time, from which a run can be continued bitwise.
 ///

@@ -1,6 +1,6 @@
 #pragma once
 // The compact pose message of a recording's /ssx/poses channel (layout in ssx/recording.hpp):
-// positions as float32 planes, orientations as int16 planes.
+// positions as float32, orientations as int16, each field stored as byte planes.
 
 #include <ssx/types.hpp>
 
@@ -16,8 +16,9 @@ namespace ssx::detail {
 
 /// The layout in words, kept in the file as the channel's schema.
 inline constexpr const char* kPoseLayout =
-    "ssx.poses.v1, little-endian: uint32 N; float32 x[N]; float32 y[N]; float32 z[N] (m, world frame); "
-    "int16 qw[N]; int16 qx[N]; int16 qy[N]; int16 qz[N] (unit quaternion times 32767, qw >= 0)";
+    "ssx.poses.v1, little-endian: uint32 N; then the fields float32 x, y, z (m, world frame) and int16 qw, qx, "
+    "qy, qz (unit quaternion times 32767, qw >= 0), each as byte planes: byte b of the field's value for body i "
+    "at (the field's start) + b * N + i, the fields one after another (x: 4 N bytes, ..., qz: 2 N bytes)";
 
 /// Writes the poses of `bodies` (body indices) of `env` into `out` (resized).
 void encodePoses(const Environment& env, std::span<const int> bodies, std::vector<std::byte>& out);
