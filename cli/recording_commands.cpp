@@ -43,13 +43,7 @@ std::string jsonString(const std::string& s) {
 // ssx-out/<scene>-resimulated/ rather than over the recorded run's
 Scene buildRecorded(const Recording& r, const ReplayArgs& args, bool draw, int* status) {
   SceneOptions options;
-  for (const auto& p : args.plugin_path) options.plugin_path.emplace_back(p);
-  if (const char* env = std::getenv("SSX_PLUGIN_PATH"))
-    for (std::string_view rest = env; !rest.empty();) {
-      const auto colon = rest.find(':');
-      if (colon != 0) options.plugin_path.emplace_back(std::string(rest.substr(0, colon)));
-      rest = colon == std::string_view::npos ? std::string_view() : rest.substr(colon + 1);
-    }
+  options.plugin_path = pluginPath(args.plugin_path);
   options.extensions = !draw;
   if (!draw) options.output_directory = fs::path("ssx-out") / (fs::path(r.sceneLabel()).stem().string() + "-resimulated");
   for (const std::string& s : args.set) {
@@ -110,6 +104,24 @@ Scene buildRecorded(const Recording& r, const ReplayArgs& args, bool draw, int* 
   }
 }
 
+// the root node each recorded name stands for ("artifact", or "artifact/node" for an artifact's
+// later roots), in the recording's order; empty, with a message, when one is missing
+std::vector<const PhysicNode*> recordedNodes(const Environment& env, const Recording& r) {
+  std::vector<const PhysicNode*> nodes;
+  for (const std::string& name : r.names()) {
+    const auto slash = name.find('/');
+    const Artifact* a = env.findArtifact(name.substr(0, slash));
+    const PhysicNode* node = a == nullptr ? nullptr : slash == std::string::npos ? &a->root() : a->node(name.substr(slash + 1));
+    if (node == nullptr || node->bodyIndex() < 0) {
+      std::cerr << "ssx: error: " << r.names().size() << " bodies recorded, but the recorded scene has no body '" << name
+                << "' (a recording of another version?)\n";
+      return {};
+    }
+    nodes.push_back(node);
+  }
+  return nodes;
+}
+
 int draw(const Recording& r, const ReplayArgs& args) {
   if (args.snapshot.empty() && args.video.empty() && args.frames.empty()) {
     std::cerr << "ssx: error: ssx replay draws into --snapshot, --video or --frames (or re-simulates: "
@@ -120,20 +132,9 @@ int draw(const Recording& r, const ReplayArgs& args) {
   Scene scene = buildRecorded(r, args, true, &status);
   if (status != 0) return status;
   Environment& env = *scene.environment;
-  // the recording's bodies in this environment
-  std::vector<int> bodies;
   env.start();
-  for (const std::string& name : r.names()) {
-    const auto slash = name.find('/');
-    const Artifact* a = env.findArtifact(name.substr(0, slash));
-    const PhysicNode* node = a == nullptr ? nullptr : slash == std::string::npos ? &a->root() : a->node(name.substr(slash + 1));
-    if (node == nullptr || node->bodyIndex() < 0) {
-      std::cerr << "ssx: error: " << r.names().size() << " bodies recorded, but the recorded scene has no body '" << name
-                << "' (a recording of another version?)\n";
-      return kExitBadInput;
-    }
-    bodies.push_back(node->bodyIndex());
-  }
+  const std::vector<const PhysicNode*> nodes = recordedNodes(env, r);
+  if (nodes.size() != r.names().size()) return kExitBadInput;
   const Nanoseconds from = toNanoseconds(args.from);
   const Nanoseconds to = args.to >= 0 ? toNanoseconds(args.to) : std::numeric_limits<Nanoseconds>::max();
   std::int64_t drawn = 0;
@@ -143,13 +144,15 @@ int draw(const Recording& r, const ReplayArgs& args) {
       const Nanoseconds t = r.times()[k];
       if (t < from || t > to) continue;
       const std::vector<float> p = r.positions(k), q = r.orientations(k);
-      for (std::size_t i = 0; i < bodies.size(); ++i) {
-        BodyState s = env.bodyState(bodies[i]);
-        s.pose.position = Vec3(p[3 * i], p[3 * i + 1], p[3 * i + 2]);
-        s.pose.orientation = Quat(q[4 * i], q[4 * i + 1], q[4 * i + 2], q[4 * i + 3]).normalized();
+      for (std::size_t i = 0; i < nodes.size(); ++i) {
+        // the recorded pose is the root node's: its body's centre-of-mass frame from it
+        const Pose node{Vec3(p[3 * i], p[3 * i + 1], p[3 * i + 2]),
+                        Quat(q[4 * i], q[4 * i + 1], q[4 * i + 2], q[4 * i + 3]).normalized()};
+        BodyState s = env.bodyState(nodes[i]->bodyIndex());
+        s.pose = node * nodes[i]->poseInBody().inverse();
         s.linear_velocity.setZero();
         s.angular_velocity.setZero();
-        env.setBodyState(bodies[i], s);
+        env.setBodyState(nodes[i]->bodyIndex(), s);
       }
       env.drawFrame(t);
       ++drawn;
@@ -160,7 +163,7 @@ int draw(const Recording& r, const ReplayArgs& args) {
     std::cerr << "ssx: error: " << e.what() << '\n';
     return kExitRunFailure;
   }
-  std::cout << "replayed " << drawn << " samples of " << bodies.size() << " bodies";
+  std::cout << "replayed " << drawn << " samples of " << nodes.size() << " bodies";
   if (drawn > 0) std::cout << " (" << seconds(std::max(from, r.times().front())) << " to " << seconds(std::min(to, r.times().back())) << ")";
   std::cout << '\n';
   for (const auto& c : cameras) {
@@ -218,6 +221,8 @@ int resimulate(const Recording& r, const ReplayArgs& args) {
   }
   const Nanoseconds end = args.duration > 0 ? at + toNanoseconds(args.duration) : r.times().empty() ? at : r.times().back();
   // step, comparing each recorded sample on the way
+  const std::vector<const PhysicNode*> nodes = recordedNodes(env, r);
+  if (nodes.size() != r.names().size()) return kExitBadInput;
   std::size_t compared = 0, equal = 0;
   double largest = 0;
   std::string largest_at, first_difference;
@@ -229,11 +234,9 @@ int resimulate(const Recording& r, const ReplayArgs& args) {
       if (k < r.times().size() && r.times()[k] == env.time()) {
         const std::vector<float> recorded = r.positions(k);
         bool same = true;
-        for (std::size_t i = 0; i < r.names().size(); ++i) {
+        for (std::size_t i = 0; i < nodes.size(); ++i) {
           const std::string& name = r.names()[i];
-          const Artifact* a = env.findArtifact(name.substr(0, name.find('/')));
-          if (a == nullptr) continue;
-          const Vec3 p = a->pose().position;
+          const Vec3 p = nodes[i]->pose().position;
           double d = 0;
           for (int c = 0; c < 3; ++c) {
             const auto now = static_cast<float>(p[c]);
@@ -273,8 +276,11 @@ int commandInspect(const InspectArgs& args) {
   try {
     const Recording r(args.file);
     if (!args.complete.empty()) {
-      if (fs::exists(args.complete) && fs::equivalent(args.complete, args.file)) {
-        std::cerr << "ssx: error: --complete " << args.complete << " is the recording itself: name another file\n";
+      // the one output check: never over the recording read, a symbolic link, a FIFO or a device
+      RunFiles files;
+      files.addInput(args.file);
+      if (const std::string problem = files.claimOutput(args.complete, "--complete", true); !problem.empty()) {
+        std::cerr << "ssx: error: " << problem << '\n';
         return kExitBadInput;
       }
       completeRecording(args.file, args.complete);

@@ -509,6 +509,21 @@ class PyEnvironment {
   fs::path recording_file_;
 };
 
+// every sample of a recording, decoded by `decode` (Recording::positions or orientations), as one
+// float32 array of times x bodies x Cols
+template <int Cols>
+py::array_t<float> allSamples(const ssx::Recording& r, std::vector<float> (ssx::Recording::*decode)(std::size_t) const) {
+  const auto t = static_cast<py::ssize_t>(r.times().size()), n = static_cast<py::ssize_t>(r.names().size());
+  py::array_t<float> out({t, n, static_cast<py::ssize_t>(Cols)});
+  float* dst = out.mutable_data();
+  py::gil_scoped_release release;
+  for (std::size_t k = 0; k < r.times().size(); ++k) {
+    const std::vector<float> v = (r.*decode)(k);
+    std::copy(v.begin(), v.end(), dst + k * v.size());
+  }
+  return out;
+}
+
 ssx::SceneOptions sceneOptions(std::optional<std::uint64_t> seed, std::optional<int> threads,
                                const std::vector<fs::path>& plugin_path, const std::optional<std::string>& physics) {
   ssx::SceneOptions o;
@@ -650,38 +665,10 @@ PYBIND11_MODULE(_ssx, m) {
             return out;
           },
           "Sample times, s (a numpy array).")
-      .def(
-          "positions",
-          [](const ssx::Recording& r) {
-            const auto t = static_cast<py::ssize_t>(r.times().size()), n = static_cast<py::ssize_t>(r.names().size());
-            py::array_t<float> out({t, n, py::ssize_t{3}});
-            float* dst = out.mutable_data();
-            {
-              py::gil_scoped_release release;
-              for (std::size_t k = 0; k < r.times().size(); ++k) {
-                const std::vector<float> p = r.positions(k);
-                std::copy(p.begin(), p.end(), dst + k * p.size());
-              }
-            }
-            return out;
-          },
-          "Every sample's positions: a float32 array of times x bodies x 3 (m, world frame).")
-      .def(
-          "orientations",
-          [](const ssx::Recording& r) {
-            const auto t = static_cast<py::ssize_t>(r.times().size()), n = static_cast<py::ssize_t>(r.names().size());
-            py::array_t<float> out({t, n, py::ssize_t{4}});
-            float* dst = out.mutable_data();
-            {
-              py::gil_scoped_release release;
-              for (std::size_t k = 0; k < r.times().size(); ++k) {
-                const std::vector<float> q = r.orientations(k);
-                std::copy(q.begin(), q.end(), dst + k * q.size());
-              }
-            }
-            return out;
-          },
-          "Every sample's orientations: a float32 array of times x bodies x 4 (w, x, y, z; unit quaternions).")
+      .def("positions", [](const ssx::Recording& r) { return allSamples<3>(r, &ssx::Recording::positions); },
+           "Every sample's positions: a float32 array of times x bodies x 3 (m, world frame).")
+      .def("orientations", [](const ssx::Recording& r) { return allSamples<4>(r, &ssx::Recording::orientations); },
+           "Every sample's orientations: a float32 array of times x bodies x 4 (w, x, y, z; unit quaternions).")
       .def(
           "at",
           [](const ssx::Recording& r, double t) {

@@ -7,6 +7,7 @@
 #include <poll.h>
 #include <signal.h>
 #include <sys/wait.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <filesystem>
@@ -481,6 +482,15 @@ TEST_CASE("ssx run --record, inspect and replay: a run kept, looked at, drawn ag
   CHECK(over.status == 2);
   CHECK_THAT(over.err, Catch::Contains("would write over the recording being replayed"));
   CHECK(run({"run", scene, "--steps", "10", "--fast", "--record", scene}).status == 2);
+  // --complete goes through the one output check: not the recording itself, not a FIFO
+  const Result onto_itself = run({"inspect", rec, "--complete", rec});
+  CHECK(onto_itself.status == 2);
+  CHECK_THAT(onto_itself.err, Catch::Contains("which this run reads"));
+  REQUIRE(mkfifo((dir / "pipe").c_str(), 0600) == 0);
+  const Result onto_fifo = run({"inspect", rec, "--complete", (dir / "pipe").string()});
+  CHECK(onto_fifo.status == 2);
+  CHECK(run({"inspect", rec, "--complete", (dir / "copy.mcap").string()}).status == 0);
+  CHECK(fs::file_size(dir / "copy.mcap") > 1000);
   CHECK(run({"inspect", rec}).status == 0);
   // a file that is not a recording: a message naming it, status 2
   const Result foreign = run({"inspect", scene});

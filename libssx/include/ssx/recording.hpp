@@ -7,8 +7,8 @@
 ///   `scene.xml`: the scene model as scene XML (SceneModel::toXml), so that a replay needs no scene file;
 /// - metadata `ssx.bodies`: the recorded bodies' names, one per line (an artifact's name, or
 ///   `artifact/node` for an artifact's second and later dynamic roots);
-/// - channel `/ssx/poses` (schema `ssx.Poses`, encoding `ssx.poses.v1`): every body's pose at the
-///   recording rate, compact for whole swarms: a little-endian uint32 body count N, then the fields
+/// - channel `/ssx/poses` (schema `ssx.Poses`, encoding `ssx.poses.v1`): the pose of every recorded
+///   body's root node (what Artifact::pose and Python's positions() give) at the recording rate, compact for whole swarms: a little-endian uint32 body count N, then the fields
 ///   float32 x, y, z (m, world frame) and int16 qw, qx, qy, qz (the orientation quaternion times
 ///   32767, sign chosen so that w >= 0), one after another, each as byte planes: byte b of body i's
 ///   value at (the field's start) + b * N + i (the schema's text says the same);

@@ -1,7 +1,7 @@
 #include "record/pose_codec.hpp"
 
-#include <ssx/environment.hpp>
 #include <ssx/error.hpp>
+#include <ssx/physic_node.hpp>
 
 #include <algorithm>
 #include <cmath>
@@ -16,8 +16,8 @@ constexpr std::size_t kBytesPerBody = 3 * 4 + 4 * 2;
 
 }  // namespace
 
-void encodePoses(const Environment& env, std::span<const int> bodies, std::vector<std::byte>& out) {
-  const std::size_t n = bodies.size();
+void encodePoses(std::span<const PhysicNode* const> nodes, std::vector<std::byte>& out) {
+  const std::size_t n = nodes.size();
   out.resize(4 + n * kBytesPerBody);
   const auto count = static_cast<std::uint32_t>(n);
   std::memcpy(out.data(), &count, 4);  // (little-endian machines only: x86-64 and arm64)
@@ -25,7 +25,7 @@ void encodePoses(const Environment& env, std::span<const int> bodies, std::vecto
   // high bytes are alike, so the planes compress far better than the values side by side
   std::byte* planes = out.data() + 4;
   for (std::size_t i = 0; i < n; ++i) {
-    const Pose& p = env.bodyState(bodies[i]).pose;
+    const Pose p = nodes[i]->pose();
     for (std::size_t k = 0; k < 3; ++k) {
       const auto v = static_cast<float>(p.position[static_cast<Eigen::Index>(k)]);
       std::uint32_t bits = 0;

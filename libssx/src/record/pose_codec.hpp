@@ -9,7 +9,7 @@
 #include <vector>
 
 namespace ssx {
-class Environment;
+class PhysicNode;
 }
 
 namespace ssx::detail {
@@ -20,8 +20,8 @@ inline constexpr const char* kPoseLayout =
     "qy, qz (unit quaternion times 32767, qw >= 0), each as byte planes: byte b of the field's value for body i "
     "at (the field's start) + b * N + i, the fields one after another (x: 4 N bytes, ..., qz: 2 N bytes)";
 
-/// Writes the poses of `bodies` (body indices) of `env` into `out` (resized).
-void encodePoses(const Environment& env, std::span<const int> bodies, std::vector<std::byte>& out);
+/// Writes the poses of `nodes` (each a robot's root node, as the snapshot has it) into `out` (resized).
+void encodePoses(std::span<const PhysicNode* const> nodes, std::vector<std::byte>& out);
 
 /// Reads a message back: positions (N x 3) and orientations (N x 4, w x y z, normalised). Throws
 /// Error when the message's size does not fit its count.

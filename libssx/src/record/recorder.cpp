@@ -40,7 +40,7 @@ struct Recorder::Impl {
   std::int64_t period_steps = 1;
   Nanoseconds next_state = 0;
   std::vector<std::string> names;
-  std::vector<int> bodies;  // body index of each name
+  std::vector<const PhysicNode*> nodes;  // the root node of each name
   std::uint16_t poses_channel = 0;
   Nanoseconds first_time = -1, last_time = 0;
   // shared with the writer thread
@@ -76,7 +76,7 @@ void Recorder::Impl::begin() {
       const PhysicNode& root = a.root(r);
       if (root.isStatic() || root.bodyIndex() < 0) continue;
       names.push_back(first ? a.name() : a.name() + "/" + root.name());
-      bodies.push_back(root.bodyIndex());
+      nodes.push_back(&root);
       first = false;
     }
   }
@@ -128,7 +128,7 @@ void Recorder::Impl::observe() {
       spare.pop_back();
     }
   }
-  detail::encodePoses(*env, bodies, job.bytes);
+  detail::encodePoses(nodes, job.bytes);
   if (first_time < 0) first_time = now;
   last_time = now;
   push(std::move(job));
