@@ -6,6 +6,8 @@
 
 #include <CLI/CLI.hpp>
 
+#include <algorithm>
+
 #include <limits>
 #include <ostream>
 
@@ -61,6 +63,12 @@ CommandLine parseCommandLine(int argc, const char* const* argv, std::ostream& ou
                       "ssx replay, ssx.Recording)");
   run_cmd->add_option("--record-rate", c.run.record_rate, "pose samples per simulated second in --record (0: every step)")
       ->check(realNumber(0.0, 1e6));
+  run_cmd->add_option("--record-channels", c.run.record_channels,
+                      "channels recorded besides the poses, comma-separated: foxglove (/tf and /scene for Foxglove and "
+                      "Lichtblick), timing (/ssx/timing, each step's cost), sensors (/ssx/sensors: IMU, pose, range), "
+                      "none (default: foxglove for swarms up to 1,000 bodies)")
+      ->delimiter(',')
+      ->check(CLI::IsMember({"foxglove", "timing", "sensors", "none"}));
   run_cmd->add_option("--record-states", c.run.record_states,
                       "simulated seconds between saved states in --record (0: only the first)")
       ->check(realNumber(0.0, ssx::kMaxDurationSeconds));
@@ -116,6 +124,10 @@ CommandLine parseCommandLine(int argc, const char* const* argv, std::ostream& ou
   replay_cmd->add_option("--video", c.replay.video, "write the frames as MP4 to FILE (needs ffmpeg)");
   replay_cmd->add_option("--frames", c.replay.frames, "write the frames as PNG files into DIR");
   replay_cmd->add_option("--follow", c.replay.follow, "a camera that follows this robot");
+  replay_cmd->add_option("--speed", c.replay.speed,
+                         "recorded seconds per second of the video or frames (0.25: slow motion; 4: four times as "
+                         "fast), at the recording's sample rate")
+      ->check(realNumber(1e-3, 1e3));
   replay_cmd->add_option("--plugin-path", c.replay.plugin_path, "plugin directory (repeatable)");
   replay_cmd
       ->add_option("--resimulate-from", c.replay.resimulate_from,
@@ -142,6 +154,11 @@ CommandLine parseCommandLine(int argc, const char* const* argv, std::ostream& ou
     c.realtime_given = realtime->count() > 0;
     c.run.duration_given = duration->count() > 0;
     if (c.realtime_given && (realtime->results().empty() || realtime->results().front().empty())) c.run.realtime = 1.0;
+    const auto& channels = c.run.record_channels;
+    if (channels.size() > 1 && std::find(channels.begin(), channels.end(), "none") != channels.end()) {
+      err << "ssx run: --record-channels: 'none' cannot go with other channels\n";
+      c.exit_status = kExitBadInput;
+    }
   } else if (*validate_cmd) {
     c.command = CommandLine::Command::Validate;
   } else if (*sweep_cmd) {

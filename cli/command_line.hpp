@@ -29,6 +29,9 @@ struct RunArgs {
   std::string record;          // an MCAP recording of the run (empty: none)
   double record_rate = 25;     // pose samples per simulated second (0: every step)
   double record_states = 10;   // simulated seconds between saved states in the recording
+  // channels besides the poses: foxglove, timing, sensors, none (given: exactly these; not given:
+  // foxglove for swarms up to RecordOptions::kFoxgloveAutoBodies bodies)
+  std::vector<std::string> record_channels;
   std::string out;  // the scene's own outputs (empty: ssx-out/<scene>/)
   bool allow_special_outputs = false;
   bool duration_given = false;
@@ -66,6 +69,7 @@ struct InspectArgs {
 struct ReplayArgs {
   std::string file;
   double from = 0, to = -1;  // seconds; to < 0: the end
+  double speed = 1;          // recorded seconds per second of the video or frames
   std::string snapshot, video, frames, follow;
   std::vector<std::string> plugin_path;
   double resimulate_from = -1;  // seconds; < 0: draw the recorded poses only

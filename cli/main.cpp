@@ -280,6 +280,14 @@ int commandRun(const RunArgs& args, bool realtime_given) {
       record.rate_hz = args.record_rate;
       record.state_every_s = args.record_states;
       record.drop_when_behind = !args.fast;
+      if (!args.record_channels.empty()) {
+        const auto has = [&](const char* name) {
+          return std::find(args.record_channels.begin(), args.record_channels.end(), name) != args.record_channels.end();
+        };
+        record.foxglove = has("foxglove");
+        record.timing = has("timing");
+        record.sensors = has("sensors");
+      }
       record.scene_xml = scene.model->toXml();
       record.scene_label = fs::path(args.scene).filename().string();
       recorder = std::make_unique<ssx::Recorder>(env, std::move(record));

@@ -42,6 +42,11 @@ std::string jsonString(const std::string& s) {
 // re-simulation keeps them (a saved state holds theirs), their relative outputs going into
 // ssx-out/<scene>-resimulated/ rather than over the recorded run's
 Scene buildRecorded(const Recording& r, const ReplayArgs& args, bool draw, int* status) {
+  // said before anything is built: a scene of another version may read differently, and a
+  // re-simulation compares bits that another version's physics need not give
+  if (r.version() != SSX_VERSION_STRING)
+    std::cerr << "ssx replay: warning: " << args.file << " was recorded by ssx " << r.version() << ", this is ssx "
+              << SSX_VERSION_STRING << ": the scene may read differently and a re-simulation may not match\n";
   SceneOptions options;
   options.plugin_path = pluginPath(args.plugin_path);
   options.extensions = !draw;
@@ -139,10 +144,25 @@ int draw(const Recording& r, const ReplayArgs& args) {
   const Nanoseconds to = args.to >= 0 ? toNanoseconds(args.to) : std::numeric_limits<Nanoseconds>::max();
   std::int64_t drawn = 0;
   std::vector<CameraSpec> cameras;
+  // the samples drawn, one per frame: every one at --speed 1; at another speed the frames keep the
+  // recording's rate and each shows the sample at or before its time (repeated in slow motion)
+  std::vector<std::size_t> frames;
+  const auto& times = r.times();
+  const auto first = std::lower_bound(times.begin(), times.end(), from);
+  if (first != times.end() && args.speed == 1) {
+    for (auto it = first; it != times.end() && *it <= to; ++it) frames.push_back(static_cast<std::size_t>(it - times.begin()));
+  } else if (first != times.end() && times.size() > 1) {
+    const double step = toSeconds(times[1] - times[0]) * args.speed;
+    const Nanoseconds end = std::min(to, times.back());
+    for (std::int64_t f = 0;; ++f) {
+      const Nanoseconds t = *first + toNanoseconds(static_cast<double>(f) * step);
+      if (t > end) break;
+      frames.push_back(static_cast<std::size_t>(std::upper_bound(times.begin(), times.end(), t) - times.begin() - 1));
+    }
+  }
   try {
-    for (std::size_t k = 0; k < r.times().size(); ++k) {
-      const Nanoseconds t = r.times()[k];
-      if (t < from || t > to) continue;
+    for (const std::size_t k : frames) {
+      const Nanoseconds t = times[k];
       const std::vector<float> p = r.positions(k), q = r.orientations(k);
       for (std::size_t i = 0; i < nodes.size(); ++i) {
         // the recorded pose is the root node's: its body's centre-of-mass frame from it
@@ -163,7 +183,7 @@ int draw(const Recording& r, const ReplayArgs& args) {
     std::cerr << "ssx: error: " << e.what() << '\n';
     return kExitRunFailure;
   }
-  std::cout << "replayed " << drawn << " samples of " << nodes.size() << " bodies";
+  std::cout << "replayed " << drawn << (args.speed == 1 ? " samples" : " frames") << " of " << nodes.size() << " bodies";
   if (drawn > 0) std::cout << " (" << seconds(std::max(from, r.times().front())) << " to " << seconds(std::min(to, r.times().back())) << ")";
   std::cout << '\n';
   for (const auto& c : cameras) {
@@ -290,7 +310,9 @@ int commandInspect(const InspectArgs& args) {
       std::ostringstream o;
       o << "{\"file\":" << jsonString(args.file) << ",\"complete\":" << (r.complete() ? "true" : "false")
         << ",\"bytes\":" << r.size() << ",\"version\":" << jsonString(r.version()) << ",\"seed\":" << r.seed()
-        << ",\"scene\":" << jsonString(r.sceneLabel()) << ",\"bodies\":" << r.names().size() << ",\"channels\":{";
+        << ",\"scene\":" << jsonString(r.sceneLabel()) << ",\"bodies\":" << r.names().size() << ",\"names\":[";
+      for (std::size_t i = 0; i < r.names().size(); ++i) o << (i ? "," : "") << jsonString(r.names()[i]);
+      o << "],\"channels\":{";
       bool first = true;
       for (const auto& [topic, count] : r.channels()) {
         o << (first ? "" : ",") << jsonString(topic) << ":" << count;

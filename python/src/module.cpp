@@ -5,6 +5,8 @@
 // is used by one thread at a time (as in C++): a call made while another thread is stepping the
 // same environment raises RuntimeError instead of racing it.
 #include "commands.hpp"
+#include "convert.hpp"
+#include "recording.hpp"
 
 #include <ssx/ssx.hpp>
 
@@ -27,86 +29,13 @@ namespace fs = std::filesystem;
 namespace {
 
 using ssx_python::Array;
-
-// Marks an environment as in use for the length of one call.
-class InUse {
- public:
-  explicit InUse(std::atomic<bool>& flag) : flag_(flag) {
-    if (flag_.exchange(true))
-      throw std::runtime_error("ssx: this Environment is in use by another thread (stepping or running); "
-                               "an environment is used from one thread at a time");
-  }
-  InUse(const InUse&) = delete;
-  InUse& operator=(const InUse&) = delete;
-  ~InUse() { flag_.store(false); }
-
- private:
-  std::atomic<bool>& flag_;
-};
-
-py::array_t<double> vector3(const ssx::Vec3& v) {
-  py::array_t<double> a(3);
-  auto r = a.mutable_unchecked<1>();
-  for (py::ssize_t i = 0; i < 3; ++i) r(i) = v[i];
-  return a;
-}
-
-py::array_t<double> quaternion(const ssx::Quat& q) {
-  py::array_t<double> a(4);
-  auto r = a.mutable_unchecked<1>();
-  r(0) = q.w();
-  r(1) = q.x();
-  r(2) = q.y();
-  r(3) = q.z();
-  return a;
-}
-
-template <std::size_t N>
-py::array_t<std::int32_t> counts(const std::array<std::int32_t, N>& c) {
-  py::array_t<std::int32_t> a(static_cast<py::ssize_t>(N));
-  auto r = a.mutable_unchecked<1>();
-  for (std::size_t i = 0; i < N; ++i) r(static_cast<py::ssize_t>(i)) = c[i];
-  return a;
-}
-
-py::dict summaryDict(const ssx::TimingSummary& s) {
-  py::dict d;
-  d["steps"] = s.steps;
-  d["timed_steps"] = s.timed_steps;
-  d["median_ms"] = s.median_ms;
-  d["p95_ms"] = s.p95_ms;
-  d["p99_ms"] = s.p99_ms;
-  d["max_ms"] = s.max_ms;
-  d["mean_ms"] = s.mean_ms;
-  d["physics_median_ms"] = s.physics_median_ms;
-  d["sensors_median_ms"] = s.sensors_median_ms;
-  d["drivers_median_ms"] = s.drivers_median_ms;
-  d["render_median_ms"] = s.render_median_ms;
-  d["overruns"] = s.overruns;
-  d["overruns_long"] = s.overruns_long;
-  d["overruns_began_late"] = s.overruns_began_late;
-  d["max_lateness_ms"] = s.max_lateness_ms;
-  d["wall_s"] = s.wall_s;
-  d["simulated_s"] = s.simulated_s;
-  d["realtime_factor"] = s.realtime_factor;
-  return d;
-}
-
-// The library's messages go to Python's logging (logger "ssx"), from whichever thread writes them
-// (the GIL is taken for it; a step runs without it). Before Python is up or after it is gone: stderr.
-void toLogging(ssx::LogLevel level, std::string_view message) {
-  if (Py_IsInitialized() == 0 || _Py_IsFinalizing() != 0) {
-    std::fprintf(stderr, "ssx: %.*s\n", static_cast<int>(message.size()), message.data());
-    return;
-  }
-  py::gil_scoped_acquire gil;
-  try {
-    const char* method = level == ssx::LogLevel::Error ? "error" : level == ssx::LogLevel::Warning ? "warning" : "info";
-    py::module_::import("logging").attr("getLogger")("ssx").attr(method)(std::string(message));
-  } catch (py::error_already_set& e) {
-    e.discard_as_unraisable("ssx logging");
-  }
-}
+using ssx_python::counts;
+using ssx_python::InUse;
+using ssx_python::quaternion;
+using ssx_python::sceneOptions;
+using ssx_python::summaryDict;
+using ssx_python::toLogging;
+using ssx_python::vector3;
 
 class PyEnvironment {
  public:
@@ -371,7 +300,7 @@ class PyEnvironment {
                std::optional<int> realtime_priority, std::optional<fs::path> record) {
     if (record) {
       // this run recorded: samples dropped rather than a paced step held up
-      this->record(*record, 25.0, 10.0, realtime);
+      this->record(*record, 25.0, 10.0, realtime, std::nullopt, false, false);
       py::dict out;
       try {
         out = run(seconds, realtime, realtime_factor, realtime_priority, std::nullopt);
@@ -438,7 +367,8 @@ class PyEnvironment {
   }
 
   // records from the next step on, whether stepped or run, until stop_recording() or close()
-  void record(const fs::path& file, double rate_hz, double state_every_s, bool drop_when_behind) {
+  void record(const fs::path& file, double rate_hz, double state_every_s, bool drop_when_behind,
+              std::optional<bool> foxglove, bool timing, bool sensors) {
     InUse use(busy_);
     if (recorder_) throw py::value_error("ssx: already recording to " + recording_file_.string() + ": stop_recording() first");
     ssx::RecordOptions o;
@@ -446,6 +376,7 @@ class PyEnvironment {
     o.rate_hz = rate_hz;
     o.state_every_s = state_every_s;
     o.drop_when_behind = drop_when_behind;
+    o.foxglove = foxglove, o.timing = timing, o.sensors = sensors;
     o.scene_xml = scene_.model ? scene_.model->toXml() : std::string();
     o.scene_label = scene_.file.filename().string();
     // never over what the scene reads or writes
@@ -508,39 +439,6 @@ class PyEnvironment {
   std::unique_ptr<ssx::Recorder> recorder_;
   fs::path recording_file_;
 };
-
-// every sample of a recording, decoded by `decode` (Recording::positions or orientations), as one
-// float32 array of times x bodies x Cols
-template <int Cols>
-py::array_t<float> allSamples(const ssx::Recording& r, std::vector<float> (ssx::Recording::*decode)(std::size_t) const) {
-  const auto t = static_cast<py::ssize_t>(r.times().size()), n = static_cast<py::ssize_t>(r.names().size());
-  py::array_t<float> out({t, n, static_cast<py::ssize_t>(Cols)});
-  float* dst = out.mutable_data();
-  py::gil_scoped_release release;
-  for (std::size_t k = 0; k < r.times().size(); ++k) {
-    const std::vector<float> v = (r.*decode)(k);
-    std::copy(v.begin(), v.end(), dst + k * v.size());
-  }
-  return out;
-}
-
-ssx::SceneOptions sceneOptions(std::optional<std::uint64_t> seed, std::optional<int> threads,
-                               const std::vector<fs::path>& plugin_path, const std::optional<std::string>& physics) {
-  ssx::SceneOptions o;
-  o.seed = seed;
-  if (physics) {
-    const auto names = ssx::physicEngineNames();
-    if (std::find(names.begin(), names.end(), *physics) == names.end())
-      throw py::value_error("ssx: unknown physics engine '" + *physics + "' (physics_engines() lists them)");
-    o.physics_engine = physics;
-  }
-  if (threads) {
-    if (*threads < 0) throw py::value_error("ssx: threads must be >= 0 (0: one per core), got " + std::to_string(*threads));
-    o.threads = threads;
-  }
-  o.plugin_path = plugin_path;
-  return o;
-}
 
 }  // namespace
 
@@ -633,10 +531,12 @@ PYBIND11_MODULE(_ssx, m) {
            "records the run (as record() does; samples dropped rather than a paced step held up), its summary under "
            "'recording'.")
       .def("record", &PyEnvironment::record, py::arg("file"), py::arg("rate_hz") = 25.0, py::arg("state_every_s") = 10.0,
-           py::arg("drop_when_behind") = false,
+           py::arg("drop_when_behind") = false, py::arg("foxglove") = py::none(), py::arg("timing") = false,
+           py::arg("sensors") = false,
            "Records the run from the next step on (stepped or run) into an MCAP file: the scene, every body's pose "
            "at rate_hz, a saved state every state_every_s; read it back with ssx.Recording. Written by a thread of "
-           "its own; drop_when_behind drops samples rather than wait for it.")
+           "its own; drop_when_behind drops samples rather than wait for it. foxglove: /tf and /scene for Foxglove "
+           "(None: for up to 1,000 bodies); timing: /ssx/timing; sensors: /ssx/sensors.")
       .def("stop_recording", &PyEnvironment::stopRecording,
            "Ends the recording (the file complete) and returns what it wrote: samples, dropped, states, bytes.")
       .def_property_readonly("recording", &PyEnvironment::recording, "Whether a recording is running.")
@@ -646,81 +546,7 @@ PYBIND11_MODULE(_ssx, m) {
       .def("__exit__", [](PyEnvironment& e, const py::args&) { e.close(); })
       .def("__repr__", &PyEnvironment::repr);
 
-  py::class_<ssx::Recording>(m, "Recording",
-                             "A recording (ssx run --record, Environment.record) read back: names, times, every body's "
-                             "poses as numpy arrays, the scene, and saved states to continue from.")
-      .def(py::init([](const fs::path& file) {
-             py::gil_scoped_release release;
-             return ssx::Recording(file);
-           }),
-           py::arg("file"), "Reads a recording; raises RuntimeError naming the file and the byte offset when it is "
-                            "not one or is corrupted (a file cut short is read up to its last complete chunk).")
-      .def_property_readonly("names", &ssx::Recording::names, "The recorded bodies, in the order of the arrays' rows.")
-      .def_property_readonly(
-          "times",
-          [](const ssx::Recording& r) {
-            py::array_t<double> out(static_cast<py::ssize_t>(r.times().size()));
-            auto w = out.mutable_unchecked<1>();
-            for (std::size_t k = 0; k < r.times().size(); ++k) w(static_cast<py::ssize_t>(k)) = ssx::toSeconds(r.times()[k]);
-            return out;
-          },
-          "Sample times, s (a numpy array).")
-      .def("positions", [](const ssx::Recording& r) { return allSamples<3>(r, &ssx::Recording::positions); },
-           "Every sample's positions: a float32 array of times x bodies x 3 (m, world frame).")
-      .def("orientations", [](const ssx::Recording& r) { return allSamples<4>(r, &ssx::Recording::orientations); },
-           "Every sample's orientations: a float32 array of times x bodies x 4 (w, x, y, z; unit quaternions).")
-      .def(
-          "at",
-          [](const ssx::Recording& r, double t) {
-            const auto& times = r.times();
-            const ssx::Nanoseconds ns = ssx::toNanoseconds(t);
-            auto it = std::upper_bound(times.begin(), times.end(), ns);
-            if (it == times.begin()) throw py::value_error("ssx: no sample at or before " + std::to_string(t) + " s");
-            const auto k = static_cast<std::size_t>(it - times.begin() - 1);
-            const auto n = static_cast<py::ssize_t>(r.names().size());
-            py::array_t<float> p({n, py::ssize_t{3}}), q({n, py::ssize_t{4}});
-            const std::vector<float> pv = r.positions(k), qv = r.orientations(k);
-            std::copy(pv.begin(), pv.end(), p.mutable_data());
-            std::copy(qv.begin(), qv.end(), q.mutable_data());
-            return py::make_tuple(ssx::toSeconds(times[k]), p, q);
-          },
-          py::arg("t"), "The sample at or before t seconds: (its time, positions bodies x 3, orientations bodies x 4).")
-      .def_property_readonly("scene_xml", &ssx::Recording::sceneXml, "The recorded scene as scene XML.")
-      .def_property_readonly("scene", &ssx::Recording::sceneLabel, "The scene's file name when it was recorded.")
-      .def_property_readonly("version", &ssx::Recording::version, "The ssx version that recorded it.")
-      .def_property_readonly("seed", &ssx::Recording::seed, "The recorded run's seed.")
-      .def_property_readonly("complete", &ssx::Recording::complete, "False for a file cut short (a killed run).")
-      .def_property_readonly("size", &ssx::Recording::size, "Bytes in the file.")
-      .def_property_readonly(
-          "state_times",
-          [](const ssx::Recording& r) {
-            std::vector<double> out;
-            for (const ssx::Nanoseconds t : r.stateTimes()) out.push_back(ssx::toSeconds(t));
-            return out;
-          },
-          "Times of the saved states, s.")
-      .def(
-          "snapshot",
-          [](const ssx::Recording& r, double t) {
-            ssx::Nanoseconds at = 0;
-            const std::vector<std::byte> s = r.stateAtOrBefore(ssx::toNanoseconds(t), &at);
-            return py::make_tuple(ssx::toSeconds(at), py::bytes(reinterpret_cast<const char*>(s.data()), s.size()));
-          },
-          py::arg("t"),
-          "The saved state at or before t seconds: (its time, bytes for Environment.restore_state of the recorded "
-          "scene, e.g. load_scene_string(recording.scene_xml)).")
-      .def(
-          "channels", [](const ssx::Recording& r) {
-            py::dict d;
-            for (const auto& [topic, count] : r.channels()) d[py::str(topic)] = count;
-            return d;
-          },
-          "Every channel's topic and message count.")
-      .def("__len__", [](const ssx::Recording& r) { return r.times().size(); })
-      .def("__repr__", [](const ssx::Recording& r) {
-        return "<ssx.Recording " + r.sceneLabel() + ": " + std::to_string(r.names().size()) + " bodies, " +
-               std::to_string(r.times().size()) + " samples>";
-      });
+  ssx_python::bindRecording(m);
 
   m.def(
       "load_scene",

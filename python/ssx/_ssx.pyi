@@ -86,8 +86,10 @@ class Environment:
         """Runs `seconds` of simulated time, paced unless realtime=False; returns the timing summary.
         record=FILE records the run (summary under 'recording')."""
     def record(self, file: _Path, rate_hz: float = 25.0, state_every_s: float = 10.0,
-               drop_when_behind: bool = False) -> None:
-        """Records from the next step on into an MCAP file (read back with Recording)."""
+               drop_when_behind: bool = False, foxglove: Optional[bool] = None, timing: bool = False,
+               sensors: bool = False) -> None:
+        """Records from the next step on into an MCAP file (read back with Recording); foxglove adds /tf and
+        /scene (None: for up to 1,000 bodies), timing /ssx/timing, sensors /ssx/sensors."""
     def stop_recording(self) -> Dict[str, Any]:
         """Ends the recording; returns samples, dropped, states, bodies, bytes and a line of text."""
     @property
@@ -136,6 +138,8 @@ class Recording:
     @property
     def state_times(self) -> List[float]:
         """Times of the saved states, s."""
+    def channel(self, name: str) -> List[Any]:
+        """The messages of a channel as (time in s, message): JSON channels decoded, others as bytes."""
     def snapshot(self, t: float) -> Any:
         """The saved state at or before t: (its time, bytes for Environment.restore_state)."""
     def channels(self) -> Dict[str, int]:

@@ -6,7 +6,9 @@
 Records SCENE with `ssx run --record`, reads the file with Foxglove's @mcap/core (NPM_DIR holds it,
 installed by `./dev.sh test` with `npm ci`; mcap_check.mjs beside this script is copied there) and
 compares channels, message counts, time span, attachments and metadata with `ssx inspect --json`.
-Then cuts the file in half (a killed run), has `ssx inspect --complete` write a complete copy and
+The run also records Foxglove's /tf and /scene and the timing and sensor channels: every JSON message
+and schema must parse, /tf must hold a transform from "world" to every body at every pose sample and
+/scene an entity locked to each body. Then cuts the file in half (a killed run), has `ssx inspect --complete` write a complete copy and
 checks that copy the same way. Exit status 1 with the differences when anything disagrees.
 """
 import json
@@ -59,14 +61,36 @@ def compare(file, expect_samples=None):
     check("metadata", ["ssx", "ssx.bodies"], sorted(m["name"] for m in theirs["metadata"]))
     if expect_samples is not None:
         check("pose samples", expect_samples, ours["channels"].get("/ssx/poses"))
+    # the JSON channels, parsed by Node
+    j = theirs["json"]
+    check("JSON messages that do not parse", 0, j["badMessages"])
+    for topic, c in theirs["channels"].items():
+        if c["messageEncoding"] == "json":
+            check(f"JSON Schema title of {topic}", c["schema"], c.get("schemaTitle", c.get("schemaError")))
+    check("schema of /tf", "foxglove.FrameTransforms", theirs["channels"].get("/tf", {}).get("schema"))
+    check("schema of /scene", "foxglove.SceneUpdate", theirs["channels"].get("/scene", {}).get("schema"))
+    check("/tf messages", ours["channels"].get("/ssx/poses"), ours["channels"].get("/tf"))
+    check("transforms in each /tf message", [ours["bodies"]] * len(j["tfSizes"]), j["tfSizes"])
+    check("/tf parent frames", ["world"], j["tfParents"])
+    check("/tf child frames", ours["names"], j["tfFrames"])
+    entities = {e["id"]: e for e in j["sceneEntities"] or []}
+    for name in ours["names"]:
+        e = entities.get(name)
+        check(f"/scene entity of {name} (frame, locked, has shapes)", (name, True, True),
+              (e["frame"], e["locked"], e["primitives"] > 0) if e else None)
+    check("/ssx/timing steps", list(range(len(j["timingSteps"]))), j["timingSteps"])
+    check("/ssx/sensors artifacts with measurements", ours["bodies"], j["sensorArtifacts"])
     return ours
 
 
 recording = work / "run.mcap"
-out = run(ssx, "run", scene, "--steps", "1500", "--fast", "--record", str(recording), "--out", str(work / "out"))
+out = run(ssx, "run", scene, "--steps", "1500", "--fast", "--record", str(recording), "--out", str(work / "out"),
+          "--record-channels", "foxglove,timing,sensors")
 if "recording " not in out:
     problems.append(f"ssx run printed no recording line:\n{out}")
 ours = compare(recording, expect_samples=75)  # 3 s at 25 samples per simulated second
+if ours["channels"].get("/ssx/timing") != 1500:
+    problems.append(f"/ssx/timing holds {ours['channels'].get('/ssx/timing')} messages, the run made 1500 steps")
 
 # a run killed half way: the first half of the file, completed
 data = recording.read_bytes()

@@ -13,7 +13,13 @@
 ///   32767, sign chosen so that w >= 0), one after another, each as byte planes: byte b of body i's
 ///   value at (the field's start) + b * N + i (the schema's text says the same);
 /// - attachments `state/<nanoseconds>`: saved states (Environment::saveState) at the first sample and
-///   then every `state_every_s` of simulated time, from which a run can be continued bitwise.
+///   then every `state_every_s` of simulated time, from which a run can be continued bitwise;
+/// - for Foxglove and Lichtblick (RecordOptions::foxglove), in their well-known schemas, JSON-encoded:
+///   channel `/tf` (foxglove.FrameTransforms: "world" to each body, at every pose sample) and
+///   channel `/scene` (foxglove.SceneUpdate, once: the render trees' shapes, an entity per body
+///   locked to its frame, and one for what is fixed in the world);
+/// - optional JSON channels: `/ssx/timing` (each step's wall-clock cost by phase and how late it
+///   ended) and `/ssx/sensors` (every artifact's IMU, pose and range measurements at each sample).
 ///
 /// The stepping thread copies each sample into a buffer and hands it to a writer thread through a
 /// bounded queue; compression (zstd) and writing happen there. When the queue is full a real-time
@@ -27,6 +33,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -36,6 +43,8 @@ class Environment;
 
 /// What to record, and how.
 struct RecordOptions {
+  /// Swarms up to this many bodies get Foxglove's channels unless `foxglove` says otherwise.
+  static constexpr std::size_t kFoxgloveAutoBodies = 1000;
   std::filesystem::path file;       ///< the MCAP file written (created, or replaced)
   double rate_hz = 25;              ///< pose samples per simulated second; 0: every step
   double state_every_s = 10;        ///< simulated time between saved states; 0: only the first
@@ -43,6 +52,11 @@ struct RecordOptions {
   std::size_t queue_samples = 64;   ///< samples that may wait for the writer thread, at most
   std::string scene_xml;            ///< the scene as scene XML (SceneModel::toXml), kept in the file
   std::string scene_label;          ///< the scene's file name, for messages
+  /// `/tf` and `/scene` for Foxglove and Lichtblick; unset: for at most kFoxgloveAutoBodies bodies
+  /// (their JSON is about 15 times the size of the compact poses, and is made on the writer thread)
+  std::optional<bool> foxglove;
+  bool timing = false;   ///< channel `/ssx/timing`: every step's wall-clock cost
+  bool sensors = false;  ///< channel `/ssx/sensors`: IMU, pose and range measurements at each sample
 };
 
 /// What a recording wrote (Recorder::finish).
@@ -53,7 +67,8 @@ struct SSX_EXPORT RecordSummary {
   std::uint64_t bytes = 0;   ///< size of the file
   std::int64_t bodies = 0;   ///< bodies in each sample
   double simulated_s = 0;    ///< time from the first sample to the last
-  /// "recording run.mcap: 250 samples of 70 bodies (0 dropped), 2 saved states, 1.2 MB"
+  std::vector<std::string> channels;  ///< the channels' topics, in the file's order
+  /// "recording run.mcap: 250 samples of 70 bodies (0 dropped), 2 saved states, 1.2 MB; channels /ssx/poses, /tf, /scene"
   std::string str(const std::filesystem::path& file) const;
 };
 
@@ -117,6 +132,12 @@ class SSX_EXPORT Recording {
   std::vector<std::byte> stateAtOrBefore(Nanoseconds time, Nanoseconds* at = nullptr) const;
   /// Whether the file ends as a finished recording does (summary and footer).
   bool complete() const noexcept;
+  /// The messages of channel `topic` (log time in ns, the message's bytes), in the file's order
+  /// (ascending time within a channel). Throws Error naming the channels there are when there is
+  /// no such channel.
+  std::vector<std::pair<Nanoseconds, std::string>> messages(const std::string& topic) const;
+  /// The message encoding of channel `topic` ("json", "ssx.poses.v1"), or "" when there is none.
+  std::string encoding(const std::string& topic) const;
   /// Every channel's topic and message count, in id order.
   std::vector<std::pair<std::string, std::uint64_t>> channels() const;
   /// Bytes in the file.

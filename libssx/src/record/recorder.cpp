@@ -1,18 +1,22 @@
 // Recording a run (ssx/recording.hpp): samples taken on the stepping thread, written by a thread of
 // the recorder's own through a bounded queue.
+#include "record/foxglove.hpp"
 #include "record/mcap_writer.hpp"
 #include "record/pose_codec.hpp"
 
 #include <ssx/environment.hpp>
 #include <ssx/error.hpp>
+#include <ssx/measurements.hpp>
 #include <ssx/recording.hpp>
 #include <ssx/version.hpp>
 
+#include <algorithm>
 #include <condition_variable>
 #include <cmath>
 #include <cstdio>
 #include <deque>
 #include <exception>
+#include <limits>
 #include <mutex>
 #include <thread>
 
@@ -20,12 +24,131 @@ namespace ssx {
 
 namespace {
 
-// one job for the writer: a pose sample, or a saved state
+// the optional channels' JSON Schemas (only what is written)
+const char* const kTimingSchema =
+    R"j({"title":"ssx.StepTiming","description":"one step's wall-clock cost, ms, and how late it ended (real-time runs)","type":"object","properties":{)j"
+    R"j("step":{"type":"integer"},"total_ms":{"type":"number"},"physics_ms":{"type":"number"},"snapshot_ms":{"type":"number"},)j"
+    R"j("sensors_ms":{"type":"number"},"drivers_ms":{"type":"number"},"render_ms":{"type":"number"},"late_ms":{"type":"number"}}})j";
+const char* const kSensorsSchema =
+    R"j({"title":"ssx.Sensors","description":"each artifact's latest measurements by sensor index: imu (accelerometer m/s^2, gyroscope rad/s, sensor frame), )j"
+    R"j(pose (position m, orientation w x y z, velocities world frame), range (detections: seen, obstacle, relative m, distance m)","type":"object",)j"
+    R"j("additionalProperties":{"type":"object","additionalProperties":{"type":"object","properties":{"kind":{"type":"string"},"stamp":{"type":"number"}}}}})j";
+
+// a JSON message of an optional channel, made on the stepping thread
+struct Extra {
+  std::uint16_t channel = 0;
+  Nanoseconds time = 0;
+  std::string json;
+};
+
+// one job for the writer: a pose sample (with the optional channels' messages since the last), or
+// a saved state
 struct Job {
   Nanoseconds time = 0;
   bool state = false;
   std::vector<std::byte> bytes;
+  std::vector<Extra> extras;
 };
+
+double ms(Nanoseconds t) { return static_cast<double>(t) / 1e6; }
+
+// /ssx/timing: one step's cost
+std::string timingJson(const StepTiming& t) {
+  std::string out = R"({"step":)" + std::to_string(t.step);
+  const std::pair<const char*, Nanoseconds> fields[] = {{"total_ms", t.total},     {"physics_ms", t.physics},
+                                                        {"snapshot_ms", t.snapshot}, {"sensors_ms", t.sensors},
+                                                        {"drivers_ms", t.drivers}, {"render_ms", t.render},
+                                                        {"late_ms", t.lateness}};
+  for (const auto& [name, value] : fields) {
+    out += ",\"";
+    out += name;
+    out += "\":";
+    detail::appendNumber(out, ms(value));
+  }
+  return out + "}";
+}
+
+void appendArray(std::string& out, const char* name, std::initializer_list<double> values) {
+  out += '"';
+  out += name;
+  out += "\":[";
+  bool first = true;
+  for (const double v : values) {
+    if (!first) out += ',';
+    first = false;
+    detail::appendNumber(out, v);
+  }
+  out += ']';
+}
+
+// one measurement as a JSON object, or "" for kinds not recorded (clock, camera images)
+std::string measurementJson(const Environment& env, const Measurement& m) {
+  std::string out;
+  if (const auto* imu = dynamic_cast<const ImuMeasurement*>(&m)) {
+    out = R"({"kind":"imu","stamp":)";
+    detail::appendNumber(out, toSeconds(m.stamp));
+    out += ',';
+    appendArray(out, "accelerometer", {imu->accelerometer.x(), imu->accelerometer.y(), imu->accelerometer.z()});
+    out += ',';
+    appendArray(out, "gyroscope", {imu->gyroscope.x(), imu->gyroscope.y(), imu->gyroscope.z()});
+  } else if (const auto* pose = dynamic_cast<const PoseMeasurement*>(&m)) {
+    const Pose& p = pose->pose;
+    out = R"({"kind":"pose","stamp":)";
+    detail::appendNumber(out, toSeconds(m.stamp));
+    out += ',';
+    appendArray(out, "position", {p.position.x(), p.position.y(), p.position.z()});
+    out += ',';
+    appendArray(out, "orientation", {p.orientation.w(), p.orientation.x(), p.orientation.y(), p.orientation.z()});
+    out += ',';
+    appendArray(out, "linear_velocity", {pose->linear_velocity.x(), pose->linear_velocity.y(), pose->linear_velocity.z()});
+    out += ',';
+    appendArray(out, "angular_velocity",
+                {pose->angular_velocity.x(), pose->angular_velocity.y(), pose->angular_velocity.z()});
+  } else if (const auto* range = dynamic_cast<const RangeMeasurement*>(&m)) {
+    out = R"({"kind":"range","stamp":)";
+    detail::appendNumber(out, toSeconds(m.stamp));
+    out += range->body_frame ? R"(,"frame":"body","detections":[)" : R"(,"frame":"world","detections":[)";
+    bool first = true;
+    for (const auto& d : range->detections) {
+      if (!first) out += ',';
+      first = false;
+      out += R"({"seen":)";
+      detail::appendString(out, d.artifact < env.artifactCount() ? std::as_const(env).artifact(d.artifact).name()
+                                                                 : std::string());
+      out += d.obstacle ? R"(,"obstacle":true,)" : R"(,"obstacle":false,)";
+      appendArray(out, "relative", {d.relative.x(), d.relative.y(), d.relative.z()});
+      out += R"(,"distance":)";
+      detail::appendNumber(out, d.distance);
+      out += '}';
+    }
+    out += ']';
+  } else {
+    return {};
+  }
+  return out + "}";
+}
+
+// /ssx/sensors: {"<artifact>": {"0": {measurement}, ...}, ...} for every artifact with a recorded kind
+std::string sensorsJson(const Environment& env) {
+  std::string out = "{";
+  bool first_artifact = true;
+  for (std::size_t i = 0; i < env.artifactCount(); ++i) {
+    const Artifact& a = env.artifact(i);
+    std::string body;
+    for (std::size_t k = 0; k < a.sensorCount(); ++k) {
+      const std::string m = measurementJson(env, a.sensor(k).latest());
+      if (m.empty()) continue;
+      if (!body.empty()) body += ',';
+      body += '"' + std::to_string(k) + "\":" + m;
+    }
+    if (body.empty()) continue;
+    if (!first_artifact) out += ',';
+    first_artifact = false;
+    detail::appendString(out, a.name());
+    out += ":{" + body + "}";
+  }
+  return out + "}";
+}
 
 }  // namespace
 
@@ -42,6 +165,9 @@ struct Recorder::Impl {
   std::vector<std::string> names;
   std::vector<const PhysicNode*> nodes;  // the root node of each name
   std::uint16_t poses_channel = 0;
+  int tf_channel = -1, timing_channel = -1, sensors_channel = -1;  // -1: not recorded
+  std::vector<Extra> extras;                                     // since the last sample
+  std::vector<float> tf_positions, tf_orientations;              // the writer thread's
   Nanoseconds first_time = -1, last_time = 0;
   // shared with the writer thread
   mutable std::mutex mutex;
@@ -56,6 +182,9 @@ struct Recorder::Impl {
 
   void begin();
   void observe();
+  void addJsonChannel(int& channel, const char* topic, const char* schema_name, const char* schema);
+  std::string sceneJson() const;
+  void takeTiming(const StepTiming& t);
   void push(Job job);
   void loop();
 };
@@ -95,15 +224,66 @@ void Recorder::Impl::begin() {
   const std::uint16_t schema =
       writer->addSchema("ssx.Poses", "", std::as_bytes(std::span(layout.data(), layout.size())));
   poses_channel = writer->addChannel(schema, "/ssx/poses", "ssx.poses.v1", {{"bodies", std::to_string(names.size())}});
+  summary.channels.push_back("/ssx/poses");
+  if (options.foxglove.value_or(names.size() <= RecordOptions::kFoxgloveAutoBodies)) {
+    int scene = -1;
+    addJsonChannel(tf_channel, "/tf", "foxglove.FrameTransforms", detail::kFrameTransformsSchema);
+    addJsonChannel(scene, "/scene", "foxglove.SceneUpdate", detail::kSceneUpdateSchema);
+    const std::string update = sceneJson();
+    writer->addMessage(static_cast<std::uint16_t>(scene), env->time(),
+                       std::as_bytes(std::span(update.data(), update.size())));
+  }
+  if (options.timing) addJsonChannel(timing_channel, "/ssx/timing", "ssx.StepTiming", kTimingSchema);
+  if (options.sensors) addJsonChannel(sensors_channel, "/ssx/sensors", "ssx.Sensors", kSensorsSchema);
   next_state = env->time();
   thread = std::thread([this] { loop(); });
+}
+
+void Recorder::Impl::addJsonChannel(int& channel, const char* topic, const char* schema_name, const char* schema) {
+  const std::uint16_t id =
+      writer->addSchema(schema_name, "jsonschema", std::as_bytes(std::span(schema, std::char_traits<char>::length(schema))));
+  channel = writer->addChannel(id, topic, "json");
+  summary.channels.push_back(topic);
+}
+
+std::string Recorder::Impl::sceneJson() const {
+  // each render tree in the frame of the recorded body it moves with, or of the world
+  std::vector<detail::SceneShape> shapes;
+  auto add = [&](auto& self, const RenderNodeSpec& spec, const std::string& frame, const Pose& parent) -> void {
+    const Pose pose = parent * spec.pose;
+    shapes.push_back({frame, &spec, pose});
+    for (const auto& c : spec.children) self(self, c, frame, pose);
+  };
+  for (std::size_t i = 0; i < env->artifactCount(); ++i) {
+    const Artifact& a = std::as_const(*env).artifact(i);
+    for (const auto& tree : a.renderRoots()) {
+      const PhysicNode* follow = tree->follow.empty() ? nullptr : a.node(tree->follow);
+      const PhysicNode* root = follow;
+      while (root != nullptr && root->parent() != nullptr) root = root->parent();
+      const auto body = std::find(nodes.begin(), nodes.end(), root);
+      if (follow == nullptr) {
+        add(add, *tree, detail::kWorldFrame, a.placement());
+      } else if (body == nodes.end()) {  // a static root: where it is now, for good
+        add(add, *tree, detail::kWorldFrame, follow->pose());
+      } else {  // the followed node in its root's frame (children are rigidly part of their root)
+        add(add, *tree, names[static_cast<std::size_t>(body - nodes.begin())],
+            root->poseInBody().inverse() * follow->poseInBody());
+      }
+    }
+  }
+  return detail::sceneUpdate(env->time(), shapes);
+}
+
+void Recorder::Impl::takeTiming(const StepTiming& t) {
+  const std::string json = timingJson(t);
+  extras.push_back({static_cast<std::uint16_t>(timing_channel), (t.step + 1) * env->timestep(), json});
 }
 
 void Recorder::Impl::push(Job job) {
   std::unique_lock lock(mutex);
   if (error) std::rethrow_exception(error);
   if (queue.size() >= options.queue_samples) {
-    if (options.drop_when_behind && !job.state) {
+    if (options.drop_when_behind && !job.state && job.time >= 0) {
       ++summary.dropped;
       spare.push_back(std::move(job.bytes));
       return;
@@ -118,9 +298,17 @@ void Recorder::Impl::push(Job job) {
 void Recorder::Impl::observe() {
   if (!begun) begin();
   const Nanoseconds now = env->time();
+  if (timing_channel >= 0) {
+    // the step before this one: the run loop has told its lateness by now
+    const TimingRecorder& timing = env->timing();
+    if (timing.size() >= 2 && timing[timing.size() - 2].step + 1 == timing[timing.size() - 1].step)
+      takeTiming(timing[timing.size() - 2]);
+  }
   if (env->stepCount() % period_steps != 0) return;
   Job job;
   job.time = now;
+  if (sensors_channel >= 0) extras.push_back({static_cast<std::uint16_t>(sensors_channel), now, sensorsJson(*env)});
+  job.extras.swap(extras);
   {
     std::lock_guard lock(mutex);
     if (!spare.empty()) {
@@ -155,10 +343,18 @@ void Recorder::Impl::loop() {
       changed.notify_all();
     }
     try {
+      // the optional channels' messages first: they are stamped at or before the sample
+      for (const Extra& e : job.extras)
+        writer->addMessage(e.channel, e.time, std::as_bytes(std::span(e.json.data(), e.json.size())));
       if (job.state) {
         writer->addAttachment("state/" + std::to_string(job.time), "application/x-ssx-state", job.time, job.bytes);
-      } else {
+      } else if (job.time >= 0) {
         writer->addMessage(poses_channel, job.time, job.bytes);
+        if (tf_channel >= 0) {
+          detail::decodePoses(job.bytes, &tf_positions, &tf_orientations);
+          const std::string tf = detail::frameTransforms(job.time, names, tf_positions, tf_orientations);
+          writer->addMessage(static_cast<std::uint16_t>(tf_channel), job.time, std::as_bytes(std::span(tf.data(), tf.size())));
+        }
       }
     } catch (...) {
       std::lock_guard lock(mutex);
@@ -170,7 +366,7 @@ void Recorder::Impl::loop() {
     std::lock_guard lock(mutex);
     if (job.state)
       ++summary.states;
-    else
+    else if (job.time >= 0)
       ++summary.samples;
     summary.bytes = writer->bytesWritten();
     spare.push_back(std::move(job.bytes));
@@ -206,6 +402,17 @@ RecordSummary Recorder::finish() {
   if (m.listening) m.env->removeStepListener(m.listener);
   m.listening = false;
   if (!m.begun) m.begin();  // no step was taken: the scene and no samples
+  // what the optional channels hold since the last sample, and the last step's timing
+  if (m.timing_channel >= 0 && m.env->timing().size() > 0) {
+    const TimingRecorder& timing = m.env->timing();
+    m.takeTiming(timing[timing.size() - 1]);
+  }
+  if (!m.extras.empty()) {
+    Job job;
+    job.time = -1;  // extras only
+    job.extras.swap(m.extras);
+    m.push(std::move(job));
+  }
   {
     std::lock_guard lock(m.mutex);
     m.done = true;
@@ -229,10 +436,12 @@ RecordSummary Recorder::summary() const {
 
 std::string RecordSummary::str(const std::filesystem::path& file) const {
   char text[256];
-  std::snprintf(text, sizeof text, "recording %s: %lld samples of %lld bodies (%lld dropped), %lld saved states, %.1f MB",
-                file.string().c_str(), static_cast<long long>(samples), static_cast<long long>(bodies),
-                static_cast<long long>(dropped), static_cast<long long>(states), static_cast<double>(bytes) / 1e6);
-  return text;
+  std::snprintf(text, sizeof text, "%lld samples of %lld bodies (%lld dropped), %lld saved states, %.1f MB",
+                static_cast<long long>(samples), static_cast<long long>(bodies), static_cast<long long>(dropped),
+                static_cast<long long>(states), static_cast<double>(bytes) / 1e6);
+  std::string out = "recording " + file.string() + ": " + text;
+  for (std::size_t i = 0; i < channels.size(); ++i) out += (i == 0 ? "; channels " : ", ") + channels[i];
+  return out;
 }
 
 }  // namespace ssx

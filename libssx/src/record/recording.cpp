@@ -144,3 +144,28 @@ std::vector<std::pair<std::string, std::uint64_t>> Recording::channels() const {
 }
 
 }  // namespace ssx
+
+namespace ssx {
+
+std::vector<std::pair<Nanoseconds, std::string>> Recording::messages(const std::string& topic) const {
+  const detail::McapFile& f = impl_->file;
+  const int channel = f.channelId(topic);
+  if (channel < 0) {
+    std::string there;
+    for (const auto& [id, c] : f.channels) there += (there.empty() ? "" : ", ") + c.topic;
+    throw Error(f.file.string() + ": no channel '" + topic + "' (there are: " + there + ")");
+  }
+  std::vector<std::pair<Nanoseconds, std::string>> out;
+  for (const auto& msg : f.messages)
+    if (msg.channel == channel)
+      out.emplace_back(msg.log_time, std::string(reinterpret_cast<const char*>(msg.data.data()), msg.data.size()));
+  return out;
+}
+
+std::string Recording::encoding(const std::string& topic) const {
+  const detail::McapFile& f = impl_->file;
+  const int channel = f.channelId(topic);
+  return channel < 0 ? std::string() : f.channels.at(static_cast<std::uint16_t>(channel)).encoding;
+}
+
+}  // namespace ssx

@@ -13,6 +13,7 @@
 // per robot on the ground, straight below it, as wide as the robot and fading with its height,
 // blended over the ground last.
 #include "render/osmesa_engine.hpp"
+#include "render/osmesa_shaders.hpp"
 #include "render/unit_meshes.hpp"
 
 #define GL_GLEXT_PROTOTYPES 1
@@ -37,74 +38,9 @@ namespace ssx::detail {
 
 namespace {
 
-// The instanced shaders are compiled twice: for meshes whose faces are flat (box, plane, disc) the
-// normal is the same at a face's three corners and is passed flat, not interpolated, as are the
-// instance's colour and grid flag. llvmpipe's per-pixel cost grows with what it interpolates: with
-// 70 robots, where the ground is most of the picture, a 640 x 480 frame took 6.7-7.0 ms with all
-// interpolated and 4.1-4.5 ms with only the world position interpolated (one run each of three).
-constexpr const char* kVersion = "#version 330 core\n";
-constexpr const char* kSmoothFaces = "#define FACE\n";
-constexpr const char* kFlatFaces = "#define FACE flat\n";
-
-constexpr const char* kVertexShader = R"(
-layout(location = 0) in vec3 a_position;
-layout(location = 1) in vec3 a_normal;
-layout(location = 2) in vec3 i_position;
-layout(location = 3) in vec4 i_rotation;  // quaternion x y z w
-layout(location = 4) in vec3 i_scale;
-layout(location = 5) in vec4 i_color;
-layout(location = 6) in float i_grid;
-uniform mat4 u_view_projection;
-FACE out vec3 v_normal;
-out vec3 v_world;
-flat out vec4 v_color;
-flat out float v_grid;
-vec3 rotate(vec4 q, vec3 v) {
-  vec3 t = 2.0 * cross(q.xyz, v);
-  return v + q.w * t + cross(q.xyz, t);
-}
-void main() {
-  vec3 world = rotate(i_rotation, a_position * i_scale) + i_position;
-  v_world = world;
-  v_normal = rotate(i_rotation, a_normal / i_scale);  // inverse transpose of rotation * scale
-  v_color = i_color;
-  v_grid = i_grid;
-  gl_Position = u_view_projection * vec4(world, 1.0);
-}
-)";
-
-constexpr const char* kFragmentShader = R"(
-FACE in vec3 v_normal;
-in vec3 v_world;
-flat in vec4 v_color;
-flat in float v_grid;
-uniform vec3 u_sun;  // unit vector towards the sun
-uniform vec3 u_eye;
-out vec4 o_color;
-void main() {
-  vec3 n = normalize(v_normal);
-  if (!gl_FrontFacing) n = -n;
-  vec3 to_eye = normalize(u_eye - v_world);
-  float light = 0.3 + 0.45 * max(dot(n, u_sun), 0.0) + 0.3 * max(dot(n, to_eye), 0.0);
-  vec3 c = v_color.rgb * min(light, 1.0);
-  if (v_grid > 0.5) {
-    vec2 w = max(fwidth(v_world.xy), vec2(1e-4));
-    vec2 d = abs(fract(v_world.xy + 0.5) - 0.5) / w;
-    float line = 1.0 - min(min(d.x, d.y), 1.0);
-    float fade = clamp(1.0 - 6.0 * max(w.x, w.y), 0.0, 1.0);  // no moire far away
-    c *= 1.0 - 0.35 * line * fade;
-  }
-  o_color = vec4(c, v_color.a);
-}
-)";
-
 // one instance: position, rotation quaternion (x y z w), scale, colour, grid flag
 struct Instance {
-  float position[3];
-  float rotation[4];
-  float scale[3];
-  float color[4];
-  float grid;
+  float position[3], rotation[4], scale[3], color[4], grid;
 };
 
 // spheres and cylinders in four levels of detail, chosen by the size they appear in the image
@@ -120,37 +56,18 @@ constexpr bool twoSided(int mesh) { return mesh == kPlane || (mesh >= kDisc && m
 // every face flat: one normal at all three corners of each triangle
 constexpr bool flatFaces(int mesh) { return mesh == kBox || twoSided(mesh); }
 
-// what appears small: vertices placed in the world and lit here, drawn as they are
-constexpr const char* kBatchVertexShader = R"(
-layout(location = 0) in vec3 a_position;
-layout(location = 1) in vec4 a_color;
-uniform mat4 u_view_projection;
-out vec4 v_color;
-void main() {
-  v_color = a_color;
-  gl_Position = u_view_projection * vec4(a_position, 1.0);
-}
-)";
-
-constexpr const char* kBatchFragmentShader = R"(
-in vec4 v_color;
-out vec4 o_color;
-void main() { o_color = v_color; }
-)";
-
 // a vertex placed in the world, with its lit colour
 struct BatchVertex {
   float position[3];
   std::uint8_t color[4];
 };
 
-// towards the sun (unit)
-const Vec3 kSun = Vec3(0.35, 0.25, 0.9).normalized();
+const Vec3 kSun = Vec3(0.35, 0.25, 0.9).normalized();  // towards the sun (unit)
 
 // a shader from the version line, a definition and the source
 GLuint compile(GLenum kind, const char* definition, const char* source) {
   const GLuint shader = glCreateShader(kind);
-  const char* parts[] = {kVersion, definition, source};
+  const char* parts[] = {shaders::kVersion, definition, source};
   glShaderSource(shader, 3, parts, nullptr);
   glCompileShader(shader);
   GLint ok = 0;
@@ -258,12 +175,12 @@ void OsmesaRenderEngine::makeCurrent(int width, int height) {
 void OsmesaRenderEngine::setup() {
   Gl& g = *gl_;
   for (int f = 0; f < 2; ++f) {
-    g.program[f] = link(f == 0 ? kSmoothFaces : kFlatFaces, kVertexShader, kFragmentShader);
+    g.program[f] = link(f == 0 ? shaders::kSmoothFaces : shaders::kFlatFaces, shaders::kVertexShader, shaders::kFragmentShader);
     g.u_view_projection[f] = glGetUniformLocation(g.program[f], "u_view_projection");
     g.u_sun[f] = glGetUniformLocation(g.program[f], "u_sun");
     g.u_eye[f] = glGetUniformLocation(g.program[f], "u_eye");
   }
-  g.batch_program = link("", kBatchVertexShader, kBatchFragmentShader);
+  g.batch_program = link("", shaders::kBatchVertexShader, shaders::kBatchFragmentShader);
   g.batch_view_projection = glGetUniformLocation(g.batch_program, "u_view_projection");
 
   glGenVertexArrays(kMeshCount, g.vao);

@@ -2,6 +2,7 @@
 // off the stepping thread; nothing dropped when it may wait; a write that fails stops the run.
 #include <ssx/ssx.hpp>
 
+#include "record/foxglove.hpp"
 #include "scene_util.hpp"
 
 #include <catch2/catch.hpp>
@@ -61,7 +62,8 @@ TEST_CASE("recorder: poses of every body at 25 Hz, saved states every second, th
   CHECK(r.sceneLabel() == "quads.xml");
   CHECK(r.seed() == 5);
   CHECK(r.version() == SSX_VERSION_STRING);
-  CHECK(r.channels() == std::vector<std::pair<std::string, std::uint64_t>>{{"/ssx/poses", 50}});
+  // the compact poses, and (four bodies: Foxglove's channels by default) a transform message per sample and the shapes once
+  CHECK(r.channels() == std::vector<std::pair<std::string, std::uint64_t>>{{"/ssx/poses", 50}, {"/tf", 50}, {"/scene", 1}});
   // a second finish is the same summary; steps after it are not recorded
   CHECK(recorder.finish().samples == 50);
   env.step(100);
@@ -95,4 +97,61 @@ TEST_CASE("recorder: a recording that cannot be written stops the run with the f
   bad.rate_hz = -1;
   CHECK_THROWS_WITH(Recorder(env, bad), Catch::Contains("rate_hz"));
   CHECK_FALSE(fs::exists(bad.file));
+}
+
+TEST_CASE("recorder: Foxglove's /tf and /scene, every step's timing and the sensors' measurements", "[record][recorder]") {
+  const fs::path file = fs::current_path() / "recorder_channels.mcap";
+  Scene scene = loadSceneFromString(kQuads, "quads.xml", kArtifacts, testOptions());
+  Environment& env = *scene.environment;
+  RecordOptions o = options(file, scene);
+  o.timing = true;
+  o.sensors = true;  // foxglove unset: 4 bodies get it
+  Recorder recorder(env, o);
+  env.step(1000);
+  const RecordSummary s = recorder.finish();
+  const std::vector<std::string> topics{"/ssx/poses", "/tf", "/scene", "/ssx/timing", "/ssx/sensors"};
+  CHECK(s.channels == topics);
+  CHECK(s.str(file).find("; channels /ssx/poses, /tf, /scene, /ssx/timing, /ssx/sensors") != std::string::npos);
+
+  const Recording r(file);
+  CHECK(r.encoding("/tf") == "json");
+  CHECK(r.encoding("/nothing").empty());
+  CHECK_THROWS_WITH(r.messages("/nothing"), Catch::Contains("no channel '/nothing'") && Catch::Contains("/ssx/sensors"));
+  // a transform per body at every pose sample, at its time, with the sample's position
+  const auto tf = r.messages("/tf");
+  REQUIRE(tf.size() == 50);
+  for (std::size_t k = 0; k < tf.size(); ++k) CHECK(tf[k].first == r.times()[k]);
+  const std::vector<float> last = r.positions(49);
+  for (std::size_t i = 0; i < 4; ++i) {
+    std::string x;
+    detail::appendNumber(x, last[3 * i]);
+    CHECK(tf.back().second.find(R"("child_frame_id":"q)" + std::to_string(i) + R"(","translation":{"x":)" + x + ",") !=
+          std::string::npos);
+  }
+  // the shapes once: an entity per quadrotor, locked to its frame, and the ground in the world's
+  const auto scene_update = r.messages("/scene");
+  REQUIRE(scene_update.size() == 1);
+  for (const char* id : {R"("id":"q0")", R"("id":"q3")", R"("id":"world")"})
+    CHECK(scene_update[0].second.find(id) != std::string::npos);
+  // every step's cost, in order, stamped with the step's end
+  const auto timing = r.messages("/ssx/timing");
+  REQUIRE(timing.size() == 1000);
+  for (std::size_t k = 0; k < timing.size(); ++k) {
+    CHECK(timing[k].second.rfind(R"({"step":)" + std::to_string(k) + ",", 0) == 0);
+    CHECK(timing[k].first == static_cast<Nanoseconds>(k + 1) * env.timestep());
+  }
+  // each robot's IMU and pose sensors at every sample
+  const auto sensors = r.messages("/ssx/sensors");
+  REQUIRE(sensors.size() == 50);
+  for (const char* what : {R"("q0":{)", R"("q3":{)", R"("kind":"imu")", R"("kind":"pose")", R"("gyroscope":[)"})
+    CHECK(sensors.back().second.find(what) != std::string::npos);
+
+  // asked off: the poses alone
+  Scene again = loadSceneFromString(kQuads, "quads.xml", kArtifacts, testOptions());
+  RecordOptions plain = options(file, again);
+  plain.foxglove = false;
+  Recorder off(*again.environment, plain);
+  again.environment->step(100);
+  CHECK(off.finish().channels == std::vector<std::string>{"/ssx/poses"});
+  CHECK(Recording(file).channels().size() == 1);
 }

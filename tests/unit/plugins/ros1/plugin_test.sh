@@ -1,11 +1,11 @@
 #!/bin/bash
-# ctest: lock-step with a real ROS master. (1) Ten quadrotors run as fast as they can with
+# ctest: the ros1 extension (plugins/ros1/plugin.cpp) in lock-step with a real ROS master. (1) Ten quadrotors run as fast as they can with
 # lockstep="true" while a peer answers each odometry message after a varying delay; the peer checks
 # that no odometry round arrives before every robot's answer to the round before was sent, and that
 # the robots reach their set-points. (2) Without a peer the run fails, inside its connect timeout,
 # with the documented message. Exits 77 (ctest: skipped) when ROS 1 is not installed.
 #
-# usage: lockstep_test.sh SSX_BINARY
+# usage: plugin_test.sh SSX_BINARY
 set -u
 here=$(cd "$(dirname "$0")" && pwd)
 ssx=$1
@@ -22,7 +22,7 @@ echo "with a peer: ssx exit $ssx_status, peer exit $peer_status"
 
 # no peer: the same scene with a 2 s connect timeout
 sed -e 's|lockstep_connect_timeout_s="20"|lockstep_connect_timeout_s="2"|' \
-    -e "s|file=\"../../examples/|file=\"$here/../../examples/|" "$here/ros_lockstep.xml" > "$ROS_HOME/alone.xml"
+    -e "s|file=\"../../../../examples/|file=\"$here/../../../../examples/|" "$here/ros_lockstep.xml" > "$ROS_HOME/alone.xml"
 start=$(date +%s)
 "$ssx" run "$ROS_HOME/alone.xml" --fast --quiet 2> "$ROS_HOME/alone.err"
 status=$?

@@ -1,5 +1,5 @@
 #!/bin/bash
-# ctest: a real ROS master on a free loopback port, ssx with the ros1 extension and ten quadrotors,
+# ctest (plugins/ros1/ros_bridge.cpp): a real ROS master on a free loopback port, ssx with the ros1 extension and ten quadrotors,
 # and a separate peer process that reads odometry and sends set-points; passes when every robot
 # reaches its set-point and ssx ends cleanly. Exits 77 (ctest: skipped) when ROS 1 is not installed.
 #

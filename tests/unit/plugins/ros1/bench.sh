@@ -1,7 +1,7 @@
 #!/bin/bash
 # Benchmark (not a test): N quadrotors bridged to ROS 1, odometry at 50 Hz out, a peer answering each
 # odometry message with a set-point; prints the peer's message counts (loss) and the bridge's round
-# trips, and ssx's timing summary (real time).  usage: tests/ros/bench.sh SSX_BINARY [N] [SECONDS]
+# trips, and ssx's timing summary (real time).  usage: tests/unit/plugins/ros1/bench.sh SSX_BINARY [N] [SECONDS]
 set -u
 here=$(cd "$(dirname "$0")" && pwd)
 ssx=$1; n=${2:-100}; seconds=${3:-20}
@@ -16,7 +16,7 @@ for _ in $(seq 100); do
   sleep 0.1
 done
 sed "s/count=\"10\"/count=\"$n\"/; s/duration=\"16\"/duration=\"$seconds\"/" "$here/ros_swarm.xml" > "$ROS_HOME/scene.xml"
-sed -i "s|file=\"../../examples|file=\"$here/../../examples|" "$ROS_HOME/scene.xml"
+sed -i "s|file=\"../../../../examples|file=\"$here/../../../../examples|" "$ROS_HOME/scene.xml"
 /usr/bin/python3 "$here/peer.py" "$n" "$((seconds + 3))" --bench &
 peer=$!
 sleep 1
