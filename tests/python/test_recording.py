@@ -26,7 +26,14 @@ def test_a_recording_read_back_into_numpy_and_continued_from_its_state(tmp_path)
     t, p_at, _ = r.at(1.011)
     assert t == pytest.approx(1.0) and np.array_equal(p_at, p[49])
     assert r.state_times == pytest.approx([0.02, 1.02, 2.02])
-    assert r.channels() == {"/ssx/poses": 150} and r.scene == "quad_hover.xml"
+    # three bodies: Foxglove's channels by default, a transform message per sample and the shapes once
+    assert r.channels() == {"/ssx/poses": 150, "/tf": 150, "/scene": 1} and r.scene == "quad_hover.xml"
+    t_tf, tf = r.channel("/tf")[-1]
+    assert t_tf == pytest.approx(3.0) and [f["child_frame_id"] for f in tf["transforms"]] == r.names
+    assert [f["translation"]["z"] for f in tf["transforms"]] == pytest.approx(p[-1, :, 2], abs=1e-6)
+    assert isinstance(r.channel("/ssx/poses")[0][1], bytes)
+    with pytest.raises(RuntimeError, match="no channel '/imu'"):
+        r.channel("/imu")
 
     # the recorded scene from its state at 1.02 s: the recorded poses again, bit for bit
     at, state = r.snapshot(1.5)
@@ -55,3 +62,19 @@ def test_run_records_and_refuses_what_it_must_not_write(tmp_path):
     (tmp_path / "not.mcap").write_text("<scene/>")
     with pytest.raises(RuntimeError, match=r"not.mcap: byte 0: not an MCAP file"):
         ssx.Recording(tmp_path / "not.mcap")
+
+
+def test_optional_channels_from_python(tmp_path):
+    env = ssx.load_scene(ssx.data_directory() / "scenes" / "quad_hover.xml")
+    env.record(tmp_path / "all.mcap", foxglove=False, timing=True, sensors=True)
+    env.step(100)
+    env.stop_recording()
+    r = ssx.Recording(tmp_path / "all.mcap")
+    assert set(r.channels()) == {"/ssx/poses", "/ssx/timing", "/ssx/sensors"}
+    timing = r.channel("/ssx/timing")
+    assert [m["step"] for _, m in timing] == list(range(100))
+    assert all(m["total_ms"] >= m["physics_ms"] >= 0 for _, m in timing)
+    t, sensors = r.channel("/ssx/sensors")[-1]
+    assert t == pytest.approx(0.2) and set(sensors) == {"mk", "hb", "cf"}
+    kinds = sorted(m["kind"] for m in sensors["mk"].values())
+    assert "imu" in kinds and "pose" in kinds

@@ -54,8 +54,14 @@ def compare(file, expect_samples=None):
     check("messages read record by record (CRCs checked)", total, theirs["streamedMessages"])
     check("message count in the statistics", str(total), theirs["statisticsMessageCount"])
     check("footer", True, theirs["footer"] and theirs["done"])
-    check("first message time", str(ours["first_time_ns"]), theirs["firstTime"])
-    check("last message time", str(ours["last_time_ns"]), theirs["lastTime"])
+    poses = theirs["channels"].get("/ssx/poses", {})
+    check("first pose sample's time", str(ours["first_time_ns"]), poses.get("firstTime"))
+    check("last pose sample's time", str(ours["last_time_ns"]), poses.get("lastTime"))
+    # the file's span: from the first step's timing (2 ms) to the last pose sample
+    check("first message time", str(min(int(c["firstTime"]) for c in theirs["channels"].values() if "firstTime" in c)),
+          theirs["firstTime"])
+    check("last message time", str(max(int(ours["last_time_ns"]), *(int(c["lastTime"]) for c in theirs["channels"].values() if "lastTime" in c))),
+          theirs["lastTime"])
     names = sorted(a["name"] for a in theirs["attachments"])
     check("attachments", sorted(["scene.xml"] + [f"state/{t}" for t in ours["states_ns"]]), names)
     check("metadata", ["ssx", "ssx.bodies"], sorted(m["name"] for m in theirs["metadata"]))

@@ -40,6 +40,9 @@ let first = null, last = null, count = 0;
 for await (const m of indexed.readMessages()) {
   const topic = indexed.channelsById.get(m.channelId).topic;
   channels[topic].count++;
+  const c = channels[topic];
+  if (c.firstTime === undefined || m.logTime < BigInt(c.firstTime)) c.firstTime = m.logTime.toString();
+  if (c.lastTime === undefined || m.logTime > BigInt(c.lastTime)) c.lastTime = m.logTime.toString();
   count++;
   if (first === null || m.logTime < first) first = m.logTime;
   if (last === null || m.logTime > last) last = m.logTime;

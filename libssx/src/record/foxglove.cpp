@@ -104,7 +104,7 @@ const char* const kSceneUpdateSchema =
     R"j("lifetime":{"type":"object","properties":{"sec":{"type":"integer"},"nsec":{"type":"integer"}}},"frame_locked":{"type":"boolean"},)j"
     R"j("cubes":{"type":"array","items":)j" SSX_JSON_SHAPE R"j(}}},"spheres":{"type":"array","items":)j" SSX_JSON_SHAPE
     R"j(}}},"cylinders":{"type":"array","items":)j" SSX_JSON_SHAPE
-    R"j(,"bottom_scale":{"type":"number"},"top_scale":{"type":"number"}}}}}}}}}})j";
+    R"j(,"bottom_scale":{"type":"number"},"top_scale":{"type":"number"}}}}}}}}})j";
 
 void appendNumber(std::string& out, double value) {
   if (!std::isfinite(value)) {  // JSON has no NaN or infinity
