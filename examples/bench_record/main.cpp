@@ -6,8 +6,10 @@
 // every pose back (ssx::Recording, every sample decoded):
 //   n=N run=K record=0|1 median_ms=... p99_ms=... late=... dropped=...
 //   n=N bytes_per_robot_s=... (poses) ... (with states) read_s=... samples=... bodies=... floats=...
-// --fast runs unpaced (the stepper then waits for the writer: nothing is dropped).
-// usage: ssx_bench_record [--n N] [--seconds S] [--runs R] [--fast]
+// --fast runs unpaced (the stepper then waits for the writer: nothing is dropped). --keep FILE keeps
+// the last recording there (read_numpy.py beside this program times reading it into numpy).
+// --writer-nice K sets the writer thread's nice value (default 19, as RecordOptions has it).
+// usage: ssx_bench_record [--n N] [--seconds S] [--runs R] [--fast] [--keep FILE] [--writer-nice K]
 #include <ssx/ssx.hpp>
 
 #include <algorithm>
@@ -28,6 +30,8 @@ int main(int argc, char** argv) {
   int n = 10000, runs = 2;
   double seconds = 30;
   bool fast = false;
+  std::string keep;
+  int writer_nice = 19;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     if (a == "--fast") {
@@ -35,15 +39,20 @@ int main(int argc, char** argv) {
       continue;
     }
     if (i + 1 >= argc) {
-      std::fprintf(stderr, "usage: ssx_bench_record [--n N] [--seconds S] [--runs R] [--fast]\n");
+      std::fprintf(stderr, "usage: ssx_bench_record [--n N] [--seconds S] [--runs R] [--fast] [--keep FILE]\n");
       return 2;
+    }
+    if (a == "--keep") {
+      keep = argv[++i];
+      continue;
     }
     const double v = std::stod(argv[++i]);
     if (a == "--n") n = static_cast<int>(v);
+    else if (a == "--writer-nice") writer_nice = static_cast<int>(v);
     else if (a == "--seconds") seconds = v;
     else if (a == "--runs") runs = static_cast<int>(v);
     else {
-      std::fprintf(stderr, "usage: ssx_bench_record [--n N] [--seconds S] [--runs R] [--fast]\n");
+      std::fprintf(stderr, "usage: ssx_bench_record [--n N] [--seconds S] [--runs R] [--fast] [--keep FILE]\n");
       return 2;
     }
   }
@@ -71,6 +80,7 @@ int main(int argc, char** argv) {
       ssx::RecordOptions o;
       o.file = file;
       o.drop_when_behind = !fast;
+      o.writer_nice = writer_nice;
       o.scene_xml = scene.model->toXml();
       recorder = std::make_unique<ssx::Recorder>(env, o);
     }
@@ -96,6 +106,12 @@ int main(int argc, char** argv) {
   std::printf("n=%d bytes_per_robot_s=%.0f (poses) %.0f (with states) read_s=%.2f samples=%zu bodies=%zu floats=%zu\n", n,
               static_cast<double>(last.bytes - state_bytes) / robot_seconds, static_cast<double>(last.bytes) / robot_seconds,
               read_s, r.times().size(), r.names().size(), floats);
-  fs::remove(file);
+  if (keep.empty()) {
+    fs::remove(file);
+  } else {
+    fs::copy_file(file, keep, fs::copy_options::overwrite_existing);
+    fs::remove(file);
+    std::printf("kept %s\n", keep.c_str());
+  }
   return 0;
 }

@@ -50,6 +50,9 @@ struct RecordOptions {
   double state_every_s = 10;        ///< simulated time between saved states; 0: only the first
   bool drop_when_behind = false;    ///< a full queue drops samples (real-time runs) instead of waiting
   std::size_t queue_samples = 64;   ///< samples that may wait for the writer thread, at most
+  /// The writer thread's nice value (Linux: each thread has its own; only the recorder's thread is
+  /// changed): 19 lets the stepping threads take a core first when they wake; 0 leaves it as made.
+  int writer_nice = 19;
   std::string scene_xml;            ///< the scene as scene XML (SceneModel::toXml), kept in the file
   std::string scene_label;          ///< the scene's file name, for messages
   /// `/tf` and `/scene` for Foxglove and Lichtblick; unset: for at most kFoxgloveAutoBodies bodies

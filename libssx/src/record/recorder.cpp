@@ -20,6 +20,10 @@
 #include <mutex>
 #include <thread>
 
+#include <sys/resource.h>
+#include <sys/syscall.h>
+#include <unistd.h>
+
 namespace ssx {
 
 namespace {
@@ -332,6 +336,10 @@ void Recorder::Impl::observe() {
 }
 
 void Recorder::Impl::loop() {
+  // this thread only (Linux's nice value is per thread); raising one's own never fails for want of
+  // rights, and a failure would change nothing but the priority
+  if (options.writer_nice != 0)
+    (void)setpriority(PRIO_PROCESS, static_cast<id_t>(::syscall(SYS_gettid)), options.writer_nice);
   for (;;) {
     Job job;
     {
@@ -383,6 +391,8 @@ Recorder::Recorder(Environment& env, RecordOptions options) : impl_(std::make_un
   if (!(m.options.state_every_s >= 0 && std::isfinite(m.options.state_every_s)))
     throw ConfigError({}, "record: state_every_s must be 0 (the first only) or positive");
   if (m.options.queue_samples < 1) throw ConfigError({}, "record: queue_samples must be at least 1");
+  if (m.options.writer_nice < 0 || m.options.writer_nice > 19)
+    throw ConfigError({}, "record: writer_nice must be 0 (unchanged) to 19 (a lower priority than the stepping threads)");
   m.writer = std::make_unique<detail::McapWriter>(m.options.file, "ssx", std::string("ssx ") + SSX_VERSION_STRING);
   m.listener = env.addStepListener([&m](const Environment&) { m.observe(); });
   m.listening = true;
