@@ -31,7 +31,7 @@ namespace {
 // the optional channels' JSON Schemas (only what is written)
 const char* const kTimingSchema =
     R"j({"title":"ssx.StepTiming","description":"one step's wall-clock cost, ms, and how late it ended (real-time runs)","type":"object","properties":{)j"
-    R"j("step":{"type":"integer"},"total_ms":{"type":"number"},"physics_ms":{"type":"number"},"snapshot_ms":{"type":"number"},)j"
+    R"j("step":{"type":"integer"},"contacts":{"type":"integer"},"total_ms":{"type":"number"},"physics_ms":{"type":"number"},"snapshot_ms":{"type":"number"},)j"
     R"j("sensors_ms":{"type":"number"},"drivers_ms":{"type":"number"},"render_ms":{"type":"number"},"late_ms":{"type":"number"}}})j";
 const char* const kSensorsSchema =
     R"j({"title":"ssx.Sensors","description":"each artifact's latest measurements by sensor index: imu (accelerometer m/s^2, gyroscope rad/s, sensor frame), )j"
@@ -57,8 +57,8 @@ struct Job {
 double ms(Nanoseconds t) { return static_cast<double>(t) / 1e6; }
 
 // /ssx/timing: one step's cost
-std::string timingJson(const StepTiming& t) {
-  std::string out = R"({"step":)" + std::to_string(t.step);
+std::string timingJson(const StepTiming& t, std::size_t contacts) {
+  std::string out = R"({"step":)" + std::to_string(t.step) + R"(,"contacts":)" + std::to_string(contacts);
   const std::pair<const char*, Nanoseconds> fields[] = {{"total_ms", t.total},     {"physics_ms", t.physics},
                                                         {"snapshot_ms", t.snapshot}, {"sensors_ms", t.sensors},
                                                         {"drivers_ms", t.drivers}, {"render_ms", t.render},
@@ -189,6 +189,7 @@ struct Recorder::Impl {
   void addJsonChannel(int& channel, const char* topic, const char* schema_name, const char* schema);
   std::string sceneJson() const;
   void takeTiming(const StepTiming& t);
+  std::size_t contacts = 0;  // the physics engine's contact points in the step taken last
   void push(Job job);
   void loop();
 };
@@ -279,7 +280,7 @@ std::string Recorder::Impl::sceneJson() const {
 }
 
 void Recorder::Impl::takeTiming(const StepTiming& t) {
-  const std::string json = timingJson(t);
+  const std::string json = timingJson(t, contacts);
   extras.push_back({static_cast<std::uint16_t>(timing_channel), (t.step + 1) * env->timestep(), json});
 }
 
@@ -307,6 +308,7 @@ void Recorder::Impl::observe() {
     const TimingRecorder& timing = env->timing();
     if (timing.size() >= 2 && timing[timing.size() - 2].step + 1 == timing[timing.size() - 1].step)
       takeTiming(timing[timing.size() - 2]);
+    contacts = env->physics().contactCount();  // this step's, sent with its timing at the next
   }
   if (env->stepCount() % period_steps != 0) return;
   Job job;

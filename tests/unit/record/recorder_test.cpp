@@ -4,6 +4,7 @@
 
 #include "record/foxglove.hpp"
 #include "scene_util.hpp"
+#include "test_util.hpp"
 
 #include <catch2/catch.hpp>
 
@@ -154,4 +155,25 @@ TEST_CASE("recorder: Foxglove's /tf and /scene, every step's timing and the sens
   again.environment->step(100);
   CHECK(off.finish().channels == std::vector<std::string>{"/ssx/poses"});
   CHECK(Recording(file).channels().size() == 1);
+}
+
+TEST_CASE("recorder: /ssx/timing counts each step's contact points: none in the air, some once a box lands",
+          "[record][recorder]") {
+  const fs::path file = fs::current_path() / "recorder_contacts.mcap";
+  Environment env;
+  env.addGround();
+  Artifact& box = env.addArtifact("box", Pose{Vec3(0, 0, 0.3), Quat::Identity()});
+  box.addPhysicRoot(boxBody(Vec3(0.2, 0.2, 0.2), 1.0));
+  env.start();
+  RecordOptions o;
+  o.file = file;
+  o.timing = true;
+  Recorder recorder(env, o);
+  env.step(1000);  // 1 s: it falls 0.2 m in about 0.2 s and rests
+  recorder.finish();
+  const auto timing = Recording(file).messages("/ssx/timing");
+  REQUIRE(timing.size() == 1000);
+  CHECK(timing[10].second.find(R"("contacts":0,)") != std::string::npos);
+  CHECK(timing[999].second.find(R"("contacts":0,)") == std::string::npos);
+  CHECK(timing[999].second.find(R"("contacts":)") != std::string::npos);
 }
