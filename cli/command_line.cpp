@@ -66,9 +66,9 @@ CommandLine parseCommandLine(int argc, const char* const* argv, std::ostream& ou
   run_cmd->add_option("--record-channels", c.run.record_channels,
                       "channels recorded besides the poses, comma-separated: foxglove (/tf and /scene for Foxglove and "
                       "Lichtblick), timing (/ssx/timing, each step's cost), sensors (/ssx/sensors: IMU, pose, range), "
-                      "none (default: foxglove for swarms up to 1,000 bodies)")
+                      "commands (/ssx/commands), none (default: foxglove for swarms up to 1,000 bodies)")
       ->delimiter(',')
-      ->check(CLI::IsMember({"foxglove", "timing", "sensors", "none"}));
+      ->check(CLI::IsMember({"foxglove", "timing", "sensors", "commands", "none"}));
   run_cmd->add_option("--record-states", c.run.record_states,
                       "simulated seconds between saved states in --record (0: only the first)")
       ->check(realNumber(0.0, ssx::kMaxDurationSeconds));

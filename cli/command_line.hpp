@@ -29,7 +29,7 @@ struct RunArgs {
   std::string record;          // an MCAP recording of the run (empty: none)
   double record_rate = 25;     // pose samples per simulated second (0: every step)
   double record_states = 10;   // simulated seconds between saved states in the recording
-  // channels besides the poses: foxglove, timing, sensors, none (given: exactly these; not given:
+  // channels besides the poses: foxglove, timing, sensors, commands, none (given: exactly these; not given:
   // foxglove for swarms up to RecordOptions::kFoxgloveAutoBodies bodies)
   std::vector<std::string> record_channels;
   std::string out;  // the scene's own outputs (empty: ssx-out/<scene>/)

@@ -118,6 +118,26 @@ Command Command::fromRow(CommandLevel level, std::span<const double> r) {
   return {};
 }
 
+std::vector<double> Command::toRow() const {
+  switch (level) {
+    case CommandLevel::Position: {
+      const Setpoint& p = setpoint;
+      return {p.position.x(),     p.position.y(),     p.position.z(),     p.yaw,
+              p.velocity.x(),     p.velocity.y(),     p.velocity.z(),     p.acceleration.x(),
+              p.acceleration.y(), p.acceleration.z(), p.yaw_rate};
+    }
+    case CommandLevel::Velocity:
+      return {velocity.x(), velocity.y(), velocity.z(), yaw_rate};
+    case CommandLevel::Attitude:
+      return {roll, pitch, yaw_rate, thrust};
+    case CommandLevel::Rates:
+      return {body_rates.x(), body_rates.y(), body_rates.z(), thrust};
+    case CommandLevel::Rotors:
+      return rotor_speeds;
+  }
+  return {};
+}
+
 std::string Command::problem() const {
   switch (level) {
     case CommandLevel::Position:
@@ -150,6 +170,13 @@ std::string Command::problem() const {
 }
 
 CommandInterface::~CommandInterface() = default;
+
+Command CommandInterface::currentCommand() const {
+  Command c;
+  c.level = commandLevel();
+  if (c.level == CommandLevel::Position) c.setpoint = currentSetpoint();
+  return c;
+}
 
 std::string CommandInterface::refusal(const Command& command) const {
   if (!acceptsCommand(command.level))

@@ -39,6 +39,14 @@ class FlightController {
   virtual void setCommand(const Command& command, const Vec3& position) = 0;
   /// The set-point tracked at the position and velocity levels.
   virtual Setpoint currentSetpoint() const = 0;
+  /// The command followed now (CommandInterface::currentCommand); this default knows the level and,
+  /// at the position level, the set-point.
+  virtual Command command() const {
+    Command c;
+    c.level = level();
+    if (c.level == CommandLevel::Position) c.setpoint = currentSetpoint();
+    return c;
+  }
   /// One run of the driver (`run` counts them from 0, at simulated time `t`): writes the commanded
   /// speed of each rotor (rad/s) into `speeds`, or leaves them as they were.
   virtual void step(std::int64_t run, double t, FlightInputs& in, std::span<double> speeds) = 0;

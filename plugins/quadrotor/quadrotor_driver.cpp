@@ -173,6 +173,12 @@ void QuadrotorDriver::setCommand(const Command& command) {
   controller_.setCommand(command, artifact().state().pose.position);
 }
 
+Command QuadrotorDriver::currentCommand() const {
+  Command c = controller_.command();
+  if (c.level == CommandLevel::Rotors) c.rotor_speeds.resize(vehicle_.rotorCount());
+  return c;
+}
+
 void QuadrotorDriver::position(Pose& pose, Vec3& velocity) const {
   if (have_pose_) {
     pose = pose_.pose;

@@ -49,6 +49,7 @@ class QuadrotorDriver final : public Driver, public CommandInterface, public Met
   std::size_t rotorCount() const override { return vehicle_.rotorCount(); }
   void setCommand(const Command& command) override;
   CommandLevel commandLevel() const override { return controller_.level(); }
+  Command currentCommand() const override;
   Setpoint currentSetpoint() const override { return controller_.currentSetpoint(); }
   /// In formation: `formation_error`, the mean over the members its range sensor sees whose
   /// places on the sphere are within sensing range of its own, of | distance - desired distance |

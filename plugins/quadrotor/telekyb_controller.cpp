@@ -116,6 +116,23 @@ void TeleKybController::startInAir(double weight) {
   std::fill(command_queue_.begin(), command_queue_.end(), command_);
 }
 
+Command TeleKybController::command() const {
+  switch (level_) {
+    case CommandLevel::Position:
+      return Command::position(current_);
+    case CommandLevel::Velocity:
+      return Command::velocityYawRate(command_velocity_, command_yaw_rate_);
+    case CommandLevel::Attitude:
+      return Command::attitude(attitude_.roll, attitude_.pitch, attitude_.yaw_rate, attitude_.thrust);
+    case CommandLevel::Rates:
+      return Command::rates(Vec3(command_.roll_q12, command_.pitch_q12, command_.yaw_rate_q12) / 4096.0,
+                            command_.thrust_q16 / 65536.0);
+    case CommandLevel::Rotors:
+      return Command::rotors(std::vector<double>(rotor_command_.begin(), rotor_command_.end()));
+  }
+  return {};
+}
+
 void TeleKybController::setCommand(const Command& command, const Vec3& position) {
   const CommandLevel previous = level_;
   level_ = command.level;

@@ -88,6 +88,9 @@ class TeleKybController final : public FlightController {
   CommandLevel level() const override { return level_; }
   void setCommand(const Command& command, const Vec3& position) override;
   Setpoint currentSetpoint() const override { return current_; }
+  /// As the vehicle took it: attitude after the serial link's rounding, rates in the inner loop's
+  /// Q12/Q16 steps, all kMaxRotors rotor speeds (the driver keeps its rotors').
+  Command command() const override;
   void step(std::int64_t run, double t, FlightInputs& in, std::span<double> speeds) override;
   void saveState(StateWriter& out) const override;
   void loadState(StateReader& in) override;

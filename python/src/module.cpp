@@ -300,7 +300,7 @@ class PyEnvironment {
                std::optional<int> realtime_priority, std::optional<fs::path> record) {
     if (record) {
       // this run recorded: samples dropped rather than a paced step held up
-      this->record(*record, 25.0, 10.0, realtime, std::nullopt, false, false);
+      this->record(*record, 25.0, 10.0, realtime, std::nullopt, false, false, false);
       py::dict out;
       try {
         out = run(seconds, realtime, realtime_factor, realtime_priority, std::nullopt);
@@ -368,7 +368,7 @@ class PyEnvironment {
 
   // records from the next step on, whether stepped or run, until stop_recording() or close()
   void record(const fs::path& file, double rate_hz, double state_every_s, bool drop_when_behind,
-              std::optional<bool> foxglove, bool timing, bool sensors) {
+              std::optional<bool> foxglove, bool timing, bool sensors, bool commands) {
     InUse use(busy_);
     if (recorder_) throw py::value_error("ssx: already recording to " + recording_file_.string() + ": stop_recording() first");
     ssx::RecordOptions o;
@@ -376,7 +376,7 @@ class PyEnvironment {
     o.rate_hz = rate_hz;
     o.state_every_s = state_every_s;
     o.drop_when_behind = drop_when_behind;
-    o.foxglove = foxglove, o.timing = timing, o.sensors = sensors;
+    o.foxglove = foxglove, o.timing = timing, o.sensors = sensors, o.commands = commands;
     o.scene_xml = scene_.model ? scene_.model->toXml() : std::string();
     o.scene_label = scene_.file.filename().string();
     // never over what the scene reads or writes
@@ -532,11 +532,11 @@ PYBIND11_MODULE(_ssx, m) {
            "'recording'.")
       .def("record", &PyEnvironment::record, py::arg("file"), py::arg("rate_hz") = 25.0, py::arg("state_every_s") = 10.0,
            py::arg("drop_when_behind") = false, py::arg("foxglove") = py::none(), py::arg("timing") = false,
-           py::arg("sensors") = false,
+           py::arg("sensors") = false, py::arg("commands") = false,
            "Records the run from the next step on (stepped or run) into an MCAP file: the scene, every body's pose "
            "at rate_hz, a saved state every state_every_s; read it back with ssx.Recording. Written by a thread of "
            "its own; drop_when_behind drops samples rather than wait for it. foxglove: /tf and /scene for Foxglove "
-           "(None: for up to 1,000 bodies); timing: /ssx/timing; sensors: /ssx/sensors.")
+           "(None: for up to 1,000 bodies); timing: /ssx/timing; sensors: /ssx/sensors; commands: /ssx/commands.")
       .def("stop_recording", &PyEnvironment::stopRecording,
            "Ends the recording (the file complete) and returns what it wrote: samples, dropped, states, bytes.")
       .def_property_readonly("recording", &PyEnvironment::recording, "Whether a recording is running.")

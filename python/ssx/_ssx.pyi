@@ -87,9 +87,9 @@ class Environment:
         record=FILE records the run (summary under 'recording')."""
     def record(self, file: _Path, rate_hz: float = 25.0, state_every_s: float = 10.0,
                drop_when_behind: bool = False, foxglove: Optional[bool] = None, timing: bool = False,
-               sensors: bool = False) -> None:
+               sensors: bool = False, commands: bool = False) -> None:
         """Records from the next step on into an MCAP file (read back with Recording); foxglove adds /tf and
-        /scene (None: for up to 1,000 bodies), timing /ssx/timing, sensors /ssx/sensors."""
+        /scene (None: for up to 1,000 bodies), timing /ssx/timing, sensors /ssx/sensors, commands /ssx/commands."""
     def stop_recording(self) -> Dict[str, Any]:
         """Ends the recording; returns samples, dropped, states, bodies, bytes and a line of text."""
     @property

@@ -66,11 +66,16 @@ def test_run_records_and_refuses_what_it_must_not_write(tmp_path):
 
 def test_optional_channels_from_python(tmp_path):
     env = ssx.load_scene(ssx.data_directory() / "scenes" / "quad_hover.xml")
-    env.record(tmp_path / "all.mcap", foxglove=False, timing=True, sensors=True)
-    env.step(100)
+    env.record(tmp_path / "all.mcap", foxglove=False, timing=True, sensors=True, commands=True)
+    env.step(50)
+    env.set_commands("attitude", [[0.0, 0.0, 0.0, 9.0]], robots=["hb"])
+    env.step(50)
     env.stop_recording()
     r = ssx.Recording(tmp_path / "all.mcap")
-    assert set(r.channels()) == {"/ssx/poses", "/ssx/timing", "/ssx/sensors"}
+    assert set(r.channels()) == {"/ssx/poses", "/ssx/timing", "/ssx/sensors", "/ssx/commands"}
+    first, last = r.channel("/ssx/commands")[0][1], r.channel("/ssx/commands")[-1][1]
+    assert first["hb"]["level"] == "position" and len(first["hb"]["values"]) == 11
+    assert last["hb"]["level"] == "attitude" and last["mk"]["level"] == "position"
     timing = r.channel("/ssx/timing")
     assert [m["step"] for _, m in timing] == list(range(100))
     assert all(m["total_ms"] >= m["physics_ms"] >= 0 for _, m in timing)

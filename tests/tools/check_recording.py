@@ -86,12 +86,13 @@ def compare(file, expect_samples=None):
               (e["frame"], e["locked"], e["primitives"] > 0) if e else None)
     check("/ssx/timing steps", list(range(len(j["timingSteps"]))), j["timingSteps"])
     check("/ssx/sensors artifacts with measurements", ours["bodies"], j["sensorArtifacts"])
+    check("/ssx/commands messages", ours["channels"].get("/ssx/poses"), ours["channels"].get("/ssx/commands"))
     return ours
 
 
 recording = work / "run.mcap"
 out = run(ssx, "run", scene, "--steps", "1500", "--fast", "--record", str(recording), "--out", str(work / "out"),
-          "--record-channels", "foxglove,timing,sensors")
+          "--record-channels", "foxglove,timing,sensors,commands")
 if "recording " not in out:
     problems.append(f"ssx run printed no recording line:\n{out}")
 ours = compare(recording, expect_samples=75)  # 3 s at 25 samples per simulated second

@@ -33,3 +33,15 @@ TEST_CASE("command levels have names and rows of known sizes", "[command]") {
   CHECK(Command::rotors({400, -1, 400, 400}).problem().find("magnitudes") != std::string::npos);
   CHECK(Command::velocityYawRate(Vec3(1, 0, 0), 0.1).problem().empty());
 }
+
+TEST_CASE("a command's row is the row it was read from (position: all 11 columns)", "[command]") {
+  const std::vector<std::vector<double>> rows{{1, 2, 3, 0.5, 4, 5, 6, 7, 8, 9, 0.25}, {0.5, -1, 0.25, 0.1},
+                                              {0.1, -0.2, 0.3, 7}, {1, -2, 3, 9.5}, {400, 410.5, 420, 430}};
+  for (std::size_t i = 0; i < rows.size(); ++i) {
+    INFO(commandLevelName(kCommandLevels[i]));
+    CHECK(Command::fromRow(kCommandLevels[i], rows[i]).toRow() == rows[i]);
+  }
+  const double short_position[] = {1, 2, 3, 0.5};
+  CHECK(Command::fromRow(CommandLevel::Position, short_position).toRow() ==
+        std::vector<double>{1, 2, 3, 0.5, 0, 0, 0, 0, 0, 0, 0});
+}

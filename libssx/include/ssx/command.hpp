@@ -72,6 +72,8 @@ struct SSX_EXPORT Command {
   static std::string rowSizes(CommandLevel level, std::size_t rotor_count);
   /// A command from one row in the column order above (its size as rowSizeFits accepts).
   static Command fromRow(CommandLevel level, std::span<const double> row);
+  /// Its values as one row in the column order above (position: all 11), as fromRow reads them.
+  std::vector<double> toRow() const;
 
   /// What is wrong with it whatever the vehicle (a value not finite, a negative thrust or rotor
   /// speed, a roll or pitch beyond 80 degrees), or an empty string.
@@ -95,6 +97,10 @@ class SSX_EXPORT CommandInterface : public SetpointInterface {
   virtual void setCommand(const Command& command) = 0;
   /// The level of the latest command (position while a reference of the scene's drives it).
   virtual CommandLevel commandLevel() const = 0;
+  /// The command followed now: at the position level the set-point tracked (currentSetpoint: a
+  /// scene's reference moves it), at the others the latest command as the vehicle took it. This
+  /// default knows only the level and the set-point; drivers that keep lower levels' values say them.
+  virtual Command currentCommand() const;
   /// A set-point is a command at the position level.
   void setSetpoint(const Setpoint& setpoint) override { setCommand(Command::position(setpoint)); }
 };

@@ -37,7 +37,7 @@
 /// (Plugin, Driver, Sensor, SimulationExtension: their virtual functions and members) or the
 /// members of the classes whose inline accessors plugins compile in (Artifact) or the structs
 /// handed to them (PluginContext) change.
-#define SSX_PLUGIN_ABI_VERSION 9u
+#define SSX_PLUGIN_ABI_VERSION 10u
 
 /// @cond
 #define SSX_PLUGIN_STRINGIFY2(x) #x

@@ -19,7 +19,8 @@
 ///   channel `/scene` (foxglove.SceneUpdate, once: the render trees' shapes, an entity per body
 ///   locked to its frame, and one for what is fixed in the world);
 /// - optional JSON channels: `/ssx/timing` (each step's wall-clock cost by phase and how late it
-///   ended) and `/ssx/sensors` (every artifact's IMU, pose and range measurements at each sample).
+///   ended) and `/ssx/sensors` (every artifact's IMU, pose and range measurements at each sample),
+///   `/ssx/commands` (each commandable robot's command level and values, CommandInterface::currentCommand).
 ///
 /// The stepping thread copies each sample into a buffer and hands it to a writer thread through a
 /// bounded queue; compression (zstd) and writing happen there. When the queue is full a real-time
@@ -60,6 +61,7 @@ struct RecordOptions {
   std::optional<bool> foxglove;
   bool timing = false;   ///< channel `/ssx/timing`: every step's wall-clock cost
   bool sensors = false;  ///< channel `/ssx/sensors`: IMU, pose and range measurements at each sample
+  bool commands = false;  ///< channel `/ssx/commands`: each commandable robot's current command at each sample
 };
 
 /// What a recording wrote (Recorder::finish).

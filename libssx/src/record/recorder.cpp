@@ -4,6 +4,7 @@
 #include "record/mcap_writer.hpp"
 #include "record/pose_codec.hpp"
 
+#include <ssx/command.hpp>
 #include <ssx/environment.hpp>
 #include <ssx/error.hpp>
 #include <ssx/measurements.hpp>
@@ -37,6 +38,10 @@ const char* const kSensorsSchema =
     R"j({"title":"ssx.Sensors","description":"each artifact's latest measurements by sensor index: imu (accelerometer m/s^2, gyroscope rad/s, sensor frame), )j"
     R"j(pose (position m, orientation w x y z, velocities world frame), range (detections: seen, obstacle, relative m, distance m)","type":"object",)j"
     R"j("additionalProperties":{"type":"object","additionalProperties":{"type":"object","properties":{"kind":{"type":"string"},"stamp":{"type":"number"}}}}})j";
+
+const char* const kCommandsSchema =
+    R"j({"title":"ssx.Commands","description":"each commandable robot's current command: its level (position, velocity, attitude, rates, rotors) and values in the column order of Python's set_commands","type":"object",)j"
+    R"j("additionalProperties":{"type":"object","properties":{"level":{"type":"string"},"values":{"type":"array","items":{"type":"number"}}}}})j";
 
 // a JSON message of an optional channel, made on the stepping thread
 struct Extra {
@@ -154,6 +159,31 @@ std::string sensorsJson(const Environment& env) {
   return out + "}";
 }
 
+// /ssx/commands: {"<artifact>": {"level": "attitude", "values": [...]}, ...} in set_commands' column order
+std::string commandsJson(const Environment& env) {
+  std::string out = "{";
+  bool first = true;
+  for (std::size_t i = 0; i < env.artifactCount(); ++i) {
+    const Artifact& a = env.artifact(i);
+    const auto* commandable = dynamic_cast<const CommandInterface*>(a.driver());
+    if (commandable == nullptr) continue;
+    const Command c = commandable->currentCommand();
+    if (!first) out += ',';
+    first = false;
+    detail::appendString(out, a.name());
+    out += R"(:{"level":")";
+    out += commandLevelName(c.level);
+    out += R"(","values":[)";
+    const std::vector<double> row = c.toRow();
+    for (std::size_t k = 0; k < row.size(); ++k) {
+      if (k > 0) out += ',';
+      detail::appendNumber(out, row[k]);
+    }
+    out += "]}";
+  }
+  return out + "}";
+}
+
 }  // namespace
 
 struct Recorder::Impl {
@@ -169,7 +199,7 @@ struct Recorder::Impl {
   std::vector<std::string> names;
   std::vector<const PhysicNode*> nodes;  // the root node of each name
   std::uint16_t poses_channel = 0;
-  int tf_channel = -1, timing_channel = -1, sensors_channel = -1;  // -1: not recorded
+  int tf_channel = -1, timing_channel = -1, sensors_channel = -1, commands_channel = -1;  // -1: not recorded
   std::vector<Extra> extras;                                     // since the last sample
   std::vector<float> tf_positions, tf_orientations;              // the writer thread's
   Nanoseconds first_time = -1, last_time = 0;
@@ -240,6 +270,7 @@ void Recorder::Impl::begin() {
   }
   if (options.timing) addJsonChannel(timing_channel, "/ssx/timing", "ssx.StepTiming", kTimingSchema);
   if (options.sensors) addJsonChannel(sensors_channel, "/ssx/sensors", "ssx.Sensors", kSensorsSchema);
+  if (options.commands) addJsonChannel(commands_channel, "/ssx/commands", "ssx.Commands", kCommandsSchema);
   next_state = env->time();
   thread = std::thread([this] { loop(); });
 }
@@ -314,6 +345,8 @@ void Recorder::Impl::observe() {
   Job job;
   job.time = now;
   if (sensors_channel >= 0) extras.push_back({static_cast<std::uint16_t>(sensors_channel), now, sensorsJson(*env)});
+  if (commands_channel >= 0)
+    extras.push_back({static_cast<std::uint16_t>(commands_channel), now, commandsJson(*env)});
   job.extras.swap(extras);
   {
     std::lock_guard lock(mutex);

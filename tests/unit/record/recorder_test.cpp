@@ -177,3 +177,22 @@ TEST_CASE("recorder: /ssx/timing counts each step's contact points: none in the 
   CHECK(timing[999].second.find(R"("contacts":0,)") == std::string::npos);
   CHECK(timing[999].second.find(R"("contacts":)") != std::string::npos);
 }
+
+TEST_CASE("recorder: /ssx/commands says each quadrotor's command level and values at every sample", "[record][recorder]") {
+  const fs::path file = fs::current_path() / "recorder_commands.mcap";
+  Scene scene = loadSceneFromString(kQuads, "quads.xml", kArtifacts, testOptions());
+  Environment& env = *scene.environment;
+  RecordOptions o = options(file, scene);
+  o.foxglove = false;
+  o.commands = true;
+  Recorder recorder(env, o);
+  env.step(20);  // the first sample, at 0.04 s: every one at its position set-point
+  dynamic_cast<CommandInterface&>(*env.findArtifact("q1")->driver()).setCommand(Command::rotors({400, 410, 420, 430}));
+  env.step(20);
+  recorder.finish();
+  const auto commands = Recording(file).messages("/ssx/commands");
+  REQUIRE(commands.size() == 2);
+  CHECK(commands[0].second.find(R"("q1":{"level":"position","values":[)") != std::string::npos);
+  CHECK(commands[1].second.find(R"("q1":{"level":"rotors","values":[400,410,420,430]})") != std::string::npos);
+  CHECK(commands[1].second.find(R"("q0":{"level":"position")") != std::string::npos);
+}

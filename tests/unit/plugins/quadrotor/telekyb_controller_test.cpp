@@ -192,3 +192,25 @@ TEST_CASE("a command level and its command survive save and restore bitwise", "[
     CHECK(g.quad.pose().orientation.coeffs() == expected.orientation.coeffs());
   }
 }
+
+TEST_CASE("the current command is the one taken, at every level (rates in the inner loop's steps)",
+          "[quadrotor][commands]") {
+  Flight f;
+  // position: the set-point tracked
+  CHECK(f.input.currentCommand().level == CommandLevel::Position);
+  CHECK(f.input.currentCommand().setpoint.position.isApprox(f.input.currentSetpoint().position));
+  const std::vector<Command> commands{Command::velocityYawRate(Vec3(0.5, -0.25, 0.1), 0.2),
+                                      Command::attitude(0.05, -0.1, 0.3, f.mass * f.g),
+                                      Command::rates(Vec3(0.5, -0.25, 0.125), f.mass * f.g),
+                                      Command::rotors({400, 410, 420, 430})};
+  for (const Command& c : commands) {
+    INFO(commandLevelName(c.level));
+    f.input.setCommand(c);
+    f.env.step(1);
+    const Command now = f.input.currentCommand();
+    CHECK(now.level == c.level);
+    const std::vector<double> want = c.toRow(), got = now.toRow();
+    REQUIRE(got.size() == want.size());
+    for (std::size_t k = 0; k < want.size(); ++k) CHECK(got[k] == Approx(want[k]).margin(1.0 / 4096));
+  }
+}
