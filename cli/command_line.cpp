@@ -128,6 +128,8 @@ CommandLine parseCommandLine(int argc, const char* const* argv, std::ostream& ou
                          "recorded seconds per second of the video or frames (0.25: slow motion; 4: four times as "
                          "fast), at the recording's sample rate")
       ->check(realNumber(1e-3, 1e3));
+  replay_cmd->add_option("--trails", c.replay.trails, "draw the last S recorded seconds of each robot's path behind it")
+      ->check(realNumber(0.0, ssx::kMaxDurationSeconds));
   replay_cmd->add_option("--plugin-path", c.replay.plugin_path, "plugin directory (repeatable)");
   replay_cmd
       ->add_option("--resimulate-from", c.replay.resimulate_from,

@@ -70,6 +70,7 @@ struct ReplayArgs {
   std::string file;
   double from = 0, to = -1;  // seconds; to < 0: the end
   double speed = 1;          // recorded seconds per second of the video or frames
+  double trails = 0;         // seconds of each robot's path drawn behind it (0: none)
   std::string snapshot, video, frames, follow;
   std::vector<std::string> plugin_path;
   double resimulate_from = -1;  // seconds; < 0: draw the recorded poses only

@@ -160,9 +160,39 @@ int draw(const Recording& r, const ReplayArgs& args) {
       frames.push_back(static_cast<std::size_t>(std::upper_bound(times.begin(), times.end(), t) - times.begin() - 1));
     }
   }
+  // trails: a dot at each recorded position of the last --trails seconds, a tenth of the robot's
+  // width across, in the robot's colour (the first shape it draws)
+  std::vector<RenderNodeSpec> dots(nodes.size());
+  std::vector<RenderNode> overlay;
+  for (std::size_t i = 0; i < nodes.size(); ++i) {
+    double reach = 0;
+    dots[i].color = {1.0f, 0.6f, 0.1f, 1.0f};
+    bool coloured = false;
+    for (const auto& tree : nodes[i]->artifact().renderRoots()) {
+      auto visit = [&](auto& self, const RenderNodeSpec& n, const Vec3& at) -> void {
+        const Vec3 here = at + n.pose.position;
+        if (n.primitive != RenderNodeSpec::Primitive::None) {
+          if (!coloured) dots[i].color = n.color, coloured = true;
+          const double half = n.primitive == RenderNodeSpec::Primitive::Box ? 0.5 * n.size.maxCoeff() : n.radius;
+          reach = std::max(reach, here.norm() + half);
+        }
+        for (const auto& c : n.children) self(self, c, here);
+      };
+      visit(visit, *tree, Vec3::Zero());
+    }
+    dots[i].primitive = RenderNodeSpec::Primitive::Sphere;
+    dots[i].radius = std::max(0.005, 0.1 * reach);
+  }
+  const Nanoseconds trail = toNanoseconds(args.trails);
   try {
     for (const std::size_t k : frames) {
       const Nanoseconds t = times[k];
+      overlay.clear();
+      for (std::size_t j = k; args.trails > 0 && j-- > 0 && times[j] >= t - trail;) {
+        const std::vector<float> past = r.positions(j);
+        for (std::size_t i = 0; i < nodes.size(); ++i)
+          overlay.push_back({&dots[i], nullptr, Pose{Vec3(past[3 * i], past[3 * i + 1], past[3 * i + 2]), Quat::Identity()}});
+      }
       const std::vector<float> p = r.positions(k), q = r.orientations(k);
       for (std::size_t i = 0; i < nodes.size(); ++i) {
         // the recorded pose is the root node's: its body's centre-of-mass frame from it
@@ -174,7 +204,7 @@ int draw(const Recording& r, const ReplayArgs& args) {
         s.angular_velocity.setZero();
         env.setBodyState(nodes[i]->bodyIndex(), s);
       }
-      env.drawFrame(t);
+      env.drawFrame(t, overlay);
       ++drawn;
     }
     cameras = env.cameras();

@@ -442,11 +442,11 @@ const std::vector<RenderNode>& Environment::renderNodes() const noexcept { retur
 
 std::int64_t Environment::frameCount() const noexcept { return cameras_->frameCount(); }
 
-void Environment::drawFrame(Nanoseconds time) {
+void Environment::drawFrame(Nanoseconds time, std::span<const RenderNode> overlay) {
   requireOutsidePhases("drawFrame");
   if (world_->state != State::Running) throw Error("drawFrame: the environment is not running");
   cameras_->invalidate();  // the bodies may have moved without a step: pose the items again
-  cameras_->drawFrame(world_->steps, settings_.render, world_->artifacts, time);
+  cameras_->drawFrame(world_->steps, settings_.render, world_->artifacts, time, overlay);
 }
 
 void Environment::addCameraRequest(std::string owner, std::function<bool(std::int64_t, CameraView&)> due,

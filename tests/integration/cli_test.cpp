@@ -1,6 +1,8 @@
 // The `ssx` command, run as a child process: exit codes, messages, files, Ctrl-C.
 #include <ssx/ssx.hpp>
 
+#include "render_util.hpp"
+
 #include <catch2/catch.hpp>
 
 #include <fcntl.h>
@@ -469,6 +471,20 @@ TEST_CASE("ssx run --record, inspect and replay: a run kept, looked at, drawn ag
   CHECK(drawn.status == 0);
   CHECK_THAT(drawn.out, Catch::Contains("replayed 26 samples of 3 bodies (1.000 s to 2.000 s)"));
   CHECK(fs::file_size(dir / "replay.png") > 1000);
+  // the last second's path behind each robot: the same picture with dots added where they flew
+  const Result trails = run({"replay", rec, "--snapshot", (dir / "trails.png").string(), "--from", "1", "--trails", "1"});
+  CHECK(trails.status == 0);
+  const ssx::Image plain = ssx::test::readPng(dir / "replay.png"), dotted = ssx::test::readPng(dir / "trails.png");
+  REQUIRE((plain.width > 0 && plain.width == dotted.width && plain.height == dotted.height));
+  std::size_t changed_pixels = 0;
+  for (std::size_t i = 0; i + 2 < plain.rgb.size(); i += 3)
+    changed_pixels += plain.rgb[i] != dotted.rgb[i] || plain.rgb[i + 1] != dotted.rgb[i + 1] || plain.rgb[i + 2] != dotted.rgb[i + 2];
+  CHECK(changed_pixels > 200);
+  CHECK(changed_pixels < plain.rgb.size() / 3 / 10);  // dots, not another picture
+  // at half speed each sample is drawn twice: 51 frames for the second from 1 s to 2 s
+  const Result slow = run({"replay", rec, "--frames", (dir / "slow").string(), "--from", "1", "--speed", "0.5"});
+  CHECK(slow.status == 0);
+  CHECK_THAT(slow.out, Catch::Contains("replayed 51 frames of 3 bodies (1.000 s to 2.000 s)"));
   const Result again = run({"replay", rec, "--resimulate-from", "0"});
   CHECK(again.status == 0);
   CHECK_THAT(again.out, Catch::Contains("49 recorded samples compared, every one equal to the recording bit for bit"));

@@ -308,8 +308,10 @@ class SSX_EXPORT Environment {
   /// Draws the scene cameras' frame of the world as it is now, stamped with `time`, outside a step:
   /// for a replay that poses the bodies itself (setBodyState) without stepping. Needs the
   /// environment running; a camera that follows a robot follows it. Throws StepError when a frame
-  /// cannot be drawn or written.
-  void drawFrame(Nanoseconds time);
+  /// cannot be drawn or written. `overlay`: more nodes drawn in this frame only, in the world
+  /// (a replay's trails; their specs must live until the frame is written: keep them for the
+  /// environment's life); they cast no shadows.
+  void drawFrame(Nanoseconds time, std::span<const RenderNode> overlay = {});
   /// Frames drawn for the scene's cameras so far.
   std::int64_t frameCount() const noexcept;
   /// The scene cameras' specs as used (frame_scene cameras placed), from start() on.

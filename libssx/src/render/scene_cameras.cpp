@@ -173,7 +173,7 @@ void SceneCameras::renderRequests(std::int64_t step, RenderEngine& renderer, con
 }
 
 void SceneCameras::drawFrame(std::int64_t step, const RenderSettings& settings, const Artifacts& artifacts,
-                             Nanoseconds time) {
+                             Nanoseconds time, std::span<const RenderNode> overlay) {
   sync(step + 1, artifacts);  // also without cameras: renderNodes() serves viewers outside ssx
   if (!worker_) return;
   std::vector<CameraView> views;
@@ -203,7 +203,14 @@ void SceneCameras::drawFrame(std::int64_t step, const RenderSettings& settings, 
     views.push_back(view);
   }
   try {
-    worker_->submit(items_, std::move(views), time >= 0 ? time : (step + 1) * timestep_);
+    const Nanoseconds stamp = time >= 0 ? time : (step + 1) * timestep_;
+    if (overlay.empty()) {
+      worker_->submit(items_, std::move(views), stamp);
+    } else {
+      std::vector<RenderNode> all = items_;
+      all.insert(all.end(), overlay.begin(), overlay.end());
+      worker_->submit(all, std::move(views), stamp);
+    }
   } catch (const std::exception& e) {
     throw StepError("", "render", step, std::string("drawing or writing frames: ") + e.what());
   }

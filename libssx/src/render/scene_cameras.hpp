@@ -11,6 +11,7 @@
 #include <memory>
 #include <string>
 #include <string_view>
+#include <span>
 #include <vector>
 
 namespace ssx::detail {
@@ -42,7 +43,8 @@ class SceneCameras {
   void renderRequests(std::int64_t step, RenderEngine& renderer, const Color& background, const Artifacts& artifacts);
   /// Hands the scene cameras' views of the snapshot at `step` to the frame thread, stamped with
   /// `time` (< 0: the time after that step). Throws StepError.
-  void drawFrame(std::int64_t step, const RenderSettings& settings, const Artifacts& artifacts, Nanoseconds time = -1);
+  void drawFrame(std::int64_t step, const RenderSettings& settings, const Artifacts& artifacts, Nanoseconds time = -1,
+                 std::span<const RenderNode> overlay = {});
   /// Forgets the posed items (after a restore: the snapshot changed under the same step count).
   void invalidate() noexcept { items_step_ = -1; }
 
