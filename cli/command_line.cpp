@@ -40,6 +40,14 @@ CommandLine parseCommandLine(int argc, const char* const* argv, std::ostream& ou
           ->expected(0, 1)
           ->check(realNumber(ssx::kMinRealtimeFactor, ssx::kMaxRealtimeFactor));
   auto* fast = run_cmd->add_flag("--fast", c.run.fast, "run as fast as possible")->excludes(realtime);
+  auto* view = run_cmd->add_option("--view", c.run.view,
+                                   "serve a live 3D view of the run to web browsers at http://127.0.0.1:PORT/ "
+                                   "(default 8765; 0: a free port)")
+                   ->expected(0, 1)
+                   ->check(CLI::Range(0, 65535));
+  run_cmd->add_option("--view-bind", c.run.view_bind,
+                      "address the viewer listens on (default 127.0.0.1; another prints a token the page's URL needs)")
+      ->needs(view);
   run_cmd
       ->add_option("--rt-priority", c.run.rt_priority,
                    "step at this SCHED_FIFO priority (1-99; needs root or CAP_SYS_NICE): steps are not woken late "
@@ -154,6 +162,7 @@ CommandLine parseCommandLine(int argc, const char* const* argv, std::ostream& ou
     c.command = CommandLine::Command::Run;
     // --realtime alone means factor 1
     c.realtime_given = realtime->count() > 0;
+    if (view->count() > 0 && (view->results().empty() || view->results().front().empty())) c.run.view = 8765;
     c.run.duration_given = duration->count() > 0;
     if (c.realtime_given && (realtime->results().empty() || realtime->results().front().empty())) c.run.realtime = 1.0;
     const auto& channels = c.run.record_channels;

@@ -1,0 +1,260 @@
+// viewer: an extension that serves a live 3D view of the run to web browsers (three.js), on
+// 127.0.0.1 unless told otherwise. The page gets the scene once (every artifact's shapes, a model
+// per render tree, so that a swarm's members are drawn as instances of one mesh) and then frames of
+// every body's pose at up to rate_hz per wall-clock second.
+//
+// Frame (binary, little-endian): uint32 magic 0x46585353 ("SSXF"), uint32 N, float64 simulated
+// time (s), float32 real-time factor since the last frame, uint32 late steps so far, uint64 step,
+// then N x float32 x, y, z, qx, qy, qz, qw (28 bytes per body).
+//
+// Parameters: kParameters below, or `ssx plugins --params viewer`.
+#include "viewer_server.hpp"
+
+#include <ssx/environment.hpp>
+#include <ssx/plugin_abi.hpp>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstring>
+#include <map>
+#include <memory>
+#include <random>
+#include <string>
+#include <vector>
+
+extern "C" {
+extern const char ssx_viewer_index_html[], ssx_viewer_index_html_end[];
+extern const char ssx_viewer_js[], ssx_viewer_js_end[];
+extern const char ssx_viewer_three_js[], ssx_viewer_three_js_end[];
+extern const char ssx_viewer_orbit_js[], ssx_viewer_orbit_js_end[];
+}
+
+namespace ssx::plugins {
+
+namespace {
+
+void number(std::string& out, double v) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.6g", std::isfinite(v) ? v : 0.0);
+  out += text;
+}
+
+void string(std::string& out, const std::string& s) {
+  out += '"';
+  for (const char c : s) {
+    if (c == '"' || c == '\\') out += '\\';
+    if (static_cast<unsigned char>(c) < 0x20) continue;
+    out += c;
+  }
+  out += '"';
+}
+
+const char* kindName(RenderNodeSpec::Primitive p) {
+  switch (p) {
+    case RenderNodeSpec::Primitive::Box: return "box";
+    case RenderNodeSpec::Primitive::Sphere: return "sphere";
+    case RenderNodeSpec::Primitive::Cylinder: return "cylinder";
+    case RenderNodeSpec::Primitive::Capsule: return "capsule";
+    case RenderNodeSpec::Primitive::Plane: return "plane";
+    case RenderNodeSpec::Primitive::None: break;
+  }
+  return "";
+}
+
+// the shapes of a render tree, each posed in `frame` (a body's root, or the world)
+void shapes(std::string& out, const RenderNodeSpec& n, const Pose& parent, bool& first) {
+  const Pose pose = parent * n.pose;
+  if (n.primitive != RenderNodeSpec::Primitive::None) {
+    out += first ? "" : ",";
+    first = false;
+    out += R"({"kind":")";
+    out += kindName(n.primitive);
+    out += R"(","size":[)";
+    number(out, n.size.x()), out += ',', number(out, n.size.y()), out += ',', number(out, n.size.z());
+    out += R"(],"radius":)";
+    number(out, n.radius);
+    out += R"(,"length":)";
+    number(out, n.length);
+    out += R"(,"grid":)";
+    out += n.grid ? "true" : "false";
+    out += R"(,"color":[)";
+    for (int k = 0; k < 4; ++k) number(out, n.color[static_cast<std::size_t>(k)]), out += k < 3 ? "," : "";
+    out += R"(],"pose":[)";
+    const Quat& q = pose.orientation;
+    for (const double v : {pose.position.x(), pose.position.y(), pose.position.z(), q.x(), q.y(), q.z(), q.w()})
+      number(out, v), out += ',';
+    out.back() = ']';
+    out += '}';
+  }
+  for (const auto& c : n.children) shapes(out, c, pose, first);
+}
+
+}  // namespace
+
+class Viewer final : public SimulationExtension {
+ public:
+  static constexpr const char* kDoc = "a live 3D view of the run in a web browser (three.js), on 127.0.0.1 by default";
+  static constexpr ssx_plugin_param kParameters[] = {
+      param::integer("port", "8765", param::atLeast(0) & param::atMost(65535),
+                     "TCP port of the page (http://ADDR:PORT/); 0: a free one, said when the run starts"),
+      param::text("bind", "127.0.0.1",
+                  "address listened on; another than 127.0.0.1 needs the token printed at start in the page's URL"),
+      param::real("rate_hz", "30", "Hz", param::positive() & param::atMost(240),
+                  "frames sent to the pages per wall-clock second, at most"),
+      param::integer("max_clients", "4", param::atLeast(1) & param::atMost(64), "pages connected at once, at most"),
+  };
+
+  void init(Environment& env, const Descriptor& params) override {
+    const int port = static_cast<int>(params.get<std::int64_t>("port"));
+    const std::string bind = params.get<std::string>("bind");
+    period_ = std::chrono::duration<double>(1.0 / params.get<double>("rate_hz"));
+    const bool loopback = bind == "127.0.0.1" || bind == "localhost";
+    std::string token;
+    if (!loopback) {
+      std::random_device random;
+      const char* digits = "0123456789abcdef";
+      for (int i = 0; i < 32; ++i) token += digits[random() % 16];
+    }
+    const std::vector<viewer::Asset> assets{
+        {"/", "text/html; charset=utf-8", ssx_viewer_index_html,
+         static_cast<std::size_t>(ssx_viewer_index_html_end - ssx_viewer_index_html)},
+        {"/viewer.js", "text/javascript; charset=utf-8", ssx_viewer_js, static_cast<std::size_t>(ssx_viewer_js_end - ssx_viewer_js)},
+        {"/three.min.js", "text/javascript; charset=utf-8", ssx_viewer_three_js,
+         static_cast<std::size_t>(ssx_viewer_three_js_end - ssx_viewer_three_js)},
+        {"/OrbitControls.js", "text/javascript; charset=utf-8", ssx_viewer_orbit_js,
+         static_cast<std::size_t>(ssx_viewer_orbit_js_end - ssx_viewer_orbit_js)}};
+    try {
+      server_ = std::make_unique<viewer::Server>(
+          bind, port, token, static_cast<int>(params.get<std::int64_t>("max_clients")), assets, sceneJson(env),
+          [](const std::string& text) { return text.find(R"("type":"hello")") != std::string::npos; });
+    } catch (const std::exception& e) {
+      throw params.error(std::string("viewer: ") + e.what());
+    }
+    url_ = "http://" + (loopback ? std::string("127.0.0.1") : bind) + ":" + std::to_string(server_->port()) + "/" +
+           (token.empty() ? "" : "?token=" + token);
+    env.log(LogLevel::Info, "viewer: " + url_);
+    last_wall_ = std::chrono::steady_clock::now() - std::chrono::hours(1);
+  }
+
+  void afterStep(Environment& env) override {
+    if (!begun_) {
+      // the bodies exist from the first step on: each artifact's first dynamic root, as the
+      // recorder has them; the pages get the scene with them now
+      begun_ = true;
+      for (std::size_t i = 0; i < env.artifactCount(); ++i) {
+        const Artifact& a = std::as_const(env).artifact(i);
+        for (std::size_t r = 0; r < a.rootCount(); ++r) {
+          const PhysicNode& root = a.root(r);
+          if (root.isStatic() || root.bodyIndex() < 0) continue;
+          nodes_.push_back(&root);
+          names_.push_back(r == 0 ? a.name() : a.name() + "/" + root.name());
+          break;
+        }
+      }
+      server_->setHello(sceneJson(env));
+    }
+    const TimingRecorder& timing = env.timing();
+    if (timing.size() >= 2 && timing[timing.size() - 2].lateness > 0) ++late_;
+    const auto now = std::chrono::steady_clock::now();
+    if (now - last_wall_ < period_) return;
+    const double wall = std::chrono::duration<double>(now - last_wall_).count();
+    const double rtf = last_sim_ >= 0 && wall < 60 ? (toSeconds(env.time()) - last_sim_) / wall : 0;
+    last_wall_ = now;
+    last_sim_ = toSeconds(env.time());
+    const std::uint32_t n = static_cast<std::uint32_t>(nodes_.size());
+    frame_.resize(32 + 28 * static_cast<std::size_t>(n));
+    std::uint8_t* p = frame_.data();
+    const std::uint32_t magic = 0x46585353;
+    const double t = toSeconds(env.time());
+    const float rate = static_cast<float>(rtf);
+    const std::uint64_t step = static_cast<std::uint64_t>(env.stepCount());
+    std::memcpy(p, &magic, 4), std::memcpy(p + 4, &n, 4), std::memcpy(p + 8, &t, 8), std::memcpy(p + 16, &rate, 4);
+    std::memcpy(p + 20, &late_, 4), std::memcpy(p + 24, &step, 8);
+    float* f = reinterpret_cast<float*>(p + 32);
+    for (const PhysicNode* node : nodes_) {
+      const Pose pose = node->pose();
+      const Quat& q = pose.orientation;
+      for (const double v : {pose.position.x(), pose.position.y(), pose.position.z(), q.x(), q.y(), q.z(), q.w()})
+        *f++ = static_cast<float>(v);
+    }
+    server_->publish(frame_);
+  }
+
+  void shutdown(Environment& env) override {
+    if (!server_) return;
+    const viewer::ServerCounts c = server_->counts();
+    server_->stop();
+    env.log(LogLevel::Info, "viewer: " + std::to_string(c.frames_published) + " frames published, " +
+                                std::to_string(c.frames_sent) + " sent, " + std::to_string(c.frames_skipped) +
+                                " skipped by slow pages, " + std::to_string(c.messages_dropped) + " messages dropped, " +
+                                std::to_string(c.clients_refused) + " pages refused");
+    server_.reset();
+  }
+
+  ~Viewer() override {
+    if (server_) server_->stop();
+  }
+
+ private:
+  // the scene for a page: the models (render trees, each in its body's frame), the bodies with
+  // their model, and what is fixed in the world
+  std::string sceneJson(const Environment& env) const {
+    std::map<const RenderNodeSpec*, std::size_t> model_of;  // a render tree shared by a swarm's members: one model
+    std::string models, bodies, world;
+    bool first_world = true;
+    for (std::size_t b = 0; b < nodes_.size(); ++b) {
+      const Artifact& a = nodes_[b]->artifact();
+      std::size_t model = 0;
+      const RenderNodeSpec* key = a.renderRoots().empty() ? nullptr : a.renderRoots().front().get();
+      if (const auto it = model_of.find(key); it != model_of.end()) {
+        model = it->second;
+      } else {
+        model = model_of.size();
+        model_of[key] = model;
+        std::string list;
+        bool first = true;
+        for (const auto& tree : a.renderRoots()) {
+          const PhysicNode* follow = tree->follow.empty() ? nullptr : a.node(tree->follow);
+          if (follow == nullptr) continue;  // drawn with the world below
+          shapes(list, *tree, nodes_[b]->poseInBody().inverse() * follow->poseInBody(), first);
+        }
+        models += (models.empty() ? "" : ",") + std::string("[") + list + "]";
+      }
+      bodies += b == 0 ? "" : ",";
+      bodies += "{\"name\":";
+      string(bodies, names_[b]);
+      bodies += ",\"model\":" + std::to_string(model) + "}";
+    }
+    for (std::size_t i = 0; i < env.artifactCount(); ++i) {
+      const Artifact& a = env.artifact(i);
+      const bool moving = std::find_if(nodes_.begin(), nodes_.end(), [&](const PhysicNode* n) {
+                            return &n->artifact() == &a;
+                          }) != nodes_.end();
+      for (const auto& tree : a.renderRoots()) {
+        const PhysicNode* follow = tree->follow.empty() ? nullptr : a.node(tree->follow);
+        if (follow != nullptr && moving) continue;
+        shapes(world, *tree, follow != nullptr ? follow->pose() : a.placement(), first_world);
+      }
+    }
+    std::string out = R"({"type":"scene","time":)";
+    number(out, toSeconds(env.time()));
+    out += R"(,"models":[)" + models + R"(],"bodies":[)" + bodies + R"(],"world":[)" + world + "]}";
+    return out;
+  }
+
+  std::unique_ptr<viewer::Server> server_;
+  std::vector<const PhysicNode*> nodes_;
+  std::vector<std::string> names_;
+  std::vector<std::uint8_t> frame_;
+  std::chrono::duration<double> period_{};
+  std::chrono::steady_clock::time_point last_wall_;
+  double last_sim_ = -1;
+  std::uint32_t late_ = 0;
+  bool begun_ = false;
+  std::string url_;
+};
+
+}  // namespace ssx::plugins
+
+SSX_PLUGIN(SSX_EXTENSION(ssx::plugins::Viewer, "viewer"));

@@ -1,0 +1,192 @@
+// The ssx viewer's page: the scene from the simulation (once), then frames of every body's pose,
+// drawn with three.js. A swarm's members share a model: each of its shapes is one InstancedMesh.
+"use strict";
+
+const state = {
+  bodies: [],       // {name, model}
+  models: [],       // per model: [{mesh (InstancedMesh), local (Matrix4)}]
+  slots: [],        // per body: its instance index in its model's meshes
+  positions: null,  // Float32Array of the newest frame's 7 floats per body
+  previous: null, previousTime: 0, time: 0,
+  selected: -1, frames: 0, fpsFrames: 0, fpsSince: performance.now(),
+};
+
+const renderer = new THREE.WebGLRenderer({ antialias: true, preserveDrawingBuffer: true });
+renderer.setPixelRatio(window.devicePixelRatio);
+renderer.setSize(window.innerWidth, window.innerHeight);
+document.body.appendChild(renderer.domElement);
+const scene = new THREE.Scene();
+scene.background = new THREE.Color(0x9eb8d9);
+const camera = new THREE.PerspectiveCamera(50, window.innerWidth / window.innerHeight, 0.05, 2000);
+camera.up.set(0, 0, 1);  // ssx's world: z up
+camera.position.set(-12, -12, 9);
+const controls = new THREE.OrbitControls(camera, renderer.domElement);
+controls.target.set(0, 0, 1.5);
+controls.update();
+scene.add(new THREE.HemisphereLight(0xffffff, 0x505050, 0.75));
+const sun = new THREE.DirectionalLight(0xffffff, 0.6);
+sun.position.set(0.35, 0.25, 0.9);
+scene.add(sun);
+window.addEventListener("resize", () => {
+  camera.aspect = window.innerWidth / window.innerHeight;
+  camera.updateProjectionMatrix();
+  renderer.setSize(window.innerWidth, window.innerHeight);
+});
+
+// a shape of the scene as geometry, in its own frame (ssx: cylinders and capsules along z)
+function geometries(shape) {
+  const [sx, sy, sz] = shape.size;
+  const r = shape.radius, l = shape.length;
+  const along_z = (g) => g.rotateX(Math.PI / 2);
+  switch (shape.kind) {
+    case "box": return [new THREE.BoxBufferGeometry(sx, sy, sz)];
+    case "sphere": return [new THREE.SphereBufferGeometry(r, 16, 12)];
+    case "cylinder": return [along_z(new THREE.CylinderBufferGeometry(r, r, l, 20))];
+    case "capsule": return [along_z(new THREE.CylinderBufferGeometry(r, r, l, 20)),
+                            new THREE.SphereBufferGeometry(r, 16, 12).translate(0, 0, l / 2),
+                            new THREE.SphereBufferGeometry(r, 16, 12).translate(0, 0, -l / 2)];
+    case "plane": return [new THREE.PlaneBufferGeometry(sx, sy)];
+  }
+  return [];
+}
+
+function material(shape) {
+  const [r, g, b, a] = shape.color;
+  return new THREE.MeshLambertMaterial({ color: new THREE.Color(r, g, b), transparent: a < 1, opacity: a,
+                                         side: shape.kind === "plane" ? THREE.DoubleSide : THREE.FrontSide });
+}
+
+function poseMatrix(p) {
+  return new THREE.Matrix4().compose(new THREE.Vector3(p[0], p[1], p[2]), new THREE.Quaternion(p[3], p[4], p[5], p[6]),
+                                     new THREE.Vector3(1, 1, 1));
+}
+
+const built = [];  // what the last scene message added
+function buildScene(msg) {
+  for (const object of built) scene.remove(object);
+  built.length = 0;
+  const add = (object) => { scene.add(object); built.push(object); };
+  state.positions = state.previous = null;
+  for (const shape of msg.world) {
+    for (const g of geometries(shape)) {
+      const mesh = new THREE.Mesh(g, material(shape));
+      mesh.applyMatrix(poseMatrix(shape.pose));
+      add(mesh);
+    }
+    if (shape.kind === "plane" && shape.grid) {
+      const grid = new THREE.GridHelper(Math.max(shape.size[0], shape.size[1]),
+                                        Math.round(Math.max(shape.size[0], shape.size[1])), 0x555555, 0x777777);
+      grid.rotateX(Math.PI / 2);
+      grid.applyMatrix(poseMatrix(shape.pose));
+      grid.position.z += 0.002;
+      add(grid);
+    }
+  }
+  state.bodies = msg.bodies;
+  const members = msg.models.map(() => 0);
+  state.slots = msg.bodies.map((b) => members[b.model]++);
+  state.models = msg.models.map((shapes, m) => {
+    const parts = [];
+    for (const shape of shapes)
+      for (const g of geometries(shape)) {
+        const mesh = new THREE.InstancedMesh(g, material(shape), Math.max(1, members[m]));
+        mesh.instanceMatrix.setUsage(THREE.DynamicDrawUsage);
+        mesh.userData.model = m;
+        mesh.frustumCulled = false;
+        add(mesh);
+        parts.push({ mesh, local: poseMatrix(shape.pose) });
+      }
+    return parts;
+  });
+  state.byModelSlot = msg.models.map(() => []);
+  msg.bodies.forEach((b, i) => { state.byModelSlot[b.model][state.slots[i]] = i; });
+  document.getElementById("robots").textContent = msg.bodies.length;
+}
+
+const body = new THREE.Matrix4(), world = new THREE.Matrix4();
+function applyFrame(buffer) {
+  const view = new DataView(buffer);
+  if (view.getUint32(0, true) !== 0x46585353) return;
+  const n = view.getUint32(4, true);
+  if (n !== state.bodies.length) return;
+  state.previous = state.positions;
+  state.previousTime = state.time;
+  state.time = view.getFloat64(8, true);
+  state.positions = new Float32Array(buffer, 32, 7 * n);
+  const p = state.positions;
+  for (let i = 0; i < n; ++i) {
+    const k = 7 * i;
+    body.compose(new THREE.Vector3(p[k], p[k + 1], p[k + 2]), new THREE.Quaternion(p[k + 3], p[k + 4], p[k + 5], p[k + 6]),
+                 new THREE.Vector3(1, 1, 1));
+    for (const part of state.models[state.bodies[i].model]) {
+      world.multiplyMatrices(body, part.local);
+      part.mesh.setMatrixAt(state.slots[i], world);
+    }
+  }
+  for (const parts of state.models) for (const part of parts) part.mesh.instanceMatrix.needsUpdate = true;
+  document.getElementById("time").textContent = state.time.toFixed(3);
+  document.getElementById("rtf").textContent = view.getFloat32(16, true).toFixed(2);
+  document.getElementById("late").textContent = view.getUint32(20, true);
+  state.frames++;
+  showSelected();
+}
+
+function showSelected() {
+  const i = state.selected;
+  if (i < 0 || !state.positions) return;
+  const p = state.positions, k = 7 * i;
+  let text = `${state.bodies[i].name}\nposition ${p[k].toFixed(2)} ${p[k + 1].toFixed(2)} ${p[k + 2].toFixed(2)} m`;
+  if (state.previous && state.time > state.previousTime) {
+    const dt = state.time - state.previousTime, q = state.previous;
+    const v = [0, 1, 2].map((a) => (p[k + a] - q[k + a]) / dt);
+    text += `\nvelocity ${v.map((x) => x.toFixed(2)).join(" ")} m/s`;
+  }
+  document.getElementById("selected").textContent = text;
+  if (document.getElementById("follow").checked) controls.target.set(p[k], p[k + 1], p[k + 2]);
+}
+
+// a click selects the robot under the pointer
+const raycaster = new THREE.Raycaster();
+renderer.domElement.addEventListener("click", (event) => {
+  const pointer = new THREE.Vector2((event.clientX / window.innerWidth) * 2 - 1, -(event.clientY / window.innerHeight) * 2 + 1);
+  raycaster.setFromCamera(pointer, camera);
+  const meshes = state.models.flat().map((part) => part.mesh);
+  const hit = raycaster.intersectObjects(meshes)[0];
+  if (hit && hit.instanceId !== undefined) {
+    state.selected = state.byModelSlot[hit.object.userData.model][hit.instanceId];
+    showSelected();
+  }
+});
+
+function connect() {
+  const token = new URLSearchParams(location.search).get("token");
+  const socket = new WebSocket(`ws://${location.host}/ws${token ? "?token=" + encodeURIComponent(token) : ""}`);
+  socket.binaryType = "arraybuffer";
+  const status = document.getElementById("status");
+  socket.onopen = () => { status.textContent = ""; socket.send(JSON.stringify({ type: "hello" })); };
+  socket.onmessage = (event) => {
+    if (typeof event.data === "string") {
+      const msg = JSON.parse(event.data);
+      if (msg.type === "scene") buildScene(msg);
+    } else if (state.bodies.length > 0) {
+      applyFrame(event.data);
+    }
+  };
+  socket.onclose = () => { status.textContent = "disconnected (the run ended?)"; };
+}
+
+function animate() {
+  requestAnimationFrame(animate);
+  controls.update();
+  renderer.render(scene, camera);
+  state.fpsFrames++;
+  const now = performance.now();
+  if (now - state.fpsSince > 1000) {
+    document.getElementById("fps").textContent = Math.round((1000 * state.fpsFrames) / (now - state.fpsSince));
+    state.fpsFrames = 0;
+    state.fpsSince = now;
+  }
+}
+
+connect();
+animate();
