@@ -16,10 +16,11 @@ cd "$(dirname "$0")"
 
 packages=(build-essential cmake ninja-build pkg-config ccache
           libode-dev libbullet-dev libeigen3-dev libpugixml-dev libcli11-dev catch2 libpng-dev libosmesa6-dev libzstd-dev
+          libcivetweb-dev libjs-three
           python3-dev python3-numpy pybind11-dev libopenmpi-dev openmpi-bin)
-# for `test` also pytest and matplotlib (the Python module's tests and examples) and doxygen (the
-# API reference and its check)
-python_test_packages=(python3-pytest python3-matplotlib doxygen)
+# for `test` also pytest and matplotlib (the Python module's tests and examples), doxygen (the
+# API reference and its check), and Chromium with selenium and websockets (the viewer's tests)
+python_test_packages=(python3-pytest python3-matplotlib doxygen chromium chromium-driver python3-selenium python3-websockets)
 # for `test` also ROS 1 (Debian's), so that the ros1 extension is built and tested against a real master
 ros_packages=(libroscpp-dev libgeometry-msgs-dev libsensor-msgs-dev libnav-msgs-dev
               python3-rosmaster python3-rospy python3-rostopic python3-geometry-msgs python3-nav-msgs)

@@ -183,7 +183,7 @@ class Viewer final : public SimulationExtension {
 
   void shutdown(Environment& env) override {
     if (!server_) return;
-    const viewer::ServerCounts c = server_->counts();
+    const viewer::ServerCounts c = server_->counts();  // (with the pages still connected: what they missed)
     server_->stop();
     env.log(LogLevel::Info, "viewer: " + std::to_string(c.frames_published) + " frames published, " +
                                 std::to_string(c.frames_sent) + " sent, " + std::to_string(c.frames_skipped) +

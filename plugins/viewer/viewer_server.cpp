@@ -15,6 +15,8 @@ struct Server::Client {
   bool closed = false;  // (under the server's mutex)
   std::uint64_t sent_seq = 0;
   std::uint64_t hello_seq = 0;  // the scene this page has
+  std::uint64_t first_seq = 0;  // the newest frame when it connected
+  std::uint64_t sent = 0;       // frames sent to it
   // the page's message rate: messages in the current second
   std::chrono::steady_clock::time_point window;
   int messages = 0;
@@ -82,6 +84,8 @@ ServerCounts Server::counts() const {
   std::lock_guard lock(mutex_);
   ServerCounts c = counts_;
   c.clients = clients_.size();
+  // a page skipped what was published while it was connected and not sent to it
+  for (const auto& client : clients_) c.frames_skipped += newest_seq_ - client->first_seq - client->sent;
   return c;
 }
 
@@ -122,6 +126,7 @@ int Server::onConnect(const mg_connection* conn, void* self) {
   }
   auto client = std::make_shared<Client>();
   client->conn = const_cast<mg_connection*>(conn);
+  client->first_seq = client->sent_seq = s.newest_seq_;
   client->window = std::chrono::steady_clock::now();
   s.clients_.push_back(client);
   mg_set_user_connection_data(conn, client.get());
@@ -154,7 +159,6 @@ void Server::sendLoop(const std::shared_ptr<Client>& client) {
         client->hello_seq = hello_seq_;
         hello = hello_;
       } else {
-        if (client->sent_seq > 0) counts_.frames_skipped += newest_seq_ - client->sent_seq - 1;
         client->sent_seq = newest_seq_;
         frame = newest_;
       }
@@ -166,7 +170,7 @@ void Server::sendLoop(const std::shared_ptr<Client>& client) {
     mg_unlock_connection(client->conn);
     if (written <= 0) return;  // the page went away: onClose ends it
     std::lock_guard lock(mutex_);
-    if (frame) ++counts_.frames_sent;
+    if (frame) ++counts_.frames_sent, ++client->sent;
   }
 }
 
@@ -182,6 +186,12 @@ int Server::onData(mg_connection* conn, int opcode, char* data, std::size_t size
   auto* client = static_cast<Client*>(mg_get_user_connection_data(conn));
   const int kind = opcode & 0xf;
   if (kind == MG_WEBSOCKET_OPCODE_CONNECTION_CLOSE) return 0;
+  if (kind == MG_WEBSOCKET_OPCODE_PING && size <= 125) {  // answered, as the protocol asks (clients' keep-alive)
+    mg_lock_connection(conn);
+    mg_websocket_write(conn, MG_WEBSOCKET_OPCODE_PONG, data, size);
+    mg_unlock_connection(conn);
+    return 1;
+  }
   if (kind == MG_WEBSOCKET_OPCODE_PING || kind == MG_WEBSOCKET_OPCODE_PONG) return 1;
   bool take = client != nullptr && kind == MG_WEBSOCKET_OPCODE_TEXT && size <= kMaxMessage;
   if (take) {
@@ -209,6 +219,7 @@ void Server::onClose(const mg_connection* conn, void* self) {
       if ((*it)->conn == conn) {
         client = *it;
         client->closed = true;
+        s.counts_.frames_skipped += s.newest_seq_ - client->first_seq - client->sent;
         s.clients_.erase(it);
         break;
       }

@@ -188,5 +188,23 @@ function animate() {
   }
 }
 
+// for tests and for a look from the browser's console
+window.ssxViewer = {
+  state, camera, controls, renderer,
+  // where body i appears in the page, in CSS pixels from the top left (null: behind the camera)
+  project(i) {
+    const p = state.positions, k = 7 * i;
+    const v = new THREE.Vector3(p[k], p[k + 1], p[k + 2]).project(camera);
+    if (v.z > 1) return null;
+    return [((v.x + 1) / 2) * window.innerWidth, ((1 - v.y) / 2) * window.innerHeight];
+  },
+  // the colour drawn at a point of the page (CSS pixels), as 0-255 RGBA
+  pixel(x, y) {
+    const gl = renderer.getContext(), ratio = renderer.getPixelRatio(), out = new Uint8Array(4);
+    gl.readPixels(Math.round(x * ratio), Math.round(gl.drawingBufferHeight - y * ratio), 1, 1, gl.RGBA, gl.UNSIGNED_BYTE, out);
+    return Array.from(out);
+  },
+};
+
 connect();
 animate();

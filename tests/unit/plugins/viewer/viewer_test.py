@@ -1,0 +1,110 @@
+#!/usr/bin/env python3
+"""The viewer in a real browser: the formation runs in real time with --view; headless Chromium
+(Debian's chromium and chromium-driver, driven by selenium; WebGL through SwiftShader) opens the
+page. Passes when the page shows every robot and the simulated time advancing, draws each robot
+where the simulation has it (the robot's blue at the projected centre of most robots in view, and
+mostly not a little beside them), and a second page sees the same run.
+
+    browser_test.py SSX SCENE WORK_DIR [SCREENSHOT]
+
+Exits 77 (ctest: skipped) when Chromium, its driver or selenium is not installed."""
+import pathlib
+import shutil
+import sys
+import time
+
+from viewer_util import ViewedRun, chromium_available
+
+try:
+    from selenium import webdriver
+    from selenium.webdriver.chrome.options import Options
+    from selenium.webdriver.chrome.service import Service
+except ImportError:
+    print("selenium is not installed (apt-get install python3-selenium): skipped")
+    sys.exit(77)
+if not chromium_available():
+    print("chromium or chromedriver is not installed (apt-get install chromium chromium-driver): skipped")
+    sys.exit(77)
+
+ssx, scene, work = sys.argv[1], sys.argv[2], pathlib.Path(sys.argv[3])
+screenshot = sys.argv[4] if len(sys.argv) > 4 else None
+shutil.rmtree(work, ignore_errors=True)
+work.mkdir(parents=True)
+problems = []
+
+
+def browser():
+    options = Options()
+    for a in ("--headless=new", "--no-sandbox", "--use-angle=swiftshader", "--enable-unsafe-swiftshader",
+              "--window-size=1024,700", f"--user-data-dir={work}/profile{len(pages)}"):
+        options.add_argument(a)
+    return webdriver.Chrome(service=Service("/usr/bin/chromedriver"), options=options)
+
+
+def wait_for(page, what, condition, seconds=60):
+    deadline = time.monotonic() + seconds
+    while time.monotonic() < deadline:
+        value = page.execute_script(what)
+        if condition(value):
+            return value
+        time.sleep(0.2)
+    problems.append(f"waited {seconds} s for {what!r}: last {value!r}")
+    return value
+
+
+pages = []
+run = ViewedRun(ssx, scene, str(work / "out"), "--duration", "120")
+try:
+    page = browser()
+    pages.append(page)
+    page.get(run.url)
+    robots = wait_for(page, "return document.getElementById('robots').textContent", lambda v: v == "70")
+    t0 = float(wait_for(page, "return document.getElementById('time').textContent",
+                        lambda v: v not in ("-", "") and float(v) > 1.0))
+    time.sleep(1.0)
+    t1 = float(page.execute_script("return document.getElementById('time').textContent"))
+    if not t1 > t0:
+        problems.append(f"the displayed time did not advance: {t0} then {t1}")
+    # each robot where the simulation has it: its blue box at its projected centre
+    result = page.execute_script("""
+        const v = window.ssxViewer, n = v.state.bodies.length;
+        let seen = 0, blue = 0, beside = 0;
+        const isBlue = (c) => c[2] > c[0] + 40 && c[2] > c[1] + 20;
+        for (let i = 0; i < n; ++i) {
+          const at = v.project(i);
+          if (!at || at[0] < 20 || at[1] < 60 || at[0] > innerWidth - 20 || at[1] > innerHeight - 20) continue;
+          ++seen;
+          let hit = false;
+          for (const [dx, dy] of [[0, 0], [1, 0], [-1, 0], [0, 1], [0, -1]]) hit = hit || isBlue(v.pixel(at[0] + dx, at[1] + dy));
+          if (hit) ++blue;
+          if (isBlue(v.pixel(at[0] + 40, at[1] + 40))) ++beside;
+        }
+        return [seen, blue, beside];""")
+    seen, blue, beside = result
+    print(f"robots in view {seen}, robot colour at their centre {blue}, 40 px beside them {beside}")
+    if seen < 30:
+        problems.append(f"only {seen} of 70 robots in view")
+    if blue < 0.8 * seen:
+        problems.append(f"the robot's colour at only {blue} of {seen} robots' projected centres")
+    if beside > 0.3 * seen:
+        problems.append(f"the robot's colour 40 px beside {beside} of {seen} robots: not drawn where they are")
+    if screenshot:
+        page.save_screenshot(screenshot)
+    # a second page sees the same run
+    second = browser()
+    pages.append(second)
+    second.get(run.url)
+    wait_for(second, "return document.getElementById('robots').textContent", lambda v: v == "70")
+    t2 = float(wait_for(second, "return document.getElementById('time').textContent",
+                        lambda v: v not in ("-", "") and float(v) > t1))
+    print(f"first page at {t1:.3f} s, second page at {t2:.3f} s")
+finally:
+    for p in pages:
+        p.quit()
+    status, err = run.stop()
+if status != 130:
+    problems.append(f"ssx ended with status {status} after Ctrl-C (130 expected):\n{err[-2000:]}")
+if "viewer: " not in err or " frames published" not in err:
+    problems.append(f"no viewer summary at the end:\n{err[-2000:]}")
+print("\n".join(problems) if problems else "the page drew the run as the simulation had it, on two pages")
+sys.exit(1 if problems else 0)

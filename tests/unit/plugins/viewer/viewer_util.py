@@ -1,0 +1,40 @@
+"""What the viewer's tests share: a run with the viewer on a free port, its address, and its end."""
+import os
+import re
+import signal
+import subprocess
+import time
+
+
+class ViewedRun:
+    """`ssx run SCENE --realtime --view 0 ...` in the background; url is the page's address."""
+
+    def __init__(self, ssx, scene, out_dir, *extra):
+        self.process = subprocess.Popen(
+            [ssx, "run", scene, "--realtime", "--view", "0", "--out", out_dir, *extra],
+            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+        self.err_lines = []
+        deadline = time.monotonic() + 30
+        self.url = None
+        while self.url is None:
+            line = self.process.stderr.readline()
+            if not line:
+                raise RuntimeError("ssx ended before the viewer listened:\n" + "".join(self.err_lines))
+            self.err_lines.append(line)
+            found = re.search(r"viewer: (http://\S+)", line)
+            if found:
+                self.url = found.group(1)
+            if time.monotonic() > deadline:
+                raise RuntimeError("no viewer address in 30 s:\n" + "".join(self.err_lines))
+        self.port = int(re.search(r":(\d+)/", self.url).group(1))
+
+    def stop(self):
+        """Ctrl-C, as a person stops a run; returns (exit status, everything it wrote to stderr)."""
+        if self.process.poll() is None:
+            self.process.send_signal(signal.SIGINT)
+        out, err = self.process.communicate(timeout=60)
+        return self.process.returncode, "".join(self.err_lines) + err
+
+
+def chromium_available():
+    return os.path.exists("/usr/bin/chromium") and os.path.exists("/usr/bin/chromedriver")
