@@ -179,6 +179,7 @@ function animate() {
   requestAnimationFrame(animate);
   controls.update();
   renderer.render(scene, camera);
+  state.drawn = state.positions;  // what the picture shows now
   state.fpsFrames++;
   const now = performance.now();
   if (now - state.fpsSince > 1000) {
@@ -191,9 +192,9 @@ function animate() {
 // for tests and for a look from the browser's console
 window.ssxViewer = {
   state, camera, controls, renderer,
-  // where body i appears in the page, in CSS pixels from the top left (null: behind the camera)
+  // where body i appears in the picture drawn last, in CSS pixels from the top left (null: behind the camera)
   project(i) {
-    const p = state.positions, k = 7 * i;
+    const p = state.drawn, k = 7 * i;
     const v = new THREE.Vector3(p[k], p[k + 1], p[k + 2]).project(camera);
     if (v.z > 1) return null;
     return [((v.x + 1) / 2) * window.innerWidth, ((1 - v.y) / 2) * window.innerHeight];
