@@ -7,9 +7,15 @@
 // time (s), float32 real-time factor since the last frame, uint32 late steps so far, uint64 step,
 // then N x float32 x, y, z, qx, qy, qz, qw (28 bytes per body).
 //
+// Teleoperation: a page sends {"type":"velocity","body":I,"v":[vx,vy,vz],"yaw_rate":W} (m/s in the
+// world frame, rad/s) while a key or stick is held; before the next step the body's driver gets it
+// as a velocity-level command (ssx::CommandInterface). No message for 0.5 s of the wall clock
+// (a key released, a page gone) stops the robot: velocity 0, where it is.
+//
 // Parameters: kParameters below, or `ssx plugins --params viewer`.
 #include "viewer_server.hpp"
 
+#include <ssx/command.hpp>
 #include <ssx/environment.hpp>
 #include <ssx/plugin_abi.hpp>
 
@@ -17,8 +23,11 @@
 #include <chrono>
 #include <cmath>
 #include <cstring>
+#include <cstdlib>
 #include <map>
 #include <memory>
+#include <mutex>
+#include <optional>
 #include <random>
 #include <string>
 #include <vector>
@@ -90,6 +99,28 @@ void shapes(std::string& out, const RenderNodeSpec& n, const Pose& parent, bool&
   for (const auto& c : n.children) shapes(out, c, pose, first);
 }
 
+// the number after `"key":` (or after `"key":[` and `index` commas), or nothing
+std::optional<double> jsonNumber(const std::string& text, const char* key, int index = -1) {
+  const std::string quoted = std::string("\"") + key + "\":";
+  auto at = text.find(quoted);
+  if (at == std::string::npos) return std::nullopt;
+  at += quoted.size();
+  if (index >= 0) {
+    if (at >= text.size() || text[at] != '[') return std::nullopt;
+    ++at;
+    for (int i = 0; i < index; ++i) {
+      at = text.find(',', at);
+      if (at == std::string::npos) return std::nullopt;
+      ++at;
+    }
+  }
+  const char* begin = text.c_str() + at;
+  char* end = nullptr;
+  const double v = std::strtod(begin, &end);
+  if (end == begin || !std::isfinite(v)) return std::nullopt;
+  return v;
+}
+
 }  // namespace
 
 class Viewer final : public SimulationExtension {
@@ -127,7 +158,7 @@ class Viewer final : public SimulationExtension {
     try {
       server_ = std::make_unique<viewer::Server>(
           bind, port, token, static_cast<int>(params.get<std::int64_t>("max_clients")), assets, sceneJson(env),
-          [](const std::string& text) { return text.find(R"("type":"hello")") != std::string::npos; });
+          [this](const std::string& text) { return onMessage(text); });
     } catch (const std::exception& e) {
       throw params.error(std::string("viewer: ") + e.what());
     }
@@ -137,11 +168,32 @@ class Viewer final : public SimulationExtension {
     last_wall_ = std::chrono::steady_clock::now() - std::chrono::hours(1);
   }
 
+  // a page's command enters the simulation here, before the step's drivers
+  void beforeStep(Environment&) override {
+    std::lock_guard lock(teleop_mutex_);
+    if (teleop_.body < 0 || teleop_.body >= static_cast<int>(nodes_.size())) return;
+    auto* driver = dynamic_cast<CommandInterface*>(
+        const_cast<Artifact&>(nodes_[static_cast<std::size_t>(teleop_.body)]->artifact()).driver());
+    if (driver == nullptr) return;
+    const auto now = std::chrono::steady_clock::now();
+    if (now - teleop_.received > std::chrono::milliseconds(500)) {  // the dead-man rule
+      driver->setCommand(Command::velocityYawRate(Vec3::Zero(), 0));
+      teleop_.body = -1;
+      ++teleop_stops_;
+      return;
+    }
+    if (!teleop_.fresh) return;
+    driver->setCommand(Command::velocityYawRate(teleop_.velocity, teleop_.yaw_rate));
+    teleop_.fresh = false;
+    delays_ms_.push_back(std::chrono::duration<double, std::milli>(now - teleop_.received).count());
+  }
+
   void afterStep(Environment& env) override {
     if (!begun_) {
       // the bodies exist from the first step on: each artifact's first dynamic root, as the
       // recorder has them; the pages get the scene with them now
       begun_ = true;
+      std::lock_guard lock(teleop_mutex_);  // (pages' commands look the bodies up)
       for (std::size_t i = 0; i < env.artifactCount(); ++i) {
         const Artifact& a = std::as_const(env).artifact(i);
         for (std::size_t r = 0; r < a.rootCount(); ++r) {
@@ -189,7 +241,36 @@ class Viewer final : public SimulationExtension {
                                 std::to_string(c.frames_sent) + " sent, " + std::to_string(c.frames_skipped) +
                                 " skipped by slow pages, " + std::to_string(c.messages_dropped) + " messages dropped, " +
                                 std::to_string(c.clients_refused) + " pages refused");
+    if (!delays_ms_.empty()) {
+      std::sort(delays_ms_.begin(), delays_ms_.end());
+      char text[160];
+      std::snprintf(text, sizeof text,
+                    "viewer: %zu velocity commands from pages, from arrival to the step that used them median %.2f ms, "
+                    "max %.2f ms; %llu dead-man stops",
+                    delays_ms_.size(), delays_ms_[delays_ms_.size() / 2], delays_ms_.back(),
+                    static_cast<unsigned long long>(teleop_stops_));
+      env.log(LogLevel::Info, text);
+    }
     server_.reset();
+  }
+
+  // a page's message (on a server thread): true when understood
+  bool onMessage(const std::string& text) {
+    if (text.find(R"("type":"hello")") != std::string::npos) return true;
+    if (text.find(R"("type":"velocity")") == std::string::npos) return false;
+    const auto body = jsonNumber(text, "body");
+    const auto vx = jsonNumber(text, "v", 0), vy = jsonNumber(text, "v", 1), vz = jsonNumber(text, "v", 2);
+    const auto yaw_rate = jsonNumber(text, "yaw_rate");
+    if (!body || !vx || !vy || !vz || !yaw_rate || *body < 0 || *body != std::floor(*body)) return false;
+    const Vec3 v(*vx, *vy, *vz);
+    if (v.norm() > kMaxSpeed || std::abs(*yaw_rate) > kMaxYawRate) return false;
+    std::lock_guard lock(teleop_mutex_);
+    if (*body >= static_cast<double>(nodes_.size())) return false;
+    const int index = static_cast<int>(*body);
+    const auto* driver = dynamic_cast<const CommandInterface*>(nodes_[static_cast<std::size_t>(index)]->artifact().driver());
+    if (driver == nullptr || !driver->acceptsCommand(CommandLevel::Velocity)) return false;
+    teleop_ = {index, v, *yaw_rate, std::chrono::steady_clock::now(), true};
+    return true;
   }
 
   ~Viewer() override {
@@ -252,6 +333,19 @@ class Viewer final : public SimulationExtension {
   double last_sim_ = -1;
   std::uint32_t late_ = 0;
   bool begun_ = false;
+  // teleoperation: the newest command from a page (under teleop_mutex_; nodes_ is fixed once begun)
+  static constexpr double kMaxSpeed = 20, kMaxYawRate = 10;
+  struct Teleop {
+    int body = -1;
+    Vec3 velocity = Vec3::Zero();
+    double yaw_rate = 0;
+    std::chrono::steady_clock::time_point received;
+    bool fresh = false;
+  };
+  std::mutex teleop_mutex_;
+  Teleop teleop_;
+  std::vector<double> delays_ms_;  // from a command's arrival to the step that used it
+  std::uint64_t teleop_stops_ = 0;
   std::string url_;
 };
 

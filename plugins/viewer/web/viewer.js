@@ -22,6 +22,7 @@ camera.up.set(0, 0, 1);  // ssx's world: z up
 camera.position.set(-12, -12, 9);
 const controls = new THREE.OrbitControls(camera, renderer.domElement);
 controls.target.set(0, 0, 1.5);
+controls.enableKeys = false;  // the keys steer the selected robot
 controls.update();
 scene.add(new THREE.HemisphereLight(0xffffff, 0x505050, 0.75));
 const sun = new THREE.DirectionalLight(0xffffff, 0.6);
@@ -141,6 +142,7 @@ function showSelected() {
     const v = [0, 1, 2].map((a) => (p[k + a] - q[k + a]) / dt);
     text += `\nvelocity ${v.map((x) => x.toFixed(2)).join(" ")} m/s`;
   }
+  if (teleop.sent) text += `\ncommanded ${teleop.sent.map((x) => x.toFixed(2)).join(" ")} m/s`;
   document.getElementById("selected").textContent = text;
   if (document.getElementById("follow").checked) controls.target.set(p[k], p[k + 1], p[k + 2]);
 }
@@ -152,15 +154,62 @@ renderer.domElement.addEventListener("click", (event) => {
   raycaster.setFromCamera(pointer, camera);
   const meshes = state.models.flat().map((part) => part.mesh);
   const hit = raycaster.intersectObjects(meshes)[0];
-  if (hit && hit.instanceId !== undefined) {
-    state.selected = state.byModelSlot[hit.object.userData.model][hit.instanceId];
-    showSelected();
-  }
+  if (hit && hit.instanceId !== undefined) select(state.byModelSlot[hit.object.userData.model][hit.instanceId]);
 });
+
+function select(i) {
+  state.selected = i;
+  teleop.sent = null;
+  showSelected();
+}
+
+// teleoperation of the selected robot: W/S (or the arrows) forward and back along the view, A/D
+// sideways, R/F up and down, Q/E turn; or a gamepad's sticks. Sent 20 times a second while held; the
+// simulation stops the robot when nothing comes for 0.5 s (the dead-man rule).
+const teleop = { keys: new Set(), socket: null, sent: null, last: 0 };
+const kSpeed = 1.0, kClimb = 0.5, kTurn = 0.8;
+window.addEventListener("keydown", (e) => { teleop.keys.add(e.key.toLowerCase()); });
+window.addEventListener("keyup", (e) => { teleop.keys.delete(e.key.toLowerCase()); });
+window.addEventListener("blur", () => teleop.keys.clear());
+
+function teleopCommand() {
+  const k = teleop.keys, has = (...names) => names.some((n) => k.has(n));
+  let forward = (has("w", "arrowup") ? 1 : 0) - (has("s", "arrowdown") ? 1 : 0);
+  let side = (has("a", "arrowleft") ? 1 : 0) - (has("d", "arrowright") ? 1 : 0);
+  let up = (has("r") ? 1 : 0) - (has("f") ? 1 : 0);
+  let turn = (has("q") ? 1 : 0) - (has("e") ? 1 : 0);
+  for (const pad of navigator.getGamepads ? navigator.getGamepads() : []) {
+    if (!pad) continue;
+    const axis = (i) => (Math.abs(pad.axes[i] || 0) > 0.15 ? pad.axes[i] : 0);
+    forward -= axis(1); side -= axis(0); up -= axis(3); turn -= axis(2);
+  }
+  if (!forward && !side && !up && !turn) return null;
+  // along the view, on the ground
+  const look = new THREE.Vector3().subVectors(controls.target, camera.position);
+  look.z = 0;
+  if (look.lengthSq() < 1e-9) look.set(1, 0, 0);
+  look.normalize();
+  const left = new THREE.Vector3(-look.y, look.x, 0);
+  const v = look.multiplyScalar(forward * kSpeed).add(left.multiplyScalar(side * kSpeed));
+  return [v.x, v.y, up * kClimb, turn * kTurn];
+}
+
+function teleopTick(now) {
+  const socket = teleop.socket;
+  if (!socket || socket.readyState !== 1 || state.selected < 0) return;
+  const c = teleopCommand();
+  if (!c && !teleop.sent) return;
+  if (now - teleop.last < 45) return;
+  teleop.last = now;
+  const command = c || [0, 0, 0, 0];  // released: stop now (the dead-man rule would in 0.5 s)
+  socket.send(JSON.stringify({ type: "velocity", body: state.selected, v: command.slice(0, 3), yaw_rate: command[3] }));
+  teleop.sent = c ? command.slice(0, 3) : null;
+}
 
 function connect() {
   const token = new URLSearchParams(location.search).get("token");
   const socket = new WebSocket(`ws://${location.host}/ws${token ? "?token=" + encodeURIComponent(token) : ""}`);
+  teleop.socket = socket;
   socket.binaryType = "arraybuffer";
   const status = document.getElementById("status");
   socket.onopen = () => { status.textContent = ""; socket.send(JSON.stringify({ type: "hello" })); };
@@ -191,7 +240,7 @@ function animate() {
 
 // for tests and for a look from the browser's console
 window.ssxViewer = {
-  state, camera, controls, renderer,
+  state, camera, controls, renderer, select,
   // where body i appears in the picture drawn last, in CSS pixels from the top left (null: behind the camera)
   project(i) {
     const p = state.drawn, k = 7 * i;
@@ -209,3 +258,4 @@ window.ssxViewer = {
 
 connect();
 animate();
+setInterval(() => teleopTick(performance.now()), 50);  // not tied to the drawing rate

@@ -3,12 +3,15 @@
 (Debian's chromium and chromium-driver, driven by selenium; WebGL through SwiftShader) opens the
 page. Passes when the page shows every robot and the simulated time advancing, draws each robot
 where the simulation has it (the robot's blue at the projected centre of most robots in view, and
-mostly not a little beside them), and a second page sees the same run.
+mostly not a little beside them), a robot selected and steered with the W key (forward along the
+view) for 2 s moves forward in the simulation and stops when the key is let go, and a second page
+sees the same run.
 
     browser_test.py SSX SCENE WORK_DIR [SCREENSHOT]
 
 Exits 77 (ctest: skipped) when Chromium, its driver or selenium is not installed."""
 import pathlib
+import re
 import shutil
 import sys
 import time
@@ -17,6 +20,7 @@ from viewer_util import ViewedRun, chromium_available
 
 try:
     from selenium import webdriver
+    from selenium.webdriver.common.action_chains import ActionChains
     from selenium.webdriver.chrome.options import Options
     from selenium.webdriver.chrome.service import Service
 except ImportError:
@@ -90,6 +94,34 @@ try:
         problems.append(f"the robot's colour 40 px beside {beside} of {seen} robots: not drawn where they are")
     if screenshot:
         page.save_screenshot(screenshot)
+    # steer robot 0 forward along the view for 2 s with the W key, then let go
+    where = """const v = window.ssxViewer, p = v.state.positions;
+               const look = [v.controls.target.x - v.camera.position.x, v.controls.target.y - v.camera.position.y];
+               const n = Math.hypot(look[0], look[1]);
+               return [p[0], p[1], p[2], look[0] / n, look[1] / n, v.state.time];"""
+    page.execute_script("window.ssxViewer.select(0)")
+
+    def wait_simulated(seconds):
+        """Waits until the page shows `seconds` more of simulated time (the run may be slower than real time
+        on a loaded machine); returns the robot's pose then."""
+        start = page.execute_script(where)[5]
+        return wait_for(page, where, lambda w: w[5] >= start + seconds, 120)
+
+    before = page.execute_script(where)
+    ActionChains(page).key_down("w").perform()
+    during = wait_simulated(2.0)
+    ActionChains(page).key_up("w").perform()
+    settled = wait_simulated(2.0)  # the velocity level's reference point stops at once; the robot settles on it
+    still = wait_simulated(1.0)
+    held = during[5] - before[5]
+    forward = (during[0] - before[0]) * before[3] + (during[1] - before[1]) * before[4]
+    drift = sum((still[k] - settled[k]) ** 2 for k in range(3)) ** 0.5
+    print(f"robot 0 moved {forward:.2f} m forward in {held:.2f} s of the key held (1 m/s asked); "
+          f"{drift:.3f} m in the {still[5] - settled[5]:.2f} s from 2 s after it was let go")
+    if forward < 1.0:
+        problems.append(f"steered forward at 1 m/s for {held:.2f} s, robot 0 moved {forward:.2f} m along the view")
+    if drift > 0.05:
+        problems.append(f"robot 0 still moved {drift:.3f} m in a second, 2 s after the key was let go")
     # a second page sees the same run
     second = browser()
     pages.append(second)
@@ -106,5 +138,12 @@ if status != 130:
     problems.append(f"ssx ended with status {status} after Ctrl-C (130 expected):\n{err[-2000:]}")
 if "viewer: " not in err or " frames published" not in err:
     problems.append(f"no viewer summary at the end:\n{err[-2000:]}")
+delays = re.search(r"viewer: (\d+) velocity commands from pages, from arrival to the step that used them median "
+                   r"([\d.]+) ms, max ([\d.]+) ms", err)
+if not delays:
+    problems.append(f"no account of the velocity commands:\n{err[-2000:]}")
+else:
+    print(f"{delays.group(1)} velocity commands, from arrival to the step that used them: median {delays.group(2)} ms, "
+          f"max {delays.group(3)} ms")
 print("\n".join(problems) if problems else "the page drew the run as the simulation had it, on two pages")
 sys.exit(1 if problems else 0)
