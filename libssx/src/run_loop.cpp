@@ -8,7 +8,9 @@
 #include <sys/prctl.h>
 #include <time.h>
 
+#include <algorithm>
 #include <cerrno>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -102,6 +104,53 @@ std::string realtimePriorityProblem(int priority) {
   return error == 0 ? std::string() : describeSchedError(error, priority);
 }
 
+void RunControl::pause() {
+  std::lock_guard lock(mutex_);
+  paused_ = true;
+  changed_.notify_all();
+}
+
+void RunControl::resume() {
+  std::lock_guard lock(mutex_);
+  paused_ = false;
+  steps_ = 0;
+  changed_.notify_all();
+}
+
+void RunControl::stepOnce(std::int64_t n) {
+  std::lock_guard lock(mutex_);
+  if (paused_) steps_ += std::max<std::int64_t>(0, n);
+  changed_.notify_all();
+}
+
+void RunControl::setRealtimeFactor(double factor) {
+  if (!(factor >= kMinRealtimeFactor && factor <= kMaxRealtimeFactor))
+    throw ConfigError({}, "real-time factor must be from 0.001 to 1e6");
+  std::lock_guard lock(mutex_);
+  factor_ = factor;
+}
+
+bool RunControl::paused() const {
+  std::lock_guard lock(mutex_);
+  return paused_;
+}
+
+double RunControl::realtimeFactor() const {
+  std::lock_guard lock(mutex_);
+  return factor_;
+}
+
+bool RunControl::waitWhilePaused(const std::atomic<bool>* stop) {
+  std::unique_lock lock(mutex_);
+  while (paused_ && steps_ == 0) {
+    if (stop != nullptr && stop->load()) return false;
+    // (the stop flag is a plain atomic that nobody notifies: looked at every 20 ms)
+    changed_.wait_for(lock, std::chrono::milliseconds(20));
+  }
+  if (paused_) --steps_;
+  return true;
+}
+
 TimingSummary Environment::run(const RunOptions& options) {
   if (options.mode == RunOptions::Mode::RealTime &&
       !(options.realtime_factor >= kMinRealtimeFactor && options.realtime_factor <= kMaxRealtimeFactor))
@@ -136,7 +185,6 @@ TimingSummary Environment::run(const RunOptions& options) {
     fifo.emplace(threads, options.realtime_priority);
   }
 
-  const double period = static_cast<double>(settings_.timestep) / (realtime ? options.realtime_factor : 1.0);
   const std::int64_t first_sample = timing_.recorded();
   const Nanoseconds sim_start = time();
   const Nanoseconds wall_start = monotonicNow();
@@ -150,7 +198,24 @@ TimingSummary Environment::run(const RunOptions& options) {
   Nanoseconds last_warning = wall_start - options.warn_interval;
   Nanoseconds worst_unreported = 0;
 
+  double factor = realtime ? options.realtime_factor : 1.0;
+  double period = static_cast<double>(settings_.timestep) / factor;
   while ((options.steps < 0 || done < options.steps) && !(options.stop != nullptr && options.stop->load())) {
+    // steered from elsewhere (RunControl): a pause holds the run here; real time starts afresh
+    // after it, and a new factor takes over from now
+    RunControl& control = *run_control_;
+    const bool was_paused = control.paused();
+    if (was_paused) {
+      if (!control.waitWhilePaused(options.stop)) break;
+    }
+    const double asked = control.realtimeFactor();
+    if (realtime && ((asked > 0 && asked != factor) || was_paused)) {
+      if (asked > 0) factor = asked;
+      period = static_cast<double>(settings_.timestep) / factor;
+      grid_start = monotonicNow();
+      grid_k = 0;
+      previous_late = false;
+    }
     step();
     ++done;
     ++grid_k;

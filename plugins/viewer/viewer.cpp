@@ -7,6 +7,9 @@
 // time (s), float32 real-time factor since the last frame, uint32 late steps so far, uint64 step,
 // then N x float32 x, y, z, qx, qy, qz, qw (28 bytes per body).
 //
+// Steering the run: {"type":"pause"}, {"type":"resume"}, {"type":"step"} (one step while paused) and
+// {"type":"rate","factor":F} (the real-time factor of a real-time run), through Environment::runControl.
+//
 // Teleoperation: a page sends {"type":"velocity","body":I,"v":[vx,vy,vz],"yaw_rate":W} (m/s in the
 // world frame, rad/s) while a key or stick is held; before the next step the body's driver gets it
 // as a velocity-level command (ssx::CommandInterface). No message for 0.5 s of the wall clock
@@ -137,6 +140,7 @@ class Viewer final : public SimulationExtension {
   };
 
   void init(Environment& env, const Descriptor& params) override {
+    control_ = &env.runControl();
     const int port = static_cast<int>(params.get<std::int64_t>("port"));
     const std::string bind = params.get<std::string>("bind");
     period_ = std::chrono::duration<double>(1.0 / params.get<double>("rate_hz"));
@@ -209,7 +213,8 @@ class Viewer final : public SimulationExtension {
     const TimingRecorder& timing = env.timing();
     if (timing.size() >= 2 && timing[timing.size() - 2].lateness > 0) ++late_;
     const auto now = std::chrono::steady_clock::now();
-    if (now - last_wall_ < period_) return;
+    // (and every step of a paused run: the one it was paused after, and each single step)
+    if (now - last_wall_ < period_ && !control_->paused()) return;
     const double wall = std::chrono::duration<double>(now - last_wall_).count();
     const double rtf = last_sim_ >= 0 && wall < 60 ? (toSeconds(env.time()) - last_sim_) / wall : 0;
     last_wall_ = now;
@@ -257,6 +262,16 @@ class Viewer final : public SimulationExtension {
   // a page's message (on a server thread): true when understood
   bool onMessage(const std::string& text) {
     if (text.find(R"("type":"hello")") != std::string::npos) return true;
+    // pause, single steps, resume and the real-time factor (Environment::runControl: any thread)
+    if (text.find(R"("type":"pause")") != std::string::npos) return control_->pause(), true;
+    if (text.find(R"("type":"resume")") != std::string::npos) return control_->resume(), true;
+    if (text.find(R"("type":"step")") != std::string::npos) return control_->stepOnce(1), true;
+    if (text.find(R"("type":"rate")") != std::string::npos) {
+      const auto factor = jsonNumber(text, "factor");
+      if (!factor || !(*factor >= kMinRealtimeFactor && *factor <= kMaxRealtimeFactor)) return false;
+      control_->setRealtimeFactor(*factor);
+      return true;
+    }
     if (text.find(R"("type":"velocity")") == std::string::npos) return false;
     const auto body = jsonNumber(text, "body");
     const auto vx = jsonNumber(text, "v", 0), vy = jsonNumber(text, "v", 1), vz = jsonNumber(text, "v", 2);
@@ -325,6 +340,7 @@ class Viewer final : public SimulationExtension {
   }
 
   std::unique_ptr<viewer::Server> server_;
+  RunControl* control_ = nullptr;
   std::vector<const PhysicNode*> nodes_;
   std::vector<std::string> names_;
   std::vector<std::uint8_t> frame_;

@@ -6,7 +6,9 @@
 #include <sched.h>
 #include <sys/prctl.h>
 
+#include <atomic>
 #include <chrono>
+#include <thread>
 #include <limits>
 #include <map>
 #include <mutex>
@@ -287,4 +289,67 @@ TEST_CASE("a run's summary counts every step even when the timing ring keeps onl
   CHECK(summary.timed_steps == 16);
   CHECK_THAT(summary.str(), Catch::Contains("steps 100,") && Catch::Contains("(of the newest 16 steps)"));
   CHECK(env.timing().samples().size() == 16);
+}
+
+TEST_CASE("a run paused from another thread holds between steps, takes single steps, and resumes without catching up",
+          "[run]") {
+  EnvironmentSettings s;
+  s.timestep = toNanoseconds(0.002);
+  Environment env(s);
+  withBall(env);
+  RunControl& control = env.runControl();
+  std::atomic<std::int64_t> steps{0};
+  std::atomic<bool> stop{false};
+  RunOptions o;
+  o.steps = 300;
+  o.stop = &stop;
+  o.on_step = [&](const Environment& e) {
+    steps = e.stepCount();
+    if (e.stepCount() == 50) control.pause();  // held after this step
+  };
+  TimingSummary summary;
+  std::thread runner([&] { summary = env.run(o); });
+  // held at 50: nothing moves while paused, however long one waits for it
+  while (!control.paused()) std::this_thread::yield();
+  const auto until = std::chrono::steady_clock::now() + std::chrono::milliseconds(300);
+  while (std::chrono::steady_clock::now() < until) CHECK(steps.load() == 50);
+  // three single steps, taken at once
+  control.stepOnce(3);
+  while (steps.load() < 53) std::this_thread::yield();
+  const auto hold = std::chrono::steady_clock::now() + std::chrono::milliseconds(100);
+  while (std::chrono::steady_clock::now() < hold) CHECK(steps.load() == 53);
+  // resumed: the other 247 steps take their 0.494 s of real time (no burst to catch up on the pause)
+  double wall = 0;
+  {
+    const auto t0 = std::chrono::steady_clock::now();
+    control.resume();
+    runner.join();
+    wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  }
+  CHECK(summary.steps == 300);
+  CHECK(wall >= 0.494 * 0.99);
+  CHECK(env.stepCount() == 300);
+}
+
+TEST_CASE("a real-time factor set from another thread paces the rest of the run", "[run]") {
+  EnvironmentSettings s;
+  s.timestep = toNanoseconds(0.010);
+  Environment env(s);
+  withBall(env);
+  RunOptions o;
+  o.steps = 40;
+  env.runControl().setRealtimeFactor(4.0);  // 0.4 s simulated in 0.1 s
+  const double wall = secondsOf([&] { env.run(o); });
+  CHECK(wall >= 0.1 * 0.99);
+  CHECK(wall < 0.4);
+  CHECK_THROWS_AS(env.runControl().setRealtimeFactor(0), ConfigError);
+  // a stop while paused ends the run
+  std::atomic<bool> stop{false};
+  o.stop = &stop;
+  o.steps = -1;
+  env.runControl().pause();
+  std::thread stopper([&] { stop = true; });
+  env.run(o);
+  stopper.join();
+  CHECK(env.stepCount() == 40);
 }

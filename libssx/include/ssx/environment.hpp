@@ -31,9 +31,11 @@
 #include <ssx/types.hpp>
 
 #include <atomic>
+#include <condition_variable>
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <mutex>
 #include <span>
 #include <string>
 #include <string_view>
@@ -82,6 +84,39 @@ struct EnvironmentSettings {
   PhysicsSettings physics;  ///< the physics engine and its parameters
   RenderSettings render;    ///< the render engine, scene cameras and outputs
   WindSettings wind;        ///< the scene's wind
+};
+
+/// A run steered while it runs, from any thread (a viewer's page, a program's UI): Environment::run
+/// looks at it between steps. Pausing holds the run between two steps (and the stop flag still ends
+/// it); on resuming, real time starts afresh from that moment (no catching up on the pause). A
+/// step asked for while paused is taken at once. A real-time factor set here replaces the run's
+/// from the next step on (real-time runs; a fast run ignores it).
+class SSX_EXPORT RunControl {
+ public:
+  /// Holds the run after its current step.
+  void pause();
+  /// Lets a paused run go on.
+  void resume();
+  /// While paused: one more step (or n).
+  void stepOnce(std::int64_t n = 1);
+  /// The real-time factor of real-time runs from the next step on (kMinRealtimeFactor to
+  /// kMaxRealtimeFactor; ConfigError otherwise).
+  void setRealtimeFactor(double factor);
+  /// Whether a pause was asked for.
+  bool paused() const;
+  /// The factor set, or 0 when none was (the run's own applies).
+  double realtimeFactor() const;
+
+  /// For Environment::run: waits while paused (returns at once otherwise) until resumed, a step is
+  /// asked for, or `stop` is set; returns true when a step may be taken.
+  bool waitWhilePaused(const std::atomic<bool>* stop);
+
+ private:
+  mutable std::mutex mutex_;
+  std::condition_variable changed_;
+  bool paused_ = false;
+  std::int64_t steps_ = 0;
+  double factor_ = 0;
 };
 
 /// How a run is paced.
@@ -330,6 +365,8 @@ class SSX_EXPORT Environment {
   /// Removes a listener added by addStepListener (an unknown id is ignored).
   void removeStepListener(std::size_t id) noexcept;
 
+  /// Pausing, single steps and the real-time factor of run(), from any thread.
+  RunControl& runControl() noexcept { return *run_control_; }
   /// Per-step timing of every step taken so far.
   TimingRecorder& timing() noexcept { return timing_; }
   /// @copydoc timing()
@@ -369,6 +406,7 @@ class SSX_EXPORT Environment {
   // step listeners (addStepListener), after the members plugins' inline accessors read
   std::vector<std::pair<std::size_t, std::function<void(const Environment&)>>> listeners_;
   std::size_t next_listener_ = 0;
+  std::unique_ptr<RunControl> run_control_ = std::make_unique<RunControl>();
 };
 
 template <class M>

@@ -4,7 +4,9 @@
 #include <charconv>
 #include <cmath>
 #include <cstdio>
+#include <initializer_list>
 #include <map>
+#include <utility>
 
 namespace ssx::detail {
 
@@ -20,30 +22,28 @@ namespace {
   R"j({"type":"object","properties":{"r":{"type":"number"},"g":{"type":"number"},"b":{"type":"number"},"a":{"type":"number"}}})j"
 #define SSX_JSON_SHAPE R"j({"type":"object","properties":{"pose":)j" SSX_JSON_POSE R"j(,"size":)j" SSX_JSON_VEC3 R"j(,"color":)j" SSX_JSON_COLOR
 
-void appendVec(std::string& out, const char* name, double x, double y, double z) {
+// "name":{"k1":v1,"k2":v2,...}
+void appendObject(std::string& out, const char* name, std::initializer_list<std::pair<const char*, double>> fields) {
   out += '"';
   out += name;
-  out += R"j(":{"x":)j";
-  appendNumber(out, x);
-  out += R"j(,"y":)j";
-  appendNumber(out, y);
-  out += R"j(,"z":)j";
-  appendNumber(out, z);
+  out += "\":{";
+  bool first = true;
+  for (const auto& [key, value] : fields) {
+    out += first ? "\"" : ",\"";
+    first = false;
+    out += key;
+    out += "\":";
+    appendNumber(out, value);
+  }
   out += '}';
 }
 
+void appendVec(std::string& out, const char* name, double x, double y, double z) {
+  appendObject(out, name, {{"x", x}, {"y", y}, {"z", z}});
+}
+
 void appendQuat(std::string& out, const char* name, double w, double x, double y, double z) {
-  out += '"';
-  out += name;
-  out += R"j(":{"x":)j";
-  appendNumber(out, x);
-  out += R"j(,"y":)j";
-  appendNumber(out, y);
-  out += R"j(,"z":)j";
-  appendNumber(out, z);
-  out += R"j(,"w":)j";
-  appendNumber(out, w);
-  out += '}';
+  appendObject(out, name, {{"x", x}, {"y", y}, {"z", z}, {"w", w}});
 }
 
 void appendTime(std::string& out, Nanoseconds time) {
@@ -67,15 +67,8 @@ void appendShape(std::string& out, const Pose& pose, const Vec3& size, const Col
   appendPose(out, pose);
   out += ',';
   appendVec(out, "size", size.x(), size.y(), size.z());
-  out += R"j(,"color":{"r":)j";
-  appendNumber(out, color[0]);
-  out += R"j(,"g":)j";
-  appendNumber(out, color[1]);
-  out += R"j(,"b":)j";
-  appendNumber(out, color[2]);
-  out += R"j(,"a":)j";
-  appendNumber(out, color[3]);
-  out += '}';
+  out += ',';
+  appendObject(out, "color", {{"r", color[0]}, {"g", color[1]}, {"b", color[2]}, {"a", color[3]}});
   out += extra;
   out += '}';
 }

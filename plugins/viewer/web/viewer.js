@@ -206,6 +206,19 @@ function teleopTick(now) {
   teleop.sent = c ? command.slice(0, 3) : null;
 }
 
+// the run from the page: pause and resume, one step while paused, the real-time factor
+function send(message) {
+  if (teleop.socket && teleop.socket.readyState === 1) teleop.socket.send(JSON.stringify(message));
+}
+const pauseButton = document.getElementById("pause");
+pauseButton.addEventListener("click", () => {
+  const pausing = pauseButton.textContent === "pause";
+  send({ type: pausing ? "pause" : "resume" });
+  pauseButton.textContent = pausing ? "resume" : "pause";
+});
+document.getElementById("step").addEventListener("click", () => send({ type: "step" }));
+document.getElementById("factor").addEventListener("change", (e) => send({ type: "rate", factor: Number(e.target.value) }));
+
 function connect() {
   const token = new URLSearchParams(location.search).get("token");
   const socket = new WebSocket(`ws://${location.host}/ws${token ? "?token=" + encodeURIComponent(token) : ""}`);

@@ -4,8 +4,10 @@
 page. Passes when the page shows every robot and the simulated time advancing, draws each robot
 where the simulation has it (the robot's blue at the projected centre of most robots in view, and
 mostly not a little beside them), a robot selected and steered with the W key (forward along the
-view) for 2 s moves forward in the simulation and stops when the key is let go, and a second page
-sees the same run.
+view) for 2 s moves forward in the simulation and stops when the key is let go, the page's pause
+holds the run (the time shown stands still), its step button takes a step and holds again, its resume and
+real-time factor 4 let the run go on four times as fast as the wall clock, and a second page sees the
+same run.
 
     browser_test.py SSX SCENE WORK_DIR [SCREENSHOT]
 
@@ -122,6 +124,33 @@ try:
         problems.append(f"steered forward at 1 m/s for {held:.2f} s, robot 0 moved {forward:.2f} m along the view")
     if drift > 0.05:
         problems.append(f"robot 0 still moved {drift:.3f} m in a second, 2 s after the key was let go")
+    # pause, one step, then on at four times real time, all from the page
+    shown = "return Number(document.getElementById('time').textContent)"
+    page.find_element("id", "pause").click()
+    time.sleep(0.5)
+    held = page.execute_script(shown)
+    time.sleep(0.7)
+    if page.execute_script(shown) != held:
+        problems.append(f"paused from the page, the time shown went on from {held}")
+    page.find_element("id", "step").click()
+    stepped = wait_for(page, shown, lambda v: v != held, 10)
+    # (the frame shown before may be a few steps older than the pause, if the pause came while the
+    # run waited for a deadline: C++'s run-loop test checks single steps exactly)
+    if not 0.0015 < stepped - held < 0.05:
+        problems.append(f"one step from the page went from {held} to {stepped} s (one step is 0.002 s)")
+    time.sleep(0.5)
+    if page.execute_script(shown) != stepped:
+        problems.append("after one step from the page the run did not hold again")
+    from selenium.webdriver.support.ui import Select
+    Select(page.find_element("id", "factor")).select_by_visible_text("4")
+    page.find_element("id", "pause").click()  # resume
+    t_a, wall_a = page.execute_script(shown), time.monotonic()
+    time.sleep(2.0)
+    t_b, wall_b = page.execute_script(shown), time.monotonic()
+    factor = (t_b - t_a) / (wall_b - wall_a)
+    print(f"paused at {held:.3f} s, one step to {stepped:.3f} s, then x{factor:.2f} real time with 4 asked")
+    if not 2.5 < factor < 4.5:
+        problems.append(f"asked for 4 times real time from the page, the run went x{factor:.2f}")
     # a second page sees the same run
     second = browser()
     pages.append(second)
