@@ -1,3 +1,5 @@
+#include "record/foxglove.hpp"
+
 #include <ssx/command.hpp>
 
 #include <cmath>
@@ -185,6 +187,18 @@ std::string CommandInterface::refusal(const Command& command) const {
     return "a rotors command needs one speed per rotor: " + std::to_string(rotorCount()) + ", got " +
            std::to_string(command.rotor_speeds.size());
   return command.problem();
+}
+
+std::string commandJson(const Command& command) {
+  std::string out = R"({"level":")";
+  out += commandLevelName(command.level);
+  out += R"(","values":[)";
+  const std::vector<double> row = command.toRow();
+  for (std::size_t k = 0; k < row.size(); ++k) {
+    if (k > 0) out += ',';
+    detail::appendNumber(out, row[k]);
+  }
+  return out + "]}";
 }
 
 }  // namespace ssx

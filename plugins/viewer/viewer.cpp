@@ -10,16 +10,23 @@
 // Steering the run: {"type":"pause"}, {"type":"resume"}, {"type":"step"} (one step while paused) and
 // {"type":"rate","factor":F} (the real-time factor of a real-time run), through Environment::runControl.
 //
+// After the poses: uint32 L, then L bytes of JSON (L = 0: none), {"details":[...]}: for each body
+// a page has selected ({"type":"select","body":I}, asked again each second, forgotten 3 s after
+// the last), its name, linear and angular velocity (world frame), current command
+// (ssx::commandJson) and latest measurements (ssx::measurementJson, with the sensor's class).
+//
 // Teleoperation: a page sends {"type":"velocity","body":I,"v":[vx,vy,vz],"yaw_rate":W} (m/s in the
-// world frame, rad/s) while a key or stick is held; before the next step the body's driver gets it
-// as a velocity-level command (ssx::CommandInterface). No message for 0.5 s of the wall clock
-// (a key released, a page gone) stops the robot: velocity 0, where it is.
+// world frame, rad/s), or with "all":true instead of a body for every robot whose driver takes
+// velocity commands (the whole formation, moved as one), while a key or stick is held; before the
+// next step the drivers get it as a velocity-level command (ssx::CommandInterface). No message for
+// 0.5 s of the wall clock (a key released, a page gone) stops the robots: velocity 0, where they are.
 //
 // Parameters: kParameters below, or `ssx plugins --params viewer`.
 #include "viewer_server.hpp"
 
 #include <ssx/command.hpp>
 #include <ssx/environment.hpp>
+#include <ssx/measurements.hpp>
 #include <ssx/plugin_abi.hpp>
 
 #include <algorithm>
@@ -74,6 +81,8 @@ const char* kindName(RenderNodeSpec::Primitive p) {
   return "";
 }
 
+using viewer::jsonNumber;
+
 // the shapes of a render tree, each posed in `frame` (a body's root, or the world)
 void shapes(std::string& out, const RenderNodeSpec& n, const Pose& parent, bool& first) {
   const Pose pose = parent * n.pose;
@@ -100,28 +109,6 @@ void shapes(std::string& out, const RenderNodeSpec& n, const Pose& parent, bool&
     out += '}';
   }
   for (const auto& c : n.children) shapes(out, c, pose, first);
-}
-
-// the number after `"key":` (or after `"key":[` and `index` commas), or nothing
-std::optional<double> jsonNumber(const std::string& text, const char* key, int index = -1) {
-  const std::string quoted = std::string("\"") + key + "\":";
-  auto at = text.find(quoted);
-  if (at == std::string::npos) return std::nullopt;
-  at += quoted.size();
-  if (index >= 0) {
-    if (at >= text.size() || text[at] != '[') return std::nullopt;
-    ++at;
-    for (int i = 0; i < index; ++i) {
-      at = text.find(',', at);
-      if (at == std::string::npos) return std::nullopt;
-      ++at;
-    }
-  }
-  const char* begin = text.c_str() + at;
-  char* end = nullptr;
-  const double v = std::strtod(begin, &end);
-  if (end == begin || !std::isfinite(v)) return std::nullopt;
-  return v;
 }
 
 }  // namespace
@@ -174,20 +161,19 @@ class Viewer final : public SimulationExtension {
 
   // a page's command enters the simulation here, before the step's drivers
   void beforeStep(Environment&) override {
-    std::lock_guard lock(teleop_mutex_);
-    if (teleop_.body < 0 || teleop_.body >= static_cast<int>(nodes_.size())) return;
-    auto* driver = dynamic_cast<CommandInterface*>(
-        const_cast<Artifact&>(nodes_[static_cast<std::size_t>(teleop_.body)]->artifact()).driver());
-    if (driver == nullptr) return;
+    std::lock_guard lock(mutex_);
+    if (teleop_.body < 0 && !teleop_.all) return;
     const auto now = std::chrono::steady_clock::now();
     if (now - teleop_.received > std::chrono::milliseconds(500)) {  // the dead-man rule
-      driver->setCommand(Command::velocityYawRate(Vec3::Zero(), 0));
+      forEachSteered([](CommandInterface& driver) { driver.setCommand(Command::velocityYawRate(Vec3::Zero(), 0)); });
       teleop_.body = -1;
+      teleop_.all = false;
       ++teleop_stops_;
       return;
     }
     if (!teleop_.fresh) return;
-    driver->setCommand(Command::velocityYawRate(teleop_.velocity, teleop_.yaw_rate));
+    const Command command = Command::velocityYawRate(teleop_.velocity, teleop_.yaw_rate);
+    forEachSteered([&](CommandInterface& driver) { driver.setCommand(command); });
     teleop_.fresh = false;
     delays_ms_.push_back(std::chrono::duration<double, std::milli>(now - teleop_.received).count());
   }
@@ -197,7 +183,7 @@ class Viewer final : public SimulationExtension {
       // the bodies exist from the first step on: each artifact's first dynamic root, as the
       // recorder has them; the pages get the scene with them now
       begun_ = true;
-      std::lock_guard lock(teleop_mutex_);  // (pages' commands look the bodies up)
+      std::lock_guard lock(mutex_);  // (pages' commands look the bodies up)
       for (std::size_t i = 0; i < env.artifactCount(); ++i) {
         const Artifact& a = std::as_const(env).artifact(i);
         for (std::size_t r = 0; r < a.rootCount(); ++r) {
@@ -235,6 +221,12 @@ class Viewer final : public SimulationExtension {
       for (const double v : {pose.position.x(), pose.position.y(), pose.position.z(), q.x(), q.y(), q.z(), q.w()})
         *f++ = static_cast<float>(v);
     }
+    const std::string details = detailsJson(env, now);
+    const std::uint32_t length = static_cast<std::uint32_t>(details.size());
+    const std::size_t at = frame_.size();
+    frame_.resize(at + 4 + details.size());
+    std::memcpy(frame_.data() + at, &length, 4);
+    std::memcpy(frame_.data() + at + 4, details.data(), details.size());
     server_->publish(frame_);
   }
 
@@ -272,19 +264,28 @@ class Viewer final : public SimulationExtension {
       control_->setRealtimeFactor(*factor);
       return true;
     }
+    if (text.find(R"("type":"select")") != std::string::npos) {
+      const auto body = jsonNumber(text, "body");
+      std::lock_guard lock(mutex_);
+      if (!body || *body < 0 || *body != std::floor(*body) || *body >= static_cast<double>(nodes_.size())) return false;
+      const int index = static_cast<int>(*body);
+      if (watched_.size() >= kMaxWatched && watched_.count(index) == 0) return false;
+      watched_[index] = std::chrono::steady_clock::now();
+      return true;
+    }
     if (text.find(R"("type":"velocity")") == std::string::npos) return false;
-    const auto body = jsonNumber(text, "body");
+    const bool all = text.find(R"("all":true)") != std::string::npos;
+    const auto body = all ? std::optional<double>(0) : jsonNumber(text, "body");
     const auto vx = jsonNumber(text, "v", 0), vy = jsonNumber(text, "v", 1), vz = jsonNumber(text, "v", 2);
     const auto yaw_rate = jsonNumber(text, "yaw_rate");
     if (!body || !vx || !vy || !vz || !yaw_rate || *body < 0 || *body != std::floor(*body)) return false;
     const Vec3 v(*vx, *vy, *vz);
     if (v.norm() > kMaxSpeed || std::abs(*yaw_rate) > kMaxYawRate) return false;
-    std::lock_guard lock(teleop_mutex_);
+    std::lock_guard lock(mutex_);
     if (*body >= static_cast<double>(nodes_.size())) return false;
-    const int index = static_cast<int>(*body);
-    const auto* driver = dynamic_cast<const CommandInterface*>(nodes_[static_cast<std::size_t>(index)]->artifact().driver());
-    if (driver == nullptr || !driver->acceptsCommand(CommandLevel::Velocity)) return false;
-    teleop_ = {index, v, *yaw_rate, std::chrono::steady_clock::now(), true};
+    const int index = all ? -1 : static_cast<int>(*body);
+    if (steerable(all ? std::nullopt : std::optional<std::size_t>(static_cast<std::size_t>(*body))) == 0) return false;
+    teleop_ = {index, all, v, *yaw_rate, std::chrono::steady_clock::now(), true};
     return true;
   }
 
@@ -293,6 +294,69 @@ class Viewer final : public SimulationExtension {
   }
 
  private:
+  static CommandInterface* velocityDriver(const PhysicNode& node) {
+    auto* driver = dynamic_cast<CommandInterface*>(const_cast<Artifact&>(node.artifact()).driver());
+    return driver != nullptr && driver->acceptsCommand(CommandLevel::Velocity) ? driver : nullptr;
+  }
+
+  // how many robots a command to `body` (nothing: all) would steer (under mutex_)
+  std::size_t steerable(std::optional<std::size_t> body) const {
+    if (body) return velocityDriver(*nodes_[*body]) != nullptr ? 1 : 0;
+    return static_cast<std::size_t>(
+        std::count_if(nodes_.begin(), nodes_.end(), [](const PhysicNode* n) { return velocityDriver(*n) != nullptr; }));
+  }
+
+  // each driver the current teleoperation steers (under mutex_, on the stepping thread)
+  template <class F>
+  void forEachSteered(F&& f) {
+    for (std::size_t i = 0; i < nodes_.size(); ++i) {
+      if (!teleop_.all && static_cast<int>(i) != teleop_.body) continue;
+      if (CommandInterface* driver = velocityDriver(*nodes_[i])) f(*driver);
+    }
+  }
+
+  // the details of the bodies pages have selected, for the frame (stepping thread)
+  std::string detailsJson(const Environment& env, std::chrono::steady_clock::time_point now) {
+    std::vector<int> bodies;
+    {
+      std::lock_guard lock(mutex_);
+      std::erase_if(watched_, [&](const auto& w) { return now - w.second > std::chrono::seconds(3); });
+      for (const auto& w : watched_) bodies.push_back(w.first);
+    }
+    if (bodies.empty()) return {};
+    std::string out = R"({"details":[)";
+    for (const int b : bodies) {
+      const PhysicNode& node = *nodes_[static_cast<std::size_t>(b)];
+      const Artifact& a = node.artifact();
+      const BodyState s = env.bodyState(node.bodyIndex());
+      out += out.back() == '[' ? "" : ",";
+      out += R"({"body":)" + std::to_string(b) + R"(,"name":)";
+      string(out, names_[static_cast<std::size_t>(b)]);
+      out += R"(,"v":[)";
+      number(out, s.linear_velocity.x()), out += ',', number(out, s.linear_velocity.y()), out += ',';
+      number(out, s.linear_velocity.z());
+      out += R"(],"w":[)";
+      number(out, s.angular_velocity.x()), out += ',', number(out, s.angular_velocity.y()), out += ',';
+      number(out, s.angular_velocity.z());
+      out += R"(],"command":)";
+      const auto* commandable = dynamic_cast<const CommandInterface*>(a.driver());
+      out += commandable != nullptr ? commandJson(commandable->currentCommand()) : "null";
+      out += R"(,"sensors":[)";
+      bool first = true;
+      for (std::size_t k = 0; k < a.sensorCount(); ++k) {
+        const std::string m = measurementJson(a.sensor(k).latest(), env);
+        if (m.size() < 2) continue;
+        out += first ? "" : ",";
+        first = false;
+        out += R"({"sensor":)";
+        string(out, a.sensor(k).className());
+        out += ',' + m.substr(1);
+      }
+      out += "]}";
+    }
+    return out + "]}";
+  }
+
   // the scene for a page: the models (render trees, each in its body's frame), the bodies with
   // their model, and what is fixed in the world
   std::string sceneJson(const Environment& env) const {
@@ -349,17 +413,21 @@ class Viewer final : public SimulationExtension {
   double last_sim_ = -1;
   std::uint32_t late_ = 0;
   bool begun_ = false;
-  // teleoperation: the newest command from a page (under teleop_mutex_; nodes_ is fixed once begun)
+  // what pages asked (under mutex_; nodes_ is fixed once begun): the newest teleoperation command,
+  // the bodies whose details they see
   static constexpr double kMaxSpeed = 20, kMaxYawRate = 10;
+  static constexpr std::size_t kMaxWatched = 64;
   struct Teleop {
-    int body = -1;
+    int body = -1;  // -1 and not all: none
+    bool all = false;
     Vec3 velocity = Vec3::Zero();
     double yaw_rate = 0;
     std::chrono::steady_clock::time_point received;
     bool fresh = false;
   };
-  std::mutex teleop_mutex_;
+  std::mutex mutex_;
   Teleop teleop_;
+  std::map<int, std::chrono::steady_clock::time_point> watched_;
   std::vector<double> delays_ms_;  // from a command's arrival to the step that used it
   std::uint64_t teleop_stops_ = 0;
   std::string url_;

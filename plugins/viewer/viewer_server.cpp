@@ -4,6 +4,8 @@
 #include <civetweb.h>
 
 #include <chrono>
+#include <cmath>
+#include <cstdlib>
 #include <cstring>
 #include <stdexcept>
 
@@ -17,6 +19,8 @@ struct Server::Client {
   std::uint64_t hello_seq = 0;  // the scene this page has
   std::uint64_t first_seq = 0;  // the newest frame when it connected
   std::uint64_t sent = 0;       // frames sent to it
+  std::chrono::duration<double> period{0};  // the least time between two frames the page asked for
+  std::chrono::steady_clock::time_point next_send;
   // the page's message rate: messages in the current second
   std::chrono::steady_clock::time_point window;
   int messages = 0;
@@ -32,6 +36,27 @@ std::string queryValue(const char* query, const char* key) {
 }
 
 }  // namespace
+
+std::optional<double> jsonNumber(const std::string& text, const char* key, int index) {
+  const std::string quoted = std::string("\"") + key + "\":";
+  auto at = text.find(quoted);
+  if (at == std::string::npos) return std::nullopt;
+  at += quoted.size();
+  if (index >= 0) {
+    if (at >= text.size() || text[at] != '[') return std::nullopt;
+    ++at;
+    for (int i = 0; i < index; ++i) {
+      at = text.find(',', at);
+      if (at == std::string::npos) return std::nullopt;
+      ++at;
+    }
+  }
+  const char* begin = text.c_str() + at;
+  char* end = nullptr;
+  const double v = std::strtod(begin, &end);
+  if (end == begin || !std::isfinite(v)) return std::nullopt;
+  return v;
+}
 
 Server::Server(const std::string& bind, int port, std::string token, int max_clients, std::vector<Asset> assets,
                std::string hello, MessageHandler on_message)
@@ -159,6 +184,13 @@ void Server::sendLoop(const std::shared_ptr<Client>& client) {
         client->hello_seq = hello_seq_;
         hello = hello_;
       } else {
+        const auto now = std::chrono::steady_clock::now();
+        if (now < client->next_send) {  // at the page's rate: the newest frame when its time comes
+          changed_.wait_until(lock, client->next_send,
+                              [&] { return client->closed || stopping_ || hello_seq_ > client->hello_seq; });
+          continue;
+        }
+        client->next_send = now + std::chrono::duration_cast<std::chrono::steady_clock::duration>(client->period);
         client->sent_seq = newest_seq_;
         frame = newest_;
       }
@@ -202,7 +234,15 @@ int Server::onData(mg_connection* conn, int opcode, char* data, std::size_t size
     }
     take = ++client->messages <= kMaxMessagesPerSecond;
   }
-  if (take) take = s.on_message_ && s.on_message_(std::string(data, size));
+  std::string text(take ? data : "", take ? size : 0);
+  if (take && text.find(R"("type":"hello")") != std::string::npos) {
+    if (const auto rate = jsonNumber(text, "rate_hz")) {
+      take = *rate > 0 && *rate <= 240;
+      std::lock_guard lock(s.mutex_);
+      if (take) client->period = std::chrono::duration<double>(1.0 / *rate);
+    }
+  }
+  if (take) take = s.on_message_ && s.on_message_(text);
   if (!take) {
     std::lock_guard lock(s.mutex_);
     ++s.counts_.messages_dropped;

@@ -4,7 +4,8 @@
 //
 // Never slows the simulation: publish() copies a frame into the newest-frame slot under a mutex and
 // returns; each client has a thread of its own that sends the newest frame it has not sent yet, so
-// a slow or stalled page skips frames (counted) and holds up nobody. Bounded: at most max_clients
+// a slow or stalled page skips frames (counted) and holds up nobody. A page may ask for fewer
+// frames: {"type":"hello","rate_hz":R} (0 < R <= 240) sends it at most R a second. Bounded: at most max_clients
 // pages; messages from a page larger than kMaxMessage bytes, more than kMaxMessagesPerSecond a
 // second, or not understood are dropped and counted.
 #include <atomic>
@@ -15,6 +16,7 @@
 #include <list>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <string>
 #include <thread>
 #include <vector>
@@ -23,6 +25,10 @@ struct mg_context;
 struct mg_connection;
 
 namespace ssx::viewer {
+
+/// The number after `"key":` in a page's JSON message (or, with `index`, the index-th number of
+/// the array after it); nothing when missing or not a finite number.
+std::optional<double> jsonNumber(const std::string& text, const char* key, int index = -1);
 
 /// A file the server serves.
 struct Asset {

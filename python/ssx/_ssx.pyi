@@ -95,6 +95,8 @@ class Environment:
     @property
     def recording(self) -> bool:
         """Whether a recording is running."""
+    def view(self, port: int = 8765, bind: str = "127.0.0.1", rate_hz: float = 30.0, max_clients: int = 4) -> str:
+        """Serves a live 3D view to web browsers (as ssx run --view); returns its URL. Before the first step or run."""
     def close(self) -> None:
         """Stops the environment: a recording finished, plugins destroyed, files and videos finished."""
     def __enter__(self) -> "Environment": ...

@@ -42,6 +42,12 @@ SSX_EXPORT const char* commandLevelName(CommandLevel level);
 /// The level of that name; nothing for another name.
 SSX_EXPORT std::optional<CommandLevel> commandLevelFromName(std::string_view name);
 
+struct Command;
+/// A command as a JSON object: `{"level":"velocity","values":[...]}`, the values in the column
+/// order of Python's set_commands (Command::toRow), as the recorder's `/ssx/commands` channel and
+/// the viewer have it.
+SSX_EXPORT std::string commandJson(const Command& command);
+
 /// One command at one level; only the fields of its level are read.
 struct SSX_EXPORT Command {
   CommandLevel level = CommandLevel::Position;  ///< which of the fields below are read

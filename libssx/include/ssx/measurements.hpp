@@ -12,6 +12,7 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <string>
 #include <vector>
 
 namespace ssx {
@@ -69,6 +70,16 @@ struct SSX_EXPORT CameraMeasurement : Measurement {
   ~CameraMeasurement() override;
   bool finite() const noexcept override;
 };
+
+class Environment;
+
+/// A measurement as a JSON object, as the recorder's `/ssx/sensors` channel and the viewer have it:
+/// `{"kind":"imu","stamp":S,"accelerometer":[..],"gyroscope":[..]}` (sensor frame),
+/// `{"kind":"pose",..,"position","orientation" (w x y z),"linear_velocity","angular_velocity"}`
+/// (world frame) or `{"kind":"range",..,"frame":"body"|"world","detections":[{"seen":NAME,
+/// "obstacle":B,"relative":[..],"distance":D}]}`; "" for kinds without one (clock, camera images).
+/// `env` names the artifacts a range measurement saw.
+SSX_EXPORT std::string measurementJson(const Measurement& m, const Environment& env);
 
 /// Measurements into and out of a saved state (for sensors' and drivers' saveState / loadState).
 inline void save(StateWriter& out, const ClockMeasurement& m) {

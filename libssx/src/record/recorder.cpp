@@ -77,66 +77,6 @@ std::string timingJson(const StepTiming& t, std::size_t contacts) {
   return out + "}";
 }
 
-void appendArray(std::string& out, const char* name, std::initializer_list<double> values) {
-  out += '"';
-  out += name;
-  out += "\":[";
-  bool first = true;
-  for (const double v : values) {
-    if (!first) out += ',';
-    first = false;
-    detail::appendNumber(out, v);
-  }
-  out += ']';
-}
-
-// one measurement as a JSON object, or "" for kinds not recorded (clock, camera images)
-std::string measurementJson(const Environment& env, const Measurement& m) {
-  std::string out;
-  if (const auto* imu = dynamic_cast<const ImuMeasurement*>(&m)) {
-    out = R"({"kind":"imu","stamp":)";
-    detail::appendNumber(out, toSeconds(m.stamp));
-    out += ',';
-    appendArray(out, "accelerometer", {imu->accelerometer.x(), imu->accelerometer.y(), imu->accelerometer.z()});
-    out += ',';
-    appendArray(out, "gyroscope", {imu->gyroscope.x(), imu->gyroscope.y(), imu->gyroscope.z()});
-  } else if (const auto* pose = dynamic_cast<const PoseMeasurement*>(&m)) {
-    const Pose& p = pose->pose;
-    out = R"({"kind":"pose","stamp":)";
-    detail::appendNumber(out, toSeconds(m.stamp));
-    out += ',';
-    appendArray(out, "position", {p.position.x(), p.position.y(), p.position.z()});
-    out += ',';
-    appendArray(out, "orientation", {p.orientation.w(), p.orientation.x(), p.orientation.y(), p.orientation.z()});
-    out += ',';
-    appendArray(out, "linear_velocity", {pose->linear_velocity.x(), pose->linear_velocity.y(), pose->linear_velocity.z()});
-    out += ',';
-    appendArray(out, "angular_velocity",
-                {pose->angular_velocity.x(), pose->angular_velocity.y(), pose->angular_velocity.z()});
-  } else if (const auto* range = dynamic_cast<const RangeMeasurement*>(&m)) {
-    out = R"({"kind":"range","stamp":)";
-    detail::appendNumber(out, toSeconds(m.stamp));
-    out += range->body_frame ? R"(,"frame":"body","detections":[)" : R"(,"frame":"world","detections":[)";
-    bool first = true;
-    for (const auto& d : range->detections) {
-      if (!first) out += ',';
-      first = false;
-      out += R"({"seen":)";
-      detail::appendString(out, d.artifact < env.artifactCount() ? std::as_const(env).artifact(d.artifact).name()
-                                                                 : std::string());
-      out += d.obstacle ? R"(,"obstacle":true,)" : R"(,"obstacle":false,)";
-      appendArray(out, "relative", {d.relative.x(), d.relative.y(), d.relative.z()});
-      out += R"(,"distance":)";
-      detail::appendNumber(out, d.distance);
-      out += '}';
-    }
-    out += ']';
-  } else {
-    return {};
-  }
-  return out + "}";
-}
-
 // /ssx/sensors: {"<artifact>": {"0": {measurement}, ...}, ...} for every artifact with a recorded kind
 std::string sensorsJson(const Environment& env) {
   std::string out = "{";
@@ -145,7 +85,7 @@ std::string sensorsJson(const Environment& env) {
     const Artifact& a = env.artifact(i);
     std::string body;
     for (std::size_t k = 0; k < a.sensorCount(); ++k) {
-      const std::string m = measurementJson(env, a.sensor(k).latest());
+      const std::string m = measurementJson(a.sensor(k).latest(), env);
       if (m.empty()) continue;
       if (!body.empty()) body += ',';
       body += '"' + std::to_string(k) + "\":" + m;
@@ -167,19 +107,10 @@ std::string commandsJson(const Environment& env) {
     const Artifact& a = env.artifact(i);
     const auto* commandable = dynamic_cast<const CommandInterface*>(a.driver());
     if (commandable == nullptr) continue;
-    const Command c = commandable->currentCommand();
     if (!first) out += ',';
     first = false;
     detail::appendString(out, a.name());
-    out += R"(:{"level":")";
-    out += commandLevelName(c.level);
-    out += R"(","values":[)";
-    const std::vector<double> row = c.toRow();
-    for (std::size_t k = 0; k < row.size(); ++k) {
-      if (k > 0) out += ',';
-      detail::appendNumber(out, row[k]);
-    }
-    out += "]}";
+    out += ':' + commandJson(commandable->currentCommand());
   }
   return out + "}";
 }

@@ -7,7 +7,8 @@ const state = {
   models: [],       // per model: [{mesh (InstancedMesh), local (Matrix4)}]
   slots: [],        // per body: its instance index in its model's meshes
   positions: null,  // Float32Array of the newest frame's 7 floats per body
-  previous: null, previousTime: 0, time: 0,
+  time: 0,
+  details: null,    // the selected robot's details from the simulation (velocities, command, sensors)
   selected: -1, frames: 0, fpsFrames: 0, fpsSince: performance.now(),
 };
 
@@ -67,7 +68,7 @@ function buildScene(msg) {
   for (const object of built) scene.remove(object);
   built.length = 0;
   const add = (object) => { scene.add(object); built.push(object); };
-  state.positions = state.previous = null;
+  state.positions = null;
   for (const shape of msg.world) {
     for (const g of geometries(shape)) {
       const mesh = new THREE.Mesh(g, material(shape));
@@ -110,10 +111,17 @@ function applyFrame(buffer) {
   if (view.getUint32(0, true) !== 0x46585353) return;
   const n = view.getUint32(4, true);
   if (n !== state.bodies.length) return;
-  state.previous = state.positions;
-  state.previousTime = state.time;
   state.time = view.getFloat64(8, true);
   state.positions = new Float32Array(buffer, 32, 7 * n);
+  // then the details of the bodies selected (JSON), when any
+  const at = 32 + 28 * n;
+  if (buffer.byteLength >= at + 4) {
+    const length = view.getUint32(at, true);
+    if (length > 0 && buffer.byteLength >= at + 4 + length) {
+      const details = JSON.parse(new TextDecoder().decode(new Uint8Array(buffer, at + 4, length))).details;
+      for (const d of details) if (d.body === state.selected) state.details = d;
+    }
+  }
   const p = state.positions;
   for (let i = 0; i < n; ++i) {
     const k = 7 * i;
@@ -132,18 +140,40 @@ function applyFrame(buffer) {
   showSelected();
 }
 
+const fixed = (values, digits = 2) => values.map((x) => x.toFixed(digits)).join(" ");
+
+// one measurement in a line (ssx::measurementJson's objects)
+function measurementText(m) {
+  switch (m.kind) {
+    case "imu": return `${m.sensor}: accelerometer ${fixed(m.accelerometer)} m/s², gyroscope ${fixed(m.gyroscope)} rad/s`;
+    case "pose": return `${m.sensor}: position ${fixed(m.position)} m, velocity ${fixed(m.linear_velocity)} m/s`;
+    case "range": {
+      const nearest = m.detections.reduce((d, x) => Math.min(d, x.distance), Infinity);
+      return `${m.sensor}: ${m.detections.length} in range` + (m.detections.length ? `, nearest ${nearest.toFixed(2)} m` : "");
+    }
+  }
+  return `${m.sensor}: ${m.kind}`;
+}
+
 function showSelected() {
   const i = state.selected;
   if (i < 0 || !state.positions) return;
   const p = state.positions, k = 7 * i;
-  let text = `${state.bodies[i].name}\nposition ${p[k].toFixed(2)} ${p[k + 1].toFixed(2)} ${p[k + 2].toFixed(2)} m`;
-  if (state.previous && state.time > state.previousTime) {
-    const dt = state.time - state.previousTime, q = state.previous;
-    const v = [0, 1, 2].map((a) => (p[k + a] - q[k + a]) / dt);
-    text += `\nvelocity ${v.map((x) => x.toFixed(2)).join(" ")} m/s`;
+  // the pose as drawn; the rest from the simulation's details of this robot (at most a frame older)
+  const euler = new THREE.Euler().setFromQuaternion(new THREE.Quaternion(p[k + 3], p[k + 4], p[k + 5], p[k + 6]), "ZYX");
+  const lines = [state.bodies[i].name, `position ${fixed([p[k], p[k + 1], p[k + 2]])} m`,
+                 `roll pitch yaw ${fixed([euler.x, euler.y, euler.z].map((a) => (a * 180) / Math.PI), 1)}°`];
+  const d = state.details && state.details.body === i ? state.details : null;
+  if (d) {
+    lines.push(`velocity ${fixed(d.v)} m/s`, `angular velocity ${fixed(d.w)} rad/s`);
+    if (d.command) {
+      lines.push(`command (${d.command.level}) ${fixed(d.command.values)}`);
+      if (d.command.level === "velocity")
+        lines.push(`commanded ${fixed(d.command.values.slice(0, 3))} m/s, achieved ${fixed(d.v)} m/s`);
+    }
+    for (const m of d.sensors) lines.push(measurementText(m));
   }
-  if (teleop.sent) text += `\ncommanded ${teleop.sent.map((x) => x.toFixed(2)).join(" ")} m/s`;
-  document.getElementById("selected").textContent = text;
+  document.getElementById("selected").textContent = lines.join("\n");
   if (document.getElementById("follow").checked) controls.target.set(p[k], p[k + 1], p[k + 2]);
 }
 
@@ -159,14 +189,17 @@ renderer.domElement.addEventListener("click", (event) => {
 
 function select(i) {
   state.selected = i;
+  state.details = null;
   teleop.sent = null;
+  teleop.asked = 0;  // its details asked for at once (then each second)
   showSelected();
 }
 
-// teleoperation of the selected robot: W/S (or the arrows) forward and back along the view, A/D
-// sideways, R/F up and down, Q/E turn; or a gamepad's sticks. Sent 20 times a second while held; the
-// simulation stops the robot when nothing comes for 0.5 s (the dead-man rule).
-const teleop = { keys: new Set(), socket: null, sent: null, last: 0 };
+// teleoperation of the selected robot, or of every robot (the formation): W/S (or the arrows)
+// forward and back along the view, A/D sideways, R/F up and down, Q/E turn; or a gamepad's sticks.
+// Sent 20 times a second while held; the simulation stops the robots when nothing comes for 0.5 s
+// (the dead-man rule).
+const teleop = { keys: new Set(), socket: null, sent: null, last: 0, asked: 0 };
 const kSpeed = 1.0, kClimb = 0.5, kTurn = 0.8;
 window.addEventListener("keydown", (e) => { teleop.keys.add(e.key.toLowerCase()); });
 window.addEventListener("keyup", (e) => { teleop.keys.delete(e.key.toLowerCase()); });
@@ -196,13 +229,20 @@ function teleopCommand() {
 
 function teleopTick(now) {
   const socket = teleop.socket;
-  if (!socket || socket.readyState !== 1 || state.selected < 0) return;
+  if (!socket || socket.readyState !== 1) return;
+  if (state.selected >= 0 && now - teleop.asked >= 1000) {  // the selected robot's details, for 3 s more
+    teleop.asked = now;
+    socket.send(JSON.stringify({ type: "select", body: state.selected }));
+  }
+  const all = document.getElementById("steer_all").checked;
+  if (state.selected < 0 && !all) return;
   const c = teleopCommand();
   if (!c && !teleop.sent) return;
   if (now - teleop.last < 45) return;
   teleop.last = now;
   const command = c || [0, 0, 0, 0];  // released: stop now (the dead-man rule would in 0.5 s)
-  socket.send(JSON.stringify({ type: "velocity", body: state.selected, v: command.slice(0, 3), yaw_rate: command[3] }));
+  const target = all ? { all: true } : { body: state.selected };
+  socket.send(JSON.stringify({ type: "velocity", ...target, v: command.slice(0, 3), yaw_rate: command[3] }));
   teleop.sent = c ? command.slice(0, 3) : null;
 }
 
@@ -220,12 +260,17 @@ document.getElementById("step").addEventListener("click", () => send({ type: "st
 document.getElementById("factor").addEventListener("change", (e) => send({ type: "rate", factor: Number(e.target.value) }));
 
 function connect() {
-  const token = new URLSearchParams(location.search).get("token");
+  const query = new URLSearchParams(location.search), token = query.get("token");
   const socket = new WebSocket(`ws://${location.host}/ws${token ? "?token=" + encodeURIComponent(token) : ""}`);
   teleop.socket = socket;
   socket.binaryType = "arraybuffer";
   const status = document.getElementById("status");
-  socket.onopen = () => { status.textContent = ""; socket.send(JSON.stringify({ type: "hello" })); };
+  // ?rate=R asks for at most R frames a second (the run's rate_hz otherwise)
+  const rate = Number(query.get("rate"));
+  socket.onopen = () => {
+    status.textContent = "";
+    socket.send(JSON.stringify(rate > 0 ? { type: "hello", rate_hz: rate } : { type: "hello" }));
+  };
   socket.onmessage = (event) => {
     if (typeof event.data === "string") {
       const msg = JSON.parse(event.data);
