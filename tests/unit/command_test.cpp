@@ -45,3 +45,9 @@ TEST_CASE("a command's row is the row it was read from (position: all 11 columns
   CHECK(Command::fromRow(CommandLevel::Position, short_position).toRow() ==
         std::vector<double>{1, 2, 3, 0.5, 0, 0, 0, 0, 0, 0, 0});
 }
+
+TEST_CASE("a command as JSON: its level's name and its row", "[command]") {
+  CHECK(commandJson(Command::velocityYawRate(Vec3(0.5, -1, 0.25), 0.1)) ==
+        R"({"level":"velocity","values":[0.5,-1,0.25,0.1]})");
+  CHECK(commandJson(Command::rotors({400, 410.5})) == R"({"level":"rotors","values":[400,410.5]})");
+}

@@ -1,5 +1,6 @@
 // Measurements: each kind says whether its numbers are finite, so that the environment can stop a
 // sensor that writes a NaN before anyone reads it; a camera's +infinity depth is no such number.
+#include <ssx/environment.hpp>
 #include <ssx/measurements.hpp>
 
 #include <catch2/catch.hpp>
@@ -55,4 +56,23 @@ TEST_CASE("measurements: a camera image with depth +infinity where nothing was h
   CHECK(camera.finite());
   camera.view.pose.position.x() = kNaN;
   CHECK_FALSE(camera.finite());
+}
+
+TEST_CASE("measurements as JSON: IMU and range readings with their kind and stamp; none for a clock", "[measurements]") {
+  const Environment env;
+  ImuMeasurement imu;
+  imu.stamp = 1'500'000'000;
+  imu.accelerometer = Vec3(0, 0.5, 9.75);
+  imu.gyroscope = Vec3(-1, 0, 0.25);
+  CHECK(measurementJson(imu, env) ==
+        R"({"kind":"imu","stamp":1.5,"accelerometer":[0,0.5,9.75],"gyroscope":[-1,0,0.25]})");
+  RangeMeasurement range;
+  range.detections.push_back({});
+  range.detections.back().artifact = 7;  // not in this environment: no name
+  range.detections.back().distance = 2;
+  const std::string text = measurementJson(range, env);
+  CHECK(text.find(R"("kind":"range")") != std::string::npos);
+  CHECK(text.find(R"({"seen":"","obstacle":false,)") != std::string::npos);
+  CHECK(text.find(R"("distance":2})") != std::string::npos);
+  CHECK(measurementJson(ClockMeasurement{}, env).empty());
 }
