@@ -150,6 +150,15 @@ CommandLine parseCommandLine(int argc, const char* const* argv, std::ostream& ou
                          "PATH=VALUE: an attribute of the recorded scene set for the re-simulation, as a sweep sets it "
                          "(repeatable)");
   replay_cmd->add_option("--record", c.replay.record, "record the re-simulation into FILE");
+  auto* replay_view = replay_cmd
+                          ->add_option("--view", c.replay.view,
+                                       "play the recording in web browsers at http://127.0.0.1:PORT/, with a time slider "
+                                       "(default 8765; 0: a free port); until Ctrl-C")
+                          ->expected(0, 1)
+                          ->check(CLI::Range(0, 65535));
+  replay_cmd->add_option("--view-bind", c.replay.view_bind,
+                         "address the page is served on (default 127.0.0.1; another prints a token the page's URL needs)")
+      ->needs(replay_view);
 
   try {
     app.parse(argc, argv);
@@ -178,6 +187,14 @@ CommandLine parseCommandLine(int argc, const char* const* argv, std::ostream& ou
     c.command = CommandLine::Command::Inspect;
   } else if (*replay_cmd) {
     c.command = CommandLine::Command::Replay;
+    if (replay_view->count() > 0 && (replay_view->results().empty() || replay_view->results().front().empty()))
+      c.replay.view = 8765;
+    const ReplayArgs& r = c.replay;
+    if (r.view >= 0 && (r.resimulate_from >= 0 || !r.snapshot.empty() || !r.video.empty() || !r.frames.empty())) {
+      err << "ssx replay: --view plays the recording on a page: it does not go with --resimulate-from, --snapshot, "
+             "--video or --frames\n";
+      c.exit_status = kExitBadInput;
+    }
     if (c.replay.resimulate_from < 0 && (!c.replay.set.empty() || !c.replay.record.empty() || c.replay.duration > 0)) {
       err << "ssx replay: --set, --record and --duration need --resimulate-from\n";
       c.exit_status = kExitBadInput;

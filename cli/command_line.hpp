@@ -79,6 +79,8 @@ struct ReplayArgs {
   double duration = -1;         // of a re-simulation; < 0: to the recording's end
   std::vector<std::string> set;  // PATH=VALUE overrides of the recorded scene, for a re-simulation
   std::string record;           // record the re-simulation
+  int view = -1;                // play it on a page at this port (0: a free one); < 0: no
+  std::string view_bind = "127.0.0.1";
 };
 
 struct CommandLine {

@@ -3,11 +3,15 @@
 #include <ssx/ssx.hpp>
 
 #include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <csignal>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
 #include <sstream>
+#include <thread>
 
 namespace ssx::cli {
 
@@ -62,7 +66,8 @@ Scene buildRecorded(const Recording& r, const ReplayArgs& args, bool draw, int* 
     }
     options.overrides.push_back({s.substr(0, eq), s.substr(eq + 1), SourceLocation{"--set", 0}});
   }
-  if (draw) options.render_engine = "osmesa";
+  const bool pictures = draw && args.view < 0;  // (a page draws for itself)
+  if (pictures) options.render_engine = "osmesa";
   try {
     SceneModel model = parseSceneString(r.sceneXml(), r.sceneLabel().empty() ? "recorded scene" : r.sceneLabel(),
                                         fs::current_path(), options);
@@ -73,13 +78,13 @@ Scene buildRecorded(const Recording& r, const ReplayArgs& args, bool draw, int* 
     }
     // the outputs asked for, on the first camera: the follow camera, the scene's first, or one
     // framing every robot
-    if (draw && model.settings.render.cameras.empty() && args.follow.empty()) {
+    if (pictures && model.settings.render.cameras.empty() && args.follow.empty()) {
       CameraSpec all;
       all.name = "replay";
       all.frame_scene = true;
       model.settings.render.cameras.push_back(all);
     }
-    if (draw && !args.follow.empty()) {
+    if (pictures && !args.follow.empty()) {
       CameraSpec chase;
       chase.name = "follow";
       chase.follow = args.follow;
@@ -87,14 +92,14 @@ Scene buildRecorded(const Recording& r, const ReplayArgs& args, bool draw, int* 
       chase.look_at = Vec3::Zero();
       model.settings.render.cameras.insert(model.settings.render.cameras.begin(), chase);
     }
-    if (draw) {
+    if (pictures) {
       CameraSpec& first = model.settings.render.cameras.front();
       first.snapshot = args.snapshot;
       first.video = args.video;
       first.frames_dir = args.frames;
     }
     // frames at the recording's rate
-    if (draw && r.times().size() > 1) {
+    if (pictures && r.times().size() > 1) {
       const Nanoseconds interval = r.times()[1] - r.times()[0];
       if (interval > 0) model.settings.render.rate_hz = 1.0 / toSeconds(interval);
     }
@@ -222,6 +227,39 @@ int draw(const Recording& r, const ReplayArgs& args) {
     if (!c.frames_dir.empty()) std::cout << "camera " << c.name << ": " << drawn << " frames in " << c.frames_dir.string() << '\n';
   }
   return 0;
+}
+
+// --view: the recorded scene built, and the viewer extension playing the recording on a page (its
+// own thread, its own clock: viewer.cpp) until SIGINT or SIGTERM
+std::atomic<int> g_view_signal{0};
+
+int view(const Recording& r, const ReplayArgs& args) {
+  int status = 0;
+  Scene scene = buildRecorded(r, args, true, &status);
+  if (status != 0) return status;
+  Environment& env = *scene.environment;
+  try {
+    Descriptor params("viewer", {"--view", 0});
+    params.set("port", static_cast<std::int64_t>(args.view)).set("bind", args.view_bind).set("recording", args.file);
+    env.addExtension("viewer", env.classLoader().createExtension("viewer", "viewer"), params);
+    env.start();
+  } catch (const std::exception& e) {
+    std::cerr << "ssx: error: --view: " << e.what() << '\n';
+    return kExitBadInput;
+  }
+  std::signal(SIGINT, [](int sig) { g_view_signal = sig; });
+  std::signal(SIGTERM, [](int sig) { g_view_signal = sig; });
+  try {
+    env.step(1);  // the bodies exist from the first step on: the viewer takes them, and the scene, then
+    std::cerr << "ssx replay: playing " << args.file << " (" << r.names().size() << " bodies, " << seconds(r.times().front())
+              << " to " << seconds(r.times().back()) << ") on the page until Ctrl-C\n";
+    while (g_view_signal == 0) std::this_thread::sleep_for(std::chrono::milliseconds(100));
+    env.stop();
+  } catch (const std::exception& e) {
+    std::cerr << "ssx: error: " << e.what() << '\n';
+    return kExitRunFailure;
+  }
+  return 128 + g_view_signal;
 }
 
 int resimulate(const Recording& r, const ReplayArgs& args) {
@@ -388,6 +426,7 @@ int commandReplay(const ReplayArgs& args) {
   }
   try {
     const Recording r(args.file);
+    if (args.view >= 0) return view(r, args);
     return args.resimulate_from >= 0 ? resimulate(r, args) : draw(r, args);
   } catch (const std::exception& e) {
     std::cerr << "ssx: error: " << e.what() << '\n';

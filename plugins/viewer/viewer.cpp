@@ -21,16 +21,25 @@
 // next step the drivers get it as a velocity-level command (ssx::CommandInterface). No message for
 // 0.5 s of the wall clock (a key released, a page gone) stops the robots: velocity 0, where they are.
 //
+// Replaying (`ssx replay FILE --view`, the parameter `recording`): the page gets the recorded
+// scene with "replay":{"start":S,"end":E} (s) and frames of the recorded poses, played by a thread
+// of the viewer's own on the wall clock (Playback): pause, resume, step (one sample), rate (the
+// speed) and {"type":"seek","time":T} (the page's slider). Nothing is steered; no details.
+//
 // Parameters: kParameters below, or `ssx plugins --params viewer`.
+#include "playback.hpp"
 #include "viewer_server.hpp"
 
 #include <ssx/command.hpp>
 #include <ssx/environment.hpp>
+#include <ssx/error.hpp>
 #include <ssx/measurements.hpp>
 #include <ssx/plugin_abi.hpp>
+#include <ssx/recording.hpp>
 
 #include <algorithm>
 #include <chrono>
+#include <condition_variable>
 #include <cmath>
 #include <cstring>
 #include <cstdlib>
@@ -40,6 +49,7 @@
 #include <optional>
 #include <random>
 #include <string>
+#include <thread>
 #include <vector>
 
 extern "C" {
@@ -124,6 +134,9 @@ class Viewer final : public SimulationExtension {
       param::real("rate_hz", "30", "Hz", param::positive() & param::atMost(240),
                   "frames sent to the pages per wall-clock second, at most"),
       param::integer("max_clients", "4", param::atLeast(1) & param::atMost(64), "pages connected at once, at most"),
+      param::text("recording", "",
+                  "play this recording (MCAP) on the page instead of the run, as ssx replay FILE --view does; "
+                  "default: none"),
   };
 
   void init(Environment& env, const Descriptor& params) override {
@@ -131,6 +144,15 @@ class Viewer final : public SimulationExtension {
     const int port = static_cast<int>(params.get<std::int64_t>("port"));
     const std::string bind = params.get<std::string>("bind");
     period_ = std::chrono::duration<double>(1.0 / params.get<double>("rate_hz"));
+    if (const std::string file = params.has("recording") ? params.get<std::string>("recording") : ""; !file.empty()) {
+      try {
+        recording_ = std::make_unique<Recording>(file);
+      } catch (const std::exception& e) {
+        throw params.error(std::string("viewer: ") + e.what());
+      }
+      if (recording_->times().empty()) throw params.error("viewer: " + file + " holds no pose sample to play");
+      playback_ = std::make_unique<viewer::Playback>(recording_->times());
+    }
     const bool loopback = bind == "127.0.0.1" || bind == "localhost";
     std::string token;
     if (!loopback) {
@@ -194,8 +216,13 @@ class Viewer final : public SimulationExtension {
           break;
         }
       }
+      if (recording_ && names_ != recording_->names())
+        throw Error("viewer: the recording's " + std::to_string(recording_->names().size()) +
+                    " bodies are not the scene's " + std::to_string(names_.size()) + " (a recording of another version?)");
       server_->setHello(sceneJson(env));
+      if (recording_) player_ = std::thread([this] { play(); });
     }
+    if (recording_) return;  // the frames are the recording's
     const TimingRecorder& timing = env.timing();
     if (timing.size() >= 2 && timing[timing.size() - 2].lateness > 0) ++late_;
     const auto now = std::chrono::steady_clock::now();
@@ -231,6 +258,7 @@ class Viewer final : public SimulationExtension {
   }
 
   void shutdown(Environment& env) override {
+    stopPlaying();
     if (!server_) return;
     const viewer::ServerCounts c = server_->counts();  // (with the pages still connected: what they missed)
     server_->stop();
@@ -254,6 +282,7 @@ class Viewer final : public SimulationExtension {
   // a page's message (on a server thread): true when understood
   bool onMessage(const std::string& text) {
     if (text.find(R"("type":"hello")") != std::string::npos) return true;
+    if (playback_) return onReplayMessage(text);
     // pause, single steps, resume and the real-time factor (Environment::runControl: any thread)
     if (text.find(R"("type":"pause")") != std::string::npos) return control_->pause(), true;
     if (text.find(R"("type":"resume")") != std::string::npos) return control_->resume(), true;
@@ -290,10 +319,83 @@ class Viewer final : public SimulationExtension {
   }
 
   ~Viewer() override {
+    stopPlaying();
     if (server_) server_->stop();
   }
 
  private:
+  // a page's message about the recording played: true when understood
+  bool onReplayMessage(const std::string& text) {
+    std::lock_guard lock(mutex_);
+    if (text.find(R"("type":"pause")") != std::string::npos) return playback_->pause(), true;
+    if (text.find(R"("type":"resume")") != std::string::npos) return playback_->resume(), true;
+    if (text.find(R"("type":"step")") != std::string::npos) return playback_->stepOnce(), true;
+    if (text.find(R"("type":"select")") != std::string::npos) return true;  // (a recording has no details to show)
+    if (text.find(R"("type":"rate")") != std::string::npos) {
+      const auto factor = jsonNumber(text, "factor");
+      return factor && playback_->setSpeed(*factor);
+    }
+    if (text.find(R"("type":"seek")") != std::string::npos) {
+      const auto t = jsonNumber(text, "time");
+      if (!t || *t < 0 || *t > 1e9) return false;
+      playback_->seek(toNanoseconds(*t));
+      return true;
+    }
+    return false;  // nothing to steer in a recording
+  }
+
+  // the playback thread: every period, the clock moved on and its sample sent (again at least
+  // once a second, for pages that connect while it stands still)
+  void play() {
+    auto last = std::chrono::steady_clock::now(), sent = last - std::chrono::hours(1);
+    std::size_t shown = static_cast<std::size_t>(-1);
+    bool shown_paused = false;
+    {
+      std::lock_guard lock(mutex_);
+      playback_->resume();
+    }
+    for (;;) {
+      std::size_t k = 0;
+      bool paused = false;
+      double speed = 1;
+      {
+        std::unique_lock lock(mutex_);
+        if (playing_cv_.wait_for(lock, period_, [this] { return stop_playing_; })) return;
+        const auto now = std::chrono::steady_clock::now();
+        playback_->advance(std::chrono::duration<double>(now - last).count());
+        last = now;
+        k = playback_->sample(), paused = playback_->paused(), speed = playback_->speed();
+      }
+      if (k == shown && paused == shown_paused && last - sent < std::chrono::seconds(1)) continue;
+      shown = k, shown_paused = paused, sent = last;
+      const std::vector<float> p = recording_->positions(k), q = recording_->orientations(k);  // (q: w x y z)
+      const std::uint32_t n = static_cast<std::uint32_t>(recording_->names().size());
+      std::vector<std::uint8_t> frame(36 + 28 * static_cast<std::size_t>(n), 0);  // (no details: L = 0)
+      std::uint8_t* out = frame.data();
+      const std::uint32_t magic = 0x46585353, late = 0;
+      const double t = toSeconds(recording_->times()[k]);
+      const float rate = paused ? 0.0f : static_cast<float>(speed);
+      const std::uint64_t sample = k;
+      std::memcpy(out, &magic, 4), std::memcpy(out + 4, &n, 4), std::memcpy(out + 8, &t, 8), std::memcpy(out + 16, &rate, 4);
+      std::memcpy(out + 20, &late, 4), std::memcpy(out + 24, &sample, 8);
+      float* f = reinterpret_cast<float*>(out + 32);
+      for (std::size_t i = 0; i < n; ++i) {
+        for (std::size_t a = 0; a < 3; ++a) *f++ = p[3 * i + a];
+        *f++ = q[4 * i + 1], *f++ = q[4 * i + 2], *f++ = q[4 * i + 3], *f++ = q[4 * i];
+      }
+      server_->publish(frame);
+    }
+  }
+
+  void stopPlaying() {
+    {
+      std::lock_guard lock(mutex_);
+      stop_playing_ = true;
+    }
+    playing_cv_.notify_all();
+    if (player_.joinable()) player_.join();
+  }
+
   static CommandInterface* velocityDriver(const PhysicNode& node) {
     auto* driver = dynamic_cast<CommandInterface*>(const_cast<Artifact&>(node.artifact()).driver());
     return driver != nullptr && driver->acceptsCommand(CommandLevel::Velocity) ? driver : nullptr;
@@ -399,6 +501,13 @@ class Viewer final : public SimulationExtension {
     }
     std::string out = R"({"type":"scene","time":)";
     number(out, toSeconds(env.time()));
+    if (playback_) {
+      out += R"(,"replay":{"start":)";
+      number(out, toSeconds(playback_->start()));
+      out += R"(,"end":)";
+      number(out, toSeconds(playback_->end()));
+      out += '}';
+    }
     out += R"(,"models":[)" + models + R"(],"bodies":[)" + bodies + R"(],"world":[)" + world + "]}";
     return out;
   }
@@ -431,6 +540,12 @@ class Viewer final : public SimulationExtension {
   std::vector<double> delays_ms_;  // from a command's arrival to the step that used it
   std::uint64_t teleop_stops_ = 0;
   std::string url_;
+  // replaying: the recording, its clock (under mutex_) and the thread that plays it
+  std::unique_ptr<Recording> recording_;
+  std::unique_ptr<viewer::Playback> playback_;
+  std::thread player_;
+  std::condition_variable playing_cv_;
+  bool stop_playing_ = false;
 };
 
 }  // namespace ssx::plugins

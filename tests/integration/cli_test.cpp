@@ -520,6 +520,11 @@ TEST_CASE("ssx run --record, inspect and replay: a run kept, looked at, drawn ag
   const Result over = run({"replay", rec, "--snapshot", rec});
   CHECK(over.status == 2);
   CHECK_THAT(over.err, Catch::Contains("would write over the recording being replayed"));
+  // a page plays the recording: not together with pictures or a re-simulation
+  const Result view_and_picture = run({"replay", rec, "--view", "0", "--snapshot", (dir / "v.png").string()});
+  CHECK(view_and_picture.status == 2);
+  CHECK_THAT(view_and_picture.err, Catch::Contains("--view plays the recording on a page"));
+  CHECK_FALSE(fs::exists(dir / "v.png"));
   CHECK(run({"run", scene, "--steps", "10", "--fast", "--record", scene}).status == 2);
   // --complete goes through the one output check: not the recording itself, not a FIFO
   const Result onto_itself = run({"inspect", rec, "--complete", rec});

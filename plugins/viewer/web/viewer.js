@@ -9,6 +9,8 @@ const state = {
   positions: null,  // Float32Array of the newest frame's 7 floats per body
   time: 0,
   details: null,    // the selected robot's details from the simulation (velocities, command, sensors)
+  replay: null,     // a recording played: {start, end} (s)
+  sliding: false,   // its slider held
   selected: -1, frames: 0, fpsFrames: 0, fpsSince: performance.now(),
 };
 
@@ -103,6 +105,16 @@ function buildScene(msg) {
   state.byModelSlot = msg.models.map(() => []);
   msg.bodies.forEach((b, i) => { state.byModelSlot[b.model][state.slots[i]] = i; });
   document.getElementById("robots").textContent = msg.bodies.length;
+  // a recording played (ssx replay --view): a time slider, and nothing to steer
+  state.replay = msg.replay || null;
+  document.getElementById("replay").hidden = !state.replay;
+  document.getElementById("steer").hidden = !!state.replay;
+  if (state.replay) {
+    const slider = document.getElementById("slider");
+    slider.min = state.replay.start;
+    slider.max = state.replay.end;
+    document.getElementById("span").textContent = `${state.replay.start.toFixed(1)}-${state.replay.end.toFixed(1)} s`;
+  }
 }
 
 const body = new THREE.Matrix4(), world = new THREE.Matrix4();
@@ -134,6 +146,9 @@ function applyFrame(buffer) {
   }
   for (const parts of state.models) for (const part of parts) part.mesh.instanceMatrix.needsUpdate = true;
   document.getElementById("time").textContent = state.time.toFixed(3);
+  if (state.replay && !state.sliding) document.getElementById("slider").value = state.time;
+  // a recording stands still at its end (or paused by another page): the button says so
+  if (state.replay) pauseButton.textContent = view.getFloat32(16, true) === 0 ? "resume" : "pause";
   document.getElementById("rtf").textContent = view.getFloat32(16, true).toFixed(2);
   document.getElementById("late").textContent = view.getUint32(20, true);
   state.frames++;
@@ -230,6 +245,7 @@ function teleopCommand() {
 function teleopTick(now) {
   const socket = teleop.socket;
   if (!socket || socket.readyState !== 1) return;
+  if (state.replay) return;  // nothing to steer in a recording
   if (state.selected >= 0 && now - teleop.asked >= 1000) {  // the selected robot's details, for 3 s more
     teleop.asked = now;
     socket.send(JSON.stringify({ type: "select", body: state.selected }));
@@ -257,6 +273,11 @@ pauseButton.addEventListener("click", () => {
   pauseButton.textContent = pausing ? "resume" : "pause";
 });
 document.getElementById("step").addEventListener("click", () => send({ type: "step" }));
+// a recording's slider: where it is dragged to is shown at once, paused or playing
+const slider = document.getElementById("slider");
+slider.addEventListener("pointerdown", () => { state.sliding = true; });
+slider.addEventListener("pointerup", () => { state.sliding = false; });
+slider.addEventListener("input", () => send({ type: "seek", time: Number(slider.value) }));
 document.getElementById("factor").addEventListener("change", (e) => send({ type: "rate", factor: Number(e.target.value) }));
 
 function connect() {

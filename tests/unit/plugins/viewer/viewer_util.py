@@ -7,12 +7,13 @@ import time
 
 
 class ViewedRun:
-    """`ssx run SCENE --realtime --view 0 ...` in the background; url is the page's address."""
+    """`ssx run SCENE --realtime --view 0 ...` in the background (or, with `replay`, `ssx replay RECORDING
+    --view 0`); url is the page's address."""
 
-    def __init__(self, ssx, scene, out_dir, *extra):
-        self.process = subprocess.Popen(
-            [ssx, "run", scene, "--realtime", "--view", "0", "--out", out_dir, *extra],
-            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    def __init__(self, ssx, scene, out_dir, *extra, replay=None):
+        args = [ssx, "replay", replay, "--view", "0"] if replay else \
+            [ssx, "run", scene, "--realtime", "--view", "0", "--out", out_dir]
+        self.process = subprocess.Popen([*args, *extra], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
         self.err_lines = []
         deadline = time.monotonic() + 30
         self.url = None
