@@ -12,21 +12,42 @@ const state = {
   replay: null,     // a recording played: {start, end} (s)
   sliding: false,   // its slider held
   selected: -1, frames: 0, fpsFrames: 0, fpsSince: performance.now(),
+  dirty: true,      // something to draw
 };
 
-const renderer = new THREE.WebGLRenderer({ antialias: true, preserveDrawingBuffer: true });
-renderer.setPixelRatio(window.devicePixelRatio);
-renderer.setSize(window.innerWidth, window.innerHeight);
-document.body.appendChild(renderer.domElement);
+const query = new URLSearchParams(location.search);
+// Drawing what a page can: antialiased up to kSmoothBodies bodies (?aa=1 or ?aa=0 to choose), and
+// a swarm of more than kFullBudget robots drawn in full only for the kFullBudget nearest the camera,
+// the rest as dots of the robot's colour and size (?full=N to choose N). Measured in headless
+// Chromium with software WebGL (docs/viewer.md): both cost most of the frame rate there.
+const kSmoothBodies = 300;
+const kFullBudget = Number(query.get("full")) > 0 ? Number(query.get("full")) : 1000;
+// the renderer is made when the scene arrives (antialiasing is chosen then); its canvas goes into
+// #view, where the orbit controls and the clicks are
+const view = document.getElementById("view");
+let renderer = null, smooth = null;
+function makeRenderer(antialias) {
+  if (renderer && smooth === antialias) return;
+  if (renderer) {
+    view.removeChild(renderer.domElement);
+    renderer.dispose();
+  }
+  renderer = new THREE.WebGLRenderer({ antialias });
+  smooth = antialias;
+  renderer.setPixelRatio(window.devicePixelRatio);
+  renderer.setSize(window.innerWidth, window.innerHeight);
+  view.appendChild(renderer.domElement);
+}
 const scene = new THREE.Scene();
 scene.background = new THREE.Color(0x9eb8d9);
 const camera = new THREE.PerspectiveCamera(50, window.innerWidth / window.innerHeight, 0.05, 2000);
 camera.up.set(0, 0, 1);  // ssx's world: z up
 camera.position.set(-12, -12, 9);
-const controls = new THREE.OrbitControls(camera, renderer.domElement);
+const controls = new THREE.OrbitControls(camera, view);
 controls.target.set(0, 0, 1.5);
 controls.enableKeys = false;  // the keys steer the selected robot
 controls.update();
+controls.addEventListener("change", () => { state.dirty = true; });
 scene.add(new THREE.HemisphereLight(0xffffff, 0x505050, 0.75));
 const sun = new THREE.DirectionalLight(0xffffff, 0.6);
 sun.position.set(0.35, 0.25, 0.9);
@@ -34,8 +55,20 @@ scene.add(sun);
 window.addEventListener("resize", () => {
   camera.aspect = window.innerWidth / window.innerHeight;
   camera.updateProjectionMatrix();
-  renderer.setSize(window.innerWidth, window.innerHeight);
+  if (renderer) renderer.setSize(window.innerWidth, window.innerHeight);
+  state.dirty = true;
 });
+
+// how far a shape reaches from its origin
+function extent(shape) {
+  switch (shape.kind) {
+    case "box": return 0.5 * Math.hypot(...shape.size);
+    case "sphere": return shape.radius;
+    case "cylinder": return Math.hypot(shape.radius, shape.length / 2);
+    case "capsule": return shape.radius + shape.length / 2;
+  }
+  return 0;
+}
 
 // a shape of the scene as geometry, in its own frame (ssx: cylinders and capsules along z)
 function geometries(shape) {
@@ -78,8 +111,10 @@ function buildScene(msg) {
       add(mesh);
     }
     if (shape.kind === "plane" && shape.grid) {
-      const grid = new THREE.GridHelper(Math.max(shape.size[0], shape.size[1]),
-                                        Math.round(Math.max(shape.size[0], shape.size[1])), 0x555555, 0x777777);
+      // 1 m cells, or 10 m, ... on a larger ground: at most 100 lines each way
+      const size = Math.max(shape.size[0], shape.size[1]);
+      const cell = 10 ** Math.max(0, Math.ceil(Math.log10(size / 100)));
+      const grid = new THREE.GridHelper(size, Math.max(1, Math.round(size / cell)), 0x555555, 0x777777);
       grid.rotateX(Math.PI / 2);
       grid.applyMatrix(poseMatrix(shape.pose));
       grid.position.z += 0.002;
@@ -87,11 +122,15 @@ function buildScene(msg) {
     }
   }
   state.bodies = msg.bodies;
+  const aa = query.get("aa");
+  makeRenderer(aa === null ? msg.bodies.length <= kSmoothBodies : aa !== "0");
   const members = msg.models.map(() => 0);
-  state.slots = msg.bodies.map((b) => members[b.model]++);
+  msg.bodies.forEach((b) => members[b.model]++);
+  const dots = msg.bodies.length > kFullBudget;
   state.models = msg.models.map((shapes, m) => {
     const parts = [];
-    for (const shape of shapes)
+    let reach = 0.05;
+    for (const shape of shapes) {
       for (const g of geometries(shape)) {
         const mesh = new THREE.InstancedMesh(g, material(shape), Math.max(1, members[m]));
         mesh.instanceMatrix.setUsage(THREE.DynamicDrawUsage);
@@ -100,11 +139,24 @@ function buildScene(msg) {
         add(mesh);
         parts.push({ mesh, local: poseMatrix(shape.pose) });
       }
-    return parts;
+      reach = Math.max(reach, Math.hypot(...shape.pose.slice(0, 3)) + extent(shape));
+    }
+    // the far members as dots: one vertex each, as wide as the robot
+    let points = null;
+    if (dots && shapes.length > 0) {
+      const geometry = new THREE.BufferGeometry();
+      geometry.setAttribute("position", new THREE.BufferAttribute(new Float32Array(3 * members[m]), 3).setUsage(THREE.DynamicDrawUsage));
+      const [r, g, b] = shapes[0].color;
+      points = new THREE.Points(geometry, new THREE.PointsMaterial({ color: new THREE.Color(r, g, b), size: 2 * reach }));
+      points.userData.model = m;
+      points.frustumCulled = false;
+      add(points);
+    }
+    return { parts, points, full: new Int32Array(members[m]), far: new Int32Array(members[m]) };
   });
-  state.byModelSlot = msg.models.map(() => []);
-  msg.bodies.forEach((b, i) => { state.byModelSlot[b.model][state.slots[i]] = i; });
   document.getElementById("robots").textContent = msg.bodies.length;
+  state.framed = false;
+  state.dirty = true;
   // a recording played (ssx replay --view): a time slider, and nothing to steer
   state.replay = msg.replay || null;
   document.getElementById("replay").hidden = !state.replay;
@@ -117,7 +169,6 @@ function buildScene(msg) {
   }
 }
 
-const body = new THREE.Matrix4(), world = new THREE.Matrix4();
 function applyFrame(buffer) {
   const view = new DataView(buffer);
   if (view.getUint32(0, true) !== 0x46585353) return;
@@ -134,17 +185,9 @@ function applyFrame(buffer) {
       for (const d of details) if (d.body === state.selected) state.details = d;
     }
   }
-  const p = state.positions;
-  for (let i = 0; i < n; ++i) {
-    const k = 7 * i;
-    body.compose(new THREE.Vector3(p[k], p[k + 1], p[k + 2]), new THREE.Quaternion(p[k + 3], p[k + 4], p[k + 5], p[k + 6]),
-                 new THREE.Vector3(1, 1, 1));
-    for (const part of state.models[state.bodies[i].model]) {
-      world.multiplyMatrices(body, part.local);
-      part.mesh.setMatrixAt(state.slots[i], world);
-    }
-  }
-  for (const parts of state.models) for (const part of parts) part.mesh.instanceMatrix.needsUpdate = true;
+  if (!state.framed) frameBodies(n);
+  placeBodies(n);
+  state.dirty = true;
   document.getElementById("time").textContent = state.time.toFixed(3);
   if (state.replay && !state.sliding) document.getElementById("slider").value = state.time;
   // a recording stands still at its end (or paused by another page): the button says so
@@ -170,6 +213,68 @@ function measurementText(m) {
   return `${m.sensor}: ${m.kind}`;
 }
 
+// the first frame of a scene: the view from the south-west and above, every body in it
+function frameBodies(n) {
+  const p = state.positions, box = new THREE.Box3();
+  for (let i = 0; i < n; ++i) box.expandByPoint(at.set(p[7 * i], p[7 * i + 1], p[7 * i + 2]));
+  state.framed = true;
+  if (n === 0) return;
+  const centre = box.getCenter(new THREE.Vector3()), radius = Math.max(2, 0.5 * box.getSize(new THREE.Vector3()).length());
+  const distance = radius / Math.sin((camera.fov * Math.PI) / 360);
+  controls.target.copy(centre);
+  camera.position.copy(centre).add(new THREE.Vector3(-0.6, -0.6, 0.5).normalize().multiplyScalar(distance));
+  camera.near = Math.max(0.05, distance / 2000);
+  camera.far = Math.max(2000, distance * 10);
+  camera.updateProjectionMatrix();
+  controls.update();
+}
+
+// each body into its model: in full (an instance of each of its shapes) when near enough, else a dot
+const body = new THREE.Matrix4(), world = new THREE.Matrix4(), at = new THREE.Vector3(), turn = new THREE.Quaternion(),
+  unit = new THREE.Vector3(1, 1, 1);
+function placeBodies(n) {
+  const p = state.positions;
+  let limit = Infinity;
+  if (n > kFullBudget) {  // the distance of the kFullBudget-th nearest
+    if (!state.distances || state.distances.length !== n) {
+      state.distances = new Float32Array(n);
+      state.sorted = new Float32Array(n);
+    }
+    const d = state.distances, c = camera.position;
+    for (let i = 0; i < n; ++i) d[i] = (p[7 * i] - c.x) ** 2 + (p[7 * i + 1] - c.y) ** 2 + (p[7 * i + 2] - c.z) ** 2;
+    state.sorted.set(d);
+    state.sorted.sort();
+    limit = state.sorted[kFullBudget - 1];
+  }
+  const full = state.models.map(() => 0), far = state.models.map(() => 0);
+  for (let i = 0; i < n; ++i) {
+    const m = state.bodies[i].model, model = state.models[m], k = 7 * i;
+    if (limit === Infinity || state.distances[i] <= limit || !model.points) {
+      const slot = full[m]++;
+      model.full[slot] = i;
+      body.compose(at.set(p[k], p[k + 1], p[k + 2]), turn.set(p[k + 3], p[k + 4], p[k + 5], p[k + 6]), unit);
+      for (const part of model.parts) {
+        world.multiplyMatrices(body, part.local);
+        part.mesh.setMatrixAt(slot, world);
+      }
+    } else {
+      const slot = far[m]++;
+      model.far[slot] = i;
+      model.points.geometry.attributes.position.array.set([p[k], p[k + 1], p[k + 2]], 3 * slot);
+    }
+  }
+  state.models.forEach((model, m) => {
+    for (const part of model.parts) {
+      part.mesh.count = full[m];
+      part.mesh.instanceMatrix.needsUpdate = true;
+    }
+    if (model.points) {
+      model.points.geometry.setDrawRange(0, far[m]);
+      model.points.geometry.attributes.position.needsUpdate = true;
+    }
+  });
+}
+
 function showSelected() {
   const i = state.selected;
   if (i < 0 || !state.positions) return;
@@ -189,17 +294,23 @@ function showSelected() {
     for (const m of d.sensors) lines.push(measurementText(m));
   }
   document.getElementById("selected").textContent = lines.join("\n");
-  if (document.getElementById("follow").checked) controls.target.set(p[k], p[k + 1], p[k + 2]);
+  if (document.getElementById("follow").checked) {
+    controls.target.set(p[k], p[k + 1], p[k + 2]);
+    controls.update();
+  }
 }
 
 // a click selects the robot under the pointer
 const raycaster = new THREE.Raycaster();
-renderer.domElement.addEventListener("click", (event) => {
+view.addEventListener("click", (event) => {
   const pointer = new THREE.Vector2((event.clientX / window.innerWidth) * 2 - 1, -(event.clientY / window.innerHeight) * 2 + 1);
   raycaster.setFromCamera(pointer, camera);
-  const meshes = state.models.flat().map((part) => part.mesh);
-  const hit = raycaster.intersectObjects(meshes)[0];
-  if (hit && hit.instanceId !== undefined) select(state.byModelSlot[hit.object.userData.model][hit.instanceId]);
+  const objects = state.models.flatMap((model) => [...model.parts.map((part) => part.mesh), ...(model.points ? [model.points] : [])]);
+  const hit = raycaster.intersectObjects(objects)[0];
+  if (!hit) return;
+  const model = state.models[hit.object.userData.model];
+  if (hit.object.isPoints) select(model.far[hit.index]);
+  else if (hit.instanceId !== undefined) select(model.full[hit.instanceId]);
 });
 
 function select(i) {
@@ -303,13 +414,17 @@ function connect() {
   socket.onclose = () => { status.textContent = "disconnected (the run ended?)"; };
 }
 
+// drawn when something changed (a frame, the view, the window): a page that keeps up draws each
+// frame once and leaves the cores to the simulation otherwise; the fps shown counts the drawings
 function animate() {
   requestAnimationFrame(animate);
-  controls.update();
-  renderer.render(scene, camera);
-  state.drawn = state.positions;  // what the picture shows now
-  state.fpsFrames++;
   const now = performance.now();
+  if (renderer && state.dirty) {
+    state.dirty = false;
+    renderer.render(scene, camera);
+    state.drawn = state.positions;  // what the picture shows now
+    state.fpsFrames++;
+  }
   if (now - state.fpsSince > 1000) {
     document.getElementById("fps").textContent = Math.round((1000 * state.fpsFrames) / (now - state.fpsSince));
     state.fpsFrames = 0;
@@ -319,7 +434,13 @@ function animate() {
 
 // for tests and for a look from the browser's console
 window.ssxViewer = {
-  state, camera, controls, renderer, select,
+  state, camera, controls, select,
+  get renderer() { return renderer; },
+  // draws now (for a test: pixel() reads this picture in the same task)
+  draw() {
+    renderer.render(scene, camera);
+    state.drawn = state.positions;
+  },
   // where body i appears in the picture drawn last, in CSS pixels from the top left (null: behind the camera)
   project(i) {
     const p = state.drawn, k = 7 * i;

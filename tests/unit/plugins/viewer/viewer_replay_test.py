@@ -6,8 +6,9 @@ ssx.Recording: positions, and orientations turned from w x y z into the frame's 
 going with the wall clock at speed 1 and four times as fast at speed 4, pause holding it, a step
 going one sample on, a seek landing on the sample at or before the time asked; a velocity command
 is dropped (nothing to steer in a recording), and Ctrl-C ends it with status 130. Then, with
-Chromium and selenium installed, the page itself: every robot, the time slider over the recording's
-span and no steering; paused from the page and the slider moved to 3 s, the page shows the sample
+Chromium and selenium installed, the page itself: every robot, the 50 nearest the camera in full and
+the others as dots when asked for 50 (?full=50), the time slider over the recording's span and no
+steering; paused from the page and the slider moved to 3 s, the page shows the sample
 at or before 3 s.
 
     viewer_replay_test.py SSX EXAMPLES_DIR PYTHON_DIR WORK_DIR
@@ -167,7 +168,7 @@ def in_browser():
     page = webdriver.Chrome(service=Service("/usr/bin/chromedriver"), options=options)
     played = ViewedRun(ssx, None, None, replay=str(recording))
     try:
-        page.get(played.url)
+        page.get(played.url + "?full=50")  # the 50 nearest robots in full, the others as dots
         deadline = time.monotonic() + 60
         while page.execute_script("return document.getElementById('robots').textContent") != str(len(r.names)):
             if time.monotonic() > deadline:
@@ -179,6 +180,16 @@ def in_browser():
         print(f"the page: slider hidden {shown[0]}, steering hidden {shown[1]}, slider {shown[2]} to {shown[3]} s")
         if shown[0] or not shown[1] or abs(shown[2] - times[0]) > 1e-3 or abs(shown[3] - times[-1]) > 1e-3:
             problems.append(f"the page's slider and steering: {shown}")
+        near = page.execute_script("""const v = window.ssxViewer, m = v.state.models[0], c = v.camera.position;
+            const p = v.state.positions, d = (i) => Math.hypot(p[7 * i] - c.x, p[7 * i + 1] - c.y, p[7 * i + 2] - c.z);
+            const full = Array.from(m.full.slice(0, m.parts[0].mesh.count));
+            const far = Array.from(m.far.slice(0, m.points.geometry.drawRange.count));
+            return [full.length, far.length, Math.max(...full.map(d)), Math.min(...far.map(d)),
+                    new Set([...full, ...far]).size]""")
+        print(f"?full=50: {near[0]} robots in full up to {near[2]:.2f} m from the camera, {near[1]} as dots from "
+              f"{near[3]:.2f} m, {near[4]} different robots")
+        if near[0] != 50 or near[1] != len(r.names) - 50 or near[2] > near[3] or near[4] != len(r.names):
+            problems.append(f"with ?full=50 the page drew {near}")
         page.find_element("id", "pause").click()
         page.execute_script("""const s = document.getElementById('slider'); s.value = 3;
                                s.dispatchEvent(new Event('input'));""")

@@ -76,6 +76,7 @@ try:
     # each robot where the simulation has it: its blue box at its projected centre
     result = page.execute_script("""
         const v = window.ssxViewer, n = v.state.bodies.length;
+        v.draw();  // the picture read below, of the poses project() uses
         let seen = 0, blue = 0, beside = 0;
         const isBlue = (c) => c[2] > c[0] + 40 && c[2] > c[1] + 20;
         for (let i = 0; i < n; ++i) {
