@@ -213,6 +213,9 @@ class Viewer final : public SimulationExtension {
           if (root.isStatic() || root.bodyIndex() < 0) continue;
           nodes_.push_back(&root);
           names_.push_back(r == 0 ? a.name() : a.name() + "/" + root.name());
+          const Pose& in_body = root.poseInBody();
+          bodies_.push_back({root.bodyIndex(), in_body,
+                             in_body.position.isZero(0) && in_body.orientation.coeffs() == Quat::Identity().coeffs()});
           break;
         }
       }
@@ -229,6 +232,7 @@ class Viewer final : public SimulationExtension {
     // (and every step of a paused run: the one it was paused after, and each single step)
     if (now - last_wall_ < period_ && !control_->paused()) return;
     const double wall = std::chrono::duration<double>(now - last_wall_).count();
+    const auto build_start = std::chrono::steady_clock::now();
     const double rtf = last_sim_ >= 0 && wall < 60 ? (toSeconds(env.time()) - last_sim_) / wall : 0;
     last_wall_ = now;
     last_sim_ = toSeconds(env.time());
@@ -242,8 +246,9 @@ class Viewer final : public SimulationExtension {
     std::memcpy(p, &magic, 4), std::memcpy(p + 4, &n, 4), std::memcpy(p + 8, &t, 8), std::memcpy(p + 16, &rate, 4);
     std::memcpy(p + 20, &late_, 4), std::memcpy(p + 24, &step, 8);
     float* f = reinterpret_cast<float*>(p + 32);
-    for (const PhysicNode* node : nodes_) {
-      const Pose pose = node->pose();
+    for (std::size_t b = 0; b < nodes_.size(); ++b) {  // (each root node's pose from its body's state)
+      const Pose& body = env.bodyState(bodies_[b].index).pose;
+      const Pose pose = bodies_[b].at_body ? body : body * bodies_[b].in_body;
       const Quat& q = pose.orientation;
       for (const double v : {pose.position.x(), pose.position.y(), pose.position.z(), q.x(), q.y(), q.z(), q.w()})
         *f++ = static_cast<float>(v);
@@ -255,6 +260,8 @@ class Viewer final : public SimulationExtension {
     std::memcpy(frame_.data() + at, &length, 4);
     std::memcpy(frame_.data() + at + 4, details.data(), details.size());
     server_->publish(frame_);
+    const double build_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - build_start).count();
+    ++built_, build_ms_sum_ += build_ms, build_ms_max_ = std::max(build_ms_max_, build_ms);
   }
 
   void shutdown(Environment& env) override {
@@ -266,6 +273,12 @@ class Viewer final : public SimulationExtension {
                                 std::to_string(c.frames_sent) + " sent, " + std::to_string(c.frames_skipped) +
                                 " skipped by slow pages, " + std::to_string(c.messages_dropped) + " messages dropped, " +
                                 std::to_string(c.clients_refused) + " pages refused");
+    if (built_ > 0) {
+      char text[160];
+      std::snprintf(text, sizeof text, "viewer: a frame took %.3f ms on the stepping thread on average, %.3f ms at most",
+                    build_ms_sum_ / static_cast<double>(built_), build_ms_max_);
+      env.log(LogLevel::Info, text);
+    }
     if (!delays_ms_.empty()) {
       std::sort(delays_ms_.begin(), delays_ms_.end());
       char text[160];
@@ -370,7 +383,8 @@ class Viewer final : public SimulationExtension {
       shown = k, shown_paused = paused, sent = last;
       const std::vector<float> p = recording_->positions(k), q = recording_->orientations(k);  // (q: w x y z)
       const std::uint32_t n = static_cast<std::uint32_t>(recording_->names().size());
-      std::vector<std::uint8_t> frame(36 + 28 * static_cast<std::size_t>(n), 0);  // (no details: L = 0)
+      std::vector<std::uint8_t>& frame = play_frame_;
+      frame.assign(36 + 28 * static_cast<std::size_t>(n), 0);  // (no details: L = 0)
       std::uint8_t* out = frame.data();
       const std::uint32_t magic = 0x46585353, late = 0;
       const double t = toSeconds(recording_->times()[k]);
@@ -516,12 +530,20 @@ class Viewer final : public SimulationExtension {
   RunControl* control_ = nullptr;
   std::vector<const PhysicNode*> nodes_;
   std::vector<std::string> names_;
+  struct Body {  // each node's body, and the node's pose in it
+    int index = -1;
+    Pose in_body;
+    bool at_body = true;
+  };
+  std::vector<Body> bodies_;
   std::vector<std::uint8_t> frame_;
   std::chrono::duration<double> period_{};
   std::chrono::steady_clock::time_point last_wall_;
   double last_sim_ = -1;
   std::uint32_t late_ = 0;
   bool begun_ = false;
+  std::uint64_t built_ = 0;  // frames built on the stepping thread, and what they took
+  double build_ms_sum_ = 0, build_ms_max_ = 0;
   // what pages asked (under mutex_; nodes_ is fixed once begun): the newest teleoperation command,
   // the bodies whose details they see
   static constexpr double kMaxSpeed = 20, kMaxYawRate = 10;
@@ -544,6 +566,7 @@ class Viewer final : public SimulationExtension {
   std::unique_ptr<Recording> recording_;
   std::unique_ptr<viewer::Playback> playback_;
   std::thread player_;
+  std::vector<std::uint8_t> play_frame_;  // (the player's own)
   std::condition_variable playing_cv_;
   bool stop_playing_ = false;
 };

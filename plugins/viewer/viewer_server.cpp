@@ -96,10 +96,14 @@ void Server::stop() {
   ctx_ = nullptr;
 }
 
-void Server::publish(const std::vector<std::uint8_t>& frame) {
-  auto copy = std::make_shared<const std::vector<std::uint8_t>>(frame);
+void Server::publish(std::vector<std::uint8_t>& frame) {
   std::lock_guard lock(mutex_);
-  newest_ = std::move(copy);
+  // the frame goes into the spare buffer (when no page is still sending from it), whose bytes come back
+  std::shared_ptr<std::vector<std::uint8_t>> fresh =
+      spare_ && spare_.use_count() == 1 ? std::move(spare_) : std::make_shared<std::vector<std::uint8_t>>();
+  fresh->swap(frame);
+  spare_ = std::move(newest_);
+  newest_ = std::move(fresh);
   ++newest_seq_;
   ++counts_.frames_published;
   changed_.notify_all();

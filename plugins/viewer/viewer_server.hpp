@@ -2,8 +2,8 @@
 // The viewer's HTTP and WebSocket server (civetweb): serves the page and its scripts from memory
 // and streams frames to every page connected at /ws.
 //
-// Never slows the simulation: publish() copies a frame into the newest-frame slot under a mutex and
-// returns; each client has a thread of its own that sends the newest frame it has not sent yet, so
+// Never slows the simulation: publish() swaps a frame into the newest-frame slot under a mutex (no
+// copy: the buffer of an earlier frame no page holds any more comes back) and returns; each client has a thread of its own that sends the newest frame it has not sent yet, so
 // a slow or stalled page skips frames (counted) and holds up nobody. A page may ask for fewer
 // frames: {"type":"hello","rate_hz":R} (0 < R <= 240) sends it at most R a second. Bounded: at most max_clients
 // pages; messages from a page larger than kMaxMessage bytes, more than kMaxMessagesPerSecond a
@@ -67,8 +67,9 @@ class Server {
 
   /// The port listened on.
   int port() const noexcept { return port_; }
-  /// Hands a frame (binary) to every client; returns at once.
-  void publish(const std::vector<std::uint8_t>& frame);
+  /// Hands a frame (binary) to every client and returns at once. Takes the bytes, not a copy:
+  /// `frame` comes back holding an earlier frame's buffer (any content) to build the next one in.
+  void publish(std::vector<std::uint8_t>& frame);
   /// Replaces the message every page gets first (the scene), and sends it to the pages connected.
   void setHello(std::string hello);
   /// What was counted so far.
@@ -93,7 +94,7 @@ class Server {
   MessageHandler on_message_;
   mutable std::mutex mutex_;
   std::condition_variable changed_;
-  std::shared_ptr<const std::vector<std::uint8_t>> newest_;
+  std::shared_ptr<std::vector<std::uint8_t>> newest_, spare_;  // (spare_: the frame before, maybe still being sent)
   std::uint64_t newest_seq_ = 0;
   std::uint64_t hello_seq_ = 1;
   std::list<std::shared_ptr<Client>> clients_;
