@@ -10,8 +10,9 @@
 // Steering the run: {"type":"pause"}, {"type":"resume"}, {"type":"step"} (one step while paused) and
 // {"type":"rate","factor":F} (the real-time factor of a real-time run), through Environment::runControl.
 //
-// After the poses: uint32 L, then L bytes of JSON (L = 0: none), {"details":[...]}: for each body
-// a page has selected ({"type":"select","body":I}, asked again each second, forgotten 3 s after
+// After the poses: uint32 L, then L bytes of JSON, {"run":{"factor":F,"paused":B},"details":[...]}:
+// the real-time factor set from a page (0: the run's own) and whether the run is paused; and, for
+// each body a page has selected ({"type":"select","body":I}, asked again each second, forgotten 3 s after
 // the last), its name, linear and angular velocity (world frame), current command
 // (ssx::commandJson) and latest measurements (ssx::measurementJson, with the sensor's class).
 //
@@ -253,7 +254,7 @@ class Viewer final : public SimulationExtension {
       for (const double v : {pose.position.x(), pose.position.y(), pose.position.z(), q.x(), q.y(), q.z(), q.w()})
         *f++ = static_cast<float>(v);
     }
-    const std::string details = detailsJson(env, now);
+    const std::string details = trailerJson(control_->realtimeFactor(), control_->paused(), detailsJson(env, now));
     const std::uint32_t length = static_cast<std::uint32_t>(details.size());
     const std::size_t at = frame_.size();
     frame_.resize(at + 4 + details.size());
@@ -383,8 +384,9 @@ class Viewer final : public SimulationExtension {
       shown = k, shown_paused = paused, sent = last;
       const std::vector<float> p = recording_->positions(k), q = recording_->orientations(k);  // (q: w x y z)
       const std::uint32_t n = static_cast<std::uint32_t>(recording_->names().size());
+      const std::string trailer = trailerJson(speed, paused, {});
       std::vector<std::uint8_t>& frame = play_frame_;
-      frame.assign(36 + 28 * static_cast<std::size_t>(n), 0);  // (no details: L = 0)
+      frame.assign(36 + 28 * static_cast<std::size_t>(n) + trailer.size(), 0);
       std::uint8_t* out = frame.data();
       const std::uint32_t magic = 0x46585353, late = 0;
       const double t = toSeconds(recording_->times()[k]);
@@ -397,6 +399,9 @@ class Viewer final : public SimulationExtension {
         for (std::size_t a = 0; a < 3; ++a) *f++ = p[3 * i + a];
         *f++ = q[4 * i + 1], *f++ = q[4 * i + 2], *f++ = q[4 * i + 3], *f++ = q[4 * i];
       }
+      const std::uint32_t length = static_cast<std::uint32_t>(trailer.size());
+      std::memcpy(out + 32 + 28 * static_cast<std::size_t>(n), &length, 4);
+      std::memcpy(out + 36 + 28 * static_cast<std::size_t>(n), trailer.data(), trailer.size());
       server_->publish(frame);
     }
   }
@@ -431,7 +436,7 @@ class Viewer final : public SimulationExtension {
     }
   }
 
-  // the details of the bodies pages have selected, for the frame (stepping thread)
+  // the details of the bodies pages have selected, as a JSON array, or "" (stepping thread)
   std::string detailsJson(const Environment& env, std::chrono::steady_clock::time_point now) {
     std::vector<int> bodies;
     {
@@ -440,7 +445,7 @@ class Viewer final : public SimulationExtension {
       for (const auto& w : watched_) bodies.push_back(w.first);
     }
     if (bodies.empty()) return {};
-    std::string out = R"({"details":[)";
+    std::string out = "[";
     for (const int b : bodies) {
       const PhysicNode& node = *nodes_[static_cast<std::size_t>(b)];
       const Artifact& a = node.artifact();
@@ -470,7 +475,17 @@ class Viewer final : public SimulationExtension {
       }
       out += "]}";
     }
-    return out + "]}";
+    return out + "]";
+  }
+
+  // what follows the poses of a frame: the run's pace as set ("factor": 0 for the run's own) and
+  // whether it is paused, then the details when any
+  static std::string trailerJson(double factor, bool paused, const std::string& details) {
+    std::string out = R"({"run":{"factor":)";
+    number(out, factor);
+    out += paused ? R"(,"paused":true})" : R"(,"paused":false})";
+    if (!details.empty()) out += R"(,"details":)" + details;
+    return out + "}";
   }
 
   // the scene for a page: the models (render trees, each in its body's frame), the bodies with

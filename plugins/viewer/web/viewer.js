@@ -13,6 +13,7 @@ const state = {
   sliding: false,   // its slider held
   selected: -1, frames: 0, fpsFrames: 0, fpsSince: performance.now(),
   dirty: true,      // something to draw
+  pressedAt: -1e9,  // when the pause button was last pressed
 };
 
 const query = new URLSearchParams(location.search);
@@ -176,13 +177,14 @@ function applyFrame(buffer) {
   if (n !== state.bodies.length) return;
   state.time = view.getFloat64(8, true);
   state.positions = new Float32Array(buffer, 32, 7 * n);
-  // then the details of the bodies selected (JSON), when any
+  // then the run's pace as set and whether it is paused, and the details of the robots selected (JSON)
   const at = 32 + 28 * n;
   if (buffer.byteLength >= at + 4) {
     const length = view.getUint32(at, true);
     if (length > 0 && buffer.byteLength >= at + 4 + length) {
-      const details = JSON.parse(new TextDecoder().decode(new Uint8Array(buffer, at + 4, length))).details;
-      for (const d of details) if (d.body === state.selected) state.details = d;
+      const trailer = JSON.parse(new TextDecoder().decode(new Uint8Array(buffer, at + 4, length)));
+      for (const d of trailer.details || []) if (d.body === state.selected) state.details = d;
+      if (trailer.run) showRun(trailer.run);
     }
   }
   if (!state.framed) frameBodies(n);
@@ -190,8 +192,6 @@ function applyFrame(buffer) {
   state.dirty = true;
   document.getElementById("time").textContent = state.time.toFixed(3);
   if (state.replay && !state.sliding) document.getElementById("slider").value = state.time;
-  // a recording stands still at its end (or paused by another page): the button says so
-  if (state.replay) pauseButton.textContent = view.getFloat32(16, true) === 0 ? "resume" : "pause";
   document.getElementById("rtf").textContent = view.getFloat32(16, true).toFixed(2);
   document.getElementById("late").textContent = view.getUint32(20, true);
   state.frames++;
@@ -273,6 +273,13 @@ function placeBodies(n) {
       model.points.geometry.attributes.position.needsUpdate = true;
     }
   });
+}
+
+// the run as set from pages (this one or another): its factor, and paused or not
+function showRun(run) {
+  document.getElementById("asked").textContent = run.factor > 0 ? ` (×${run.factor} asked)` : "";
+  // (a frame on its way when this page's button was pressed says what was before)
+  if (performance.now() - state.pressedAt > 500) pauseButton.textContent = run.paused ? "resume" : "pause";
 }
 
 function showSelected() {
@@ -380,6 +387,7 @@ function send(message) {
 const pauseButton = document.getElementById("pause");
 pauseButton.addEventListener("click", () => {
   const pausing = pauseButton.textContent === "pause";
+  state.pressedAt = performance.now();
   send({ type: pausing ? "pause" : "resume" });
   pauseButton.textContent = pausing ? "resume" : "pause";
 });

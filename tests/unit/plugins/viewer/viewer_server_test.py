@@ -64,7 +64,10 @@ async def scene_and_frames(ws, frames=3, description=None):
         if magic != 0x46585353 or len(message) != 36 + 28 * n + length:
             problems.append(f"a frame of {len(message)} bytes, magic {magic:#x}, {n} bodies, details {length}")
             length = 0
-        details = json.loads(message[36 + 28 * n:].decode())["details"] if length > 0 else []
+        trailer = json.loads(message[36 + 28 * n:].decode()) if length > 0 else {}
+        if "run" not in trailer or set(trailer["run"]) != {"factor", "paused"}:
+            problems.append(f"a frame without the run's pace: {trailer}")
+        details = trailer.get("details", [])
         out.append((t, n, step, details))
     return description, out
 
