@@ -24,8 +24,9 @@ python_test_packages=(python3-pytest python3-matplotlib doxygen chromium chromiu
 # for `test` also ROS 1 (Debian's), so that the ros1 extension is built and tested against a real master
 ros_packages=(libroscpp-dev libgeometry-msgs-dev libsensor-msgs-dev libnav-msgs-dev
               python3-rosmaster python3-rospy python3-rostopic python3-geometry-msgs python3-nav-msgs)
-# for `sanitize`: clang with its sanitizer and libFuzzer runtimes
-sanitize_packages=(clang libclang-rt-14-dev)
+# for `sanitize`: clang with its sanitizer and libFuzzer runtimes; Chromium, selenium and websockets,
+# so that the viewer's tests run the instrumented ssx
+sanitize_packages=(clang libclang-rt-14-dev chromium chromium-driver python3-selenium python3-websockets)
 build_dir=${BUILD_DIR:-build}
 jobs=${JOBS:-2}
 
