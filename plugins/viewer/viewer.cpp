@@ -11,7 +11,10 @@
 // {"type":"rate","factor":F} (the real-time factor of a real-time run), through Environment::runControl.
 //
 // After the poses: uint32 L, then L bytes of JSON, {"run":{"factor":F,"paused":B},"details":[...]}:
-// the real-time factor set from a page (0: the run's own) and whether the run is paused; and, for
+// the real-time factor set from a page (0: the run's own) and whether the run is paused; the newest
+// velocity command a step used since the last frame ("command":{"page":P,"sent":S,"waited_ms":D}:
+// the page's own number and time stamp, "page" and "sent" in its message, and how long it waited
+// for its step); and, for
 // each body a page has selected ({"type":"select","body":I}, asked again each second, forgotten 3 s after
 // the last), its name, linear and angular velocity (world frame), current command
 // (ssx::commandJson) and latest measurements (ssx::measurementJson, with the sensor's class).
@@ -199,6 +202,7 @@ class Viewer final : public SimulationExtension {
     forEachSteered([&](CommandInterface& driver) { driver.setCommand(command); });
     teleop_.fresh = false;
     delays_ms_.push_back(std::chrono::duration<double, std::milli>(now - teleop_.received).count());
+    used_sent_ = teleop_.sent, used_page_ = teleop_.page, used_wait_ms_ = delays_ms_.back();
   }
 
   void afterStep(Environment& env) override {
@@ -254,7 +258,14 @@ class Viewer final : public SimulationExtension {
       for (const double v : {pose.position.x(), pose.position.y(), pose.position.z(), q.x(), q.y(), q.z(), q.w()})
         *f++ = static_cast<float>(v);
     }
-    const std::string details = trailerJson(control_->realtimeFactor(), control_->paused(), detailsJson(env, now));
+    double used_sent = -1, used_page = 0, used_wait_ms = 0;
+    {
+      std::lock_guard lock(mutex_);
+      std::swap(used_sent, used_sent_);  // (said once)
+      used_page = used_page_, used_wait_ms = used_wait_ms_;
+    }
+    const std::string details = trailerJson(control_->realtimeFactor(), control_->paused(), detailsJson(env, now),
+                                            used_sent, used_page, used_wait_ms);
     const std::uint32_t length = static_cast<std::uint32_t>(details.size());
     const std::size_t at = frame_.size();
     frame_.resize(at + 4 + details.size());
@@ -328,7 +339,9 @@ class Viewer final : public SimulationExtension {
     if (*body >= static_cast<double>(nodes_.size())) return false;
     const int index = all ? -1 : static_cast<int>(*body);
     if (steerable(all ? std::nullopt : std::optional<std::size_t>(static_cast<std::size_t>(*body))) == 0) return false;
-    teleop_ = {index, all, v, *yaw_rate, std::chrono::steady_clock::now(), true};
+    // (the page's own number and clock, ms: echoed, never interpreted)
+    const auto sent = jsonNumber(text, "sent"), page = jsonNumber(text, "page");
+    teleop_ = {index, all, v, *yaw_rate, std::chrono::steady_clock::now(), true, sent.value_or(-1), page.value_or(0)};
     return true;
   }
 
@@ -480,10 +493,16 @@ class Viewer final : public SimulationExtension {
 
   // what follows the poses of a frame: the run's pace as set ("factor": 0 for the run's own) and
   // whether it is paused, then the details when any
-  static std::string trailerJson(double factor, bool paused, const std::string& details) {
+  static std::string trailerJson(double factor, bool paused, const std::string& details, double sent = -1,
+                                 double page = 0, double waited_ms = 0) {
     std::string out = R"({"run":{"factor":)";
     number(out, factor);
     out += paused ? R"(,"paused":true})" : R"(,"paused":false})";
+    if (sent >= 0) {  // the newest command a step used: the page's time stamp, and its wait here
+      char text[128];
+      std::snprintf(text, sizeof text, R"(,"command":{"page":%.0f,"sent":%.3f,"waited_ms":%.3f})", page, sent, waited_ms);
+      out += text;
+    }
     if (!details.empty()) out += R"(,"details":)" + details;
     return out + "}";
   }
@@ -570,7 +589,11 @@ class Viewer final : public SimulationExtension {
     double yaw_rate = 0;
     std::chrono::steady_clock::time_point received;
     bool fresh = false;
+    double sent = -1;  // when the page sent it, on the page's clock (ms), or -1
+    double page = 0;   // the page's number for itself
   };
+  // the newest command used by a step: its page, when it sent it, and how long it waited here for the step
+  double used_sent_ = -1, used_page_ = 0, used_wait_ms_ = 0;
   std::mutex mutex_;
   Teleop teleop_;
   std::map<int, std::chrono::steady_clock::time_point> watched_;

@@ -185,6 +185,9 @@ function applyFrame(buffer) {
       const trailer = JSON.parse(new TextDecoder().decode(new Uint8Array(buffer, at + 4, length)));
       for (const d of trailer.details || []) if (d.body === state.selected) state.details = d;
       if (trailer.run) showRun(trailer.run);
+      // a command of this page a step used: from its key press (sent at once) to this frame, and its wait for the step
+      if (trailer.command && trailer.command.page === teleop.page)
+        state.latency = { seen: performance.now() - trailer.command.sent, waited: trailer.command.waited_ms };
     }
   }
   if (!state.framed) frameBodies(n);
@@ -300,6 +303,9 @@ function showSelected() {
     }
     for (const m of d.sensors) lines.push(measurementText(m));
   }
+  if (state.latency)
+    lines.push(`steering: ${state.latency.waited.toFixed(1)} ms from a command's arrival to its step,`,
+               `  ${state.latency.seen.toFixed(0)} ms from the key to the picture of that step`);
   document.getElementById("selected").textContent = lines.join("\n");
   if (document.getElementById("follow").checked) {
     controls.target.set(p[k], p[k + 1], p[k + 2]);
@@ -332,9 +338,13 @@ function select(i) {
 // forward and back along the view, A/D sideways, R/F up and down, Q/E turn; or a gamepad's sticks.
 // Sent 20 times a second while held; the simulation stops the robots when nothing comes for 0.5 s
 // (the dead-man rule).
-const teleop = { keys: new Set(), socket: null, sent: null, last: 0, asked: 0 };
+const teleop = { keys: new Set(), socket: null, sent: null, last: 0, asked: 0,
+                 page: 1 + Math.floor(Math.random() * 1e9) };  // (this page's number in its commands)
 const kSpeed = 1.0, kClimb = 0.5, kTurn = 0.8;
-window.addEventListener("keydown", (e) => { teleop.keys.add(e.key.toLowerCase()); });
+window.addEventListener("keydown", (e) => {
+  teleop.keys.add(e.key.toLowerCase());
+  teleopTick(performance.now());  // the first command at the key press
+});
 window.addEventListener("keyup", (e) => { teleop.keys.delete(e.key.toLowerCase()); });
 window.addEventListener("blur", () => teleop.keys.clear());
 
@@ -376,7 +386,8 @@ function teleopTick(now) {
   teleop.last = now;
   const command = c || [0, 0, 0, 0];  // released: stop now (the dead-man rule would in 0.5 s)
   const target = all ? { all: true } : { body: state.selected };
-  socket.send(JSON.stringify({ type: "velocity", ...target, v: command.slice(0, 3), yaw_rate: command[3] }));
+  socket.send(JSON.stringify({ type: "velocity", ...target, v: command.slice(0, 3), yaw_rate: command[3],
+                               page: teleop.page, sent: now }));
   teleop.sent = c ? command.slice(0, 3) : null;
 }
 

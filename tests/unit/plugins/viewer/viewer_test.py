@@ -5,7 +5,8 @@ page. Passes when the page shows every robot and the simulated time advancing, d
 where the simulation has it (the robot's blue at the projected centre of most robots in view, and
 mostly not a little beside them), a robot selected shows its velocities, command and sensors in
 the panel, and steered with the W key (forward along the view) for 2 s it moves forward in the
-simulation (the panel showing the velocity commanded and achieved) and stops when the key is let
+simulation (the panel showing the velocity commanded and achieved, how long a command waited for
+its step and how long from the key to the picture of that step) and stops when the key is let
 go, with "steer every robot" the W key moves the whole formation, the page's pause
 holds the run (the time shown stands still), its step button takes a step and holds again, its resume and
 real-time factor 4 reach the run (its frames say so, and it goes no faster than 4 times the wall
@@ -126,6 +127,13 @@ try:
     ActionChains(page).key_up("w").perform()
     if "command (velocity)" not in steering or "commanded " not in steering or "achieved " not in steering:
         problems.append(f"steering, the panel does not show the velocity commanded and achieved: {steering!r}")
+    latency = re.search(r"steering: ([\d.]+) ms from a command's arrival to its step,\s+(\d+) ms from the key to the "
+                        r"picture of that step", steering)
+    if not latency:
+        problems.append(f"steering, the panel does not show a command's delays: {steering!r}")
+    else:
+        print(f"the panel while steering: {latency.group(1)} ms from arrival to step, {latency.group(2)} ms from the key "
+              f"to the picture")
     settled = wait_simulated(2.0)  # the velocity level's reference point stops at once; the robot settles on it
     still = wait_simulated(1.0)
     held = during[5] - before[5]
