@@ -1,7 +1,10 @@
 #!/usr/bin/env python3
 """The viewer's protocol against hostile and slow pages (python3-websockets), on loopback.
 
-    protocol_test.py SSX EXAMPLES_DIR WORK_DIR
+    viewer_server_test.py SSX EXAMPLES_DIR WORK_DIR [ROBOTS]
+
+ROBOTS (default 3,000) is fewer in the sanitized builds, whose ssx is slower than real time with
+3,000.
 
 A swarm of 3,000 light robots (84 KB a frame) runs in real time with --view; then:
 - a page gets the scene (JSON: every body) and binary frames of every body in the documented
@@ -40,7 +43,7 @@ except ImportError:
 ssx, examples, work = sys.argv[1], pathlib.Path(sys.argv[2]), pathlib.Path(sys.argv[3])
 shutil.rmtree(work, ignore_errors=True)
 work.mkdir(parents=True)
-ROBOTS = 3000
+ROBOTS = int(sys.argv[4]) if len(sys.argv) > 4 else 3000
 scene = work / "swarm.xml"
 scene.write_text(f"""<scene><environment timestep="0.01" seed="1" threads="2"/>
   <type name="r" file="{examples / 'artifacts' / 'hover_body.xml'}"/><ground/>
