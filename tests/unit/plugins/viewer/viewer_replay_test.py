@@ -137,8 +137,9 @@ async def main(url):
         stepped = await newest(ws, 0.5)
         if abs(stepped[0] - (expected + interval)) > 1e-6:
             problems.append(f"one step from {expected} went to {stepped[0]} (samples every {interval} s)")
-        print(f"samples {first[2]} and {stepped[2]}: largest difference from the recording "
-              f"{max(difference(first), difference(stepped)):.2e}")
+        if positions is not None:
+            print(f"samples {first[2]} and {stepped[2]}: largest difference from the recording "
+                  f"{max(difference(first), difference(stepped)):.2e}")
         if difference(stepped) > 1e-6:
             problems.append(f"the frame of sample {stepped[2]} differs from the recording by {difference(stepped)}")
         # speed 4 from the start
