@@ -3,9 +3,7 @@
 // per render tree, so that a swarm's members are drawn as instances of one mesh) and then frames of
 // every body's pose at up to rate_hz per wall-clock second.
 //
-// Frame (binary, little-endian): uint32 magic 0x46585353 ("SSXF"), uint32 N, float64 simulated
-// time (s), float32 real-time factor since the last frame, uint32 late steps so far, uint64 step,
-// then N x float32 x, y, z, qx, qy, qz, qw (28 bytes per body).
+// Frames: frame.hpp (the real-time factor since the last frame, the late steps so far, the step).
 //
 // Steering the run: {"type":"pause"}, {"type":"resume"}, {"type":"step"} (one step while paused) and
 // {"type":"rate","factor":F} (the real-time factor of a real-time run), through Environment::runControl.
@@ -31,6 +29,7 @@
 // speed) and {"type":"seek","time":T} (the page's slider). Nothing is steered; no details.
 //
 // Parameters: kParameters below, or `ssx plugins --params viewer`.
+#include "frame.hpp"
 #include "playback.hpp"
 #include "viewer_server.hpp"
 
@@ -67,21 +66,8 @@ namespace ssx::plugins {
 
 namespace {
 
-void number(std::string& out, double v) {
-  char text[32];
-  std::snprintf(text, sizeof text, "%.6g", std::isfinite(v) ? v : 0.0);
-  out += text;
-}
-
-void string(std::string& out, const std::string& s) {
-  out += '"';
-  for (const char c : s) {
-    if (c == '"' || c == '\\') out += '\\';
-    if (static_cast<unsigned char>(c) < 0x20) continue;
-    out += c;
-  }
-  out += '"';
-}
+using viewer::appendNumber;
+using viewer::appendString;
 
 const char* kindName(RenderNodeSpec::Primitive p) {
   switch (p) {
@@ -106,19 +92,19 @@ void shapes(std::string& out, const RenderNodeSpec& n, const Pose& parent, bool&
     out += R"({"kind":")";
     out += kindName(n.primitive);
     out += R"(","size":[)";
-    number(out, n.size.x()), out += ',', number(out, n.size.y()), out += ',', number(out, n.size.z());
+    appendNumber(out, n.size.x()), out += ',', appendNumber(out, n.size.y()), out += ',', appendNumber(out, n.size.z());
     out += R"(],"radius":)";
-    number(out, n.radius);
+    appendNumber(out, n.radius);
     out += R"(,"length":)";
-    number(out, n.length);
+    appendNumber(out, n.length);
     out += R"(,"grid":)";
     out += n.grid ? "true" : "false";
     out += R"(,"color":[)";
-    for (int k = 0; k < 4; ++k) number(out, n.color[static_cast<std::size_t>(k)]), out += k < 3 ? "," : "";
+    for (int k = 0; k < 4; ++k) appendNumber(out, n.color[static_cast<std::size_t>(k)]), out += k < 3 ? "," : "";
     out += R"(],"pose":[)";
     const Quat& q = pose.orientation;
     for (const double v : {pose.position.x(), pose.position.y(), pose.position.z(), q.x(), q.y(), q.z(), q.w()})
-      number(out, v), out += ',';
+      appendNumber(out, v), out += ',';
     out.back() = ']';
     out += '}';
   }
@@ -202,7 +188,7 @@ class Viewer final : public SimulationExtension {
     forEachSteered([&](CommandInterface& driver) { driver.setCommand(command); });
     teleop_.fresh = false;
     delays_ms_.push_back(std::chrono::duration<double, std::milli>(now - teleop_.received).count());
-    used_sent_ = teleop_.sent, used_page_ = teleop_.page, used_wait_ms_ = delays_ms_.back();
+    used_ = {teleop_.page, teleop_.sent, delays_ms_.back()};
   }
 
   void afterStep(Environment& env) override {
@@ -242,15 +228,8 @@ class Viewer final : public SimulationExtension {
     last_wall_ = now;
     last_sim_ = toSeconds(env.time());
     const std::uint32_t n = static_cast<std::uint32_t>(nodes_.size());
-    frame_.resize(32 + 28 * static_cast<std::size_t>(n));
-    std::uint8_t* p = frame_.data();
-    const std::uint32_t magic = 0x46585353;
-    const double t = toSeconds(env.time());
-    const float rate = static_cast<float>(rtf);
-    const std::uint64_t step = static_cast<std::uint64_t>(env.stepCount());
-    std::memcpy(p, &magic, 4), std::memcpy(p + 4, &n, 4), std::memcpy(p + 8, &t, 8), std::memcpy(p + 16, &rate, 4);
-    std::memcpy(p + 20, &late_, 4), std::memcpy(p + 24, &step, 8);
-    float* f = reinterpret_cast<float*>(p + 32);
+    float* f = viewer::beginFrame(frame_, {toSeconds(env.time()), static_cast<float>(rtf), late_,
+                                           static_cast<std::uint64_t>(env.stepCount())}, n);
     for (std::size_t b = 0; b < nodes_.size(); ++b) {  // (each root node's pose from its body's state)
       const Pose& body = env.bodyState(bodies_[b].index).pose;
       const Pose pose = bodies_[b].at_body ? body : body * bodies_[b].in_body;
@@ -258,19 +237,12 @@ class Viewer final : public SimulationExtension {
       for (const double v : {pose.position.x(), pose.position.y(), pose.position.z(), q.x(), q.y(), q.z(), q.w()})
         *f++ = static_cast<float>(v);
     }
-    double used_sent = -1, used_page = 0, used_wait_ms = 0;
+    viewer::CommandEcho echo;
     {
       std::lock_guard lock(mutex_);
-      std::swap(used_sent, used_sent_);  // (said once)
-      used_page = used_page_, used_wait_ms = used_wait_ms_;
+      std::swap(echo, used_);  // (said once)
     }
-    const std::string details = trailerJson(control_->realtimeFactor(), control_->paused(), detailsJson(env, now),
-                                            used_sent, used_page, used_wait_ms);
-    const std::uint32_t length = static_cast<std::uint32_t>(details.size());
-    const std::size_t at = frame_.size();
-    frame_.resize(at + 4 + details.size());
-    std::memcpy(frame_.data() + at, &length, 4);
-    std::memcpy(frame_.data() + at + 4, details.data(), details.size());
+    viewer::endFrame(frame_, n, viewer::trailerJson(control_->realtimeFactor(), control_->paused(), detailsJson(env, now), echo));
     server_->publish(frame_);
     const double build_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - build_start).count();
     ++built_, build_ms_sum_ += build_ms, build_ms_max_ = std::max(build_ms_max_, build_ms);
@@ -397,25 +369,13 @@ class Viewer final : public SimulationExtension {
       shown = k, shown_paused = paused, sent = last;
       const std::vector<float> p = recording_->positions(k), q = recording_->orientations(k);  // (q: w x y z)
       const std::uint32_t n = static_cast<std::uint32_t>(recording_->names().size());
-      const std::string trailer = trailerJson(speed, paused, {});
-      std::vector<std::uint8_t>& frame = play_frame_;
-      frame.assign(36 + 28 * static_cast<std::size_t>(n) + trailer.size(), 0);
-      std::uint8_t* out = frame.data();
-      const std::uint32_t magic = 0x46585353, late = 0;
-      const double t = toSeconds(recording_->times()[k]);
-      const float rate = paused ? 0.0f : static_cast<float>(speed);
-      const std::uint64_t sample = k;
-      std::memcpy(out, &magic, 4), std::memcpy(out + 4, &n, 4), std::memcpy(out + 8, &t, 8), std::memcpy(out + 16, &rate, 4);
-      std::memcpy(out + 20, &late, 4), std::memcpy(out + 24, &sample, 8);
-      float* f = reinterpret_cast<float*>(out + 32);
+      float* f = viewer::beginFrame(play_frame_, {toSeconds(recording_->times()[k]), paused ? 0.0f : static_cast<float>(speed), 0, k}, n);
       for (std::size_t i = 0; i < n; ++i) {
         for (std::size_t a = 0; a < 3; ++a) *f++ = p[3 * i + a];
         *f++ = q[4 * i + 1], *f++ = q[4 * i + 2], *f++ = q[4 * i + 3], *f++ = q[4 * i];
       }
-      const std::uint32_t length = static_cast<std::uint32_t>(trailer.size());
-      std::memcpy(out + 32 + 28 * static_cast<std::size_t>(n), &length, 4);
-      std::memcpy(out + 36 + 28 * static_cast<std::size_t>(n), trailer.data(), trailer.size());
-      server_->publish(frame);
+      viewer::endFrame(play_frame_, n, viewer::trailerJson(speed, paused, {}));
+      server_->publish(play_frame_);
     }
   }
 
@@ -465,13 +425,13 @@ class Viewer final : public SimulationExtension {
       const BodyState s = env.bodyState(node.bodyIndex());
       out += out.back() == '[' ? "" : ",";
       out += R"({"body":)" + std::to_string(b) + R"(,"name":)";
-      string(out, names_[static_cast<std::size_t>(b)]);
+      appendString(out, names_[static_cast<std::size_t>(b)]);
       out += R"(,"v":[)";
-      number(out, s.linear_velocity.x()), out += ',', number(out, s.linear_velocity.y()), out += ',';
-      number(out, s.linear_velocity.z());
+      appendNumber(out, s.linear_velocity.x()), out += ',', appendNumber(out, s.linear_velocity.y()), out += ',';
+      appendNumber(out, s.linear_velocity.z());
       out += R"(],"w":[)";
-      number(out, s.angular_velocity.x()), out += ',', number(out, s.angular_velocity.y()), out += ',';
-      number(out, s.angular_velocity.z());
+      appendNumber(out, s.angular_velocity.x()), out += ',', appendNumber(out, s.angular_velocity.y()), out += ',';
+      appendNumber(out, s.angular_velocity.z());
       out += R"(],"command":)";
       const auto* commandable = dynamic_cast<const CommandInterface*>(a.driver());
       out += commandable != nullptr ? commandJson(commandable->currentCommand()) : "null";
@@ -483,28 +443,12 @@ class Viewer final : public SimulationExtension {
         out += first ? "" : ",";
         first = false;
         out += R"({"sensor":)";
-        string(out, a.sensor(k).className());
+        appendString(out, a.sensor(k).className());
         out += ',' + m.substr(1);
       }
       out += "]}";
     }
     return out + "]";
-  }
-
-  // what follows the poses of a frame: the run's pace as set ("factor": 0 for the run's own) and
-  // whether it is paused, then the details when any
-  static std::string trailerJson(double factor, bool paused, const std::string& details, double sent = -1,
-                                 double page = 0, double waited_ms = 0) {
-    std::string out = R"({"run":{"factor":)";
-    number(out, factor);
-    out += paused ? R"(,"paused":true})" : R"(,"paused":false})";
-    if (sent >= 0) {  // the newest command a step used: the page's time stamp, and its wait here
-      char text[128];
-      std::snprintf(text, sizeof text, R"(,"command":{"page":%.0f,"sent":%.3f,"waited_ms":%.3f})", page, sent, waited_ms);
-      out += text;
-    }
-    if (!details.empty()) out += R"(,"details":)" + details;
-    return out + "}";
   }
 
   // the scene for a page: the models (render trees, each in its body's frame), the bodies with
@@ -533,7 +477,7 @@ class Viewer final : public SimulationExtension {
       }
       bodies += b == 0 ? "" : ",";
       bodies += "{\"name\":";
-      string(bodies, names_[b]);
+      appendString(bodies, names_[b]);
       bodies += ",\"model\":" + std::to_string(model) + "}";
     }
     for (std::size_t i = 0; i < env.artifactCount(); ++i) {
@@ -548,12 +492,12 @@ class Viewer final : public SimulationExtension {
       }
     }
     std::string out = R"({"type":"scene","time":)";
-    number(out, toSeconds(env.time()));
+    appendNumber(out, toSeconds(env.time()));
     if (playback_) {
       out += R"(,"replay":{"start":)";
-      number(out, toSeconds(playback_->start()));
+      appendNumber(out, toSeconds(playback_->start()));
       out += R"(,"end":)";
-      number(out, toSeconds(playback_->end()));
+      appendNumber(out, toSeconds(playback_->end()));
       out += '}';
     }
     out += R"(,"models":[)" + models + R"(],"bodies":[)" + bodies + R"(],"world":[)" + world + "]}";
@@ -592,8 +536,7 @@ class Viewer final : public SimulationExtension {
     double sent = -1;  // when the page sent it, on the page's clock (ms), or -1
     double page = 0;   // the page's number for itself
   };
-  // the newest command used by a step: its page, when it sent it, and how long it waited here for the step
-  double used_sent_ = -1, used_page_ = 0, used_wait_ms_ = 0;
+  viewer::CommandEcho used_;  // the newest command a step used, for the next frame
   std::mutex mutex_;
   Teleop teleop_;
   std::map<int, std::chrono::steady_clock::time_point> watched_;
