@@ -1,0 +1,211 @@
+// The Crazyflie firmware's default controller (crazyflie_pid.hpp).
+#include "crazyflie_pid.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+#include <stdexcept>
+
+namespace ssx::quadrotor {
+
+namespace {
+
+constexpr double kDeg = 180.0 / std::numbers::pi;
+
+double wrap180(double degrees) {
+  degrees = std::fmod(degrees + 180.0, 360.0);
+  return (degrees < 0 ? degrees + 360.0 : degrees) - 180.0;
+}
+
+// roll, pitch, yaw (degrees) of an orientation, Z-Y-X
+Vec3 eulerDegrees(const Quat& q) {
+  const double roll = std::atan2(2 * (q.w() * q.x() + q.y() * q.z()), 1 - 2 * (q.x() * q.x() + q.y() * q.y()));
+  const double pitch = std::asin(std::clamp(2 * (q.w() * q.y() - q.z() * q.x()), -1.0, 1.0));
+  const double yaw = std::atan2(2 * (q.w() * q.z() + q.x() * q.y()), 1 - 2 * (q.y() * q.y() + q.z() * q.z()));
+  return Vec3(roll, pitch, yaw) * kDeg;
+}
+
+// x, y of a world vector in the frame turned by `yaw` (radians) about z
+Vec3 intoYawFrame(const Vec3& v, double yaw) {
+  const double c = std::cos(yaw), s = std::sin(yaw);
+  return {c * v.x() + s * v.y(), -s * v.x() + c * v.y(), v.z()};
+}
+
+double sign(double v) { return v > 0 ? 1.0 : -1.0; }
+
+}  // namespace
+
+double Pid::update(double desired, double measured, double dt, bool wrap_degrees) {
+  double error = desired - measured;
+  if (wrap_degrees) error = wrap180(error);
+  integral_ = std::clamp(integral_ + error * dt, -g_.integral_limit, g_.integral_limit);
+  double change = started_ ? measured - previous_ : 0.0;
+  if (wrap_degrees) change = wrap180(change);
+  const double derivative = -change / dt;  // on the measurement: a set-point step gives no kick
+  previous_ = measured;
+  started_ = true;
+  const double out = g_.kp * error + g_.ki * integral_ + g_.kd * derivative;
+  return g_.output_limit > 0 ? std::clamp(out, -g_.output_limit, g_.output_limit) : out;
+}
+
+void Pid::reset() {
+  integral_ = 0;
+  started_ = false;
+}
+
+void Pid::save(StateWriter& out) const {
+  out.write(integral_);
+  out.write(previous_);
+  out.write(started_);
+}
+
+void Pid::load(StateReader& in) {
+  in.read(integral_);
+  in.read(previous_);
+  in.read(started_);
+}
+
+CrazyfliePidController::CrazyfliePidController(const CrazyfliePidGains& gains, const std::vector<Rotor>& rotors,
+                                               const RotorParams& rotor, const CrazyflieThrustCurve& curve)
+    : g_(gains), curve_(curve), thrust_coefficient_(rotor.thrust_coefficient) {
+  if (rotors.size() != 4) throw std::invalid_argument("crazyflie_pid: four rotors, got " + std::to_string(rotors.size()));
+  for (std::size_t i = 0; i < 4; ++i) {
+    const Rotor& r = rotors[i];
+    if (std::abs(r.position.x()) < 1e-6 || std::abs(r.position.y()) < 1e-6)
+      throw std::invalid_argument("crazyflie_pid: the firmware's mixer is for an X frame; rotor " + std::to_string(i) +
+                                  " stands on a body axis");
+    // more thrust on the left rolls positive, at the rear pitches positive; a rotor whose reaction
+    // torque points down (direction +1) yaws negative
+    signs_[i] = {sign(r.position.y()), -sign(r.position.x()), -static_cast<double>(r.direction)};
+  }
+  const double ratio = g_.attitude_rate_hz / g_.position_rate_hz;
+  if (!(ratio >= 1) || std::abs(ratio - std::round(ratio)) > 1e-9)
+    throw std::invalid_argument("crazyflie_pid: the attitude rate must be a whole multiple of the position rate");
+  position_every_ = static_cast<std::int64_t>(std::llround(ratio));
+  const PidGains* p[3] = {&g_.position_xy, &g_.position_xy, &g_.position_z};
+  const PidGains* v[3] = {&g_.velocity_xy, &g_.velocity_xy, &g_.velocity_z};
+  const PidGains* a[3] = {&g_.attitude_rp, &g_.attitude_rp, &g_.attitude_yaw};
+  const PidGains* w[3] = {&g_.rate_rp, &g_.rate_rp, &g_.rate_yaw};
+  for (int k = 0; k < 3; ++k) pos_[k] = Pid(*p[k]), vel_[k] = Pid(*v[k]), att_[k] = Pid(*a[k]), rate_[k] = Pid(*w[k]);
+}
+
+void CrazyfliePidController::setCommand(const Command& command, const Vec3&) {
+  level_ = command.level;
+  if (command.level == CommandLevel::Position) {
+    current_ = command.setpoint;
+  } else if (command.level == CommandLevel::Velocity) {
+    command_velocity_ = command.velocity;
+    command_yaw_rate_ = command.yaw_rate;
+  }
+}
+
+Command CrazyfliePidController::command() const {
+  if (level_ == CommandLevel::Velocity) return Command::velocityYawRate(command_velocity_, command_yaw_rate_);
+  return FlightController::command();
+}
+
+double CrazyfliePidController::motorThrust(double command) const {
+  const double pwm = curve_.pwm(command, battery_volts_);
+  if (pwm <= 0) return 0;
+  return std::max(0.0, curve_.thrust(pwm / 65535.0 * battery_volts_));
+}
+
+void CrazyfliePidController::resetAll(double yaw_deg) {
+  for (int k = 0; k < 3; ++k) pos_[k].reset(), vel_[k].reset(), att_[k].reset(), rate_[k].reset();
+  yaw_target_deg_ = yaw_deg;
+}
+
+void CrazyfliePidController::positionLoop(double t, FlightInputs& in) {
+  const double dt = 1.0 / g_.position_rate_hz;
+  Pose pose;
+  Vec3 velocity;
+  in.position(pose, velocity);
+  const Vec3 euler = eulerDegrees(pose.orientation);
+  const double yaw = euler.z() / kDeg;
+  if (!yaw_target_set_) yaw_target_deg_ = euler.z(), yaw_target_set_ = true;
+  Vec3 desired_body;  // the velocity asked for: x, y in the yaw frame, z in the world's
+  if (level_ == CommandLevel::Velocity) {
+    desired_body = intoYawFrame(command_velocity_, yaw);
+  } else {
+    current_ = in.reference(t, dt);
+    if (in.holdsHeading()) yaw_target_deg_ = current_.yaw * kDeg;
+    const Vec3 target = intoYawFrame(current_.position, yaw), at = intoYawFrame(pose.position, yaw);
+    desired_body.x() = std::clamp(pos_[0].update(target.x(), at.x(), dt), -g_.velocity_max_xy, g_.velocity_max_xy);
+    desired_body.y() = std::clamp(pos_[1].update(target.y(), at.y(), dt), -g_.velocity_max_xy, g_.velocity_max_xy);
+    desired_body.z() = std::clamp(pos_[2].update(target.z(), at.z(), dt), -g_.velocity_max_z, g_.velocity_max_z);
+  }
+  const double c = std::cos(yaw), s = std::sin(yaw);
+  velocity_desired_ = {c * desired_body.x() - s * desired_body.y(), s * desired_body.x() + c * desired_body.y(),
+                       desired_body.z()};
+  // the velocity loop: tilt towards the velocity error, thrust from the vertical one
+  const Vec3 measured = intoYawFrame(velocity, yaw);
+  pitch_deg_ = std::clamp(vel_[0].update(desired_body.x(), measured.x(), dt), -g_.tilt_max_deg, g_.tilt_max_deg);
+  roll_deg_ = std::clamp(-vel_[1].update(desired_body.y(), measured.y(), dt), -g_.tilt_max_deg, g_.tilt_max_deg);
+  const double thrust = vel_[2].update(desired_body.z(), measured.z(), dt) * g_.thrust_scale + g_.thrust_base;
+  thrust_ = std::clamp(std::max(thrust, g_.thrust_min), 0.0, 65535.0);
+}
+
+void CrazyfliePidController::attitudeLoop(FlightInputs& in) {
+  const double dt = 1.0 / g_.attitude_rate_hz;
+  Pose pose;
+  Vec3 velocity;
+  in.position(pose, velocity);
+  const Vec3 euler = eulerDegrees(pose.orientation);
+  if (thrust_ <= 0) {  // as the firmware: every loop reset, the heading held where it is
+    resetAll(euler.z());
+    motors_.fill(0);
+    return;
+  }
+  const double yaw_rate = level_ == CommandLevel::Velocity ? command_yaw_rate_ : current_.yaw_rate;
+  if (level_ == CommandLevel::Velocity || !in.holdsHeading()) yaw_target_deg_ = wrap180(yaw_target_deg_ + yaw_rate * kDeg * dt);
+  const Vec3 rates_desired(att_[0].update(roll_deg_, euler.x(), dt), att_[1].update(pitch_deg_, euler.y(), dt),
+                           att_[2].update(yaw_target_deg_, euler.z(), dt, true));
+  const Vec3 gyro = in.bodyRates() * kDeg;
+  const double roll = rate_[0].update(rates_desired.x(), gyro.x(), dt);
+  const double pitch = rate_[1].update(rates_desired.y(), gyro.y(), dt);
+  const double yaw = rate_[2].update(rates_desired.z(), gyro.z(), dt);
+  // the legacy mixer: half the roll and pitch outputs, truncated as the firmware's integers are
+  const double r = std::trunc(roll / 2), p = std::trunc(pitch / 2), y = std::trunc(yaw);
+  double highest = 0;
+  for (std::size_t i = 0; i < 4; ++i) {
+    motors_[i] = thrust_ + signs_[i][0] * r + signs_[i][1] * p + signs_[i][2] * y;
+    highest = std::max(highest, motors_[i]);
+  }
+  // capped: the excess over the ceiling taken from every motor (the differential kept), then floored
+  const double excess = std::max(0.0, highest - 65535.0);
+  for (double& m : motors_) m = std::max(0.0, m - excess);
+}
+
+void CrazyfliePidController::step(std::int64_t run, double t, FlightInputs& in, std::span<double> speeds) {
+  if (run % position_every_ == 0) positionLoop(t, in);
+  attitudeLoop(in);
+  for (std::size_t i = 0; i < 4 && i < speeds.size(); ++i) speeds[i] = std::sqrt(motorThrust(motors_[i]) / thrust_coefficient_);
+}
+
+void CrazyfliePidController::saveState(StateWriter& out) const {
+  for (int k = 0; k < 3; ++k) pos_[k].save(out), vel_[k].save(out), att_[k].save(out), rate_[k].save(out);
+  out.write(static_cast<std::uint8_t>(level_));
+  for (const double v : {current_.position.x(), current_.position.y(), current_.position.z(), current_.yaw,
+                         current_.yaw_rate, command_velocity_.x(), command_velocity_.y(), command_velocity_.z(),
+                         command_yaw_rate_, velocity_desired_.x(), velocity_desired_.y(), velocity_desired_.z(), roll_deg_,
+                         pitch_deg_, yaw_target_deg_, thrust_, battery_volts_})
+    out.write(v);
+  out.write(yaw_target_set_);
+  for (const double m : motors_) out.write(m);
+}
+
+void CrazyfliePidController::loadState(StateReader& in) {
+  for (int k = 0; k < 3; ++k) pos_[k].load(in), vel_[k].load(in), att_[k].load(in), rate_[k].load(in);
+  std::uint8_t level = 0;
+  in.read(level);
+  level_ = static_cast<CommandLevel>(level);
+  double* fields[] = {&current_.position.x(), &current_.position.y(), &current_.position.z(), &current_.yaw,
+                      &current_.yaw_rate, &command_velocity_.x(), &command_velocity_.y(), &command_velocity_.z(),
+                      &command_yaw_rate_, &velocity_desired_.x(), &velocity_desired_.y(), &velocity_desired_.z(),
+                      &roll_deg_, &pitch_deg_, &yaw_target_deg_, &thrust_, &battery_volts_};
+  for (double* f : fields) in.read(*f);
+  in.read(yaw_target_set_);
+  for (double& m : motors_) in.read(m);
+}
+
+}  // namespace ssx::quadrotor

@@ -1,0 +1,123 @@
+#pragma once
+// The Crazyflie firmware's default controller (crazyflie-firmware 2025.12.1: controller_pid.c,
+// position_controller_pid.c, attitude_pid_controller.c, pid.c, power_distribution_quadrotor.c; gains
+// from platform_defaults_cf2.h), written from its description:
+// - position P(I) and velocity PI at 100 Hz, x and y in the frame turned by the vehicle's yaw; no
+//   feed-forward of the set-point's motion (the firmware drops it), the velocity asked for clamped
+//   to 1.1 m/s per axis and the tilt to 20 degrees;
+// - thrust = 36000 + 1000 * the vertical velocity PI, at least 20000, no tilt compensation;
+// - attitude PI and rate PID at 500 Hz, in degrees, D on the measurement, integrals clamped;
+// - the quad-X mixer in the firmware's 0-65535 command units (half the roll and pitch outputs,
+//   truncated), capped by giving up collective thrust first;
+// - each motor's command is newtons through the battery compensation (CrazyflieThrustCurve), and a
+//   rotor speed through the thrust coefficient.
+// Signs are ssx's (x forward, y left, z up; a positive pitch tilts the thrust towards +x); the
+// firmware's pitch has the other sign, which changes nothing else.
+//
+// It takes position and velocity commands. It is not in the quadrotor driver yet: the crazyflie
+// preset's controller to come.
+#include "controller.hpp"
+#include "crazyflie_thrust.hpp"
+#include "quadrotor_model.hpp"
+
+#include <array>
+#include <vector>
+
+namespace ssx::quadrotor {
+
+/// pid.c's element.
+struct PidGains {
+  double kp = 0, ki = 0, kd = 0;
+  double integral_limit = 5000;  ///< |integral| at most this (the firmware's default: no real limit)
+  double output_limit = 0;       ///< |output| at most this; 0: no limit
+};
+
+class Pid {
+ public:
+  Pid() = default;
+  explicit Pid(const PidGains& gains) : g_(gains) {}
+  /// One update: kp e + ki (integral of e) + kd (-d measured / dt), D on the measurement (a
+  /// set-point step gives no kick). `wrap_degrees`: the error is wrapped to +-180.
+  double update(double desired, double measured, double dt, bool wrap_degrees = false);
+  void reset();
+  double integral() const { return integral_; }
+  void save(StateWriter& out) const;
+  void load(StateReader& in);
+
+ private:
+  PidGains g_;
+  double integral_ = 0, previous_ = 0;
+  bool started_ = false;
+};
+
+/// The firmware's defaults (platform_defaults_cf2.h).
+struct CrazyfliePidGains {
+  PidGains position_xy{2, 0, 0};
+  PidGains position_z{2, 0.5, 0};
+  double velocity_max_xy = 1.1, velocity_max_z = 1.1;  ///< m/s: 1.0 and max(zVelMax, 0.5), each x 1.1
+  PidGains velocity_xy{25, 1, 0, 5000, 22};             ///< degrees of tilt per m/s; output +-1.1 x 20 degrees
+  PidGains velocity_z{25, 15, 0, 5000, 65535.0 / 2 / 1000};
+  double tilt_max_deg = 20;
+  double thrust_base = 36000, thrust_scale = 1000, thrust_min = 20000;
+  PidGains attitude_rp{6, 3, 0, 20};
+  PidGains attitude_yaw{6, 1, 0.35, 360};
+  PidGains rate_rp{250, 500, 2.5, 33.3, 32767};
+  PidGains rate_yaw{120, 16.7, 0, 166.7, 32767};
+  double position_rate_hz = 100, attitude_rate_hz = 500;
+};
+
+class CrazyfliePidController final : public FlightController {
+ public:
+  /// `rotors`: four rotors in an X (none on an axis); `rotor`: kF for the rotor speeds; stepped at
+  /// gains.attitude_rate_hz. std::invalid_argument for another layout or rates that do not divide.
+  CrazyfliePidController(const CrazyfliePidGains& gains, const std::vector<Rotor>& rotors, const RotorParams& rotor,
+                         const CrazyflieThrustCurve& curve = CrazyflieThrustCurve::propellers21plus());
+
+  /// The battery voltage the compensation sees (filtered; 4.2 V until told).
+  void setBatteryVoltage(double volts) { battery_volts_ = volts; }
+
+  bool accepts(CommandLevel level) const override {
+    return level == CommandLevel::Position || level == CommandLevel::Velocity;
+  }
+  CommandLevel level() const override { return level_; }
+  void setCommand(const Command& command, const Vec3& position) override;
+  Setpoint currentSetpoint() const override { return current_; }
+  Command command() const override;
+  void step(std::int64_t run, double t, FlightInputs& in, std::span<double> speeds) override;
+  void saveState(StateWriter& out) const override;
+  void loadState(StateReader& in) override;
+
+  /// What the velocity loop asks of the attitude loop: roll, pitch (degrees, ssx's signs) and the
+  /// thrust command (0-65535), as the firmware logs them (controller.roll/pitch/cmd_thrust).
+  std::array<double, 3> desiredAttitude() const { return {roll_deg_, pitch_deg_, thrust_}; }
+  /// The velocity the position loop asks for (m/s, world frame).
+  Vec3 desiredVelocity() const { return velocity_desired_; }
+  /// The four motors' commands after mixing and capping (0-65535), in the rotors' order.
+  std::array<double, 4> motorCommands() const { return motors_; }
+  /// Each motor's thrust (N) for a command, through the battery compensation at `battery_volts`.
+  double motorThrust(double command) const;
+
+ private:
+  void positionLoop(double t, FlightInputs& in);
+  void attitudeLoop(FlightInputs& in);
+  void resetAll(double yaw_deg);
+
+  CrazyfliePidGains g_;
+  CrazyflieThrustCurve curve_;
+  double thrust_coefficient_;
+  std::array<std::array<double, 3>, 4> signs_{};  // per rotor: roll, pitch, yaw
+  std::int64_t position_every_ = 5;
+  double battery_volts_ = 4.2;
+  CommandLevel level_ = CommandLevel::Position;
+  Setpoint current_;
+  Vec3 command_velocity_ = Vec3::Zero();
+  double command_yaw_rate_ = 0;  // rad/s
+  // the loops
+  Pid pos_[3], vel_[3], att_[3], rate_[3];
+  Vec3 velocity_desired_ = Vec3::Zero();
+  double roll_deg_ = 0, pitch_deg_ = 0, yaw_target_deg_ = 0, thrust_ = 0;
+  bool yaw_target_set_ = false;
+  std::array<double, 4> motors_{};
+};
+
+}  // namespace ssx::quadrotor

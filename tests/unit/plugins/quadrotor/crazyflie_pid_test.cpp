@@ -1,0 +1,147 @@
+// The Crazyflie firmware's controller, loop by loop: pid.c's element (D on the measurement, the
+// integral's and the output's clamps, wrapped yaw errors); the position loop asks for no more than
+// 1.1 m/s and the velocity loop tilts no more than 20 degrees, in the frame turned by the vehicle's
+// yaw; hover takes the thrust base (36000) and no tilt compensation; the mixer gives up collective
+// thrust first; a command is newtons per motor; a saved state continues identically.
+#include "crazyflie_pid.hpp"
+
+#include <catch2/catch.hpp>
+
+#include <cmath>
+#include <numbers>
+
+using namespace ssx;
+using namespace ssx::quadrotor;
+
+namespace {
+
+// a vehicle that stands where the test puts it
+struct Standing : FlightInputs {
+  Pose pose;
+  Vec3 velocity = Vec3::Zero(), rates = Vec3::Zero();
+  Setpoint setpoint;
+  bool heading = true;
+  Setpoint reference(double, double) override { return setpoint; }
+  bool holdsHeading() const override { return heading; }
+  void position(Pose& p, Vec3& v) const override { p = pose, v = velocity; }
+  Vec3 bodyRates() const override { return rates; }
+};
+
+// the Crazyflie's X: front-right, rear-right, rear-left, front-left (M1..M4), M1 and M3 spinning alike
+std::vector<Rotor> xFrame() {
+  const double a = 0.046 * std::sqrt(0.5);
+  return {{Vec3(a, -a, 0), 1}, {Vec3(-a, -a, 0), -1}, {Vec3(-a, a, 0), 1}, {Vec3(a, a, 0), -1}};
+}
+
+RotorParams crazyflieRotors() {
+  RotorParams r;
+  r.thrust_coefficient = 2.27e-8;
+  return r;
+}
+
+}  // namespace
+
+TEST_CASE("crazyflie_pid: the PID element", "[quadrotor][crazyflie]") {
+  Pid p({2, 1, 0.5, 0.3, 4});
+  CHECK(p.update(1, 0, 0.1) == Approx(2 * 1 + 1 * 0.1));  // no derivative kick from the set-point
+  CHECK(p.update(1, 0.2, 0.1) == Approx(2 * 0.8 + 1 * 0.18 + 0.5 * (-0.2 / 0.1)));
+  for (int i = 0; i < 100; ++i) p.update(1, 0.2, 0.1);
+  CHECK(p.integral() == Approx(0.3));                     // clamped
+  CHECK(p.update(100, 0.2, 0.1) == 4);                    // output clamped
+  Pid yaw({1, 0, 0});
+  CHECK(yaw.update(170, -170, 0.002, true) == Approx(-20));  // the short way round
+}
+
+TEST_CASE("crazyflie_pid: hover, limits, the yaw frame, no tilt compensation", "[quadrotor][crazyflie]") {
+  const CrazyfliePidGains gains;
+  Standing in;
+  in.pose.position = Vec3(0, 0, 1);
+  in.setpoint.position = Vec3(0, 0, 1);
+  CrazyfliePidController c(gains, xFrame(), crazyflieRotors());
+  std::array<double, 4> speeds{};
+  c.step(0, 0, in, speeds);
+  // on the set-point, at rest: the thrust base, every motor alike, each 36000/65535 of 0.12 N
+  CHECK(c.desiredAttitude()[2] == 36000);
+  for (const double m : c.motorCommands()) CHECK(m == 36000);
+  CHECK(c.motorThrust(36000) == Approx(36000.0 / 65535 * 0.12).epsilon(1e-9));
+  CHECK(speeds[0] == Approx(std::sqrt(36000.0 / 65535 * 0.12 / 2.27e-8)).epsilon(1e-9));
+  // 1 m behind in x: 2 m/s asked, 1.1 m/s allowed; 25 degrees per m/s, 20 allowed, nose down towards +x
+  in.setpoint.position = Vec3(1, 0, 1);
+  c.step(5, 0.01, in, speeds);
+  CHECK(c.desiredVelocity().x() == Approx(1.1));
+  CHECK(c.desiredAttitude()[1] == Approx(20));
+  CHECK(c.desiredAttitude()[0] == Approx(0).margin(1e-12));
+  // turned 90 degrees left, the same error is along the body's -y: the vehicle rolls, positive (right side down)
+  Standing turned = in;
+  turned.pose.orientation = Quat(Eigen::AngleAxisd(std::numbers::pi / 2, Vec3::UnitZ()));
+  CrazyfliePidController d(gains, xFrame(), crazyflieRotors());
+  d.step(0, 0, turned, speeds);
+  CHECK(d.desiredVelocity().x() == Approx(1.1));
+  CHECK(d.desiredAttitude()[0] == Approx(20));
+  CHECK(d.desiredAttitude()[1] == Approx(0).margin(1e-9));
+  // tilted by 15 degrees, on the set-point: the same thrust (no compensation for the tilt)
+  Standing tilted;
+  tilted.pose.position = tilted.setpoint.position = Vec3(0, 0, 1);
+  tilted.pose.orientation = Quat(Eigen::AngleAxisd(15 * std::numbers::pi / 180, Vec3::UnitX()));
+  CrazyfliePidController e(gains, xFrame(), crazyflieRotors());
+  e.step(0, 0, tilted, speeds);
+  CHECK(e.desiredAttitude()[2] == 36000);
+  // falling at 1 m/s on the set-point: thrust up by 25 x 1000 per m/s (and the integral's first step)
+  Standing falling;
+  falling.pose.position = falling.setpoint.position = Vec3(0, 0, 1);
+  falling.velocity = Vec3(0, 0, -1);
+  CrazyfliePidController f(gains, xFrame(), crazyflieRotors());
+  f.step(0, 0, falling, speeds);
+  CHECK(f.desiredAttitude()[2] == Approx(36000 + 1000 * (25 * 1 + 15 * 0.01)));
+}
+
+TEST_CASE("crazyflie_pid: the mixer rolls with the left motors, gives up collective thrust first", "[quadrotor][crazyflie]") {
+  CrazyfliePidGains gains;
+  gains.thrust_base = 65000;  // near the ceiling
+  Standing in;
+  in.pose.position = in.setpoint.position = Vec3(0, 0, 1);
+  in.rates = Vec3(-0.5, 0, 0);  // rolling right at 0.5 rad/s: the rate loop asks for positive roll torque
+  CrazyfliePidController c(gains, xFrame(), crazyflieRotors());
+  std::array<double, 4> speeds{};
+  c.step(0, 0, in, speeds);
+  const auto m = c.motorCommands();
+  CHECK(m[2] == Approx(m[3]));  // left pair alike
+  CHECK(m[0] == Approx(m[1]));  // right pair alike
+  CHECK(m[3] > m[0]);           // more on the left
+  CHECK(std::max({m[0], m[1], m[2], m[3]}) == 65535);  // capped at the ceiling
+  // the differential survives the cap: half the rate loop's output on each side
+  const double roll = 250 * (0.5 * 180 / std::numbers::pi) + 500 * (0.5 * 180 / std::numbers::pi) * 0.002;
+  CHECK(m[3] - m[0] == Approx(2 * std::trunc(std::min(roll, 32767.0) / 2)));
+  CHECK((m[0] + m[3]) / 2 < 65000);  // the collective given up
+}
+
+TEST_CASE("crazyflie_pid: a saved state continues identically; velocity commands", "[quadrotor][crazyflie]") {
+  const CrazyfliePidGains gains;
+  Standing in;
+  in.pose.position = Vec3(0.3, -0.2, 0.9);
+  in.setpoint.position = Vec3(0, 0, 1);
+  in.velocity = Vec3(0.1, 0, 0);
+  in.rates = Vec3(0.05, -0.02, 0.01);
+  CrazyfliePidController a(gains, xFrame(), crazyflieRotors()), b(gains, xFrame(), crazyflieRotors());
+  std::array<double, 4> sa{}, sb{};
+  for (int i = 0; i < 7; ++i) a.step(i, i * 0.002, in, sa);
+  std::vector<std::byte> saved;
+  StateWriter out(saved);
+  a.saveState(out);
+  StateReader back(saved);
+  b.loadState(back);
+  for (int i = 7; i < 20; ++i) {
+    a.step(i, i * 0.002, in, sa);
+    b.step(i, i * 0.002, in, sb);
+    CHECK(sa == sb);
+  }
+  CHECK(a.accepts(CommandLevel::Velocity));
+  CHECK_FALSE(a.accepts(CommandLevel::Attitude));
+  a.setCommand(Command::velocityYawRate(Vec3(0.5, 0, 0), 0), in.pose.position);
+  a.step(20, 0.04, in, sa);
+  CHECK(a.desiredVelocity().x() == Approx(0.5));
+  CHECK(a.command().level == CommandLevel::Velocity);
+  CHECK_THROWS_AS(CrazyfliePidController(gains, {{Vec3(0.046, 0, 0), 1}, {Vec3(0, 0.046, 0), -1}, {Vec3(-0.046, 0, 0), 1},
+                                                 {Vec3(0, -0.046, 0), -1}}, crazyflieRotors()),
+                  std::invalid_argument);  // a plus frame
+}
