@@ -82,11 +82,29 @@ CrazyfliePidController::CrazyfliePidController(const CrazyfliePidGains& gains, c
   if (!(ratio >= 1) || std::abs(ratio - std::round(ratio)) > 1e-9)
     throw std::invalid_argument("crazyflie_pid: the attitude rate must be a whole multiple of the position rate");
   position_every_ = static_cast<std::int64_t>(std::llround(ratio));
+  position_dt_ = 1.0 / g_.position_rate_hz;
+  attitude_dt_ = 1.0 / g_.attitude_rate_hz;
   const PidGains* p[3] = {&g_.position_xy, &g_.position_xy, &g_.position_z};
   const PidGains* v[3] = {&g_.velocity_xy, &g_.velocity_xy, &g_.velocity_z};
   const PidGains* a[3] = {&g_.attitude_rp, &g_.attitude_rp, &g_.attitude_yaw};
   const PidGains* w[3] = {&g_.rate_rp, &g_.rate_rp, &g_.rate_yaw};
   for (int k = 0; k < 3; ++k) pos_[k] = Pid(*p[k]), vel_[k] = Pid(*v[k]), att_[k] = Pid(*a[k]), rate_[k] = Pid(*w[k]);
+}
+
+void CrazyfliePidController::setRuns(std::int64_t attitude_runs, std::int64_t position_runs, double run_seconds) {
+  if (attitude_runs < 1 || position_runs < 1)
+    throw std::invalid_argument("crazyflie_pid: its loops cannot run faster than the driver");
+  attitude_every_ = attitude_runs;
+  position_every_ = position_runs;
+  attitude_dt_ = static_cast<double>(attitude_runs) * run_seconds;
+  position_dt_ = static_cast<double>(position_runs) * run_seconds;
+}
+
+void CrazyfliePidController::startInAir(double weight) {
+  if (weight <= 0) return;
+  // thrust = base + scale (ki integral) at no error: the integral that gives the weight's command
+  const double command = weight / 4 / curve_.thrust_max * 65535.0;
+  vel_[2].setIntegral((command - g_.thrust_base) / (g_.thrust_scale * g_.velocity_z.ki));
 }
 
 void CrazyfliePidController::setCommand(const Command& command, const Vec3&) {
@@ -116,7 +134,7 @@ void CrazyfliePidController::resetAll(double yaw_deg) {
 }
 
 void CrazyfliePidController::positionLoop(double t, FlightInputs& in) {
-  const double dt = 1.0 / g_.position_rate_hz;
+  const double dt = position_dt_;
   Pose pose;
   Vec3 velocity;
   in.position(pose, velocity);
@@ -146,7 +164,7 @@ void CrazyfliePidController::positionLoop(double t, FlightInputs& in) {
 }
 
 void CrazyfliePidController::attitudeLoop(FlightInputs& in) {
-  const double dt = 1.0 / g_.attitude_rate_hz;
+  const double dt = attitude_dt_;
   Pose pose;
   Vec3 velocity;
   in.position(pose, velocity);
@@ -178,7 +196,7 @@ void CrazyfliePidController::attitudeLoop(FlightInputs& in) {
 
 void CrazyfliePidController::step(std::int64_t run, double t, FlightInputs& in, std::span<double> speeds) {
   if (run % position_every_ == 0) positionLoop(t, in);
-  attitudeLoop(in);
+  if (run % attitude_every_ == 0) attitudeLoop(in);
   for (std::size_t i = 0; i < 4 && i < speeds.size(); ++i) speeds[i] = std::sqrt(motorThrust(motors_[i]) / thrust_coefficient_);
 }
 

@@ -14,8 +14,7 @@
 // Signs are ssx's (x forward, y left, z up; a positive pitch tilts the thrust towards +x); the
 // firmware's pitch has the other sign, which changes nothing else.
 //
-// It takes position and velocity commands. It is not in the quadrotor driver yet: the crazyflie
-// preset's controller to come.
+// It takes position and velocity commands. The quadrotor driver runs it with controller="crazyflie_pid".
 #include "controller.hpp"
 #include "crazyflie_thrust.hpp"
 #include "quadrotor_model.hpp"
@@ -24,6 +23,19 @@
 #include <vector>
 
 namespace ssx::quadrotor {
+
+/// The quadrotor driver's choice of controller, and this one's settings (part "controller").
+inline constexpr ssx_plugin_param kControllerChoiceParameters[] = {
+    param::choice("controller", "telekyb", "telekyb crazyflie_pid",
+                  "the flight controller: TeleKyb's cascade (the mk_quad's; every command level), or the Crazyflie "
+                  "firmware's PID cascade (four rotors in an X; position and velocity commands)"),
+    param::real("crazyflie_position_rate_hz", "100", "Hz", param::positive(),
+                "crazyflie_pid: position and velocity loops (its period a whole multiple of the driver's)"),
+    param::real("crazyflie_attitude_rate_hz", "500", "Hz", param::positive(),
+                "crazyflie_pid: attitude and rate loops (its period a whole multiple of the driver's)"),
+    param::real("crazyflie_battery_volts", "4.2", "V", param::atLeast(2) & param::atMost(4.35),
+                "crazyflie_pid: the battery voltage its thrust compensation sees (held constant)"),
+};
 
 /// pid.c's element.
 struct PidGains {
@@ -41,6 +53,7 @@ class Pid {
   double update(double desired, double measured, double dt, bool wrap_degrees = false);
   void reset();
   double integral() const { return integral_; }
+  void setIntegral(double integral) { integral_ = integral; }
   void save(StateWriter& out) const;
   void load(StateReader& in);
 
@@ -75,6 +88,13 @@ class CrazyfliePidController final : public FlightController {
 
   /// The battery voltage the compensation sees (filtered; 4.2 V until told).
   void setBatteryVoltage(double volts) { battery_volts_ = volts; }
+  /// In a driver that runs every `run_seconds`: the attitude loop every `attitude_runs` runs, the
+  /// position loop every `position_runs` (the mixer's output held between). By default every run
+  /// is an attitude period and the position loop every gains' ratio of runs.
+  void setRuns(std::int64_t attitude_runs, std::int64_t position_runs, double run_seconds);
+  /// A vehicle placed in the air: the vertical velocity loop's integral holds `weight` (N) from the
+  /// first step, as it would after hovering a while.
+  void startInAir(double weight);
 
   bool accepts(CommandLevel level) const override {
     return level == CommandLevel::Position || level == CommandLevel::Velocity;
@@ -106,7 +126,8 @@ class CrazyfliePidController final : public FlightController {
   CrazyflieThrustCurve curve_;
   double thrust_coefficient_;
   std::array<std::array<double, 3>, 4> signs_{};  // per rotor: roll, pitch, yaw
-  std::int64_t position_every_ = 5;
+  std::int64_t position_every_ = 5, attitude_every_ = 1;
+  double position_dt_ = 0.01, attitude_dt_ = 0.002;
   double battery_volts_ = 4.2;
   CommandLevel level_ = CommandLevel::Position;
   Setpoint current_;

@@ -18,6 +18,9 @@ struct QuadrotorDriver::Config {
   DownwashParams downwash_params;
   TeleKybParams controller;
   ReferenceParams reference;
+  bool crazyflie_pid;
+  CrazyfliePidGains crazyflie_gains;
+  double crazyflie_battery;
 
   Config(const Descriptor& params, const Environment& env)
       : vehicle(params),
@@ -26,7 +29,21 @@ struct QuadrotorDriver::Config {
         downwash(params.get<bool>("downwash")),
         downwash_params(DownwashParams::of(params)),
         controller(params),
-        reference(params) {}
+        reference(params),
+        crazyflie_pid(params.get<std::string>("controller") == "crazyflie_pid"),
+        crazyflie_battery(params.get<double>("crazyflie_battery_volts")) {
+    crazyflie_gains.position_rate_hz = params.get<double>("crazyflie_position_rate_hz");
+    crazyflie_gains.attitude_rate_hz = params.get<double>("crazyflie_attitude_rate_hz");
+  }
+  // the Crazyflie's controller for these rotors, run by a driver of this context (invalid_argument
+  // for another frame than an X of four, or rates that do not fit)
+  std::unique_ptr<CrazyfliePidController> crazyflie(const std::vector<Rotor>& rotors, const PluginContext& context) const {
+    auto c = std::make_unique<CrazyfliePidController>(crazyflie_gains, rotors, vehicle.rotor);
+    c->setRuns(runsPerPeriod(crazyflie_gains.attitude_rate_hz, context),
+               runsPerPeriod(crazyflie_gains.position_rate_hz, context), toSeconds(context.period()));
+    c->setBatteryVoltage(crazyflie_battery);
+    return c;
+  }
   // the text a Config is parsed from (every given parameter but formation_index); marks those read
   static std::string key(const Descriptor& params) {
     std::string key;
@@ -101,7 +118,23 @@ void QuadrotorDriver::validate(const Descriptor& params, const PluginContext& co
   const auto shared_config =
       context.shared<Config>(Config::key(params), [&] { return Config(params, *context.environment); });
   const Config& config = *shared_config;
-  (void)context.shared<Airframe>(frameKey(shared_config.get(), a), [&] { return Airframe(config, params, a); });
+  const auto frame =
+      context.shared<Airframe>(frameKey(shared_config.get(), a), [&] { return Airframe(config, params, a); });
+  if (config.crazyflie_pid) {
+    // (checked only for this controller: the rates mean nothing to TeleKyb's)
+    const double period = toSeconds(context.period());
+    for (const char* rate : {"crazyflie_attitude_rate_hz", "crazyflie_position_rate_hz"}) {
+      const double runs = 1.0 / (params.get<double>(rate) * period);
+      if (runs < 1 - 1e-9 || std::abs(runs - std::round(runs)) > 1e-6)
+        throw params.errorAt(rate, std::string(rate) + ": its period must be a whole multiple of the driver's (" +
+                                       std::to_string(period * 1e3) + " ms)");
+    }
+    try {
+      (void)config.crazyflie(frame->rotors, context);
+    } catch (const std::invalid_argument& e) {
+      throw params.errorAt("controller", std::string(e.what()) + " (the rotors: the `rotors` parameter)");
+    }
+  }
   // checked while loading, so that `ssx validate` refuses what `ssx run` would
   (void)config.controller.commandDelayTicks(params, context);
   if (firstSensorOf<ImuMeasurement>(a) == nullptr)
@@ -143,6 +176,8 @@ void QuadrotorDriver::configure(const Descriptor& params, PluginSetup& setup) {
   if (imu == nullptr) throw params.error("a quadrotor needs an IMU: add <sensor plugin=\"imu\"/> to the artifact");
   const PluginContext context{&env, &a, periodSteps(), env.timestep(), {}};
   controller_.configure(c.controller, frame->controller, c.vehicle.rotor, params, context, *imu, setup, frame_key);
+  crazyflie_.reset();
+  if (c.crazyflie_pid) crazyflie_ = c.crazyflie(frame->rotors, context);
   if (const Sensor* pose = firstSensorOf<PoseMeasurement>(a)) {
     have_pose_ = true;
     setup.subscribe<PoseMeasurement>(*pose, [this](const PoseMeasurement& m) { pose_ = m; });
@@ -162,6 +197,7 @@ void QuadrotorDriver::configure(const Descriptor& params, PluginSetup& setup) {
     commanded_speeds_.fill(hover);
     vehicle_.spinAt(std::span(commanded_speeds_).first(n));
     controller_.startInAir(frame->controller.mass * g);
+    if (crazyflie_) crazyflie_->startInAir(frame->controller.mass * g);
   } else {
     controller_.startInAir(0);
   }
@@ -170,11 +206,14 @@ void QuadrotorDriver::configure(const Descriptor& params, PluginSetup& setup) {
 void QuadrotorDriver::setCommand(const Command& command) {
   if (const std::string why = refusal(command); !why.empty()) throw std::invalid_argument("quadrotor: " + why);
   if (command.level == CommandLevel::Position) references_.setExternal(command.setpoint);
-  controller_.setCommand(command, artifact().state().pose.position);
+  if (crazyflie_)
+    crazyflie_->setCommand(command, artifact().state().pose.position);
+  else
+    controller_.setCommand(command, artifact().state().pose.position);
 }
 
 Command QuadrotorDriver::currentCommand() const {
-  Command c = controller_.command();
+  Command c = flight().command();
   if (c.level == CommandLevel::Rotors) c.rotor_speeds.resize(vehicle_.rotorCount());
   return c;
 }
@@ -195,7 +234,10 @@ void QuadrotorDriver::step(const StepInfo& info) {
   const double t = toSeconds(info.time);
   const std::size_t n = vehicle_.rotorCount();
   // the controller chooses the rotor speeds, the vehicle spins up to them
-  controller_.step(info.step / periodSteps(), t, *this, std::span(commanded_speeds_).first(n));
+  if (crazyflie_)
+    crazyflie_->step(info.step / periodSteps(), t, *this, std::span(commanded_speeds_).first(n));
+  else
+    controller_.step(info.step / periodSteps(), t, *this, std::span(commanded_speeds_).first(n));
   vehicle_.stepMotors(period, std::span(commanded_speeds_).first(n));
   PhysicNode& body = artifact().root();
   const BodyState s = body.state();
@@ -234,6 +276,7 @@ void QuadrotorDriver::saveState(StateWriter& out) const {
   out.write(std::vector<double>(commanded_speeds_.begin(),
                                 commanded_speeds_.begin() + static_cast<std::ptrdiff_t>(vehicle_.rotorCount())));
   controller_.saveState(out);
+  if (crazyflie_) crazyflie_->saveState(out);
   references_.saveState(out);
   wind_.saveState(out);
   ssx::save(out, pose_);
@@ -247,6 +290,7 @@ void QuadrotorDriver::loadState(StateReader& in) {
     throw StateError("quadrotor: the saved commanded speeds do not fit this driver");
   std::copy(commanded.begin(), commanded.end(), commanded_speeds_.begin());
   controller_.loadState(in);
+  if (crazyflie_) crazyflie_->loadState(in);
   references_.loadState(in);
   wind_.loadState(in);
   ssx::load(in, pose_);

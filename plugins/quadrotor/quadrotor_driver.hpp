@@ -4,6 +4,7 @@
 //   effects.hpp             wind (the scene's <wind> and the artifact's own), ground effect, downwash
 //   telekyb_controller.hpp  the flight controller (controller.hpp: the interface), taking commands
 //                           at the five command levels (ssx/command.hpp)
+//   crazyflie_pid.hpp       the Crazyflie firmware's controller instead (controller="crazyflie_pid")
 //   references.hpp          hover, figure eights, formation, trajectory file, external set-points
 //
 // Parameters: each part's table, joined in kParameters (`ssx plugins --params quadrotor` prints
@@ -17,6 +18,7 @@
 // else the ground truth. The formation needs a `range` sensor; its members must be one swarm
 // (consecutive artifacts), member i at artifact index (own - own i + i).
 #include "controller.hpp"
+#include "crazyflie_pid.hpp"
 #include "effects.hpp"
 #include "references.hpp"
 #include "telekyb_controller.hpp"
@@ -25,6 +27,7 @@
 #include <ssx/ssx.hpp>
 
 #include <array>
+#include <memory>
 #include <optional>
 
 namespace ssx::quadrotor {
@@ -37,6 +40,7 @@ class QuadrotorDriver final : public Driver, public CommandInterface, public Met
   static constexpr auto kParameters =
       param::join(param::part("vehicle", kVehicleParameters), param::part("ground effect", kGroundEffectParameters),
                   param::part("wind", kWindParameters), param::part("downwash", kDownwashParameters),
+                  param::part("controller", kControllerChoiceParameters),
                   param::part("controller (TeleKyb)", kTeleKybParameters), param::part("references", kReferenceParameters));
   static void validate(const Descriptor& params, const PluginContext& context);
   void configure(const Descriptor& params, PluginSetup& setup) override;
@@ -44,13 +48,14 @@ class QuadrotorDriver final : public Driver, public CommandInterface, public Met
   void saveState(StateWriter& out) const override;
   void loadState(StateReader& in) override;
 
-  /// Every level (TeleKybController); a position command is an external set-point.
-  bool acceptsCommand(CommandLevel level) const override { return controller_.accepts(level); }
+  /// Every level (TeleKybController), position and velocity (crazyflie_pid); a position command
+  /// is an external set-point.
+  bool acceptsCommand(CommandLevel level) const override { return flight().accepts(level); }
   std::size_t rotorCount() const override { return vehicle_.rotorCount(); }
   void setCommand(const Command& command) override;
-  CommandLevel commandLevel() const override { return controller_.level(); }
+  CommandLevel commandLevel() const override { return flight().level(); }
   Command currentCommand() const override;
-  Setpoint currentSetpoint() const override { return controller_.currentSetpoint(); }
+  Setpoint currentSetpoint() const override { return flight().currentSetpoint(); }
   /// In formation: `formation_error`, the mean over the members its range sensor sees whose
   /// places on the sphere are within sensing range of its own, of | distance - desired distance |
   /// (m), as of its latest range measurement (NaN when it sees none).
@@ -60,10 +65,17 @@ class QuadrotorDriver final : public Driver, public CommandInterface, public Met
   /// For tests: the parts.
   const RotorModel& rotors() const { return vehicle_.rotors(); }
   const TeleKybController& controller() const { return controller_; }
+  /// The Crazyflie firmware's controller, when it flies this one (controller="crazyflie_pid").
+  const CrazyfliePidController* crazyflie() const { return crazyflie_.get(); }
 
  private:
   struct Config;    // the parameters, parsed: one per parameter set (PluginSetup::shared)
   struct Airframe;  // what the rotors' places make of them: one per parameter set and artifact type
+
+  // the controller flying it: TeleKyb's (held inline: every step reads it), or the Crazyflie's
+  const FlightController& flight() const {
+    return crazyflie_ ? static_cast<const FlightController&>(*crazyflie_) : controller_;
+  }
 
   // FlightInputs, for the controller
   Setpoint reference(double t, double dt) override { return references_.at(t, dt); }
@@ -88,6 +100,7 @@ class QuadrotorDriver final : public Driver, public CommandInterface, public Met
   Wind wind_;
   std::optional<Downwash> downwash_;
   double ground_z_ = 0;  // the ground plane's height (-inf: none)
+  std::unique_ptr<CrazyfliePidController> crazyflie_;  // controller="crazyflie_pid"
 };
 
 }  // namespace ssx::quadrotor

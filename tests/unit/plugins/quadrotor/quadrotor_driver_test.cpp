@@ -5,7 +5,10 @@
 
 #include <cmath>
 #include <filesystem>
+#include <fstream>
 #include <vector>
+
+#include <unistd.h>
 
 using namespace ssx;
 
@@ -100,4 +103,75 @@ TEST_CASE("quadrotors with noisy IMUs fly bitwise identically on 1 and 2 threads
     return s.environment->stateHash();
   };
   CHECK(hashAfter(1) == hashAfter(2));
+}
+
+TEST_CASE("controller=\"crazyflie_pid\" flies an X-frame Crazyflie: hover, the 1.1 m/s clamp, half a second behind",
+          "[quadrotor][flight][crazyflie]") {
+  // a Crazyflie in an X (M1 front-right, M2 rear-right, M3 rear-left, M4 front-left; rotors alternate
+  // their spin by index), 29 g, 65 ms motors, Bitcraze's measured thrust coefficient
+  const auto dir = std::filesystem::temp_directory_path() / ("ssx_cf_x_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  {
+    std::ofstream out(dir / "cf_x.xml");
+    out << R"(<artifact><physic name="body" mass="0.029" inertia="16.57e-6 16.66e-6 29.26e-6"><box size="0.05 0.05 0.02"/>
+      <physic name="rotor0" xyz="0.0325 -0.0325 0.02"/><physic name="rotor1" xyz="-0.0325 -0.0325 0.02"/>
+      <physic name="rotor2" xyz="-0.0325 0.0325 0.02"/><physic name="rotor3" xyz="0.0325 0.0325 0.02"/></physic>
+      <sensor plugin="imu" noise="false"/><sensor plugin="pose" position_noise="0" velocity_noise="0"/>
+      <driver plugin="quadrotor" preset="crazyflie" controller="crazyflie_pid" thrust_coefficient="2.27e-8"
+              max_rotor_speed="2501" time_constant_up="0.065" time_constant_down="0.065" reference="external"/></artifact>)";
+  }
+  Scene s = loadSceneFromString(R"(<scene><environment timestep="0.002" seed="3"/><type name="cf" file="cf_x.xml"/><ground/>
+    <artifact name="cf" type="cf" xyz="0 0 1"/></scene>)",
+                                "cf.xml", dir);
+  std::filesystem::remove_all(dir);
+  Environment& env = *s.environment;
+  env.start();
+  Artifact& cf = *env.findArtifact("cf");
+  auto* input = dynamic_cast<CommandInterface*>(cf.driver());
+  REQUIRE(input != nullptr);
+  CHECK(input->acceptsCommand(CommandLevel::Velocity));
+  CHECK_FALSE(input->acceptsCommand(CommandLevel::Rotors));
+  Setpoint sp;
+  sp.position = Vec3(0, 0, 1);
+  input->setSetpoint(sp);
+  env.step(1500);  // 3 s of hover from a start in the air
+  CHECK((cf.pose().position - sp.position).norm() < 0.02);
+  // 1 m to the side: the position loop asks 2 m/s and is clamped to 1.1 (the velocity loop overshoots it a little)
+  sp.position = Vec3(0, 1, 1);
+  input->setSetpoint(sp);
+  double fastest = 0;
+  for (int i = 0; i < 2000; ++i) {
+    env.step();
+    fastest = std::max(fastest, cf.state().linear_velocity.head<2>().norm());
+  }
+  INFO("fastest " << fastest << " m/s");
+  CHECK(fastest < 1.1 * 1.2);
+  CHECK(fastest > 0.9);
+  CHECK((cf.pose().position - sp.position).norm() < 0.03);
+  // a set-point moving at 0.5 m/s along x: half a second (0.25 m) behind
+  for (int i = 1; i <= 3000; ++i) {
+    sp.position = Vec3(0.5 * i * 0.002, 1, 1);
+    input->setSetpoint(sp);
+    env.step();
+  }
+  const double behind = sp.position.x() - cf.pose().position.x();
+  INFO("behind " << behind << " m");
+  CHECK(behind == Approx(0.25).margin(0.04));
+  CHECK(std::abs(cf.pose().position.y() - 1) < 0.03);
+}
+
+TEST_CASE("controller=\"crazyflie_pid\" is refused while loading for a plus frame and for rates the driver cannot keep",
+          "[quadrotor][crazyflie]") {
+  // the crazyflie preset's artifact is a plus frame (as of now)
+  CHECK_THROWS_WITH(quadScene("<driver controller=\"crazyflie_pid\"/>", 1.0, 1, "crazyflie"),
+                    Catch::Contains("error: <driver>") && Catch::Contains("X frame"));
+  const std::string slow = "<scene><environment timestep=\"0.02\"/><type name=\"q\" file=\"mk_quad.xml\"/>"
+                           "<artifact name=\"q\" type=\"q\" xyz=\"0 0 1\"><driver controller=\"crazyflie_pid\" inner_rate_hz=\"50\"/>"
+                           "</artifact></scene>";
+  CHECK_THROWS_WITH(loadSceneFromString(slow, "slow.xml", kArtifacts),
+                    Catch::Contains("crazyflie_attitude_rate_hz: its period must be a whole multiple of the driver's"));
+  // the same slow scene with TeleKyb's controller: its rates are not asked about
+  const std::string telekyb = "<scene><environment timestep=\"0.02\"/><type name=\"q\" file=\"mk_quad.xml\"/>"
+                              "<artifact name=\"q\" type=\"q\" xyz=\"0 0 1\"><driver inner_rate_hz=\"50\"/></artifact></scene>";
+  CHECK_NOTHROW(loadSceneFromString(telekyb, "slow.xml", kArtifacts));
 }
