@@ -92,6 +92,7 @@ class QuadrotorDriver final : public Driver, public CommandInterface, public Met
   // they all point to, which stays in the cache; what only some features read comes last.
   bool have_pose_ = false;
   bool ground_effect_ = false;
+  std::unique_ptr<CrazyfliePidController> crazyflie_;  // controller="crazyflie_pid" (every step asks)
   TeleKybController controller_;
   std::array<double, kMaxRotors> commanded_speeds_{};  // the first rotorCount() in use
   Vehicle vehicle_;
@@ -100,7 +101,6 @@ class QuadrotorDriver final : public Driver, public CommandInterface, public Met
   Wind wind_;
   std::optional<Downwash> downwash_;
   double ground_z_ = 0;  // the ground plane's height (-inf: none)
-  std::unique_ptr<CrazyfliePidController> crazyflie_;  // controller="crazyflie_pid"
 };
 
 }  // namespace ssx::quadrotor
