@@ -21,6 +21,21 @@ void addMaxInputOption(CLI::App* command, double& mb) {
       ->default_val(kDefaultMaxInputMb);
 }
 
+// --view [PORT] and --view-bind ADDR on `command`; --view alone: port 8765 (viewPort)
+CLI::Option* addViewOptions(CLI::App* command, int& port, std::string& bind, const char* what) {
+  auto* view = command->add_option("--view", port, std::string(what) + " (default 8765; 0: a free port)")
+                   ->expected(0, 1)
+                   ->check(CLI::Range(0, 65535));
+  command->add_option("--view-bind", bind,
+                      "address the page is served on (default 127.0.0.1; another prints a token the page's URL needs)")
+      ->needs(view);
+  return view;
+}
+
+void viewPort(const CLI::Option* view, int& port) {
+  if (view->count() > 0 && (view->results().empty() || view->results().front().empty())) port = 8765;
+}
+
 }  // namespace
 
 CommandLine parseCommandLine(int argc, const char* const* argv, std::ostream& out, std::ostream& err) {
@@ -40,14 +55,8 @@ CommandLine parseCommandLine(int argc, const char* const* argv, std::ostream& ou
           ->expected(0, 1)
           ->check(realNumber(ssx::kMinRealtimeFactor, ssx::kMaxRealtimeFactor));
   auto* fast = run_cmd->add_flag("--fast", c.run.fast, "run as fast as possible")->excludes(realtime);
-  auto* view = run_cmd->add_option("--view", c.run.view,
-                                   "serve a live 3D view of the run to web browsers at http://127.0.0.1:PORT/ "
-                                   "(default 8765; 0: a free port)")
-                   ->expected(0, 1)
-                   ->check(CLI::Range(0, 65535));
-  run_cmd->add_option("--view-bind", c.run.view_bind,
-                      "address the viewer listens on (default 127.0.0.1; another prints a token the page's URL needs)")
-      ->needs(view);
+  auto* view = addViewOptions(run_cmd, c.run.view, c.run.view_bind,
+                              "serve a live 3D view of the run to web browsers at http://127.0.0.1:PORT/");
   run_cmd
       ->add_option("--rt-priority", c.run.rt_priority,
                    "step at this SCHED_FIFO priority (1-99; needs root or CAP_SYS_NICE): steps are not woken late "
@@ -150,15 +159,9 @@ CommandLine parseCommandLine(int argc, const char* const* argv, std::ostream& ou
                          "PATH=VALUE: an attribute of the recorded scene set for the re-simulation, as a sweep sets it "
                          "(repeatable)");
   replay_cmd->add_option("--record", c.replay.record, "record the re-simulation into FILE");
-  auto* replay_view = replay_cmd
-                          ->add_option("--view", c.replay.view,
-                                       "play the recording in web browsers at http://127.0.0.1:PORT/, with a time slider "
-                                       "(default 8765; 0: a free port); until Ctrl-C")
-                          ->expected(0, 1)
-                          ->check(CLI::Range(0, 65535));
-  replay_cmd->add_option("--view-bind", c.replay.view_bind,
-                         "address the page is served on (default 127.0.0.1; another prints a token the page's URL needs)")
-      ->needs(replay_view);
+  auto* replay_view = addViewOptions(replay_cmd, c.replay.view, c.replay.view_bind,
+                                     "play the recording in web browsers at http://127.0.0.1:PORT/ until Ctrl-C, with a "
+                                     "time slider");
 
   try {
     app.parse(argc, argv);
@@ -171,7 +174,7 @@ CommandLine parseCommandLine(int argc, const char* const* argv, std::ostream& ou
     c.command = CommandLine::Command::Run;
     // --realtime alone means factor 1
     c.realtime_given = realtime->count() > 0;
-    if (view->count() > 0 && (view->results().empty() || view->results().front().empty())) c.run.view = 8765;
+    viewPort(view, c.run.view);
     c.run.duration_given = duration->count() > 0;
     if (c.realtime_given && (realtime->results().empty() || realtime->results().front().empty())) c.run.realtime = 1.0;
     const auto& channels = c.run.record_channels;
@@ -187,8 +190,7 @@ CommandLine parseCommandLine(int argc, const char* const* argv, std::ostream& ou
     c.command = CommandLine::Command::Inspect;
   } else if (*replay_cmd) {
     c.command = CommandLine::Command::Replay;
-    if (replay_view->count() > 0 && (replay_view->results().empty() || replay_view->results().front().empty()))
-      c.replay.view = 8765;
+    viewPort(replay_view, c.replay.view);
     const ReplayArgs& r = c.replay;
     if (r.view >= 0 && (r.resimulate_from >= 0 || !r.snapshot.empty() || !r.video.empty() || !r.frames.empty())) {
       err << "ssx replay: --view plays the recording on a page: it does not go with --resimulate-from, --snapshot, "

@@ -1,5 +1,7 @@
 #pragma once
 // What the ssx command's subcommands share: exit statuses, the plugin search path, lists.
+#include <ssx/ssx.hpp>
+
 #include <cstdint>
 #include <cstdlib>
 #include <filesystem>
@@ -33,6 +35,15 @@ inline std::string joined(const std::vector<std::string>& names) {
   std::string out;
   for (const auto& n : names) out += (out.empty() ? "" : ", ") + n;
   return out;
+}
+
+// --view: the viewer extension, as <extension plugin="viewer"/> adds it (it listens when the
+// environment starts); with `recording`, playing that recording instead of the run
+inline void addViewer(ssx::Environment& env, int port, const std::string& bind, const std::string& recording = {}) {
+  ssx::Descriptor params("viewer", {"--view", 0});
+  params.set("port", static_cast<std::int64_t>(port)).set("bind", bind);
+  if (!recording.empty()) params.set("recording", recording);
+  env.addExtension("viewer", env.classLoader().createExtension("viewer", "viewer"), params);
 }
 
 }  // namespace ssx::cli

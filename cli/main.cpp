@@ -191,11 +191,8 @@ int commandRun(const RunArgs& args, bool realtime_given) {
   printWarnings(scene);
   ssx::Environment& env = *scene.environment;
   if (args.view >= 0) {
-    // the viewer extension, as <extension plugin="viewer"/> would add it (it listens when the run starts)
     try {
-      ssx::Descriptor params("viewer", {"--view", 0});
-      params.set("port", static_cast<std::int64_t>(args.view)).set("bind", args.view_bind);
-      env.addExtension("viewer", env.classLoader().createExtension("viewer", "viewer"), params);
+      addViewer(env, args.view, args.view_bind);
     } catch (const std::exception& e) {
       std::cerr << "ssx: error: --view: " << e.what() << '\n';
       return kExitBadInput;

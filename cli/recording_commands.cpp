@@ -239,9 +239,7 @@ int view(const Recording& r, const ReplayArgs& args) {
   if (status != 0) return status;
   Environment& env = *scene.environment;
   try {
-    Descriptor params("viewer", {"--view", 0});
-    params.set("port", static_cast<std::int64_t>(args.view)).set("bind", args.view_bind).set("recording", args.file);
-    env.addExtension("viewer", env.classLoader().createExtension("viewer", "viewer"), params);
+    addViewer(env, args.view, args.view_bind, args.file);
     env.start();
   } catch (const std::exception& e) {
     std::cerr << "ssx: error: --view: " << e.what() << '\n';

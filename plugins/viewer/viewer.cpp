@@ -205,8 +205,12 @@ class Viewer final : public SimulationExtension {
           nodes_.push_back(&root);
           names_.push_back(r == 0 ? a.name() : a.name() + "/" + root.name());
           const Pose& in_body = root.poseInBody();
+          // (which drivers take velocity commands, known once: a page's command looks it up)
+          auto* driver = dynamic_cast<CommandInterface*>(env.artifact(i).driver());
+          CommandInterface* steer = driver != nullptr && driver->acceptsCommand(CommandLevel::Velocity) ? driver : nullptr;
+          steerable_ += steer != nullptr;
           bodies_.push_back({root.bodyIndex(), in_body,
-                             in_body.position.isZero(0) && in_body.orientation.coeffs() == Quat::Identity().coeffs()});
+                             in_body.position.isZero(0) && in_body.orientation.coeffs() == Quat::Identity().coeffs(), steer});
           break;
         }
       }
@@ -388,25 +392,20 @@ class Viewer final : public SimulationExtension {
     if (player_.joinable()) player_.join();
   }
 
-  static CommandInterface* velocityDriver(const PhysicNode& node) {
-    auto* driver = dynamic_cast<CommandInterface*>(const_cast<Artifact&>(node.artifact()).driver());
-    return driver != nullptr && driver->acceptsCommand(CommandLevel::Velocity) ? driver : nullptr;
-  }
-
   // how many robots a command to `body` (nothing: all) would steer (under mutex_)
   std::size_t steerable(std::optional<std::size_t> body) const {
-    if (body) return velocityDriver(*nodes_[*body]) != nullptr ? 1 : 0;
-    return static_cast<std::size_t>(
-        std::count_if(nodes_.begin(), nodes_.end(), [](const PhysicNode* n) { return velocityDriver(*n) != nullptr; }));
+    return body ? (bodies_[*body].steer != nullptr ? 1 : 0) : steerable_;
   }
 
   // each driver the current teleoperation steers (under mutex_, on the stepping thread)
   template <class F>
   void forEachSteered(F&& f) {
-    for (std::size_t i = 0; i < nodes_.size(); ++i) {
-      if (!teleop_.all && static_cast<int>(i) != teleop_.body) continue;
-      if (CommandInterface* driver = velocityDriver(*nodes_[i])) f(*driver);
+    if (!teleop_.all) {
+      if (CommandInterface* driver = bodies_[static_cast<std::size_t>(teleop_.body)].steer) f(*driver);
+      return;
     }
+    for (const Body& b : bodies_)
+      if (b.steer != nullptr) f(*b.steer);
   }
 
   // the details of the bodies pages have selected, as a JSON array, or "" (stepping thread)
@@ -508,12 +507,14 @@ class Viewer final : public SimulationExtension {
   RunControl* control_ = nullptr;
   std::vector<const PhysicNode*> nodes_;
   std::vector<std::string> names_;
-  struct Body {  // each node's body, and the node's pose in it
+  struct Body {  // each node's body, the node's pose in it, and its driver if it takes velocity commands
     int index = -1;
     Pose in_body;
     bool at_body = true;
+    CommandInterface* steer = nullptr;
   };
   std::vector<Body> bodies_;
+  std::size_t steerable_ = 0;  // bodies with a steer
   std::vector<std::uint8_t> frame_;
   std::chrono::duration<double> period_{};
   std::chrono::steady_clock::time_point last_wall_;
