@@ -26,9 +26,10 @@ namespace ssx::quadrotor {
 
 /// The quadrotor driver's choice of controller, and this one's settings (part "controller").
 inline constexpr ssx_plugin_param kControllerChoiceParameters[] = {
-    param::choice("controller", "telekyb", "telekyb crazyflie_pid",
-                  "the flight controller: TeleKyb's cascade (the mk_quad's; every command level), or the Crazyflie "
-                  "firmware's PID cascade (four rotors in an X; position and velocity commands)"),
+    param::choice("controller", "auto", "auto telekyb crazyflie_pid",
+                  "the flight controller: TeleKyb's cascade (the mk_quad's; every command level), the Crazyflie "
+                  "firmware's PID cascade (four rotors in an X; position and velocity commands), or auto: the "
+                  "preset's (crazyflie_pid for the crazyflie, telekyb for the others)"),
     param::real("crazyflie_position_rate_hz", "100", "Hz", param::positive(),
                 "crazyflie_pid: position and velocity loops (its period a whole multiple of the driver's)"),
     param::real("crazyflie_attitude_rate_hz", "500", "Hz", param::positive(),

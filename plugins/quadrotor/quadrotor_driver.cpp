@@ -30,7 +30,9 @@ struct QuadrotorDriver::Config {
         downwash_params(DownwashParams::of(params)),
         controller(params),
         reference(params),
-        crazyflie_pid(params.get<std::string>("controller") == "crazyflie_pid"),
+        crazyflie_pid(params.get<std::string>("controller") == "crazyflie_pid" ||
+                      (params.get<std::string>("controller") == "auto" &&
+                       params.get<std::string>("preset") == "crazyflie")),
         crazyflie_battery(params.get<double>("crazyflie_battery_volts")) {
     crazyflie_gains.position_rate_hz = params.get<double>("crazyflie_position_rate_hz");
     crazyflie_gains.attitude_rate_hz = params.get<double>("crazyflie_attitude_rate_hz");

@@ -26,12 +26,15 @@ std::optional<RotorParams> preset(const std::string& name) {
     return p;
   }
   if (name == "crazyflie") {
-    p.thrust_coefficient = 1.28192e-8;
-    p.moment_constant = 5.964552e-3;
-    p.max_rotor_speed = 3052.0;
-    p.rotor_radius = 0.0231;  // as gym-pybullet-drones' cf2x
-    p.rotor_drag_coefficient = 0.0;  // no published figure
-    p.rolling_moment_coefficient = 0.0;
+    // published values, each with its source in docs/quadrotor-reference.md (section 1, "crazyflie")
+    p.thrust_coefficient = 2.27e-8;       // Bitcraze's 2015 thrust stand: 57.9 g at 23,882 rpm
+    p.moment_constant = 6.9929e-3;        // the firmware's 2.1+ thrust-to-torque (platform_defaults_cf2.h)
+    p.time_constant_up = 0.065;           // Förster 2015: a first-order pole at -15.47 1/s
+    p.time_constant_down = 0.065;
+    p.max_rotor_speed = 2501.0;           // Bitcraze's 2015 table: 2,501 rad/s (0.142 N) at 93.75 % PWM
+    p.rotor_drag_coefficient = 9.1785e-7; // Förster 2015: K_aero,xy, force = -K (sum of rotor speeds) v
+    p.rolling_moment_coefficient = 0.0;   // none published
+    p.rotor_radius = 0.0231;              // as gym-pybullet-drones' cf2x
     return p;
   }
   return std::nullopt;

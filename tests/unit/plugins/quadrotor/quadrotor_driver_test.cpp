@@ -162,9 +162,18 @@ TEST_CASE("controller=\"crazyflie_pid\" flies an X-frame Crazyflie: hover, the 1
 
 TEST_CASE("controller=\"crazyflie_pid\" is refused while loading for a plus frame and for rates the driver cannot keep",
           "[quadrotor][crazyflie]") {
-  // the crazyflie preset's artifact is a plus frame (as of now)
-  CHECK_THROWS_WITH(quadScene("<driver controller=\"crazyflie_pid\"/>", 1.0, 1, "crazyflie"),
+  // the mk_quad is a plus frame
+  CHECK_THROWS_WITH(quadScene("<driver controller=\"crazyflie_pid\"/>", 1.0, 1, "mk_quad"),
                     Catch::Contains("error: <driver>") && Catch::Contains("X frame"));
+  // so is a Crazyflie's preset on plus-frame rotors, unless it is told to fly TeleKyb's controller
+  const std::string plus_cf = "<scene><type name=\"q\" file=\"mk_quad.xml\"/><artifact name=\"q\" type=\"q\" "
+                              "xyz=\"0 0 1\"><driver preset=\"crazyflie\"{}/></artifact></scene>";
+  auto with = [&](const std::string& extra) {
+    std::string xml = plus_cf;
+    return loadSceneFromString(xml.replace(xml.find("{}"), 2, extra), "plus_cf.xml", kArtifacts);
+  };
+  CHECK_THROWS_WITH(with(""), Catch::Contains("X frame"));
+  CHECK_NOTHROW(with(" controller=\"telekyb\""));
   const std::string slow = "<scene><environment timestep=\"0.02\"/><type name=\"q\" file=\"mk_quad.xml\"/>"
                            "<artifact name=\"q\" type=\"q\" xyz=\"0 0 1\"><driver controller=\"crazyflie_pid\" inner_rate_hz=\"50\"/>"
                            "</artifact></scene>";
