@@ -14,7 +14,8 @@ namespace ssx::flight {
 
 namespace {
 
-constexpr std::array<const char*, 10> kColumns = {"t", "px", "py", "pz", "yaw", "sp_x", "sp_y", "sp_z", "cmd_thrust", "vbat"};
+constexpr std::array<const char*, 12> kColumns = {"t",    "px",   "py",   "pz",   "roll",       "pitch",
+                                                  "yaw",  "sp_x", "sp_y", "sp_z", "cmd_thrust", "vbat"};
 
 std::vector<std::string> split(const std::string& line) {
   std::vector<std::string> out;
@@ -43,7 +44,7 @@ Log readLog(const std::filesystem::path& file) {
     const auto it = std::find(header.begin(), header.end(), kColumns[c]);
     if (it == header.end())
       throw errorAt(file, 1, std::string("no column '") + kColumns[c] +
-                                 "' in the header (a NanoBench log: t, px, py, pz, yaw, sp_x, sp_y, sp_z, cmd_thrust, vbat)");
+                                 "' in the header (a NanoBench log: t, px, py, pz, roll, pitch, yaw, sp_x, sp_y, sp_z, cmd_thrust, vbat)");
     at[c] = static_cast<std::size_t>(it - header.begin());
   }
   Log log;
@@ -61,7 +62,7 @@ Log readLog(const std::filesystem::path& file) {
       if (cell.empty() || end != cell.c_str() + cell.size() || errno != 0 || !std::isfinite(v[c]))
         throw errorAt(file, number, std::string("'") + kColumns[c] + "' is '" + cell + "', not a finite number");
     }
-    const Row r{v[0], v[1], v[2], v[3], v[4], v[5], v[6], v[7], v[8], v[9]};
+    const Row r{v[0], v[1], v[2], v[3], v[4], v[5], v[6], v[7], v[8], v[9], v[10], v[11]};
     if (!log.rows.empty() && !(r.t > log.rows.back().t))
       throw errorAt(file, number, "t does not increase (" + std::to_string(r.t) + " s after " +
                                       std::to_string(log.rows.back().t) + " s)");
@@ -90,34 +91,21 @@ double median(const std::vector<double>& values, std::size_t first, std::size_t 
   return (*mid + *std::max_element(v.begin(), mid)) / 2;
 }
 
-double hoverCommand(const Log& log, const Segment& flight, const std::string& label) {
+double cruiseThrustCommand(const Log& log, const Segment& flight, const std::string& label) {
   const auto& rows = log.rows;
   std::vector<double> heights;
   for (std::size_t i = flight.first; i <= flight.last; ++i) heights.push_back(rows[i].sp_z);
   const double cruise = median(heights, 0, heights.size());
-  // the row nearest t + dt within the flight
-  auto at = [&](std::size_t i, double dt) {
-    std::size_t j = i;
-    if (dt > 0)
-      while (j < flight.last && rows[j + 1].t <= rows[i].t + dt) ++j;
-    else
-      while (j > flight.first && rows[j - 1].t >= rows[i].t + dt) --j;
-    return j;
-  };
+  std::vector<double> up;
   for (std::size_t i = flight.first; i <= flight.last; ++i) {
-    if (std::abs(rows[i].sp_z - cruise) > 0.05) continue;
-    const Row &a = rows[at(i, -0.25)], &b = rows[at(i, 0.25)];
-    if (b.t - a.t < 0.4) continue;
-    if (std::hypot(b.sp_x - a.sp_x, b.sp_y - a.sp_y) / (b.t - a.t) < 0.1) continue;
-    // the eight starts at row i: the hover is the second before it, at cruise altitude
-    std::vector<double> commands;
-    for (std::size_t j = at(i, -1.0); j < i; ++j)
-      if (std::abs(rows[j].sp_z - cruise) <= 0.05 && rows[j].cmd_thrust > 0) commands.push_back(rows[j].cmd_thrust);
-    if (commands.size() < 10) break;
-    return median(commands, 0, commands.size());
+    const Row& r = rows[i];
+    if (std::abs(r.sp_z - cruise) <= 0.01 && r.pz > cruise / 2 && r.cmd_thrust > 0)
+      up.push_back(r.cmd_thrust * std::cos(r.roll) * std::cos(r.pitch));
   }
-  throw Error(label + ": error: no second of hover at cruise altitude (" + std::to_string(cruise) +
-              " m) before the set-point starts moving: give the take-off mass with --mass KG");
+  if (up.size() < 100)
+    throw Error(label + ": error: fewer than 100 rows (1 s) of flight at cruise altitude (" + std::to_string(cruise) +
+                " m): give the take-off mass with --mass KG");
+  return median(up, 0, up.size());
 }
 
 }  // namespace ssx::flight

@@ -9,7 +9,7 @@
 namespace ssx::flight {
 
 struct Row {
-  double t, px, py, pz, yaw, sp_x, sp_y, sp_z, cmd_thrust, vbat;
+  double t, px, py, pz, roll, pitch, yaw, sp_x, sp_y, sp_z, cmd_thrust, vbat;
 };
 
 struct Log {
@@ -31,11 +31,11 @@ struct Segment {
 /// the motors are off) to the last such set-point. ssx::Error naming `label` if there is none.
 Segment findFlight(const Log& log, const std::string& label);
 
-/// The median thrust command over the second of hover before the figure eight: the eight starts at
-/// the first row whose set-point moves at 0.1 m/s or more horizontally (over a centred 0.5 s) within
-/// 5 cm of the cruise altitude (the median set-point height in flight). ssx::Error naming `label`
-/// when the log has no such hover.
-double hoverCommand(const Log& log, const Segment& flight, const std::string& label);
+/// The thrust command that holds the vehicle up in level flight: the median over the flight at
+/// cruise altitude (the set-point within 1 cm of the median set-point height, the vehicle above half
+/// of it) of the thrust command times the cosine of the roll and of the pitch (what of it points
+/// up). ssx::Error naming `label` when the log has fewer than 100 such rows.
+double cruiseThrustCommand(const Log& log, const Segment& flight, const std::string& label);
 
 /// The median of values[first, last).
 double median(const std::vector<double>& values, std::size_t first, std::size_t last);

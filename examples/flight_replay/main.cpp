@@ -1,7 +1,7 @@
 // ssx_flight_replay: flies a real Crazyflie flight again in simulation, from its log.
 //
 // Reads a log in NanoBench's format (the columns of examples/fidelity_nanobench/data/README.md;
-// t, px, py, pz, yaw, sp_x, sp_y, sp_z, cmd_thrust and vbat are used), starts the installed
+// t, px, py, pz, roll, pitch, yaw, sp_x, sp_y, sp_z, cmd_thrust and vbat are used), starts the installed
 // `crazyflie` (its firmware's PID cascade) where the log's vehicle stands, gives it each logged
 // set-point at the simulated time the firmware received it (held until the next), and writes
 //   t,px,py,pz,sp_x,sp_y,sp_z,vx,vy,vz,roll,pitch,yaw
@@ -9,15 +9,16 @@
 // last such set-point.
 //
 // Identified from the log, and printed (nothing is fitted to the tracking error):
-// - the take-off mass: the median thrust command over the second of hover before the figure
-//   eight, through the firmware's thrust model (u / 65535 x 0.12 N a motor): m = 4 x 0.12 u / 65535 / g
-//   (--mass KG instead gives it);
+// - the take-off mass: the thrust command that holds the vehicle up in level flight at cruise
+//   altitude (the median of the command times the cosine of roll and of pitch), through the
+//   firmware's thrust model (u / 65535 x 0.12 N a motor): m = 4 x 0.12 u / 65535 / g (--mass KG
+//   instead gives it);
 // - the battery voltage the firmware's compensation sees: the median logged voltage in flight;
 // - the vertical offset between the log's tracked point (motion-capture markers) and the
 //   simulated centre of mass: the log's height at rest minus the simulated vehicle's.
 //
 // usage: ssx_flight_replay LOG.csv --out SIM.csv [--mass KG] [--physics ode|bullet]
-//                          [--artifact FILE] [--driver KEY=VALUE]... [--sensor KEY=VALUE]...
+//                          [--artifact FILE] [--inertia-scale S] [--driver KEY=VALUE]... [--sensor KEY=VALUE]...
 // --driver and --sensor set the crazyflie's driver and pose-sensor parameters (the sweep over
 // unpublished values: time_constant_up=..., delay=...); --artifact flies another artifact file.
 #include "flight_log.hpp"
@@ -52,6 +53,7 @@ ssx::Vec3 rollPitchYaw(const ssx::Quat& q) {
 struct Options {
   fs::path log, out, artifact;
   double mass = 0;  // 0: from the log
+  double inertia_scale = 1;
   std::string physics;
   std::vector<std::string> driver, sensor;
 };
@@ -78,6 +80,15 @@ class ArtifactCopy {
     pugi::xml_node body = artifact.child("physic");
     if (!body || !body.attribute("mass")) throw ssx::Error(o.artifact.string() + ": error: no root <physic> with a mass");
     body.attribute("mass").set_value(mass);
+    if (o.inertia_scale != 1) {
+      double i[3];
+      if (std::sscanf(body.attribute("inertia").as_string(), "%lf %lf %lf", &i[0], &i[1], &i[2]) != 3)
+        throw ssx::Error(o.artifact.string() + ": error: --inertia-scale needs the root <physic>'s inertia=\"IXX IYY IZZ\"");
+      char scaled[128];
+      std::snprintf(scaled, sizeof scaled, "%.9g %.9g %.9g", i[0] * o.inertia_scale, i[1] * o.inertia_scale,
+                    i[2] * o.inertia_scale);
+      body.attribute("inertia").set_value(scaled);
+    }
     pugi::xml_node driver = artifact.child("driver");
     pugi::xml_node pose = artifact.find_child_by_attribute("sensor", "plugin", "pose");
     if (!driver || !pose) throw ssx::Error(o.artifact.string() + ": error: needs a <driver> and a pose <sensor>");
@@ -103,11 +114,11 @@ class ArtifactCopy {
 int replay(const Options& o) {
   const ssx::flight::Log log = ssx::flight::readLog(o.log);
   const ssx::flight::Segment flight = ssx::flight::findFlight(log, o.log.string());
-  const double hover = ssx::flight::hoverCommand(log, flight, o.log.string());
+  const double hover = ssx::flight::cruiseThrustCommand(log, flight, o.log.string());
   const double mass = o.mass > 0 ? o.mass : 4 * 0.12 * hover / 65535.0 / kGravity;
   const double volts = ssx::flight::median(log.vbat, flight.first, flight.last + 1);
   const auto& start = log.rows[flight.first];
-  std::printf("flight %.2f-%.2f s; hover command %.0f before the eight: take-off mass %.1f g%s; battery %.3f V\n",
+  std::printf("flight %.2f-%.2f s; thrust command %.0f in level flight: take-off mass %.1f g%s; battery %.3f V\n",
               start.t, log.rows[flight.last].t, hover, mass * 1e3, o.mass > 0 ? " (given: --mass)" : "", volts);
 
   ArtifactCopy copy(o, mass);
@@ -170,6 +181,8 @@ int main(int argc, char** argv) {
   app.add_option("--out", o.out, "the simulated flight: t,px,py,pz,sp_x,sp_y,sp_z,vx,vy,vz,roll,pitch,yaw")->required();
   app.add_option("--mass", o.mass, "take-off mass, kg (default: from the log's hover thrust)")
       ->check(CLI::Range(0.005, 0.2));
+  app.add_option("--inertia-scale", o.inertia_scale, "the vehicle's inertia times this (a guess's range)")
+      ->check(CLI::Range(0.25, 4.0));
   app.add_option("--physics", o.physics, "physics engine")->check(CLI::IsMember({"ode", "bullet"}));
   o.artifact = ssx::installedDataDirectory() / "artifacts" / "crazyflie.xml";
   app.add_option("--artifact", o.artifact, "the vehicle (default: the installed crazyflie)")
