@@ -6,7 +6,7 @@
 Each fenced block is preceded by a marker line `<!-- doc-test: KIND -->`:
 
   run            sh: each command runs (bash -e); python: the block runs; cpp: compiled against the
-                 build and run. All in WORK_DIR, where build/, examples/ and tests/ are links to the
+                 build and run. All in WORK_DIR, where build/, examples/, tests/ and docs/ are links to the
                  tree, so outputs land there and never in the repository.
   run, prints: RE  as run, and what it prints matches the regular expression RE (a figure the text
                  beside the block quotes)
@@ -63,7 +63,8 @@ class Checker:
     def __init__(self, source, build, work):
         self.source, self.build, self.work = source, build, work
         self.errors = 0
-        for name, target in (("build", build), ("examples", source / "examples"), ("tests", source / "tests")):
+        for name, target in (("build", build), ("examples", source / "examples"), ("tests", source / "tests"),
+                             ("docs", source / "docs")):
             link = work / name
             if not link.exists():
                 link.symlink_to(target)

@@ -15,6 +15,7 @@ overshoot within 30 %.
 --plots DIR   writes nanobench_slow.png and nanobench_fast.png (x(t) and y(t), real and simulated,
               of each speed's first flight)
 --write DOC   puts the table into DOC between <!-- nanobench-table --> and <!-- /nanobench-table -->
+              (with --sweep: <!-- nanobench-sweep --> ...)
 --check DOC   fails (exit 1) unless DOC's table is the one computed now
 --sweep       flies every flight once per value of each unpublished parameter and prints how much
               the mean, the lag, the distance after the lag and the take-off overshoot move (the
@@ -32,7 +33,6 @@ here = pathlib.Path(__file__).resolve().parent
 sys.path.insert(0, str(here))
 import score_flight  # noqa: E402
 
-BEGIN, END = "<!-- nanobench-table -->", "<!-- /nanobench-table -->"
 
 # the values nobody published for this vehicle and their plausible ranges (each flown alone)
 SWEEP = [
@@ -139,14 +139,35 @@ def plots(rows, data, out_dir, plot_dir):
 
 
 def sweep(program, flights, out_dir, extra):
-    print("| unpublished value | flown | mean (m) | lag (s) | after the lag (m) | take-off overshoot (m) |")
-    print("|---|---|---|---|---|---|")
+    lines = ["| unpublished value | flown | mean (m) | lag (s) | after the lag (m) | take-off overshoot (m) |",
+             "|---|---|---|---|---|---|"]
     for label, option, forms, values in SWEEP:
         for v in values:
             args = [option, v] if forms is None else [a for f in forms for a in (option, f.format(v))]
             rows = compare(program, flights, out_dir, [*extra, *args])
             m = [np.mean([r["sim"][k] for r in rows]) for k in ("mean_m", "lag_s", "mean_after_lag_m", "overshoot_m")]
-            print(f"| {label} | {v} | {m[0]:.3f} | {m[1]:.2f} | {m[2]:.3f} | {m[3]:.3f} |", flush=True)
+            lines.append(f"| {label} | {v} | {m[0]:.3f} | {m[1]:.2f} | {m[2]:.3f} | {m[3]:.3f} |")
+    return "\n".join(lines)
+
+
+def put(doc_path, marker, text, write):
+    """Writes `text` between <!-- marker --> and <!-- /marker --> of the document, or checks that it
+    is there; returns the exit status."""
+    begin, end = f"<!-- {marker} -->", f"<!-- /{marker} -->"
+    doc = doc_path.read_text()
+    if begin not in doc or end not in doc:
+        print(f"{doc_path}: no {begin} ... {end}", file=sys.stderr)
+        return 1
+    head, rest = doc.split(begin, 1)
+    old, tail = rest.split(end, 1)
+    if write:
+        doc_path.write_text(f"{head}{begin}\n{text}\n{end}{tail}")
+        return 0
+    if old.strip() != text.strip():
+        print(f"{doc_path}: its {marker} is not the one computed now (above): run compare.py --write", file=sys.stderr)
+        return 1
+    print(f"{doc_path}: its {marker} is the one computed now")
+    return 0
 
 
 def main():
@@ -168,27 +189,15 @@ def main():
         sys.exit(f"{a.data}: expected the five NanoBench flights, found {len(flights)}")
     a.out.mkdir(parents=True, exist_ok=True)
     if a.sweep:
-        sweep(a.program, flights, a.out, extra)
-        return 0
-    rows = compare(a.program, flights, a.out, extra)
-    text = table(rows)
+        text, marker = sweep(a.program, flights, a.out, extra), "nanobench-sweep"
+    else:
+        rows = compare(a.program, flights, a.out, extra)
+        text, marker = table(rows), "nanobench-table"
+        if a.plots:
+            plots(rows, a.data, a.out, a.plots)
     print(text)
-    if a.plots:
-        plots(rows, a.data, a.out, a.plots)
-    if a.write or a.check:
-        doc = (a.write or a.check).read_text()
-        if BEGIN not in doc or END not in doc:
-            sys.exit(f"{a.write or a.check}: no {BEGIN} ... {END}")
-        head, rest = doc.split(BEGIN, 1)
-        old, tail = rest.split(END, 1)
-        if a.write:
-            a.write.write_text(f"{head}{BEGIN}\n{text}\n{END}{tail}")
-        elif old.strip() != text.strip():
-            print(f"{a.check}: its table is not the one computed now (above): run compare.py --write", file=sys.stderr)
-            return 1
-        else:
-            print(f"{a.check}: its table is the one computed now")
-    return 0
+    doc = a.write or a.check
+    return put(doc, marker, text, a.write is not None) if doc else 0
 
 
 if __name__ == "__main__":
