@@ -98,6 +98,7 @@ void CrazyfliePidController::setRuns(std::int64_t attitude_runs, std::int64_t po
   position_every_ = position_runs;
   attitude_dt_ = static_cast<double>(attitude_runs) * run_seconds;
   position_dt_ = static_cast<double>(position_runs) * run_seconds;
+  filter_ticks_ = std::max(1, static_cast<int>(std::lround(run_seconds * 1000)));
 }
 
 void CrazyfliePidController::startInAir(double weight) {
@@ -123,9 +124,9 @@ Command CrazyfliePidController::command() const {
 }
 
 double CrazyfliePidController::motorThrust(double command) const {
-  const double pwm = curve_.pwm(command, battery_volts_);
+  const double pwm = curve_.pwm(command, filter_.volts());
   if (pwm <= 0) return 0;
-  return std::max(0.0, curve_.thrust(pwm / 65535.0 * battery_volts_));
+  return std::max(0.0, curve_.thrust(pwm / 65535.0 * motor_volts_));
 }
 
 void CrazyfliePidController::resetAll(double yaw_deg) {
@@ -206,7 +207,7 @@ void CrazyfliePidController::saveState(StateWriter& out) const {
   for (const double v : {current_.position.x(), current_.position.y(), current_.position.z(), current_.yaw,
                          current_.yaw_rate, command_velocity_.x(), command_velocity_.y(), command_velocity_.z(),
                          command_yaw_rate_, velocity_desired_.x(), velocity_desired_.y(), velocity_desired_.z(), roll_deg_,
-                         pitch_deg_, yaw_target_deg_, thrust_, battery_volts_})
+                         pitch_deg_, yaw_target_deg_, thrust_, filter_.volts(), motor_volts_})
     out.write(v);
   out.write(yaw_target_set_);
   for (const double m : motors_) out.write(m);
@@ -217,11 +218,13 @@ void CrazyfliePidController::loadState(StateReader& in) {
   std::uint8_t level = 0;
   in.read(level);
   level_ = static_cast<CommandLevel>(level);
+  double filtered = 0;
   double* fields[] = {&current_.position.x(), &current_.position.y(), &current_.position.z(), &current_.yaw,
                       &current_.yaw_rate, &command_velocity_.x(), &command_velocity_.y(), &command_velocity_.z(),
                       &command_yaw_rate_, &velocity_desired_.x(), &velocity_desired_.y(), &velocity_desired_.z(),
-                      &roll_deg_, &pitch_deg_, &yaw_target_deg_, &thrust_, &battery_volts_};
+                      &roll_deg_, &pitch_deg_, &yaw_target_deg_, &thrust_, &filtered, &motor_volts_};
   for (double* f : fields) in.read(*f);
+  filter_.reset(filtered);
   in.read(yaw_target_set_);
   for (double& m : motors_) in.read(m);
 }

@@ -35,7 +35,7 @@ inline constexpr ssx_plugin_param kControllerChoiceParameters[] = {
     param::real("crazyflie_attitude_rate_hz", "500", "Hz", param::positive(),
                 "crazyflie_pid: attitude and rate loops (its period a whole multiple of the driver's)"),
     param::real("crazyflie_battery_volts", "4.2", "V", param::atLeast(2) & param::atMost(4.35),
-                "crazyflie_pid: the battery voltage its thrust compensation sees (held constant)"),
+                "crazyflie_pid without battery=\"true\": the battery voltage its thrust compensation sees and its motors get (held constant)"),
 };
 
 /// pid.c's element.
@@ -87,8 +87,19 @@ class CrazyfliePidController final : public FlightController {
   CrazyfliePidController(const CrazyfliePidGains& gains, const std::vector<Rotor>& rotors, const RotorParams& rotor,
                          const CrazyflieThrustCurve& curve = CrazyflieThrustCurve::propellers21plus());
 
-  /// The battery voltage the compensation sees (filtered; 4.2 V until told).
-  void setBatteryVoltage(double volts) { battery_volts_ = volts; }
+  /// A battery held at `volts` (4.2 V until told): what the compensation sees and what the motors get.
+  void setBatteryVoltage(double volts) {
+    filter_.reset(volts);
+    motor_volts_ = volts;
+  }
+  /// A battery measured now at `volts` (its terminal voltage): the motors get it; the compensation
+  /// sees it through the firmware's low-pass, advanced by the driver's period (whole milliseconds).
+  void measureBattery(double volts) {
+    motor_volts_ = volts;
+    filter_.update(volts, filter_ticks_);
+  }
+  /// The voltage the compensation sees.
+  double compensationVoltage() const { return filter_.volts(); }
   /// In a driver that runs every `run_seconds`: the attitude loop every `attitude_runs` runs, the
   /// position loop every `position_runs` (the mixer's output held between). By default every run
   /// is an attitude period and the position loop every gains' ratio of runs.
@@ -115,7 +126,8 @@ class CrazyfliePidController final : public FlightController {
   Vec3 desiredVelocity() const { return velocity_desired_; }
   /// The four motors' commands after mixing and capping (0-65535), in the rotors' order.
   std::array<double, 4> motorCommands() const { return motors_; }
-  /// Each motor's thrust (N) for a command, through the battery compensation at `battery_volts`.
+  /// Each motor's thrust (N) for a command: the PWM the compensation makes of it at the voltage it
+  /// sees, given the motor voltage of that PWM of the battery's.
   double motorThrust(double command) const;
 
  private:
@@ -129,7 +141,9 @@ class CrazyfliePidController final : public FlightController {
   std::array<std::array<double, 3>, 4> signs_{};  // per rotor: roll, pitch, yaw
   std::int64_t position_every_ = 5, attitude_every_ = 1;
   double position_dt_ = 0.01, attitude_dt_ = 0.002;
-  double battery_volts_ = 4.2;
+  BatteryFilter filter_;
+  double motor_volts_ = 4.2;
+  int filter_ticks_ = 2;  // the firmware's 1 ms ticks per run of the driver
   CommandLevel level_ = CommandLevel::Position;
   Setpoint current_;
   Vec3 command_velocity_ = Vec3::Zero();

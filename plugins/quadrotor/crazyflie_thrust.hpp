@@ -40,6 +40,8 @@ class BatteryFilter {
   /// Advances by `ticks` ms with the measured voltage `measured`; returns the filtered one.
   double update(double measured, int ticks = 1);
   double volts() const { return v_; }
+  /// Holds `volts` (a battery measured long enough).
+  void reset(double volts) { v_ = volts; }
 
  private:
   double v_ = 4.2;

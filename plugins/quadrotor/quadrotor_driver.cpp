@@ -122,6 +122,9 @@ void QuadrotorDriver::validate(const Descriptor& params, const PluginContext& co
   const Config& config = *shared_config;
   const auto frame =
       context.shared<Airframe>(frameKey(shared_config.get(), a), [&] { return Airframe(config, params, a); });
+  if (config.vehicle.battery && config.vehicle.battery->compensated && !config.crazyflie_pid)
+    throw params.errorAt("battery", "the crazyflie's battery is compensated by its firmware's controller: fly "
+                                    "controller=\"crazyflie_pid\" (or \"auto\") with battery=\"true\"");
   if (config.crazyflie_pid) {
     // (checked only for this controller: the rates mean nothing to TeleKyb's)
     const double period = toSeconds(context.period());
@@ -180,6 +183,8 @@ void QuadrotorDriver::configure(const Descriptor& params, PluginSetup& setup) {
   controller_.configure(c.controller, frame->controller, c.vehicle.rotor, params, context, *imu, setup, frame_key);
   crazyflie_.reset();
   if (c.crazyflie_pid) crazyflie_ = c.crazyflie(frame->rotors, context);
+  // the firmware has measured the battery since it was switched on
+  if (crazyflie_ && vehicle_.hasBattery()) crazyflie_->setBatteryVoltage(vehicle_.batteryVoltage());
   if (const Sensor* pose = firstSensorOf<PoseMeasurement>(a)) {
     have_pose_ = true;
     setup.subscribe<PoseMeasurement>(*pose, [this](const PoseMeasurement& m) { pose_ = m; });
@@ -236,8 +241,10 @@ void QuadrotorDriver::step(const StepInfo& info) {
   const double t = toSeconds(info.time);
   const std::size_t n = vehicle_.rotorCount();
   // the controller chooses the rotor speeds, the vehicle spins up to them
-  if (crazyflie_)
+  if (crazyflie_) {
+    if (vehicle_.hasBattery()) crazyflie_->measureBattery(vehicle_.batteryVoltage());
     crazyflie_->step(info.step / periodSteps(), t, *this, std::span(commanded_speeds_).first(n));
+  }
   else
     controller_.step(info.step / periodSteps(), t, *this, std::span(commanded_speeds_).first(n));
   vehicle_.stepMotors(period, std::span(commanded_speeds_).first(n));

@@ -40,6 +40,20 @@ std::optional<RotorParams> preset(const std::string& name) {
   return std::nullopt;
 }
 
+BatteryParams batteryPreset(const std::string& name) {
+  BatteryParams b;  // the defaults are the mk_quad's
+  if (name != "crazyflie") return b;
+  b.full_voltage = 4.2;         // one LiPo cell, full
+  b.empty_voltage = 3.2;        // EST: the firmware's low-battery threshold (pm_stm32f4.c)
+  b.capacity = 0.25;            // Bitcraze: the Crazyflie 2.1's 250 mAh pack
+  b.resistance = 0.15;          // EST: a small 1S pack
+  b.efficiency = 0.45;          // EST: 250 mAh lasts about 7 min of hover at 29 g, Bitcraze's flight time
+  b.nominal_voltage = 3.7;      // (unused: compensated)
+  b.zero_thrust_voltage = 0.0;  // (unused: compensated)
+  b.compensated = true;
+  return b;
+}
+
 // --- allocation and rotors -------------------------------------------------------------------------
 
 Allocation::Allocation(const std::vector<Rotor>& rotors, const RotorParams& p) {

@@ -47,8 +47,11 @@ double groundEffectGain(double height, double radius);
 
 /// A battery pack: its open-circuit voltage falls linearly with the charge drawn, an internal
 /// resistance sags it under load, and the thrust of a rotor at a fixed command follows the
-/// MikroKopter law F proportional to (U - 7.575 V), equal to the model's at the nominal voltage.
-/// Values marked EST are guesses for a 4S 2200 mAh pack (no published figure for the MK's).
+/// MikroKopter law F proportional to (U - 7.575 V), equal to the model's at the nominal voltage;
+/// or, `compensated`, not at all: the flight controller reads the voltage and compensates (the
+/// Crazyflie's firmware; its controller then gives the thrust the voltage allows).
+/// The defaults are the mk_quad's: EST marks guesses for a 4S 2200 mAh pack (no published figure
+/// for the MK's). batteryPreset() has each preset's.
 struct BatteryParams {
   double full_voltage = 16.8;          ///< V, open circuit when full (4S LiPo, 4.2 V a cell)
   double empty_voltage = 14.0;         ///< V, open circuit when the capacity is drawn (EST, 3.5 V a cell)
@@ -58,13 +61,19 @@ struct BatteryParams {
   double nominal_voltage = 15.5;       ///< V: thrust gain 1 (the MK law's reference)
   double zero_thrust_voltage = 7.575;  ///< V: the MK law's offset
   double initial_charge = 1.0;         ///< fraction of the capacity at the start
+  bool compensated = false;            ///< the controller compensates: no thrust law here
 };
+
+/// The battery of a preset: the MikroKopter's 4S law for "mk_quad" and "hummingbird"; for
+/// "crazyflie" its 1S 250 mAh pack, compensated by its firmware (docs/quadrotor-reference.md).
+BatteryParams batteryPreset(const std::string& name);
 
 class Battery {
  public:
   explicit Battery(const BatteryParams& p) : p_(p), charge_(p.initial_charge), voltage_(openCircuit()) {}
   /// Thrust at a fixed command relative to the nominal voltage's: (U - U0) / (U_nom - U0).
   double thrustGain(double voltage) const {
+    if (p_.compensated) return 1.0;
     return (voltage - p_.zero_thrust_voltage) / (p_.nominal_voltage - p_.zero_thrust_voltage);
   }
   double thrustGain() const { return thrustGain(voltage_); }

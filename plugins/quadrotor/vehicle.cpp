@@ -36,17 +36,18 @@ RotorParams rotorParams(const Descriptor& params) {
   return rp;
 }
 
-// the battery, its voltages checked against each other
+// the battery: the preset's, then any override; its voltages checked against each other
 BatteryParams batteryParams(const Descriptor& params) {
-  BatteryParams bp;
-  bp.full_voltage = params.get<double>("battery_full_voltage");
-  bp.empty_voltage = params.get<double>("battery_empty_voltage");
-  bp.capacity = params.get<double>("battery_capacity");
-  bp.resistance = params.get<double>("battery_resistance");
-  bp.efficiency = params.get<double>("battery_efficiency");
-  bp.initial_charge = params.get<double>("battery_initial_charge");
-  bp.nominal_voltage = params.get<double>("battery_nominal_voltage");
-  bp.zero_thrust_voltage = params.get<double>("battery_zero_thrust_voltage");
+  BatteryParams bp = batteryPreset(params.get<std::string>("preset"));
+  auto override = [&](const char* key, double& value) { value = params.get<double>(key, value); };
+  override("battery_full_voltage", bp.full_voltage);
+  override("battery_empty_voltage", bp.empty_voltage);
+  override("battery_capacity", bp.capacity);
+  override("battery_resistance", bp.resistance);
+  override("battery_efficiency", bp.efficiency);
+  override("battery_initial_charge", bp.initial_charge);
+  override("battery_nominal_voltage", bp.nominal_voltage);
+  override("battery_zero_thrust_voltage", bp.zero_thrust_voltage);
   if (!(bp.empty_voltage < bp.full_voltage) || !(bp.nominal_voltage > bp.zero_thrust_voltage) ||
       !(bp.empty_voltage > bp.zero_thrust_voltage))
     throw params.error("battery: needs battery_zero_thrust_voltage < battery_empty_voltage < battery_full_voltage "

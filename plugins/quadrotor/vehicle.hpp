@@ -30,16 +30,20 @@ inline constexpr ssx_plugin_param kVehicleParameters[] = {
     param::real("rotor_inertia", "", "kg m^2", param::nonNegative(), "(default: the preset's)"),
     param::text("rotors", "rotor0 rotor1 rotor2 rotor3", "physic node names of the rotors (4 to 8)"),
     param::text("directions", "1 -1 1 -1", "spin of each rotor: 1 counter-clockwise seen from above, -1 clockwise"),
-    param::flag("battery", "false", "a battery whose voltage sags with current and charge drawn; thrust at a fixed command follows it"),
-    param::real("battery_full_voltage", "16.8", "V", param::positive(), "open circuit when full"),
-    param::real("battery_empty_voltage", "14", "V", param::positive(), "open circuit when the capacity is drawn (EST)"),
-    param::real("battery_capacity", "2.2", "Ah", param::positive(), "capacity (EST)"),
-    param::real("battery_resistance", "0.04", "ohm", param::nonNegative(), "internal resistance (EST)"),
-    param::real("battery_efficiency", "0.6", "", param::positive() & param::atMost(1), "mechanical / electrical power (EST)"),
+    param::flag("battery", "false", "a battery whose voltage sags with current and charge drawn; thrust at a fixed command follows it "
+                "(the crazyflie's firmware compensates: its thrust holds until the voltage cannot give it)"),
+    param::real("battery_full_voltage", "", "V", param::positive(), "open circuit when full (default: the preset's; mk_quad 16.8)"),
+    param::real("battery_empty_voltage", "", "V", param::positive(),
+                "open circuit when the capacity is drawn (default: the preset's; mk_quad 14, EST)"),
+    param::real("battery_capacity", "", "Ah", param::positive(), "capacity (default: the preset's; mk_quad 2.2, EST)"),
+    param::real("battery_resistance", "", "ohm", param::nonNegative(), "internal resistance (default: the preset's; mk_quad 0.04, EST)"),
+    param::real("battery_efficiency", "", "", param::positive() & param::atMost(1),
+                "mechanical / electrical power (default: the preset's; mk_quad 0.6, EST)"),
     param::real("battery_initial_charge", "1", "", param::nonNegative() & param::atMost(1), "fraction of the capacity at the start"),
-    param::real("battery_nominal_voltage", "15.5", "V", param::positive(), "voltage at which the rotor model's thrust holds (MK law)"),
-    param::real("battery_zero_thrust_voltage", "7.575", "V", param::nonNegative(),
-                "the MK law's offset: thrust at a fixed command is proportional to U minus this"),
+    param::real("battery_nominal_voltage", "", "V", param::positive(),
+                "voltage at which the rotor model's thrust holds (MK law; default: the preset's; mk_quad 15.5)"),
+    param::real("battery_zero_thrust_voltage", "", "V", param::nonNegative(),
+                "the MK law's offset: thrust at a fixed command is proportional to U minus this (default: the preset's; mk_quad 7.575)"),
 };
 
 /// The vehicle's constants from its parameters, checked against each other.
@@ -66,6 +70,8 @@ class Vehicle {
   void stepMotors(double dt, std::span<const double> commanded) { rotors_->step(dt, commanded); }
   /// Whether thrust gains change from step to step (a battery; or ground effect, told by the caller).
   bool hasBattery() const { return battery_.has_value(); }
+  /// The battery's terminal voltage (V) after the last step; call only with a battery.
+  double batteryVoltage() const { return battery_->voltage(); }
   /// Updates each rotor's thrust gain: the battery's (after drawing the rotors' power for dt) times
   /// `ground_gain(i)`, a per-rotor gain from the environment (1: none).
   template <class GroundGain>
