@@ -89,6 +89,26 @@ CrazyfliePidController::CrazyfliePidController(const CrazyfliePidGains& gains, c
   const PidGains* a[3] = {&g_.attitude_rp, &g_.attitude_rp, &g_.attitude_yaw};
   const PidGains* w[3] = {&g_.rate_rp, &g_.rate_rp, &g_.rate_yaw};
   for (int k = 0; k < 3; ++k) pos_[k] = Pid(*p[k]), vel_[k] = Pid(*v[k]), att_[k] = Pid(*a[k]), rate_[k] = Pid(*w[k]);
+  if (g_.gyro_cutoff_hz > 0)
+    for (LowPass2& f : gyro_filter_) f = LowPass2(g_.attitude_rate_hz, g_.gyro_cutoff_hz);
+}
+
+LowPass2::LowPass2(double sample_hz, double cutoff_hz) {
+  const double ohm = std::tan(std::numbers::pi * cutoff_hz / sample_hz);
+  const double c = 1 + 2 * std::cos(std::numbers::pi / 4) * ohm + ohm * ohm;
+  b0_ = ohm * ohm / c;
+  b1_ = 2 * b0_;
+  b2_ = b0_;
+  a1_ = 2 * (ohm * ohm - 1) / c;
+  a2_ = (1 - 2 * std::cos(std::numbers::pi / 4) * ohm + ohm * ohm) / c;
+}
+
+double LowPass2::apply(double sample) {
+  const double d0 = sample - d1_ * a1_ - d2_ * a2_;
+  const double out = d0 * b0_ + d1_ * b1_ + d2_ * b2_;
+  d2_ = d1_;
+  d1_ = d0;
+  return out;
 }
 
 void CrazyfliePidController::setRuns(std::int64_t attitude_runs, std::int64_t position_runs, double run_seconds) {
@@ -99,6 +119,8 @@ void CrazyfliePidController::setRuns(std::int64_t attitude_runs, std::int64_t po
   attitude_dt_ = static_cast<double>(attitude_runs) * run_seconds;
   position_dt_ = static_cast<double>(position_runs) * run_seconds;
   filter_ticks_ = std::max(1, static_cast<int>(std::lround(run_seconds * 1000)));
+  // the gyro filtered at every run of the driver (the firmware: every 1 ms sample)
+  for (LowPass2& f : gyro_filter_) f = g_.gyro_cutoff_hz > 0 ? LowPass2(1.0 / run_seconds, g_.gyro_cutoff_hz) : LowPass2();
 }
 
 void CrazyfliePidController::startInAir(double weight) {
@@ -179,7 +201,7 @@ void CrazyfliePidController::attitudeLoop(FlightInputs& in) {
   if (level_ == CommandLevel::Velocity || !in.holdsHeading()) yaw_target_deg_ = wrap180(yaw_target_deg_ + yaw_rate * kDeg * dt);
   const Vec3 rates_desired(att_[0].update(roll_deg_, euler.x(), dt), att_[1].update(pitch_deg_, euler.y(), dt),
                            att_[2].update(yaw_target_deg_, euler.z(), dt, true));
-  const Vec3 gyro = in.bodyRates() * kDeg;
+  const Vec3& gyro = gyro_deg_;
   const double roll = rate_[0].update(rates_desired.x(), gyro.x(), dt);
   const double pitch = rate_[1].update(rates_desired.y(), gyro.y(), dt);
   const double yaw = rate_[2].update(rates_desired.z(), gyro.z(), dt);
@@ -196,6 +218,8 @@ void CrazyfliePidController::attitudeLoop(FlightInputs& in) {
 }
 
 void CrazyfliePidController::step(std::int64_t run, double t, FlightInputs& in, std::span<double> speeds) {
+  const Vec3 rates = in.bodyRates() * kDeg;
+  for (int k = 0; k < 3; ++k) gyro_deg_[k] = gyro_filter_[k].apply(rates[k]);
   if (run % position_every_ == 0) positionLoop(t, in);
   if (run % attitude_every_ == 0) attitudeLoop(in);
   for (std::size_t i = 0; i < 4 && i < speeds.size(); ++i) speeds[i] = std::sqrt(motorThrust(motors_[i]) / thrust_coefficient_);
@@ -211,6 +235,7 @@ void CrazyfliePidController::saveState(StateWriter& out) const {
     out.write(v);
   out.write(yaw_target_set_);
   for (const double m : motors_) out.write(m);
+  for (int k = 0; k < 3; ++k) out.write(gyro_filter_[k].state(0)), out.write(gyro_filter_[k].state(1)), out.write(gyro_deg_[k]);
 }
 
 void CrazyfliePidController::loadState(StateReader& in) {
@@ -227,6 +252,11 @@ void CrazyfliePidController::loadState(StateReader& in) {
   filter_.reset(filtered);
   in.read(yaw_target_set_);
   for (double& m : motors_) in.read(m);
+  for (int k = 0; k < 3; ++k) {
+    const double d1 = in.get<double>(), d2 = in.get<double>();
+    gyro_filter_[k].setState(d1, d2);
+    in.read(gyro_deg_[k]);
+  }
 }
 
 }  // namespace ssx::quadrotor

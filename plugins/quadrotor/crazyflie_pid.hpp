@@ -64,6 +64,21 @@ class Pid {
   bool started_ = false;
 };
 
+/// The firmware's two-pole low-pass (filter.c lpf2p, a Butterworth biquad), as it filters the gyro
+/// at 80 Hz (sensors_bmi088_bmp3xx.c).
+class LowPass2 {
+ public:
+  LowPass2() = default;
+  LowPass2(double sample_hz, double cutoff_hz);
+  double apply(double sample);
+  double state(int k) const { return k == 0 ? d1_ : d2_; }
+  void setState(double d1, double d2) { d1_ = d1, d2_ = d2; }
+
+ private:
+  double b0_ = 1, b1_ = 0, b2_ = 0, a1_ = 0, a2_ = 0;
+  double d1_ = 0, d2_ = 0;
+};
+
 /// The firmware's defaults (platform_defaults_cf2.h).
 struct CrazyfliePidGains {
   PidGains position_xy{2, 0, 0};
@@ -78,6 +93,7 @@ struct CrazyfliePidGains {
   PidGains rate_rp{250, 500, 2.5, 33.3, 32767};
   PidGains rate_yaw{120, 16.7, 0, 166.7, 32767};
   double position_rate_hz = 100, attitude_rate_hz = 500;
+  double gyro_cutoff_hz = 80;  ///< the gyro's low-pass (0: none)
 };
 
 class CrazyfliePidController final : public FlightController {
@@ -150,6 +166,8 @@ class CrazyfliePidController final : public FlightController {
   double command_yaw_rate_ = 0;  // rad/s
   // the loops
   Pid pos_[3], vel_[3], att_[3], rate_[3];
+  LowPass2 gyro_filter_[3];
+  Vec3 gyro_deg_ = Vec3::Zero();  // the filtered gyro, deg/s
   Vec3 velocity_desired_ = Vec3::Zero();
   double roll_deg_ = 0, pitch_deg_ = 0, yaw_target_deg_ = 0, thrust_ = 0;
   bool yaw_target_set_ = false;

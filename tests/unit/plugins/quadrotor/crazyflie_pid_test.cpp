@@ -53,6 +53,26 @@ TEST_CASE("crazyflie_pid: the PID element", "[quadrotor][crazyflie]") {
   CHECK(yaw.update(170, -170, 0.002, true) == Approx(-20));  // the short way round
 }
 
+TEST_CASE("crazyflie_pid: the gyro's two-pole low-pass passes DC, halves the power at its cut-off", "[quadrotor][crazyflie]") {
+  // the firmware's: 80 Hz at 1 kHz; the amplitude of a sine after the transient
+  auto gain = [](double hz) {
+    LowPass2 f(1000, 80);
+    double highest = 0;
+    for (int i = 0; i < 4000; ++i) {
+      const double out = f.apply(std::sin(2 * std::numbers::pi * hz * i / 1000.0));
+      if (i >= 2000) highest = std::max(highest, std::abs(out));
+    }
+    return highest;
+  };
+  LowPass2 dc(1000, 80);
+  double out = 0;
+  for (int i = 0; i < 200; ++i) out = dc.apply(3.0);
+  CHECK(out == Approx(3.0).epsilon(1e-9));
+  CHECK(gain(5) == Approx(1).margin(0.01));
+  CHECK(gain(80) == Approx(std::sqrt(0.5)).margin(0.02));
+  CHECK(gain(300) < 0.1);
+}
+
 TEST_CASE("crazyflie_pid: hover, limits, the yaw frame, no tilt compensation", "[quadrotor][crazyflie]") {
   const CrazyfliePidGains gains;
   Standing in;
@@ -99,6 +119,7 @@ TEST_CASE("crazyflie_pid: hover, limits, the yaw frame, no tilt compensation", "
 TEST_CASE("crazyflie_pid: the mixer rolls with the left motors, gives up collective thrust first", "[quadrotor][crazyflie]") {
   CrazyfliePidGains gains;
   gains.thrust_base = 65000;  // near the ceiling
+  gains.gyro_cutoff_hz = 0;    // the rates as they are (the filter would take the first sample's edge off)
   Standing in;
   in.pose.position = in.setpoint.position = Vec3(0, 0, 1);
   in.rates = Vec3(-0.5, 0, 0);  // rolling right at 0.5 rad/s: the rate loop asks for positive roll torque
