@@ -1,0 +1,246 @@
+#pragma once
+// What the ROS bridges share above their transport: which robots are bridged, what is published
+// when (rates in simulated time), applying what arrived between steps (set-points, velocity
+// commands), lock-step with the controllers outside, and the log lines at the end. A bridge is this
+// class with a transport (open()); ros1 and ros2 differ only there.
+#include "transport.hpp"
+
+#include <ssx/command.hpp>
+#include <ssx/environment.hpp>
+#include <ssx/measurements.hpp>
+#include <ssx/plugin_abi.hpp>
+#include <ssx/setpoint.hpp>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace ssx::bridge {
+
+/// The parameters both bridges take, with the same meaning (the part "bridge" of their tables).
+inline constexpr ssx_plugin_param kBridgeParameters[] = {
+    param::text("artifacts", "*", "artifact names separated by spaces, or * for every artifact with a dynamic root"),
+    param::real("odom_rate_hz", "50", "Hz", param::nonNegative(), "odometry rate in simulated time; 0: every step"),
+    param::real("imu_rate_hz", "100", "Hz", param::nonNegative(), "IMU rate in simulated time; 0: no IMU topics"),
+    param::real("clock_rate_hz", "100", "Hz", param::nonNegative(), "/clock rate in simulated time; 0: every step"),
+    param::flag("lockstep", "false", "wait after each odometry message until every robot answered with a set-point"),
+    param::real("lockstep_timeout_s", "2", "s", param::positive() & param::atMost(86400), "longest wait for the set-points of one step"),
+    param::real("lockstep_connect_timeout_s", "10", "s", param::positive() & param::atMost(86400),
+                "how long the first step waits for every robot's controller to connect"),
+};
+
+class BridgeExtension : public SimulationExtension {
+ public:
+  // what is bridged exists before the transport is started
+  static void validate(const Descriptor& params, const PluginContext& context) {
+    (void)context.environment->selectArtifacts(params, "artifacts", "bridge");
+  }
+
+  void init(Environment& env, const Descriptor& params) override {
+    publish_costs_.reserve(1 << 16);
+    odom_rate_ = rateOf(params, "odom_rate_hz", env.timestep());
+    imu_rate_ = rateOf(params, "imu_rate_hz", env.timestep());
+    if (params.get<double>("imu_rate_hz") == 0) imu_rate_.period = 0;
+    clock_rate_ = rateOf(params, "clock_rate_hz", env.timestep());
+    lockstep_ = params.get<bool>("lockstep");
+    lockstep_timeout_ = params.get<double>("lockstep_timeout_s");
+    connect_timeout_ = params.get<double>("lockstep_connect_timeout_s");
+    std::vector<RobotTopics> topics;
+    for (Artifact* a : env.selectArtifacts(params, "artifacts", "bridge")) {
+      Robot r;
+      r.artifact = a;
+      r.tracker = dynamic_cast<SetpointInterface*>(a->driver());
+      r.commands = dynamic_cast<CommandInterface*>(a->driver());
+      if (r.commands != nullptr && !r.commands->acceptsCommand(CommandLevel::Velocity)) r.commands = nullptr;
+      for (std::size_t k = 0; k < a->sensorCount(); ++k)
+        if (r.imu == nullptr) r.imu = dynamic_cast<const ImuMeasurement*>(&a->sensor(k).latest());
+      topics.push_back({a->name(), r.imu != nullptr && imu_rate_.period > 0, r.tracker != nullptr, r.commands != nullptr});
+      robots_.push_back(r);
+    }
+    try {
+      transport_ = open(env, params, topics);
+    } catch (const std::exception& e) {
+      throw params.error(e.what());
+    }
+  }
+
+  void beforeStep(Environment&) override {
+    if (lockstep_ && !connected_) {
+      // before the first step: the controllers must be connected, or the first odometry is lost
+      const auto missing = transport_->waitForPeers(connect_timeout_);
+      if (!missing.empty())
+        throw Error("lock-step: no controller connected within " + std::to_string(connect_timeout_) +
+                    " s (subscribed to /<robot>/odom and publishing /<robot>/setpoint) for " +
+                    std::to_string(missing.size()) + " robot(s), first '" + missing.front() + "'");
+      connected_ = true;
+    }
+    if (lockstep_ && waiting_for_ >= 0) {
+      const auto missing = transport_->waitForSetpoints(waiting_for_, lockstep_timeout_);
+      if (!missing.empty()) {
+        std::string names;
+        for (std::size_t i = 0; i < missing.size() && i < 5; ++i) names += (i ? ", " : "") + missing[i];
+        if (missing.size() > 5) names += ", ...";
+        throw Error("lock-step: no set-point stamped at or after t = " + std::to_string(waiting_for_) + " s within " +
+                    std::to_string(lockstep_timeout_) + " s from " + std::to_string(missing.size()) +
+                    " robot(s): " + names);
+      }
+      waiting_for_ = -1;
+    }
+    // each robot's newest set-point and velocity command, applied between steps in the order they arrived
+    for (std::size_t i = 0; i < robots_.size(); ++i) {
+      Robot& r = robots_[i];
+      const Setpoint s = r.tracker != nullptr ? transport_->latestSetpoint(i) : Setpoint{};
+      const Velocity v = r.commands != nullptr ? transport_->latestVelocity(i) : Velocity{};
+      const bool new_setpoint = s.count != r.setpoints, new_velocity = v.count != r.velocities;
+      r.setpoints = s.count;
+      r.velocities = v.count;
+      if (new_velocity && new_setpoint && v.order < s.order) applyVelocity(r, v);
+      if (new_setpoint) applySetpoint(r, s);
+      if (new_velocity && !(new_setpoint && v.order < s.order)) applyVelocity(r, v);
+    }
+  }
+
+  void afterStep(Environment& env) override {
+    const auto started = std::chrono::steady_clock::now();
+    const Nanoseconds now = env.time();
+    const double t = toSeconds(now);
+    // (due() moves a rate on to its next time: asked once per step)
+    const bool clock_due = clock_rate_.due(now), imu_due = imu_rate_.due(now), odom_due = odom_rate_.due(now);
+    if (clock_due) transport_->publishClock(t);
+    if (imu_due) {
+      for (std::size_t i = 0; i < robots_.size(); ++i) {
+        const Robot& r = robots_[i];
+        if (r.imu == nullptr) continue;
+        Imu m;
+        m.time = t;
+        m.angular_velocity = array3(r.imu->gyroscope);
+        m.linear_acceleration = array3(r.imu->accelerometer);
+        m.orientation = array4(r.artifact->root().pose().orientation);
+        transport_->publishImu(i, m);
+      }
+    }
+    if (odom_due) {
+      for (std::size_t i = 0; i < robots_.size(); ++i) {
+        const BodyState s = robots_[i].artifact->root().state();
+        const Quat to_body = s.pose.orientation.conjugate();
+        Odometry m;
+        m.time = t;
+        m.position = array3(s.pose.position);
+        m.orientation = array4(s.pose.orientation);
+        m.velocity = array3(to_body * s.linear_velocity);
+        m.angular_velocity = array3(to_body * s.angular_velocity);
+        transport_->publishOdometry(i, m);
+      }
+      if (lockstep_) waiting_for_ = t;
+    }
+    transport_->commit();  // serialised and sent on the transport's own thread
+    // what publishing costs the stepping thread, for the log (the first 2^16 publishing steps)
+    if ((clock_due || imu_due || odom_due) && publish_costs_.size() < publish_costs_.capacity())
+      publish_costs_.push_back(std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count());
+  }
+
+  void shutdown(Environment& env) override {
+    if (transport_) {
+      logSummary(env);
+      close(*transport_);
+    }
+    transport_.reset();
+  }
+
+ protected:
+  /// The bridge's transport for these robots; throws std::exception (its message becomes the
+  /// scene's error) when it cannot start.
+  virtual std::unique_ptr<Transport> open(Environment& env, const Descriptor& params,
+                                          const std::vector<RobotTopics>& robots) = 0;
+  /// Stops the transport (sending what is staged first).
+  virtual void close(Transport& transport) = 0;
+  /// "ros1", "ros2": the log lines' prefix.
+  virtual const char* name() const = 0;
+
+ private:
+  // a rate in simulated time: due at 0, period, 2 period, ...
+  struct Rate {
+    Nanoseconds period = 0;  // 0: never
+    Nanoseconds next = 0;
+    bool due(Nanoseconds now) {
+      if (period <= 0 || now < next) return false;
+      next += period;
+      if (next <= now) next = now + period;
+      return true;
+    }
+  };
+  struct Robot {
+    Artifact* artifact = nullptr;
+    SetpointInterface* tracker = nullptr;
+    CommandInterface* commands = nullptr;  // takes velocity commands
+    const ImuMeasurement* imu = nullptr;
+    std::uint64_t setpoints = 0, velocities = 0;  // applied so far
+  };
+
+  static Rate rateOf(const Descriptor& params, const char* key, Nanoseconds every_step) {
+    const double hz = params.get<double>(key);
+    Rate r;
+    r.period = hz > 0 ? toNanoseconds(1.0 / hz) : every_step;
+    return r;
+  }
+  static std::array<double, 3> array3(const Vec3& v) { return {v.x(), v.y(), v.z()}; }
+  static std::array<double, 4> array4(const Quat& q) { return {q.w(), q.x(), q.y(), q.z()}; }
+
+  static void applySetpoint(Robot& r, const Setpoint& s) {
+    ssx::Setpoint sp;
+    sp.position = Vec3(s.position[0], s.position[1], s.position[2]);
+    const Quat q(s.orientation[0], s.orientation[1], s.orientation[2], s.orientation[3]);
+    sp.yaw = std::atan2(2 * (q.w() * q.z() + q.x() * q.y()), 1 - 2 * (q.y() * q.y() + q.z() * q.z()));
+    if (!sp.position.allFinite() || !std::isfinite(sp.yaw))
+      throw Error("set-point for '" + r.artifact->name() + "' is not finite");
+    r.tracker->setSetpoint(sp);
+  }
+  // a Twist in the robot's frame (x forward): turned by its heading into the world's
+  static void applyVelocity(Robot& r, const Velocity& v) {
+    const Quat q = r.artifact->root().pose().orientation;
+    const double yaw = std::atan2(2 * (q.w() * q.z() + q.x() * q.y()), 1 - 2 * (q.y() * q.y() + q.z() * q.z()));
+    const Vec3 world(std::cos(yaw) * v.linear[0] - std::sin(yaw) * v.linear[1],
+                     std::sin(yaw) * v.linear[0] + std::cos(yaw) * v.linear[1], v.linear[2]);
+    const Command c = Command::velocityYawRate(world, v.angular[2]);
+    if (const std::string why = r.commands->refusal(c); !why.empty())
+      throw Error("velocity command for '" + r.artifact->name() + "': " + why);
+    r.commands->setCommand(c);
+  }
+
+  void logSummary(Environment& env) const {
+    // how quickly the controllers outside answered, and what publishing cost the stepping thread
+    std::vector<double> rt = transport_->roundTrips();
+    char line[240];
+    if (!rt.empty()) {
+      std::sort(rt.begin(), rt.end());
+      std::snprintf(line, sizeof line,
+                    "%s: %zu set-points answered odometry; round trip median %.2f ms, p99 %.2f ms, max %.2f ms", name(),
+                    rt.size(), 1e3 * rt[rt.size() / 2], 1e3 * rt[rt.size() * 99 / 100], 1e3 * rt.back());
+      env.log(LogLevel::Info, line);
+    }
+    if (!publish_costs_.empty()) {
+      std::vector<double> c = publish_costs_;
+      std::sort(c.begin(), c.end());
+      std::snprintf(line, sizeof line,
+                    "%s: publishing took the stepping thread median %.1f us, p99 %.1f us, max %.1f us per "
+                    "publishing step (%zu steps)",
+                    name(), 1e6 * c[c.size() / 2], 1e6 * c[c.size() * 99 / 100], 1e6 * c.back(), c.size());
+      env.log(LogLevel::Info, line);
+    }
+  }
+
+  std::unique_ptr<Transport> transport_;
+  std::vector<Robot> robots_;
+  Rate odom_rate_, imu_rate_, clock_rate_;
+  bool lockstep_ = false;
+  double lockstep_timeout_ = 2.0, connect_timeout_ = 10.0;
+  bool connected_ = false;
+  double waiting_for_ = -1;            // lock-step: the odometry time set-points must answer
+  std::vector<double> publish_costs_;  // s, per publishing step (reserved at init)
+};
+
+}  // namespace ssx::bridge

@@ -1,0 +1,134 @@
+#pragma once
+// What the ROS bridges (plugins/ros1, plugins/ros2) share below the simulation: the messages as
+// plain numbers, and a Transport that stages what a step publishes, sends it on a thread of its own
+// (serialising and writing never on the stepping thread), and keeps what arrived (each robot's
+// newest set-point and velocity command, the round trips, the waits of lock-step). A transport
+// subclass only sends (send, on the publishing thread), tells whether a robot's peers are there
+// (connected), and hands over what it receives (receivedSetpoint, receivedVelocity).
+//
+// Standard library only, and C++17: the ROS 1 side, whose message headers do not compile as C++20,
+// includes it too.
+#include <array>
+#include <chrono>
+#include <condition_variable>
+#include <cstdint>
+#include <map>
+#include <mutex>
+#include <string>
+#include <thread>
+#include <vector>
+
+namespace ssx::bridge {
+
+struct Odometry {
+  double time = 0;                                        // simulated seconds
+  std::array<double, 3> position{};                       // world
+  std::array<double, 3> velocity{}, angular_velocity{};   // body frame (ROS: the child frame)
+  std::array<double, 4> orientation{1, 0, 0, 0};          // w x y z
+};
+
+struct Imu {
+  double time = 0;
+  std::array<double, 3> angular_velocity{}, linear_acceleration{};  // sensor frame
+  std::array<double, 4> orientation{1, 0, 0, 0};                     // w x y z (ground truth)
+};
+
+struct Setpoint {
+  double stamp = 0;  // header.stamp, seconds
+  std::array<double, 3> position{};
+  std::array<double, 4> orientation{1, 0, 0, 0};  // w x y z
+  std::uint64_t count = 0;                        // set-points received so far for this robot
+  std::uint64_t order = 0;                        // when it arrived, among every message received
+};
+
+struct Velocity {
+  std::array<double, 3> linear{}, angular{};  // m/s and rad/s (a Twist: the robot's body frame)
+  std::uint64_t count = 0;                    // commands received so far for this robot
+  std::uint64_t order = 0;                    // when it arrived, among every message received
+};
+
+struct RobotTopics {
+  std::string name;       // the namespace: /<name>/odom, /<name>/imu, /<name>/setpoint, /<name>/cmd_vel
+  bool imu = false;       // publishes /<name>/imu
+  bool setpoint = false;  // takes /<name>/setpoint
+  bool velocity = false;  // takes /<name>/cmd_vel (where the transport offers it)
+};
+
+/// One message to send: what the stepping thread stages.
+struct Outgoing {
+  enum class Kind : std::uint8_t { Clock, Odometry, Imu } kind = Kind::Clock;
+  std::size_t robot = 0;
+  double time = 0;  // the clock's
+  Odometry odometry;
+  Imu imu;
+};
+
+class Transport {
+ public:
+  explicit Transport(std::vector<RobotTopics> robots);
+  virtual ~Transport();
+  Transport(const Transport&) = delete;
+  Transport& operator=(const Transport&) = delete;
+
+  const std::vector<RobotTopics>& robots() const { return robots_; }
+
+  // Staged for the publishing thread by the stepping thread, which only copies a few numbers and
+  // takes no lock; commit() hands what is staged to that thread (one lock and one wake-up per
+  // step, not per message). Messages go out in the order staged, with the stamps given.
+  void publishClock(double time);
+  void publishOdometry(std::size_t robot, const Odometry& odometry);
+  void publishImu(std::size_t robot, const Imu& imu);
+  void commit();
+  // Waits until everything staged so far has been sent.
+  void flush();
+  // The newest set-point and velocity command of a robot (count 0: none yet). Thread-safe.
+  Setpoint latestSetpoint(std::size_t robot) const;
+  Velocity latestVelocity(std::size_t robot) const;
+  // Waits until every robot with a set-point topic has one stamped at or after `time` (seconds),
+  // at most `timeout_s`; returns the names of those still missing (empty: all there).
+  std::vector<std::string> waitForSetpoints(double time, double timeout_s) const;
+  // Waits until every robot that takes set-points has its peers (connected()), at most
+  // `timeout_s`; returns the names of the robots still unconnected.
+  std::vector<std::string> waitForPeers(double timeout_s) const;
+  // Round trips in wall-clock seconds: from sending the odometry of time t (robot 0's) to receiving
+  // a set-point stamped t (one sample per set-point that answers an odometry message).
+  std::vector<double> roundTrips() const;
+  // Sends what is staged, then stops the publishing thread (idempotent). A subclass calls it first
+  // in its own shutdown, before it tears down what send() uses.
+  void stopPublishing();
+
+ protected:
+  // Starts the publishing thread: a subclass calls it once what send() uses exists.
+  void startPublishing();
+  // Sends one message (on the publishing thread).
+  virtual void send(const Outgoing& message) = 0;
+  // Whether robot `robot`'s controller is there: someone reads its odometry and writes its set-points.
+  virtual bool connected(std::size_t robot) const = 0;
+  // What a subclass received, from any thread.
+  void receivedSetpoint(std::size_t robot, double stamp, const std::array<double, 3>& position,
+                        const std::array<double, 4>& orientation_wxyz);
+  void receivedVelocity(std::size_t robot, const std::array<double, 3>& linear, const std::array<double, 3>& angular);
+
+ private:
+  void publishLoop();
+  std::vector<std::string> missingSetpoints(double time) const;  // (mutex_ held)
+
+  std::vector<RobotTopics> robots_;
+  // what arrived
+  mutable std::mutex mutex_;
+  mutable std::condition_variable arrived_;
+  std::vector<Setpoint> setpoints_;                                    // mutex_
+  std::vector<Velocity> velocities_;                                   // mutex_
+  std::map<std::int64_t, std::chrono::steady_clock::time_point> sent_;  // odometry time (ns) -> wall time; mutex_
+  std::vector<double> round_trips_;                                    // mutex_
+  std::uint64_t received_ = 0;                                         // mutex_
+  // what goes out
+  std::mutex queue_mutex_;
+  std::condition_variable queue_changed_;
+  std::vector<Outgoing> staged_;           // the stepping thread's, until commit hands them over
+  std::vector<Outgoing> queue_, sending_;  // queue_mutex_ guards queue_, busy_, stop_
+  bool busy_ = false, stop_ = false;
+  std::thread publisher_;
+};
+
+}  // namespace ssx::bridge
