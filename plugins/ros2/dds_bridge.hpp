@@ -1,0 +1,30 @@
+#pragma once
+// The ROS 2 side of the ros2 extension: the bridges' transport (plugins/bridge/transport.hpp) over
+// Eclipse Cyclone DDS, speaking ROS 2's topics as ROS 2 maps them onto DDS: the topic /a/b is the
+// DDS topic rt/a/b, the message pkg/msg/T the DDS type pkg::msg::dds_::T_ in plain CDR (XCDR1),
+// the QoS as rclcpp's profiles (idl/ros2_messages.idl holds the types).
+#include "../bridge/transport.hpp"
+
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace ssx::ros2 {
+
+/// Where the DDS participant talks.
+enum class Network {
+  Loopback,  ///< 127.0.0.1 only, discovery by unicast to the well-known ports there (the default)
+  System,    ///< Cyclone's own choice of interfaces, or $CYCLONEDDS_URI's
+};
+
+/// The Cyclone DDS configuration of Network::Loopback (a ROS 2 program on this machine that is to
+/// see ssx uses the same, in CYCLONEDDS_URI).
+std::string loopbackConfig();
+
+/// Joins DDS domain `domain`, creating its topics, writers and readers; throws std::runtime_error
+/// saying why when DDS cannot start.
+std::unique_ptr<bridge::Transport> open(int domain, Network network, const std::vector<bridge::RobotTopics>& robots);
+/// Sends what is staged, then leaves the domain.
+void close(bridge::Transport& transport);
+
+}  // namespace ssx::ros2

@@ -1,0 +1,71 @@
+// ros2: a SimulationExtension that bridges robots to ROS 2 over DDS (Eclipse Cyclone DDS, the
+// middleware of rmw_cyclonedds_cpp), without ROS 2 installed: it publishes and subscribes ROS 2's
+// topics with ROS 2's types and QoS, so ROS 2 nodes see and drive the robots.
+//
+// Per robot (its artifact name is the namespace): /<name>/odom (nav_msgs/msg/Odometry, world frame
+// pose, body-frame twist; default QoS), /<name>/imu (sensor_msgs/msg/Imu, sensor-data QoS) when it
+// has an IMU sensor, /<name>/setpoint (geometry_msgs/msg/PoseStamped) in for drivers that follow
+// set-points, /<name>/cmd_vel (geometry_msgs/msg/Twist, the robot's frame) in for drivers that take
+// velocity commands; /clock (rosgraph_msgs/msg/Clock, clock QoS) carries simulated time. Stamps are
+// simulated time. What is published when, lock-step and applying what arrived between steps are the
+// bridges' shared logic (plugins/bridge), as in the ros1 extension; this file is the DDS transport's
+// parameters.
+//
+// Parameters: kParameters below, or `ssx plugins --params ros2`.
+#include "dds_bridge.hpp"
+
+#include "../bridge/extension.hpp"
+
+#include <charconv>
+#include <cstdlib>
+
+namespace ssx::plugins {
+
+inline constexpr ssx_plugin_param kRos2Parameters[] = {
+    param::text("domain_id", "", "the ROS 2 domain, 0 to 232 (default: $ROS_DOMAIN_ID, else 0)"),
+    param::choice("network", "loopback", "loopback system",
+                  "loopback: this machine only (127.0.0.1; discovery by unicast there: a ROS 2 program uses the same "
+                  "CYCLONEDDS_URI, see docs); system: Cyclone's choice of interfaces, or $CYCLONEDDS_URI's"),
+};
+
+class Ros2Bridge final : public bridge::BridgeExtension {
+ public:
+  static constexpr const char* kDoc =
+      "bridges robots to ROS 2 over DDS: odometry, IMU and /clock out, set-points and velocity commands in";
+  static constexpr auto kParameters =
+      param::join(param::part("ROS 2", kRos2Parameters), param::part("bridge", bridge::kBridgeParameters));
+
+  static void validate(const Descriptor& params, const PluginContext& context) {
+    BridgeExtension::validate(params, context);
+    (void)domainOf(params);
+  }
+
+ protected:
+  std::unique_ptr<bridge::Transport> open(Environment&, const Descriptor& params,
+                                          const std::vector<bridge::RobotTopics>& robots) override {
+    const auto network = params.get<std::string>("network") == "system" ? ros2::Network::System : ros2::Network::Loopback;
+    return ros2::open(domainOf(params), network, robots);
+  }
+  void close(bridge::Transport& transport) override { ros2::close(transport); }
+  const char* name() const override { return "ros2"; }
+
+ private:
+  // the parameter, else $ROS_DOMAIN_ID, else 0; a domain ROS 2 cannot use is an error where it was given
+  static int domainOf(const Descriptor& params) {
+    const char* from_env = std::getenv("ROS_DOMAIN_ID");
+    const std::string text = params.get<std::string>("domain_id", from_env != nullptr ? from_env : "0");
+    int domain = -1;
+    const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), domain);
+    if (ec != std::errc() || end != text.data() + text.size() || domain < 0 || domain > 232) {
+      const std::string where = params.has("domain_id") ? "" : " ($ROS_DOMAIN_ID)";
+      if (params.has("domain_id"))
+        throw params.errorAt("domain_id", "domain_id '" + text + "' is not a ROS 2 domain: give 0 to 232");
+      throw params.error("ROS_DOMAIN_ID is '" + text + "', not a ROS 2 domain: give 0 to 232, or domain_id" + where);
+    }
+    return domain;
+  }
+};
+
+}  // namespace ssx::plugins
+
+SSX_PLUGIN(SSX_EXTENSION(ssx::plugins::Ros2Bridge, "ros2"));

@@ -1,0 +1,279 @@
+/* A ROS 2 controller that is not ssx: a plain Cyclone DDS program built from the same IDL (ROS 2's
+ * types), talking to the ros2 extension over loopback as a ROS 2 node would (topics rt/..., the
+ * DDS configuration from CYCLONEDDS_URI, as docs/ros.md tells a ROS 2 user).
+ *
+ * It checks what ssx publishes: each topic's DDS type name and reliability (odometry reliable, IMU
+ * and clock best effort, as ROS 2's default, sensor-data and clock QoS), odometry stamped every
+ * 0.02 s of simulated time, /clock whole 0.01 s apart, and it flies the robots:
+ *
+ *   peer COUNT TIMEOUT_S                 set-points: each robot q<i> 1 m east, 0.5 m south of where it
+ *                                        started, 1.5 m up; success once every robot held within
+ *                                        0.1 m for 1 s of simulated time
+ *   peer COUNT TIMEOUT_S --cmd-vel       velocity commands: 0.5 m/s forward (a Twist, the robot's
+ *                                        frame) for 2 s of simulated time, then 0; success once every
+ *                                        robot moved 0.7-1.3 m along x and its odometry reached 0.4 m/s
+ *   peer COUNT TIMEOUT_S --lockstep      answers each odometry message after 0-30 ms with a set-point
+ *                                        stamped like it; no odometry of a round may arrive before
+ *                                        every robot's answer to the round before was sent; answers
+ *                                        until the run ends (no odometry for 2 s); success after 100
+ *                                        rounds or more with every robot holding its set-point
+ *   --vanish-after S                     (with any) ends the process abruptly after S wall seconds
+ *
+ * Exit 0 on success, 1 with a message otherwise. */
+#include "ros2_messages.h"
+
+#include <dds/dds.h>
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+#include <unistd.h>
+
+#define MAX_ROBOTS 64
+
+static double wall(void) {
+  struct timespec ts;
+  clock_gettime(CLOCK_MONOTONIC, &ts);
+  return (double)ts.tv_sec + ts.tv_nsec * 1e-9;
+}
+
+static double seconds(builtin_interfaces_msg_dds__Time_ t) { return t.sec + t.nanosec * 1e-9; }
+
+static builtin_interfaces_msg_dds__Time_ stamp(double t) {
+  long long ns = llround(t * 1e9);
+  builtin_interfaces_msg_dds__Time_ s = {(int32_t)(ns / 1000000000), (uint32_t)(ns % 1000000000)};
+  return s;
+}
+
+static dds_qos_t* qos(int reliable, int depth) {
+  dds_qos_t* q = dds_create_qos();
+  dds_qset_reliability(q, reliable ? DDS_RELIABILITY_RELIABLE : DDS_RELIABILITY_BEST_EFFORT, DDS_MSECS(100));
+  dds_qset_history(q, DDS_HISTORY_KEEP_LAST, depth);
+  dds_qset_durability(q, DDS_DURABILITY_VOLATILE);
+  dds_data_representation_id_t xcdr1[] = {DDS_DATA_REPRESENTATION_XCDR1};
+  dds_qset_data_representation(q, 1, xcdr1);
+  return q;
+}
+
+static int failures = 0;
+static void fail(const char* what) {
+  fprintf(stderr, "peer: %s\n", what);
+  ++failures;
+}
+
+/* the type name and reliability of what matched `reader` (returns the matched count) */
+static int checkPublisher(dds_entity_t reader, const char* type, int reliable) {
+  dds_instance_handle_t handles[4];
+  const dds_return_t n = dds_get_matched_publications(reader, handles, 4);
+  for (int i = 0; i < n && i < 4; ++i) {
+    dds_builtintopic_endpoint_t* e = dds_get_matched_publication_data(reader, handles[i]);
+    if (e == NULL) continue;
+    char line[256];
+    if (strcmp(e->type_name, type) != 0) {
+      snprintf(line, sizeof line, "%s: type %s, expected %s", e->topic_name, e->type_name, type);
+      fail(line);
+    }
+    dds_reliability_kind_t kind;
+    dds_duration_t blocking;
+    if (dds_qget_reliability(e->qos, &kind, &blocking) && (kind == DDS_RELIABILITY_RELIABLE) != reliable) {
+      snprintf(line, sizeof line, "%s: %s, expected %s", e->topic_name, kind == DDS_RELIABILITY_RELIABLE ? "reliable" : "best effort",
+               reliable ? "reliable" : "best effort");
+      fail(line);
+    }
+    dds_builtintopic_free_endpoint(e);
+  }
+  return n;
+}
+
+int main(int argc, char** argv) {
+  if (argc < 3) {
+    fprintf(stderr, "usage: peer COUNT TIMEOUT_S [--lockstep|--cmd-vel] [--vanish-after S]\n");
+    return 2;
+  }
+  const int count = atoi(argv[1]);
+  const double timeout = atof(argv[2]);
+  int lockstep = 0, cmd_vel = 0;
+  double vanish = -1;
+  for (int i = 3; i < argc; ++i) {
+    if (strcmp(argv[i], "--lockstep") == 0) lockstep = 1;
+    else if (strcmp(argv[i], "--cmd-vel") == 0) cmd_vel = 1;
+    else if (strcmp(argv[i], "--vanish-after") == 0 && i + 1 < argc) vanish = atof(argv[++i]);
+  }
+  if (count < 1 || count > MAX_ROBOTS) return 2;
+  const char* domain_env = getenv("ROS_DOMAIN_ID");
+  const dds_domainid_t domain = domain_env ? (dds_domainid_t)atoi(domain_env) : 0;
+  const dds_entity_t participant = dds_create_participant(domain, NULL, NULL);
+  if (participant < 0) {
+    fprintf(stderr, "peer: no DDS participant: %s\n", dds_strretcode(participant));
+    return 1;
+  }
+  dds_qos_t *reliable = qos(1, 10), *sensor = qos(0, 5), *clockq = qos(0, 1);
+  dds_entity_t odom[MAX_ROBOTS], setpoint[MAX_ROBOTS], twist[MAX_ROBOTS];
+  char name[128];
+  for (int i = 0; i < count; ++i) {
+    snprintf(name, sizeof name, "rt/q%d/odom", i);
+    odom[i] = dds_create_reader(participant, dds_create_topic(participant, &nav_msgs_msg_dds__Odometry__desc, name, NULL, NULL), reliable, NULL);
+    snprintf(name, sizeof name, "rt/q%d/setpoint", i);
+    setpoint[i] = dds_create_writer(participant, dds_create_topic(participant, &geometry_msgs_msg_dds__PoseStamped__desc, name, NULL, NULL), reliable, NULL);
+    snprintf(name, sizeof name, "rt/q%d/cmd_vel", i);
+    twist[i] = dds_create_writer(participant, dds_create_topic(participant, &geometry_msgs_msg_dds__Twist__desc, name, NULL, NULL), reliable, NULL);
+  }
+  const dds_entity_t imu_topic = dds_create_topic(participant, &sensor_msgs_msg_dds__Imu__desc, "rt/q0/imu", NULL, NULL);
+  const dds_entity_t imu = dds_create_reader(participant, imu_topic, sensor, NULL);
+  const dds_entity_t imu_reliable = dds_create_reader(participant, imu_topic, reliable, NULL);  /* must not match */
+  const dds_entity_t clock_reader =
+      dds_create_reader(participant, dds_create_topic(participant, &rosgraph_msgs_msg_dds__Clock__desc, "rt/clock", NULL, NULL), clockq, NULL);
+
+  double start_x[MAX_ROBOTS], start_y[MAX_ROBOTS], start_z[MAX_ROBOTS], latest_t[MAX_ROBOTS], held_since[MAX_ROBOTS];
+  double fastest[MAX_ROBOTS], x_at_go[MAX_ROBOTS], answered[MAX_ROBOTS];
+  int have_start[MAX_ROBOTS], done[MAX_ROBOTS];
+  double pending_due[MAX_ROBOTS], pending_stamp[MAX_ROBOTS];
+  for (int i = 0; i < count; ++i) {
+    have_start[i] = done[i] = 0;
+    latest_t[i] = held_since[i] = -1;
+    fastest[i] = 0;
+    x_at_go[i] = NAN;
+    answered[i] = -1;
+    pending_due[i] = -1;
+  }
+  double last_clock = -1, imu_seen = 0, last_odom_wall = wall();
+  long odom_messages = 0, clock_messages = 0, rounds = 0, violations = 0;
+  int types_checked = 0;
+  unsigned seed = 12345;
+  const double started = wall();
+  void* samples[1] = {NULL};
+  dds_sample_info_t info[1];
+  for (;;) {
+    const double now = wall();
+    if (vanish > 0 && now - started > vanish) _exit(0); /* as a crashed controller: no goodbye */
+    if (now - started > timeout) {
+      fail("timed out");
+      break;
+    }
+    int busy = 0;
+    /* odometry */
+    for (int i = 0; i < count; ++i) {
+      while (dds_take(odom[i], samples, info, 1, 1) > 0) {
+        busy = 1;
+        if (info[0].valid_data) {
+          const nav_msgs_msg_dds__Odometry_* m = samples[0];
+          const double t = seconds(m->header.stamp);
+          /* (the first comes after the first step, the next at 0.02 s: every 0.02 s from then on) */
+          if (latest_t[i] >= 0.02 - 1e-9 && fabs(t - latest_t[i] - 0.02) > 1e-6 && !lockstep) {
+            char line[160];
+            snprintf(line, sizeof line, "q%d: odometry at %.6f s after %.6f s (every 0.02 s expected)", i, t, latest_t[i]);
+            if (failures < 5) fail(line);
+          }
+          if (lockstep && i == 0 && latest_t[0] >= 0) {
+            /* a new round: every robot must have answered the one before */
+            for (int k = 0; k < count; ++k)
+              if (answered[k] < latest_t[0] - 1e-9) ++violations;
+            ++rounds;
+          }
+          latest_t[i] = t;
+          ++odom_messages;
+          last_odom_wall = wall();
+          const double x = m->pose.pose.position.x, y = m->pose.pose.position.y, z = m->pose.pose.position.z;
+          if (!have_start[i]) start_x[i] = x, start_y[i] = y, start_z[i] = z, have_start[i] = 1;
+          if (cmd_vel) {
+            if (t >= 1.0 && isnan(x_at_go[i])) x_at_go[i] = x;
+            if (m->twist.twist.linear.x > fastest[i]) fastest[i] = m->twist.twist.linear.x;
+            if (t >= 5.0 && !done[i]) {
+              const double moved = x - x_at_go[i];
+              if (moved >= 0.7 && moved <= 1.3 && fastest[i] >= 0.4) done[i] = 1;
+              else {
+                char line[160];
+                snprintf(line, sizeof line, "q%d moved %.3f m, fastest %.3f m/s", i, moved, fastest[i]);
+                fail(line);
+                done[i] = 1;
+              }
+            }
+          } else {
+            const double dx = x - (start_x[i] + 1), dy = y - (start_y[i] - 0.5), dz = z - (start_z[i] + 1.5);
+            if (sqrt(dx * dx + dy * dy + dz * dz) < 0.1) {
+              if (held_since[i] < 0) held_since[i] = t;
+              if (t - held_since[i] >= 1.0) done[i] = 1;
+            } else {
+              held_since[i] = -1;
+            }
+            if (lockstep) {
+              pending_due[i] = wall() + (rand_r(&seed) % 31) * 1e-3;
+              pending_stamp[i] = t;
+            }
+          }
+        }
+        dds_return_loan(odom[i], samples, 1);
+      }
+    }
+    /* the answers */
+    for (int i = 0; i < count; ++i) {
+      if (!have_start[i]) continue;
+      if (cmd_vel) {
+        if (latest_t[i] < 0) continue;
+        geometry_msgs_msg_dds__Twist_ tw;
+        memset(&tw, 0, sizeof tw);
+        tw.linear.x = latest_t[i] >= 1.0 && latest_t[i] < 3.0 ? 0.5 : 0.0;
+        dds_write(twist[i], &tw);
+        continue;
+      }
+      if (lockstep && (pending_due[i] < 0 || wall() < pending_due[i])) continue;
+      geometry_msgs_msg_dds__PoseStamped_ sp;
+      memset(&sp, 0, sizeof sp);
+      sp.header.stamp = stamp(lockstep ? pending_stamp[i] : latest_t[i]);
+      sp.header.frame_id = "world";
+      sp.pose.position.x = start_x[i] + 1;
+      sp.pose.position.y = start_y[i] - 0.5;
+      sp.pose.position.z = start_z[i] + 1.5;
+      sp.pose.orientation.w = 1;
+      if (lockstep) {
+        dds_write(setpoint[i], &sp);
+        answered[i] = pending_stamp[i];
+        pending_due[i] = -1;
+      } else if (busy) {
+        dds_write(setpoint[i], &sp);
+      }
+    }
+    /* the clock and the IMU */
+    while (dds_take(clock_reader, samples, info, 1, 1) > 0) {
+      if (info[0].valid_data) {
+        const double t = seconds(((const rosgraph_msgs_msg_dds__Clock_*)samples[0])->clock);
+        /* (the first comes after the first step; then every 0.01 s of simulated time, some may be lost: best effort) */
+        const double steps = (t - last_clock) / 0.01;
+        if (last_clock >= 0.01 && (fabs(steps - llround(steps)) > 1e-6 || steps < 0.5) && failures < 5) {
+          char line[160];
+          snprintf(line, sizeof line, "/clock at %.6f s after %.6f s (whole 0.01 s apart expected)", t, last_clock);
+          fail(line);
+        }
+        last_clock = t;
+        ++clock_messages;
+      }
+      dds_return_loan(clock_reader, samples, 1);
+    }
+    while (dds_take(imu, samples, info, 1, 1) > 0) {
+      if (info[0].valid_data) ++imu_seen;
+      dds_return_loan(imu, samples, 1);
+    }
+    if (!types_checked && odom_messages > 0 && clock_messages > 0 && imu_seen > 0) {
+      checkPublisher(odom[0], "nav_msgs::msg::dds_::Odometry_", 1);
+      checkPublisher(imu, "sensor_msgs::msg::dds_::Imu_", 0);
+      checkPublisher(clock_reader, "rosgraph_msgs::msg::dds_::Clock_", 0);
+      dds_subscription_matched_status_t st;
+      dds_get_subscription_matched_status(imu_reliable, &st);
+      if (st.current_count != 0) fail("a reliable reader matched the IMU's writer (sensor data is best effort)");
+      types_checked = 1;
+    }
+    int all = 1;
+    for (int i = 0; i < count; ++i) all &= done[i];
+    /* in lock-step the run waits for every answer: answer until it ends (no odometry for 2 s) */
+    if (all && (!lockstep || (rounds >= 100 && wall() - last_odom_wall > 2.0))) break;
+    if (!busy) usleep(200);
+  }
+  if (!types_checked) fail("never saw odometry, clock and IMU together");
+  if (lockstep && violations > 0) fail("lock-step violated: odometry of a round came before every answer to the last");
+  printf("peer: %ld odometry, %ld clock messages, %.0f IMU; %ld rounds, %ld violations; %d failure(s)\n", odom_messages,
+         clock_messages, imu_seen, rounds, violations, failures);
+  dds_delete(participant);
+  return failures == 0 ? 0 : 1;
+}
