@@ -88,7 +88,9 @@ DdsTransport::DdsTransport(int domain, Network network, const std::vector<bridge
     const dds_return_t code = participant_;
     participant_ = 0;
     if (domain_ > 0) dds_delete(domain_);
-    throw ddsError("joining DDS domain " + std::to_string(domain), code);
+    throw ddsError("joining DDS domain " + std::to_string(domain) +
+                       (network == Network::System ? " (network=\"system\": with $CYCLONEDDS_URI's configuration, if set)" : ""),
+                   code);
   }
   running_ = true;
   try {

@@ -113,7 +113,7 @@ int main(int argc, char** argv) {
     fprintf(stderr, "peer: no DDS participant: %s\n", dds_strretcode(participant));
     return 1;
   }
-  dds_qos_t *reliable = qos(1, 10), *sensor = qos(0, 5), *clockq = qos(0, 1);
+  dds_qos_t *reliable = qos(1, 10), *sensor = qos(0, 5), *clockq = qos(0, 1);  /* (the entities copy them) */
   dds_entity_t odom[MAX_ROBOTS], setpoint[MAX_ROBOTS], twist[MAX_ROBOTS];
   char name[128];
   for (int i = 0; i < count; ++i) {
@@ -129,6 +129,9 @@ int main(int argc, char** argv) {
   const dds_entity_t imu_reliable = dds_create_reader(participant, imu_topic, reliable, NULL);  /* must not match */
   const dds_entity_t clock_reader =
       dds_create_reader(participant, dds_create_topic(participant, &rosgraph_msgs_msg_dds__Clock__desc, "rt/clock", NULL, NULL), clockq, NULL);
+  dds_delete_qos(reliable);
+  dds_delete_qos(sensor);
+  dds_delete_qos(clockq);
 
   double start_x[MAX_ROBOTS], start_y[MAX_ROBOTS], start_z[MAX_ROBOTS], latest_t[MAX_ROBOTS], held_since[MAX_ROBOTS];
   double fastest[MAX_ROBOTS], x_at_go[MAX_ROBOTS], answered[MAX_ROBOTS];

@@ -5,7 +5,8 @@
 # robot's answer to the round before was sent, and that the robots reach their set-points.
 # (2) A peer that vanishes mid-run: the run stops with the lock-step message, inside its timeout.
 # (3) Without a peer the run fails, inside its connect timeout, with the documented message.
-# (4) A domain ROS 2 cannot use is refused before anything runs.
+# (4) A domain ROS 2 cannot use is refused before anything runs. (5) So is a run whose DDS cannot
+# start (network="system" with a broken CYCLONEDDS_URI), with the reason.
 #
 # usage: plugin_test.sh SSX_BINARY PEER_BINARY
 set -u
@@ -58,3 +59,11 @@ cat "$work/domain.err"
 echo "(4) domain 300: ssx validate exit $status"
 [ $status -ne 0 ] || exit 1
 grep -q "domain.xml:[0-9]*: error: .*domain_id '300' is not a ROS 2 domain" "$work/domain.err" || exit 1
+
+sed -e 's|plugin="ros2"|plugin="ros2" network="system"|' "$work/alone.xml" > "$work/system.xml"
+CYCLONEDDS_URI='<CycloneDDS><Domain><Bogus>1</Bogus></Domain></CycloneDDS>' "$ssx" run "$work/system.xml" --fast 2> "$work/system.err"
+status=$?
+cat "$work/system.err"
+echo "(5) DDS cannot start: ssx run exit $status"
+[ $status -ne 0 ] || exit 1
+grep -q "system.xml:[0-9]*: error: .*ros2: joining DDS domain 62 .*failed" "$work/system.err" || exit 1
