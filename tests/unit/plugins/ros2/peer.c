@@ -4,7 +4,8 @@
  *
  * It checks what ssx publishes: each topic's DDS type name and reliability (odometry reliable, IMU
  * and clock best effort, as ROS 2's default, sensor-data and clock QoS), odometry stamped every
- * 0.02 s of simulated time, /clock whole 0.01 s apart, and it flies the robots:
+ * 0.02 s of simulated time, /clock whole 0.01 s apart, twice as many IMU messages as odometry, and
+ * it flies the robots:
  *
  *   peer COUNT TIMEOUT_S                 set-points: each robot q<i> 1 m east, 0.5 m south of where it
  *                                        started, 1.5 m up; success once every robot held within
@@ -288,6 +289,12 @@ int main(int argc, char** argv) {
     return 0;
   }
   if (!types_checked) fail("never saw odometry, clock and IMU together");
+  /* the IMU at 100 Hz against the odometry's 50 (best effort: a few may be lost) */
+  if (per_robot[0] > 100 && (imu_seen < 1.8 * per_robot[0] || imu_seen > 2.2 * per_robot[0])) {
+    char line[160];
+    snprintf(line, sizeof line, "q0: %.0f IMU messages against %ld odometry (twice as many expected)", imu_seen, per_robot[0]);
+    fail(line);
+  }
   if (lockstep && violations > 0) fail("lock-step violated: odometry of a round came before every answer to the last");
   printf("peer: %ld odometry, %ld clock messages, %.0f IMU; %ld rounds, %ld violations; %d failure(s)\n", odom_messages,
          clock_messages, imu_seen, rounds, violations, failures);
