@@ -18,6 +18,7 @@
 #include <ssx/parameters.hpp>
 #include <ssx/plugin.hpp>
 #include <ssx/plugin_abi.hpp>
+#include <ssx/pose_stream.hpp>
 #include <ssx/random.hpp>
 #include <ssx/recording.hpp>
 #include <ssx/render.hpp>

@@ -1,0 +1,79 @@
+#pragma once
+/// \file
+/// The poses of a body measured outside the simulation (motion capture of a real robot), stamped in
+/// simulated time, and the pose to use at a simulated time: interpolated between the samples
+/// around it, extrapolated past the newest for at most a horizon, and lost when the samples stop
+/// for longer than a timeout. The first part of real robots inside the simulation (ghost artifacts,
+/// which the simulation will move by it).
+
+#include <ssx/export.hpp>
+#include <ssx/state.hpp>
+#include <ssx/types.hpp>
+
+#include <cstddef>
+#include <deque>
+#include <optional>
+#include <vector>
+
+namespace ssx {
+
+class SSX_EXPORT PoseStream {
+ public:
+  struct Settings {
+    double horizon = 0.05;      ///< s: past the newest sample, extrapolate at most this long, then hold
+    double timeout = 0.5;       ///< s: with no sample this long, the body is lost
+    std::size_t capacity = 64;  ///< samples kept (the oldest go first)
+  };
+
+  /// What to use at a simulated time.
+  struct Estimate {
+    Pose pose;
+    Vec3 linear_velocity = Vec3::Zero();   ///< m/s, world frame (between the samples used)
+    Vec3 angular_velocity = Vec3::Zero();  ///< rad/s, world frame
+    double age = 0;                        ///< s: the time asked minus the newest sample's stamp at or before it
+    bool extrapolated = false;             ///< past the newest sample (within the horizon, or held)
+    bool lost = false;                     ///< no sample for longer than the timeout (the pose is the last known)
+  };
+
+  /// std::invalid_argument for a horizon or timeout that is negative or not finite, or capacity < 2.
+  explicit PoseStream(const Settings& settings);
+  PoseStream() : PoseStream(Settings{}) {}
+
+  /// Adds a sample stamped `stamp` (simulated seconds). Samples may come out of order: each takes its
+  /// place by stamp; one with a stamp already there replaces it. std::invalid_argument (nothing
+  /// changed) for a non-finite stamp or pose, or an orientation far from unit length (normalised otherwise).
+  void add(double stamp, const Pose& pose);
+  /// The pose at simulated time `t`, or nothing before the first sample. Between two samples:
+  /// position linear, orientation slerp. Before the oldest kept: the oldest. Past the newest: from the
+  /// last two samples' velocities for at most `horizon`, then held; `lost` once t is more than
+  /// `timeout` past the newest.
+  std::optional<Estimate> at(double t) const;
+  /// The samples kept.
+  std::size_t size() const noexcept { return samples_.size(); }
+  /// The newest stamp (no value before the first sample).
+  std::optional<double> newest() const;
+  const Settings& settings() const noexcept { return settings_; }
+
+  /// The samples, for Environment::saveState: what `at` answers depends on nothing else.
+  void saveState(StateWriter& out) const;
+  /// Reads them back; StateError (nothing changed) for data that does not fit.
+  void loadState(StateReader& in);
+
+ private:
+  struct Sample {
+    double stamp;
+    Pose pose;
+  };
+  Settings settings_;
+  std::deque<Sample> samples_;  // by stamp, oldest first
+};
+
+/// The median and the 99th percentile of the ages of the poses used (seconds), for the summary of a run.
+struct AgeSummary {
+  std::size_t count = 0;
+  double median = 0, p99 = 0, max = 0;
+};
+/// Summarises `ages` (left in an unspecified order).
+SSX_EXPORT AgeSummary summarizeAges(std::vector<double>& ages);
+
+}  // namespace ssx

@@ -1,0 +1,134 @@
+#include <ssx/pose_stream.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+namespace ssx {
+
+namespace {
+
+// the rotation vector (axis times angle) that turns `a` into `b`, in the world frame
+Vec3 rotationBetween(const Quat& a, const Quat& b) {
+  Quat d = b * a.conjugate();
+  if (d.w() < 0) d.coeffs() = -d.coeffs();  // the short way round
+  const Eigen::AngleAxisd aa(d);
+  return aa.axis() * aa.angle();
+}
+
+}  // namespace
+
+PoseStream::PoseStream(const Settings& settings) : settings_(settings) {
+  if (!std::isfinite(settings.horizon) || settings.horizon < 0)
+    throw std::invalid_argument("pose stream: the extrapolation horizon must be finite and at least 0 s");
+  if (!std::isfinite(settings.timeout) || settings.timeout < 0)
+    throw std::invalid_argument("pose stream: the timeout must be finite and at least 0 s");
+  if (settings.capacity < 2) throw std::invalid_argument("pose stream: keep at least 2 samples");
+}
+
+void PoseStream::add(double stamp, const Pose& pose) {
+  if (!std::isfinite(stamp)) throw std::invalid_argument("pose stream: the stamp is not finite");
+  if (!pose.position.allFinite() || !pose.orientation.coeffs().allFinite())
+    throw std::invalid_argument("pose stream: the pose is not finite");
+  const double norm = pose.orientation.norm();
+  if (std::abs(norm - 1) > 1e-3)
+    throw std::invalid_argument("pose stream: the orientation is not a unit quaternion (norm " + std::to_string(norm) + ")");
+  const Sample s{stamp, {pose.position, pose.orientation.normalized()}};
+  // (almost always the newest: a search from the back)
+  auto it = samples_.end();
+  while (it != samples_.begin() && std::prev(it)->stamp > stamp) --it;
+  if (it != samples_.begin() && std::prev(it)->stamp == stamp)
+    *std::prev(it) = s;
+  else
+    samples_.insert(it, s);
+  while (samples_.size() > settings_.capacity) samples_.pop_front();
+}
+
+std::optional<double> PoseStream::newest() const {
+  if (samples_.empty()) return std::nullopt;
+  return samples_.back().stamp;
+}
+
+std::optional<PoseStream::Estimate> PoseStream::at(double t) const {
+  if (samples_.empty()) return std::nullopt;
+  Estimate e;
+  const Sample& last = samples_.back();
+  if (t >= last.stamp) {
+    // past the newest: its velocity from the last two, for at most the horizon, then held
+    e.age = t - last.stamp;
+    e.extrapolated = t > last.stamp;
+    e.lost = e.age > settings_.timeout;
+    e.pose = last.pose;
+    if (samples_.size() >= 2) {
+      const Sample& before = samples_[samples_.size() - 2];
+      const double dt = last.stamp - before.stamp;
+      e.linear_velocity = (last.pose.position - before.pose.position) / dt;
+      e.angular_velocity = rotationBetween(before.pose.orientation, last.pose.orientation) / dt;
+      const double ahead = std::min(e.age, settings_.horizon);
+      if (ahead > 0) {
+        e.pose.position += e.linear_velocity * ahead;
+        const Vec3 turn = e.angular_velocity * ahead;
+        if (turn.norm() > 0)
+          e.pose.orientation = (Quat(Eigen::AngleAxisd(turn.norm(), turn.normalized())) * last.pose.orientation).normalized();
+      }
+      if (e.age > settings_.horizon) e.linear_velocity = e.angular_velocity = Vec3::Zero();  // held
+    }
+    return e;
+  }
+  // the first sample after t, and the one before it
+  const auto after = std::upper_bound(samples_.begin(), samples_.end(), t,
+                                      [](double time, const Sample& s) { return time < s.stamp; });
+  if (after == samples_.begin()) {  // before the oldest kept
+    e.pose = after->pose;
+    e.age = 0;
+    return e;
+  }
+  const Sample& a = *std::prev(after);
+  const Sample& b = *after;
+  const double span = b.stamp - a.stamp;
+  const double u = (t - a.stamp) / span;
+  e.pose.position = a.pose.position + u * (b.pose.position - a.pose.position);
+  e.pose.orientation = a.pose.orientation.slerp(u, b.pose.orientation).normalized();
+  e.linear_velocity = (b.pose.position - a.pose.position) / span;
+  e.angular_velocity = rotationBetween(a.pose.orientation, b.pose.orientation) / span;
+  e.age = t - a.stamp;
+  return e;
+}
+
+void PoseStream::saveState(StateWriter& out) const {
+  out.write(static_cast<std::uint64_t>(samples_.size()));
+  for (const Sample& s : samples_) {
+    out.write(s.stamp);
+    out.write(s.pose);
+  }
+}
+
+void PoseStream::loadState(StateReader& in) {
+  std::deque<Sample> samples;
+  const auto n = in.get<std::uint64_t>();
+  if (n > settings_.capacity)
+    throw StateError("pose stream: " + std::to_string(n) + " saved samples, this one keeps " +
+                     std::to_string(settings_.capacity));
+  for (std::uint64_t i = 0; i < n; ++i) {
+    Sample s{};
+    in.read(s.stamp);
+    in.read(s.pose);
+    if (!samples.empty() && !(s.stamp > samples.back().stamp)) throw StateError("pose stream: saved samples out of order");
+    samples.push_back(s);
+  }
+  samples_ = std::move(samples);
+}
+
+AgeSummary summarizeAges(std::vector<double>& ages) {
+  AgeSummary s;
+  s.count = ages.size();
+  if (ages.empty()) return s;
+  std::sort(ages.begin(), ages.end());
+  s.median = ages[ages.size() / 2];
+  s.p99 = ages[std::min(ages.size() - 1, ages.size() * 99 / 100)];
+  s.max = ages.back();
+  return s;
+}
+
+}  // namespace ssx
