@@ -17,8 +17,10 @@
 
 namespace ssx {
 
+/// One body's stamped poses from outside, and the pose to use at a simulated time.
 class SSX_EXPORT PoseStream {
  public:
+  /// How far past the newest sample to extrapolate, when to call the body lost, how many samples to keep.
   struct Settings {
     double horizon = 0.05;      ///< s: past the newest sample, extrapolate at most this long, then hold
     double timeout = 0.5;       ///< s: with no sample this long, the body is lost
@@ -27,7 +29,7 @@ class SSX_EXPORT PoseStream {
 
   /// What to use at a simulated time.
   struct Estimate {
-    Pose pose;
+    Pose pose;                             ///< the pose to use
     Vec3 linear_velocity = Vec3::Zero();   ///< m/s, world frame (between the samples used)
     Vec3 angular_velocity = Vec3::Zero();  ///< rad/s, world frame
     double age = 0;                        ///< s: the time asked minus the newest sample's stamp at or before it
@@ -52,6 +54,7 @@ class SSX_EXPORT PoseStream {
   std::size_t size() const noexcept { return samples_.size(); }
   /// The newest stamp (no value before the first sample).
   std::optional<double> newest() const;
+  /// What it was made with.
   const Settings& settings() const noexcept { return settings_; }
 
   /// The samples, for Environment::saveState: what `at` answers depends on nothing else.
@@ -70,8 +73,10 @@ class SSX_EXPORT PoseStream {
 
 /// The median and the 99th percentile of the ages of the poses used (seconds), for the summary of a run.
 struct AgeSummary {
-  std::size_t count = 0;
-  double median = 0, p99 = 0, max = 0;
+  std::size_t count = 0;  ///< ages summarised
+  double median = 0;      ///< s
+  double p99 = 0;         ///< s
+  double max = 0;         ///< s
 };
 /// Summarises `ages` (left in an unspecified order).
 SSX_EXPORT AgeSummary summarizeAges(std::vector<double>& ages);
