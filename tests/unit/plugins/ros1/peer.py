@@ -12,15 +12,55 @@ usage: peer.py COUNT [TIMEOUT_S]   (robots q0 .. q<COUNT-1>; exit 0 on success, 
                                        100 rounds, no violation, and every robot held its set-point)
        peer.py COUNT SECONDS --bench  (answer every odometry message at once with a set-point stamped
                                        like it, for SECONDS; print how many messages came per robot)
+       peer.py COUNT TIMEOUT_S --cmd-vel  (send /<robot>/cmd_vel, a Twist 0.5 m/s forward from 4 to 6 s of
+                                       simulated time (the robots took off from the ground before), then 0;
+                                       exit 0 once every robot moved 0.7-1.3 m along x from 4 s to 8 s and
+                                       its odometry reached 0.4 m/s)
 """
 import sys
 import threading
 import time
 
 import rospy
-from geometry_msgs.msg import PoseStamped
+from geometry_msgs.msg import PoseStamped, Twist
 from nav_msgs.msg import Odometry
 from rosgraph_msgs.msg import Clock
+
+
+def fly_by_velocity(names, timeout):
+    """Twists in the robots' frame: 0.5 m/s forward from 4 s to 6 s of simulated time."""
+    lock = threading.Lock()
+    x_at_go, fastest, latest, x_now = {}, {}, {}, {}
+
+    def on_odom(msg, name):
+        t = msg.header.stamp.to_sec()
+        with lock:
+            latest[name] = t
+            x_now[name] = msg.pose.pose.position.x
+            if t >= 4.0 and name not in x_at_go:
+                x_at_go[name] = msg.pose.pose.position.x
+            fastest[name] = max(fastest.get(name, 0.0), msg.twist.twist.linear.x)
+
+    subs = [rospy.Subscriber("/%s/odom" % n, Odometry, on_odom, callback_args=n, tcp_nodelay=True) for n in names]
+    pubs = {n: rospy.Publisher("/%s/cmd_vel" % n, Twist, queue_size=10) for n in names}
+    start = time.time()
+    while time.time() - start < timeout:
+        with lock:
+            state = {n: (latest.get(n, -1.0), x_now.get(n), x_at_go.get(n), fastest.get(n, 0.0)) for n in names}
+        for n in names:
+            if state[n][0] >= 0:
+                m = Twist()
+                m.linear.x = 0.5 if 4.0 <= state[n][0] < 6.0 else 0.0
+                pubs[n].publish(m)
+        if all(state[n][0] >= 8.0 for n in names):
+            moved = {n: state[n][1] - state[n][2] for n in names}
+            ok = all(0.7 <= moved[n] <= 1.3 and state[n][3] >= 0.4 for n in names)
+            print("peer: cmd_vel: moved %s m, fastest %s m/s" % (" ".join("%.3f" % moved[n] for n in names),
+                                                               " ".join("%.2f" % state[n][3] for n in names)))
+            return 0 if ok else 1
+        time.sleep(0.05)
+    print("peer: cmd_vel: timed out")
+    return 1
 
 
 def main():
@@ -91,6 +131,8 @@ def main():
         else:
             held_since.pop(name, None)
 
+    if "--cmd-vel" in sys.argv:
+        return fly_by_velocity(names, timeout)
     subs = [rospy.Subscriber("/%s/odom" % n, Odometry, on_odom, callback_args=n, tcp_nodelay=True) for n in names]
     clock_stamps = []
     clock_sub = rospy.Subscriber("/clock", Clock, lambda m: clock_stamps.append(m.clock.to_sec()), queue_size=1000)
