@@ -130,7 +130,7 @@ def plots(rows, data, out_dir, plot_dir):
             ax.plot(sim["t"], sim[f"p{k}"], color="tab:orange", lw=1.3, label="ssx")
             ax.set_ylabel(f"{k} (m)")
             ax.grid(alpha=0.3)
-        axes[0].legend(loc="upper right", ncol=3, fontsize=8)
+        axes[0].legend(loc="lower left", ncol=3, fontsize=8)
         axes[1].set_xlabel("time (s)")
         fig.suptitle(f"{name}: the Crazyflie's firmware controller, real and simulated")
         fig.tight_layout()
