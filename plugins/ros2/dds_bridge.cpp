@@ -120,7 +120,6 @@ DdsTransport::DdsTransport(int domain, Network network, const std::vector<bridge
   startPublishing();
 }
 
-
 dds_entity_t DdsTransport::topic(const dds_topic_descriptor_t* type, const std::string& ros_name) {
   const dds_entity_t t = dds_create_topic(participant_, type, ("rt" + ros_name).c_str(), nullptr, nullptr);
   if (t < 0) throw ddsError("creating topic rt" + ros_name, t);
@@ -128,18 +127,20 @@ dds_entity_t DdsTransport::topic(const dds_topic_descriptor_t* type, const std::
 }
 
 dds_entity_t DdsTransport::writer(const dds_topic_descriptor_t* type, const std::string& ros_name, Profile profile) {
+  const dds_entity_t t = topic(type, ros_name);  // (first: it may throw)
   dds_qos_t* q = qosOf(profile);
-  const dds_entity_t w = dds_create_writer(participant_, topic(type, ros_name), q, nullptr);
+  const dds_entity_t w = dds_create_writer(participant_, t, q, nullptr);
   dds_delete_qos(q);
   if (w < 0) throw ddsError("creating the writer of " + ros_name, w);
   return w;
 }
 
 void DdsTransport::reader(Reader& r, const dds_topic_descriptor_t* type, const std::string& ros_name) {
+  const dds_entity_t t = topic(type, ros_name);  // (first: it may throw)
   dds_qos_t* q = qosOf(Profile::Default);
   dds_listener_t* listener = dds_create_listener(&r);
   dds_lset_data_available(listener, &DdsTransport::onData);
-  r.entity = dds_create_reader(participant_, topic(type, ros_name), q, listener);
+  r.entity = dds_create_reader(participant_, t, q, listener);
   dds_delete_listener(listener);
   dds_delete_qos(q);
   if (r.entity < 0) throw ddsError("creating the reader of " + ros_name, r.entity);
