@@ -90,7 +90,11 @@ class BridgeExtension : public SimulationExtension {
       }
       waiting_for_ = -1;
     }
-    // each robot's newest set-point and velocity command, applied between steps in the order they arrived
+    // each robot's newest set-point and velocity command, applied between steps in the order they
+    // arrived (most steps nothing did: then no robot is looked up)
+    const std::uint64_t received = transport_->received();
+    if (received == received_seen_) return;
+    received_seen_ = received;
     for (std::size_t i = 0; i < robots_.size(); ++i) {
       Robot& r = robots_[i];
       const Setpoint s = r.tracker != nullptr ? transport_->latestSetpoint(i) : Setpoint{};
@@ -240,6 +244,7 @@ class BridgeExtension : public SimulationExtension {
   double lockstep_timeout_ = 2.0, connect_timeout_ = 10.0;
   bool connected_ = false;
   double waiting_for_ = -1;            // lock-step: the odometry time set-points must answer
+  std::uint64_t received_seen_ = 0;    // Transport::received() when what arrived was last applied
   std::vector<double> publish_costs_;  // s, per publishing step (reserved at init)
 };
 

@@ -117,6 +117,7 @@ void Transport::receivedSetpoint(std::size_t robot, double stamp, const std::arr
     s.orientation = orientation_wxyz;
     ++s.count;
     s.order = ++received_;
+    received_count_.store(received_, std::memory_order_release);
   }
   arrived_.notify_all();
 }
@@ -129,6 +130,7 @@ void Transport::receivedVelocity(std::size_t robot, const std::array<double, 3>&
   v.angular = angular;
   ++v.count;
   v.order = ++received_;
+  received_count_.store(received_, std::memory_order_release);
 }
 
 Setpoint Transport::latestSetpoint(std::size_t robot) const {

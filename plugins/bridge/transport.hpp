@@ -9,6 +9,7 @@
 // Standard library only, and C++17: the ROS 1 side, whose message headers do not compile as C++20,
 // includes it too.
 #include <array>
+#include <atomic>
 #include <chrono>
 #include <condition_variable>
 #include <cstdint>
@@ -84,6 +85,9 @@ class Transport {
   // The newest set-point and velocity command of a robot (count 0: none yet). Thread-safe.
   Setpoint latestSetpoint(std::size_t robot) const;
   Velocity latestVelocity(std::size_t robot) const;
+  // How many set-points and velocity commands arrived so far, for all robots (without a lock: a
+  // step that sees the same number as the last skips the look-ups).
+  std::uint64_t received() const { return received_count_.load(std::memory_order_acquire); }
   // Waits until every robot with a set-point topic has one stamped at or after `time` (seconds),
   // at most `timeout_s`; returns the names of those still missing (empty: all there).
   std::vector<std::string> waitForSetpoints(double time, double timeout_s) const;
@@ -122,6 +126,7 @@ class Transport {
   std::map<std::int64_t, std::chrono::steady_clock::time_point> sent_;  // odometry time (ns) -> wall time; mutex_
   std::vector<double> round_trips_;                                    // mutex_
   std::uint64_t received_ = 0;                                         // mutex_
+  std::atomic<std::uint64_t> received_count_{0};                       // received_, published after each arrival
   // what goes out
   std::mutex queue_mutex_;
   std::condition_variable queue_changed_;

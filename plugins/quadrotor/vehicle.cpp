@@ -13,20 +13,22 @@ std::vector<std::string> words(const std::string& text) {
   return out;
 }
 
+// a value the parameters give, else the preset's
+void presetOr(const Descriptor& params, const char* key, double& value) { value = params.get<double>(key, value); }
+
 // the rotor and motor constants: the preset, then any override (values checked while loading)
 RotorParams rotorParams(const Descriptor& params) {
   RotorParams rp = *preset(params.get<std::string>("preset"));
-  auto override = [&](const char* key, double& value) { value = params.get<double>(key, value); };
-  override("thrust_coefficient", rp.thrust_coefficient);
-  override("moment_constant", rp.moment_constant);
-  override("time_constant_up", rp.time_constant_up);
-  override("time_constant_down", rp.time_constant_down);
-  override("max_rotor_speed", rp.max_rotor_speed);
-  override("min_rotor_speed", rp.min_rotor_speed);
-  override("rotor_drag_coefficient", rp.rotor_drag_coefficient);
-  override("rolling_moment_coefficient", rp.rolling_moment_coefficient);
-  override("rotor_inertia", rp.rotor_inertia);
-  override("rotor_radius", rp.rotor_radius);
+  presetOr(params, "thrust_coefficient", rp.thrust_coefficient);
+  presetOr(params, "moment_constant", rp.moment_constant);
+  presetOr(params, "time_constant_up", rp.time_constant_up);
+  presetOr(params, "time_constant_down", rp.time_constant_down);
+  presetOr(params, "max_rotor_speed", rp.max_rotor_speed);
+  presetOr(params, "min_rotor_speed", rp.min_rotor_speed);
+  presetOr(params, "rotor_drag_coefficient", rp.rotor_drag_coefficient);
+  presetOr(params, "rolling_moment_coefficient", rp.rolling_moment_coefficient);
+  presetOr(params, "rotor_inertia", rp.rotor_inertia);
+  presetOr(params, "rotor_radius", rp.rotor_radius);
   if (rp.min_rotor_speed >= rp.max_rotor_speed) {
     std::ostringstream m;
     m << "min_rotor_speed (" << rp.min_rotor_speed << " rad/s) must be below max_rotor_speed (" << rp.max_rotor_speed
@@ -39,15 +41,14 @@ RotorParams rotorParams(const Descriptor& params) {
 // the battery: the preset's, then any override; its voltages checked against each other
 BatteryParams batteryParams(const Descriptor& params) {
   BatteryParams bp = batteryPreset(params.get<std::string>("preset"));
-  auto override = [&](const char* key, double& value) { value = params.get<double>(key, value); };
-  override("battery_full_voltage", bp.full_voltage);
-  override("battery_empty_voltage", bp.empty_voltage);
-  override("battery_capacity", bp.capacity);
-  override("battery_resistance", bp.resistance);
-  override("battery_efficiency", bp.efficiency);
-  override("battery_initial_charge", bp.initial_charge);
-  override("battery_nominal_voltage", bp.nominal_voltage);
-  override("battery_zero_thrust_voltage", bp.zero_thrust_voltage);
+  presetOr(params, "battery_full_voltage", bp.full_voltage);
+  presetOr(params, "battery_empty_voltage", bp.empty_voltage);
+  presetOr(params, "battery_capacity", bp.capacity);
+  presetOr(params, "battery_resistance", bp.resistance);
+  presetOr(params, "battery_efficiency", bp.efficiency);
+  presetOr(params, "battery_initial_charge", bp.initial_charge);
+  presetOr(params, "battery_nominal_voltage", bp.nominal_voltage);
+  presetOr(params, "battery_zero_thrust_voltage", bp.zero_thrust_voltage);
   if (!(bp.empty_voltage < bp.full_voltage) || !(bp.nominal_voltage > bp.zero_thrust_voltage) ||
       !(bp.empty_voltage > bp.zero_thrust_voltage))
     throw params.error("battery: needs battery_zero_thrust_voltage < battery_empty_voltage < battery_full_voltage "
