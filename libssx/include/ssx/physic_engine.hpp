@@ -99,6 +99,14 @@ class SSX_EXPORT PhysicEngine {
 
   /// Adds a dynamic body; `state.pose` is the pose of its centre-of-mass frame. Returns its index.
   virtual int addBody(const MassProperties& mass, const std::vector<Shape>& shapes, const BodyState& state) = 0;
+  /// Makes a body kinematic: from now on it moves only as setState puts it, at the velocities set
+  /// with it, whatever forces, gravity and contacts act on it. Dynamic bodies that touch it meet an
+  /// infinitely heavy body moving at its velocity; it does not collide with static shapes or with
+  /// other kinematic bodies. Before the first step; which bodies are kinematic is part of the scene,
+  /// not of the saved state.
+  virtual void setKinematic(int body) = 0;
+  /// Whether setKinematic made `body` kinematic.
+  virtual bool isKinematic(int body) const = 0;
   /// Adds shapes fixed in the world at `pose`.
   virtual void addStatic(const std::vector<Shape>& shapes, const Pose& pose) = 0;
   /// Integrates one timestep (in the configured substeps), with `wrenches[i]` applied to body i

@@ -48,6 +48,8 @@ class BulletEngine final : public PhysicEngine {
 
   std::string name() const override { return "bullet"; }
   int addBody(const MassProperties& mass, const std::vector<Shape>& shapes, const BodyState& state) override;
+  void setKinematic(int body) override;
+  bool isKinematic(int body) const override;
   void addStatic(const std::vector<Shape>& shapes, const Pose& pose) override;
   void setTaskRunner(TaskRunner* runner) override { runner_ = runner; }
   void step(Nanoseconds dt, std::span<const Wrench> wrenches) override;

@@ -75,6 +75,12 @@ void OdeEngine::indexGeoms() {
 
 
 void OdeEngine::collidePair(dGeomID a, dGeomID b, std::vector<dContact>& out, std::vector<dContact>& scratch) const {
+  // nothing between two things that cannot move (static shapes and kinematic bodies)
+  auto movable = [this](dGeomID g) {
+    const auto owner = reinterpret_cast<std::intptr_t>(dGeomGetData(g));
+    return owner != 0 && !bodies_[static_cast<std::size_t>(owner - 1)].kinematic;
+  };
+  if (!movable(a) && !movable(b)) return;
   const int n = dCollide(a, b, static_cast<int>(scratch.size()), &scratch[0].geom, sizeof(dContact));
   const PhysicsSettings& s = settings_;
   for (int i = 0; i < n; ++i) {

@@ -249,6 +249,16 @@ int OdeEngine::addBody(const MassProperties& mass, const std::vector<Shape>& sha
   return index;
 }
 
+void OdeEngine::setKinematic(int index) {
+  Body& body = bodies_.at(static_cast<std::size_t>(index));
+  ensureThreadData();
+  dBodySetKinematic(body.id);
+  body.kinematic = true;
+  proxies_stale_ = true;
+}
+
+bool OdeEngine::isKinematic(int index) const { return bodies_.at(static_cast<std::size_t>(index)).kinematic; }
+
 void OdeEngine::addStatic(const std::vector<Shape>& shapes, const Pose& pose) {
   ensureThreadData();
   for (const auto& s : shapes) {
@@ -301,6 +311,7 @@ void OdeEngine::moveBody(int index, int to) {
   const dBodyID old = body.id;
   const dBodyID b = dBodyCreate(into.world);
   dBodySetMass(b, &body.mass);
+  if (body.kinematic) dBodySetKinematic(b);
   dBodySetData(b, dBodyGetData(old));
   dReal bits[kOdeBodyReals];
   readBits(old, bits);

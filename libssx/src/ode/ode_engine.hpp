@@ -34,6 +34,8 @@ class OdeEngine final : public PhysicEngine {
 
   std::string name() const override { return "ode"; }
   int addBody(const MassProperties& mass, const std::vector<Shape>& shapes, const BodyState& state) override;
+  void setKinematic(int body) override;
+  bool isKinematic(int body) const override;
   void addStatic(const std::vector<Shape>& shapes, const Pose& pose) override;
   void setTaskRunner(TaskRunner* runner) override { runner_ = runner; }
   void step(Nanoseconds dt, std::span<const Wrench> wrenches) override;
@@ -65,6 +67,7 @@ class OdeEngine final : public PhysicEngine {
     dBodyID id = nullptr;
     int partition = 0;
     int home = 0;
+    bool kinematic = false;  // moved only by setState (dBodySetKinematic)
     dMass mass;
     std::vector<Geom> geoms;
   };
