@@ -1,3 +1,4 @@
+#include "ghosts.hpp"
 #include "neighbor_index.hpp"
 #include "phase_guard.hpp"
 #include "phases.hpp"
@@ -52,7 +53,8 @@ Environment::Environment(EnvironmentSettings settings)
       loader_(std::make_unique<ClassLoader>()),
       world_(std::make_unique<detail::World>(*this, settings_)),
       cameras_(std::make_unique<detail::SceneCameras>()),
-      neighbors_(std::make_unique<detail::NeighborIndex>()) {
+      neighbors_(std::make_unique<detail::NeighborIndex>()),
+      ghosts_(std::make_unique<detail::Ghosts>()) {
   checkSettings(settings_);
   RenderSettings& r = settings_.render;
   if (r.rate_hz > 0)
@@ -294,6 +296,7 @@ void Environment::start() {
     physics_ = createPhysicEngine(settings_.physics);
     renderer_ = createRenderEngine(settings_.render);
     detail::buildBodies(w, *physics_, static_shapes_);
+    ghosts_->start(w, *physics_);
     detail::publishSnapshot(w, *physics_, true);
     cameras_->start(settings_.render, settings_.timestep, *renderer_, w.artifacts,
                     [this](std::string_view m) { log(LogLevel::Warning, m); });

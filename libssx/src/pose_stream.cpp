@@ -7,18 +7,6 @@
 
 namespace ssx {
 
-namespace {
-
-// the rotation vector (axis times angle) that turns `a` into `b`, in the world frame
-Vec3 rotationBetween(const Quat& a, const Quat& b) {
-  Quat d = b * a.conjugate();
-  if (d.w() < 0) d.coeffs() = -d.coeffs();  // the short way round
-  const Eigen::AngleAxisd aa(d);
-  return aa.axis() * aa.angle();
-}
-
-}  // namespace
-
 PoseStream::PoseStream(const Settings& settings) : settings_(settings) {
   if (!std::isfinite(settings.horizon) || settings.horizon < 0)
     throw std::invalid_argument("pose stream: the extrapolation horizon must be finite and at least 0 s");
@@ -60,7 +48,9 @@ std::optional<PoseStream::Estimate> PoseStream::at(double t) const {
     e.extrapolated = t > last.stamp;
     e.lost = e.age > settings_.timeout;
     e.pose = last.pose;
-    if (samples_.size() >= 2) {
+    // (the last two samples' velocity, unless a gap longer than the timeout lies between them: a
+    // body found again is not extrapolated from where it was before it was lost)
+    if (samples_.size() >= 2 && last.stamp - samples_[samples_.size() - 2].stamp <= settings_.timeout) {
       const Sample& before = samples_[samples_.size() - 2];
       const double dt = last.stamp - before.stamp;
       e.linear_velocity = (last.pose.position - before.pose.position) / dt;
@@ -120,14 +110,32 @@ void PoseStream::loadState(StateReader& in) {
   samples_ = std::move(samples);
 }
 
-AgeSummary summarizeAges(std::vector<double>& ages) {
+void AgeHistogram::add(double age) {
+  if (bins_.empty()) bins_.assign(kBins, 0);
+  age = std::max(age, 0.0);
+  // (ceil: an age on a bin's upper edge is in that bin, so the edge reported is never below it)
+  const double bin = std::ceil(age / kBinSeconds) - 1;
+  ++bins_[static_cast<std::size_t>(std::clamp(bin, 0.0, static_cast<double>(kBins - 1)))];
+  ++count_;
+  max_ = std::max(max_, age);
+}
+
+AgeSummary AgeHistogram::summary() const {
   AgeSummary s;
-  s.count = ages.size();
-  if (ages.empty()) return s;
-  std::sort(ages.begin(), ages.end());
-  s.median = ages[ages.size() / 2];
-  s.p99 = ages[std::min(ages.size() - 1, ages.size() * 99 / 100)];
-  s.max = ages.back();
+  s.count = count_;
+  s.max = max_;
+  if (count_ == 0) return s;
+  // the upper edge of the bin holding the k-th smallest age (the maximum when it is the last bin)
+  auto quantile = [&](std::size_t k) {
+    std::size_t seen = 0;
+    for (std::size_t b = 0; b < kBins; ++b) {
+      seen += bins_[b];
+      if (seen > k) return std::min(max_, static_cast<double>(b + 1) * kBinSeconds);
+    }
+    return max_;
+  };
+  s.median = quantile(count_ / 2);
+  s.p99 = quantile(std::min(count_ - 1, count_ * 99 / 100));
   return s;
 }
 

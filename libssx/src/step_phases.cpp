@@ -1,5 +1,6 @@
 // One step: physics, snapshot, the sensors and drivers phases on the worker pool, render, and the
 // extensions' hooks around them (the order is documented in environment.hpp).
+#include "ghosts.hpp"
 #include "neighbor_index.hpp"
 #include "phase_guard.hpp"
 #include "phases.hpp"
@@ -83,6 +84,7 @@ void runSensors(World& world, std::size_t begin, std::size_t end) {
       const SensorSlot& slot = world.sensor_slots[at];
       std::uint8_t& fresh = world.fresh[slot.plugin];
       fresh = 0;
+      if (a.silent) continue;
       Sensor& sensor = *slot.sensor;
       const std::int64_t period = slot.period_steps;
       if (step % period != 0) continue;
@@ -191,10 +193,13 @@ void Environment::step() {
 
   runExtensionHook(&SimulationExtension::beforeStep, "beforeStep");
 
-  // physics, with the actuation written before
+  // physics, with the actuation written before (and the ghosts moving to their next poses)
   auto t = Clock::now();
+  const double t_next = toSeconds((w.steps + 1) * settings_.timestep);
   try {
+    if (!ghosts_->empty()) ghosts_->beforePhysics(w, *physics_, t_next, toSeconds(settings_.timestep));
     physics_->step(settings_.timestep, w.wrenches);
+    if (!ghosts_->empty()) ghosts_->afterPhysics(w, *physics_, t_next, *this);
   } catch (const std::exception& e) {
     // the engine gave up (ODE reports a NaN it met as an internal error): name the first
     // artifact whose state is no longer finite, if the engine can still tell

@@ -88,6 +88,7 @@ struct ArtifactData {
   // sequence), in World::subscriptions, [begin, end)
   std::uint32_t sensor_begin = 0, sensor_end = 0;
   std::uint32_t inbox_begin = 0, inbox_end = 0;
+  bool silent = false;             // a lost ghost: its sensors do not measure
   int body_begin = 0;               // bodies [body_begin, body_end) in the body arrays
   int body_end = 0;
   // where its nodes and plugin slots are in the world's tables, for prefetching: [first, end)

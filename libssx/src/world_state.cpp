@@ -6,6 +6,7 @@
 // snapshot (body states with accelerations, the velocities before the last step), the command
 // buffers, every plugin's random stream (the world's plugin table, in order), then one block per
 // plugin (driver first, then sensors, artifact by artifact: what it saved) and one per extension.
+#include "ghosts.hpp"
 #include "neighbor_index.hpp"
 #include "render/scene_cameras.hpp"
 #include "state_checks.hpp"
@@ -80,6 +81,7 @@ std::uint64_t Environment::sceneFingerprint() const {
     mix((p.index == 0 ? "driver " : "sensor ") + p.class_name + " " + std::to_string(p.period_steps) + " of " +
         std::to_string(p.artifact));
   for (const auto& e : extensions_) mix("extension " + e.name);
+  for (const auto& g : ghosts_->list()) mix("ghost " + std::to_string(g.artifact));
   return h;
 }
 
@@ -106,6 +108,7 @@ std::vector<std::byte> Environment::saveState() const {
     for (const auto& s : a.sensors) writeBlock(out, [&] { s.sensor->saveState(out); });
   }
   for (const auto& e : extensions_) writeBlock(out, [&] { e.extension->saveState(out); });
+  if (!ghosts_->empty()) writeBlock(out, [&] { ghosts_->save(out); });
 
   // the header, now that the payload is known
   const std::uint64_t payload = buffer.size() - kHeaderSize;
@@ -200,6 +203,7 @@ void Environment::applyState(std::span<const std::byte> payload) {
   }
   for (auto& e : extensions_)
     readBlock(in, "extension '" + e.name + "'", [&](StateReader& block) { e.extension->loadState(block); });
+  if (!ghosts_->empty()) readBlock(in, "the ghosts' poses", [&](StateReader& block) { ghosts_->load(block, w); });
   if (!in.done()) throw StateError("saved state: " + std::to_string(in.remaining()) + " bytes left over (corrupted)");
   w.steps = steps;
   w.current_step = steps;

@@ -25,6 +25,7 @@
 #include <ssx/export.hpp>
 #include <ssx/physic_engine.hpp>
 #include <ssx/plugin.hpp>
+#include <ssx/pose_stream.hpp>
 #include <ssx/render.hpp>
 #include <ssx/spatial_index.hpp>
 #include <ssx/timing.hpp>
@@ -51,6 +52,7 @@ struct World;
 class WorkerPool;
 class SceneCameras;
 class NeighborIndex;
+class Ghosts;
 }
 
 /// Everything that defines an environment before it is populated.
@@ -296,6 +298,37 @@ class SSX_EXPORT Environment {
   /// A 64-bit hash (FNV-1a) of every body's pose and velocities, bit for bit, and the time.
   std::uint64_t stateHash() const;
 
+  // --- ghosts: real robots inside the simulation --------------------------------------------
+
+  /// Makes `artifact` a ghost (before start): a robot whose pose comes from outside, a real one's
+  /// motion capture. Its body is kinematic: simulated robots collide with it and sense it, nothing
+  /// pushes it. At each step it is where its samples (setExternalPose) say at the step's time:
+  /// interpolated between them, extrapolated past the newest for at most `settings.horizon`.
+  /// With no sample yet, or none for longer than `settings.timeout`, it is lost: it holds where
+  /// it was, its sensors do not measure, and the log says so. Its sensors measure the simulated
+  /// world for the real robot. ConfigError for an artifact of another environment, one that is not
+  /// one dynamic physic tree, or one with a driver (a ghost moves by its samples alone).
+  void setGhost(Artifact& artifact, const PoseStream::Settings& settings = {});
+  /// Whether the artifact is a ghost.
+  bool isGhost(const Artifact& artifact) const;
+  /// Adds a pose of ghost `name`'s root frame (world frame), measured at simulated time `stamp`
+  /// (s). Samples may come late and out of order (see PoseStream). Before start or between steps,
+  /// from the thread that steps (the bridges call it in their beforeStep). Error for a name that
+  /// is not a ghost's; std::invalid_argument for a non-finite stamp or pose or a quaternion far
+  /// from unit length.
+  void setExternalPose(std::string_view name, const Pose& pose, double stamp);
+  /// What a ghost's pose stream says now.
+  struct GhostStatus {
+    bool lost = true;          ///< no pose yet, or none for longer than the timeout
+    double age = 0;            ///< s: the current time minus the newest sample at or before it
+    std::size_t samples = 0;   ///< samples kept
+  };
+  /// The status of ghost `artifact` (Error for an artifact that is not a ghost).
+  GhostStatus ghostStatus(const Artifact& artifact) const;
+  /// The ages of the poses the ghosts were placed at, every step of the run so far (while
+  /// tracked): median, p99 and maximum.
+  AgeSummary ghostAges() const;
+
   /// Neighbour queries. A plugin that wants them calls enableNeighborQueries from configure (never
   /// from sense, step or a callback: those run in parallel with the queries); from
   /// then on the index of every artifact's first dynamic root position is rebuilt once per step,
@@ -400,6 +433,7 @@ class SSX_EXPORT Environment {
   std::unique_ptr<detail::WorkerPool> pool_;
   std::unique_ptr<detail::SceneCameras> cameras_;  // scene cameras, camera images, render items
   std::unique_ptr<detail::NeighborIndex> neighbors_;
+  std::unique_ptr<detail::Ghosts> ghosts_;
   std::vector<StaticShape> static_shapes_;
   TimingRecorder timing_{settings_.timing_samples};
   LogSink log_;

@@ -11,6 +11,7 @@
 #include <ssx/types.hpp>
 
 #include <cstddef>
+#include <cstdint>
 #include <deque>
 #include <optional>
 #include <vector>
@@ -47,8 +48,8 @@ class SSX_EXPORT PoseStream {
   void add(double stamp, const Pose& pose);
   /// The pose at simulated time `t`, or nothing before the first sample. Between two samples:
   /// position linear, orientation slerp. Before the oldest kept: the oldest. Past the newest: from the
-  /// last two samples' velocities for at most `horizon`, then held; `lost` once t is more than
-  /// `timeout` past the newest.
+  /// last two samples' velocities for at most `horizon`, then held (held at once when the last two
+  /// are more than `timeout` apart); `lost` once t is more than `timeout` past the newest.
   std::optional<Estimate> at(double t) const;
   /// The samples kept.
   std::size_t size() const noexcept { return samples_.size(); }
@@ -78,7 +79,22 @@ struct AgeSummary {
   double p99 = 0;         ///< s
   double max = 0;         ///< s
 };
-/// Summarises `ages` (left in an unspecified order).
-SSX_EXPORT AgeSummary summarizeAges(std::vector<double>& ages);
+
+/// The ages of the poses used over a run, in bins of 0.1 ms up to 1 s (the memory a run needs does
+/// not grow with its length): the median and p99 to the upper edge of their bin, the maximum exact.
+class SSX_EXPORT AgeHistogram {
+ public:
+  static constexpr double kBinSeconds = 1e-4;   ///< width of a bin
+  static constexpr std::size_t kBins = 10'000;  ///< bins; older ages go into the last
+  /// Adds one age (s); a negative one counts as 0.
+  void add(double age);
+  /// The summary of the ages added (all zero when none were).
+  AgeSummary summary() const;
+
+ private:
+  std::vector<std::uint64_t> bins_;
+  std::size_t count_ = 0;
+  double max_ = 0;
+};
 
 }  // namespace ssx

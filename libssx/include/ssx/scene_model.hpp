@@ -13,6 +13,7 @@
 #include <ssx/export.hpp>
 #include <ssx/parameters.hpp>
 #include <ssx/physic_node.hpp>
+#include <ssx/pose_stream.hpp>
 #include <ssx/render.hpp>
 
 #include <cstdint>
@@ -69,6 +70,10 @@ struct SSX_EXPORT PlacementModel {
   /// member's index.
   std::shared_ptr<const Descriptor> driver;
   std::vector<std::shared_ptr<const Descriptor>> sensors;  ///< by sensor index of the type
+  /// `<ghost>` inside it: the artifact (each member of a swarm) is a ghost with these settings
+  /// (Environment::setGhost); its type's driver is left out.
+  std::optional<PoseStream::Settings> ghost;
+  SourceLocation ghost_where;  ///< of the `<ghost>`
   // a swarm
   std::int64_t count = 1;        ///< swarm: how many members
   std::int64_t first_index = 0;  ///< swarm: the first member's {i}

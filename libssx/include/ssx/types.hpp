@@ -51,6 +51,15 @@ struct Pose {
   }
 };
 
+/// The rotation vector (axis times angle, rad, in the frame both are given in) that turns the
+/// orientation `from` into `to`, the short way round.
+inline Vec3 rotationBetween(const Quat& from, const Quat& to) {
+  Quat d = to * from.conjugate();
+  if (d.w() < 0) d.coeffs() = -d.coeffs();
+  const Eigen::AngleAxisd aa(d);
+  return aa.axis() * aa.angle();
+}
+
 /// The kinematic state of a rigid body or of a point fixed on it, all in the world frame.
 /// Velocities and accelerations are those of the frame's origin.
 struct SSX_EXPORT BodyState {

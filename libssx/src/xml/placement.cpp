@@ -139,7 +139,7 @@ void SceneLoader::readPlacements() {
       p.type = require(d, "type");
       p.xyz = read<Vec3>(d, "xyz", Vec3::Zero());
       p.rpy = read<Vec3>(d, "rpy", Vec3::Zero());
-      checkUnknown(d, {"driver", "sensor"});
+      checkUnknown(d, {"driver", "sensor", "ghost"});
       ok = !p.name.empty() && !p.type.empty() && readOverrides(d, p);
     } else if (d.name() == "swarm") {
       p.kind = PlacementModel::Kind::Swarm;
@@ -176,6 +176,23 @@ bool SceneLoader::readOverrides(const Descriptor& d, PlacementModel& p) {
   }
   if (p.driver != nullptr && !type->driver)
     error(p.driver->where(), "<driver>: artifact type '" + p.type + "' has no driver to set parameters of");
+  if (const Descriptor* g = d.child("ghost")) {
+    // a real robot: its poses from outside, interpolated to simulated time (PoseStream)
+    PoseStream::Settings s;
+    for (auto [key, value] : {std::pair{"timeout", &s.timeout}, std::pair{"horizon", &s.horizon}}) {
+      const double v = read<double>(*g, key, *value);
+      if (v >= 0 && v <= kMaxDurationSeconds)
+        *value = v;
+      else
+        record(g->errorAt(key, std::string("attribute '") + key + "' must be 0 s or more, got '" + g->find(key)->value + "'"));
+    }
+    s.capacity = static_cast<std::size_t>(readCount(*g, "capacity", static_cast<std::int64_t>(s.capacity), 2, 1'000'000));
+    checkUnknown(*g);
+    if (p.driver != nullptr)
+      error(p.driver->where(), "<driver>: '" + p.name + "' is a ghost (moved by the poses it is given): it runs no driver");
+    p.ghost = s;
+    p.ghost_where = g->where();
+  }
   return true;
 }
 
@@ -245,7 +262,7 @@ bool SceneLoader::readSwarm(const Descriptor& d, PlacementModel& p, std::size_t 
     p.radius = readPositive(d, "radius", 1.0);
     p.positions = detail::sphereLayout(count, p.radius);
   }
-  checkUnknown(d, {"driver", "sensor"});
+  checkUnknown(d, {"driver", "sensor", "ghost"});
   if (count > 1 && p.name.find("{i}") == std::string::npos)
     error(d.where(), "<swarm>: the name pattern '" + p.name + "' needs {i} to give " + std::to_string(count) +
                          " artifacts different names");
@@ -291,7 +308,7 @@ bool SceneLoader::place(Environment& env, const std::string& name, const Placeme
   ClassLoader& loader = env.classLoader();
   // each plugin's parameters are checked against its declarations as it is attached, then each
   // class's own checks run on the whole artifact (a driver may need a sensor of some kind)
-  if (type.driver) {
+  if (type.driver && !p.ghost) {
     const PluginDecl& decl = *type.driver;
     auto create = [&](std::string_view pl, std::string_view c) -> Driver& { return loader.createDriver(pl, c); };
     if (Driver* d = createPlugin<Driver>(decl, create)) {
@@ -311,6 +328,13 @@ bool SceneLoader::place(Environment& env, const std::string& name, const Placeme
       checkPlugin(env, s, params, &a, period, "sensor " + std::to_string(i) + " '" + decl.class_name + "'",
                   periodFrom(decl, sensor_override(i)), &decl, sensor_override(i));
       a.addSensor(*s, std::move(params), period, decl.class_name);
+    }
+  }
+  if (p.ghost) {
+    try {
+      env.setGhost(a, *p.ghost);
+    } catch (const ConfigError& e) {
+      error(p.ghost_where, std::string("<ghost>: ") + e.what());
     }
   }
   if (errorCount() != errors_before) return false;  // the class checks assume values of the declared types
