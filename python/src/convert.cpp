@@ -1,6 +1,8 @@
 // Values from the library as Python objects (convert.hpp).
 #include "convert.hpp"
 
+#include <pybind11/stl.h>
+
 #include <algorithm>
 #include <cstdio>
 
@@ -23,6 +25,35 @@ py::array_t<double> quaternion(const ssx::Quat& q) {
   r(2) = q.y();
   r(3) = q.z();
   return a;
+}
+
+py::dict flightSummaryDict(const ssx::FlightSummary& s) {
+  py::dict d;
+  d["robots"] = s.robots;
+  d["airborne"] = s.airborne;
+  d["landed"] = s.landed;
+  d["crashed"] = s.crashed;
+  d["crashed_names"] = s.crashed_names;
+  d["impacts"] = s.impacts;
+  d["hardest_impact_mps"] = s.hardest_impact_mps;
+  d["hardest_impact_robot"] = s.hardest_impact_robot;
+  d["collisions"] = s.collisions;
+  d["first_collision_s"] = s.first_collision_s >= 0 ? py::object(py::float_(s.first_collision_s)) : py::object(py::none());
+  d["first_collision_pair"] = s.first_collision_pair;
+  d["closest_approach_m"] = s.closest_approach_m >= 0 ? py::object(py::float_(s.closest_approach_m)) : py::object(py::none());
+  d["closest_pair"] = s.closest_pair;
+  d["mean_distance_flown_m"] = s.mean_distance_flown_m;
+  d["text"] = s.str();
+  return d;
+}
+
+py::dict ageDict(const ssx::AgeSummary& s) {
+  py::dict d;
+  d["count"] = s.count;
+  d["median"] = s.median;
+  d["p99"] = s.p99;
+  d["max"] = s.max;
+  return d;
 }
 
 py::dict summaryDict(const ssx::TimingSummary& s) {

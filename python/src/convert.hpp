@@ -49,6 +49,10 @@ py::array_t<std::int32_t> counts(const std::array<std::int32_t, N>& c) {
   for (std::size_t i = 0; i < N; ++i) r(static_cast<py::ssize_t>(i)) = c[i];
   return a;
 }
+/// What happened to the robots (FlightRecorder) as a dict of its fields, with 'text'.
+py::dict flightSummaryDict(const ssx::FlightSummary& s);
+/// The ghosts' pose ages as a dict: count, median, p99, max.
+py::dict ageDict(const ssx::AgeSummary& s);
 /// A run's timing summary as a dict of its fields.
 py::dict summaryDict(const ssx::TimingSummary& s);
 /// load_scene's arguments as SceneOptions (ValueError for an unknown engine or negative threads).

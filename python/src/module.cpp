@@ -6,6 +6,7 @@
 // same environment raises RuntimeError instead of racing it.
 #include "commands.hpp"
 #include "convert.hpp"
+#include "ghosts.hpp"
 #include "recording.hpp"
 #include "view.hpp"
 
@@ -100,24 +101,7 @@ class PyEnvironment {
     InUse use(busy_);
     ssx::FlightRecorder now = flights_;
     if (env_.state() == ssx::Environment::State::Running) now.observe(env_);  // the end states as of now
-    const ssx::FlightSummary s = now.summary();
-    py::dict d;
-    d["robots"] = s.robots;
-    d["airborne"] = s.airborne;
-    d["landed"] = s.landed;
-    d["crashed"] = s.crashed;
-    d["crashed_names"] = s.crashed_names;
-    d["impacts"] = s.impacts;
-    d["hardest_impact_mps"] = s.hardest_impact_mps;
-    d["hardest_impact_robot"] = s.hardest_impact_robot;
-    d["collisions"] = s.collisions;
-    d["first_collision_s"] = s.first_collision_s >= 0 ? py::object(py::float_(s.first_collision_s)) : py::object(py::none());
-    d["first_collision_pair"] = s.first_collision_pair;
-    d["closest_approach_m"] = s.closest_approach_m >= 0 ? py::object(py::float_(s.closest_approach_m)) : py::object(py::none());
-    d["closest_pair"] = s.closest_pair;
-    d["mean_distance_flown_m"] = s.mean_distance_flown_m;
-    d["text"] = s.str();
-    return d;
+    return ssx_python::flightSummaryDict(now.summary());
   }
   // every metric the plugins publish now (ssx::MetricSource), by artifact: {name: {metric: value}}
   py::dict metrics() {
@@ -526,6 +510,24 @@ PYBIND11_MODULE(_ssx, m) {
       .def("metrics", &PyEnvironment::metrics,
            "Every metric the drivers publish now (ssx::MetricSource, e.g. the formation's formation_error), as "
            "{artifact: {metric: value}}.")
+      .def("set_external_pose",
+           [](PyEnvironment& e, const std::string& artifact, const py::object& position, const py::object& orientation,
+              std::optional<double> stamp) {
+             e.guarded([&] { ssx_python::setExternalPose(e.env(), artifact, position, orientation, stamp); });
+           },
+           py::arg("artifact"), py::arg("position"), py::arg("orientation") = py::none(), py::arg("stamp") = py::none(),
+           "A pose of ghost `artifact` (<ghost/> in the scene: a real robot) measured at simulated time `stamp` "
+           "(s; None: now): position (m, world), orientation (w, x, y, z; None: level). Samples may come late and "
+           "out of order; each step uses their interpolation at its time.")
+      .def("ghost_status",
+           [](PyEnvironment& e, const std::string& artifact) {
+             return e.guarded([&] { return ssx_python::ghostStatus(e.env(), artifact); });
+           },
+           py::arg("artifact"),
+           "A ghost's status: lost (no pose yet, or none for longer than its timeout), age (s) of its newest pose, "
+           "samples kept.")
+      .def("ghost_ages", [](PyEnvironment& e) { return e.guarded([&] { return ssx_python::ageDict(e.env().ghostAges()); }); },
+           "The ages of the poses the ghosts were placed at, every step so far: count, median, p99, max (s).")
       .def("contacts", &PyEnvironment::contacts, "Contact points the physics engine found in the last step.")
       .def("save_state", &PyEnvironment::saveState, "Everything that determines the future, as bytes.")
       .def("restore_state", &PyEnvironment::restoreState, py::arg("state"),

@@ -75,6 +75,13 @@ class Environment:
         """What happened to the robots so far: airborne, landed, crashed, impacts, collisions, closest approach, distance flown."""
     def metrics(self) -> Dict[str, Dict[str, float]]:
         """Every metric the drivers publish now, as {artifact: {metric: value}}."""
+    def set_external_pose(self, artifact: str, position: _Rows, orientation: Optional[_Rows] = None,
+                          stamp: Optional[float] = None) -> None:
+        """A pose of ghost `artifact` (a real robot) measured at simulated time `stamp` (None: now); orientation (w, x, y, z)."""
+    def ghost_status(self, artifact: str) -> Dict[str, Any]:
+        """A ghost's status: lost, age (s) of its newest pose, samples kept."""
+    def ghost_ages(self) -> Dict[str, float]:
+        """The ages of the poses the ghosts were placed at, every step so far: count, median, p99, max (s)."""
     def contacts(self) -> int:
         """Contact points the physics engine found in the last step."""
     def save_state(self) -> bytes:
