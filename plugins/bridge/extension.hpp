@@ -31,6 +31,11 @@ inline constexpr ssx_plugin_param kBridgeParameters[] = {
     param::real("lockstep_timeout_s", "2", "s", param::positive() & param::atMost(86400), "longest wait for the set-points of one step"),
     param::real("lockstep_connect_timeout_s", "10", "s", param::positive() & param::atMost(86400),
                 "how long the first step waits for every robot's controller to connect"),
+    param::real("range_rate_hz", "10", "Hz", param::nonNegative(),
+                "rate of /<robot>/range (what a range sensor sees, as a PoseArray) in simulated time; 0: none"),
+    param::choice("pose_stamps", "sim", "sim wall",
+                  "a ghost's /<robot>/pose stamps are simulated time (sim: a peer on /clock) or the system clock "
+                  "(wall: a motion-capture driver's); a zero stamp is the time it arrived"),
 };
 
 class BridgeExtension : public SimulationExtension {
@@ -49,6 +54,12 @@ class BridgeExtension : public SimulationExtension {
     lockstep_ = params.get<bool>("lockstep");
     lockstep_timeout_ = params.get<double>("lockstep_timeout_s");
     connect_timeout_ = params.get<double>("lockstep_connect_timeout_s");
+    range_rate_ = rateOf(params, "range_rate_hz", env.timestep());
+    if (params.get<double>("range_rate_hz") == 0) range_rate_.period = 0;
+    wall_stamps_ = params.get<std::string>("pose_stamps") == "wall";
+    if (lockstep_ && wall_stamps_)
+      throw params.error("pose_stamps=\"wall\" cannot be lock-stepped (the wall clock is not the same twice): use "
+                         "pose_stamps=\"sim\" with lockstep=\"true\"");
     std::vector<RobotTopics> topics;
     for (Artifact* a : env.selectArtifacts(params, "artifacts", "bridge")) {
       Robot r;
@@ -56,9 +67,14 @@ class BridgeExtension : public SimulationExtension {
       r.tracker = dynamic_cast<SetpointInterface*>(a->driver());
       r.commands = dynamic_cast<CommandInterface*>(a->driver());
       if (r.commands != nullptr && !r.commands->acceptsCommand(CommandLevel::Velocity)) r.commands = nullptr;
-      for (std::size_t k = 0; k < a->sensorCount(); ++k)
+      for (std::size_t k = 0; k < a->sensorCount(); ++k) {
         if (r.imu == nullptr) r.imu = dynamic_cast<const ImuMeasurement*>(&a->sensor(k).latest());
-      topics.push_back({a->name(), r.imu != nullptr && imu_rate_.period > 0, r.tracker != nullptr, r.commands != nullptr});
+        if (r.range == nullptr) r.range = dynamic_cast<const RangeMeasurement*>(&a->sensor(k).latest());
+      }
+      RobotTopics t{a->name(), r.imu != nullptr && imu_rate_.period > 0, r.tracker != nullptr, r.commands != nullptr};
+      t.ghost = env.isGhost(*a);
+      t.range = r.range != nullptr && range_rate_.period > 0;
+      topics.push_back(t);
       robots_.push_back(r);
     }
     try {
@@ -68,7 +84,7 @@ class BridgeExtension : public SimulationExtension {
     }
   }
 
-  void beforeStep(Environment&) override {
+  void beforeStep(Environment& env) override {
     if (lockstep_ && !connected_) {
       // before the first step: the controllers must be connected, or the first odometry is lost
       const auto missing = transport_->waitForPeers(connect_timeout_);
@@ -88,13 +104,20 @@ class BridgeExtension : public SimulationExtension {
                     std::to_string(lockstep_timeout_) + " s from " + std::to_string(missing.size()) +
                     " robot(s): " + names);
       }
+      cutoff_ = waiting_for_;
       waiting_for_ = -1;
     }
     // each robot's newest set-point and velocity command, applied between steps in the order they
-    // arrived (most steps nothing did: then no robot is looked up)
+    // arrived, and every pose of a ghost (most steps nothing did: then no robot is looked up)
     const std::uint64_t received = transport_->received();
-    if (received == received_seen_) return;
+    if (received == received_seen_) {
+      if (!held_.empty()) applyPoses(env);
+      return;
+    }
     received_seen_ = received;
+    transport_->takePoses(arrived_);
+    held_.insert(held_.end(), arrived_.begin(), arrived_.end());
+    if (!held_.empty()) applyPoses(env);
     for (std::size_t i = 0; i < robots_.size(); ++i) {
       Robot& r = robots_[i];
       const Setpoint s = r.tracker != nullptr ? transport_->latestSetpoint(i) : Setpoint{};
@@ -141,6 +164,17 @@ class BridgeExtension : public SimulationExtension {
       }
       if (lockstep_) waiting_for_ = t;
     }
+    if (range_rate_.due(now)) {
+      for (std::size_t i = 0; i < robots_.size(); ++i) {
+        Robot& r = robots_[i];
+        // (a sensor that did not measure since, a lost ghost's, publishes nothing new)
+        if (r.range == nullptr || r.range->stamp == r.range_published) continue;
+        r.range_published = r.range->stamp;
+        points_.clear();
+        for (const auto& d : r.range->detections) points_.push_back(array3(d.relative));
+        transport_->publishRange(i, toSeconds(r.range->stamp), r.range->body_frame, points_);
+      }
+    }
     transport_->commit();  // serialised and sent on the transport's own thread
     // what publishing costs the stepping thread, for the log (the first 2^16 publishing steps)
     if ((clock_due || imu_due || odom_due) && publish_costs_.size() < publish_costs_.capacity())
@@ -182,8 +216,44 @@ class BridgeExtension : public SimulationExtension {
     SetpointInterface* tracker = nullptr;
     CommandInterface* commands = nullptr;  // takes velocity commands
     const ImuMeasurement* imu = nullptr;
+    const RangeMeasurement* range = nullptr;
+    Nanoseconds range_published = -1;             // the stamp of the range last published
     std::uint64_t setpoints = 0, velocities = 0;  // applied so far
+    std::uint64_t bad_poses = 0;                  // a ghost's poses refused (not finite, not a rotation)
   };
+
+  // the ghosts' poses that arrived, in arrival order, stamped in simulated time. Lock-stepped,
+  // only those stamped at or before the last odometry answered are applied (the later ones wait):
+  // which poses a step uses is then the same in every run.
+  void applyPoses(Environment& env) {
+    const double now = toSeconds(env.time());
+    const double wall = std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count();
+    std::size_t kept = 0;
+    for (PoseSample& p : held_) {
+      if (p.stamp == 0)
+        p.stamp = now;  // unstamped: now
+      else if (wall_stamps_)
+        p.stamp = now - (wall - p.stamp);
+      if (lockstep_ && p.stamp > cutoff_ + 1e-9) {
+        held_[kept++] = p;
+        continue;
+      }
+      Robot& r = robots_[p.robot];
+      const Pose pose{Vec3(p.position[0], p.position[1], p.position[2]),
+                      Quat(p.orientation[0], p.orientation[1], p.orientation[2], p.orientation[3])};
+      try {
+        env.setExternalPose(r.artifact->name(), pose, p.stamp);
+        ++poses_applied_;
+      } catch (const std::invalid_argument& e) {
+        // a glitch of the motion capture (a zero quaternion when it loses the body) drops that
+        // sample, not the run
+        if (r.bad_poses++ == 0)
+          env.log(LogLevel::Warning, std::string(name()) + ": a pose of ghost '" + r.artifact->name() + "' was dropped (" +
+                                         e.what() + "); later ones are counted at the end");
+      }
+    }
+    held_.resize(kept);  // (only lock-stepped, so never wall-clock stamps: converted once)
+  }
 
   static Rate rateOf(const Descriptor& params, const char* key, Nanoseconds every_step) {
     const double hz = params.get<double>(key);
@@ -216,6 +286,19 @@ class BridgeExtension : public SimulationExtension {
   }
 
   void logSummary(Environment& env) const {
+    if (poses_applied_ > 0 || transport_->posesDropped() > 0) {
+      std::uint64_t bad = 0;
+      for (const Robot& r : robots_) bad += r.bad_poses;
+      const AgeSummary ages = env.ghostAges();
+      char text[320];
+      std::snprintf(text, sizeof text,
+                    "%s: %llu ghost poses applied, %llu refused, %llu dropped unread; pose age when used median "
+                    "%.1f ms, p99 %.1f ms, max %.1f ms",
+                    name(), static_cast<unsigned long long>(poses_applied_), static_cast<unsigned long long>(bad),
+                    static_cast<unsigned long long>(transport_->posesDropped()), 1e3 * ages.median, 1e3 * ages.p99,
+                    1e3 * ages.max);
+      env.log(LogLevel::Info, text);
+    }
     // how quickly the controllers outside answered, and what publishing cost the stepping thread
     std::vector<double> rt = transport_->roundTrips();
     char line[240];
@@ -239,7 +322,12 @@ class BridgeExtension : public SimulationExtension {
 
   std::unique_ptr<Transport> transport_;
   std::vector<Robot> robots_;
-  Rate odom_rate_, imu_rate_, clock_rate_;
+  Rate odom_rate_, imu_rate_, clock_rate_, range_rate_;
+  bool wall_stamps_ = false;
+  double cutoff_ = -1;                 // lock-step: poses stamped later wait
+  std::vector<PoseSample> arrived_, held_;
+  std::uint64_t poses_applied_ = 0;
+  std::vector<std::array<double, 3>> points_;  // a range's, reused
   bool lockstep_ = false;
   double lockstep_timeout_ = 2.0, connect_timeout_ = 10.0;
   bool connected_ = false;

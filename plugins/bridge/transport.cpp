@@ -1,6 +1,7 @@
 // The ROS bridges' shared transport logic (C++17). See transport.hpp.
 #include "transport.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 namespace ssx::bridge {
@@ -11,7 +12,11 @@ std::int64_t nanos(double seconds) { return std::llround(seconds * 1e9); }
 }  // namespace
 
 Transport::Transport(std::vector<RobotTopics> robots)
-    : robots_(std::move(robots)), setpoints_(robots_.size()), velocities_(robots_.size()) {
+    : robots_(std::move(robots)),
+      setpoints_(robots_.size()),
+      velocities_(robots_.size()),
+      queued_(robots_.size(), 0),
+      newest_pose_(robots_.size(), -1.0) {
   const std::size_t room = 4 * robots_.size() + 16;
   staged_.reserve(room);
   queue_.reserve(room);
@@ -49,17 +54,37 @@ void Transport::publishImu(std::size_t robot, const Imu& imu) {
   staged_.push_back(m);
 }
 
+void Transport::publishRange(std::size_t robot, double time, bool body_frame,
+                             const std::vector<std::array<double, 3>>& points) {
+  if (!robots_.at(robot).range) return;
+  Outgoing m;
+  m.kind = Outgoing::Kind::Range;
+  m.robot = robot;
+  m.time = time;
+  m.body_frame = body_frame;
+  m.first = staged_points_.size();
+  m.count = points.size();
+  staged_points_.insert(staged_points_.end(), points.begin(), points.end());
+  staged_.push_back(m);
+}
+
 void Transport::commit() {
   if (staged_.empty()) return;  // (most steps publish nothing: no lock, no wake-up)
   {
     // one lock per step, however many robots: the buffers trade places, so none is allocated
     std::lock_guard<std::mutex> lock(queue_mutex_);
-    if (queue_.empty())
+    if (queue_.empty() && queue_points_.empty()) {
       queue_.swap(staged_);
-    else
+      queue_points_.swap(staged_points_);
+    } else {
+      const std::size_t offset = queue_points_.size();
+      for (Outgoing& m : staged_) m.first += offset;
       queue_.insert(queue_.end(), staged_.begin(), staged_.end());
+      queue_points_.insert(queue_points_.end(), staged_points_.begin(), staged_points_.end());
+    }
   }
   staged_.clear();
+  staged_points_.clear();
   queue_changed_.notify_all();
 }
 
@@ -69,9 +94,11 @@ void Transport::publishLoop() {
     queue_changed_.wait(lock, [&] { return stop_ || !queue_.empty(); });
     if (queue_.empty() && stop_) return;
     sending_.swap(queue_);
+    sending_points_.swap(queue_points_);
     busy_ = true;
     lock.unlock();
-    for (const Outgoing& m : sending_) {
+    for (Outgoing& m : sending_) {
+      if (m.kind == Outgoing::Kind::Range) m.points = sending_points_.data() + m.first;
       if (m.kind == Outgoing::Kind::Odometry && m.robot == 0) {  // the round trip starts when it leaves
         std::lock_guard<std::mutex> guard(mutex_);
         sent_[nanos(m.odometry.time)] = std::chrono::steady_clock::now();
@@ -80,6 +107,7 @@ void Transport::publishLoop() {
       send(m);
     }
     sending_.clear();
+    sending_points_.clear();
     lock.lock();
     busy_ = false;
     queue_changed_.notify_all();  // (flush waits for this)
@@ -133,6 +161,38 @@ void Transport::receivedVelocity(std::size_t robot, const std::array<double, 3>&
   received_count_.store(received_, std::memory_order_release);
 }
 
+void Transport::receivedPose(std::size_t robot, double stamp, const std::array<double, 3>& position,
+                             const std::array<double, 4>& orientation_wxyz) {
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (queued_.at(robot) >= kMaxPosesQueued) {
+      // (nobody took them: the simulation is not stepping; a client cannot make the queue grow)
+      const auto oldest = std::find_if(poses_.begin(), poses_.end(), [&](const PoseSample& p) { return p.robot == robot; });
+      poses_.erase(oldest);
+      --queued_[robot];
+      ++poses_dropped_;
+    }
+    poses_.push_back({robot, stamp, position, orientation_wxyz});
+    ++queued_[robot];
+    newest_pose_[robot] = std::max(newest_pose_[robot], stamp);
+    ++received_;
+    received_count_.store(received_, std::memory_order_release);
+  }
+  arrived_.notify_all();
+}
+
+void Transport::takePoses(std::vector<PoseSample>& out) {
+  out.clear();
+  std::lock_guard<std::mutex> lock(mutex_);
+  out.swap(poses_);
+  std::fill(queued_.begin(), queued_.end(), 0);
+}
+
+std::uint64_t Transport::posesDropped() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return poses_dropped_;
+}
+
 Setpoint Transport::latestSetpoint(std::size_t robot) const {
   std::lock_guard<std::mutex> lock(mutex_);
   return setpoints_.at(robot);
@@ -146,7 +206,8 @@ Velocity Transport::latestVelocity(std::size_t robot) const {
 std::vector<std::string> Transport::missingSetpoints(double time) const {
   std::vector<std::string> names;
   for (std::size_t i = 0; i < robots_.size(); ++i)
-    if (robots_[i].setpoint && (setpoints_[i].count == 0 || setpoints_[i].stamp < time - 1e-9))
+    if ((robots_[i].setpoint && (setpoints_[i].count == 0 || setpoints_[i].stamp < time - 1e-9)) ||
+        (robots_[i].ghost && newest_pose_[i] < time - 1e-9))
       names.push_back(robots_[i].name);
   return names;
 }
@@ -163,7 +224,7 @@ std::vector<std::string> Transport::waitForPeers(double timeout_s) const {
   for (;;) {
     missing.clear();
     for (std::size_t i = 0; i < robots_.size(); ++i)
-      if (robots_[i].setpoint && !connected(i)) missing.push_back(robots_[i].name);
+      if ((robots_[i].setpoint || robots_[i].ghost) && !connected(i)) missing.push_back(robots_[i].name);
     if (missing.empty() || std::chrono::steady_clock::now() >= deadline) return missing;
     std::this_thread::sleep_for(std::chrono::milliseconds(20));
   }

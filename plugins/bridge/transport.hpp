@@ -2,9 +2,10 @@
 // What the ROS bridges (plugins/ros1, plugins/ros2) share below the simulation: the messages as
 // plain numbers, and a Transport that stages what a step publishes, sends it on a thread of its own
 // (serialising and writing never on the stepping thread), and keeps what arrived (each robot's
-// newest set-point and velocity command, the round trips, the waits of lock-step). A transport
+// newest set-point and velocity command, every pose of a ghost, the round trips, the waits of
+// lock-step). A transport
 // subclass only sends (send, on the publishing thread), tells whether a robot's peers are there
-// (connected), and hands over what it receives (receivedSetpoint, receivedVelocity).
+// (connected), and hands over what it receives (receivedSetpoint, receivedVelocity, receivedPose).
 //
 // Standard library only, and C++17: the ROS 1 side, whose message headers do not compile as C++20,
 // includes it too.
@@ -48,20 +49,34 @@ struct Velocity {
   std::uint64_t order = 0;                    // when it arrived, among every message received
 };
 
+// A ghost's pose as measured outside (motion capture): every one is kept, in arrival order
+struct PoseSample {
+  std::size_t robot = 0;
+  double stamp = 0;  // header.stamp, seconds (0: unstamped)
+  std::array<double, 3> position{};
+  std::array<double, 4> orientation{1, 0, 0, 0};  // w x y z
+};
+
 struct RobotTopics {
   std::string name;       // the namespace: /<name>/odom, /<name>/imu, /<name>/setpoint, /<name>/cmd_vel
   bool imu = false;       // publishes /<name>/imu
   bool setpoint = false;  // takes /<name>/setpoint
   bool velocity = false;  // takes /<name>/cmd_vel (where the transport offers it)
+  bool ghost = false;     // takes /<name>/pose (a real robot's motion capture)
+  bool range = false;     // publishes /<name>/range (what its range sensor sees)
 };
 
 /// One message to send: what the stepping thread stages.
 struct Outgoing {
-  enum class Kind : std::uint8_t { Clock, Odometry, Imu } kind = Kind::Clock;
+  enum class Kind : std::uint8_t { Clock, Odometry, Imu, Range } kind = Kind::Clock;
   std::size_t robot = 0;
-  double time = 0;  // the clock's
+  double time = 0;  // the clock's, the range's
   Odometry odometry;
   Imu imu;
+  // a range: its detections' relative positions, [first, first + count) of the points staged with it
+  bool body_frame = false;
+  std::size_t first = 0, count = 0;
+  const std::array<double, 3>* points = nullptr;  // set for send(): the first of them
 };
 
 class Transport {
@@ -79,6 +94,8 @@ class Transport {
   void publishClock(double time);
   void publishOdometry(std::size_t robot, const Odometry& odometry);
   void publishImu(std::size_t robot, const Imu& imu);
+  // `points`: the detections' positions relative to the robot, nearest first
+  void publishRange(std::size_t robot, double time, bool body_frame, const std::vector<std::array<double, 3>>& points);
   void commit();
   // Waits until everything staged so far has been sent.
   void flush();
@@ -88,8 +105,14 @@ class Transport {
   // How many set-points and velocity commands arrived so far, for all robots (without a lock: a
   // step that sees the same number as the last skips the look-ups).
   std::uint64_t received() const { return received_count_.load(std::memory_order_acquire); }
+  // Moves the ghosts' poses received since the last call to `out` (cleared first), in arrival order.
+  // At most kMaxPosesQueued wait per robot: beyond, the oldest are dropped (posesDropped counts them).
+  void takePoses(std::vector<PoseSample>& out);
+  static constexpr std::size_t kMaxPosesQueued = 1024;
+  std::uint64_t posesDropped() const;
   // Waits until every robot with a set-point topic has one stamped at or after `time` (seconds),
-  // at most `timeout_s`; returns the names of those still missing (empty: all there).
+  // and every ghost a pose, at most `timeout_s`; returns the names of those still missing (empty:
+  // all there).
   std::vector<std::string> waitForSetpoints(double time, double timeout_s) const;
   // Waits until every robot that takes set-points has its peers (connected()), at most
   // `timeout_s`; returns the names of the robots still unconnected.
@@ -112,6 +135,8 @@ class Transport {
   void receivedSetpoint(std::size_t robot, double stamp, const std::array<double, 3>& position,
                         const std::array<double, 4>& orientation_wxyz);
   void receivedVelocity(std::size_t robot, const std::array<double, 3>& linear, const std::array<double, 3>& angular);
+  void receivedPose(std::size_t robot, double stamp, const std::array<double, 3>& position,
+                    const std::array<double, 4>& orientation_wxyz);
 
  private:
   void publishLoop();
@@ -123,6 +148,10 @@ class Transport {
   mutable std::condition_variable arrived_;
   std::vector<Setpoint> setpoints_;                                    // mutex_
   std::vector<Velocity> velocities_;                                   // mutex_
+  std::vector<PoseSample> poses_;                                      // mutex_: not yet taken
+  std::vector<std::size_t> queued_;                                    // mutex_: poses_ per robot
+  std::vector<double> newest_pose_;                                    // mutex_: per robot (-1: none)
+  std::uint64_t poses_dropped_ = 0;                                    // mutex_
   std::map<std::int64_t, std::chrono::steady_clock::time_point> sent_;  // odometry time (ns) -> wall time; mutex_
   std::vector<double> round_trips_;                                    // mutex_
   std::uint64_t received_ = 0;                                         // mutex_
@@ -132,6 +161,7 @@ class Transport {
   std::condition_variable queue_changed_;
   std::vector<Outgoing> staged_;           // the stepping thread's, until commit hands them over
   std::vector<Outgoing> queue_, sending_;  // queue_mutex_ guards queue_, busy_, stop_
+  std::vector<std::array<double, 3>> staged_points_, queue_points_, sending_points_;  // ranges', likewise
   bool busy_ = false, stop_ = false;
   std::thread publisher_;
 };

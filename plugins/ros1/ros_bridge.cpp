@@ -1,6 +1,7 @@
 // The ROS 1 side of the ros1 extension (C++17). See ros_bridge.hpp.
 #include "ros_bridge.hpp"
 
+#include <geometry_msgs/PoseArray.h>
 #include <geometry_msgs/PoseStamped.h>
 #include <geometry_msgs/Twist.h>
 #include <nav_msgs/Odometry.h>
@@ -42,14 +43,17 @@ class RosTransport final : public bridge::Transport {
  private:
   void send(const bridge::Outgoing& out) override;
   bool connected(std::size_t robot) const override {
-    return odom_[robot].getNumSubscribers() > 0 && setpoint_subscribers_[robot].getNumPublishers() > 0;
+    const bridge::RobotTopics& r = robots()[robot];
+    return odom_[robot].getNumSubscribers() > 0 &&
+           (!r.setpoint || setpoint_subscribers_[robot].getNumPublishers() > 0) &&
+           (!r.ghost || pose_subscribers_[robot].getNumPublishers() > 0);
   }
 
   std::unique_ptr<ros::NodeHandle> node_;
   std::unique_ptr<ros::AsyncSpinner> spinner_;
   ros::Publisher clock_;
-  std::vector<ros::Publisher> odom_, imu_;
-  std::vector<ros::Subscriber> setpoint_subscribers_, velocity_subscribers_;  // per robot (empty where none)
+  std::vector<ros::Publisher> odom_, imu_, range_;
+  std::vector<ros::Subscriber> setpoint_subscribers_, velocity_subscribers_, pose_subscribers_;  // per robot (empty where none)
   bool running_ = false;
 };
 
@@ -93,8 +97,20 @@ RosTransport::RosTransport(const std::string& master_uri, const std::string& nod
       velocities = node_->subscribe<geometry_msgs::Twist>(ns + "/cmd_vel", 10, on_velocity, ros::VoidConstPtr(),
                                                            ros::TransportHints().tcpNoDelay());
     }
+    ros::Subscriber poses;
+    if (robots[i].ghost) {
+      // (a queue deep enough for a motion-capture burst: every pose counts)
+      auto on_pose = [this, i](const geometry_msgs::PoseStamped::ConstPtr& m) {
+        receivedPose(i, m->header.stamp.toSec(), {m->pose.position.x, m->pose.position.y, m->pose.position.z},
+                     {m->pose.orientation.w, m->pose.orientation.x, m->pose.orientation.y, m->pose.orientation.z});
+      };
+      poses = node_->subscribe<geometry_msgs::PoseStamped>(ns + "/pose", 100, on_pose, ros::VoidConstPtr(),
+                                                            ros::TransportHints().tcpNoDelay());
+    }
+    range_.push_back(robots[i].range ? node_->advertise<geometry_msgs::PoseArray>(ns + "/range", 10) : ros::Publisher());
     setpoint_subscribers_.push_back(setpoints);
     velocity_subscribers_.push_back(velocities);
+    pose_subscribers_.push_back(poses);
   }
   spinner_ = std::make_unique<ros::AsyncSpinner>(1);
   spinner_->start();
@@ -108,7 +124,9 @@ void RosTransport::shutdown() {
   if (spinner_) spinner_->stop();
   setpoint_subscribers_.clear();
   velocity_subscribers_.clear();
+  pose_subscribers_.clear();
   odom_.clear();
+  range_.clear();
   imu_.clear();
   clock_ = ros::Publisher();
   spinner_.reset();
@@ -146,6 +164,19 @@ void RosTransport::send(const bridge::Outgoing& out) {
       setXyz(m.angular_velocity, u.angular_velocity);
       setXyz(m.linear_acceleration, u.linear_acceleration);
       imu_[out.robot].publish(m);
+      break;
+    }
+    case bridge::Outgoing::Kind::Range: {
+      // each detection a pose at its relative position (orientation the identity), nearest first
+      geometry_msgs::PoseArray m;
+      m.header.stamp = stamp(out.time);
+      m.header.frame_id = out.body_frame ? robots()[out.robot].name + "/base_link" : "world";
+      m.poses.resize(out.count);
+      for (std::size_t k = 0; k < out.count; ++k) {
+        setXyz(m.poses[k].position, out.points[k]);
+        m.poses[k].orientation.w = 1;
+      }
+      range_[out.robot].publish(m);
       break;
     }
   }

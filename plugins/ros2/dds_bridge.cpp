@@ -43,33 +43,36 @@ dds_qos_t* qosOf(Profile p) {
 
 class DdsTransport final : public bridge::Transport {
  public:
-  DdsTransport(int domain, Network network, const std::vector<bridge::RobotTopics>& robots);
+  DdsTransport(int domain, Network network, const std::vector<bridge::RobotTopics>& robots, bool reliable_poses);
   ~DdsTransport() override { shutdown(); }
   void shutdown();
 
  private:
   struct Reader {
+    enum class Kind : std::uint8_t { Setpoint, Velocity, Pose };
     DdsTransport* self;
     std::size_t robot;
-    bool velocity;  // cmd_vel, else setpoint
+    Kind kind;
     dds_entity_t entity = 0;
   };
   void send(const bridge::Outgoing& out) override;
   bool connected(std::size_t robot) const override;
   dds_entity_t topic(const dds_topic_descriptor_t* type, const std::string& ros_name);
   dds_entity_t writer(const dds_topic_descriptor_t* type, const std::string& ros_name, Profile profile);
-  void reader(Reader& r, const dds_topic_descriptor_t* type, const std::string& ros_name);
+  void reader(Reader& r, const dds_topic_descriptor_t* type, const std::string& ros_name, Profile profile);
   static void onData(dds_entity_t reader, void* arg);
 
   dds_entity_t domain_ = 0, participant_ = 0;
   dds_entity_t clock_ = 0;
-  std::vector<dds_entity_t> odom_, imu_;
+  std::vector<dds_entity_t> odom_, imu_, range_;
   std::vector<Reader> readers_;  // reserved up front: listeners hold pointers to them
   std::vector<std::string> odom_frames_, imu_frames_;
+  std::vector<geometry_msgs_msg_dds__Pose_> range_poses_;  // the publishing thread's, reused
   bool running_ = false;
 };
 
-DdsTransport::DdsTransport(int domain, Network network, const std::vector<bridge::RobotTopics>& robots)
+DdsTransport::DdsTransport(int domain, Network network, const std::vector<bridge::RobotTopics>& robots,
+                           bool reliable_poses)
     : Transport(robots) {
   if (domain < 0 || domain > 232)
     throw std::runtime_error("ros2: domain " + std::to_string(domain) + " is not a ROS 2 domain (0 to 232)");
@@ -95,22 +98,31 @@ DdsTransport::DdsTransport(int domain, Network network, const std::vector<bridge
   running_ = true;
   try {
     clock_ = writer(&rosgraph_msgs_msg_dds__Clock__desc, "/clock", Profile::Clock);
-    readers_.reserve(2 * robots.size());
+    readers_.reserve(3 * robots.size());
     for (const bridge::RobotTopics& r : robots) {
       const std::string ns = "/" + r.name;
       odom_.push_back(writer(&nav_msgs_msg_dds__Odometry__desc, ns + "/odom", Profile::Default));
       imu_.push_back(r.imu ? writer(&sensor_msgs_msg_dds__Imu__desc, ns + "/imu", Profile::SensorData) : 0);
+      range_.push_back(r.range ? writer(&geometry_msgs_msg_dds__PoseArray__desc, ns + "/range", Profile::Default) : 0);
       odom_frames_.push_back(r.name + "/base_link");
       imu_frames_.push_back(r.name + "/imu");
     }
+    using Kind = Reader::Kind;
     for (std::size_t i = 0; i < robots.size(); ++i) {
+      const std::string ns = "/" + robots[i].name;
       if (robots[i].setpoint) {
-        readers_.push_back({this, i, false});
-        reader(readers_.back(), &geometry_msgs_msg_dds__PoseStamped__desc, "/" + robots[i].name + "/setpoint");
+        readers_.push_back({this, i, Kind::Setpoint});
+        reader(readers_.back(), &geometry_msgs_msg_dds__PoseStamped__desc, ns + "/setpoint", Profile::Default);
       }
       if (robots[i].velocity) {
-        readers_.push_back({this, i, true});
-        reader(readers_.back(), &geometry_msgs_msg_dds__Twist__desc, "/" + robots[i].name + "/cmd_vel");
+        readers_.push_back({this, i, Kind::Velocity});
+        reader(readers_.back(), &geometry_msgs_msg_dds__Twist__desc, ns + "/cmd_vel", Profile::Default);
+      }
+      if (robots[i].ghost) {
+        // (every sample kept until taken: a reader's history of one would drop poses that come in bursts)
+        readers_.push_back({this, i, Kind::Pose});
+        reader(readers_.back(), &geometry_msgs_msg_dds__PoseStamped__desc, ns + "/pose",
+               reliable_poses ? Profile::Default : Profile::SensorData);
       }
     }
   } catch (...) {
@@ -135,9 +147,9 @@ dds_entity_t DdsTransport::writer(const dds_topic_descriptor_t* type, const std:
   return w;
 }
 
-void DdsTransport::reader(Reader& r, const dds_topic_descriptor_t* type, const std::string& ros_name) {
+void DdsTransport::reader(Reader& r, const dds_topic_descriptor_t* type, const std::string& ros_name, Profile profile) {
   const dds_entity_t t = topic(type, ros_name);  // (first: it may throw)
-  dds_qos_t* q = qosOf(Profile::Default);
+  dds_qos_t* q = qosOf(profile);
   dds_listener_t* listener = dds_create_listener(&r);
   dds_lset_data_available(listener, &DdsTransport::onData);
   r.entity = dds_create_reader(participant_, t, q, listener);
@@ -155,14 +167,17 @@ void DdsTransport::onData(dds_entity_t reader, void* arg) {
     const dds_return_t n = dds_take(reader, samples, info, 1, 1);
     if (n <= 0) return;
     if (info[0].valid_data) {
-      if (r.velocity) {
+      if (r.kind == Reader::Kind::Velocity) {
         const auto& m = *static_cast<const geometry_msgs_msg_dds__Twist_*>(samples[0]);
         r.self->receivedVelocity(r.robot, {m.linear.x, m.linear.y, m.linear.z}, {m.angular.x, m.angular.y, m.angular.z});
       } else {
         const auto& m = *static_cast<const geometry_msgs_msg_dds__PoseStamped_*>(samples[0]);
         const auto& p = m.pose.position;
         const auto& q = m.pose.orientation;
-        r.self->receivedSetpoint(r.robot, seconds(m.header.stamp), {p.x, p.y, p.z}, {q.w, q.x, q.y, q.z});
+        if (r.kind == Reader::Kind::Pose)
+          r.self->receivedPose(r.robot, seconds(m.header.stamp), {p.x, p.y, p.z}, {q.w, q.x, q.y, q.z});
+        else
+          r.self->receivedSetpoint(r.robot, seconds(m.header.stamp), {p.x, p.y, p.z}, {q.w, q.x, q.y, q.z});
       }
     }
     dds_return_loan(reader, samples, n);
@@ -173,7 +188,7 @@ bool DdsTransport::connected(std::size_t robot) const {
   dds_publication_matched_status_t out{};
   if (dds_get_publication_matched_status(odom_[robot], &out) < 0 || out.current_count == 0) return false;
   for (const Reader& r : readers_) {
-    if (r.robot != robot || r.velocity) continue;
+    if (r.robot != robot || r.kind == Reader::Kind::Velocity) continue;
     dds_subscription_matched_status_t in{};
     if (dds_get_subscription_matched_status(r.entity, &in) < 0 || in.current_count == 0) return false;
   }
@@ -211,6 +226,22 @@ void DdsTransport::send(const bridge::Outgoing& out) {
       dds_write(imu_[out.robot], &m);
       break;
     }
+    case bridge::Outgoing::Kind::Range: {
+      // each detection a pose at its relative position (orientation the identity), nearest first
+      range_poses_.resize(out.count);
+      for (std::size_t k = 0; k < out.count; ++k) {
+        const auto& p = out.points[k];
+        range_poses_[k] = {{p[0], p[1], p[2]}, {0, 0, 0, 1}};
+      }
+      geometry_msgs_msg_dds__PoseArray_ m{};
+      m.header.stamp = stamp(out.time);
+      m.header.frame_id = out.body_frame ? odom_frames_[out.robot].data() : const_cast<char*>("world");
+      m.poses._length = m.poses._maximum = static_cast<uint32_t>(out.count);
+      m.poses._buffer = range_poses_.data();
+      m.poses._release = false;
+      dds_write(range_[out.robot], &m);
+      break;
+    }
   }
 }
 
@@ -232,8 +263,9 @@ std::string loopbackConfig() {
          "</Discovery><Internal><WriterLingerDuration>100 ms</WriterLingerDuration></Internal></Domain></CycloneDDS>";
 }
 
-std::unique_ptr<bridge::Transport> open(int domain, Network network, const std::vector<bridge::RobotTopics>& robots) {
-  return std::make_unique<DdsTransport>(domain, network, robots);
+std::unique_ptr<bridge::Transport> open(int domain, Network network, const std::vector<bridge::RobotTopics>& robots,
+                                        bool reliable_poses) {
+  return std::make_unique<DdsTransport>(domain, network, robots, reliable_poses);
 }
 
 void close(bridge::Transport& transport) { static_cast<DdsTransport&>(transport).shutdown(); }

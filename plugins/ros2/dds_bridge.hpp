@@ -22,8 +22,10 @@ enum class Network {
 std::string loopbackConfig();
 
 /// Joins DDS domain `domain`, creating its topics, writers and readers; throws std::runtime_error
-/// saying why when DDS cannot start.
-std::unique_ptr<bridge::Transport> open(int domain, Network network, const std::vector<bridge::RobotTopics>& robots);
+/// saying why when DDS cannot start. A ghost's poses are read best-effort (a motion-capture driver's
+/// sensor-data QoS matches), reliably when `reliable_poses` (lock-step: no pose may be lost).
+std::unique_ptr<bridge::Transport> open(int domain, Network network, const std::vector<bridge::RobotTopics>& robots,
+                                        bool reliable_poses);
 /// Sends what is staged, then leaves the domain.
 void close(bridge::Transport& transport);
 

@@ -44,7 +44,7 @@ class Ros2Bridge final : public bridge::BridgeExtension {
   std::unique_ptr<bridge::Transport> open(Environment&, const Descriptor& params,
                                           const std::vector<bridge::RobotTopics>& robots) override {
     const auto network = params.get<std::string>("network") == "system" ? ros2::Network::System : ros2::Network::Loopback;
-    return ros2::open(domainOf(params), network, robots);
+    return ros2::open(domainOf(params), network, robots, params.get<bool>("lockstep"));
   }
   void close(bridge::Transport& transport) override { ros2::close(transport); }
   const char* name() const override { return "ros2"; }
