@@ -1,0 +1,50 @@
+#!/bin/bash
+# ctest (plugins/bridge: ghosts over ROS 2): the hardware-in-the-loop example as its docs run it. Two
+# real quadrotors' motion capture (examples/hardware_in_the_loop/mocap.csv) is replayed by a DDS peer
+# that is not ssx (ssx_mocap_replay) 50 ms ahead of the simulated clock; ssx places each ghost where
+# the poses say. The peer checks that every ghost's odometry is the interpolation of the poses it
+# sent (within 1 mm: printed to the micrometre) and that each ghost's /range shows the virtual pillar
+# at its nearest point whenever it is in range. Then lock-stepped (only the ghosts bridged, poses
+# stamped in simulated time): two runs give the same bits.
+#
+# usage: ghosts_test.sh SSX_BINARY REPLAY_BINARY WORK_DIR
+set -u
+here=$(cd "$(dirname "$0")" && pwd)
+example=$(cd "$here/../../../../examples/hardware_in_the_loop" && pwd)
+ssx=$1
+replay=$2
+work=$3
+mkdir -p "$work"
+. "$here/dds.sh" 64
+
+"$replay" "$example/mocap.csv" --lead 0.05 --pillar 2 0 0.25 > "$work/replay.out" 2>&1 &
+replay_pid=$!
+"$ssx" run "$example/ghosts.xml" --realtime --quiet > "$work/ssx.out" 2>&1
+ssx_status=$?
+wait "$replay_pid"
+replay_status=$?
+cat "$work/replay.out" "$work/ssx.out"
+[ $ssx_status -eq 0 ] && [ $replay_status -eq 0 ] || { echo "ssx exit $ssx_status, replay exit $replay_status"; exit 1; }
+for robot in real0 real1; do
+  grep -Eq "^$robot: 1201 of 1201 poses sent; [1-9][0-9]+ odometry messages within 0\.000[0-9]+ m of the file's poses; [1-9][0-9]+ range messages, the pillar seen in [1-9][0-9]+ \(within 0\.000[0-9]+ m\), missed in 0$" \
+    "$work/replay.out" || { echo "$robot: not as expected"; exit 1; }
+done
+grep -q "ros2: 2402 ghost poses applied, 0 refused, 0 dropped unread" "$work/ssx.out" || { echo "not every pose applied"; exit 1; }
+
+# lock-stepped twice: the same bits
+sed -e 's#file="../artifacts/#file="'"$example"'/../artifacts/#' \
+    -e 's#<extension name="ros" plugin="ros2" range_rate_hz="20"/>#<extension name="ros" plugin="ros2" artifacts="real0 real1" lockstep="true" range_rate_hz="20"/>#' \
+    -e 's#duration="12"#duration="4"#' "$example/ghosts.xml" > "$work/lockstep.xml"
+grep -q 'lockstep="true"' "$work/lockstep.xml" || { echo "the example's extension line changed: update this test"; exit 1; }
+for run in 1 2; do
+  "$replay" "$example/mocap.csv" --lead 0.05 --quiet > "$work/replay_lockstep$run.out" 2>&1 &
+  replay_pid=$!
+  "$ssx" run "$work/lockstep.xml" --fast --quiet --save-state "$work/lockstep$run.state" > "$work/ssx_lockstep$run.out" 2>&1
+  ssx_status=$?
+  kill "$replay_pid" 2>/dev/null
+  wait "$replay_pid" 2>/dev/null
+  cat "$work/ssx_lockstep$run.out"
+  [ $ssx_status -eq 0 ] || { echo "lock-stepped run $run: ssx exit $ssx_status"; exit 1; }
+done
+cmp "$work/lockstep1.state" "$work/lockstep2.state" || { echo "two lock-stepped runs differ"; exit 1; }
+echo "two lock-stepped runs: the same bits"
