@@ -1,6 +1,7 @@
 #include "record/foxglove.hpp"
 
 #include <ssx/command.hpp>
+#include <ssx/operator.hpp>
 
 #include <cmath>
 #include <numbers>
@@ -172,6 +173,8 @@ std::string Command::problem() const {
 }
 
 CommandInterface::~CommandInterface() = default;
+
+OperatorInterface::~OperatorInterface() = default;
 
 Command CommandInterface::currentCommand() const {
   Command c;

@@ -298,6 +298,8 @@ void Environment::start() {
     detail::buildBodies(w, *physics_, static_shapes_);
     ghosts_->start(w, *physics_);
     detail::publishSnapshot(w, *physics_, true);
+    // (queries enabled before start, by an extension's init, see the first snapshot too)
+    if (neighbors_->enabled()) neighbors_->markStale(w.artifacts);
     cameras_->start(settings_.render, settings_.timestep, *renderer_, w.artifacts,
                     [this](std::string_view m) { log(LogLevel::Warning, m); });
     const unsigned threads = settings_.threads > 0 ? static_cast<unsigned>(settings_.threads)

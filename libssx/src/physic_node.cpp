@@ -9,12 +9,42 @@
 
 #include <Eigen/Eigenvalues>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <numbers>
 #include <set>
 
 namespace ssx {
+
+Vec3 nearestSurfacePoint(const Shape& s, const Pose& world, const Vec3& p) {
+  const Vec3 q = world.inverse().transformPoint(p);
+  Vec3 n = q;
+  switch (s.kind) {
+    case Shape::Kind::Sphere:
+      if (q.norm() > s.radius) n = q.normalized() * s.radius;
+      break;
+    case Shape::Kind::Box:
+      n = q.cwiseMax(-s.size / 2).cwiseMin(s.size / 2);
+      break;
+    case Shape::Kind::Cylinder: {
+      n.z() = std::clamp(q.z(), -s.length / 2, s.length / 2);
+      const double r = std::hypot(q.x(), q.y());
+      if (r > s.radius) n.head<2>() = q.head<2>() * (s.radius / r);
+      break;
+    }
+    case Shape::Kind::Capsule: {
+      const Vec3 axis(0, 0, std::clamp(q.z(), -s.length / 2, s.length / 2));
+      const Vec3 d = q - axis;
+      if (d.norm() > s.radius) n = axis + d.normalized() * s.radius;
+      break;
+    }
+    case Shape::Kind::Plane:
+      n.z() = 0;
+      break;
+  }
+  return world.transformPoint(n);
+}
 
 namespace {
 

@@ -8,6 +8,7 @@
 #include <ssx/command.hpp>
 #include <ssx/environment.hpp>
 #include <ssx/measurements.hpp>
+#include <ssx/operator.hpp>
 #include <ssx/plugin_abi.hpp>
 #include <ssx/setpoint.hpp>
 
@@ -16,6 +17,7 @@
 #include <cmath>
 #include <cstdio>
 #include <memory>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -33,6 +35,8 @@ inline constexpr ssx_plugin_param kBridgeParameters[] = {
                 "how long the first step waits for every robot's controller to connect"),
     param::real("range_rate_hz", "10", "Hz", param::nonNegative(),
                 "rate of /<robot>/range (what a range sensor sees, as a PoseArray) in simulated time; 0: none"),
+    param::text("operators", "", "operator extensions bridged: names separated by spaces (/<name>/cmd_vel and "
+                "/<name>/joy in, /<name>/force out)"),
     param::choice("pose_stamps", "sim", "sim wall",
                   "a ghost's /<robot>/pose stamps are simulated time (sim: a peer on /clock) or the system clock "
                   "(wall: a motion-capture driver's); a zero stamp is the time it arrived"),
@@ -77,6 +81,22 @@ class BridgeExtension : public SimulationExtension {
       topics.push_back(t);
       robots_.push_back(r);
     }
+    // operators after the robots, their topics under their own names
+    std::istringstream names(params.get<std::string>("operators", ""));
+    for (std::string n; names >> n;) {
+      auto* op = dynamic_cast<OperatorInterface*>(env.extension(n));
+      if (op == nullptr)
+        throw params.error("operators: '" + n + "' is not an operator extension (<extension name=\"" + n +
+                           "\" plugin=\"operator\" .../> before this one)");
+      Operator o;
+      o.op = op;  // (its force rate is read at the first step: it may be initialised after this one)
+      operators_.push_back(o);
+      RobotTopics t{n, false, false, true};
+      t.odom = false;
+      t.joy = true;
+      t.force = true;
+      topics.push_back(t);
+    }
     try {
       transport_ = open(env, params, topics);
     } catch (const std::exception& e) {
@@ -115,6 +135,21 @@ class BridgeExtension : public SimulationExtension {
       return;
     }
     received_seen_ = received;
+    for (std::size_t k = 0; k < operators_.size(); ++k) {
+      // each operator's newest command and joystick state, in the order they arrived
+      Operator& o = operators_[k];
+      const std::size_t i = robots_.size() + k;
+      const Velocity v = transport_->latestVelocity(i);
+      const Joy j = transport_->latestJoy(i);
+      const bool new_velocity = v.count != o.velocities, new_joy = j.count != o.joys;
+      o.velocities = v.count;
+      o.joys = j.count;
+      auto velocity = [&] { o.op->command(Vec3(v.linear[0], v.linear[1], v.linear[2]), v.angular[2]); };
+      auto joy = [&] { o.op->joy(j.axes, j.buttons); };
+      if (new_velocity && new_joy && j.order < v.order) joy();
+      if (new_velocity) velocity();
+      if (new_joy && !(new_velocity && j.order < v.order)) joy();
+    }
     transport_->takePoses(arrived_);
     held_.insert(held_.end(), arrived_.begin(), arrived_.end());
     if (!held_.empty()) applyPoses(env);
@@ -175,6 +210,14 @@ class BridgeExtension : public SimulationExtension {
         transport_->publishRange(i, toSeconds(r.range->stamp), r.range->body_frame, points_);
       }
     }
+    for (std::size_t k = 0; k < operators_.size(); ++k) {
+      Operator& o = operators_[k];
+      if (o.force_rate.period == 0) {
+        o.force_rate.period = o.op->forceRateHz() > 0 ? toNanoseconds(1.0 / o.op->forceRateHz()) : env.timestep();
+        o.force_rate.next = now;
+      }
+      if (o.force_rate.due(now)) transport_->publishForce(robots_.size() + k, t, array3(o.op->force()));
+    }
     transport_->commit();  // serialised and sent on the transport's own thread
     // what publishing costs the stepping thread, for the log (the first 2^16 publishing steps)
     if ((clock_due || imu_due || odom_due) && publish_costs_.size() < publish_costs_.capacity())
@@ -220,6 +263,12 @@ class BridgeExtension : public SimulationExtension {
     Nanoseconds range_published = -1;             // the stamp of the range last published
     std::uint64_t setpoints = 0, velocities = 0;  // applied so far
     std::uint64_t bad_poses = 0;                  // a ghost's poses refused (not finite, not a rotation)
+  };
+
+  struct Operator {
+    OperatorInterface* op = nullptr;
+    Rate force_rate;
+    std::uint64_t velocities = 0, joys = 0;  // applied so far
   };
 
   // the ghosts' poses that arrived, in arrival order, stamped in simulated time. Lock-stepped,
@@ -322,6 +371,7 @@ class BridgeExtension : public SimulationExtension {
 
   std::unique_ptr<Transport> transport_;
   std::vector<Robot> robots_;
+  std::vector<Operator> operators_;  // their topics follow the robots'
   Rate odom_rate_, imu_rate_, clock_rate_, range_rate_;
   bool wall_stamps_ = false;
   double cutoff_ = -1;                 // lock-step: poses stamped later wait

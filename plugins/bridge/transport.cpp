@@ -15,6 +15,7 @@ Transport::Transport(std::vector<RobotTopics> robots)
     : robots_(std::move(robots)),
       setpoints_(robots_.size()),
       velocities_(robots_.size()),
+      joys_(robots_.size()),
       queued_(robots_.size(), 0),
       newest_pose_(robots_.size(), -1.0) {
   const std::size_t room = 4 * robots_.size() + 16;
@@ -65,6 +66,16 @@ void Transport::publishRange(std::size_t robot, double time, bool body_frame,
   m.first = staged_points_.size();
   m.count = points.size();
   staged_points_.insert(staged_points_.end(), points.begin(), points.end());
+  staged_.push_back(m);
+}
+
+void Transport::publishForce(std::size_t robot, double time, const std::array<double, 3>& force) {
+  if (!robots_.at(robot).force) return;
+  Outgoing m;
+  m.kind = Outgoing::Kind::Force;
+  m.robot = robot;
+  m.time = time;
+  m.force = force;
   staged_.push_back(m);
 }
 
@@ -179,6 +190,23 @@ void Transport::receivedPose(std::size_t robot, double stamp, const std::array<d
     received_count_.store(received_, std::memory_order_release);
   }
   arrived_.notify_all();
+}
+
+void Transport::receivedJoy(std::size_t robot, const float* axes, std::size_t axis_count, const int* buttons,
+                            std::size_t button_count) {
+  constexpr std::size_t kMax = 64;
+  std::lock_guard<std::mutex> lock(mutex_);
+  Joy& j = joys_.at(robot);
+  j.axes.assign(axes, axes + std::min(axis_count, kMax));
+  j.buttons.assign(buttons, buttons + std::min(button_count, kMax));
+  ++j.count;
+  j.order = ++received_;
+  received_count_.store(received_, std::memory_order_release);
+}
+
+Joy Transport::latestJoy(std::size_t robot) const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return joys_.at(robot);
 }
 
 void Transport::takePoses(std::vector<PoseSample>& out) {

@@ -57,6 +57,13 @@ struct PoseSample {
   std::array<double, 4> orientation{1, 0, 0, 0};  // w x y z
 };
 
+struct Joy {
+  std::vector<float> axes;
+  std::vector<int> buttons;
+  std::uint64_t count = 0;  // received so far for this operator
+  std::uint64_t order = 0;  // when it arrived, among every message received
+};
+
 struct RobotTopics {
   std::string name;       // the namespace: /<name>/odom, /<name>/imu, /<name>/setpoint, /<name>/cmd_vel
   bool imu = false;       // publishes /<name>/imu
@@ -64,13 +71,17 @@ struct RobotTopics {
   bool velocity = false;  // takes /<name>/cmd_vel (where the transport offers it)
   bool ghost = false;     // takes /<name>/pose (a real robot's motion capture)
   bool range = false;     // publishes /<name>/range (what its range sensor sees)
+  bool odom = true;       // publishes /<name>/odom (every robot; not an operator)
+  bool joy = false;       // takes /<name>/joy (an operator)
+  bool force = false;     // publishes /<name>/force (an operator: a WrenchStamped)
 };
 
 /// One message to send: what the stepping thread stages.
 struct Outgoing {
-  enum class Kind : std::uint8_t { Clock, Odometry, Imu, Range } kind = Kind::Clock;
+  enum class Kind : std::uint8_t { Clock, Odometry, Imu, Range, Force } kind = Kind::Clock;
   std::size_t robot = 0;
-  double time = 0;  // the clock's, the range's
+  double time = 0;  // the clock's, the range's, the force's
+  std::array<double, 3> force{};  // N, world frame
   Odometry odometry;
   Imu imu;
   // a range: its detections' relative positions, [first, first + count) of the points staged with it
@@ -96,12 +107,14 @@ class Transport {
   void publishImu(std::size_t robot, const Imu& imu);
   // `points`: the detections' positions relative to the robot, nearest first
   void publishRange(std::size_t robot, double time, bool body_frame, const std::vector<std::array<double, 3>>& points);
+  void publishForce(std::size_t robot, double time, const std::array<double, 3>& force);
   void commit();
   // Waits until everything staged so far has been sent.
   void flush();
   // The newest set-point and velocity command of a robot (count 0: none yet). Thread-safe.
   Setpoint latestSetpoint(std::size_t robot) const;
   Velocity latestVelocity(std::size_t robot) const;
+  Joy latestJoy(std::size_t robot) const;
   // How many set-points and velocity commands arrived so far, for all robots (without a lock: a
   // step that sees the same number as the last skips the look-ups).
   std::uint64_t received() const { return received_count_.load(std::memory_order_acquire); }
@@ -137,6 +150,9 @@ class Transport {
   void receivedVelocity(std::size_t robot, const std::array<double, 3>& linear, const std::array<double, 3>& angular);
   void receivedPose(std::size_t robot, double stamp, const std::array<double, 3>& position,
                     const std::array<double, 4>& orientation_wxyz);
+  // (at most 64 axes and 64 buttons are kept: a client cannot make it allocate more)
+  void receivedJoy(std::size_t robot, const float* axes, std::size_t axis_count, const int* buttons,
+                   std::size_t button_count);
 
  private:
   void publishLoop();
@@ -148,6 +164,7 @@ class Transport {
   mutable std::condition_variable arrived_;
   std::vector<Setpoint> setpoints_;                                    // mutex_
   std::vector<Velocity> velocities_;                                   // mutex_
+  std::vector<Joy> joys_;                                              // mutex_
   std::vector<PoseSample> poses_;                                      // mutex_: not yet taken
   std::vector<std::size_t> queued_;                                    // mutex_: poses_ per robot
   std::vector<double> newest_pose_;                                    // mutex_: per robot (-1: none)

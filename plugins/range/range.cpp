@@ -18,41 +18,7 @@
 
 namespace ssx::plugins {
 
-namespace {
-
 using ObstacleShape = Environment::StaticShape;
-
-// nearest point of a shape's surface (or the point itself when inside) to p
-Vec3 nearestPoint(const ObstacleShape& o, const Vec3& p) {
-  const Vec3 q = o.world.inverse().transformPoint(p);
-  Vec3 n = q;
-  const Shape& s = o.shape;
-  switch (s.kind) {
-    case Shape::Kind::Sphere:
-      if (q.norm() > s.radius) n = q.normalized() * s.radius;
-      break;
-    case Shape::Kind::Box:
-      n = q.cwiseMax(-s.size / 2).cwiseMin(s.size / 2);
-      break;
-    case Shape::Kind::Cylinder: {
-      n.z() = std::clamp(q.z(), -s.length / 2, s.length / 2);
-      const double r = std::hypot(q.x(), q.y());
-      if (r > s.radius) n.head<2>() = q.head<2>() * (s.radius / r);
-      break;
-    }
-    case Shape::Kind::Capsule: {
-      const Vec3 axis(0, 0, std::clamp(q.z(), -s.length / 2, s.length / 2));
-      const Vec3 d = q - axis;
-      if (d.norm() > s.radius) n = axis + d.normalized() * s.radius;
-      break;
-    }
-    case Shape::Kind::Plane:
-      break;
-  }
-  return o.world.transformPoint(n);
-}
-
-}  // namespace
 
 class RangeSensor final : public SensorOf<RangeMeasurement> {
  public:
@@ -121,7 +87,7 @@ class RangeSensor final : public SensorOf<RangeMeasurement> {
     });
     // obstacles, at their nearest point
     for (const ObstacleShape* o : obstacles()) {
-      const Vec3 rel = nearestPoint(*o, self.position) - self.position;
+      const Vec3 rel = nearestSurfacePoint(o->shape, o->world, self.position) - self.position;
       const double d = rel.norm();
       if (d <= range_ && visible(rel)) m.detections.push_back({rel, d, o->artifact, true});
     }

@@ -4,10 +4,12 @@
 #include <geometry_msgs/PoseArray.h>
 #include <geometry_msgs/PoseStamped.h>
 #include <geometry_msgs/Twist.h>
+#include <geometry_msgs/WrenchStamped.h>
 #include <nav_msgs/Odometry.h>
 #include <ros/ros.h>
 #include <rosgraph_msgs/Clock.h>
 #include <sensor_msgs/Imu.h>
+#include <sensor_msgs/Joy.h>
 
 #include <chrono>
 #include <stdexcept>
@@ -52,8 +54,8 @@ class RosTransport final : public bridge::Transport {
   std::unique_ptr<ros::NodeHandle> node_;
   std::unique_ptr<ros::AsyncSpinner> spinner_;
   ros::Publisher clock_;
-  std::vector<ros::Publisher> odom_, imu_, range_;
-  std::vector<ros::Subscriber> setpoint_subscribers_, velocity_subscribers_, pose_subscribers_;  // per robot (empty where none)
+  std::vector<ros::Publisher> odom_, imu_, range_, force_;
+  std::vector<ros::Subscriber> setpoint_subscribers_, velocity_subscribers_, pose_subscribers_, joy_subscribers_;  // per robot (empty where none)
   bool running_ = false;
 };
 
@@ -79,7 +81,8 @@ RosTransport::RosTransport(const std::string& master_uri, const std::string& nod
   clock_ = node_->advertise<rosgraph_msgs::Clock>("/clock", 10);
   for (std::size_t i = 0; i < robots.size(); ++i) {
     const std::string ns = "/" + robots[i].name;
-    odom_.push_back(node_->advertise<nav_msgs::Odometry>(ns + "/odom", 10));
+    odom_.push_back(robots[i].odom ? node_->advertise<nav_msgs::Odometry>(ns + "/odom", 10) : ros::Publisher());
+    force_.push_back(robots[i].force ? node_->advertise<geometry_msgs::WrenchStamped>(ns + "/force", 10) : ros::Publisher());
     imu_.push_back(robots[i].imu ? node_->advertise<sensor_msgs::Imu>(ns + "/imu", 10) : ros::Publisher());
     ros::Subscriber setpoints, velocities;
     if (robots[i].setpoint) {
@@ -107,6 +110,14 @@ RosTransport::RosTransport(const std::string& master_uri, const std::string& nod
       poses = node_->subscribe<geometry_msgs::PoseStamped>(ns + "/pose", 100, on_pose, ros::VoidConstPtr(),
                                                             ros::TransportHints().tcpNoDelay());
     }
+    ros::Subscriber joys;
+    if (robots[i].joy) {
+      auto on_joy = [this, i](const sensor_msgs::Joy::ConstPtr& m) {
+        receivedJoy(i, m->axes.data(), m->axes.size(), m->buttons.data(), m->buttons.size());
+      };
+      joys = node_->subscribe<sensor_msgs::Joy>(ns + "/joy", 10, on_joy, ros::VoidConstPtr(), ros::TransportHints().tcpNoDelay());
+    }
+    joy_subscribers_.push_back(joys);
     range_.push_back(robots[i].range ? node_->advertise<geometry_msgs::PoseArray>(ns + "/range", 10) : ros::Publisher());
     setpoint_subscribers_.push_back(setpoints);
     velocity_subscribers_.push_back(velocities);
@@ -125,6 +136,8 @@ void RosTransport::shutdown() {
   setpoint_subscribers_.clear();
   velocity_subscribers_.clear();
   pose_subscribers_.clear();
+  joy_subscribers_.clear();
+  force_.clear();
   odom_.clear();
   range_.clear();
   imu_.clear();
@@ -164,6 +177,14 @@ void RosTransport::send(const bridge::Outgoing& out) {
       setXyz(m.angular_velocity, u.angular_velocity);
       setXyz(m.linear_acceleration, u.linear_acceleration);
       imu_[out.robot].publish(m);
+      break;
+    }
+    case bridge::Outgoing::Kind::Force: {
+      geometry_msgs::WrenchStamped m;
+      m.header.stamp = stamp(out.time);
+      m.header.frame_id = "world";
+      setXyz(m.wrench.force, out.force);
+      force_[out.robot].publish(m);
       break;
     }
     case bridge::Outgoing::Kind::Range: {

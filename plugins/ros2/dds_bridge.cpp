@@ -49,7 +49,7 @@ class DdsTransport final : public bridge::Transport {
 
  private:
   struct Reader {
-    enum class Kind : std::uint8_t { Setpoint, Velocity, Pose };
+    enum class Kind : std::uint8_t { Setpoint, Velocity, Pose, Joy };
     DdsTransport* self;
     std::size_t robot;
     Kind kind;
@@ -64,7 +64,7 @@ class DdsTransport final : public bridge::Transport {
 
   dds_entity_t domain_ = 0, participant_ = 0;
   dds_entity_t clock_ = 0;
-  std::vector<dds_entity_t> odom_, imu_, range_;
+  std::vector<dds_entity_t> odom_, imu_, range_, force_;
   std::vector<Reader> readers_;  // reserved up front: listeners hold pointers to them
   std::vector<std::string> odom_frames_, imu_frames_;
   std::vector<geometry_msgs_msg_dds__Pose_> range_poses_;  // the publishing thread's, reused
@@ -98,10 +98,11 @@ DdsTransport::DdsTransport(int domain, Network network, const std::vector<bridge
   running_ = true;
   try {
     clock_ = writer(&rosgraph_msgs_msg_dds__Clock__desc, "/clock", Profile::Clock);
-    readers_.reserve(3 * robots.size());
+    readers_.reserve(4 * robots.size());
     for (const bridge::RobotTopics& r : robots) {
       const std::string ns = "/" + r.name;
-      odom_.push_back(writer(&nav_msgs_msg_dds__Odometry__desc, ns + "/odom", Profile::Default));
+      odom_.push_back(r.odom ? writer(&nav_msgs_msg_dds__Odometry__desc, ns + "/odom", Profile::Default) : 0);
+      force_.push_back(r.force ? writer(&geometry_msgs_msg_dds__WrenchStamped__desc, ns + "/force", Profile::Default) : 0);
       imu_.push_back(r.imu ? writer(&sensor_msgs_msg_dds__Imu__desc, ns + "/imu", Profile::SensorData) : 0);
       range_.push_back(r.range ? writer(&geometry_msgs_msg_dds__PoseArray__desc, ns + "/range", Profile::Default) : 0);
       odom_frames_.push_back(r.name + "/base_link");
@@ -117,6 +118,11 @@ DdsTransport::DdsTransport(int domain, Network network, const std::vector<bridge
       if (robots[i].velocity) {
         readers_.push_back({this, i, Kind::Velocity});
         reader(readers_.back(), &geometry_msgs_msg_dds__Twist__desc, ns + "/cmd_vel", Profile::Default);
+      }
+      if (robots[i].joy) {
+        // (best effort: it matches a joystick node's writer whatever its reliability)
+        readers_.push_back({this, i, Kind::Joy});
+        reader(readers_.back(), &sensor_msgs_msg_dds__Joy__desc, ns + "/joy", Profile::SensorData);
       }
       if (robots[i].ghost) {
         // (every sample kept until taken: a reader's history of one would drop poses that come in bursts)
@@ -167,7 +173,10 @@ void DdsTransport::onData(dds_entity_t reader, void* arg) {
     const dds_return_t n = dds_take(reader, samples, info, 1, 1);
     if (n <= 0) return;
     if (info[0].valid_data) {
-      if (r.kind == Reader::Kind::Velocity) {
+      if (r.kind == Reader::Kind::Joy) {
+        const auto& m = *static_cast<const sensor_msgs_msg_dds__Joy_*>(samples[0]);
+        r.self->receivedJoy(r.robot, m.axes._buffer, m.axes._length, m.buttons._buffer, m.buttons._length);
+      } else if (r.kind == Reader::Kind::Velocity) {
         const auto& m = *static_cast<const geometry_msgs_msg_dds__Twist_*>(samples[0]);
         r.self->receivedVelocity(r.robot, {m.linear.x, m.linear.y, m.linear.z}, {m.angular.x, m.angular.y, m.angular.z});
       } else {
@@ -188,7 +197,7 @@ bool DdsTransport::connected(std::size_t robot) const {
   dds_publication_matched_status_t out{};
   if (dds_get_publication_matched_status(odom_[robot], &out) < 0 || out.current_count == 0) return false;
   for (const Reader& r : readers_) {
-    if (r.robot != robot || r.kind == Reader::Kind::Velocity) continue;
+    if (r.robot != robot || r.kind == Reader::Kind::Velocity || r.kind == Reader::Kind::Joy) continue;
     dds_subscription_matched_status_t in{};
     if (dds_get_subscription_matched_status(r.entity, &in) < 0 || in.current_count == 0) return false;
   }
@@ -224,6 +233,14 @@ void DdsTransport::send(const bridge::Outgoing& out) {
       m.angular_velocity = {u.angular_velocity[0], u.angular_velocity[1], u.angular_velocity[2]};
       m.linear_acceleration = {u.linear_acceleration[0], u.linear_acceleration[1], u.linear_acceleration[2]};
       dds_write(imu_[out.robot], &m);
+      break;
+    }
+    case bridge::Outgoing::Kind::Force: {
+      geometry_msgs_msg_dds__WrenchStamped_ m{};
+      m.header.stamp = stamp(out.time);
+      m.header.frame_id = const_cast<char*>("world");
+      m.wrench.force = {out.force[0], out.force[1], out.force[2]};
+      dds_write(force_[out.robot], &m);
       break;
     }
     case bridge::Outgoing::Kind::Range: {

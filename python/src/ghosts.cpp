@@ -33,4 +33,15 @@ py::dict ghostStatus(ssx::Environment& env, const std::string& name) {
   return d;
 }
 
+ssx::OperatorInterface& operatorNamed(ssx::Environment& env, const std::string& name) {
+  auto* op = dynamic_cast<ssx::OperatorInterface*>(env.extension(name));
+  if (op == nullptr) throw py::key_error("ssx: no operator extension named '" + name + "'");
+  return *op;
+}
+
+void operatorCommand(ssx::Environment& env, const std::string& name, const py::object& velocity, double yaw_rate) {
+  const Array v = requireRows(velocity, 3, 0, "velocity");
+  operatorNamed(env, name).command(ssx::Vec3(v.at(0), v.at(1), v.at(2)), yaw_rate);
+}
+
 }  // namespace ssx_python

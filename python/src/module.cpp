@@ -459,9 +459,10 @@ PYBIND11_MODULE(_ssx, m) {
     }
   });
 
-  py::class_<PyEnvironment>(m, "Environment",
+  py::class_<PyEnvironment> environment(m, "Environment",
                             "A loaded scene: step it, read its state as numpy arrays, command it. Made by "
-                            "load_scene or load_scene_string.")
+                            "load_scene or load_scene_string.");
+  environment
       .def("step", &PyEnvironment::step, py::arg("n") = 1,
            "Advances n timesteps (starting the environment first if needed). Releases the GIL.")
       .def_property_readonly("time", &PyEnvironment::time, "Simulated time, s.")
@@ -510,24 +511,6 @@ PYBIND11_MODULE(_ssx, m) {
       .def("metrics", &PyEnvironment::metrics,
            "Every metric the drivers publish now (ssx::MetricSource, e.g. the formation's formation_error), as "
            "{artifact: {metric: value}}.")
-      .def("set_external_pose",
-           [](PyEnvironment& e, const std::string& artifact, const py::object& position, const py::object& orientation,
-              std::optional<double> stamp) {
-             e.guarded([&] { ssx_python::setExternalPose(e.env(), artifact, position, orientation, stamp); });
-           },
-           py::arg("artifact"), py::arg("position"), py::arg("orientation") = py::none(), py::arg("stamp") = py::none(),
-           "A pose of ghost `artifact` (<ghost/> in the scene: a real robot) measured at simulated time `stamp` "
-           "(s; None: now): position (m, world), orientation (w, x, y, z; None: level). Samples may come late and "
-           "out of order; each step uses their interpolation at its time.")
-      .def("ghost_status",
-           [](PyEnvironment& e, const std::string& artifact) {
-             return e.guarded([&] { return ssx_python::ghostStatus(e.env(), artifact); });
-           },
-           py::arg("artifact"),
-           "A ghost's status: lost (no pose yet, or none for longer than its timeout), age (s) of its newest pose, "
-           "samples kept.")
-      .def("ghost_ages", [](PyEnvironment& e) { return e.guarded([&] { return ssx_python::ageDict(e.env().ghostAges()); }); },
-           "The ages of the poses the ghosts were placed at, every step so far: count, median, p99, max (s).")
       .def("contacts", &PyEnvironment::contacts, "Contact points the physics engine found in the last step.")
       .def("save_state", &PyEnvironment::saveState, "Everything that determines the future, as bytes.")
       .def("restore_state", &PyEnvironment::restoreState, py::arg("state"),
@@ -560,6 +543,7 @@ PYBIND11_MODULE(_ssx, m) {
       .def("__exit__", [](PyEnvironment& e, const py::args&) { e.close(); })
       .def("__repr__", &PyEnvironment::repr);
 
+  ssx_python::bindGhostsAndOperators(environment);
   ssx_python::bindRecording(m);
 
   m.def(

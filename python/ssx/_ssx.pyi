@@ -82,6 +82,10 @@ class Environment:
         """A ghost's status: lost, age (s) of its newest pose, samples kept."""
     def ghost_ages(self) -> Dict[str, float]:
         """The ages of the poses the ghosts were placed at, every step so far: count, median, p99, max (s)."""
+    def operator_command(self, operator: str, velocity: _Rows, yaw_rate: float = 0.0) -> None:
+        """Steers the robots of operator extension `operator` as one (m/s, rad/s in its frame); the dead-man rule stops them."""
+    def operator_force(self, operator: str) -> npt.NDArray[np.float64]:
+        """The force (N, world frame) operator `operator` should feel now, by its law."""
     def contacts(self) -> int:
         """Contact points the physics engine found in the last step."""
     def save_state(self) -> bytes:

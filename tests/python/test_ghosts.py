@@ -1,5 +1,6 @@
-"""Ghosts from Python: a real robot's poses in (set_external_pose), what its virtual sensors measure
-of the simulated world out (range), its status and the ages of the poses used."""
+"""Ghosts and operators from Python: a real robot's poses in (set_external_pose), what its virtual
+sensors measure of the simulated world out (range), its status and the ages of the poses used; an
+operator's commands in (operator_command), the force it should feel out (operator_force)."""
 import numpy as np
 import pytest
 
@@ -13,6 +14,7 @@ SCENE = """<scene>
   <obstacle name="pillar" xyz="2 0 1"><cylinder radius="0.2" length="2"/></obstacle>
   <artifact name="real" type="f" xyz="0 0 1"><ghost timeout="0.1"/></artifact>
   <artifact name="sim" type="f" xyz="0 2 1"><driver formation_index="0" formation_size="1"/></artifact>
+  <extension name="op" plugin="operator" robots="sim" deadman_s="0.2"/>
 </scene>"""
 
 
@@ -65,3 +67,22 @@ def test_bad_poses_and_names_are_refused():
         env.set_external_pose("sim", [0, 0, 1])
     with pytest.raises(KeyError, match="nobody"):
         env.ghost_status("nobody")
+
+
+def test_an_operator_steers_and_feels_the_real_robot_near_it():
+    env = load()
+    env.set_external_pose("real", [0, 1.2, 1], stamp=0)  # 0.8 m south of "sim", held there
+    env.step(10)
+    force = env.operator_force("op")
+    # away from the real robot (0.8 m south): north, force_gain (1 - d / force_range)
+    np.testing.assert_allclose(force, [0, 2 * (1 - 0.8 / 1.5), 0], atol=1e-3)  # (sim hovers within 1 mm)
+    sim = env.dynamic_names().index("sim")
+    y0 = env.positions()[sim][1]
+    for _ in range(10):  # 0.3 m/s north for 1 s
+        env.operator_command("op", [0, 0.3, 0])
+        env.step(100)
+    assert env.positions()[sim][1] - y0 > 0.15
+    with pytest.raises(KeyError, match="nobody"):
+        env.operator_force("nobody")
+    with pytest.raises(ValueError, match="velocity"):
+        env.operator_command("op", [0, 1])

@@ -48,6 +48,10 @@ struct SSX_EXPORT Shape {
   Mat3 unitInertia(double mass) const;
 };
 
+/// The point of a shape's surface nearest to `p` (world frame), the shape posed at `world`; `p`
+/// itself when it is inside. A plane: the foot of the perpendicular from `p`.
+SSX_EXPORT Vec3 nearestSurfacePoint(const Shape& shape, const Pose& world, const Vec3& p);
+
 /// One node of a physic node tree, as described in a file or in code (the constant model).
 /// Children are rigidly attached to their parent (joints come later), posed relative to it.
 ///

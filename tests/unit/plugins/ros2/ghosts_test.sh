@@ -1,11 +1,13 @@
 #!/bin/bash
 # ctest (plugins/bridge: ghosts over ROS 2): the hardware-in-the-loop example as its docs run it. Two
 # real quadrotors' motion capture (examples/hardware_in_the_loop/mocap.csv) is replayed by a DDS peer
-# that is not ssx (ssx_mocap_replay) 50 ms ahead of the simulated clock; ssx places each ghost where
+# that is not ssx (ssx_hil_peer) 50 ms ahead of the simulated clock; ssx places each ghost where
 # the poses say. The peer checks that every ghost's odometry is the interpolation of the poses it
 # sent (within 1 mm: printed to the micrometre) and that each ghost's /range shows the virtual pillar
-# at its nearest point whenever it is in range. Then lock-stepped (only the ghosts bridged, poses
-# stamped in simulated time): two runs give the same bits.
+# at its nearest point whenever it is in range. An operator (the same peer) steers the four simulated
+# quadrotors by /op0/cmd_vel, 0.4 m/s north for 2 s: sim0 moves 0.8 m (0.6-1.0), then the dead-man
+# rule stops it (at most 0.35 m more); the force on /op0/force comes at 100 Hz. Then lock-stepped
+# (only the ghosts bridged, poses stamped in simulated time): two runs give the same bits.
 #
 # usage: ghosts_test.sh SSX_BINARY REPLAY_BINARY WORK_DIR
 set -u
@@ -17,7 +19,7 @@ work=$3
 mkdir -p "$work"
 . "$here/dds.sh" 64
 
-"$replay" "$example/mocap.csv" --lead 0.05 --pillar 2 0 0.25 > "$work/replay.out" 2>&1 &
+"$replay" "$example/mocap.csv" --lead 0.05 --pillar 2 0 0.25 --teleop op0 0 0.4 4 2 --watch sim0 > "$work/replay.out" 2>&1 &
 replay_pid=$!
 "$ssx" run "$example/ghosts.xml" --realtime --quiet > "$work/ssx.out" 2>&1
 ssx_status=$?
@@ -30,10 +32,17 @@ for robot in real0 real1; do
     "$work/replay.out" || { echo "$robot: not as expected"; exit 1; }
 done
 grep -q "ros2: 2402 ghost poses applied, 0 refused, 0 dropped unread" "$work/ssx.out" || { echo "not every pose applied"; exit 1; }
+grep -Eq "^op0: 1[12][0-9][0-9] force messages" "$work/replay.out" || { echo "op0: the force did not come at 100 Hz"; exit 1; }
+read -r before during after < <(sed -n 's/^sim0: at 4.00 s x [-0-9.]* y \([-0-9.]*\); when the commands ended x [-0-9.]* y \([-0-9.]*\); at the end x [-0-9.]* y \([-0-9.]*\)$/\1 \2 \3/p' "$work/replay.out")
+[ -n "${after:-}" ] || { echo "sim0: no positions reported"; exit 1; }
+awk -v a="$before" -v b="$during" -v c="$after" 'BEGIN { moved = b - a; coast = c - b;
+  printf "sim0 moved %.3f m while steered, %.3f m after\n", moved, coast;
+  exit !(moved > 0.6 && moved < 1.0 && coast > -0.1 && coast < 0.35) }' || { echo "sim0 was not steered and stopped"; exit 1; }
+grep -q "operator: 40 commands, 1 stops by the dead-man rule" "$work/ssx.out" || { echo "the dead-man rule did not stop op0's robots once"; exit 1; }
 
 # lock-stepped twice: the same bits
 sed -e 's#file="../artifacts/#file="'"$example"'/../artifacts/#' \
-    -e 's#<extension name="ros" plugin="ros2" range_rate_hz="20"/>#<extension name="ros" plugin="ros2" artifacts="real0 real1" lockstep="true" range_rate_hz="20"/>#' \
+    -e 's#<extension name="ros" plugin="ros2" range_rate_hz="20" operators="op0"/>#<extension name="ros" plugin="ros2" artifacts="real0 real1" lockstep="true" range_rate_hz="20"/>#' \
     -e 's#duration="12"#duration="4"#' "$example/ghosts.xml" > "$work/lockstep.xml"
 grep -q 'lockstep="true"' "$work/lockstep.xml" || { echo "the example's extension line changed: update this test"; exit 1; }
 for run in 1 2; do

@@ -1,20 +1,29 @@
-/* ssx_mocap_replay: a motion-capture system played back from a file, as a ROS 2 node on DDS.
+/* ssx_hil_peer: the people and machines outside a hardware-in-the-loop run, as a ROS 2 node on DDS:
+ * a motion-capture system played back from a file, and an operator at a joystick.
  *
- *   ssx_mocap_replay FILE.csv [--lead S] [--pillar X Y R] [--quiet]
+ *   ssx_hil_peer FILE.csv [--lead S] [--pillar X Y R] [--teleop OP VX VY START_S SECONDS]
+ *                [--watch ROBOT] [--quiet]
  *
- * FILE.csv: a header `t,robot,x,y,z,qw,qx,qy,qz`, then one pose per line (t in simulated seconds,
- * rising per robot). Following ssx's /clock, each pose goes out on /<robot>/pose (PoseStamped,
- * stamped t) once the clock reaches t - S (--lead, default 0: as a live system, which cannot send a
- * pose before it measured it; a positive lead is a replay sending ahead). It reads what ssx says of
- * each robot in the file: /<robot>/odom (the ghost's pose as simulated, compared with the file's
- * poses interpolated at its stamp) and /<robot>/range (what the ghost's virtual range sensor sees;
- * with --pillar, a vertical cylinder at X Y of radius R that must be among the detections whenever it
- * is within 2.5 m, at its nearest point). It ends when the file is done and the clock is 0.5 s past
- * its last pose, or when the clock stops for 3 s, and prints per robot what it sent and found.
+ * Motion capture. FILE.csv: a header `t,robot,x,y,z,qw,qx,qy,qz`, then one pose per line (t in
+ * simulated seconds, rising per robot). Following ssx's /clock, each pose goes out on /<robot>/pose
+ * (PoseStamped, stamped t) once the clock reaches t - S (--lead, default 0: as a live system, which
+ * cannot send a pose before it measured it; a positive lead is a replay sending ahead). It reads what
+ * ssx says of each robot in the file: /<robot>/odom (the ghost's pose as simulated, compared with the
+ * file's poses interpolated at its stamp) and /<robot>/range (what the ghost's virtual range sensor
+ * sees; with --pillar, a vertical cylinder at X Y of radius R that must be among the detections
+ * whenever it is within 2.5 m, at its nearest point).
  *
- * Exit 0 when every robot was sent every pose, heard, and (with --pillar) the pillar was seen where
- * it is; 1 with a message otherwise (`FILE:LINE: error:` for a bad line). DDS configuration:
- * CYCLONEDDS_URI and ROS_DOMAIN_ID, as a ROS 2 node on this machine (docs/ros.md). */
+ * Operator. With --teleop, from START_S of simulated time on, for SECONDS, it sends operator OP the
+ * velocity VX VY (m/s; a Twist on /OP/cmd_vel, 20 per simulated second), then nothing (the dead-man
+ * rule must stop the robots); it reads the force on /OP/force (WrenchStamped) and reports its largest
+ * magnitude. --watch ROBOT reports where that robot's odometry was at START_S, when the commands
+ * ended, and at the end.
+ *
+ * It ends when the file is done and the clock is 0.5 s past its last pose (and the operator's part
+ * 3 s past its commands), or when the clock stops for 3 s, and prints what it sent and found. Exit 0
+ * when every robot was sent every pose, heard, and (with --pillar) the pillar was seen where it is;
+ * 1 with a message otherwise (`FILE:LINE: error:` for a bad line). DDS configuration: CYCLONEDDS_URI
+ * and ROS_DOMAIN_ID, as a ROS 2 node on this machine (docs/ros.md). */
 #include "ros2_messages.h"
 
 #include <dds/dds.h>
@@ -158,23 +167,34 @@ int main(int argc, char** argv) {
   const char* file = NULL;
   double lead = 0, pillar[3] = {0, 0, 0};
   int check_pillar = 0, quiet = 0;
+  const char* teleop = NULL;
+  const char* watch = NULL;
+  double teleop_v[2] = {0, 0}, teleop_start = 0, teleop_seconds = 0;
   for (int i = 1; i < argc; ++i) {
     if (strcmp(argv[i], "--lead") == 0 && i + 1 < argc) {
       lead = atof(argv[++i]);
     } else if (strcmp(argv[i], "--pillar") == 0 && i + 3 < argc) {
       for (int k = 0; k < 3; ++k) pillar[k] = atof(argv[++i]);
       check_pillar = 1;
+    } else if (strcmp(argv[i], "--teleop") == 0 && i + 5 < argc) {
+      teleop = argv[++i];
+      teleop_v[0] = atof(argv[++i]);
+      teleop_v[1] = atof(argv[++i]);
+      teleop_start = atof(argv[++i]);
+      teleop_seconds = atof(argv[++i]);
+    } else if (strcmp(argv[i], "--watch") == 0 && i + 1 < argc) {
+      watch = argv[++i];
     } else if (strcmp(argv[i], "--quiet") == 0) {
       quiet = 1;
     } else if (file == NULL && argv[i][0] != '-') {
       file = argv[i];
     } else {
-      fprintf(stderr, "usage: ssx_mocap_replay FILE.csv [--lead S] [--pillar X Y R] [--quiet]\n");
+      fprintf(stderr, "usage: ssx_hil_peer FILE.csv [--lead S] [--pillar X Y R] [--teleop OP VX VY START_S SECONDS] [--watch ROBOT] [--quiet]\n");
       return 1;
     }
   }
   if (file == NULL) {
-    fprintf(stderr, "usage: ssx_mocap_replay FILE.csv [--lead S] [--pillar X Y R] [--quiet]\n");
+    fprintf(stderr, "usage: ssx_hil_peer FILE.csv [--lead S] [--pillar X Y R] [--teleop OP VX VY START_S SECONDS] [--watch ROBOT] [--quiet]\n");
     return 1;
   }
   if (readFile(file) != 0) return 1;
@@ -183,7 +203,7 @@ int main(int argc, char** argv) {
   const dds_domainid_t domain = domain_env != NULL ? (dds_domainid_t)atoi(domain_env) : 0;
   const dds_entity_t participant = dds_create_participant(domain, NULL, NULL);
   if (participant < 0) {
-    fprintf(stderr, "ssx_mocap_replay: no DDS participant: %s\n", dds_strretcode(participant));
+    fprintf(stderr, "ssx_hil_peer: no DDS participant: %s\n", dds_strretcode(participant));
     return 1;
   }
   dds_qos_t* reliable = qos(1, 100);
@@ -197,6 +217,16 @@ int main(int argc, char** argv) {
     r->range = dds_create_reader(participant, topic(participant, &geometry_msgs_msg_dds__PoseArray__desc, r->name, "range"),
                                  reliable, NULL);
   }
+  dds_entity_t twist = 0, force = 0, watched = 0;
+  if (teleop != NULL) {
+    twist = dds_create_writer(participant, topic(participant, &geometry_msgs_msg_dds__Twist__desc, teleop, "cmd_vel"),
+                              reliable, NULL);
+    force = dds_create_reader(participant, topic(participant, &geometry_msgs_msg_dds__WrenchStamped__desc, teleop, "force"),
+                              reliable, NULL);
+  }
+  if (watch != NULL)
+    watched = dds_create_reader(participant, topic(participant, &nav_msgs_msg_dds__Odometry__desc, watch, "odom"),
+                                reliable, NULL);
   const dds_entity_t clock_reader = dds_create_reader(
       participant, dds_create_topic(participant, &rosgraph_msgs_msg_dds__Clock__desc, "rt/clock", NULL, NULL), clockq, NULL);
   dds_delete_qos(reliable);
@@ -206,6 +236,9 @@ int main(int argc, char** argv) {
   const double started = wall();
   double end = 0;
   for (size_t i = 0; i < robot_count; ++i) end = fmax(end, robots[i].samples[robots[i].count - 1].t);
+  if (teleop != NULL) end = fmax(end, teleop_start + teleop_seconds + 3.0);
+  double next_twist = teleop_start, max_force = 0, forces = 0;
+  double watched_at[3][3] = {{NAN, NAN, NAN}, {NAN, NAN, NAN}, {NAN, NAN, NAN}};  /* at start, end of commands, last */
   void* samples[1] = {NULL};
   dds_sample_info_t info[1];
   for (;;) {
@@ -278,6 +311,32 @@ int main(int argc, char** argv) {
         dds_return_loan(r->range, samples, 1);
       }
     }
+    if (teleop != NULL && now >= next_twist && now < teleop_start + teleop_seconds) {
+      geometry_msgs_msg_dds__Twist_ m;
+      memset(&m, 0, sizeof m);
+      m.linear.x = teleop_v[0];
+      m.linear.y = teleop_v[1];
+      dds_write(twist, &m);
+      next_twist += 0.05;
+    }
+    while (force != 0 && dds_take(force, samples, info, 1, 1) > 0) {
+      if (info[0].valid_data) {
+        const geometry_msgs_msg_dds__Vector3_* f = &((geometry_msgs_msg_dds__WrenchStamped_*)samples[0])->wrench.force;
+        max_force = fmax(max_force, sqrt(f->x * f->x + f->y * f->y + f->z * f->z));
+        ++forces;
+      }
+      dds_return_loan(force, samples, 1);
+    }
+    while (watched != 0 && dds_take(watched, samples, info, 1, 1) > 0) {
+      if (info[0].valid_data) {
+        const nav_msgs_msg_dds__Odometry_* m = samples[0];
+        const double t = seconds(m->header.stamp);
+        const double at[3] = {m->pose.pose.position.x, m->pose.pose.position.y, m->pose.pose.position.z};
+        const int slot = t <= teleop_start ? 0 : t <= teleop_start + teleop_seconds ? 1 : 2;
+        memcpy(watched_at[slot], at, sizeof at);
+      }
+      dds_return_loan(watched, samples, 1);
+    }
     if (now >= end + 0.5) break;
     if (wall() - last_tick > 3.0 && (now >= 0 || wall() - started > 30)) break;
     dds_sleepfor(DDS_MSECS(1));
@@ -296,7 +355,17 @@ int main(int argc, char** argv) {
       ok = 0;
     free(robots[i].samples);
   }
+  if (teleop != NULL) {
+    printf("%s: %.0f force messages, the largest %.3f N\n", teleop, forces, max_force);
+    if (forces == 0) ok = 0;
+  }
+  if (watch != NULL) {
+    printf("%s: at %.2f s x %.3f y %.3f; when the commands ended x %.3f y %.3f; at the end x %.3f y %.3f\n", watch,
+           teleop_start, watched_at[0][0], watched_at[0][1], watched_at[1][0], watched_at[1][1], watched_at[2][0],
+           watched_at[2][1]);
+    if (isnan(watched_at[2][0])) ok = 0;
+  }
   dds_delete(participant);
-  if (!ok) fprintf(stderr, "ssx_mocap_replay: not every robot was sent every pose and heard\n");
+  if (!ok) fprintf(stderr, "ssx_hil_peer: not every robot was sent every pose and heard\n");
   return ok ? 0 : 1;
 }
