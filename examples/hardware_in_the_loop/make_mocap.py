@@ -5,6 +5,8 @@ seen at 100 Hz for 12 s; each turned to face along its path. A real system's jit
 late, positions within 1 mm.
 
     make_mocap.py [OUT.csv]
+    make_mocap.py OUT.csv --grid N SECONDS    (the benchmark's: real0..real<N-1> on a 2 m grid, ten to
+                                               a row, each circling its place 0.3 m out, 1.5 m up)
 """
 import math
 import random
@@ -26,11 +28,25 @@ def rows():
             yield f"{t:.6f},{name},{x:.6f},{y:.6f},{HEIGHT:.6f},{math.cos(yaw / 2):.6f},0,0,{math.sin(yaw / 2):.6f}"
 
 
+def grid_rows(n, seconds):
+    rng = random.Random(38)
+    for k in range(int(seconds * RATE) + 1):
+        for i in range(n):
+            t = k / RATE + rng.uniform(0, 0.002)
+            a = SPEED * t + 0.7 * i
+            x = 2.0 * (i % 10) + 0.3 * math.cos(a)
+            y = 2.0 * (i // 10) + 0.3 * math.sin(a)
+            yield f"{t:.6f},real{i},{x:.6f},{y:.6f},{HEIGHT:.6f},1,0,0,0"
+
+
 def main():
     out = sys.argv[1] if len(sys.argv) > 1 else "mocap.csv"
+    grid = len(sys.argv) == 5 and sys.argv[2] == "--grid"
+    if len(sys.argv) > 2 and not grid:
+        sys.exit(__doc__)
     with open(out, "w") as f:
         f.write("t,robot,x,y,z,qw,qx,qy,qz\n")
-        for row in rows():
+        for row in grid_rows(int(sys.argv[3]), float(sys.argv[4])) if grid else rows():
             f.write(row + "\n")
 
 
