@@ -1,7 +1,9 @@
 // The ROS bridges' shared transport: what a step stages goes out in order on the publishing thread
 // only after commit, flush waits for it, a robot without an IMU publishes none; what arrives is
 // each robot's newest, in the order it came, with the round trip from the odometry it answers;
-// lock-step's waits say who is missing.
+// lock-step's waits say who is missing. A ghost's poses are all kept, in arrival order, at most
+// 1,024 queued per robot; a range's points and an operator's force go out with their message,
+// however commits interleave with sending; a joystick's state is kept, bounded.
 #include "transport.hpp"
 
 #include <catch2/catch.hpp>
@@ -26,12 +28,16 @@ class Recording final : public Transport {
   std::atomic<bool> peer{false};
   using Transport::receivedSetpoint;
   using Transport::receivedVelocity;
+  using Transport::receivedPose;
+  using Transport::receivedJoy;
+  std::vector<std::vector<std::array<double, 3>>> points;  // each range's, copied as it is sent
 
  private:
   void send(const Outgoing& m) override {
     std::lock_guard<std::mutex> lock(mutex);
     sender = std::this_thread::get_id();
     messages.push_back(m);
+    if (m.kind == Outgoing::Kind::Range) points.emplace_back(m.points, m.points + m.count);
   }
   bool connected(std::size_t) const override { return peer; }
   mutable std::mutex mutex;
@@ -96,4 +102,70 @@ TEST_CASE("bridge transport: what arrives, in order, with its round trip; lock-s
   answer.join();
   // an older stamp does not answer a newer odometry
   CHECK(t.waitForSetpoints(0.04, 0.01) == std::vector<std::string>{"a", "b"});
+}
+
+TEST_CASE("bridge transport: a ghost's poses are all kept, in arrival order, bounded", "[bridge]") {
+  std::vector<RobotTopics> robots = twoRobots();
+  robots[1].ghost = true;
+  Recording t(robots);
+  const std::uint64_t before = t.received();
+  t.receivedPose(1, 0.02, {1, 0, 0}, {1, 0, 0, 0});
+  t.receivedPose(1, 0.01, {0, 0, 0}, {1, 0, 0, 0});  // late: kept, in the order it came
+  CHECK(t.received() == before + 2);
+  std::vector<PoseSample> got;
+  t.takePoses(got);
+  REQUIRE(got.size() == 2);
+  CHECK(got[0].stamp == 0.02);
+  CHECK(got[1].stamp == 0.01);
+  t.takePoses(got);
+  CHECK(got.empty());
+  // lock-step waits for a ghost's pose as for a set-point
+  t.receivedSetpoint(0, 0.04, {0, 0, 0}, {1, 0, 0, 0});
+  t.receivedSetpoint(1, 0.04, {0, 0, 0}, {1, 0, 0, 0});
+  CHECK(t.waitForSetpoints(0.04, 0.01) == std::vector<std::string>{"b"});
+  t.receivedPose(1, 0.04, {0, 0, 0}, {1, 0, 0, 0});
+  CHECK(t.waitForSetpoints(0.04, 0.01).empty());
+  t.takePoses(got);
+  // nobody takes them: at most 1,024 wait, the oldest dropped and counted (from another thread)
+  std::thread flood([&] {
+    for (int k = 0; k < 1100; ++k) t.receivedPose(1, 1.0 + k * 0.01, {0, 0, 0}, {1, 0, 0, 0});
+  });
+  flood.join();
+  t.takePoses(got);
+  CHECK(got.size() == Transport::kMaxPosesQueued);
+  CHECK(got.front().stamp == Approx(1.0 + 76 * 0.01));
+  CHECK(t.posesDropped() == 1100 - Transport::kMaxPosesQueued);
+}
+
+TEST_CASE("bridge transport: a range's points and an operator's force go out with their message", "[bridge]") {
+  std::vector<RobotTopics> robots = twoRobots();
+  robots[0].range = true;
+  robots[1].force = true;
+  Recording t(robots);
+  // many steps committed while the thread sends: each range keeps its own points
+  for (int k = 0; k < 200; ++k) {
+    std::vector<std::array<double, 3>> points(static_cast<std::size_t>(k % 5), {double(k), 0, 0});
+    t.publishRange(0, k, false, points);
+    t.publishRange(1, k, false, points);  // b publishes no range: dropped
+    t.publishForce(1, k, {0, double(k), 0});
+    t.commit();
+  }
+  t.flush();
+  const auto sent = t.sent();
+  REQUIRE(sent.size() == 400);
+  REQUIRE(t.points.size() == 200);
+  for (std::size_t k = 0; k < 200; ++k) {
+    CHECK(t.points[k].size() == k % 5);
+    for (const auto& p : t.points[k]) CHECK(p[0] == double(k));
+    CHECK(sent[2 * k + 1].kind == Outgoing::Kind::Force);
+    CHECK(sent[2 * k + 1].force[1] == double(k));
+  }
+  // a joystick's state: the newest, at most 64 axes and buttons
+  std::vector<float> axes(100, 0.5f);
+  std::vector<int> buttons(3, 1);
+  t.receivedJoy(1, axes.data(), axes.size(), buttons.data(), buttons.size());
+  const Joy j = t.latestJoy(1);
+  CHECK(j.count == 1);
+  CHECK(j.axes.size() == 64);
+  CHECK(j.buttons == std::vector<int>{1, 1, 1});
 }
