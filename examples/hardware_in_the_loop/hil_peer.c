@@ -2,7 +2,7 @@
  * a motion-capture system played back from a file, and an operator at a joystick.
  *
  *   ssx_hil_peer FILE.csv [--lead S] [--pillar X Y R] [--teleop OP VX VY START_S SECONDS]
- *                [--watch ROBOT] [--quiet]
+ *                [--watch ROBOT] [--image ROBOT W H] [--quiet]
  *
  * Motion capture. FILE.csv: a header `t,robot,x,y,z,qw,qx,qy,qz`, then one pose per line (t in
  * simulated seconds, rising per robot). Following ssx's /clock, each pose goes out on /<robot>/pose
@@ -17,7 +17,8 @@
  * velocity VX VY (m/s; a Twist on /OP/cmd_vel, 20 per simulated second), then nothing (the dead-man
  * rule must stop the robots); it reads the force on /OP/force (WrenchStamped) and reports its largest
  * magnitude. --watch ROBOT reports where that robot's odometry was at START_S, when the commands
- * ended, and at the end.
+ * ended, and at the end. --image ROBOT W H checks that robot's camera on /ROBOT/image: W x H rgb8
+ * images, and reports how many came and how many show more than one colour.
  *
  * It ends when the file is done and the clock is 0.5 s past its last pose (and the operator's part
  * 3 s past its commands), or when the clock stops for 3 s, and prints what it sent and found. Exit 0
@@ -169,6 +170,8 @@ int main(int argc, char** argv) {
   int check_pillar = 0, quiet = 0;
   const char* teleop = NULL;
   const char* watch = NULL;
+  const char* image_robot = NULL;
+  unsigned image_size[2] = {0, 0};
   double teleop_v[2] = {0, 0}, teleop_start = 0, teleop_seconds = 0;
   for (int i = 1; i < argc; ++i) {
     if (strcmp(argv[i], "--lead") == 0 && i + 1 < argc) {
@@ -182,6 +185,10 @@ int main(int argc, char** argv) {
       teleop_v[1] = atof(argv[++i]);
       teleop_start = atof(argv[++i]);
       teleop_seconds = atof(argv[++i]);
+    } else if (strcmp(argv[i], "--image") == 0 && i + 3 < argc) {
+      image_robot = argv[++i];
+      image_size[0] = (unsigned)atoi(argv[++i]);
+      image_size[1] = (unsigned)atoi(argv[++i]);
     } else if (strcmp(argv[i], "--watch") == 0 && i + 1 < argc) {
       watch = argv[++i];
     } else if (strcmp(argv[i], "--quiet") == 0) {
@@ -189,12 +196,12 @@ int main(int argc, char** argv) {
     } else if (file == NULL && argv[i][0] != '-') {
       file = argv[i];
     } else {
-      fprintf(stderr, "usage: ssx_hil_peer FILE.csv [--lead S] [--pillar X Y R] [--teleop OP VX VY START_S SECONDS] [--watch ROBOT] [--quiet]\n");
+      fprintf(stderr, "usage: ssx_hil_peer FILE.csv [--lead S] [--pillar X Y R] [--teleop OP VX VY START_S SECONDS] [--watch ROBOT] [--image ROBOT W H] [--quiet]\n");
       return 1;
     }
   }
   if (file == NULL) {
-    fprintf(stderr, "usage: ssx_hil_peer FILE.csv [--lead S] [--pillar X Y R] [--teleop OP VX VY START_S SECONDS] [--watch ROBOT] [--quiet]\n");
+    fprintf(stderr, "usage: ssx_hil_peer FILE.csv [--lead S] [--pillar X Y R] [--teleop OP VX VY START_S SECONDS] [--watch ROBOT] [--image ROBOT W H] [--quiet]\n");
     return 1;
   }
   if (readFile(file) != 0) return 1;
@@ -224,6 +231,11 @@ int main(int argc, char** argv) {
     force = dds_create_reader(participant, topic(participant, &geometry_msgs_msg_dds__WrenchStamped__desc, teleop, "force"),
                               reliable, NULL);
   }
+  dds_entity_t images = 0;
+  size_t image_count = 0, image_bad = 0, image_varied = 0;
+  if (image_robot != NULL)
+    images = dds_create_reader(participant, topic(participant, &sensor_msgs_msg_dds__Image__desc, image_robot, "image"),
+                               reliable, NULL);
   if (watch != NULL)
     watched = dds_create_reader(participant, topic(participant, &nav_msgs_msg_dds__Odometry__desc, watch, "odom"),
                                 reliable, NULL);
@@ -327,6 +339,23 @@ int main(int argc, char** argv) {
       }
       dds_return_loan(force, samples, 1);
     }
+    while (images != 0 && dds_take(images, samples, info, 1, 1) > 0) {
+      if (info[0].valid_data) {
+        const sensor_msgs_msg_dds__Image_* m = samples[0];
+        ++image_count;
+        if (m->width != image_size[0] || m->height != image_size[1] || strcmp(m->encoding, "rgb8") != 0 ||
+            m->step != 3 * m->width || m->data._length != m->step * m->height) {
+          ++image_bad;
+        } else {
+          for (uint32_t k = 3; k < m->data._length; ++k)
+            if (m->data._buffer[k] != m->data._buffer[k % 3]) {
+              ++image_varied;
+              break;
+            }
+        }
+      }
+      dds_return_loan(images, samples, 1);
+    }
     while (watched != 0 && dds_take(watched, samples, info, 1, 1) > 0) {
       if (info[0].valid_data) {
         const nav_msgs_msg_dds__Odometry_* m = samples[0];
@@ -350,14 +379,19 @@ int main(int argc, char** argv) {
              "the pillar seen in %zu (within %.6f m), missed in %zu\n",
              r->name, r->sent, r->count, r->odoms, r->odom_error, r->ranges, r->pillar_seen, r->pillar_error,
              r->pillar_missed);
-    if (r->sent < r->count || r->ranges == 0 || (lead > 0 && r->odoms == 0) || r->pillar_missed > 0 ||
-        (check_pillar && r->pillar_seen == 0))
+    if (r->sent < r->count || (lead > 0 && r->odoms == 0) || r->pillar_missed > 0 ||
+        (check_pillar && (r->ranges == 0 || r->pillar_seen == 0)))
       ok = 0;
     free(robots[i].samples);
   }
   if (teleop != NULL) {
     printf("%s: %.0f force messages, the largest %.3f N\n", teleop, forces, max_force);
     if (forces == 0) ok = 0;
+  }
+  if (image_robot != NULL) {
+    printf("%s: %zu images, %zu not %ux%u rgb8, %zu with more than one colour\n", image_robot, image_count, image_bad,
+           image_size[0], image_size[1], image_varied);
+    if (image_count == 0 || image_bad > 0) ok = 0;
   }
   if (watch != NULL) {
     printf("%s: at %.2f s x %.3f y %.3f; when the commands ended x %.3f y %.3f; at the end x %.3f y %.3f\n", watch,

@@ -35,6 +35,8 @@ inline constexpr ssx_plugin_param kBridgeParameters[] = {
                 "how long the first step waits for every robot's controller to connect"),
     param::real("range_rate_hz", "10", "Hz", param::nonNegative(),
                 "rate of /<robot>/range (what a range sensor sees, as a PoseArray) in simulated time; 0: none"),
+    param::real("image_rate_hz", "10", "Hz", param::nonNegative(),
+                "rate of /<robot>/image (what a camera sensor sees, rgb8) in simulated time; 0: none"),
     param::text("operators", "", "operator extensions bridged: names separated by spaces (/<name>/cmd_vel and "
                 "/<name>/joy in, /<name>/force out)"),
     param::choice("pose_stamps", "sim", "sim wall",
@@ -60,6 +62,8 @@ class BridgeExtension : public SimulationExtension {
     connect_timeout_ = params.get<double>("lockstep_connect_timeout_s");
     range_rate_ = rateOf(params, "range_rate_hz", env.timestep());
     if (params.get<double>("range_rate_hz") == 0) range_rate_.period = 0;
+    image_rate_ = rateOf(params, "image_rate_hz", env.timestep());
+    if (params.get<double>("image_rate_hz") == 0) image_rate_.period = 0;
     wall_stamps_ = params.get<std::string>("pose_stamps") == "wall";
     if (lockstep_ && wall_stamps_)
       throw params.error("pose_stamps=\"wall\" cannot be lock-stepped (the wall clock is not the same twice): use "
@@ -74,10 +78,12 @@ class BridgeExtension : public SimulationExtension {
       for (std::size_t k = 0; k < a->sensorCount(); ++k) {
         if (r.imu == nullptr) r.imu = dynamic_cast<const ImuMeasurement*>(&a->sensor(k).latest());
         if (r.range == nullptr) r.range = dynamic_cast<const RangeMeasurement*>(&a->sensor(k).latest());
+        if (r.camera == nullptr) r.camera = dynamic_cast<const CameraMeasurement*>(&a->sensor(k).latest());
       }
       RobotTopics t{a->name(), r.imu != nullptr && imu_rate_.period > 0, r.tracker != nullptr, r.commands != nullptr};
       t.ghost = env.isGhost(*a);
       t.range = r.range != nullptr && range_rate_.period > 0;
+      t.image = r.camera != nullptr && image_rate_.period > 0;
       topics.push_back(t);
       robots_.push_back(r);
     }
@@ -210,6 +216,15 @@ class BridgeExtension : public SimulationExtension {
         transport_->publishRange(i, toSeconds(r.range->stamp), r.range->body_frame, points_);
       }
     }
+    if (image_rate_.due(now)) {
+      for (std::size_t i = 0; i < robots_.size(); ++i) {
+        Robot& r = robots_[i];
+        if (r.camera == nullptr || r.camera->stamp == r.image_published || r.camera->image.rgb.empty()) continue;
+        r.image_published = r.camera->stamp;
+        transport_->publishImage(i, toSeconds(r.camera->stamp), r.camera->image.width, r.camera->image.height,
+                                 r.camera->image.rgb);
+      }
+    }
     for (std::size_t k = 0; k < operators_.size(); ++k) {
       Operator& o = operators_[k];
       if (o.force_rate.period == 0) {
@@ -260,7 +275,9 @@ class BridgeExtension : public SimulationExtension {
     CommandInterface* commands = nullptr;  // takes velocity commands
     const ImuMeasurement* imu = nullptr;
     const RangeMeasurement* range = nullptr;
+    const CameraMeasurement* camera = nullptr;
     Nanoseconds range_published = -1;             // the stamp of the range last published
+    Nanoseconds image_published = -1;             // of the image last published
     std::uint64_t setpoints = 0, velocities = 0;  // applied so far
     std::uint64_t bad_poses = 0;                  // a ghost's poses refused (not finite, not a rotation)
   };
@@ -372,7 +389,7 @@ class BridgeExtension : public SimulationExtension {
   std::unique_ptr<Transport> transport_;
   std::vector<Robot> robots_;
   std::vector<Operator> operators_;  // their topics follow the robots'
-  Rate odom_rate_, imu_rate_, clock_rate_, range_rate_;
+  Rate odom_rate_, imu_rate_, clock_rate_, range_rate_, image_rate_;
   bool wall_stamps_ = false;
   double cutoff_ = -1;                 // lock-step: poses stamped later wait
   std::vector<PoseSample> arrived_, held_;

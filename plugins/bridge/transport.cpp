@@ -79,23 +79,40 @@ void Transport::publishForce(std::size_t robot, double time, const std::array<do
   staged_.push_back(m);
 }
 
+void Transport::publishImage(std::size_t robot, double time, int width, int height, const std::vector<std::uint8_t>& rgb) {
+  if (!robots_.at(robot).image) return;
+  Outgoing m;
+  m.kind = Outgoing::Kind::Image;
+  m.robot = robot;
+  m.time = time;
+  m.width = width;
+  m.height = height;
+  m.first = staged_bytes_.size();
+  m.count = rgb.size();
+  staged_bytes_.insert(staged_bytes_.end(), rgb.begin(), rgb.end());
+  staged_.push_back(m);
+}
+
 void Transport::commit() {
   if (staged_.empty()) return;  // (most steps publish nothing: no lock, no wake-up)
   {
     // one lock per step, however many robots: the buffers trade places, so none is allocated
     std::lock_guard<std::mutex> lock(queue_mutex_);
-    if (queue_.empty() && queue_points_.empty()) {
+    if (queue_.empty()) {
       queue_.swap(staged_);
       queue_points_.swap(staged_points_);
+      queue_bytes_.swap(staged_bytes_);
     } else {
-      const std::size_t offset = queue_points_.size();
-      for (Outgoing& m : staged_) m.first += offset;
+      const std::size_t points = queue_points_.size(), bytes = queue_bytes_.size();
+      for (Outgoing& m : staged_) m.first += m.kind == Outgoing::Kind::Image ? bytes : points;
       queue_.insert(queue_.end(), staged_.begin(), staged_.end());
       queue_points_.insert(queue_points_.end(), staged_points_.begin(), staged_points_.end());
+      queue_bytes_.insert(queue_bytes_.end(), staged_bytes_.begin(), staged_bytes_.end());
     }
   }
   staged_.clear();
   staged_points_.clear();
+  staged_bytes_.clear();
   queue_changed_.notify_all();
 }
 
@@ -106,10 +123,12 @@ void Transport::publishLoop() {
     if (queue_.empty() && stop_) return;
     sending_.swap(queue_);
     sending_points_.swap(queue_points_);
+    sending_bytes_.swap(queue_bytes_);
     busy_ = true;
     lock.unlock();
     for (Outgoing& m : sending_) {
       if (m.kind == Outgoing::Kind::Range) m.points = sending_points_.data() + m.first;
+      if (m.kind == Outgoing::Kind::Image) m.bytes = sending_bytes_.data() + m.first;
       if (m.kind == Outgoing::Kind::Odometry && m.robot == 0) {  // the round trip starts when it leaves
         std::lock_guard<std::mutex> guard(mutex_);
         sent_[nanos(m.odometry.time)] = std::chrono::steady_clock::now();
@@ -119,6 +138,7 @@ void Transport::publishLoop() {
     }
     sending_.clear();
     sending_points_.clear();
+    sending_bytes_.clear();
     lock.lock();
     busy_ = false;
     queue_changed_.notify_all();  // (flush waits for this)

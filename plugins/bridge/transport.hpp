@@ -74,11 +74,12 @@ struct RobotTopics {
   bool odom = true;       // publishes /<name>/odom (every robot; not an operator)
   bool joy = false;       // takes /<name>/joy (an operator)
   bool force = false;     // publishes /<name>/force (an operator: a WrenchStamped)
+  bool image = false;     // publishes /<name>/image (what its camera sees: rgb8)
 };
 
 /// One message to send: what the stepping thread stages.
 struct Outgoing {
-  enum class Kind : std::uint8_t { Clock, Odometry, Imu, Range, Force } kind = Kind::Clock;
+  enum class Kind : std::uint8_t { Clock, Odometry, Imu, Range, Force, Image } kind = Kind::Clock;
   std::size_t robot = 0;
   double time = 0;  // the clock's, the range's, the force's
   std::array<double, 3> force{};  // N, world frame
@@ -88,6 +89,10 @@ struct Outgoing {
   bool body_frame = false;
   std::size_t first = 0, count = 0;
   const std::array<double, 3>* points = nullptr;  // set for send(): the first of them
+  // an image: width x height rgb8 pixels, row by row from the top, [first, first + count) of the
+  // bytes staged with it
+  int width = 0, height = 0;
+  const std::uint8_t* bytes = nullptr;  // set for send(): the first of them
 };
 
 class Transport {
@@ -108,6 +113,7 @@ class Transport {
   // `points`: the detections' positions relative to the robot, nearest first
   void publishRange(std::size_t robot, double time, bool body_frame, const std::vector<std::array<double, 3>>& points);
   void publishForce(std::size_t robot, double time, const std::array<double, 3>& force);
+  void publishImage(std::size_t robot, double time, int width, int height, const std::vector<std::uint8_t>& rgb);
   void commit();
   // Waits until everything staged so far has been sent.
   void flush();
@@ -179,6 +185,7 @@ class Transport {
   std::vector<Outgoing> staged_;           // the stepping thread's, until commit hands them over
   std::vector<Outgoing> queue_, sending_;  // queue_mutex_ guards queue_, busy_, stop_
   std::vector<std::array<double, 3>> staged_points_, queue_points_, sending_points_;  // ranges', likewise
+  std::vector<std::uint8_t> staged_bytes_, queue_bytes_, sending_bytes_;               // images', likewise
   bool busy_ = false, stop_ = false;
   std::thread publisher_;
 };

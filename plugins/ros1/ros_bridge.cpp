@@ -8,6 +8,7 @@
 #include <nav_msgs/Odometry.h>
 #include <ros/ros.h>
 #include <rosgraph_msgs/Clock.h>
+#include <sensor_msgs/Image.h>
 #include <sensor_msgs/Imu.h>
 #include <sensor_msgs/Joy.h>
 
@@ -54,7 +55,7 @@ class RosTransport final : public bridge::Transport {
   std::unique_ptr<ros::NodeHandle> node_;
   std::unique_ptr<ros::AsyncSpinner> spinner_;
   ros::Publisher clock_;
-  std::vector<ros::Publisher> odom_, imu_, range_, force_;
+  std::vector<ros::Publisher> odom_, imu_, range_, force_, image_;
   std::vector<ros::Subscriber> setpoint_subscribers_, velocity_subscribers_, pose_subscribers_, joy_subscribers_;  // per robot (empty where none)
   bool running_ = false;
 };
@@ -82,6 +83,7 @@ RosTransport::RosTransport(const std::string& master_uri, const std::string& nod
   for (std::size_t i = 0; i < robots.size(); ++i) {
     const std::string ns = "/" + robots[i].name;
     odom_.push_back(robots[i].odom ? node_->advertise<nav_msgs::Odometry>(ns + "/odom", 10) : ros::Publisher());
+    image_.push_back(robots[i].image ? node_->advertise<sensor_msgs::Image>(ns + "/image", 2) : ros::Publisher());
     force_.push_back(robots[i].force ? node_->advertise<geometry_msgs::WrenchStamped>(ns + "/force", 10) : ros::Publisher());
     imu_.push_back(robots[i].imu ? node_->advertise<sensor_msgs::Imu>(ns + "/imu", 10) : ros::Publisher());
     ros::Subscriber setpoints, velocities;
@@ -138,6 +140,7 @@ void RosTransport::shutdown() {
   pose_subscribers_.clear();
   joy_subscribers_.clear();
   force_.clear();
+  image_.clear();
   odom_.clear();
   range_.clear();
   imu_.clear();
@@ -177,6 +180,18 @@ void RosTransport::send(const bridge::Outgoing& out) {
       setXyz(m.angular_velocity, u.angular_velocity);
       setXyz(m.linear_acceleration, u.linear_acceleration);
       imu_[out.robot].publish(m);
+      break;
+    }
+    case bridge::Outgoing::Kind::Image: {
+      sensor_msgs::Image m;
+      m.header.stamp = stamp(out.time);
+      m.header.frame_id = robots()[out.robot].name + "/camera";
+      m.height = static_cast<std::uint32_t>(out.height);
+      m.width = static_cast<std::uint32_t>(out.width);
+      m.encoding = "rgb8";
+      m.step = static_cast<std::uint32_t>(3 * out.width);
+      m.data.assign(out.bytes, out.bytes + out.count);
+      image_[out.robot].publish(m);
       break;
     }
     case bridge::Outgoing::Kind::Force: {

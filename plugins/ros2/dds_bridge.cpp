@@ -64,7 +64,8 @@ class DdsTransport final : public bridge::Transport {
 
   dds_entity_t domain_ = 0, participant_ = 0;
   dds_entity_t clock_ = 0;
-  std::vector<dds_entity_t> odom_, imu_, range_, force_;
+  std::vector<dds_entity_t> odom_, imu_, range_, force_, image_;
+  std::vector<std::string> camera_frames_;
   std::vector<Reader> readers_;  // reserved up front: listeners hold pointers to them
   std::vector<std::string> odom_frames_, imu_frames_;
   std::vector<geometry_msgs_msg_dds__Pose_> range_poses_;  // the publishing thread's, reused
@@ -102,6 +103,8 @@ DdsTransport::DdsTransport(int domain, Network network, const std::vector<bridge
     for (const bridge::RobotTopics& r : robots) {
       const std::string ns = "/" + r.name;
       odom_.push_back(r.odom ? writer(&nav_msgs_msg_dds__Odometry__desc, ns + "/odom", Profile::Default) : 0);
+      image_.push_back(r.image ? writer(&sensor_msgs_msg_dds__Image__desc, ns + "/image", Profile::Default) : 0);
+      camera_frames_.push_back(r.name + "/camera");
       force_.push_back(r.force ? writer(&geometry_msgs_msg_dds__WrenchStamped__desc, ns + "/force", Profile::Default) : 0);
       imu_.push_back(r.imu ? writer(&sensor_msgs_msg_dds__Imu__desc, ns + "/imu", Profile::SensorData) : 0);
       range_.push_back(r.range ? writer(&geometry_msgs_msg_dds__PoseArray__desc, ns + "/range", Profile::Default) : 0);
@@ -233,6 +236,20 @@ void DdsTransport::send(const bridge::Outgoing& out) {
       m.angular_velocity = {u.angular_velocity[0], u.angular_velocity[1], u.angular_velocity[2]};
       m.linear_acceleration = {u.linear_acceleration[0], u.linear_acceleration[1], u.linear_acceleration[2]};
       dds_write(imu_[out.robot], &m);
+      break;
+    }
+    case bridge::Outgoing::Kind::Image: {
+      sensor_msgs_msg_dds__Image_ m{};
+      m.header.stamp = stamp(out.time);
+      m.header.frame_id = camera_frames_[out.robot].data();
+      m.height = static_cast<uint32_t>(out.height);
+      m.width = static_cast<uint32_t>(out.width);
+      m.encoding = const_cast<char*>("rgb8");
+      m.step = static_cast<uint32_t>(3 * out.width);
+      m.data._length = m.data._maximum = static_cast<uint32_t>(out.count);
+      m.data._buffer = const_cast<uint8_t*>(out.bytes);
+      m.data._release = false;
+      dds_write(image_[out.robot], &m);
       break;
     }
     case bridge::Outgoing::Kind::Force: {

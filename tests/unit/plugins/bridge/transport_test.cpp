@@ -31,6 +31,7 @@ class Recording final : public Transport {
   using Transport::receivedPose;
   using Transport::receivedJoy;
   std::vector<std::vector<std::array<double, 3>>> points;  // each range's, copied as it is sent
+  std::vector<std::vector<std::uint8_t>> images;            // each image's bytes, likewise
 
  private:
   void send(const Outgoing& m) override {
@@ -38,6 +39,7 @@ class Recording final : public Transport {
     sender = std::this_thread::get_id();
     messages.push_back(m);
     if (m.kind == Outgoing::Kind::Range) points.emplace_back(m.points, m.points + m.count);
+    if (m.kind == Outgoing::Kind::Image) images.emplace_back(m.bytes, m.bytes + m.count);
   }
   bool connected(std::size_t) const override { return peer; }
   mutable std::mutex mutex;
@@ -137,10 +139,12 @@ TEST_CASE("bridge transport: a ghost's poses are all kept, in arrival order, bou
   CHECK(t.posesDropped() == 1100 - Transport::kMaxPosesQueued);
 }
 
-TEST_CASE("bridge transport: a range's points and an operator's force go out with their message", "[bridge]") {
+TEST_CASE("bridge transport: a range's points, an image's bytes and an operator's force go out with their message",
+          "[bridge]") {
   std::vector<RobotTopics> robots = twoRobots();
   robots[0].range = true;
   robots[1].force = true;
+  robots[1].image = true;
   Recording t(robots);
   // many steps committed while the thread sends: each range keeps its own points
   for (int k = 0; k < 200; ++k) {
@@ -148,17 +152,22 @@ TEST_CASE("bridge transport: a range's points and an operator's force go out wit
     t.publishRange(0, k, false, points);
     t.publishRange(1, k, false, points);  // b publishes no range: dropped
     t.publishForce(1, k, {0, double(k), 0});
+    t.publishImage(1, k, 2, 1, std::vector<std::uint8_t>(6, static_cast<std::uint8_t>(k)));
+    t.publishImage(0, k, 2, 1, std::vector<std::uint8_t>(6, 0));  // a has no image topic: dropped
     t.commit();
   }
   t.flush();
   const auto sent = t.sent();
-  REQUIRE(sent.size() == 400);
+  REQUIRE(sent.size() == 600);
   REQUIRE(t.points.size() == 200);
+  REQUIRE(t.images.size() == 200);
   for (std::size_t k = 0; k < 200; ++k) {
     CHECK(t.points[k].size() == k % 5);
     for (const auto& p : t.points[k]) CHECK(p[0] == double(k));
-    CHECK(sent[2 * k + 1].kind == Outgoing::Kind::Force);
-    CHECK(sent[2 * k + 1].force[1] == double(k));
+    CHECK(sent[3 * k + 1].kind == Outgoing::Kind::Force);
+    CHECK(sent[3 * k + 1].force[1] == double(k));
+    CHECK(sent[3 * k + 2].width == 2);
+    CHECK(t.images[k] == std::vector<std::uint8_t>(6, static_cast<std::uint8_t>(k)));
   }
   // a joystick's state: the newest, at most 64 axes and buttons
   std::vector<float> axes(100, 0.5f);

@@ -7,7 +7,8 @@
 # at its nearest point whenever it is in range. An operator (the same peer) steers the four simulated
 # quadrotors by /op0/cmd_vel, 0.4 m/s north for 2 s: sim0 moves 0.8 m (0.6-1.0), then the dead-man
 # rule stops it (at most 0.35 m more); the force on /op0/force comes at 100 Hz. Then lock-stepped
-# (only the ghosts bridged, poses stamped in simulated time): two runs give the same bits.
+# (only the ghosts bridged, poses stamped in simulated time): two runs give the same bits. Last, a
+# ghost's camera (ghost_camera.xml): its pictures of a virtual box come on /eye/image, 64 x 48 rgb8.
 #
 # usage: ghosts_test.sh SSX_BINARY REPLAY_BINARY WORK_DIR
 set -u
@@ -57,3 +58,18 @@ for run in 1 2; do
 done
 cmp "$work/lockstep1.state" "$work/lockstep2.state" || { echo "two lock-stepped runs differ"; exit 1; }
 echo "two lock-stepped runs: the same bits"
+
+# a ghost's camera: images of the simulated world on /eye/image
+printf 't,robot,x,y,z,qw,qx,qy,qz\n' > "$work/eye.csv"
+for k in $(seq 0 30); do printf '%s,eye,0,0,1,1,0,0,0\n' "$(awk -v k="$k" 'BEGIN { print k * 0.1 }')" >> "$work/eye.csv"; done
+"$replay" "$work/eye.csv" --lead 0.2 --image eye 64 48 > "$work/eye.out" 2>&1 &
+replay_pid=$!
+"$ssx" run "$here/ghost_camera.xml" --realtime --quiet > "$work/ssx_eye.out" 2>&1
+ssx_status=$?
+wait "$replay_pid"
+replay_status=$?
+cat "$work/eye.out" "$work/ssx_eye.out"
+[ $ssx_status -eq 0 ] && [ $replay_status -eq 0 ] || { echo "camera run: ssx exit $ssx_status, replay exit $replay_status"; exit 1; }
+read -r images varied < <(sed -n 's/^eye: \([0-9]*\) images, 0 not 64x48 rgb8, \([0-9]*\) with more than one colour$/\1 \2/p' "$work/eye.out")
+[ -n "${varied:-}" ] && [ "$images" -ge 10 ] && [ "$varied" -eq "$images" ] || { echo "eye: not 10 or more images, each with the box in it"; exit 1; }
+echo "eye: $images images of the virtual box"
