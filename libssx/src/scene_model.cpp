@@ -115,7 +115,8 @@ void plugin(Element& e, const PluginDeclaration& p) {
 }
 
 void overrides(std::ostringstream& out, const PlacementModel& p, Element& e) {
-  const bool any = p.driver != nullptr || std::any_of(p.sensors.begin(), p.sensors.end(), [](const auto& s) { return s != nullptr; });
+  const bool any = p.driver != nullptr || p.ghost ||
+                   std::any_of(p.sensors.begin(), p.sensors.end(), [](const auto& s) { return s != nullptr; });
   if (!any) {
     e.end();
     return;
@@ -124,6 +125,10 @@ void overrides(std::ostringstream& out, const PlacementModel& p, Element& e) {
   if (p.driver != nullptr) verbatim(out, *p.driver, 2);
   for (const auto& s : p.sensors)
     if (s != nullptr) verbatim(out, *s, 2);
+  if (p.ghost)
+    Element(out, "ghost", 2)("timeout", num(p.ghost->timeout))("horizon", num(p.ghost->horizon))(
+        "capacity", num(static_cast<double>(p.ghost->capacity)))
+        .end();
   e.close();
 }
 

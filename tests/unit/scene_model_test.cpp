@@ -23,10 +23,10 @@ SceneOptions testOptions() {
   return o;
 }
 
-// the scenes of the examples and the valid test data: each is a scene file, not an artifact file
+// the scenes of the examples (ghosts.xml: real robots) and the valid test data: each is a scene file, not an artifact file
 std::vector<fs::path> scenes() {
   std::vector<fs::path> out;
-  for (const fs::path& dir : {kExamples / "scenes", kData / "valid", kData / "valid" / "render"})
+  for (const fs::path& dir : {kExamples / "scenes", kExamples / "hardware_in_the_loop", kData / "valid", kData / "valid" / "render"})
     for (const auto& entry : fs::directory_iterator(dir)) {
       if (entry.path().extension() != ".xml") continue;
       std::ifstream in(entry.path());
