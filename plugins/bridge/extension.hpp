@@ -157,7 +157,13 @@ class BridgeExtension : public SimulationExtension {
       if (new_joy && !(new_velocity && j.order < v.order)) joy();
     }
     transport_->takePoses(arrived_);
-    held_.insert(held_.end(), arrived_.begin(), arrived_.end());
+    // a peer sending poses stamped far ahead (held until due when lock-stepped) cannot make them
+    // pile up: beyond what the transport would queue for every robot, the last to arrive (the
+    // furthest ahead) are dropped, counted with the transport's
+    const std::size_t most = Transport::kMaxPosesQueued * robots_.size();
+    const std::size_t take = std::min(arrived_.size(), most > held_.size() ? most - held_.size() : 0);
+    held_dropped_ += arrived_.size() - take;
+    held_.insert(held_.end(), arrived_.begin(), arrived_.begin() + static_cast<std::ptrdiff_t>(take));
     if (!held_.empty()) applyPoses(env);
     for (std::size_t i = 0; i < robots_.size(); ++i) {
       Robot& r = robots_[i];
@@ -352,7 +358,7 @@ class BridgeExtension : public SimulationExtension {
   }
 
   void logSummary(Environment& env) const {
-    if (poses_applied_ > 0 || transport_->posesDropped() > 0) {
+    if (poses_applied_ > 0 || transport_->posesDropped() + held_dropped_ > 0) {
       std::uint64_t bad = 0;
       for (const Robot& r : robots_) bad += r.bad_poses;
       const AgeSummary ages = env.ghostAges();
@@ -361,7 +367,7 @@ class BridgeExtension : public SimulationExtension {
                     "%s: %llu ghost poses applied, %llu refused, %llu dropped unread; pose age when used median "
                     "%.1f ms, p99 %.1f ms, max %.1f ms",
                     name(), static_cast<unsigned long long>(poses_applied_), static_cast<unsigned long long>(bad),
-                    static_cast<unsigned long long>(transport_->posesDropped()), 1e3 * ages.median, 1e3 * ages.p99,
+                    static_cast<unsigned long long>(transport_->posesDropped() + held_dropped_), 1e3 * ages.median, 1e3 * ages.p99,
                     1e3 * ages.max);
       env.log(LogLevel::Info, text);
     }
@@ -393,7 +399,7 @@ class BridgeExtension : public SimulationExtension {
   bool wall_stamps_ = false;
   double cutoff_ = -1;                 // lock-step: poses stamped later wait
   std::vector<PoseSample> arrived_, held_;
-  std::uint64_t poses_applied_ = 0;
+  std::uint64_t poses_applied_ = 0, held_dropped_ = 0;
   std::vector<std::array<double, 3>> points_;  // a range's, reused
   bool lockstep_ = false;
   double lockstep_timeout_ = 2.0, connect_timeout_ = 10.0;

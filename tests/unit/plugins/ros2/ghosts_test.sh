@@ -7,7 +7,8 @@
 # at its nearest point whenever it is in range. An operator (the same peer) steers the four simulated
 # quadrotors by /op0/cmd_vel, 0.4 m/s north for 2 s: sim0 moves 0.8 m (0.6-1.0), then the dead-man
 # rule stops it (at most 0.35 m more); the force on /op0/force comes at 100 Hz. Then lock-stepped
-# (only the ghosts bridged, poses stamped in simulated time): two runs give the same bits. Last, a
+# (only the ghosts bridged, poses stamped in simulated time): two runs give the same bits, and a
+# peer sending every pose at once cannot make them pile up. Last, a
 # ghost's camera (ghost_camera.xml): its pictures of a virtual box come on /eye/image, 64 x 48 rgb8.
 #
 # usage: ghosts_test.sh SSX_BINARY REPLAY_BINARY WORK_DIR
@@ -58,6 +59,18 @@ for run in 1 2; do
 done
 cmp "$work/lockstep1.state" "$work/lockstep2.state" || { echo "two lock-stepped runs differ"; exit 1; }
 echo "two lock-stepped runs: the same bits"
+# a peer that sends every pose at once (stamped up to 12 s ahead): lock-stepped, the poses not yet
+# due wait, at most 1,024 per robot; the rest are dropped and counted, and the run goes on
+"$replay" "$example/mocap.csv" --lead 100 --quiet > "$work/replay_ahead.out" 2>&1 &
+replay_pid=$!
+"$ssx" run "$work/lockstep.xml" --fast --quiet > "$work/ssx_ahead.out" 2>&1
+ssx_status=$?
+kill "$replay_pid" 2>/dev/null
+wait "$replay_pid" 2>/dev/null
+cat "$work/ssx_ahead.out"
+[ $ssx_status -eq 0 ] || { echo "poses far ahead: ssx exit $ssx_status"; exit 1; }
+grep -Eq "ros2: [0-9]+ ghost poses applied, 0 refused, [1-9][0-9]* dropped unread" "$work/ssx_ahead.out" ||
+  { echo "poses far ahead: none dropped"; exit 1; }
 
 # a ghost's camera: images of the simulated world on /eye/image
 printf 't,robot,x,y,z,qw,qx,qy,qz\n' > "$work/eye.csv"
