@@ -2,7 +2,7 @@
  * a motion-capture system played back from a file, and an operator at a joystick.
  *
  *   ssx_hil_peer FILE.csv [--lead S] [--pillar X Y R] [--teleop OP VX VY START_S SECONDS]
- *                [--watch ROBOT] [--image ROBOT W H] [--quiet]
+ *                [--joy OP AXIS0 START_S SECONDS] [--watch ROBOT] [--image ROBOT W H] [--quiet]
  *
  * Motion capture. FILE.csv: a header `t,robot,x,y,z,qw,qx,qy,qz`, then one pose per line (t in
  * simulated seconds, rising per robot). Following ssx's /clock, each pose goes out on /<robot>/pose
@@ -16,7 +16,9 @@
  * Operator. With --teleop, from START_S of simulated time on, for SECONDS, it sends operator OP the
  * velocity VX VY (m/s; a Twist on /OP/cmd_vel, 20 per simulated second), then nothing (the dead-man
  * rule must stop the robots); it reads the force on /OP/force (WrenchStamped) and reports its largest
- * magnitude. --watch ROBOT reports where that robot's odometry was at START_S, when the commands
+ * magnitude. --joy sends operator OP a joystick state (/OP/joy) stamped with each /clock it hears,
+ * its axis 0 AXIS0 from START_S for SECONDS and 0 otherwise (lock-stepped, a joystick answers each
+ * odometry round so). --watch ROBOT reports where that robot's odometry was at START_S, when the commands
  * ended, and at the end. --image ROBOT W H checks that robot's camera on /ROBOT/image: W x H rgb8
  * images, and reports how many came and how many show more than one colour.
  *
@@ -169,6 +171,8 @@ int main(int argc, char** argv) {
   double lead = 0, pillar[3] = {0, 0, 0};
   int check_pillar = 0, quiet = 0;
   const char* teleop = NULL;
+  const char* joy_op = NULL;
+  double joy_axis = 0, joy_start = 0, joy_seconds = 0;
   const char* watch = NULL;
   const char* image_robot = NULL;
   unsigned image_size[2] = {0, 0};
@@ -189,6 +193,11 @@ int main(int argc, char** argv) {
       image_robot = argv[++i];
       image_size[0] = (unsigned)atoi(argv[++i]);
       image_size[1] = (unsigned)atoi(argv[++i]);
+    } else if (strcmp(argv[i], "--joy") == 0 && i + 4 < argc) {
+      joy_op = argv[++i];
+      joy_axis = atof(argv[++i]);
+      joy_start = atof(argv[++i]);
+      joy_seconds = atof(argv[++i]);
     } else if (strcmp(argv[i], "--watch") == 0 && i + 1 < argc) {
       watch = argv[++i];
     } else if (strcmp(argv[i], "--quiet") == 0) {
@@ -196,12 +205,12 @@ int main(int argc, char** argv) {
     } else if (file == NULL && argv[i][0] != '-') {
       file = argv[i];
     } else {
-      fprintf(stderr, "usage: ssx_hil_peer FILE.csv [--lead S] [--pillar X Y R] [--teleop OP VX VY START_S SECONDS] [--watch ROBOT] [--image ROBOT W H] [--quiet]\n");
+      fprintf(stderr, "usage: ssx_hil_peer FILE.csv [--lead S] [--pillar X Y R] [--teleop OP VX VY START_S SECONDS] [--joy OP AXIS0 START_S SECONDS] [--watch ROBOT] [--image ROBOT W H] [--quiet]\n");
       return 1;
     }
   }
   if (file == NULL) {
-    fprintf(stderr, "usage: ssx_hil_peer FILE.csv [--lead S] [--pillar X Y R] [--teleop OP VX VY START_S SECONDS] [--watch ROBOT] [--image ROBOT W H] [--quiet]\n");
+    fprintf(stderr, "usage: ssx_hil_peer FILE.csv [--lead S] [--pillar X Y R] [--teleop OP VX VY START_S SECONDS] [--joy OP AXIS0 START_S SECONDS] [--watch ROBOT] [--image ROBOT W H] [--quiet]\n");
     return 1;
   }
   if (readFile(file) != 0) return 1;
@@ -231,6 +240,10 @@ int main(int argc, char** argv) {
     force = dds_create_reader(participant, topic(participant, &geometry_msgs_msg_dds__WrenchStamped__desc, teleop, "force"),
                               reliable, NULL);
   }
+  dds_entity_t joy = 0;
+  double joy_sent_at = -1;
+  if (joy_op != NULL)
+    joy = dds_create_writer(participant, topic(participant, &sensor_msgs_msg_dds__Joy__desc, joy_op, "joy"), reliable, NULL);
   dds_entity_t images = 0;
   size_t image_count = 0, image_bad = 0, image_varied = 0;
   if (image_robot != NULL)
@@ -330,6 +343,18 @@ int main(int argc, char** argv) {
       m.linear.y = teleop_v[1];
       dds_write(twist, &m);
       next_twist += 0.05;
+    }
+    if (joy != 0 && now > joy_sent_at) {
+      float axes[4] = {0, 0, 0, 0};
+      if (now >= joy_start && now < joy_start + joy_seconds) axes[0] = (float)joy_axis;
+      sensor_msgs_msg_dds__Joy_ m;
+      memset(&m, 0, sizeof m);
+      m.header.stamp = stamp(now);
+      m.header.frame_id = "";
+      m.axes._buffer = axes;
+      m.axes._length = m.axes._maximum = 4;
+      dds_write(joy, &m);
+      joy_sent_at = now;
     }
     while (force != 0 && dds_take(force, samples, info, 1, 1) > 0) {
       if (info[0].valid_data) {

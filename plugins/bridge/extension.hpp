@@ -136,7 +136,7 @@ class BridgeExtension : public SimulationExtension {
     // each robot's newest set-point and velocity command, applied between steps in the order they
     // arrived, and every pose of a ghost (most steps nothing did: then no robot is looked up)
     const std::uint64_t received = transport_->received();
-    if (received == received_seen_) {
+    if (received == received_seen_ && !(lockstep_ && !operators_.empty())) {
       if (!held_.empty()) applyPoses(env);
       return;
     }
@@ -147,9 +147,12 @@ class BridgeExtension : public SimulationExtension {
       const std::size_t i = robots_.size() + k;
       const Velocity v = transport_->latestVelocity(i);
       const Joy j = transport_->latestJoy(i);
-      const bool new_velocity = v.count != o.velocities, new_joy = j.count != o.joys;
+      const bool new_velocity = v.count != o.velocities;
+      // (lock-stepped, a joystick state is used once the odometry it answers is: the same step in
+      // every run; a newer one that came meanwhile replaces it)
+      const bool new_joy = j.count != o.joys && (!lockstep_ || j.stamp <= cutoff_ + 1e-9);
       o.velocities = v.count;
-      o.joys = j.count;
+      if (new_joy) o.joys = j.count;
       auto velocity = [&] { o.op->command(Vec3(v.linear[0], v.linear[1], v.linear[2]), v.angular[2]); };
       auto joy = [&] { o.op->joy(j.axes, j.buttons); };
       if (new_velocity && new_joy && j.order < v.order) joy();

@@ -212,16 +212,20 @@ void Transport::receivedPose(std::size_t robot, double stamp, const std::array<d
   arrived_.notify_all();
 }
 
-void Transport::receivedJoy(std::size_t robot, const float* axes, std::size_t axis_count, const int* buttons,
-                            std::size_t button_count) {
+void Transport::receivedJoy(std::size_t robot, double stamp, const float* axes, std::size_t axis_count,
+                            const int* buttons, std::size_t button_count) {
   constexpr std::size_t kMax = 64;
-  std::lock_guard<std::mutex> lock(mutex_);
-  Joy& j = joys_.at(robot);
-  j.axes.assign(axes, axes + std::min(axis_count, kMax));
-  j.buttons.assign(buttons, buttons + std::min(button_count, kMax));
-  ++j.count;
-  j.order = ++received_;
-  received_count_.store(received_, std::memory_order_release);
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    Joy& j = joys_.at(robot);
+    j.stamp = stamp;
+    j.axes.assign(axes, axes + std::min(axis_count, kMax));
+    j.buttons.assign(buttons, buttons + std::min(button_count, kMax));
+    ++j.count;
+    j.order = ++received_;
+    received_count_.store(received_, std::memory_order_release);
+  }
+  arrived_.notify_all();
 }
 
 Joy Transport::latestJoy(std::size_t robot) const {
@@ -255,7 +259,7 @@ std::vector<std::string> Transport::missingSetpoints(double time) const {
   std::vector<std::string> names;
   for (std::size_t i = 0; i < robots_.size(); ++i)
     if ((robots_[i].setpoint && (setpoints_[i].count == 0 || setpoints_[i].stamp < time - 1e-9)) ||
-        (robots_[i].ghost && newest_pose_[i] < time - 1e-9))
+        (robots_[i].ghost && newest_pose_[i] < time - 1e-9) || (robots_[i].joy && joys_[i].stamp < time - 1e-9))
       names.push_back(robots_[i].name);
   return names;
 }
@@ -272,7 +276,7 @@ std::vector<std::string> Transport::waitForPeers(double timeout_s) const {
   for (;;) {
     missing.clear();
     for (std::size_t i = 0; i < robots_.size(); ++i)
-      if ((robots_[i].setpoint || robots_[i].ghost) && !connected(i)) missing.push_back(robots_[i].name);
+      if ((robots_[i].setpoint || robots_[i].ghost || robots_[i].joy) && !connected(i)) missing.push_back(robots_[i].name);
     if (missing.empty() || std::chrono::steady_clock::now() >= deadline) return missing;
     std::this_thread::sleep_for(std::chrono::milliseconds(20));
   }

@@ -58,6 +58,7 @@ struct PoseSample {
 };
 
 struct Joy {
+  double stamp = -1;  // header.stamp, seconds (-1: none yet)
   std::vector<float> axes;
   std::vector<int> buttons;
   std::uint64_t count = 0;  // received so far for this operator
@@ -130,10 +131,10 @@ class Transport {
   static constexpr std::size_t kMaxPosesQueued = 1024;
   std::uint64_t posesDropped() const;
   // Waits until every robot with a set-point topic has one stamped at or after `time` (seconds),
-  // and every ghost a pose, at most `timeout_s`; returns the names of those still missing (empty:
-  // all there).
+  // every ghost a pose and every operator a joystick state, at most `timeout_s`; returns the names
+  // of those still missing (empty: all there).
   std::vector<std::string> waitForSetpoints(double time, double timeout_s) const;
-  // Waits until every robot that takes set-points has its peers (connected()), at most
+  // Waits until every robot that takes set-points or poses, and every operator, has its peers (connected()), at most
   // `timeout_s`; returns the names of the robots still unconnected.
   std::vector<std::string> waitForPeers(double timeout_s) const;
   // Round trips in wall-clock seconds: from sending the odometry of time t (robot 0's) to receiving
@@ -157,7 +158,7 @@ class Transport {
   void receivedPose(std::size_t robot, double stamp, const std::array<double, 3>& position,
                     const std::array<double, 4>& orientation_wxyz);
   // (at most 64 axes and 64 buttons are kept: a client cannot make it allocate more)
-  void receivedJoy(std::size_t robot, const float* axes, std::size_t axis_count, const int* buttons,
+  void receivedJoy(std::size_t robot, double stamp, const float* axes, std::size_t axis_count, const int* buttons,
                    std::size_t button_count);
 
  private:

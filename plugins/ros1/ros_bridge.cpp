@@ -47,9 +47,10 @@ class RosTransport final : public bridge::Transport {
   void send(const bridge::Outgoing& out) override;
   bool connected(std::size_t robot) const override {
     const bridge::RobotTopics& r = robots()[robot];
-    return odom_[robot].getNumSubscribers() > 0 &&
+    return (!r.odom || odom_[robot].getNumSubscribers() > 0) &&
            (!r.setpoint || setpoint_subscribers_[robot].getNumPublishers() > 0) &&
-           (!r.ghost || pose_subscribers_[robot].getNumPublishers() > 0);
+           (!r.ghost || pose_subscribers_[robot].getNumPublishers() > 0) &&
+           (!r.joy || joy_subscribers_[robot].getNumPublishers() > 0);
   }
 
   std::unique_ptr<ros::NodeHandle> node_;
@@ -115,7 +116,7 @@ RosTransport::RosTransport(const std::string& master_uri, const std::string& nod
     ros::Subscriber joys;
     if (robots[i].joy) {
       auto on_joy = [this, i](const sensor_msgs::Joy::ConstPtr& m) {
-        receivedJoy(i, m->axes.data(), m->axes.size(), m->buttons.data(), m->buttons.size());
+        receivedJoy(i, m->header.stamp.toSec(), m->axes.data(), m->axes.size(), m->buttons.data(), m->buttons.size());
       };
       joys = node_->subscribe<sensor_msgs::Joy>(ns + "/joy", 10, on_joy, ros::VoidConstPtr(), ros::TransportHints().tcpNoDelay());
     }

@@ -178,7 +178,8 @@ void DdsTransport::onData(dds_entity_t reader, void* arg) {
     if (info[0].valid_data) {
       if (r.kind == Reader::Kind::Joy) {
         const auto& m = *static_cast<const sensor_msgs_msg_dds__Joy_*>(samples[0]);
-        r.self->receivedJoy(r.robot, m.axes._buffer, m.axes._length, m.buttons._buffer, m.buttons._length);
+        r.self->receivedJoy(r.robot, seconds(m.header.stamp), m.axes._buffer, m.axes._length, m.buttons._buffer,
+                            m.buttons._length);
       } else if (r.kind == Reader::Kind::Velocity) {
         const auto& m = *static_cast<const geometry_msgs_msg_dds__Twist_*>(samples[0]);
         r.self->receivedVelocity(r.robot, {m.linear.x, m.linear.y, m.linear.z}, {m.angular.x, m.angular.y, m.angular.z});
@@ -198,9 +199,10 @@ void DdsTransport::onData(dds_entity_t reader, void* arg) {
 
 bool DdsTransport::connected(std::size_t robot) const {
   dds_publication_matched_status_t out{};
-  if (dds_get_publication_matched_status(odom_[robot], &out) < 0 || out.current_count == 0) return false;
+  if (odom_[robot] != 0 && (dds_get_publication_matched_status(odom_[robot], &out) < 0 || out.current_count == 0))
+    return false;
   for (const Reader& r : readers_) {
-    if (r.robot != robot || r.kind == Reader::Kind::Velocity || r.kind == Reader::Kind::Joy) continue;
+    if (r.robot != robot || r.kind == Reader::Kind::Velocity) continue;
     dds_subscription_matched_status_t in{};
     if (dds_get_subscription_matched_status(r.entity, &in) < 0 || in.current_count == 0) return false;
   }

@@ -172,9 +172,10 @@ TEST_CASE("bridge transport: a range's points, an image's bytes and an operator'
   // a joystick's state: the newest, at most 64 axes and buttons
   std::vector<float> axes(100, 0.5f);
   std::vector<int> buttons(3, 1);
-  t.receivedJoy(1, axes.data(), axes.size(), buttons.data(), buttons.size());
+  t.receivedJoy(1, 0.5, axes.data(), axes.size(), buttons.data(), buttons.size());
   const Joy j = t.latestJoy(1);
   CHECK(j.count == 1);
+  CHECK(j.stamp == 0.5);
   CHECK(j.axes.size() == 64);
   CHECK(j.buttons == std::vector<int>{1, 1, 1});
 }

@@ -7,7 +7,8 @@
 # at its nearest point whenever it is in range. An operator (the same peer) steers the four simulated
 # quadrotors by /op0/cmd_vel, 0.4 m/s north for 2 s: sim0 moves 0.8 m (0.6-1.0), then the dead-man
 # rule stops it (at most 0.35 m more); the force on /op0/force comes at 100 Hz. Then lock-stepped
-# (only the ghosts bridged, poses stamped in simulated time): two runs give the same bits, and a
+# (only the ghosts and the operator bridged, poses and the operator's joystick stamped in simulated
+# time; the joystick steers the four for 2 s): two runs give the same bits, and a
 # peer sending every pose at once cannot make them pile up. Last, a
 # ghost's camera (ghost_camera.xml): its pictures of a virtual box come on /eye/image, 64 x 48 rgb8.
 #
@@ -44,11 +45,11 @@ grep -q "operator: 40 commands, 1 stops by the dead-man rule" "$work/ssx.out" ||
 
 # lock-stepped twice: the same bits
 sed -e 's#file="../artifacts/#file="'"$example"'/../artifacts/#' \
-    -e 's#<extension name="ros" plugin="ros2" range_rate_hz="20" operators="op0"/>#<extension name="ros" plugin="ros2" artifacts="real0 real1" lockstep="true" range_rate_hz="20"/>#' \
+    -e 's#<extension name="ros" plugin="ros2" range_rate_hz="20" operators="op0"/>#<extension name="ros" plugin="ros2" artifacts="real0 real1" lockstep="true" range_rate_hz="20" operators="op0"/>#' \
     -e 's#duration="12"#duration="4"#' "$example/ghosts.xml" > "$work/lockstep.xml"
 grep -q 'lockstep="true"' "$work/lockstep.xml" || { echo "the example's extension line changed: update this test"; exit 1; }
 for run in 1 2; do
-  "$replay" "$example/mocap.csv" --lead 0.05 --quiet > "$work/replay_lockstep$run.out" 2>&1 &
+  "$replay" "$example/mocap.csv" --lead 0.05 --joy op0 0.8 1 2 --quiet > "$work/replay_lockstep$run.out" 2>&1 &
   replay_pid=$!
   "$ssx" run "$work/lockstep.xml" --fast --quiet --save-state "$work/lockstep$run.state" > "$work/ssx_lockstep$run.out" 2>&1
   ssx_status=$?
@@ -57,11 +58,12 @@ for run in 1 2; do
   cat "$work/ssx_lockstep$run.out"
   [ $ssx_status -eq 0 ] || { echo "lock-stepped run $run: ssx exit $ssx_status"; exit 1; }
 done
+grep -q "operator: [1-9][0-9]* commands" "$work/ssx_lockstep1.out" || { echo "lock-stepped: op0 was not steered"; exit 1; }
 cmp "$work/lockstep1.state" "$work/lockstep2.state" || { echo "two lock-stepped runs differ"; exit 1; }
 echo "two lock-stepped runs: the same bits"
 # a peer that sends every pose at once (stamped up to 12 s ahead): lock-stepped, the poses not yet
 # due wait, at most 1,024 per robot; the rest are dropped and counted, and the run goes on
-"$replay" "$example/mocap.csv" --lead 100 --quiet > "$work/replay_ahead.out" 2>&1 &
+"$replay" "$example/mocap.csv" --lead 100 --joy op0 0 0 0 --quiet > "$work/replay_ahead.out" 2>&1 &
 replay_pid=$!
 "$ssx" run "$work/lockstep.xml" --fast --quiet > "$work/ssx_ahead.out" 2>&1
 ssx_status=$?
