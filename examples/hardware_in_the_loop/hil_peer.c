@@ -1,7 +1,7 @@
 /* ssx_hil_peer: the people and machines outside a hardware-in-the-loop run, as a ROS 2 node on DDS:
  * a motion-capture system played back from a file, and an operator at a joystick.
  *
- *   ssx_hil_peer FILE.csv [--lead S] [--pillar X Y R] [--teleop OP VX VY START_S SECONDS]
+ *   ssx_hil_peer FILE.csv [--lead S] [--wall-stamps] [--pillar X Y R] [--teleop OP VX VY START_S SECONDS]
  *                [--joy OP AXIS0 START_S SECONDS] [--watch ROBOT] [--image ROBOT W H] [--quiet]
  *
  * Motion capture. FILE.csv: a header `t,robot,x,y,z,qw,qx,qy,qz`, then one pose per line (t in
@@ -132,7 +132,9 @@ static int readFile(const char* path) {
 }
 
 /* the file's position of robot r at time t, interpolated; 0 when t is outside its samples or the
- * later of the two was sent less than 20 ms of simulated time before t (it may not have arrived) */
+ * later of the two was sent less than half the lead before t in simulated time (it may not have
+ * arrived yet on a loaded machine) */
+static double margin = 0.02;
 static int positionAt(const Robot* r, double t, double out[3]) {
   if (r->count < 2 || t < r->samples[0].t || t > r->samples[r->count - 1].t) return 0;
   size_t lo = 0, hi = r->count - 1;
@@ -142,7 +144,7 @@ static int positionAt(const Robot* r, double t, double out[3]) {
   }
   const Sample* a = &r->samples[lo];
   const Sample* b = &r->samples[hi];
-  if (hi >= r->sent || b->sent_at + 0.02 > t) return 0;
+  if (hi >= r->sent || b->sent_at + margin > t) return 0;
   const double u = (t - a->t) / (b->t - a->t);
   out[0] = a->x + u * (b->x - a->x);
   out[1] = a->y + u * (b->y - a->y);
@@ -169,7 +171,7 @@ static dds_entity_t topic(dds_entity_t participant, const dds_topic_descriptor_t
 int main(int argc, char** argv) {
   const char* file = NULL;
   double lead = 0, pillar[3] = {0, 0, 0};
-  int check_pillar = 0, quiet = 0;
+  int check_pillar = 0, quiet = 0, wall_stamps = 0;
   const char* teleop = NULL;
   const char* joy_op = NULL;
   double joy_axis = 0, joy_start = 0, joy_seconds = 0;
@@ -200,20 +202,23 @@ int main(int argc, char** argv) {
       joy_seconds = atof(argv[++i]);
     } else if (strcmp(argv[i], "--watch") == 0 && i + 1 < argc) {
       watch = argv[++i];
+    } else if (strcmp(argv[i], "--wall-stamps") == 0) {
+      wall_stamps = 1;
     } else if (strcmp(argv[i], "--quiet") == 0) {
       quiet = 1;
     } else if (file == NULL && argv[i][0] != '-') {
       file = argv[i];
     } else {
-      fprintf(stderr, "usage: ssx_hil_peer FILE.csv [--lead S] [--pillar X Y R] [--teleop OP VX VY START_S SECONDS] [--joy OP AXIS0 START_S SECONDS] [--watch ROBOT] [--image ROBOT W H] [--quiet]\n");
+      fprintf(stderr, "usage: ssx_hil_peer FILE.csv [--lead S] [--wall-stamps] [--pillar X Y R] [--teleop OP VX VY START_S SECONDS] [--joy OP AXIS0 START_S SECONDS] [--watch ROBOT] [--image ROBOT W H] [--quiet]\n");
       return 1;
     }
   }
   if (file == NULL) {
-    fprintf(stderr, "usage: ssx_hil_peer FILE.csv [--lead S] [--pillar X Y R] [--teleop OP VX VY START_S SECONDS] [--joy OP AXIS0 START_S SECONDS] [--watch ROBOT] [--image ROBOT W H] [--quiet]\n");
+    fprintf(stderr, "usage: ssx_hil_peer FILE.csv [--lead S] [--wall-stamps] [--pillar X Y R] [--teleop OP VX VY START_S SECONDS] [--joy OP AXIS0 START_S SECONDS] [--watch ROBOT] [--image ROBOT W H] [--quiet]\n");
     return 1;
   }
   if (readFile(file) != 0) return 1;
+  if (lead > 0) margin = lead / 2;
 
   const char* domain_env = getenv("ROS_DOMAIN_ID");
   const dds_domainid_t domain = domain_env != NULL ? (dds_domainid_t)atoi(domain_env) : 0;
@@ -283,7 +288,13 @@ int main(int argc, char** argv) {
         s->sent_at = now;
         geometry_msgs_msg_dds__PoseStamped_ m;
         memset(&m, 0, sizeof m);
-        m.header.stamp = stamp(s->t);
+        if (wall_stamps) {
+          struct timespec ts;
+          clock_gettime(CLOCK_REALTIME, &ts);
+          m.header.stamp = stamp((double)ts.tv_sec + ts.tv_nsec * 1e-9 + (s->t - now));
+        } else {
+          m.header.stamp = stamp(s->t);
+        }
         m.header.frame_id = "world";
         m.pose.position.x = s->x;
         m.pose.position.y = s->y;

@@ -1,6 +1,6 @@
 #!/usr/bin/python3
 """What is outside a hardware-in-the-loop run, over ROS 1 (a rospy node): the example's motion
-capture (examples/hardware_in_the_loop/mocap.csv) sent on /<robot>/pose 50 ms ahead of the
+capture (examples/hardware_in_the_loop/mocap.csv) sent on /<robot>/pose 200 ms ahead of the
 simulated clock, an operator steering op0 north at 0.4 m/s from 4 to 6 s of simulated time.
 
 Checks: each ghost's odometry is the file's poses interpolated at its stamp (within 1 mm, where the
@@ -23,7 +23,8 @@ from geometry_msgs.msg import PoseArray, PoseStamped, Twist, WrenchStamped
 from nav_msgs.msg import Odometry
 from rosgraph_msgs.msg import Clock
 
-LEAD, PILLAR, RADIUS, RANGE = 0.05, (2.0, 0.0), 0.25, 2.5
+LEAD, PILLAR, RADIUS, RANGE = 0.2, (2.0, 0.0), 0.25, 2.5
+MARGIN = LEAD / 2  # a pose counts as arrived this long (simulated time) after it was sent
 
 
 def main():
@@ -43,11 +44,11 @@ def main():
     sim0 = {}
 
     def position(name, t):
-        """the file's position at t, interpolated, when both poses around it were sent 20 ms before"""
+        """the file's position at t, interpolated, when both poses around it were sent MARGIN before"""
         s = samples[name]
         times = [p[0] for p in s]
         hi = bisect.bisect_right(times, t)
-        if hi == 0 or hi >= len(s) or hi >= sent[name] or sent_at[name][hi] + 0.02 > t:
+        if hi == 0 or hi >= len(s) or hi >= sent[name] or sent_at[name][hi] + MARGIN > t:
             return None
         a, b = s[hi - 1], s[hi]
         u = (t - a[0]) / (b[0] - a[0])

@@ -1,7 +1,7 @@
 #!/bin/bash
 # ctest (plugins/bridge over ROS 1: ghosts and operators): the hardware-in-the-loop example with the
 # ros1 extension, a real ROS master on a free loopback port, and a rospy peer (ghosts_peer.py) that
-# sends the real robots' motion capture 50 ms ahead of /clock and steers op0; it checks that each
+# sends the real robots' motion capture 200 ms ahead of /clock and steers op0; it checks that each
 # ghost's odometry is the interpolation of its poses, that its /range shows the virtual pillar, that
 # /op0/force comes and that the operator's command moved sim0 and the dead-man rule stopped it.
 # Exits 77 (ctest: skipped) when ROS 1 is not installed.

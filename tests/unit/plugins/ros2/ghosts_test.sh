@@ -1,7 +1,7 @@
 #!/bin/bash
 # ctest (plugins/bridge: ghosts over ROS 2): the hardware-in-the-loop example as its docs run it. Two
 # real quadrotors' motion capture (examples/hardware_in_the_loop/mocap.csv) is replayed by a DDS peer
-# that is not ssx (ssx_hil_peer) 50 ms ahead of the simulated clock; ssx places each ghost where
+# that is not ssx (ssx_hil_peer) 200 ms ahead of the simulated clock; ssx places each ghost where
 # the poses say. The peer checks that every ghost's odometry is the interpolation of the poses it
 # sent (within 1 mm: printed to the micrometre) and that each ghost's /range shows the virtual pillar
 # at its nearest point whenever it is in range. An operator (the same peer) steers the four simulated
@@ -9,7 +9,8 @@
 # rule stops it (at most 0.35 m more); the force on /op0/force comes at 100 Hz. Then lock-stepped
 # (only the ghosts and the operator bridged, poses and the operator's joystick stamped in simulated
 # time; the joystick steers the four for 2 s): two runs give the same bits, and a
-# peer sending every pose at once cannot make them pile up. Last, a
+# peer sending every pose at once cannot make them pile up. With wall-clock stamps (pose_stamps="wall")
+# the ghosts are where the poses say within 1 cm. Last, a
 # ghost's camera (ghost_camera.xml): its pictures of a virtual box come on /eye/image, 64 x 48 rgb8.
 #
 # usage: ghosts_test.sh SSX_BINARY REPLAY_BINARY WORK_DIR
@@ -22,7 +23,7 @@ work=$3
 mkdir -p "$work"
 . "$here/dds.sh" 64
 
-"$replay" "$example/mocap.csv" --lead 0.05 --pillar 2 0 0.25 --teleop op0 0 0.4 4 2 --watch sim0 > "$work/replay.out" 2>&1 &
+"$replay" "$example/mocap.csv" --lead 0.2 --pillar 2 0 0.25 --teleop op0 0 0.4 4 2 --watch sim0 > "$work/replay.out" 2>&1 &
 replay_pid=$!
 "$ssx" run "$example/ghosts.xml" --realtime --quiet > "$work/ssx.out" 2>&1
 ssx_status=$?
@@ -49,7 +50,7 @@ sed -e 's#file="../artifacts/#file="'"$example"'/../artifacts/#' \
     -e 's#duration="12"#duration="4"#' "$example/ghosts.xml" > "$work/lockstep.xml"
 grep -q 'lockstep="true"' "$work/lockstep.xml" || { echo "the example's extension line changed: update this test"; exit 1; }
 for run in 1 2; do
-  "$replay" "$example/mocap.csv" --lead 0.05 --joy op0 0.8 1 2 --quiet > "$work/replay_lockstep$run.out" 2>&1 &
+  "$replay" "$example/mocap.csv" --lead 0.2 --joy op0 0.8 1 2 --quiet > "$work/replay_lockstep$run.out" 2>&1 &
   replay_pid=$!
   "$ssx" run "$work/lockstep.xml" --fast --quiet --save-state "$work/lockstep$run.state" > "$work/ssx_lockstep$run.out" 2>&1
   ssx_status=$?
@@ -73,6 +74,25 @@ cat "$work/ssx_ahead.out"
 [ $ssx_status -eq 0 ] || { echo "poses far ahead: ssx exit $ssx_status"; exit 1; }
 grep -Eq "ros2: [0-9]+ ghost poses applied, 0 refused, [1-9][0-9]* dropped unread" "$work/ssx_ahead.out" ||
   { echo "poses far ahead: none dropped"; exit 1; }
+
+# a motion-capture driver's stamps (the system clock): pose_stamps="wall" takes them back to
+# simulated time by their age at arrival; the ghosts are then where the poses say within 1 cm
+# (what moves in the milliseconds a pose takes to arrive, at 0.6 m/s)
+sed -e 's#file="../artifacts/#file="'"$example"'/../artifacts/#' \
+    -e 's#<extension name="ros" plugin="ros2" range_rate_hz="20" operators="op0"/>#<extension name="ros" plugin="ros2" artifacts="real0 real1" pose_stamps="wall"/>#' \
+    -e 's#duration="12"#duration="4"#' "$example/ghosts.xml" > "$work/wall.xml"
+grep -q 'pose_stamps="wall"' "$work/wall.xml" || { echo "the example's extension line changed: update this test"; exit 1; }
+"$replay" "$example/mocap.csv" --lead 0.2 --wall-stamps > "$work/replay_wall.out" 2>&1 &
+replay_pid=$!
+"$ssx" run "$work/wall.xml" --realtime --quiet > "$work/ssx_wall.out" 2>&1
+ssx_status=$?
+wait "$replay_pid"  # (it ends 3 s after the clock stops, the file not done: its own status says so)
+cat "$work/replay_wall.out" "$work/ssx_wall.out"
+[ $ssx_status -eq 0 ] || { echo "wall-clock stamps: ssx exit $ssx_status"; exit 1; }
+for robot in real0 real1; do
+  grep -Eq "^$robot: [0-9]+ of 1201 poses sent; [1-9][0-9]+ odometry messages within 0\.00[0-9]+ m of the file's poses" \
+    "$work/replay_wall.out" || { echo "$robot: not within 1 cm with wall-clock stamps"; exit 1; }
+done
 
 # a ghost's camera: images of the simulated world on /eye/image
 printf 't,robot,x,y,z,qw,qx,qy,qz\n' > "$work/eye.csv"
