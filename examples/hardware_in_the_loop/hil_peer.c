@@ -22,7 +22,8 @@
  * ended, and at the end. --image ROBOT W H checks that robot's camera on /ROBOT/image: W x H rgb8
  * images, and reports how many came and how many show more than one colour.
  *
- * It ends when the file is done and the clock is 0.5 s past its last pose (and the operator's part
+ * It follows the simulated time by /clock and by the robots' odometry stamps (reliable, where the
+ * clock is best effort). It ends when the file is done and the clock is 0.5 s past its last pose (and the operator's part
  * 3 s past its commands), or when the clock stops for 3 s, and prints what it sent and found. Exit 0
  * when every robot was sent every pose, heard, and (with --pillar) the pillar was seen where it is;
  * 1 with a message otherwise (`FILE:LINE: error:` for a bad line). DDS configuration: CYCLONEDDS_URI
@@ -311,6 +312,12 @@ int main(int argc, char** argv) {
           double p[3];
           /* (compared where the file has poses on both sides of the stamp, sent ahead of it) */
           const double t = seconds(m->header.stamp);
+          /* the odometry says the time too, reliably: /clock is best effort, and lock-stepped a
+           * lost one would leave ssx waiting for poses that only a clock tick would send */
+          if (t > now) {
+            now = t;
+            last_tick = wall();
+          }
           if (lead > 0 && t + lead <= end && positionAt(r, t, p)) {
             const double dx = m->pose.pose.position.x - p[0], dy = m->pose.pose.position.y - p[1],
                          dz = m->pose.pose.position.z - p[2];
