@@ -26,8 +26,16 @@ void Artifact::buildNodes(PhysicNode* parent, const PhysicNodeSpec& spec) {
   if (own.node_end == 0) own.first_node = static_cast<std::uint32_t>(index);
   own.node_end = static_cast<std::uint32_t>(index + 1);
   detail::NodeData data;
-  data.is_static = parent != nullptr ? parent->isStatic() : spec.is_static;
+  data.is_static = parent != nullptr ? parent->isStatic() && !spec.joint.isBody() : spec.is_static;
   world_->nodes.push_back(data);
+  world_->node_joint.push_back(-1);
+  if (parent != nullptr && spec.joint.isBody()) {
+    world_->node_joint.back() = static_cast<int>(world_->joints.size());
+    detail::JointData joint;
+    joint.node = static_cast<std::uint32_t>(index);
+    joint.artifact = static_cast<std::uint32_t>(index_);
+    world_->joints.push_back(joint);
+  }
   world_->node_setup.push_back({(parent != nullptr ? parent->pose() : placement_) * spec.pose});
   PhysicNode* node = &world_->node_handles.emplace_back(*world_, *this, spec, parent, index);
   nodes_.push_back(node);
@@ -57,20 +65,31 @@ PhysicNode& Artifact::addPhysicRoot(std::shared_ptr<const PhysicNodeSpec> shared
   // each node's pose in its body, known from here on (load-time checks read it: a quadrotor's
   // rotors), from the tree's own poses: the same in every member of a swarm wherever it was
   // placed (undoing the placement would leave a rounding of it). The nodes were added parents
-  // first, at consecutive indices.
+  // first, at consecutive indices. A body begins at the root and at each joined child.
   const std::size_t offset = nodes_[first]->nodeIndex();
-  std::vector<Pose> in_root(nodes_.size() - first);  // the root's: identity
-  for (std::size_t k = first + 1; k < nodes_.size(); ++k)
-    in_root[k - first] = in_root[nodes_[k]->parent()->nodeIndex() - offset] * nodes_[k]->spec().pose;
-  // a dynamic tree's body frame is at its centre of mass (the root's frame in it set exactly: its
-  // own pose undone and redone would be off by a rounding, and a root at the centre of mass would
+  std::vector<Pose> in_top(nodes_.size() - first);  // in the node that begins its body
+  std::vector<std::size_t> top(nodes_.size() - first, 0);
+  for (std::size_t k = first + 1; k < nodes_.size(); ++k) {
+    const PhysicNodeSpec& s = nodes_[k]->spec();
+    const std::size_t up = nodes_[k]->parent()->nodeIndex() - offset;
+    if (s.joint.isBody()) {
+      top[k - first] = k - first;
+      continue;
+    }
+    top[k - first] = top[up];
+    in_top[k - first] = in_top[up] * s.pose;
+  }
+  // a dynamic body's frame is at its centre of mass (the first node's frame in it set exactly: its
+  // own pose undone and redone would be off by a rounding, and a node at the centre of mass would
   // cost a transform per query)
-  const Pose root_in_body =
-      spec.is_static ? Pose{} : Pose{-combinedMass(spec).center_of_mass, Quat::Identity()};
   for (std::size_t k = first; k < nodes_.size(); ++k) {
     detail::NodeData& n = world_->nodes[offset + (k - first)];
-    n.pose_in_body = k == first ? root_in_body : root_in_body * in_root[k - first];
-    n.at_body = !spec.is_static && n.pose_in_body.position == Vec3::Zero() &&
+    if (top[k - first] == k - first) {
+      n.pose_in_body = n.is_static ? Pose{} : Pose{-bodyMass(nodes_[k]->spec()).center_of_mass, Quat::Identity()};
+    } else {
+      n.pose_in_body = world_->nodes[offset + top[k - first]].pose_in_body * in_top[k - first];
+    }
+    n.at_body = !n.is_static && n.pose_in_body.position == Vec3::Zero() &&
                 n.pose_in_body.orientation.coeffs() == Quat::Identity().coeffs();
   }
   return *nodes_[first];

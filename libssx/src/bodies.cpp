@@ -13,54 +13,55 @@ namespace ssx {
 namespace detail {
 
 void buildBodies(World& world, PhysicEngine& engine, std::vector<Environment::StaticShape>& static_shapes) {
-  // flatten each node tree into one rigid body whose frame is the tree's centre-of-mass frame
+  // each node tree becomes one rigid body whose frame is its centre-of-mass frame, and one more for
+  // each joined child (with its rigid descendants)
+  std::vector<std::size_t> head;  // per node of the artifact: the node its body begins at
   for (auto& artifact : world.artifacts) {
     ArtifactData& data = world.data(*artifact);
     data.body_begin = static_cast<int>(engine.bodyCount());
-    for (std::size_t r = 0; r < artifact->rootCount(); ++r) {
-      const PhysicNode& root = artifact->root(r);
-      const PhysicNodeSpec& spec = root.spec();
-      const NodeSetup& root_data = world.node_setup[root.nodeIndex()];
-      std::vector<Shape> shapes;
-      std::vector<std::size_t> tree;  // the root and its descendants, in order
-      std::vector<const PhysicNodeSpec*> specs;
+    const std::size_t count = artifact->nodeCount();
+    if (count == 0) {
+      data.body_end = data.body_begin;
+      continue;
+    }
+    const std::size_t offset = artifact->nodeAt(0).nodeIndex();  // (an artifact's nodes are consecutive)
+    head.assign(count, 0);
+    for (std::size_t k = 0; k < count; ++k) {
+      const PhysicNode& n = artifact->nodeAt(k);
+      head[k] = n.parent() == nullptr || n.spec().joint.isBody() ? k : head[n.parent()->nodeIndex() - offset];
+    }
+    for (std::size_t h = 0; h < count; ++h) {
+      if (head[h] != h) continue;
+      const PhysicNode& top = artifact->nodeAt(h);
+      // its first velocity: set on the node it begins at, else the tree's root's (the tree moving as one)
+      const PhysicNode* root = &top;
+      while (root->parent() != nullptr) root = root->parent();
+      const NodeSetup& top_data = world.node_setup[top.nodeIndex()];
+      const NodeSetup& root_data = top_data.velocity_set ? top_data : world.node_setup[root->nodeIndex()];
       // (each node's pose in its body was set when the tree was added: Artifact::addPhysicRoot)
-      for (std::size_t k = 0; k < artifact->nodeCount(); ++k) {
-        const PhysicNode& n = artifact->nodeAt(k);
-        const PhysicNode* top = &n;
-        while (top->parent() != nullptr) top = top->parent();
-        if (top != &root) continue;
-        tree.push_back(n.nodeIndex());
-        specs.push_back(&n.spec());
-      }
-      if (spec.is_static) {
-        for (std::size_t k = 0; k < tree.size(); ++k) {
-          const NodeData& n = world.nodes[tree[k]];
-          for (Shape s : specs[k]->shapes) {
-            s.pose = n.pose_in_body * s.pose;
-            shapes.push_back(s);
-            static_shapes.push_back({s, root_data.pose * s.pose, artifact->index()});
-          }
-        }
-        engine.addStatic(shapes, root_data.pose);
-        continue;
-      }
-      const MassProperties mass = combinedMass(spec);
-      const Pose& root_in_body = world.nodes[root.nodeIndex()].pose_in_body;
-      for (std::size_t k = 0; k < tree.size(); ++k) {
-        const NodeData& n = world.nodes[tree[k]];
-        for (Shape s : specs[k]->shapes) {
+      std::vector<Shape> shapes;
+      for (std::size_t k = h; k < count; ++k) {
+        if (head[k] != h) continue;
+        const NodeData& n = world.nodes[offset + k];
+        for (Shape s : artifact->nodeAt(k).spec().shapes) {
           s.pose = n.pose_in_body * s.pose;
           shapes.push_back(s);
+          if (n.is_static) static_shapes.push_back({s, top_data.pose * s.pose, artifact->index()});
         }
       }
+      if (top.isStatic()) {
+        engine.addStatic(shapes, top_data.pose);
+        continue;
+      }
+      const MassProperties mass = bodyMass(top.spec());
       BodyState initial;
-      initial.pose = root_data.pose * root_in_body.inverse();
+      initial.pose = top_data.pose * world.nodes[top.nodeIndex()].pose_in_body.inverse();
       initial.angular_velocity = root_data.initial_angular;
       initial.linear_velocity = root_data.initial_linear +
                                 root_data.initial_angular.cross(initial.pose.position - root_data.pose.position);
       const int body = engine.addBody(mass, shapes, initial);
-      for (std::size_t k : tree) world.nodes[k].body = body;
+      for (std::size_t k = h; k < count; ++k)
+        if (head[k] == h) world.nodes[offset + k].body = body;
       world.body_owner.push_back(static_cast<std::uint32_t>(artifact->index()));
       world.wrench_limits.push_back(wrenchLimit(mass, world.settings.physics, world.settings.timestep));
     }
@@ -70,6 +71,7 @@ void buildBodies(World& world, PhysicEngine& engine, std::vector<Environment::St
   world.previous_linear.assign(world.states.size(), Vec3::Zero());
   world.previous_angular.assign(world.states.size(), Vec3::Zero());
   world.wrenches.assign(world.states.size(), Wrench{});
+  buildJoints(world, engine);
 }
 
 void publishSnapshot(World& world, const PhysicEngine& engine, bool first) {

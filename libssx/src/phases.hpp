@@ -14,6 +14,15 @@ namespace ssx::detail {
 /// Flattens every artifact's node trees into rigid bodies of `engine` (static roots become static
 /// shapes, listed in `static_shapes`), fills the nodes' body indices and the body arrays.
 void buildBodies(World& world, PhysicEngine& engine, std::vector<Environment::StaticShape>& static_shapes);
+/// Makes the engine's joints from the node trees (the end of buildBodies; joints.cpp).
+void buildJoints(World& world, PhysicEngine& engine);
+/// Before a physics step: sets the motors' velocities; returns the wrenches to apply (the drivers',
+/// or a copy with the joints' damping added).
+const Wrench* applyJoints(World& world, PhysicEngine& engine);
+/// A hinge's angle or slider's displacement from the snapshot (0 before start).
+double jointPosition(const World& world, const JointData& joint);
+/// A hinge's or slider's rate from the snapshot (0 before start).
+double jointVelocity(const World& world, const JointData& joint);
 /// Reads the engine's states into the snapshot, with accelerations (not on the first), and checks
 /// them; a diverged body fails the world and throws StepError.
 void publishSnapshot(World& world, const PhysicEngine& engine, bool first);

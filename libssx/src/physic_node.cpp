@@ -83,21 +83,49 @@ MassProperties nodeMass(const PhysicNodeSpec& node) {
   return scaled;
 }
 
-void accumulate(const PhysicNodeSpec& node, const Pose& in_root, MassProperties& total) {
+// `joined`: whether the children with joints count too (the whole tree) or not (one body)
+void accumulate(const PhysicNodeSpec& node, const Pose& in_root, MassProperties& total, bool joined) {
   const MassProperties own = nodeMass(node);
   const Mat3 r = in_root.orientation.toRotationMatrix();
   addMass(total, own.mass, in_root.transformPoint(own.center_of_mass), r * own.inertia * r.transpose());
-  for (const auto& child : node.children) accumulate(child, in_root * child.pose, total);
+  for (const auto& child : node.children)
+    if (joined || !child.joint.isBody()) accumulate(child, in_root * child.pose, total, joined);
 }
 
 std::string nodeLabel(const PhysicNodeSpec& node) {
   return node.name.empty() ? std::string("physic node") : "physic node '" + node.name + "'";
 }
 
+void validateBody(const PhysicNodeSpec& root);
+
+void validateJoint(const PhysicNodeSpec& node, bool is_root) {
+  auto fail = [&](const std::string& what) { throw ConfigError(node.where, nodeLabel(node) + ": " + what); };
+  const JointSpec& j = node.joint;
+  if (!j.isBody()) return;
+  if (is_root) fail("a root node has no parent to be joined to: give the joint to a child node");
+  const std::string kind = jointKindName(j.kind);
+  if (j.hasPosition()) {
+    if (!j.axis.allFinite() || std::abs(j.axis.norm() - 1.0) > 1e-6)
+      fail("the " + kind + "'s axis must be a unit vector (in the node's frame)");
+    if (std::isnan(j.lower) || std::isnan(j.upper) || !(j.lower <= j.upper))
+      fail("the " + kind + "'s limits must be in order: lower <= upper");
+    if (j.kind == JointSpec::Kind::Hinge && ((std::isfinite(j.lower) && j.lower < -kPi - 1e-12) || (std::isfinite(j.upper) && j.upper > kPi + 1e-12)))
+      fail("a hinge's limits must lie within [-pi, pi] rad (leave them out for a joint that turns freely)");
+    if (!(std::isfinite(j.damping) && j.damping >= 0)) fail("damping must be finite and >= 0");
+    if (!(std::isfinite(j.max_effort) && j.max_effort >= 0))
+      fail(std::string("the motor's ") + (j.kind == JointSpec::Kind::Hinge ? "max_torque" : "max_force") +
+           " must be finite and >= 0");
+  } else if (std::isfinite(j.lower) || std::isfinite(j.upper) || j.damping != 0 || j.max_effort != 0) {
+    fail("a " + kind + " joint takes no limits, damping or motor (only hinges and sliders do)");
+  }
+  validateBody(node);
+}
+
 void validateNode(const PhysicNodeSpec& node, bool is_root, bool root_static, std::set<std::string>& names) {
   auto fail = [&](const std::string& what) { throw ConfigError(node.where, nodeLabel(node) + ": " + what); };
   if (!node.name.empty() && !names.insert(node.name).second) fail("duplicate node name in this tree");
   if (node.is_static && !is_root) fail("only a root node can be static");
+  validateJoint(node, is_root);
   if (node.mass && !(std::isfinite(*node.mass) && *node.mass > 0))
     fail("mass must be positive, got " + std::to_string(*node.mass) + " kg");
   if (node.inertia) {
@@ -225,11 +253,12 @@ constexpr double kMinBodyMass = 1e-9, kMaxBodyMass = 1e9;           // kg: a mic
 constexpr double kMinBodyInertia = 1e-18, kMaxBodyInertia = 1e18;   // kg m^2
 }  // namespace
 
-void validatePhysicTree(const PhysicNodeSpec& root) {
-  std::set<std::string> names;
-  validateNode(root, true, root.is_static, names);
-  if (!root.is_static) {
-    const MassProperties m = combinedMass(root);
+namespace {
+
+// a body's mass and inertia, as an engine steps them
+void validateBody(const PhysicNodeSpec& root) {
+  {
+    const MassProperties m = bodyMass(root);
     if (!(m.mass > 0))
       throw ConfigError(root.where, nodeLabel(root) + ": a dynamic body needs mass: give a mass or shapes with volume");
     const Vec3 eig = Eigen::SelfAdjointEigenSolver<Mat3>(m.inertia).eigenvalues();
@@ -253,10 +282,35 @@ void validatePhysicTree(const PhysicNodeSpec& root) {
   }
 }
 
+}  // namespace
+
+void validatePhysicTree(const PhysicNodeSpec& root) {
+  std::set<std::string> names;
+  validateNode(root, true, root.is_static, names);
+  if (!root.is_static) validateBody(root);
+}
+
 MassProperties combinedMass(const PhysicNodeSpec& root) {
   MassProperties total;
-  accumulate(root, Pose::identity(), total);
+  accumulate(root, Pose::identity(), total, true);
   return total;
+}
+
+MassProperties bodyMass(const PhysicNodeSpec& node) {
+  MassProperties total;
+  accumulate(node, Pose::identity(), total, false);
+  return total;
+}
+
+const char* jointKindName(JointSpec::Kind kind) {
+  switch (kind) {
+    case JointSpec::Kind::Rigid: return "rigid";
+    case JointSpec::Kind::Hinge: return "hinge";
+    case JointSpec::Kind::Slider: return "slider";
+    case JointSpec::Kind::Ball: return "ball";
+    case JointSpec::Kind::Fixed: return "fixed";
+  }
+  return "rigid";
 }
 
 BodyState BodyState::attached(const Pose& relative) const {
@@ -352,6 +406,7 @@ void PhysicNode::setVelocity(const Vec3& linear, const Vec3& angular) {
   if (env.state() == Environment::State::Setup) {
     world_->node_setup[index_].initial_linear = linear;
     world_->node_setup[index_].initial_angular = angular;
+    world_->node_setup[index_].velocity_set = true;
     return;
   }
   if (n.is_static) throw Error("node '" + name() + "' of artifact '" + artifact_->name() + "' is static");

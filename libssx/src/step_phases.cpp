@@ -198,7 +198,8 @@ void Environment::step() {
   const double t_next = toSeconds((w.steps + 1) * settings_.timestep);
   try {
     if (!ghosts_->empty()) ghosts_->beforePhysics(w, *physics_, t_next, toSeconds(settings_.timestep));
-    physics_->step(settings_.timestep, w.wrenches);
+    const Wrench* applied = w.joints.empty() ? w.wrenches.data() : detail::applyJoints(w, *physics_);
+    physics_->step(settings_.timestep, {applied, w.wrenches.size()});
     if (!ghosts_->empty()) ghosts_->afterPhysics(w, *physics_, t_next, *this);
   } catch (const std::exception& e) {
     // the engine gave up (ODE reports a NaN it met as an internal error): name the first

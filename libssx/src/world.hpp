@@ -40,6 +40,23 @@ struct NodeSetup {
   Pose pose;                           // world pose as placed
   Vec3 initial_linear = Vec3::Zero();  // of this node's origin, set before start
   Vec3 initial_angular = Vec3::Zero();
+  bool velocity_set = false;  // setVelocity was called on this node before start
+};
+
+/// One joint: a child node joined to its parent's body, its frames and its motor's command.
+struct JointData {
+  std::uint32_t node = 0;      // the child node (its spec holds the JointSpec)
+  std::uint32_t artifact = 0;
+  int parent_body = -1;        // from start: -1 for the static world
+  int child_body = -1;
+  int engine = -1;             // the engine's index of it
+  Pose in_parent;  // the joint's frame (z: its axis) in the parent body's frame (static: world)
+  Pose in_child;   // in the child body's frame
+  double damping = 0.0;  // as applied: at most what stops the joint in one step (explicit damping)
+  double effective = 0.0;  // the inertia (kg m^2) or mass (kg) the joint moves: of both bodies together
+  enum class Mode : std::uint8_t { Off, Velocity, Position };
+  Mode mode = Mode::Off;  // the motor's command, held until changed
+  double target = 0.0;
 };
 
 /// One attached driver or sensor: who it is and when it runs (its random stream is in
@@ -130,6 +147,9 @@ struct World {
   // driver reads its node's state through is then one run of memory for a swarm, not one heap
   // block per node (the artifacts point into it)
   std::deque<PhysicNode> node_handles;
+  std::vector<JointData> joints;   // in node order
+  std::vector<int> node_joint;     // per node: its joint's index in `joints`, or -1
+  std::vector<Wrench> applied;     // the wrenches with the joints' damping, when there is any
   std::vector<PluginSlot> plugins;
   std::vector<Random> randoms;
   // per plugin slot, written by the sensors phase: 1 when that sensor measured in this step (one

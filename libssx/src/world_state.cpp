@@ -15,6 +15,7 @@
 #include <ssx/environment.hpp>
 #include <ssx/hash.hpp>
 
+#include <cmath>
 #include <cstring>
 
 namespace ssx {
@@ -72,9 +73,10 @@ std::uint64_t Environment::sceneFingerprint() const {
   if (settings_.physics.engine != "ode") mix("physics " + settings_.physics.engine);
   for (const auto& a : world_->artifacts) {
     mix(a->name());
-    // each dynamic root is one body (known before the engine is built)
+    // each dynamic root is one body, and each joined child (known before the engine is built)
     std::size_t bodies = 0;
     for (std::size_t r = 0; r < a->rootCount(); ++r) bodies += a->root(r).isStatic() ? 0 : 1;
+    for (std::size_t k = 0; k < a->nodeCount(); ++k) bodies += a->nodeAt(k).joint().isBody() ? 1 : 0;
     mix(std::to_string(bodies));
   }
   for (const auto& p : world_->plugins)
@@ -100,6 +102,11 @@ std::vector<std::byte> Environment::saveState() const {
     out.write(w.previous_angular[i]);
     out.write(w.wrenches[i].force);
     out.write(w.wrenches[i].torque);
+  }
+  // the joints' motor commands (none: nothing, as before there were joints)
+  for (const auto& j : w.joints) {
+    out.write(static_cast<std::uint8_t>(j.mode));
+    out.write(j.target);
   }
   // the random streams, then each plugin's own state (driver first, then sensors, by artifact)
   for (const Random& r : w.randoms) r.save(out);
@@ -191,6 +198,13 @@ void Environment::applyState(std::span<const std::byte> payload) {
     if (!detail::finite(w.wrenches[i]) || !detail::withinLimit(w.wrenches[i], w.wrench_limits[i]))
       throw StateError("saved state: the command held for body " + std::to_string(i) +
                        " is not finite or beyond the speed guards (corrupted)");
+  }
+  for (auto& j : w.joints) {
+    const auto mode = in.get<std::uint8_t>();
+    in.read(j.target);
+    if (mode > static_cast<std::uint8_t>(detail::JointData::Mode::Position) || !std::isfinite(j.target))
+      throw StateError("saved state: a joint's motor command is not one a driver could give (corrupted)");
+    j.mode = static_cast<detail::JointData::Mode>(mode);
   }
   for (Random& r : w.randoms) r.load(in);
   for (std::size_t i = 0; i < w.artifacts.size(); ++i) {

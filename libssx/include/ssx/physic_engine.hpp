@@ -71,6 +71,18 @@ struct Wrench {
   Vec3 torque = Vec3::Zero();  ///< N m, world frame, about the centre of mass
 };
 
+/// A joint between two bodies of an engine, as PhysicEngine::addJoint takes it.
+struct EngineJoint {
+  JointSpec::Kind kind = JointSpec::Kind::Fixed;  ///< hinge, slider, ball or fixed (not Rigid)
+  int parent = -1;  ///< a body, or -1: the static world
+  int child = 0;    ///< a body
+  /// The joint's frame in the world where the bodies are now (their initial states): its origin
+  /// is the anchor, its z axis the hinge's or slider's axis. Position 0 is this configuration.
+  Pose frame;
+  double lower = -std::numeric_limits<double>::infinity();  ///< rad or m; infinite: no limit
+  double upper = std::numeric_limits<double>::infinity();   ///< rad or m
+};
+
 /// Runs independent tasks on the environment's worker pool, for an engine that can step parts
 /// of its world in parallel.
 class SSX_EXPORT TaskRunner {
@@ -107,6 +119,16 @@ class SSX_EXPORT PhysicEngine {
   virtual void setKinematic(int body) = 0;
   /// Whether setKinematic made `body` kinematic.
   virtual bool isKinematic(int body) const = 0;
+  /// Joins two bodies (or a body and the world) and returns the joint's index. Bodies joined,
+  /// directly or through others, do not collide with each other and are always solved together.
+  /// Before the first step, with the bodies in their initial states; part of the scene.
+  virtual int addJoint(const EngineJoint& joint) = 0;
+  /// Sets a joint's motor: a target velocity (rad/s or m/s of the child relative to the parent,
+  /// about or along the frame's z axis), reached with at most `max_effort` (N m or N; 0: the motor
+  /// is off and the joint turns freely); held until set again. Off until first set.
+  virtual void setJointMotor(int joint, double velocity, double max_effort) = 0;
+  /// How many joints were added.
+  virtual std::size_t jointCount() const = 0;
   /// Adds shapes fixed in the world at `pose`.
   virtual void addStatic(const std::vector<Shape>& shapes, const Pose& pose) = 0;
   /// Integrates one timestep (in the configured substeps), with `wrenches[i]` applied to body i

@@ -7,6 +7,7 @@
 #include <ssx/export.hpp>
 #include <ssx/types.hpp>
 
+#include <limits>
 #include <optional>
 #include <string>
 #include <vector>
@@ -52,8 +53,41 @@ struct SSX_EXPORT Shape {
 /// itself when it is inside. A plane: the foot of the perpendicular from `p`.
 SSX_EXPORT Vec3 nearestSurfacePoint(const Shape& shape, const Pose& world, const Vec3& p);
 
+/// How a child node is joined to its parent. `Rigid` (the default): the child is part of its
+/// parent's rigid body. Any other kind makes the child (with its rigid descendants) a body of its
+/// own, joined to its parent's body at the child's origin. The joint's position is 0 where the
+/// tree was placed; a hinge turns about `axis` (positive: the child turns right-handed about it
+/// relative to the parent), a slider moves the child along `axis`.
+struct SSX_EXPORT JointSpec {
+  /// The joint's degrees of freedom.
+  enum class Kind : std::uint8_t {
+    Rigid,   ///< no joint: the child is part of its parent's body
+    Hinge,   ///< turns about `axis` (1 degree of freedom, rad)
+    Slider,  ///< slides along `axis` (1 degree of freedom, m)
+    Ball,    ///< turns freely about its origin (3 rotational degrees of freedom; no limits or motor)
+    Fixed,   ///< a body of its own, held rigidly (its own contacts, and a joint that can be measured)
+  };
+  Kind kind = Kind::Rigid;    ///< which joint
+  Vec3 axis = Vec3::UnitZ();  ///< hinge and slider: the axis in the child's frame (unit length)
+  double lower = -std::numeric_limits<double>::infinity();  ///< hinge (rad, >= -pi) or slider (m) limit
+  double upper = std::numeric_limits<double>::infinity();   ///< hinge (rad, <= pi) or slider (m) limit
+  double damping = 0.0;  ///< viscous: N m s/rad (hinge) or N s/m (slider)
+  /// The motor's largest torque (hinge, N m) or force (slider, N); 0: no motor. A driver sets its
+  /// target velocity or position (PhysicNode::setJointVelocity, setJointPosition).
+  double max_effort = 0.0;
+
+  /// Whether the child is a body of its own (any kind but Rigid).
+  bool isBody() const noexcept { return kind != Kind::Rigid; }
+  /// Whether the joint has one degree of freedom with a position (hinge or slider).
+  bool hasPosition() const noexcept { return kind == Kind::Hinge || kind == Kind::Slider; }
+};
+
+/// The name of a joint kind, as in a scene file: "rigid", "hinge", "slider", "ball", "fixed".
+SSX_EXPORT const char* jointKindName(JointSpec::Kind kind);
+
 /// One node of a physic node tree, as described in a file or in code (the constant model).
-/// Children are rigidly attached to their parent (joints come later), posed relative to it.
+/// Children are posed relative to their parent; a child without a joint is rigidly part of its
+/// parent's body, a child with one is a body of its own (see JointSpec).
 ///
 /// Mass, in order of precedence: `mass` and `inertia` given: used as they are (inertia about
 /// `center_of_mass`, node axes); `mass` only: shapes' inertia scaled to that mass; neither:
@@ -67,8 +101,9 @@ struct SSX_EXPORT PhysicNodeSpec {
   std::optional<Mat3> inertia;         ///< kg m^2, about the centre of mass, node axes; needs `mass`
   Vec3 center_of_mass = Vec3::Zero();  ///< node frame; used with an explicit `mass`
   bool is_static = false;              ///< root only: fixed in the world, never moves
+  JointSpec joint;                     ///< children only: how it is joined to its parent
   SourceLocation where;                ///< where it was described, for messages
-  std::vector<PhysicNodeSpec> children;  ///< nodes rigidly attached to this one
+  std::vector<PhysicNodeSpec> children;  ///< nodes attached to this one
 
   /// Appends a child and returns it.
   PhysicNodeSpec& addChild(PhysicNodeSpec child);
@@ -82,11 +117,18 @@ struct MassProperties {
 };
 
 /// Checks a node tree: positive mass, positive definite inertia, positive shape sizes, planes
-/// only on static roots, unique names. Throws ConfigError naming the node.
+/// only on static roots, unique names, each body (the root and every joined child) with mass and
+/// inertia, joints that make sense (a unit axis, limits in order and within [-pi, pi] for a hinge,
+/// no limit or motor on a ball or fixed joint). Throws ConfigError naming the node.
 SSX_EXPORT void validatePhysicTree(const PhysicNodeSpec& root);
 
-/// Combined mass properties of a whole tree (children rigidly attached), in the root node's frame.
+/// Combined mass properties of a whole tree, every node as placed (joined children too), in the
+/// root node's frame: the robot's total mass.
 SSX_EXPORT MassProperties combinedMass(const PhysicNodeSpec& root);
+
+/// Mass properties of the rigid body that `node` begins (a root, or a joined child): the node and
+/// its descendants down to the next joined ones, in `node`'s frame.
+SSX_EXPORT MassProperties bodyMass(const PhysicNodeSpec& node);
 
 /// A live node of an artifact's physic tree: reads its state from the environment's current
 /// snapshot and takes forces and torques for its rigid body.
@@ -135,8 +177,25 @@ class SSX_EXPORT PhysicNode {
   /// Adds a torque, in `frame`.
   void addTorque(const Vec3& torque, Frame frame = Frame::World);
   /// Sets the linear and angular velocity (world frame) of the node's body, the node's origin
-  /// moving at `linear`. Before start: the initial state. Between steps: applied at once.
+  /// moving at `linear`. Before start: the initial state (set on a root, of every body of its
+  /// tree moving as one, but those set on their own). Between steps: applied at once.
   void setVelocity(const Vec3& linear, const Vec3& angular);
+
+  /// The joint that joins this node to its parent (kind Rigid: none).
+  const JointSpec& joint() const noexcept { return spec_->joint; }
+  /// A hinge's angle (rad, in (-pi, pi]) or a slider's displacement (m) from where the tree was
+  /// placed; 0 before start. Throws Error for a node without a hinge or slider.
+  double jointPosition() const;
+  /// A hinge's (rad/s) or slider's (m/s) rate: the child's motion relative to the parent about
+  /// or along the axis. 0 before start.
+  double jointVelocity() const;
+  /// Drives the joint's motor toward a velocity (rad/s or m/s) with at most its `max_effort`;
+  /// held until changed. Written like a force: by the artifact's own driver during a step, or by
+  /// the program between steps. Throws Error when the joint has no motor.
+  void setJointVelocity(double velocity);
+  /// Drives the joint's motor toward a position (rad or m; within the limits): each step the motor
+  /// is given the velocity that would reach it at the step's end, within `max_effort`.
+  void setJointPosition(double position);
 
  private:
   void requireWritable() const;

@@ -92,6 +92,11 @@ void BulletEngine::narrowphase(Context& context, Chunk& chunk, int a, int b, dou
   // nothing between two things that cannot move (static shapes and kinematic bodies)
   auto movable = [this](int body) { return body >= 0 && !bodies_[static_cast<std::size_t>(body)]->kinematic; };
   if (!movable(pa.body) && (b < 0 || !movable(proxies_[static_cast<std::size_t>(b)].body))) return;
+  // nothing between bodies joined to each other
+  if (b >= 0 && proxies_[static_cast<std::size_t>(b)].body >= 0 &&
+      articulation_[static_cast<std::size_t>(pa.body)] ==
+          articulation_[static_cast<std::size_t>(proxies_[static_cast<std::size_t>(b)].body)])
+    return;
   const btCollisionObject* object_b;
   const btCollisionShape* shape_b;
   const btTransform* pose_b;
@@ -234,6 +239,17 @@ void BulletEngine::buildIslands() {
     const int a = bodyOf(m->getBody0());
     return a >= 0 ? a : bodyOf(m->getBody1());
   };
+  // joined bodies are one island, contacts or not
+  auto unite = [&](int a, int b) {
+    const int ra = find(a), rb = find(b);
+    if (ra != rb) group_[static_cast<std::size_t>(std::max(ra, rb))] = std::min(ra, rb);
+  };
+  for (const Joint& j : joints_) {
+    if (j.spec.parent >= 0)
+      unite(j.spec.child, j.spec.parent);
+    else
+      (void)find(j.spec.child);
+  }
   for (const btPersistentManifold* m : manifolds_) {
     const int a = bodyOf(m->getBody0());
     const int b = bodyOf(m->getBody1());
@@ -252,7 +268,7 @@ void BulletEngine::buildIslands() {
   island_bodies_.clear();
   for (std::size_t k = 0; k < members.size(); ++k) {
     if (k == 0 || members[k].first != members[k - 1].first)
-      islands_.push_back({members[k].first, island_bodies_.size(), 0, 0, 0});
+      islands_.push_back({members[k].first, island_bodies_.size(), 0, 0, 0, 0, 0});
     island_bodies_.push_back(bodies_[static_cast<std::size_t>(members[k].second)]->rb.get());
     ++islands_.back().bodies;
   }
@@ -267,6 +283,18 @@ void BulletEngine::buildIslands() {
     if (islands_[island].manifolds == 0) islands_[island].first_manifold = island_manifolds_.size();
     island_manifolds_.push_back(manifolds_[k]);
     ++islands_[island].manifolds;
+  }
+  // the joints of each island, in the order they were added
+  joint_order_.clear();
+  for (std::size_t k = 0; k < joints_.size(); ++k) joint_order_.emplace_back(find(joints_[k].spec.child), k);
+  std::sort(joint_order_.begin(), joint_order_.end());
+  island_joints_.clear();
+  island = 0;
+  for (const auto& [root, k] : joint_order_) {
+    while (islands_[island].root != root) ++island;
+    if (islands_[island].joints == 0) islands_[island].first_joint = island_joints_.size();
+    island_joints_.push_back(joints_[k].constraint.get());
+    ++islands_[island].joints;
   }
   free_bodies_.clear();
   for (std::size_t i = 0; i < bodies_.size(); ++i)

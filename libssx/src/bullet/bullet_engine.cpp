@@ -111,6 +111,7 @@ int BulletEngine::addBody(const MassProperties& mass, const std::vector<Shape>& 
   // (a solver built thread-safe tells kinematic bodies apart by it: unique, as in a world)
   body->rb->setWorldArrayIndex(index);
   bodies_.push_back(std::move(body));
+  articulation_.push_back(index);
   proxies_stale_ = true;
   setState(index, state);
   return index;
@@ -159,6 +160,7 @@ void BulletEngine::solve(double h) {
   info.m_timeStep = h;
   info.m_numIterations = b.iterations;
   info.m_erp2 = b.erp;
+  info.m_erp = b.erp;  // joints
   info.m_globalCfm = b.cfm;
   info.m_splitImpulse = b.split_impulse ? 1 : 0;
   info.m_splitImpulsePenetrationThreshold = b.split_impulse_threshold;
@@ -174,7 +176,9 @@ void BulletEngine::solve(double h) {
       const Island& island = islands_[t];
       context.solver.solveGroup(&island_bodies_[island.first_body], static_cast<int>(island.bodies),
                                  island.manifolds == 0 ? nullptr : &island_manifolds_[island.first_manifold],
-                                 static_cast<int>(island.manifolds), nullptr, 0, info, nullptr, &context.dispatcher);
+                                 static_cast<int>(island.manifolds),
+                                 island.joints == 0 ? nullptr : &island_joints_[island.first_joint],
+                                 static_cast<int>(island.joints), info, nullptr, &context.dispatcher);
       return;
     }
     const std::size_t begin = (t - islands_.size()) * kFreeBodiesPerBatch;
@@ -188,6 +192,7 @@ void BulletEngine::step(Nanoseconds dt, std::span<const Wrench> wrenches) {
   const int substeps = std::max(1, settings_.substeps);
   const double h = toSeconds(dt) / substeps;
   contact_count_ = 0;
+  if (!joints_.empty()) setMotors(h);
   for (int s = 0; s < substeps; ++s) {
     // the held wrenches and gravity, every substep (the solver uses and the step clears them)
     for (std::size_t i = 0; i < bodies_.size(); ++i) {

@@ -14,13 +14,15 @@
 //   2. each geom is posed from its body; ssx's grid broadphase finds the pairs within the contact
 //      breaking threshold, in an order fixed by the state; each pair (and each geom near a plane)
 //      gets a fresh manifold from Bullet's algorithm for its two shapes;
-//   3. bodies joined by contacts form islands (lowest body first, manifolds in pair order), each
+//   3. bodies joined by contacts or joints form islands (lowest body first, manifolds in pair order), each
 //      solved by one solveGroup call; bodies in no contact go through the solver in batches
 //      (there Bullet applies forces, torques and the implicit gyroscopic term);
 //   4. Bullet integrates each body's transform.
 // Islands, batches and narrowphase chunks are independent, so they run on the worker pool and the
 // results do not depend on the thread count. Contacts are found afresh each substep (no warm
-// start from the last one), so a body's transform and velocities are the whole state.
+// start from the last one), so a body's transform and velocities are the whole state. Joints are
+// Bullet's constraints (hinge, slider, point-to-point, fixed), their frames fixed in the bodies
+// when made; they keep nothing from step to step that the solver uses (no warm start either).
 
 #include "grid_broadphase.hpp"
 
@@ -38,6 +40,7 @@ class btCollisionShape;
 class btCompoundShape;
 class btRigidBody;
 class btPersistentManifold;
+class btTypedConstraint;
 
 namespace ssx::detail {
 
@@ -59,6 +62,9 @@ class BulletEngine final : public PhysicEngine {
   std::size_t contactCount() const override { return contact_count_; }
   void saveState(StateWriter& out) const override;
   void restoreState(StateReader& in) override;
+  int addJoint(const EngineJoint& joint) override;
+  void setJointMotor(int joint, double velocity, double max_effort) override;
+  std::size_t jointCount() const override { return joints_.size(); }
 
  private:
   struct Geom {
@@ -77,7 +83,13 @@ class BulletEngine final : public PhysicEngine {
   };
   struct Island {
     int root;  // its lowest body
-    std::size_t first_body, bodies, first_manifold, manifolds;
+    std::size_t first_body, bodies, first_manifold, manifolds, first_joint, joints;
+  };
+  struct Joint {
+    EngineJoint spec;
+    std::unique_ptr<btTypedConstraint> constraint;
+    double velocity = 0.0;    // the motor's target
+    double max_effort = 0.0;  // off: 0
   };
 
   class Lease;  // a context for one task, given back when the task ends
@@ -90,11 +102,16 @@ class BulletEngine final : public PhysicEngine {
   void releaseContacts();
   void buildIslands();
   void solve(double h);
+  void setMotors(double h);
 
   PhysicsSettings settings_;
   TaskRunner* runner_ = nullptr;
   std::vector<std::unique_ptr<Body>> bodies_;
   std::vector<std::unique_ptr<StaticObject>> statics_;
+  std::vector<Joint> joints_;
+  std::vector<int> articulation_;  // per body: the lowest body it is joined to (itself when none)
+  std::vector<std::pair<int, std::size_t>> joint_order_;  // (island root, joint)
+  std::vector<btTypedConstraint*> island_joints_;
   std::mutex contexts_mutex_;
   std::vector<std::unique_ptr<Context>> contexts_;
   std::vector<Context*> free_contexts_;

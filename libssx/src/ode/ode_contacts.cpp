@@ -81,6 +81,12 @@ void OdeEngine::collidePair(dGeomID a, dGeomID b, std::vector<dContact>& out, st
     return owner != 0 && !bodies_[static_cast<std::size_t>(owner - 1)].kinematic;
   };
   if (!movable(a) && !movable(b)) return;
+  // nothing between bodies joined to each other
+  const auto owner_a = reinterpret_cast<std::intptr_t>(dGeomGetData(a));
+  const auto owner_b = reinterpret_cast<std::intptr_t>(dGeomGetData(b));
+  if (owner_a != 0 && owner_b != 0 &&
+      articulation_[static_cast<std::size_t>(owner_a - 1)] == articulation_[static_cast<std::size_t>(owner_b - 1)])
+    return;
   const int n = dCollide(a, b, static_cast<int>(scratch.size()), &scratch[0].geom, sizeof(dContact));
   const PhysicsSettings& s = settings_;
   for (int i = 0; i < n; ++i) {
@@ -148,7 +154,8 @@ void OdeEngine::collide() {
   for (std::size_t c = 0; c < grid_chunks + plane_chunks; ++c)
     contacts_.insert(contacts_.end(), chunks_[c].contacts.begin(), chunks_[c].contacts.end());
 
-  // contact groups: union-find over the bodies that touch each other (smallest index as the root)
+  // contact groups: union-find over the bodies that touch each other (a pinned body as the root
+  // if there is one, else the lowest)
   auto find = [&](int x) {
     if (group_[static_cast<std::size_t>(x)] < 0) {
       group_[static_cast<std::size_t>(x)] = x;
@@ -167,13 +174,15 @@ void OdeEngine::collide() {
     if (owner_a == 0 || owner_b == 0) continue;
     const int ra = find(static_cast<int>(owner_a - 1));
     const int rb = find(static_cast<int>(owner_b - 1));
-    if (ra != rb) group_[static_cast<std::size_t>(std::max(ra, rb))] = std::min(ra, rb);
+    if (ra == rb) continue;
+    const int root = firstOf(ra, rb);
+    group_[static_cast<std::size_t>(root == ra ? rb : ra)] = root;
   }
 }
 
 void OdeEngine::groupContacts() {
   // where each body steps this substep: a body in contact with others in the home world of the
-  // group's lowest-numbered body, every other body at home
+  // group's root (world 0 when a pinned body is in it), every other body at home
   for (const int i : touched_) {
     int r = i;
     while (group_[static_cast<std::size_t>(r)] != r) r = group_[static_cast<std::size_t>(r)];

@@ -244,6 +244,7 @@ int OdeEngine::addBody(const MassProperties& mass, const std::vector<Shape>& sha
   }
   p.order.push_back(index);
   bodies_.push_back(std::move(body));
+  articulation_.push_back(index);
   proxies_stale_ = true;
   setState(index, state);
   return index;
@@ -280,12 +281,9 @@ void OdeEngine::addStatic(const std::vector<Shape>& shapes, const Pose& pose) {
   proxies_stale_ = true;
 }
 
-namespace {
 // A body's state bit for bit: position, quaternion, rotation matrix (ODE keeps both; R is not
 // recomputed from a copied q, which could differ in the last bit), linear and angular velocity.
-constexpr std::size_t kOdeBodyReals = 3 + 4 + 12 + 3 + 3;
-
-void readBits(dBodyID b, dReal* out) {
+void readOdeBits(dBodyID b, dReal* out) {
   std::memcpy(out, dBodyGetPosition(b), 3 * sizeof(dReal));
   std::memcpy(out + 3, dBodyGetQuaternion(b), 4 * sizeof(dReal));
   std::memcpy(out + 7, dBodyGetRotation(b), 12 * sizeof(dReal));
@@ -293,7 +291,7 @@ void readBits(dBodyID b, dReal* out) {
   std::memcpy(out + 22, dBodyGetAngularVel(b), 3 * sizeof(dReal));
 }
 
-void writeBits(dBodyID b, const dReal* in) {
+void writeOdeBits(dBodyID b, const dReal* in) {
   dBodySetPosition(b, in[0], in[1], in[2]);
   dBodySetQuaternion(b, in + 3);
   // ODE normalises a quaternion it is given and derives the rotation from it: copy the bits
@@ -302,7 +300,6 @@ void writeBits(dBodyID b, const dReal* in) {
   dBodySetLinearVel(b, in[19], in[20], in[21]);
   dBodySetAngularVel(b, in[22], in[23], in[24]);
 }
-}  // namespace
 
 void OdeEngine::moveBody(int index, int to) {
   Body& body = bodies_[static_cast<std::size_t>(index)];
@@ -314,8 +311,8 @@ void OdeEngine::moveBody(int index, int to) {
   if (body.kinematic) dBodySetKinematic(b);
   dBodySetData(b, dBodyGetData(old));
   dReal bits[kOdeBodyReals];
-  readBits(old, bits);
-  writeBits(b, bits);
+  readOdeBits(old, bits);
+  writeOdeBits(b, bits);
   dBodyDestroy(old);
   body.id = b;
   const auto it = std::find(from.order.begin(), from.order.end(), index);
@@ -380,6 +377,7 @@ void OdeEngine::step(Nanoseconds dt, std::span<const Wrench> wrenches) {
     collide();
     groupContacts();
     for (Partition& p : partitions_) p.has_joints = false;
+    partitions_[0].has_joints = !joints_.empty();  // (the joined bodies' world: see ode_engine.hpp)
     for (const dContact& c : contacts_) {
       const auto owner_a = reinterpret_cast<std::intptr_t>(dGeomGetData(c.geom.g1));
       const auto owner_b = reinterpret_cast<std::intptr_t>(dGeomGetData(c.geom.g2));
@@ -435,7 +433,7 @@ void OdeEngine::saveState(StateWriter& out) const {
   out.write(static_cast<std::uint64_t>(bodies_.size()));
   for (const Body& body : bodies_) {
     dReal bits[kOdeBodyReals];
-    readBits(body.id, bits);
+    readOdeBits(body.id, bits);
     out.bytes(bits, sizeof bits);
   }
 }
@@ -487,6 +485,11 @@ void OdeEngine::restoreState(StateReader& in) {
         if (std::abs(v[7 + 4 * r + c] - expected(r, c)) > 1e-9) throw bad("has a rotation matrix that is not its quaternion's");
   }
   ensureThreadData();
+  // the joints let go of their bodies, made again once the bodies are
+  for (Joint& j : joints_) {
+    dJointDestroy(j.id);
+    j.id = nullptr;
+  }
   // every body created again in its saved world and order, so that ODE lists them as it did
   for (Partition& p : partitions_) p.order.clear();
   away_.clear();
@@ -499,7 +502,8 @@ void OdeEngine::restoreState(StateReader& in) {
       if (body.home != static_cast<int>(p)) away_.push_back(i);
     }
   }
-  for (std::size_t i = 0; i < bodies_.size(); ++i) writeBits(bodies_[i].id, values.data() + i * kOdeBodyReals);
+  recreateJoints();
+  for (std::size_t i = 0; i < bodies_.size(); ++i) writeOdeBits(bodies_[i].id, values.data() + i * kOdeBodyReals);
 }
 
 }  // namespace ssx::detail

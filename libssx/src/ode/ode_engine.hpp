@@ -16,6 +16,13 @@
 // They are in no ODE space at all: posing them, finding the pairs (GridBroadphase, linear in the
 // bodies however they are laid out, where ODE's sweep-and-prune is quadratic in a grid) and the
 // contacts (dCollide) run in parallel chunks too.
+//
+// Joined bodies (addJoint) are pinned to world 0: an ODE joint belongs to one world and cannot
+// follow its bodies into another, and keeps frames (anchors, axes, the hinge's reference rotation)
+// taken when it was set up. So a contact group with a pinned body in it is solved in world 0, and
+// articulated robots step there, one after another, while free bodies still step in parallel. A
+// restored engine makes each joint again with its bodies put back where they were when it was
+// first made, so that ODE computes the same frames to the bit.
 
 #include "grid_broadphase.hpp"
 
@@ -45,6 +52,9 @@ class OdeEngine final : public PhysicEngine {
   void saveState(StateWriter& out) const override;
   void restoreState(StateReader& in) override;
   std::size_t contactCount() const override { return contact_count_; }
+  int addJoint(const EngineJoint& joint) override;
+  void setJointMotor(int joint, double velocity, double max_effort) override;
+  std::size_t jointCount() const override { return joints_.size(); }
 
   static constexpr int kBlock = 64;  // consecutive bodies that share a home world
 
@@ -55,7 +65,7 @@ class OdeEngine final : public PhysicEngine {
     dThreadingImplementationID threading = nullptr;
     unsigned long rand_seed = 0;  // this world's own copy of ODE's process-wide dRand seed
     std::vector<int> order;       // its bodies in creation order (ODE lists them newest first)
-    bool has_joints = false;      // contact joints in this substep
+    bool has_joints = false;      // joints in this substep (contacts, or the joints of world 0)
   };
   struct Geom {
     dGeomID id;
@@ -68,11 +78,29 @@ class OdeEngine final : public PhysicEngine {
     int partition = 0;
     int home = 0;
     bool kinematic = false;  // moved only by setState (dBodySetKinematic)
+    bool pinned = false;     // joined to another body or the world: always in world 0
     dMass mass;
     std::vector<Geom> geoms;
   };
 
+  struct Joint {
+    EngineJoint spec;
+    dJointID id = nullptr;
+    std::vector<dReal> child_bits, parent_bits;  // the bodies' states when it was first made
+    double velocity = 0.0, max_effort = 0.0;     // the motor (off: 0 effort)
+  };
+
   dGeomID createGeom(const Shape& shape);
+  // makes joint j's ODE joint in world 0 from the bodies' current states
+  void createJoint(Joint& joint);
+  // recreates every joint, its bodies put back where they were when it was first made (restore)
+  void recreateJoints();
+  void applyMotor(const Joint& joint);
+  // the root of a contact group from two roots: a pinned one first, else the lower
+  int firstOf(int a, int b) const {
+    const bool pa = bodies_[static_cast<std::size_t>(a)].pinned, pb = bodies_[static_cast<std::size_t>(b)].pinned;
+    return pa != pb ? (pa ? a : b) : std::min(a, b);
+  }
   // appends the contacts between two geoms, with the surface settings
   void collidePair(dGeomID a, dGeomID b, std::vector<dContact>& out, std::vector<dContact>& scratch) const;
   void collide();
@@ -91,6 +119,8 @@ class OdeEngine final : public PhysicEngine {
   TaskRunner* runner_ = nullptr;
   std::vector<Partition> partitions_;
   std::vector<Body> bodies_;
+  std::vector<Joint> joints_;
+  std::vector<int> articulation_;  // per body: the lowest body it is joined to (itself when none)
   std::size_t contacts_per_pair_ = 8;
   std::vector<dContact> contacts_;  // found in this substep, in a fixed order
   // the grid broadphase: one box per geom (the bodies' geoms in body order, then static ones),
@@ -118,6 +148,11 @@ class OdeEngine final : public PhysicEngine {
 
 // every thread that calls into ODE needs its own collision data (ode_engine.cpp)
 void ensureThreadData();
+
+// a body's state bit for bit (ode_engine.cpp): kOdeBodyReals values
+inline constexpr std::size_t kOdeBodyReals = 3 + 4 + 12 + 3 + 3;
+void readOdeBits(dBodyID b, dReal* out);
+void writeOdeBits(dBodyID b, const dReal* in);
 
 template <class F>
 void OdeEngine::forEach(std::size_t n, F&& task) {

@@ -25,6 +25,40 @@ Shape SceneLoader::readShape(const Descriptor& d) {
   return s;
 }
 
+void SceneLoader::readJoint(const Descriptor& d, JointSpec& j) {
+  const std::string kind = read<std::string>(d, "joint", "");
+  static const std::map<std::string, JointSpec::Kind> kinds = {{"hinge", JointSpec::Kind::Hinge},
+                                                               {"slider", JointSpec::Kind::Slider},
+                                                               {"ball", JointSpec::Kind::Ball},
+                                                               {"fixed", JointSpec::Kind::Fixed}};
+  if (!kind.empty()) {
+    const auto it = kinds.find(kind);
+    if (it == kinds.end())
+      error(d.where(), "<physic>: joint must be hinge, slider, ball or fixed, got '" + kind + "'");
+    else
+      j.kind = it->second;
+  }
+  for (const char* key : {"axis", "lower", "upper", "damping", "max_torque", "max_force"})
+    if (d.has(key) && !j.hasPosition()) {
+      error(d.where(), std::string("<physic>: '") + key + "' belongs to a hinge or slider joint" +
+                           (kind.empty() ? " (this node has no joint attribute)" : ", and this joint is a " + kind));
+      return;
+    }
+  const Vec3 axis = read<Vec3>(d, "axis", Vec3::UnitZ());
+  if (!axis.allFinite() || !(axis.norm() > 1e-9))
+    error(d.where(), "<physic>: axis must be a non-zero vector (the joint's axis in this node's frame)");
+  else
+    j.axis = axis.normalized();
+  j.lower = read<double>(d, "lower", j.lower);
+  j.upper = read<double>(d, "upper", j.upper);
+  j.damping = read<double>(d, "damping", 0.0);
+  const char* motor = j.kind == JointSpec::Kind::Slider ? "max_force" : "max_torque";
+  const char* other = j.kind == JointSpec::Kind::Slider ? "max_torque" : "max_force";
+  if (d.has(other))
+    error(d.where(), std::string("<physic>: a ") + kind + "'s motor takes " + motor + ", not " + other);
+  j.max_effort = read<double>(d, motor, 0.0);
+}
+
 PhysicNodeSpec SceneLoader::readPhysicNode(const Descriptor& d) {
   PhysicNodeSpec n;
   n.where = d.where();
@@ -41,6 +75,7 @@ PhysicNodeSpec SceneLoader::readPhysicNode(const Descriptor& d) {
   }
   n.center_of_mass = read<Vec3>(d, "com", Vec3::Zero());
   n.is_static = read<bool>(d, "static", false);  // validatePhysicTree refuses it below the root
+  readJoint(d, n.joint);
   for (const Descriptor& c : d.children()) {
     if (kShapeElements.contains(c.name()))
       n.shapes.push_back(readShape(c));

@@ -226,6 +226,7 @@ class SceneLoader {
   const ArtifactType* artifactType(const std::string& name, const SourceLocation& where);
   ArtifactType parseArtifact(const Descriptor& root);
   Shape readShape(const Descriptor& d);
+  void readJoint(const Descriptor& d, JointSpec& joint);
   PhysicNodeSpec readPhysicNode(const Descriptor& d);
   RenderNodeSpec readRenderNode(const Descriptor& d, bool is_root);
   std::optional<PluginDecl> readPluginDecl(const Descriptor& d);
