@@ -3,7 +3,9 @@
 //
 // Parameters: kParameters below, or `ssx plugins --params csv_logger`.
 //
-// Columns: time_s,artifact,x,y,z,qw,qx,qy,qz,vx,vy,vz,wx,wy,wz (world frame, SI units).
+// Columns: time_s,artifact,x,y,z,qw,qx,qy,qz,vx,vy,vz,wx,wy,wz (world frame, SI units). With
+// bodies="all", one row per body of each artifact: its root's named as the artifact, each joined
+// child's as "artifact/node" (the pose of the node the body begins at).
 #include <ssx/environment.hpp>
 #include <ssx/plugin_abi.hpp>
 
@@ -23,6 +25,8 @@ class CsvLogger final : public SimulationExtension {
       param::required(param::output(
           "file", "", "path of the CSV file (relative: in the run's output directory, ssx run --out; else the working directory)")),
       param::text("artifacts", "*", "artifact names separated by spaces, or * for every artifact with a dynamic root"),
+      param::choice("bodies", "root", "root all",
+                    "root: one row per artifact (its first root); all: one per body, joined children as artifact/node"),
       param::real("rate_hz", "0", "Hz", param::nonNegative(),
                   "rows per artifact per simulated second; 0 writes one every step"),
       param::real("flush_s", "1", "s", param::positive() & param::atMost(1e9),
@@ -61,14 +65,14 @@ class CsvLogger final : public SimulationExtension {
     next_ += period_;
     if (next_ <= env.time()) next_ = env.time() + period_;
     const double t = toSeconds(env.time());
-    for (const Artifact* a : artifacts_) {
-      const BodyState s = a->state();
+    for (const Row& row : rows_) {
+      const BodyState s = row.node != nullptr ? row.node->state() : row.artifact->state();
       const Vec3& p = s.pose.position;
       const Quat& q = s.pose.orientation;
       const Vec3& v = s.linear_velocity;
       const Vec3& w = s.angular_velocity;
       const int written = std::fprintf(file_, "%.9g,%s,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g\n", t,
-                   field(a->name()).c_str(), p.x(), p.y(), p.z(), q.w(), q.x(), q.y(), q.z(), v.x(), v.y(), v.z(), w.x(),
+                   row.label.c_str(), p.x(), p.y(), p.z(), q.w(), q.x(), q.y(), q.z(), v.x(), v.y(), v.z(), w.x(),
                    w.y(), w.z());
       check(written > 0);
     }
@@ -105,7 +109,16 @@ class CsvLogger final : public SimulationExtension {
   }
 
   void resolve(Environment& env, const Descriptor& params) {
-    for (const Artifact* a : env.selectArtifacts(params, "artifacts", "log")) artifacts_.push_back(a);
+    const bool all = params.get<std::string>("bodies") == "all";
+    for (const Artifact* a : env.selectArtifacts(params, "artifacts", "log")) {
+      rows_.push_back({a, nullptr, field(a->name())});
+      if (!all) continue;
+      for (std::size_t k = 0; k < a->nodeCount(); ++k) {
+        const PhysicNode& n = a->nodeAt(k);
+        const bool another_root = n.parent() == nullptr && &n != &a->root() && !n.isStatic();
+        if (another_root || n.joint().isBody()) rows_.push_back({a, &n, field(a->name() + "/" + n.name())});
+      }
+    }
   }
   // a write that fails (a full disk, a removed device) stops the run naming the file
   void check(bool ok) {
@@ -125,7 +138,12 @@ class CsvLogger final : public SimulationExtension {
   std::string path_, names_;
   Nanoseconds period_ = 0, next_ = 0, flush_period_ = 0, next_flush_ = 0;
   std::FILE* file_ = nullptr;
-  std::vector<const Artifact*> artifacts_;
+  struct Row {
+    const Artifact* artifact;
+    const PhysicNode* node;  // null: the artifact's own state (its first root)
+    std::string label;       // as written (quoted when it must be)
+  };
+  std::vector<Row> rows_;
 };
 
 }  // namespace ssx::plugins

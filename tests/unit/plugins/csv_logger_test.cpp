@@ -6,6 +6,8 @@
 #include <catch2/catch.hpp>
 
 #include <algorithm>
+#include <cstdio>
+#include <fstream>
 
 using namespace ssx;
 using ssx::test::kData;
@@ -76,4 +78,31 @@ TEST_CASE("csv_logger: a write that fails stops the run naming the file", "[scen
                       Contains("extension 'log'") && Contains("cannot write '/dev/full'") &&
                           Contains("No space left on device"));
   }
+}
+
+TEST_CASE("csv_logger: bodies=\"all\" logs every body of an artifact, joined children as artifact/node", "[scene][csv][joints]") {
+  fs::create_directories("csv_joints");
+  std::ofstream("csv_joints/pendulum.xml") << R"(<artifact>
+  <physic name="base" static="true">
+    <physic name="arm" joint="hinge" axis="0 1 0" rpy="0 1 0" mass="1"><sphere radius="0.05" xyz="0 0 -1"/></physic>
+  </physic>
+</artifact>
+)";
+  Scene scene = loadSceneFromString(R"(<scene><environment timestep="0.01"/><type name="p" file="pendulum.xml"/>
+    <artifact name="p" type="p" xyz="0 0 2"/>
+    <extension name="log" plugin="csv_logger" file="bodies.csv" bodies="all" artifacts="p"/></scene>)",
+                                    "memory.xml", fs::current_path() / "csv_joints");
+  Environment& env = *scene.environment;
+  env.step(50);
+  const Vec3 arm = env.findArtifact("p")->node("arm")->pose().position;
+  env.stop();
+  const auto rows = fileLines("bodies.csv");
+  REQUIRE(rows.size() == 1 + 2 * 50);  // the static root's row and the arm's, each step
+  CHECK(rows[99].rfind("0.5,p,", 0) == 0);
+  REQUIRE(rows[100].rfind("0.5,p/arm,", 0) == 0);
+  // the arm's row is the arm's pose
+  char name[64];
+  double t, x, y, z;
+  REQUIRE(std::sscanf(rows[100].c_str(), "%lf,%63[^,],%lf,%lf,%lf", &t, name, &x, &y, &z) == 5);
+  CHECK(Vec3(x, y, z).isApprox(arm, 1e-6));
 }

@@ -117,3 +117,65 @@ TEST_CASE("artifact files: each wrong shape or root is reported at its own line"
     CHECK_THAT(e.what(), Contains("wrong_root.xml:1: error: the root element of an artifact file must be <artifact>, got <robot>"));
   }
 }
+
+TEST_CASE("artifact files: joints are read as written; what does not fit a joint is said at its line",
+          "[scene][artifact_reader][joints]") {
+  const fs::path dir = writeType("arm.xml", R"(<artifact>
+  <physic name="base" static="true">
+    <physic name="arm" joint="hinge" axis="0 2 0" lower="-1" upper="1.5" damping="0.01" max_torque="2" mass="1">
+      <box size="0.1 0.1 0.5" xyz="0 0 -0.25"/>
+      <physic name="slide" joint="slider" axis="1 0 0" max_force="5" xyz="0 0 -0.5">
+        <sphere radius="0.05"/>
+      </physic>
+      <physic name="knob" joint="ball" xyz="0 0 -0.1"><sphere radius="0.02"/></physic>
+    </physic>
+  </physic>
+</artifact>
+)");
+  Scene scene = loadSceneFromString(R"(<scene><type name="arm" file="arm.xml"/><artifact name="a" type="arm"/></scene>)",
+                                    "s.xml", dir, {});
+  const Artifact& a = *scene.environment->findArtifact("a");
+  const JointSpec& arm = a.node("arm")->joint();
+  CHECK(arm.kind == JointSpec::Kind::Hinge);
+  CHECK(arm.axis == Vec3::UnitY());  // made unit
+  CHECK(arm.lower == -1.0);
+  CHECK(arm.upper == 1.5);
+  CHECK(arm.damping == 0.01);
+  CHECK(arm.max_effort == 2.0);
+  CHECK(a.node("slide")->joint().kind == JointSpec::Kind::Slider);
+  CHECK(a.node("slide")->joint().max_effort == 5.0);
+  CHECK(a.node("knob")->joint().kind == JointSpec::Kind::Ball);
+  CHECK(a.node("base")->joint().kind == JointSpec::Kind::Rigid);
+
+  writeType("bad_joints.xml", R"(<artifact>
+  <physic name="base" static="true">
+    <physic name="a" joint="hinge" max_force="2"><sphere radius="0.1"/></physic>
+    <physic name="b" joint="wheel"><sphere radius="0.1"/></physic>
+    <physic name="c" joint="ball" lower="0"><sphere radius="0.1"/></physic>
+    <physic name="d" joint="slider" axis="0 0 0"><sphere radius="0.1"/></physic>
+    <physic name="e" axis="1 0 0"><sphere radius="0.1"/></physic>
+  </physic>
+</artifact>
+)");
+  try {
+    (void)parseSceneString(R"(<scene><type name="b" file="bad_joints.xml"/><artifact name="x" type="b"/></scene>)", "s.xml",
+                           dir, {});
+    FAIL("parsed");
+  } catch (const SceneError& e) {
+    CHECK_THAT(e.what(), Contains("bad_joints.xml:3: error: <physic>: a hinge's motor takes max_torque, not max_force"));
+    CHECK_THAT(e.what(), Contains("bad_joints.xml:4: error: <physic>: joint must be hinge, slider, ball or fixed, got 'wheel'"));
+    CHECK_THAT(e.what(), Contains("bad_joints.xml:5: error: <physic>: 'lower' belongs to a hinge or slider joint, and this joint is a ball"));
+    CHECK_THAT(e.what(), Contains("bad_joints.xml:6: error: <physic>: axis must be a non-zero vector"));
+    CHECK_THAT(e.what(), Contains("bad_joints.xml:7: error: <physic>: 'axis' belongs to a hinge or slider joint (this node has no joint attribute)"));
+  }
+  // a limit beyond what a hinge can have: at the node, when the scene is built
+  writeType("wide.xml", R"(<artifact>
+  <physic name="base" static="true">
+    <physic name="arm" joint="hinge" upper="4"><sphere radius="0.1"/></physic>
+  </physic>
+</artifact>
+)");
+  CHECK_THROWS_WITH(
+      loadSceneFromString(R"(<scene><type name="w" file="wide.xml"/><artifact name="x" type="w"/></scene>)", "s.xml", dir, {}),
+      Contains("wide.xml:3: error: physic node 'arm': a hinge's limits must lie within [-pi, pi] rad"));
+}
