@@ -1,6 +1,7 @@
 #include "record/foxglove.hpp"
 
 #include <ssx/command.hpp>
+#include <ssx/odometry.hpp>
 #include <ssx/operator.hpp>
 
 #include <cmath>
@@ -12,7 +13,7 @@ namespace ssx {
 
 namespace {
 
-constexpr const char* kNames[] = {"position", "velocity", "attitude", "rates", "rotors"};
+constexpr const char* kNames[] = {"position", "velocity", "attitude", "rates", "rotors", "wheels"};
 // the attitude estimate of a vehicle's inner loop holds pitch within +-80 degrees
 constexpr double kMaxAngle = 80.0 * std::numbers::pi / 180.0;
 
@@ -70,12 +71,22 @@ Command Command::rotors(std::vector<double> speeds) {
   return c;
 }
 
+Command Command::wheels(double left, double right) {
+  Command c;
+  c.level = CommandLevel::Wheels;
+  c.left_wheel = left;
+  c.right_wheel = right;
+  return c;
+}
+
 bool Command::rowSizeFits(CommandLevel level, std::size_t size, std::size_t rotor_count) {
   switch (level) {
     case CommandLevel::Position:
       return size == 4 || size == 7 || size == 10 || size == 11;
     case CommandLevel::Rotors:
       return size == rotor_count && size > 0;
+    case CommandLevel::Wheels:
+      return size == 2;
     default:
       return size == 4;
   }
@@ -93,6 +104,8 @@ std::string Command::rowSizes(CommandLevel level, std::size_t rotor_count) {
       return "4 (p, q, r, thrust)";
     case CommandLevel::Rotors:
       return std::to_string(rotor_count) + " (one speed per rotor)";
+    case CommandLevel::Wheels:
+      return "2 (left, right wheel speed)";
   }
   return {};
 }
@@ -117,6 +130,8 @@ Command Command::fromRow(CommandLevel level, std::span<const double> r) {
       return rates(Vec3(at(0), at(1), at(2)), at(3));
     case CommandLevel::Rotors:
       return rotors(std::vector<double>(r.begin(), r.end()));
+    case CommandLevel::Wheels:
+      return wheels(at(0), at(1));
   }
   return {};
 }
@@ -137,6 +152,8 @@ std::vector<double> Command::toRow() const {
       return {body_rates.x(), body_rates.y(), body_rates.z(), thrust};
     case CommandLevel::Rotors:
       return rotor_speeds;
+    case CommandLevel::Wheels:
+      return {left_wheel, right_wheel};
   }
   return {};
 }
@@ -167,6 +184,9 @@ std::string Command::problem() const {
         if (w < 0) return "rotor speeds are magnitudes (the spin direction is the rotor's), got " + number(w);
       }
       return {};
+    case CommandLevel::Wheels:
+      if (!std::isfinite(left_wheel) || !std::isfinite(right_wheel)) return "a wheels command holds a NaN or an infinity";
+      return {};
   }
   if (thrust < 0) return "thrust must not be negative, got " + number(thrust) + " N";
   return {};
@@ -175,6 +195,8 @@ std::string Command::problem() const {
 CommandInterface::~CommandInterface() = default;
 
 OperatorInterface::~OperatorInterface() = default;
+
+OdometryInterface::~OdometryInterface() = default;
 
 Command CommandInterface::currentCommand() const {
   Command c;

@@ -129,6 +129,8 @@ Command TeleKybController::command() const {
                             command_.thrust_q16 / 65536.0);
     case CommandLevel::Rotors:
       return Command::rotors(std::vector<double>(rotor_command_.begin(), rotor_command_.end()));
+    case CommandLevel::Wheels:
+      break;  // (refused: a quadrotor has no wheels)
   }
   return {};
 }
@@ -162,6 +164,8 @@ void TeleKybController::setCommand(const Command& command, const Vec3& position)
     case CommandLevel::Rotors:
       std::copy(command.rotor_speeds.begin(), command.rotor_speeds.end(), rotor_command_.begin());
       break;
+    case CommandLevel::Wheels:
+      break;  // (refused before: a quadrotor has no wheels)
   }
   // the position loop's integral starts afresh when it takes over again
   if (previous > CommandLevel::Velocity && level_ <= CommandLevel::Velocity) outer_->reset();

@@ -84,7 +84,7 @@ class TeleKybController final : public FlightController {
   /// A vehicle placed in the air holds its weight from the first step.
   void startInAir(double weight);
 
-  bool accepts(CommandLevel) const override { return true; }
+  bool accepts(CommandLevel level) const override { return level != CommandLevel::Wheels; }
   CommandLevel level() const override { return level_; }
   void setCommand(const Command& command, const Vec3& position) override;
   Setpoint currentSetpoint() const override { return current_; }

@@ -86,7 +86,7 @@ void CommandTargets::setCommands(const std::string& level_name, const py::handle
   const auto level = ssx::commandLevelFromName(level_name);
   if (!level)
     throw py::value_error("ssx: unknown command level '" + level_name +
-                          "': position, velocity, attitude, rates or rotors");
+                          "': position, velocity, attitude, rates, rotors or wheels");
   const std::vector<std::size_t> rows = select(robots);
   const Array a = Array::ensure(values);
   if (!a) throw py::type_error("ssx: values must be an array of numbers");

@@ -497,7 +497,8 @@ PYBIND11_MODULE(_ssx, m) {
            "Commands at a level, one row per robot (setpoint_names(), or the names or indices in `robots`): "
            "'position' x, y, z, yaw [, vx, vy, vz [, ax, ay, az [, yaw_rate]]]; 'velocity' vx, vy, vz, yaw_rate; "
            "'attitude' roll, pitch (rad), yaw_rate (rad/s), thrust (N); 'rates' p, q, r (rad/s), thrust (N); "
-           "'rotors' one speed per rotor (rad/s). Held until the next command. Every row is checked (shape, NaN, "
+           "'rotors' one speed per rotor (rad/s); 'wheels' left, right wheel speed (rad/s). Held until the next command. "
+           "Every row is checked (shape, NaN, "
            "levels and values the robot takes) before any robot gets one.")
       .def("imu", &PyEnvironment::imu, py::arg("artifact"), py::arg("sensor") = py::none(),
            "The latest IMU measurement of an artifact (its first IMU, or sensor index `sensor`), as a dict.")

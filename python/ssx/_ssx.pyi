@@ -64,7 +64,7 @@ class Environment:
                       robots: _Robots = None) -> None:
         """One row per robot (setpoint_names(), or `robots`); held until the next call; every row checked first."""
     def set_commands(self, level: str, values: _Rows, robots: _Robots = None) -> None:
-        """Commands at a level ('position', 'velocity', 'attitude', 'rates', 'rotors'), one row per robot."""
+        """Commands at a level ('position', 'velocity', 'attitude', 'rates', 'rotors', 'wheels'), one row per robot."""
     def imu(self, artifact: str, sensor: Optional[int] = None) -> Dict[str, Any]:
         """The latest IMU measurement of an artifact, as a dict of numpy arrays."""
     def pose(self, artifact: str, sensor: Optional[int] = None) -> Dict[str, Any]:

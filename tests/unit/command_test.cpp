@@ -32,11 +32,16 @@ TEST_CASE("command levels have names and rows of known sizes", "[command]") {
   CHECK(Command::rates(Vec3(0, NAN, 0), 1).problem().find("NaN") != std::string::npos);
   CHECK(Command::rotors({400, -1, 400, 400}).problem().find("magnitudes") != std::string::npos);
   CHECK(Command::velocityYawRate(Vec3(1, 0, 0), 0.1).problem().empty());
+  CHECK(Command::wheels(1, NAN).problem().find("NaN") != std::string::npos);
+  CHECK(Command::wheels(-3, 3).problem().empty());  // backwards is a direction, not a fault
+  CHECK(Command::rowSizeFits(CommandLevel::Wheels, 2, 0));
+  CHECK_FALSE(Command::rowSizeFits(CommandLevel::Wheels, 4, 0));
 }
 
 TEST_CASE("a command's row is the row it was read from (position: all 11 columns)", "[command]") {
   const std::vector<std::vector<double>> rows{{1, 2, 3, 0.5, 4, 5, 6, 7, 8, 9, 0.25}, {0.5, -1, 0.25, 0.1},
-                                              {0.1, -0.2, 0.3, 7}, {1, -2, 3, 9.5}, {400, 410.5, 420, 430}};
+                                              {0.1, -0.2, 0.3, 7}, {1, -2, 3, 9.5}, {400, 410.5, 420, 430},
+                                              {6.5, -2.25}};
   for (std::size_t i = 0; i < rows.size(); ++i) {
     INFO(commandLevelName(kCommandLevels[i]));
     CHECK(Command::fromRow(kCommandLevels[i], rows[i]).toRow() == rows[i]);

@@ -12,6 +12,10 @@
 /// | `attitude` | roll, pitch (rad), yaw rate (rad/s), collective thrust (N)                        |
 /// | `rates`    | body rates p, q, r (rad/s), collective thrust (N)                                 |
 /// | `rotors`   | each rotor's speed (rad/s), one column per rotor                                  |
+/// | `wheels`   | a differential drive's left and right wheel speeds (rad/s, positive: forward)     |
+///
+/// A ground robot takes `velocity` as a forward speed and a yaw rate: the velocity's component
+/// along its heading when the command is given, and the yaw rate.
 ///
 /// A command holds until the next one (zero-order hold).
 
@@ -29,15 +33,16 @@
 
 namespace ssx {
 
-/// A command level, from the highest (position with feed-forward) to the lowest (rotor speeds);
-/// the table above lists each level's values.
-enum class CommandLevel : std::uint8_t { Position, Velocity, Attitude, Rates, Rotors };
+/// A command level, from the highest (position with feed-forward) to the lowest (rotor speeds),
+/// then a ground robot's wheel speeds; the table above lists each level's values.
+enum class CommandLevel : std::uint8_t { Position, Velocity, Attitude, Rates, Rotors, Wheels };
 
-/// The five levels, from the highest to the lowest.
+/// The six levels: a flying vehicle's five, from the highest to the lowest, then a ground robot's wheels.
 inline constexpr CommandLevel kCommandLevels[] = {CommandLevel::Position, CommandLevel::Velocity,
-                                                  CommandLevel::Attitude, CommandLevel::Rates, CommandLevel::Rotors};
+                                                  CommandLevel::Attitude, CommandLevel::Rates,
+                                                  CommandLevel::Rotors,   CommandLevel::Wheels};
 
-/// "position", "velocity", "attitude", "rates" or "rotors".
+/// "position", "velocity", "attitude", "rates", "rotors" or "wheels".
 SSX_EXPORT const char* commandLevelName(CommandLevel level);
 /// The level of that name; nothing for another name.
 SSX_EXPORT std::optional<CommandLevel> commandLevelFromName(std::string_view name);
@@ -59,6 +64,8 @@ struct SSX_EXPORT Command {
   Vec3 body_rates = Vec3::Zero();   ///< rates: p, q, r in rad/s, body frame
   double thrust = 0;                ///< attitude, rates: collective thrust, N
   std::vector<double> rotor_speeds;  ///< rotors: rad/s, one per rotor
+  double left_wheel = 0;             ///< wheels: rad/s, positive: forward
+  double right_wheel = 0;            ///< wheels: rad/s, positive: forward
 
   /// A position command: the set-point's position, feed-forward and heading.
   static Command position(const Setpoint& setpoint);
@@ -71,8 +78,11 @@ struct SSX_EXPORT Command {
   /// A rotor command: each rotor's speed in rad/s, in the vehicle's rotor order.
   static Command rotors(std::vector<double> speeds);
 
+  /// A wheels command: a differential drive's left and right wheel speeds, rad/s.
+  static Command wheels(double left, double right);
   /// The numbers of values a row of this level may have: position 4, 7, 10 or 11 (a prefix of
-  /// the columns above, the rest zero), velocity, attitude and rates 4, rotors `rotor_count`.
+  /// the columns above, the rest zero), velocity, attitude and rates 4, rotors `rotor_count`,
+  /// wheels 2.
   static bool rowSizeFits(CommandLevel level, std::size_t size, std::size_t rotor_count);
   /// What rowSizeFits accepts, in words ("4, 7, 10 or 11").
   static std::string rowSizes(CommandLevel level, std::size_t rotor_count);

@@ -13,6 +13,7 @@
 #include <ssx/flight_summary.hpp>
 #include <ssx/measurements.hpp>
 #include <ssx/metrics.hpp>
+#include <ssx/odometry.hpp>
 #include <ssx/operator.hpp>
 #include <ssx/physic_engine.hpp>
 #include <ssx/physic_node.hpp>

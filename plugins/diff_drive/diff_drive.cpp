@@ -1,0 +1,240 @@
+// diff_drive: a differential-drive ground robot (two driven wheels on one axle), in one of two
+// models behind the same commands and odometry:
+//   full:  the wheels are bodies on hinge motors (the artifact's `left_wheel` and `right_wheel`
+//          nodes); they roll on the ground with its friction, so they can slip; the encoders read
+//          the hinges.
+//   swarm: the robot is one body, driven each step to the twist its wheels would give by a force
+//          and a torque of at most `max_force` and `max_torque` (as ARGoS's 2D dynamics drives a
+//          foot-bot), held on its plane (its height and upright) by the same means; it touches
+//          other bodies in 3D but not the floor, so it is cheap; the encoders read the wheels the
+//          body's motion would turn.
+// Commands: `wheels` (left, right wheel speeds, rad/s) or `velocity` (the velocity's component
+// along the heading, and the yaw rate), clamped to `max_wheel_speed` (a velocity command keeps
+// its curvature). Odometry: ssx::OdometryInterface, dead-reckoned from the encoders.
+//
+// Parameters: kParameters below, or `ssx plugins --params diff_drive`.
+#include <ssx/artifact.hpp>
+#include <ssx/command.hpp>
+#include <ssx/environment.hpp>
+#include <ssx/odometry.hpp>
+#include <ssx/plugin_abi.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+
+namespace ssx::plugins {
+
+namespace {
+
+constexpr double kPi = std::numbers::pi;
+
+double yawOf(const Quat& q) {
+  return std::atan2(2 * (q.w() * q.z() + q.x() * q.y()), 1 - 2 * (q.y() * q.y() + q.z() * q.z()));
+}
+
+double wrap(double a) {
+  a = std::remainder(a, 2 * kPi);
+  return a <= -kPi ? a + 2 * kPi : a;
+}
+
+}  // namespace
+
+class DiffDrive final : public Driver, public CommandInterface, public OdometryInterface {
+ public:
+  static constexpr const char* kDoc =
+      "a differential-drive ground robot: wheels on hinge motors (full) or one body driven to the wheels' twist (swarm)";
+  static constexpr ssx_plugin_param kParameters[] = {
+      param::choice("model", "swarm", "swarm full",
+                    "full: wheel bodies on hinge motors, rolling with friction; swarm: one body driven to the wheels' "
+                    "twist with limited force and torque"),
+      param::required(param::real("wheel_radius", "", "m", param::positive() & param::atMost(10), "wheel radius")),
+      param::required(param::real("axle_length", "", "m", param::positive() & param::atMost(100),
+                                  "distance between the two wheels' contact points")),
+      param::required(param::real("max_wheel_speed", "", "rad/s", param::positive() & param::atMost(1e4),
+                                  "the fastest a wheel turns, either way")),
+      param::text("left_wheel", "", "full model: the left wheel's node (a hinge with a motor; positive turns it forward)"),
+      param::text("right_wheel", "", "full model: the right wheel's node"),
+      param::real("max_force", "0", "N", param::nonNegative(),
+                  "swarm model: the largest force driving the body to the wheels' velocity; 0: friction times weight"),
+      param::real("max_torque", "0", "N m", param::nonNegative(),
+                  "swarm model: the largest torque driving its yaw rate; 0: max_force times half the axle length"),
+      param::real("encoder_noise", "0", "rad/s", param::nonNegative(),
+                  "standard deviation of each wheel speed the encoders measure, per driver step"),
+  };
+
+  static void validate(const Descriptor& params, const PluginContext& context) {
+    const Artifact& a = *context.artifact;
+    if (a.rootCount() == 0 || a.root().isStatic()) throw params.error("diff_drive needs a dynamic physic root");
+    if (params.get<std::string>("model") != "full") return;
+    for (const char* key : {"left_wheel", "right_wheel"}) {
+      const std::string name = params.get<std::string>(key, "");
+      if (name.empty()) throw params.error(std::string("the full model needs '") + key + "' (the wheel's node)");
+      const PhysicNode* n = a.node(name);
+      if (n == nullptr) throw params.errorAt(key, "no physic node '" + name + "' in this artifact");
+      if (n->joint().kind != JointSpec::Kind::Hinge || !(n->joint().max_effort > 0))
+        throw params.errorAt(key, "node '" + name + "' must be joined by a hinge with a motor (max_torque)");
+    }
+  }
+
+  void configure(const Descriptor& params, PluginSetup&) override {
+    Artifact& a = artifact();
+    full_ = params.get<std::string>("model") == "full";
+    radius_ = params.get<double>("wheel_radius");
+    axle_ = params.get<double>("axle_length");
+    max_wheel_ = params.get<double>("max_wheel_speed");
+    noise_ = params.get<double>("encoder_noise");
+    const PhysicsSettings& physics = environment().settings().physics;
+    gravity_ = physics.gravity;
+    const MassProperties m = bodyMass(a.root().spec());
+    mass_ = m.mass;
+    inertia_ = m.inertia;
+    max_force_ = params.get<double>("max_force");
+    if (max_force_ == 0) max_force_ = physics.friction * mass_ * gravity_.norm();
+    max_torque_ = params.get<double>("max_torque");
+    if (max_torque_ == 0) max_torque_ = max_force_ * axle_ / 2;
+    if (full_) {
+      left_ = a.node(params.get<std::string>("left_wheel"));
+      right_ = a.node(params.get<std::string>("right_wheel"));
+    }
+    const BodyState start = a.root().state();
+    height_ = start.pose.position.z();
+    start_ = Pose{start.pose.position, Quat(Eigen::AngleAxisd(yawOf(start.pose.orientation), Vec3::UnitZ()))};
+  }
+
+  // --- commands ---
+  bool acceptsCommand(CommandLevel level) const override {
+    return level == CommandLevel::Wheels || level == CommandLevel::Velocity;
+  }
+  std::size_t rotorCount() const override { return 0; }
+  void setCommand(const Command& c) override {
+    if (const std::string why = refusal(c); !why.empty()) throw std::invalid_argument(why);
+    level_ = c.level;
+    if (c.level == CommandLevel::Wheels) {
+      setWheels(c.left_wheel, c.right_wheel);
+      return;
+    }
+    // the velocity's part along the heading now, and the yaw rate
+    const double yaw = yawOf(artifact().root().pose().orientation);
+    const double v = c.velocity.x() * std::cos(yaw) + c.velocity.y() * std::sin(yaw);
+    setWheels((v - c.yaw_rate * axle_ / 2) / radius_, (v + c.yaw_rate * axle_ / 2) / radius_);
+  }
+  CommandLevel commandLevel() const override { return level_; }
+  Command currentCommand() const override { return Command::wheels(left_cmd_, right_cmd_); }
+  Setpoint currentSetpoint() const override {
+    Setpoint s;
+    s.position = artifact().root().pose().position;
+    s.yaw = yawOf(artifact().root().pose().orientation);
+    return s;
+  }
+
+  Odometry odometry() const override { return odometry_; }
+
+  void saveState(StateWriter& out) const override {
+    out.write(left_cmd_);
+    out.write(right_cmd_);
+    out.write(static_cast<std::uint8_t>(level_));
+    out.bytes(&odometry_, sizeof odometry_);
+  }
+  void loadState(StateReader& in) override {
+    in.read(left_cmd_);
+    in.read(right_cmd_);
+    level_ = static_cast<CommandLevel>(in.get<std::uint8_t>());
+    in.bytes(&odometry_, sizeof odometry_);
+  }
+
+  void step(const StepInfo& info) override {
+    const double dt = toSeconds(info.period);
+    if (full_) {
+      left_->setJointVelocity(left_cmd_);
+      right_->setJointVelocity(right_cmd_);
+    } else {
+      drive(dt);
+    }
+    measure(dt);
+  }
+
+ private:
+  // wheel speeds within the limit; both scaled alike, so that the path's curvature is kept
+  void setWheels(double left, double right) {
+    const double fastest = std::max(std::abs(left), std::abs(right));
+    const double scale = fastest > max_wheel_ ? max_wheel_ / fastest : 1.0;
+    left_cmd_ = left * scale;
+    right_cmd_ = right * scale;
+  }
+
+  // the swarm model: the body driven to the wheels' twist, and held on its plane, each within one step
+  void drive(double dt) {
+    PhysicNode& root = artifact().root();
+    const BodyState body = environment().bodyState(root.bodyIndex());  // at the centre of mass
+    const Quat& q = body.pose.orientation;
+    const double yaw = yawOf(q);
+    const Vec3 forward(std::cos(yaw), std::sin(yaw), 0);
+    const double v = radius_ * (left_cmd_ + right_cmd_) / 2;
+    const double w = radius_ * (right_cmd_ - left_cmd_) / axle_;
+    // in the plane: the velocity the wheels give (no sideways slip), with at most max_force
+    Vec3 change = v * forward - Vec3(body.linear_velocity.x(), body.linear_velocity.y(), 0);
+    Vec3 force = mass_ * change / dt;
+    if (force.norm() > max_force_) force *= max_force_ / force.norm();
+    // its height and upright: held (the weight carried), as the floor and its wheels would
+    const double root_z = root.pose().position.z();
+    force.z() = mass_ * ((height_ - root_z) / dt - body.linear_velocity.z()) / dt - mass_ * gravity_.z();
+    Quat upright(Eigen::AngleAxisd(yaw, Vec3::UnitZ()));
+    Quat tilt = upright * q.conjugate();
+    if (tilt.w() < 0) tilt.coeffs() = -tilt.coeffs();
+    const Eigen::AngleAxisd aa(tilt);
+    Vec3 target = aa.angle() * aa.axis() / dt;
+    target.z() = w;
+    const Mat3 r = q.toRotationMatrix();
+    const Mat3 inertia = r * inertia_ * r.transpose();
+    Vec3 torque = inertia * (target - body.angular_velocity) / dt;
+    torque.z() = std::clamp(torque.z(), -max_torque_, max_torque_);
+    root.addForce(force, Frame::World, body.pose.position, Frame::World);
+    root.addTorque(torque);
+  }
+
+  // the encoders, and the pose dead-reckoned from them (midpoint heading)
+  void measure(double dt) {
+    double left = 0, right = 0;
+    if (full_) {
+      left = left_->jointVelocity();
+      right = right_->jointVelocity();
+    } else {
+      const BodyState s = artifact().root().state();
+      const double yaw = yawOf(s.pose.orientation);
+      const double v = s.linear_velocity.x() * std::cos(yaw) + s.linear_velocity.y() * std::sin(yaw);
+      left = (v - s.angular_velocity.z() * axle_ / 2) / radius_;
+      right = (v + s.angular_velocity.z() * axle_ / 2) / radius_;
+    }
+    if (noise_ > 0) {
+      left += random().normal(0.0, noise_);
+      right += random().normal(0.0, noise_);
+    }
+    Odometry& o = odometry_;
+    o.left_speed = left;
+    o.right_speed = right;
+    o.left_angle += left * dt;
+    o.right_angle += right * dt;
+    o.forward = radius_ * (left + right) / 2;
+    o.yaw_rate = radius_ * (right - left) / axle_;
+    const double mid = o.yaw + o.yaw_rate * dt / 2;
+    o.x += o.forward * std::cos(mid) * dt;
+    o.y += o.forward * std::sin(mid) * dt;
+    o.yaw = wrap(o.yaw + o.yaw_rate * dt);
+  }
+
+  bool full_ = false;
+  double radius_ = 0, axle_ = 0, max_wheel_ = 0, noise_ = 0, mass_ = 0, max_force_ = 0, max_torque_ = 0, height_ = 0;
+  Mat3 inertia_ = Mat3::Identity();
+  Vec3 gravity_ = Vec3::Zero();
+  Pose start_;
+  PhysicNode* left_ = nullptr;
+  PhysicNode* right_ = nullptr;
+  double left_cmd_ = 0, right_cmd_ = 0;
+  CommandLevel level_ = CommandLevel::Wheels;
+  Odometry odometry_;
+};
+
+}  // namespace ssx::plugins
+
+SSX_PLUGIN(SSX_DRIVER(ssx::plugins::DiffDrive, "diff_drive"));
