@@ -93,6 +93,7 @@ void Environment::setBodyState(int i, const BodyState& state) {
     throw Error("setBodyState: body " + std::to_string(i) + " of artifact '" +
                 world_->artifacts[world_->body_owner[static_cast<std::size_t>(i)]]->name() +
                 "': the state must be finite and within max_linear_speed / max_angular_speed");
+  rays_stale_ = true;
   BodyState& b = world_->states[static_cast<std::size_t>(i)];
   b.pose = state.pose;
   b.pose.orientation.normalize();

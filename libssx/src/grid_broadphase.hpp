@@ -33,6 +33,10 @@ class GridBroadphase {
   std::size_t chunkCount() const { return band_chunks_ + (big_.empty() ? 0 : 1); }
   /// Appends the overlapping pairs of one chunk (box indices), in an order fixed by the boxes.
   void pairs(std::size_t chunk, std::vector<std::pair<int, int>>& out) const;
+  /// Calls visit(box index) for every box of the last build that overlaps [min, max] (read only:
+  /// safe from several threads at once until the next build).
+  template <class Visit>
+  void overlapping(const Vec3& min, const Vec3& max, Visit&& visit) const;
 
  private:
   struct Entry {
@@ -63,5 +67,25 @@ class GridBroadphase {
   std::vector<int> big_;
   std::size_t band_chunks_ = 0;
 };
+
+template <class Visit>
+void GridBroadphase::overlapping(const Vec3& min, const Vec3& max, Visit&& visit) const {
+  const auto hit = [&](const Box& b) {
+    return b.min.x() <= max.x() && min.x() <= b.max.x() && b.min.y() <= max.y() && min.y() <= b.max.y() &&
+           b.min.z() <= max.z() && min.z() <= b.max.z();
+  };
+  // a small box lies in the band of its lower corner and reaches at most a cell beyond it
+  const std::int64_t y0 = band(min.y()) - 1, y1 = band(max.y()), z0 = band(min.z()) - 1, z1 = band(max.z());
+  for (std::int64_t y = y0; y <= y1; ++y) {
+    for (std::size_t b = firstBandFrom(y, z0); b < bands_.size() && bands_[b].y == y && bands_[b].z <= z1; ++b) {
+      const Band& band = bands_[b];
+      for (std::uint32_t k = band.begin; k < band.end && entries_[k].min_x <= max.x(); ++k)
+        if (entries_[k].min_x >= min.x() - cell_ && hit(boxes_[static_cast<std::size_t>(entries_[k].box)]))
+          visit(entries_[k].box);
+    }
+  }
+  for (const int big : big_)
+    if (hit(boxes_[static_cast<std::size_t>(big)])) visit(big);
+}
 
 }  // namespace ssx::detail

@@ -96,6 +96,16 @@ bool RangeMeasurement::finite() const noexcept {
   return std::all_of(detections.begin(), detections.end(),
                      [](const Detection& d) { return d.relative.allFinite() && std::isfinite(d.distance); });
 }
+ProximityMeasurement::~ProximityMeasurement() = default;
+bool ProximityMeasurement::finite() const noexcept {
+  return std::all_of(readings.begin(), readings.end(), [](double r) { return std::isfinite(r); });
+}
+RangeBearingMeasurement::~RangeBearingMeasurement() = default;
+bool RangeBearingMeasurement::finite() const noexcept {
+  return std::all_of(messages.begin(), messages.end(), [](const Message& m) {
+    return std::isfinite(m.range) && std::isfinite(m.bearing) && std::isfinite(m.elevation);
+  });
+}
 CameraMeasurement::~CameraMeasurement() = default;
 // depth is +infinity where nothing was hit, by design: only the camera's pose is checked
 bool CameraMeasurement::finite() const noexcept {

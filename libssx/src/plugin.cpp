@@ -30,6 +30,8 @@ void PluginSetup::requireMeasurement(const Sensor& sensor, bool matches) const {
 
 void PluginSetup::enableNeighborQueries(double cell_size) { env_->enableNeighborQueries(cell_size); }
 
+void PluginSetup::enableRayQueries() { env_->enableRayQueries(); }
+
 std::shared_ptr<const void>* PluginSetup::findShared(const std::type_info& type, std::string_view key) {
   if (shared_ == nullptr) return nullptr;
   // per plugin class: two classes that happen to share a value type and a key share nothing

@@ -220,6 +220,10 @@ void Environment::step() {
   ++w.steps;
   detail::publishSnapshot(w, *physics_, false);
   if (neighbors_->enabled()) neighbors_->markStale(w.artifacts);
+  if (rays_enabled_) {
+    physics_->prepareRayQueries();
+    rays_stale_ = false;
+  }
   timing.snapshot = since(t);
   if (cameras_->hasRequests()) {
     t = Clock::now();

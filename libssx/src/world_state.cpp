@@ -223,6 +223,7 @@ void Environment::applyState(std::span<const std::byte> payload) {
   w.current_step = steps;
   cameras_->invalidate();
   if (neighbors_->enabled()) neighbors_->markStale(w.artifacts);
+  rays_stale_ = true;
 }
 
 }  // namespace ssx

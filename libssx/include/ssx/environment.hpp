@@ -355,6 +355,17 @@ class SSX_EXPORT Environment {
   /// The same with a plain function and its context pointer.
   void forEachNeighbor(const Vec3& point, double radius, SpatialIndex::Visitor visit, void* context) const;
 
+  /// Ray queries, for sensors that cast rays (proximity, occlusion). A plugin that casts rays calls
+  /// enableRayQueries from configure; from then on, after each step's physics, the engine poses its
+  /// shapes where the snapshot has the bodies.
+  void enableRayQueries();
+  /// Whether a plugin enabled ray queries.
+  bool rayQueriesEnabled() const noexcept { return rays_enabled_; }
+  /// Casts each ray against every shape (bodies and static shapes) but those of `ignore`'s bodies
+  /// (null: none), with the engine's ray queries; hits[i] is where rays[i] first meets one, as of
+  /// the snapshot. Safe in the parallel phases. Throws if queries were not enabled or the sizes differ.
+  void castRays(std::span<const Ray> rays, std::span<RayHit> hits, const Artifact* ignore = nullptr) const;
+
   /// A shape of a static artifact, posed in the world.
   struct StaticShape {
     Shape shape;  ///< its pose is the shape's pose in its static root's frame
@@ -434,6 +445,8 @@ class SSX_EXPORT Environment {
   std::unique_ptr<detail::SceneCameras> cameras_;  // scene cameras, camera images, render items
   std::unique_ptr<detail::NeighborIndex> neighbors_;
   std::unique_ptr<detail::Ghosts> ghosts_;
+  bool rays_enabled_ = false;
+  mutable bool rays_stale_ = true;  // the engine's shapes are not where the snapshot has the bodies
   std::vector<StaticShape> static_shapes_;
   TimingRecorder timing_{settings_.timing_samples};
   LogSink log_;

@@ -62,6 +62,30 @@ struct SSX_EXPORT RangeMeasurement : Measurement {
   bool finite() const noexcept override;
 };
 
+/// What a ring of proximity (infrared) sensors reads: one reading per ray, 0 when nothing is within
+/// range, larger when nearer (the sensor's response curve), with the distance each ray met.
+struct SSX_EXPORT ProximityMeasurement : Measurement {
+  std::vector<double> readings;   ///< per ray, in the sensor's order: 0..1
+  std::vector<double> distances;  ///< per ray: m to what it met, +inf when nothing within range
+  ~ProximityMeasurement() override;
+  bool finite() const noexcept override;
+};
+
+/// What a range-and-bearing receiver got this step: one message per robot that sent one within range.
+struct SSX_EXPORT RangeBearingMeasurement : Measurement {
+  /// One message received.
+  struct Message {
+    std::size_t sender = 0;           ///< index of the sending artifact
+    double range = 0.0;               ///< m, with noise
+    double bearing = 0.0;             ///< rad, the sender's direction in the receiver's horizontal plane (0: ahead, positive: left)
+    double elevation = 0.0;           ///< rad, above the receiver's horizontal plane
+    std::vector<std::uint8_t> data;   ///< the payload the sender set
+  };
+  std::vector<Message> messages;  ///< in sender order
+  ~RangeBearingMeasurement() override;
+  bool finite() const noexcept override;
+};
+
 /// A camera image: RGB and, when asked for, depth (m along the optical axis), drawn from the
 /// snapshot of the step it is stamped with.
 struct SSX_EXPORT CameraMeasurement : Measurement {

@@ -83,6 +83,21 @@ struct EngineJoint {
   double upper = std::numeric_limits<double>::infinity();   ///< rad or m
 };
 
+/// A segment to cast against the shapes (PhysicEngine::castRays).
+struct Ray {
+  Vec3 from = Vec3::Zero();  ///< m, world frame
+  Vec3 to = Vec3::Zero();    ///< m, world frame
+};
+
+/// Where a ray first meets a shape.
+struct RayHit {
+  bool hit = false;                                          ///< whether it met any
+  double distance = std::numeric_limits<double>::infinity();  ///< m from the ray's start
+  Vec3 point = Vec3::Zero();                                 ///< world frame
+  Vec3 normal = Vec3::Zero();                                ///< of the surface met, world frame
+  int body = -1;                                             ///< the body met; -1: a static shape
+};
+
 /// Runs independent tasks on the environment's worker pool, for an engine that can step parts
 /// of its world in parallel.
 class SSX_EXPORT TaskRunner {
@@ -129,6 +144,12 @@ class SSX_EXPORT PhysicEngine {
   virtual void setJointMotor(int joint, double velocity, double max_effort) = 0;
   /// How many joints were added.
   virtual std::size_t jointCount() const = 0;
+  /// Poses every shape where its body is now, for castRays (after a step, before the queries).
+  virtual void prepareRayQueries() = 0;
+  /// Casts each ray against every shape but those of bodies [ignore_begin, ignore_end), with the
+  /// engine's own ray queries; hits[i] is the first shape rays[i] meets. Read only, so safe from
+  /// several threads at once between prepareRayQueries and the next step.
+  virtual void castRays(std::span<const Ray> rays, std::span<RayHit> hits, int ignore_begin, int ignore_end) const = 0;
   /// Adds shapes fixed in the world at `pose`.
   virtual void addStatic(const std::vector<Shape>& shapes, const Pose& pose) = 0;
   /// Integrates one timestep (in the configured substeps), with `wrenches[i]` applied to body i

@@ -182,6 +182,8 @@ class SSX_EXPORT PluginSetup {
   /// Turns the environment's neighbour queries on (Environment::neighbors), with cells of at most
   /// `cell_size` m.
   void enableNeighborQueries(double cell_size);
+  /// Turns the environment's ray queries on (Environment::castRays).
+  void enableRayQueries();
   /// Asks for camera images (Environment::addCameraRequest), named after this plugin.
   void addCameraRequest(std::function<bool(std::int64_t step, CameraView& view)> due, Image& target);
   /// What the instances of a class compute alike, computed once: `make()`'s result (a T, or a

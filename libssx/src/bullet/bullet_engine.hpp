@@ -65,6 +65,8 @@ class BulletEngine final : public PhysicEngine {
   int addJoint(const EngineJoint& joint) override;
   void setJointMotor(int joint, double velocity, double max_effort) override;
   std::size_t jointCount() const override { return joints_.size(); }
+  void prepareRayQueries() override;
+  void castRays(std::span<const Ray> rays, std::span<RayHit> hits, int ignore_begin, int ignore_end) const override;
 
  private:
   struct Geom {

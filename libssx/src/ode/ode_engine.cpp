@@ -178,6 +178,7 @@ OdeEngine::~OdeEngine() {
   for (const Body& b : bodies_)
     for (const Geom& g : b.geoms) dGeomDestroy(g.id);
   for (dGeomID g : static_geoms_) dGeomDestroy(g);
+  for (dGeomID g : free_rays_) dGeomDestroy(g);
   for (Partition& p : partitions_) {
     dJointGroupDestroy(p.contacts);
     dWorldSetStepThreadingImplementation(p.world, nullptr, nullptr);

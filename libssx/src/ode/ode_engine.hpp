@@ -30,6 +30,7 @@
 
 #include <ode/ode.h>
 
+#include <mutex>
 #include <vector>
 
 namespace ssx::detail {
@@ -55,6 +56,8 @@ class OdeEngine final : public PhysicEngine {
   int addJoint(const EngineJoint& joint) override;
   void setJointMotor(int joint, double velocity, double max_effort) override;
   std::size_t jointCount() const override { return joints_.size(); }
+  void prepareRayQueries() override;
+  void castRays(std::span<const Ray> rays, std::span<RayHit> hits, int ignore_begin, int ignore_end) const override;
 
   static constexpr int kBlock = 64;  // consecutive bodies that share a home world
 
@@ -144,6 +147,9 @@ class OdeEngine final : public PhysicEngine {
   std::vector<int> touched_;        // bodies in a body-body contact this substep, first seen first
   std::vector<int> away_;           // bodies not in their home world
   std::size_t contact_count_ = 0;
+  // ray geoms for castRays, one per query running at once
+  mutable std::mutex rays_mutex_;
+  mutable std::vector<dGeomID> free_rays_;
 };
 
 // every thread that calls into ODE needs its own collision data (ode_engine.cpp)
