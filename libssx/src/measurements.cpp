@@ -101,6 +101,7 @@ bool ProximityMeasurement::finite() const noexcept {
   return std::all_of(readings.begin(), readings.end(), [](double r) { return std::isfinite(r); });
 }
 RangeBearingMeasurement::~RangeBearingMeasurement() = default;
+RangeBearingInterface::~RangeBearingInterface() = default;
 bool RangeBearingMeasurement::finite() const noexcept {
   return std::all_of(messages.begin(), messages.end(), [](const Message& m) {
     return std::isfinite(m.range) && std::isfinite(m.bearing) && std::isfinite(m.elevation);

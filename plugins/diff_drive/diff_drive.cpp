@@ -12,10 +12,17 @@
 // along the heading, and the yaw rate), clamped to `max_wheel_speed` (a velocity command keeps
 // its curvature). Odometry: ssx::OdometryInterface, dead-reckoned from the encoders.
 //
+// `controller="diffusion"`: the robot wanders and avoids what its first proximity sensor sees, as
+// ARGoS's foot-bot diffusion example does: the readings summed as vectors along their rays; when
+// their direction is within `diffusion_angle` of straight ahead and their length below
+// `diffusion_delta`, both wheels at `cruise_speed`; otherwise it turns away on the spot's far wheel.
+// A command from outside takes over from it.
+//
 // Parameters: kParameters below, or `ssx plugins --params diff_drive`.
 #include <ssx/artifact.hpp>
 #include <ssx/command.hpp>
 #include <ssx/environment.hpp>
+#include <ssx/measurements.hpp>
 #include <ssx/odometry.hpp>
 #include <ssx/plugin_abi.hpp>
 
@@ -61,11 +68,20 @@ class DiffDrive final : public Driver, public CommandInterface, public OdometryI
                   "swarm model: the largest torque driving its yaw rate; 0: max_force times half the axle length"),
       param::real("encoder_noise", "0", "rad/s", param::nonNegative(),
                   "standard deviation of each wheel speed the encoders measure, per driver step"),
+      param::choice("controller", "none", "none diffusion",
+                    "none: commands from outside; diffusion: wander, turning away from what the proximity sensor sees"),
+      param::real("cruise_speed", "0", "rad/s", param::nonNegative(),
+                  "diffusion: wheel speed going straight (0: max_wheel_speed)"),
+      param::real("diffusion_delta", "0.1", "", param::positive(), "diffusion: obstacle vector length that makes it turn"),
+      param::real("diffusion_angle", "5", "deg", param::between(0, 180),
+                  "diffusion: obstacles within this of straight ahead make it turn"),
   };
 
   static void validate(const Descriptor& params, const PluginContext& context) {
     const Artifact& a = *context.artifact;
     if (a.rootCount() == 0 || a.root().isStatic()) throw params.error("diff_drive needs a dynamic physic root");
+    if (params.get<std::string>("controller") == "diffusion" && proximityOf(a) < 0)
+      throw params.errorAt("controller", "the diffusion controller needs a proximity sensor on the artifact");
     if (params.get<std::string>("model") != "full") return;
     for (const char* key : {"left_wheel", "right_wheel"}) {
       const std::string name = params.get<std::string>(key, "");
@@ -97,6 +113,12 @@ class DiffDrive final : public Driver, public CommandInterface, public OdometryI
       left_ = a.node(params.get<std::string>("left_wheel"));
       right_ = a.node(params.get<std::string>("right_wheel"));
     }
+    diffusion_ = params.get<std::string>("controller") == "diffusion";
+    cruise_ = params.get<double>("cruise_speed");
+    if (cruise_ == 0) cruise_ = max_wheel_;
+    delta_ = params.get<double>("diffusion_delta");
+    straight_ = params.get<double>("diffusion_angle") * kPi / 180;
+    proximity_ = proximityOf(a);
     const BodyState start = a.root().state();
     height_ = start.pose.position.z();
     start_ = Pose{start.pose.position, Quat(Eigen::AngleAxisd(yawOf(start.pose.orientation), Vec3::UnitZ()))};
@@ -110,6 +132,7 @@ class DiffDrive final : public Driver, public CommandInterface, public OdometryI
   void setCommand(const Command& c) override {
     if (const std::string why = refusal(c); !why.empty()) throw std::invalid_argument(why);
     level_ = c.level;
+    diffusion_ = false;  // a command from outside takes over
     if (c.level == CommandLevel::Wheels) {
       setWheels(c.left_wheel, c.right_wheel);
       return;
@@ -134,17 +157,20 @@ class DiffDrive final : public Driver, public CommandInterface, public OdometryI
     out.write(left_cmd_);
     out.write(right_cmd_);
     out.write(static_cast<std::uint8_t>(level_));
+    out.write(diffusion_);
     out.bytes(&odometry_, sizeof odometry_);
   }
   void loadState(StateReader& in) override {
     in.read(left_cmd_);
     in.read(right_cmd_);
     level_ = static_cast<CommandLevel>(in.get<std::uint8_t>());
+    in.read(diffusion_);
     in.bytes(&odometry_, sizeof odometry_);
   }
 
   void step(const StepInfo& info) override {
     const double dt = toSeconds(info.period);
+    if (diffusion_) diffuse();
     if (full_) {
       left_->setJointVelocity(left_cmd_);
       right_->setJointVelocity(right_cmd_);
@@ -155,6 +181,33 @@ class DiffDrive final : public Driver, public CommandInterface, public OdometryI
   }
 
  private:
+  static int proximityOf(const Artifact& a) {
+    for (std::size_t i = 0; i < a.sensorCount(); ++i)
+      if (dynamic_cast<const ProximityMeasurement*>(&a.sensor(i).latest()) != nullptr) return static_cast<int>(i);
+    return -1;
+  }
+
+  // ARGoS's diffusion: the readings as vectors along their rays, summed
+  void diffuse() {
+    const auto& m = static_cast<const ProximityMeasurement&>(artifact().sensor(static_cast<std::size_t>(proximity_)).latest());
+    double x = 0, y = 0;
+    for (std::size_t k = 0; k < m.readings.size() && k < m.angles.size(); ++k) {
+      x += m.readings[k] * std::cos(m.angles[k]);
+      y += m.readings[k] * std::sin(m.angles[k]);
+    }
+    const double n = static_cast<double>(std::max<std::size_t>(1, m.readings.size()));
+    x /= n;
+    y /= n;
+    const double angle = std::atan2(y, x);
+    if (std::abs(angle) <= straight_ && std::hypot(x, y) < delta_) {
+      setWheels(cruise_, cruise_);
+    } else if (angle > 0) {
+      setWheels(cruise_, 0);  // something on the left: turn right
+    } else {
+      setWheels(0, cruise_);
+    }
+  }
+
   // wheel speeds within the limit; both scaled alike, so that the path's curvature is kept
   void setWheels(double left, double right) {
     const double fastest = std::max(std::abs(left), std::abs(right));
@@ -224,6 +277,9 @@ class DiffDrive final : public Driver, public CommandInterface, public OdometryI
   }
 
   bool full_ = false;
+  bool diffusion_ = false;
+  int proximity_ = -1;
+  double cruise_ = 0, delta_ = 0, straight_ = 0;
   double radius_ = 0, axle_ = 0, max_wheel_ = 0, noise_ = 0, mass_ = 0, max_force_ = 0, max_torque_ = 0, height_ = 0;
   Mat3 inertia_ = Mat3::Identity();
   Vec3 gravity_ = Vec3::Zero();

@@ -75,6 +75,7 @@ class ProximitySensor final : public SensorOf<ProximityMeasurement> {
     hits_.resize(a.size());
     output().readings.assign(a.size(), 0.0);
     output().distances.assign(a.size(), std::numeric_limits<double>::infinity());
+    output().angles = a;
     setup.enableRayQueries();
   }
 

@@ -12,6 +12,7 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -67,6 +68,7 @@ struct SSX_EXPORT RangeMeasurement : Measurement {
 struct SSX_EXPORT ProximityMeasurement : Measurement {
   std::vector<double> readings;   ///< per ray, in the sensor's order: 0..1
   std::vector<double> distances;  ///< per ray: m to what it met, +inf when nothing within range
+  std::vector<double> angles;     ///< per ray: its direction, rad from the node's x axis toward y
   ~ProximityMeasurement() override;
   bool finite() const noexcept override;
 };
@@ -84,6 +86,18 @@ struct SSX_EXPORT RangeBearingMeasurement : Measurement {
   std::vector<Message> messages;  ///< in sender order
   ~RangeBearingMeasurement() override;
   bool finite() const noexcept override;
+};
+
+/// A range-and-bearing board's transmitter: what a driver sends to the robots around it. Implemented
+/// by the range_and_bearing sensor; find it among an artifact's sensors with dynamic_cast.
+class SSX_EXPORT RangeBearingInterface {
+ public:
+  virtual ~RangeBearingInterface();
+  /// Sets the payload sent from the next sensors phase on (from the artifact's own driver, or
+  /// between steps); its size is the sensor's `payload`. Throws std::invalid_argument for another size.
+  virtual void setData(std::span<const std::uint8_t> data) = 0;
+  /// The payload being sent.
+  virtual std::span<const std::uint8_t> data() const = 0;
 };
 
 /// A camera image: RGB and, when asked for, depth (m along the optical axis), drawn from the
