@@ -64,7 +64,7 @@ std::string swarmScene(int n, int threads) {
   const double half = std::max(2.0, 0.8 * packed);  // the arena: room to spread
   return R"(<scene><environment timestep="0.02" seed="11" threads=")" + std::to_string(threads) +
          R"("/><physics substeps="10"/><type name="epuck" file="epuck.xml"/><ground/>)" + arena(half) +
-         R"(<swarm type="epuck" count=")" + std::to_string(n) + R"(" name="e{i}" layout="grid" spacing="0.2" xyz=")" +
+         R"(<swarm type="epuck" count=")" + std::to_string(n) + R"(" name="e{i}" layout="grid" spacing="0.2" random_yaw="true" xyz=")" +
          std::to_string(-packed / 2) + " " + std::to_string(-packed / 2) +
          R"( 0"><driver controller="diffusion"/></swarm></scene>)";
 }
@@ -74,7 +74,7 @@ std::string fullScene(int n, const std::string& engine) {
   const double packed = 0.2 * (columns - 1);
   return R"(<scene><environment timestep="0.002" seed="11" threads="2"/><physics engine=")" + engine +
          R"("/><type name="epuck" file="epuck_full.xml"/><ground/><swarm type="epuck" count=")" + std::to_string(n) +
-         R"(" name="e{i}" layout="grid" spacing="0.2" xyz=")" + std::to_string(-packed / 2) + " " +
+         R"(" name="e{i}" layout="grid" spacing="0.2" random_yaw="true" xyz=")" + std::to_string(-packed / 2) + " " +
          std::to_string(-packed / 2) + R"( 0"><driver controller="diffusion"/></swarm></scene>)";
 }
 

@@ -211,6 +211,7 @@ void placement(std::ostringstream& out, const PlacementModel& p) {
       if (p.layout == "grid") e("spacing", num(p.spacing))("columns", num(p.columns))("rows", num(p.rows));
       if (p.layout == "random") e("min", vec(p.min))("max", vec(p.max))("min_distance", num(p.min_distance));
       if (p.layout == "sphere") e("radius", num(p.radius));
+      if (p.random_yaw) e("random_yaw", "true");
       overrides(out, p, e);
       break;
     }

@@ -86,6 +86,8 @@ struct SSX_EXPORT PlacementModel {
   double min_distance = 0;                            ///< random
   double radius = 1.0;                                ///< sphere
   std::vector<Vec3> positions;  ///< the members' places in the swarm's frame (xyz, rpy)
+  bool random_yaw = false;      ///< each member turned about z by its own uniform angle
+  std::vector<double> yaws;     ///< with random_yaw: each member's turn, rad, from a stream of the scene seed
   std::string memberName(std::int64_t k) const;  ///< member k's name (the pattern with {i} = first_index + k)
   /// An obstacle: its element as written (shapes and colour). (The ground's height is xyz.z().)
   std::shared_ptr<const Descriptor> obstacle;

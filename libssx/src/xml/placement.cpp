@@ -262,6 +262,13 @@ bool SceneLoader::readSwarm(const Descriptor& d, PlacementModel& p, std::size_t 
     p.radius = readPositive(d, "radius", 1.0);
     p.positions = detail::sphereLayout(count, p.radius);
   }
+  p.random_yaw = read<bool>(d, "random_yaw", false);
+  if (p.random_yaw) {
+    // a stream of its own, apart from the random layout's
+    Random rng(deriveSeed(settings_.seed, 0x7a3ULL, swarm_index));
+    p.yaws.resize(static_cast<std::size_t>(count));
+    for (double& yaw : p.yaws) yaw = rng.uniform(-M_PI, M_PI);
+  }
   checkUnknown(d, {"driver", "sensor", "ghost"});
   if (count > 1 && p.name.find("{i}") == std::string::npos)
     error(d.where(), "<swarm>: the name pattern '" + p.name + "' needs {i} to give " + std::to_string(count) +
@@ -383,6 +390,8 @@ void SceneLoader::buildSwarm(Environment& env, const PlacementModel& p, const Ar
   for (std::int64_t i = 0; i < p.count && static_cast<std::size_t>(i) < p.positions.size(); ++i) {
     Pose pose = origin;
     pose.position = origin.transformPoint(p.positions[static_cast<std::size_t>(i)]);
+    if (static_cast<std::size_t>(i) < p.yaws.size())
+      pose.orientation = (origin.orientation * Quat(Eigen::AngleAxisd(p.yaws[static_cast<std::size_t>(i)], Vec3::UnitZ()))).normalized();
     if (!place(env, p.memberName(i), p, type, pose, std::to_string(p.first_index + i)))
       return;  // one report per swarm, not one per robot
   }

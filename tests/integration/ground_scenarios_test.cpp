@@ -1,0 +1,81 @@
+// Ground-robot scenarios (examples/ground): each scene runs to its end and does what it is for.
+#include "scene_util.hpp"
+
+#include <ssx/ssx.hpp>
+
+#include <catch2/catch.hpp>
+
+#include <cmath>
+#include <set>
+
+using namespace ssx;
+using namespace ssx::test;
+
+namespace {
+
+const std::filesystem::path kGround = std::filesystem::path(SSX_EXAMPLES_DIR) / "ground";
+
+Scene groundExample(const std::string& file) {
+  SceneOptions options = testOptions();
+  return loadScene(kGround / file, options);
+}
+
+}  // namespace
+
+TEST_CASE("ground scenarios: diffusion: 1,000 e-pucks spread from a packed square over the arena in 60 s",
+          "[scenario][diffusion]") {
+  Scene scene = groundExample("diffusion.xml");
+  Environment& env = *scene.environment;
+  // the arena's 0.25 m cells (40 x 40) that have had an e-puck in them, and how many hold one now
+  constexpr double kCell = 0.25;
+  std::set<std::pair<int, int>> visited;
+  auto occupied = [&] {
+    std::set<std::pair<int, int>> now;
+    for (std::size_t i = 0; i < env.artifactCount(); ++i) {
+      const Artifact& a = std::as_const(env).artifact(i);
+      if (a.rootCount() == 0 || a.root().isStatic()) continue;
+      const Vec3 p = a.root().pose().position;
+      now.insert({static_cast<int>(std::floor((p.x() + 5) / kCell)), static_cast<int>(std::floor((p.y() + 5) / kCell))});
+    }
+    visited.insert(now.begin(), now.end());
+    return now.size();
+  };
+  // how far they are from their centroid, root mean square (packed: 2.5 m; spread evenly over the
+  // arena: 4.1 m)
+  auto dispersion = [&] {
+    std::vector<Vec3> p;
+    Vec3 c = Vec3::Zero();
+    for (std::size_t i = 0; i < env.artifactCount(); ++i) {
+      const Artifact& a = std::as_const(env).artifact(i);
+      if (a.rootCount() == 0 || a.root().isStatic()) continue;
+      p.push_back(a.root().pose().position);
+      c += p.back();
+    }
+    c /= static_cast<double>(p.size());
+    double sum = 0;
+    for (const Vec3& q : p) sum += (q - c).head<2>().squaredNorm();
+    return std::sqrt(sum / static_cast<double>(p.size()));
+  };
+  const double packed = dispersion();
+  const double start = static_cast<double>(occupied()) / 1600;
+  for (int s = 0; s < 60; ++s) {
+    env.step(50);
+    (void)occupied();
+  }
+  const double spread = static_cast<double>(occupied()) / 1600;
+  const double spread_rms = dispersion();
+  const double coverage = static_cast<double>(visited.size()) / 1600;
+  INFO("cells held at the start " << start * 100 << " %, after 60 s " << spread * 100 << " %; visited " << coverage * 100
+                                  << " %; rms distance from the centroid " << packed << " m, after 60 s " << spread_rms << " m");
+  CHECK(start < 0.42);     // 25 x 25 of the 40 x 40 cells (and the rows the grid's edges straddle)
+  CHECK(coverage > 0.95);  // nearly every cell of the arena was reached
+  CHECK(spread_rms > packed + 0.8);  // and they spread out
+  // every e-puck is inside the arena, upright, on the floor
+  for (std::size_t i = 0; i < env.artifactCount(); ++i) {
+    const Artifact& a = std::as_const(env).artifact(i);
+    if (a.rootCount() == 0 || a.root().isStatic()) continue;
+    const Pose p = a.root().pose();
+    CHECK((std::abs(p.position.x()) < 5 && std::abs(p.position.y()) < 5));
+    CHECK(std::abs(p.position.z()) < 0.002);
+  }
+}
