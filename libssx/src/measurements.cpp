@@ -100,6 +100,10 @@ ProximityMeasurement::~ProximityMeasurement() = default;
 bool ProximityMeasurement::finite() const noexcept {
   return std::all_of(readings.begin(), readings.end(), [](double r) { return std::isfinite(r); });
 }
+GroundMeasurement::~GroundMeasurement() = default;
+bool GroundMeasurement::finite() const noexcept {
+  return std::all_of(readings.begin(), readings.end(), [](double r) { return std::isfinite(r); });
+}
 RangeBearingMeasurement::~RangeBearingMeasurement() = default;
 RangeBearingInterface::~RangeBearingInterface() = default;
 bool RangeBearingMeasurement::finite() const noexcept {

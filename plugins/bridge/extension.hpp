@@ -32,7 +32,7 @@ inline constexpr ssx_plugin_param kBridgeParameters[] = {
     param::flag("lockstep", "false", "wait after each odometry message until every robot answered with a set-point"),
     param::real("lockstep_timeout_s", "2", "s", param::positive() & param::atMost(86400), "longest wait for the set-points of one step"),
     param::real("lockstep_connect_timeout_s", "10", "s", param::positive() & param::atMost(86400),
-                "how long the first step waits for every robot's controller to connect"),
+                "how long the first step waits for every robot's controller to connect, and for their first answers"),
     param::real("range_rate_hz", "10", "Hz", param::nonNegative(),
                 "rate of /<robot>/range (what a range sensor sees, as a PoseArray) in simulated time; 0: none"),
     param::real("image_rate_hz", "10", "Hz", param::nonNegative(),
@@ -121,15 +121,19 @@ class BridgeExtension : public SimulationExtension {
       connected_ = true;
     }
     if (lockstep_ && waiting_for_ >= 0) {
-      const auto missing = transport_->waitForSetpoints(waiting_for_, lockstep_timeout_);
+      // the first answers may take as long as connecting: a controller that has just connected may
+      // not have heard the first odometry yet (and one matched may be a peer that just left, whose
+      // endpoints DDS still lists until their lease runs out)
+      const double wait = answered_ ? lockstep_timeout_ : std::max(lockstep_timeout_, connect_timeout_);
+      const auto missing = transport_->waitForSetpoints(waiting_for_, wait);
       if (!missing.empty()) {
         std::string names;
         for (std::size_t i = 0; i < missing.size() && i < 5; ++i) names += (i ? ", " : "") + missing[i];
         if (missing.size() > 5) names += ", ...";
         throw Error("lock-step: no set-point stamped at or after t = " + std::to_string(waiting_for_) + " s within " +
-                    std::to_string(lockstep_timeout_) + " s from " + std::to_string(missing.size()) +
-                    " robot(s): " + names);
+                    std::to_string(wait) + " s from " + std::to_string(missing.size()) + " robot(s): " + names);
       }
+      answered_ = true;
       cutoff_ = waiting_for_;
       waiting_for_ = -1;
     }
@@ -406,6 +410,7 @@ class BridgeExtension : public SimulationExtension {
   std::vector<std::array<double, 3>> points_;  // a range's, reused
   bool lockstep_ = false;
   double lockstep_timeout_ = 2.0, connect_timeout_ = 10.0;
+  bool answered_ = false;  // lock-step: every robot answered once
   bool connected_ = false;
   double waiting_for_ = -1;            // lock-step: the odometry time set-points must answer
   std::uint64_t received_seen_ = 0;    // Transport::received() when what arrived was last applied

@@ -16,7 +16,13 @@
 // ARGoS's foot-bot diffusion example does: the readings summed as vectors along their rays; when
 // their direction is within `diffusion_angle` of straight ahead and their length below
 // `diffusion_delta`, both wheels at `cruise_speed`; otherwise it turns away on the spot's far wheel.
-// A command from outside takes over from it.
+//
+// `controller="beeclust"`: BEECLUST (Schmickl et al.), cue-based aggregation. It wanders as in
+// diffusion; when its range-and-bearing board hears a robot nearer than `meet_range`, it stops and
+// waits `wait_max * c^2 / (c^2 + cue_theta)` s, c the darkness its first ground sensor reads
+// (1 - grey), then turns on the spot by a random angle and wanders again. Robots meeting on a dark
+// spot wait long there: they gather on it.
+// A command from outside takes over from either controller.
 //
 // Parameters: kParameters below, or `ssx plugins --params diff_drive`.
 #include <ssx/artifact.hpp>
@@ -68,20 +74,27 @@ class DiffDrive final : public Driver, public CommandInterface, public OdometryI
                   "swarm model: the largest torque driving its yaw rate; 0: max_force times half the axle length"),
       param::real("encoder_noise", "0", "rad/s", param::nonNegative(),
                   "standard deviation of each wheel speed the encoders measure, per driver step"),
-      param::choice("controller", "none", "none diffusion",
-                    "none: commands from outside; diffusion: wander, turning away from what the proximity sensor sees"),
+      param::choice("controller", "none", "none diffusion beeclust",
+                    "none: commands from outside; diffusion: wander, turning away from what the proximity sensor "
+                    "sees; beeclust: wander, and wait where robots meet, longer on darker floor"),
       param::real("cruise_speed", "0", "rad/s", param::nonNegative(),
                   "diffusion: wheel speed going straight (0: max_wheel_speed)"),
       param::real("diffusion_delta", "0.1", "", param::positive(), "diffusion: obstacle vector length that makes it turn"),
       param::real("diffusion_angle", "5", "deg", param::between(0, 180),
                   "diffusion: obstacles within this of straight ahead make it turn"),
+      param::real("meet_range", "0.1", "m", param::positive(), "beeclust: a robot heard nearer than this is met"),
+      param::real("wait_max", "60", "s", param::nonNegative(), "beeclust: the longest wait, on the darkest floor"),
+      param::real("cue_theta", "0.1", "", param::positive(), "beeclust: the darkness squared at which it waits half as long"),
   };
 
   static void validate(const Descriptor& params, const PluginContext& context) {
     const Artifact& a = *context.artifact;
     if (a.rootCount() == 0 || a.root().isStatic()) throw params.error("diff_drive needs a dynamic physic root");
-    if (params.get<std::string>("controller") == "diffusion" && proximityOf(a) < 0)
-      throw params.errorAt("controller", "the diffusion controller needs a proximity sensor on the artifact");
+    const std::string controller = params.get<std::string>("controller");
+    if (controller != "none" && sensorOf<ProximityMeasurement>(a) < 0)
+      throw params.errorAt("controller", "the " + controller + " controller needs a proximity sensor on the artifact");
+    if (controller == "beeclust" && (sensorOf<RangeBearingMeasurement>(a) < 0 || sensorOf<GroundMeasurement>(a) < 0))
+      throw params.errorAt("controller", "the beeclust controller needs a range_and_bearing and a ground sensor on the artifact");
     if (params.get<std::string>("model") != "full") return;
     for (const char* key : {"left_wheel", "right_wheel"}) {
       const std::string name = params.get<std::string>(key, "");
@@ -113,12 +126,18 @@ class DiffDrive final : public Driver, public CommandInterface, public OdometryI
       left_ = a.node(params.get<std::string>("left_wheel"));
       right_ = a.node(params.get<std::string>("right_wheel"));
     }
-    diffusion_ = params.get<std::string>("controller") == "diffusion";
+    diffusion_ = params.get<std::string>("controller") != "none";
+    beeclust_ = params.get<std::string>("controller") == "beeclust";
+    meet_range_ = params.get<double>("meet_range");
+    wait_max_ = params.get<double>("wait_max");
+    theta_ = params.get<double>("cue_theta");
+    board_ = sensorOf<RangeBearingMeasurement>(a);
+    ground_ = sensorOf<GroundMeasurement>(a);
     cruise_ = params.get<double>("cruise_speed");
     if (cruise_ == 0) cruise_ = max_wheel_;
     delta_ = params.get<double>("diffusion_delta");
     straight_ = params.get<double>("diffusion_angle") * kPi / 180;
-    proximity_ = proximityOf(a);
+    proximity_ = sensorOf<ProximityMeasurement>(a);
     const BodyState start = a.root().state();
     height_ = start.pose.position.z();
     start_ = Pose{start.pose.position, Quat(Eigen::AngleAxisd(yawOf(start.pose.orientation), Vec3::UnitZ()))};
@@ -158,6 +177,9 @@ class DiffDrive final : public Driver, public CommandInterface, public OdometryI
     out.write(right_cmd_);
     out.write(static_cast<std::uint8_t>(level_));
     out.write(diffusion_);
+    out.write(static_cast<std::uint8_t>(phase_));
+    out.write(until_);
+    out.write(turn_);
     out.bytes(&odometry_, sizeof odometry_);
   }
   void loadState(StateReader& in) override {
@@ -165,12 +187,19 @@ class DiffDrive final : public Driver, public CommandInterface, public OdometryI
     in.read(right_cmd_);
     level_ = static_cast<CommandLevel>(in.get<std::uint8_t>());
     in.read(diffusion_);
+    phase_ = static_cast<Phase>(in.get<std::uint8_t>() % 3);
+    in.read(until_);
+    in.read(turn_);
     in.bytes(&odometry_, sizeof odometry_);
   }
 
   void step(const StepInfo& info) override {
     const double dt = toSeconds(info.period);
-    if (diffusion_) diffuse();
+    if (beeclust_ && diffusion_) {
+      beeclust(toSeconds(info.time));
+    } else if (diffusion_) {
+      diffuse();
+    }
     if (full_) {
       left_->setJointVelocity(left_cmd_);
       right_->setJointVelocity(right_cmd_);
@@ -181,10 +210,37 @@ class DiffDrive final : public Driver, public CommandInterface, public OdometryI
   }
 
  private:
-  static int proximityOf(const Artifact& a) {
+  template <class M>
+  static int sensorOf(const Artifact& a) {
     for (std::size_t i = 0; i < a.sensorCount(); ++i)
-      if (dynamic_cast<const ProximityMeasurement*>(&a.sensor(i).latest()) != nullptr) return static_cast<int>(i);
+      if (dynamic_cast<const M*>(&a.sensor(i).latest()) != nullptr) return static_cast<int>(i);
     return -1;
+  }
+
+  // BEECLUST: wander; on meeting a robot, wait as long as the floor is dark; then turn away
+  void beeclust(double t) {
+    if (phase_ == Phase::Wait) {
+      if (t < until_) return setWheels(0, 0);
+      // a random turn on the spot, either way, up to half a turn
+      phase_ = Phase::Turn;
+      const double angle = random().uniform(-kPi, kPi);
+      turn_ = angle >= 0 ? 1.0 : -1.0;
+      until_ = t + std::abs(angle) * axle_ / (2 * radius_ * cruise_);
+    }
+    if (phase_ == Phase::Turn) {
+      if (t < until_) return setWheels(-turn_ * cruise_, turn_ * cruise_);
+      phase_ = Phase::Walk;
+      until_ = t + 1.0;  // walks on for a second before it can stop again (leaves whom it met)
+    }
+    const auto& heard = static_cast<const RangeBearingMeasurement&>(artifact().sensor(static_cast<std::size_t>(board_)).latest());
+    const bool met = t >= until_ && std::any_of(heard.messages.begin(), heard.messages.end(),
+                                                 [&](const RangeBearingMeasurement::Message& m) { return m.range < meet_range_; });
+    if (!met) return diffuse();
+    const auto& floor = static_cast<const GroundMeasurement&>(artifact().sensor(static_cast<std::size_t>(ground_)).latest());
+    const double cue = floor.readings.empty() ? 0.0 : 1.0 - floor.readings[0];
+    phase_ = Phase::Wait;
+    until_ = t + wait_max_ * cue * cue / (cue * cue + theta_);
+    setWheels(0, 0);
   }
 
   // ARGoS's diffusion: the readings as vectors along their rays, summed
@@ -277,7 +333,12 @@ class DiffDrive final : public Driver, public CommandInterface, public OdometryI
   }
 
   bool full_ = false;
-  bool diffusion_ = false;
+  bool diffusion_ = false;  // a controller drives it (diffusion, or beeclust with it)
+  bool beeclust_ = false;
+  enum class Phase : std::uint8_t { Walk, Wait, Turn };
+  Phase phase_ = Phase::Walk;
+  double until_ = 0, turn_ = 1, meet_range_ = 0, wait_max_ = 0, theta_ = 0;
+  int board_ = -1, ground_ = -1;
   int proximity_ = -1;
   double cruise_ = 0, delta_ = 0, straight_ = 0;
   double radius_ = 0, axle_ = 0, max_wheel_ = 0, noise_ = 0, mass_ = 0, max_force_ = 0, max_torque_ = 0, height_ = 0;

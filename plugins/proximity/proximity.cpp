@@ -36,7 +36,7 @@ class ProximitySensor final : public SensorOf<ProximityMeasurement> {
   };
 
   static std::vector<double> angles(const Descriptor& params) {
-    const std::string text = params.get<std::string>("angles");
+    const std::string text = params.get<std::string>("angles", "");
     std::vector<double> out;
     if (text.empty()) {
       const auto n = params.get<std::int64_t>("count");

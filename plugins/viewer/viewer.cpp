@@ -470,6 +470,8 @@ class Viewer final : public SimulationExtension {
         for (const auto& tree : a.renderRoots()) {
           const PhysicNode* follow = tree->follow.empty() ? nullptr : a.node(tree->follow);
           if (follow == nullptr) continue;  // drawn with the world below
+          // a part joined to the root (a wheel) moves on its own: not drawn yet (one body per artifact)
+          if (follow->bodyIndex() != nodes_[b]->bodyIndex()) continue;
           shapes(list, *tree, nodes_[b]->poseInBody().inverse() * follow->poseInBody(), first);
         }
         models += (models.empty() ? "" : ",") + std::string("[") + list + "]";
@@ -486,7 +488,7 @@ class Viewer final : public SimulationExtension {
                           }) != nodes_.end();
       for (const auto& tree : a.renderRoots()) {
         const PhysicNode* follow = tree->follow.empty() ? nullptr : a.node(tree->follow);
-        if (follow != nullptr && moving) continue;
+        if (follow != nullptr && (moving || follow->bodyIndex() >= 0)) continue;
         shapes(world, *tree, follow != nullptr ? follow->pose() : a.placement(), first_world);
       }
     }

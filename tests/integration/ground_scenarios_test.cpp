@@ -6,6 +6,8 @@
 #include <catch2/catch.hpp>
 
 #include <cmath>
+#include <fstream>
+#include <iterator>
 #include <set>
 
 using namespace ssx;
@@ -78,4 +80,34 @@ TEST_CASE("ground scenarios: diffusion: 1,000 e-pucks spread from a packed squar
     CHECK((std::abs(p.position.x()) < 5 && std::abs(p.position.y()) < 5));
     CHECK(std::abs(p.position.z()) < 0.002);
   }
+}
+
+TEST_CASE("ground scenarios: aggregation: BEECLUST gathers 60 e-pucks on the dark spot in 3 minutes; robots that "
+          "never wait do not gather", "[scenario][aggregation]") {
+  // the scene as written, and the same robots told never to wait (a control run)
+  std::ifstream file(kGround / "aggregation.xml");
+  const std::string xml((std::istreambuf_iterator<char>(file)), std::istreambuf_iterator<char>());
+  REQUIRE(xml.find(R"(wait_max="60")") != std::string::npos);
+  auto onSpot = [&](const std::string& text) {
+    Scene scene = loadSceneFromString(text, "aggregation.xml", kGround, testOptions());
+    Environment& env = *scene.environment;
+    env.step(9000);  // 180 s
+    int on = 0, all = 0;
+    for (std::size_t i = 0; i < env.artifactCount(); ++i) {
+      const Artifact& a = std::as_const(env).artifact(i);
+      if (a.driver() == nullptr) continue;
+      ++all;
+      const Vec3 p = a.root().pose().position;
+      if (std::hypot(p.x() - 0.7, p.y() - 0.7) < 0.45 + 0.035) ++on;
+    }
+    return static_cast<double>(on) / all;
+  };
+  const double gathered = onSpot(xml);
+  std::string never = xml;
+  never.replace(never.find(R"(wait_max="60")"), 13, R"(wait_max="0" )");
+  const double control = onSpot(never);
+  INFO("on the dark spot after 180 s: " << gathered * 100 << " %; never waiting: " << control * 100
+                                        << " % (the spot is 7 % of the arena)");
+  CHECK(gathered > 0.4);
+  CHECK(control < 0.2);
 }

@@ -73,6 +73,14 @@ struct SSX_EXPORT ProximityMeasurement : Measurement {
   bool finite() const noexcept override;
 };
 
+/// What ground sensors read: the floor's colour at each of their points, and its grey level.
+struct SSX_EXPORT GroundMeasurement : Measurement {
+  std::vector<Vec3> colors;       ///< per point: RGB 0..1
+  std::vector<double> readings;   ///< per point: grey level, 0 black .. 1 white (with noise)
+  ~GroundMeasurement() override;
+  bool finite() const noexcept override;
+};
+
 /// What a range-and-bearing receiver got this step: one message per robot that sent one within range.
 struct SSX_EXPORT RangeBearingMeasurement : Measurement {
   /// One message received.

@@ -228,6 +228,8 @@ std::string Recorder::Impl::sceneJson() const {
       const PhysicNode* root = follow;
       while (root != nullptr && root->parent() != nullptr) root = root->parent();
       const auto body = std::find(nodes.begin(), nodes.end(), root);
+      // a part joined to its root (a wheel) moves on its own: not recorded yet (one body per artifact)
+      if (follow != nullptr && follow->bodyIndex() != root->bodyIndex()) continue;
       if (follow == nullptr) {
         add(add, *tree, detail::kWorldFrame, a.placement());
       } else if (body == nodes.end()) {  // a static root: where it is now, for good

@@ -8,6 +8,8 @@
 #include <catch2/catch.hpp>
 
 #include <cmath>
+#include <filesystem>
+#include <fstream>
 #include <numbers>
 
 using namespace ssx;
@@ -99,4 +101,27 @@ TEST_CASE("proximity: a linear response, and uniform noise kept within [0, 1]", 
   CHECK(side_max <= 0.1 + 1e-12);  // nothing there: 0 plus noise, never below 0
   CHECK_THROWS_WITH(scene("ode", R"(<sensor plugin="proximity" angles="0 x"/>)"),
                     Contains("angles must be numbers in degrees"));
+}
+
+TEST_CASE("proximity: without angles, count rays are spread evenly from straight ahead", "[proximity]") {
+  std::filesystem::create_directories("proximity_count");
+  std::ofstream("proximity_count/puck.xml") << R"(<artifact>
+  <physic name="body" mass="0.1"><cylinder radius="0.03" length="0.04" xyz="0 0 0.02"/></physic>
+  <sensor plugin="proximity" count="4" range="0.2" height="0.02"/>
+</artifact>
+)";
+  Scene s = loadSceneFromString(R"(<scene><physics gravity="0 0 0"/><type name="p" file="puck.xml"/>
+    <obstacle name="wall" xyz="0 0.15 0.05"><box size="1 0.02 0.1"/></obstacle>
+    <artifact name="me" type="p"/></scene>)",
+                                "count.xml", std::filesystem::current_path() / "proximity_count", testOptions());
+  Environment& env = *s.environment;
+  env.step();
+  const ProximityMeasurement& m = reading(env, "me");
+  REQUIRE(m.angles.size() == 4);
+  CHECK(m.angles[1] == Approx(M_PI / 2));
+  // only the ray to the left (+y) meets the wall, 0.14 m out from the node's axis
+  CHECK(std::isinf(m.distances[0]));
+  CHECK(m.distances[1] == Approx(0.14).margin(1e-6));
+  CHECK(std::isinf(m.distances[2]));
+  CHECK(std::isinf(m.distances[3]));
 }
