@@ -1,0 +1,37 @@
+"""Ground robots from Python: e-pucks take 'wheels' and 'velocity' commands through set_commands,
+one row per robot, and drive at the speeds their wheels give."""
+import math
+
+import numpy as np
+import pytest
+
+import ssx
+
+SCENE = """<scene>
+  <environment timestep="0.002" seed="1"/>
+  <type name="epuck" file="epuck.xml"/>
+  <ground/>
+  <artifact name="a" type="epuck" xyz="0 0 0"/>
+  <artifact name="b" type="epuck" xyz="0 1 0"/>
+</scene>"""
+
+R, L = 0.0205, 0.053
+
+
+def test_e_pucks_take_wheel_and_velocity_commands_from_python():
+    env = ssx.load_scene_string(SCENE, base_dir=ssx.data_directory() / "artifacts", threads=1)
+    env.step(10)
+    env.set_commands("wheels", np.array([[4.0, 4.0], [-3.0, 3.0]]), robots=["a", "b"])
+    env.step(500)
+    names = env.dynamic_names()
+    a, b = names.index("a"), names.index("b")
+    np.testing.assert_allclose(env.linear_velocities()[a], [4.0 * R, 0, 0], atol=1e-3)
+    assert env.angular_velocities()[b][2] == pytest.approx(2 * 3.0 * R / L, rel=0.01)
+    # a velocity command: the component along the heading, and the yaw rate
+    env.set_commands("velocity", np.array([[0.05, 0, 0, 0.5]]), robots=["a"])
+    env.step(250)
+    v = env.linear_velocities()[a]
+    assert math.hypot(v[0], v[1]) == pytest.approx(0.05, rel=0.01)
+    assert env.angular_velocities()[a][2] == pytest.approx(0.5, rel=0.01)
+    with pytest.raises(ValueError, match="2 \\(left, right wheel speed\\)"):
+        env.set_commands("wheels", np.array([[1.0, 2.0, 3.0]]), robots=["a"])
