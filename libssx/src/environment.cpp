@@ -295,6 +295,7 @@ void Environment::start() {
       e.initialised = true;
     }
     physics_ = createPhysicEngine(settings_.physics);
+    w.engine = physics_.get();
     renderer_ = createRenderEngine(settings_.render);
     detail::buildBodies(w, *physics_, static_shapes_);
     ghosts_->start(w, *physics_);

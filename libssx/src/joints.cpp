@@ -72,6 +72,7 @@ double jointVelocity(const World& world, const JointData& j) {
 
 void buildJoints(World& world, PhysicEngine& engine) {
   const double dt = toSeconds(world.settings.timestep);
+  world.attached.assign(engine.bodyCount(), 0);
   for (JointData& j : world.joints) {
     const PhysicNode& node = world.node_handles[j.node];
     const JointSpec& spec = node.spec().joint;

@@ -19,6 +19,12 @@ void buildJoints(World& world, PhysicEngine& engine);
 /// Before a physics step: sets the motors' velocities; returns the wrenches to apply (the drivers',
 /// or a copy with the joints' damping added).
 const Wrench* applyJoints(World& world, PhysicEngine& engine);
+/// Before a physics step: carries out the run-time joints the drivers asked for in the last step
+/// (attachments.cpp), artifact by artifact.
+void applyAttachRequests(World& world, PhysicEngine& engine);
+/// Reads the run-time joints and requests saveState wrote (after the engine restored its joints);
+/// throws StateError for what does not fit the world.
+void loadAttachments(World& world, StateReader& in);
 /// A hinge's angle or slider's displacement from the snapshot (0 before start).
 double jointPosition(const World& world, const JointData& joint);
 /// A hinge's or slider's rate from the snapshot (0 before start).

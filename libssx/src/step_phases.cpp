@@ -197,6 +197,7 @@ void Environment::step() {
   auto t = Clock::now();
   const double t_next = toSeconds((w.steps + 1) * settings_.timestep);
   try {
+    if (w.attach_pending.load(std::memory_order_relaxed)) detail::applyAttachRequests(w, *physics_);
     if (!ghosts_->empty()) ghosts_->beforePhysics(w, *physics_, t_next, toSeconds(settings_.timestep));
     const Wrench* applied = w.joints.empty() ? w.wrenches.data() : detail::applyJoints(w, *physics_);
     physics_->step(settings_.timestep, {applied, w.wrenches.size()});

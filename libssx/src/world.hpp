@@ -16,6 +16,7 @@
 
 #include "state_checks.hpp"
 
+#include <atomic>
 #include <cstdint>
 #include <deque>
 #include <functional>
@@ -57,6 +58,21 @@ struct JointData {
   enum class Mode : std::uint8_t { Off, Velocity, Position };
   Mode mode = Mode::Off;  // the motor's command, held until changed
   double target = 0.0;
+};
+
+/// A joint made at run time (PhysicNode::attach): `holder`'s body holds `held`'s by a fixed joint.
+struct Attachment {
+  std::uint32_t holder = 0;  // node indices
+  std::uint32_t held = 0;
+  int engine = -1;  // the engine's index of the joint
+};
+
+/// What a driver asked for during a step, carried out before the next step's physics.
+struct AttachRequest {
+  enum class Kind : std::uint8_t { Attach, Release, Detach };
+  Kind kind = Kind::Attach;
+  std::uint32_t node = 0;   // the node that asked
+  std::uint32_t other = 0;  // attach: the node to hold
 };
 
 /// One attached driver or sensor: who it is and when it runs (its random stream is in
@@ -106,6 +122,7 @@ struct ArtifactData {
   std::uint32_t sensor_begin = 0, sensor_end = 0;
   std::uint32_t inbox_begin = 0, inbox_end = 0;
   bool silent = false;             // a lost ghost: its sensors do not measure
+  std::vector<AttachRequest> attach_requests;  // its driver's, until the next step's physics
   int body_begin = 0;               // bodies [body_begin, body_end) in the body arrays
   int body_end = 0;
   // where its nodes and plugin slots are in the world's tables, for prefetching: [first, end)
@@ -150,6 +167,10 @@ struct World {
   std::vector<JointData> joints;   // in node order
   std::vector<int> node_joint;     // per node: its joint's index in `joints`, or -1
   std::vector<Wrench> applied;     // the wrenches with the joints' damping, when there is any
+  std::vector<Attachment> attachments;  // in the order made
+  std::vector<std::uint16_t> attached;  // per body: run-time joints on it
+  std::atomic<bool> attach_pending{false};  // some artifact has attach_requests
+  PhysicEngine* engine = nullptr;           // from start
   std::vector<PluginSlot> plugins;
   std::vector<Random> randoms;
   // per plugin slot, written by the sensors phase: 1 when that sensor measured in this step (one

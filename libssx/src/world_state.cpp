@@ -4,9 +4,10 @@
 // Layout: "SSXSTATE", format version (u32), reserved (u32), scene fingerprint (u64), payload size
 // (u64), FNV-1a of the payload (u64); then the payload: step count, the engine's block, the
 // snapshot (body states with accelerations, the velocities before the last step), the command
-// buffers, every plugin's random stream (the world's plugin table, in order), then one block per
+// buffers, the joints' motor commands, the run-time joints and the requests for them, every plugin's random stream (the world's plugin table, in order), then one block per
 // plugin (driver first, then sensors, artifact by artifact: what it saved) and one per extension.
 #include "ghosts.hpp"
+#include "phases.hpp"
 #include "neighbor_index.hpp"
 #include "render/scene_cameras.hpp"
 #include "state_checks.hpp"
@@ -23,7 +24,7 @@ namespace ssx {
 namespace {
 
 constexpr char kMagic[8] = {'S', 'S', 'X', 'S', 'T', 'A', 'T', 'E'};
-constexpr std::uint32_t kFormatVersion = 3;
+constexpr std::uint32_t kFormatVersion = 4;  // 4: run-time joints (PhysicNode::attach)
 constexpr std::size_t kHeaderSize = 8 + 4 + 4 + 8 + 8 + 8;
 
 void writeBody(StateWriter& out, const BodyState& s) {
@@ -108,6 +109,22 @@ std::vector<std::byte> Environment::saveState() const {
     out.write(static_cast<std::uint8_t>(j.mode));
     out.write(j.target);
   }
+  // the run-time joints (the engine's block has what makes them again) and those asked for
+  out.write(static_cast<std::uint64_t>(w.attachments.size()));
+  for (const auto& x : w.attachments) {
+    out.write(x.holder);
+    out.write(x.held);
+    out.write(static_cast<std::int32_t>(x.engine));
+  }
+  std::uint64_t requests = 0;
+  for (const auto& a : w.artifact_data) requests += a.attach_requests.size();
+  out.write(requests);
+  for (const auto& a : w.artifact_data)
+    for (const auto& r : a.attach_requests) {
+      out.write(static_cast<std::uint8_t>(r.kind));
+      out.write(r.node);
+      out.write(r.other);
+    }
   // the random streams, then each plugin's own state (driver first, then sensors, by artifact)
   for (const Random& r : w.randoms) r.save(out);
   for (const auto& a : w.artifact_data) {
@@ -206,6 +223,7 @@ void Environment::applyState(std::span<const std::byte> payload) {
       throw StateError("saved state: a joint's motor command is not one a driver could give (corrupted)");
     j.mode = static_cast<detail::JointData::Mode>(mode);
   }
+  detail::loadAttachments(w, in);
   for (Random& r : w.randoms) r.load(in);
   for (std::size_t i = 0; i < w.artifacts.size(); ++i) {
     const std::string of = " of artifact '" + w.artifacts[i]->name() + "'";

@@ -81,6 +81,9 @@ struct EngineJoint {
   Pose frame;
   double lower = -std::numeric_limits<double>::infinity();  ///< rad or m; infinite: no limit
   double upper = std::numeric_limits<double>::infinity();   ///< rad or m
+  /// Made while the world runs (a gripper closing): removable, and part of the saved state. The
+  /// scene's joints (false) all come first, before any step.
+  bool run_time = false;
 };
 
 /// A segment to cast against the shapes (PhysicEngine::castRays).
@@ -134,15 +137,21 @@ class SSX_EXPORT PhysicEngine {
   virtual void setKinematic(int body) = 0;
   /// Whether setKinematic made `body` kinematic.
   virtual bool isKinematic(int body) const = 0;
-  /// Joins two bodies (or a body and the world) and returns the joint's index. Bodies joined,
-  /// directly or through others, do not collide with each other and are always solved together.
-  /// Before the first step, with the bodies in their initial states; part of the scene.
+  /// Joins two bodies (or a body and the world) where they are now and returns the joint's index.
+  /// Bodies joined, directly or through others, do not collide with each other and are always
+  /// solved together. A scene joint is made before the first step (or restoreState); a run-time
+  /// one (EngineJoint::run_time) between steps, part of the saved state until removeJoint: it
+  /// takes the lowest index a removed run-time joint left, else the next. Throws Error for a scene
+  /// joint after a run-time one or a step.
   virtual int addJoint(const EngineJoint& joint) = 0;
+  /// Removes a run-time joint (between steps); its bodies move freely of each other from the next
+  /// step. Throws Error for a joint of the scene or one already removed.
+  virtual void removeJoint(int joint) = 0;
   /// Sets a joint's motor: a target velocity (rad/s or m/s of the child relative to the parent,
   /// about or along the frame's z axis), reached with at most `max_effort` (N m or N; 0: the motor
   /// is off and the joint turns freely); held until set again. Off until first set.
   virtual void setJointMotor(int joint, double velocity, double max_effort) = 0;
-  /// How many joints were added.
+  /// How many joints there are (the scene's and the run-time ones not removed).
   virtual std::size_t jointCount() const = 0;
   /// Poses every shape where its body is now, for castRays (after a step, before the queries).
   virtual void prepareRayQueries() = 0;

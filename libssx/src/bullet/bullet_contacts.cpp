@@ -245,6 +245,7 @@ void BulletEngine::buildIslands() {
     if (ra != rb) group_[static_cast<std::size_t>(std::max(ra, rb))] = std::min(ra, rb);
   };
   for (const Joint& j : joints_) {
+    if (j.removed) continue;
     if (j.spec.parent >= 0)
       unite(j.spec.child, j.spec.parent);
     else
@@ -286,7 +287,8 @@ void BulletEngine::buildIslands() {
   }
   // the joints of each island, in the order they were added
   joint_order_.clear();
-  for (std::size_t k = 0; k < joints_.size(); ++k) joint_order_.emplace_back(find(joints_[k].spec.child), k);
+  for (std::size_t k = 0; k < joints_.size(); ++k)
+    if (!joints_[k].removed) joint_order_.emplace_back(find(joints_[k].spec.child), k);
   std::sort(joint_order_.begin(), joint_order_.end());
   island_joints_.clear();
   island = 0;

@@ -1,4 +1,5 @@
 #include "bullet/bullet_parts.hpp"
+#include "articulations.hpp"
 #include "state_checks.hpp"
 
 #include <ssx/error.hpp>
@@ -111,7 +112,6 @@ int BulletEngine::addBody(const MassProperties& mass, const std::vector<Shape>& 
   // (a solver built thread-safe tells kinematic bodies apart by it: unique, as in a world)
   body->rb->setWorldArrayIndex(index);
   bodies_.push_back(std::move(body));
-  articulation_.push_back(index);
   proxies_stale_ = true;
   setState(index, state);
   return index;
@@ -192,7 +192,16 @@ void BulletEngine::step(Nanoseconds dt, std::span<const Wrench> wrenches) {
   const int substeps = std::max(1, settings_.substeps);
   const double h = toSeconds(dt) / substeps;
   contact_count_ = 0;
-  if (!joints_.empty()) setMotors(h);
+  seal();
+  if (labels_stale_ || articulation_.size() != bodies_.size()) {
+    articulation_.resize(bodies_.size());
+    labelArticulations(articulation_, joints_.size(), [this](std::size_t k) {
+      const Joint& j = joints_[k];
+      return j.removed ? std::pair{-1, -1} : std::pair{j.spec.child, j.spec.parent};
+    });
+    labels_stale_ = false;
+  }
+  if (live_joints_ > 0) setMotors(h);
   for (int s = 0; s < substeps; ++s) {
     // the held wrenches and gravity, every substep (the solver uses and the step clears them)
     for (std::size_t i = 0; i < bodies_.size(); ++i) {
@@ -251,6 +260,7 @@ void BulletEngine::saveState(StateWriter& out) const {
     readBits(*body->rb, bits);
     out.bytes(bits, sizeof bits);
   }
+  saveJoints(out);
 }
 
 void BulletEngine::restoreState(StateReader& in) {
@@ -275,7 +285,18 @@ void BulletEngine::restoreState(StateReader& in) {
     if ((r * r.transpose() - Mat3::Identity()).cwiseAbs().maxCoeff() > 1e-9 || r.determinant() < 0)
       throw bad("has a rotation matrix that is not a rotation");
   }
+  seal();
+  std::vector<Joint> run_time = loadJoints(in);
   for (std::size_t i = 0; i < bodies_.size(); ++i) writeBits(*bodies_[i]->rb, values.data() + i * kBodyReals);
+  // the run-time joints the state has, in place of this engine's (made from their saved frames)
+  joints_.resize(scene_joints_);
+  for (Joint& j : run_time) {
+    if (!j.removed) makeConstraint(j);
+    joints_.push_back(std::move(j));
+  }
+  live_joints_ = 0;
+  for (const Joint& j : joints_) live_joints_ += j.removed ? 0 : 1;
+  labels_stale_ = true;
 }
 
 }  // namespace ssx::detail

@@ -22,7 +22,8 @@
 // results do not depend on the thread count. Contacts are found afresh each substep (no warm
 // start from the last one), so a body's transform and velocities are the whole state. Joints are
 // Bullet's constraints (hinge, slider, point-to-point, fixed), their frames fixed in the bodies
-// when made; they keep nothing from step to step that the solver uses (no warm start either).
+// when made; they keep nothing from step to step that the solver uses (no warm start either). A
+// joint made between steps is saved with its frames and made again from them on restore.
 
 #include "grid_broadphase.hpp"
 
@@ -64,7 +65,8 @@ class BulletEngine final : public PhysicEngine {
   void restoreState(StateReader& in) override;
   int addJoint(const EngineJoint& joint) override;
   void setJointMotor(int joint, double velocity, double max_effort) override;
-  std::size_t jointCount() const override { return joints_.size(); }
+  void removeJoint(int joint) override;
+  std::size_t jointCount() const override { return live_joints_; }
   void prepareRayQueries() override;
   void castRays(std::span<const Ray> rays, std::span<RayHit> hits, int ignore_begin, int ignore_end) const override;
 
@@ -92,6 +94,10 @@ class BulletEngine final : public PhysicEngine {
     std::unique_ptr<btTypedConstraint> constraint;
     double velocity = 0.0;    // the motor's target
     double max_effort = 0.0;  // off: 0
+    // the joint's frame in the child's and the parent's Bullet body frame, as taken when it was
+    // made (rotation row by row, then the origin): what makes it again to the bit
+    double in_child[12] = {}, in_parent[12] = {};
+    bool removed = false;  // a run-time joint let go of (its slot reusable)
   };
 
   class Lease;  // a context for one task, given back when the task ends
@@ -105,6 +111,15 @@ class BulletEngine final : public PhysicEngine {
   void buildIslands();
   void solve(double h);
   void setMotors(double h);
+  // makes the joint's Bullet constraint from its frames
+  void makeConstraint(Joint& joint);
+  void saveJoints(StateWriter& out) const;
+  // reads the run-time joints of a saved state (checked; nothing changed yet)
+  std::vector<Joint> loadJoints(StateReader& in) const;
+  void seal() {
+    if (!sealed_) scene_joints_ = joints_.size();
+    sealed_ = true;
+  }
 
   PhysicsSettings settings_;
   TaskRunner* runner_ = nullptr;
@@ -112,6 +127,10 @@ class BulletEngine final : public PhysicEngine {
   std::vector<std::unique_ptr<StaticObject>> statics_;
   std::vector<Joint> joints_;
   std::vector<int> articulation_;  // per body: the lowest body it is joined to (itself when none)
+  bool labels_stale_ = false;      // joints came or went since articulation_ was computed
+  std::size_t scene_joints_ = 0;   // joints_[0, scene_joints_) are the scene's (once sealed_)
+  bool sealed_ = false;
+  std::size_t live_joints_ = 0;
   std::vector<std::pair<int, std::size_t>> joint_order_;  // (island root, joint)
   std::vector<btTypedConstraint*> island_joints_;
   std::mutex contexts_mutex_;

@@ -1,5 +1,6 @@
 // The Bullet engine's joints: Bullet's hinge, slider, point-to-point and fixed constraints, their
-// limits and motors (solved with the island of their bodies: bullet_contacts.cpp).
+// limits and motors (solved with the island of their bodies: bullet_contacts.cpp); joints made and
+// removed between steps, saved with their frames.
 #include "bullet/bullet_parts.hpp"
 
 #include <ssx/error.hpp>
@@ -15,6 +16,17 @@ namespace {
 
 btTransform toBt(const Pose& p) { return btTransform(bullet::toBt(p.orientation.normalized()), bullet::toBt(p.position)); }
 
+void toRaw(const btTransform& t, double* out) {
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c) out[3 * r + c] = t.getBasis()[r][c];
+  for (int k = 0; k < 3; ++k) out[9 + k] = t.getOrigin()[k];
+}
+
+btTransform fromRaw(const double* in) {
+  return btTransform(btMatrix3x3(in[0], in[1], in[2], in[3], in[4], in[5], in[6], in[7], in[8]),
+                     btVector3(in[9], in[10], in[11]));
+}
+
 }  // namespace
 
 int BulletEngine::addJoint(const EngineJoint& spec) {
@@ -22,16 +34,44 @@ int BulletEngine::addJoint(const EngineJoint& spec) {
   if (spec.child < 0 || spec.child >= count || spec.parent >= count || spec.parent == spec.child ||
       spec.kind == JointSpec::Kind::Rigid)
     throw Error("bullet: a joint needs a kind and two different bodies (or a body and the world)");
-  btRigidBody& child = *bodies_[static_cast<std::size_t>(spec.child)]->rb;
-  btRigidBody& parent =
-      spec.parent >= 0 ? *bodies_[static_cast<std::size_t>(spec.parent)]->rb : btTypedConstraint::getFixedBody();
+  if (spec.run_time)
+    seal();
+  else if (sealed_)
+    throw Error("bullet: the scene's joints come before any step and any run-time joint");
+  const btRigidBody& child = *bodies_[static_cast<std::size_t>(spec.child)]->rb;
   // the joint's frame in each body (Bullet's body frame: the centre of mass on principal axes);
   // the static world's body is at the origin
   const btTransform frame = toBt(spec.frame);
-  const btTransform in_child = child.getCenterOfMassTransform().inverse() * frame;
-  const btTransform in_parent = spec.parent >= 0 ? parent.getCenterOfMassTransform().inverse() * frame : frame;
   Joint joint;
   joint.spec = spec;
+  toRaw(child.getCenterOfMassTransform().inverse() * frame, joint.in_child);
+  toRaw(spec.parent >= 0 ? bodies_[static_cast<std::size_t>(spec.parent)]->rb->getCenterOfMassTransform().inverse() * frame
+                         : frame,
+        joint.in_parent);
+  makeConstraint(joint);
+  // a run-time joint takes the first slot one let go of
+  std::size_t slot = joints_.size();
+  for (std::size_t k = scene_joints_; sealed_ && k < joints_.size(); ++k)
+    if (joints_[k].removed) {
+      slot = k;
+      break;
+    }
+  if (slot == joints_.size())
+    joints_.push_back(std::move(joint));
+  else
+    joints_[slot] = std::move(joint);
+  ++live_joints_;
+  labels_stale_ = true;
+  return static_cast<int>(slot);
+}
+
+void BulletEngine::makeConstraint(Joint& joint) {
+  const EngineJoint& spec = joint.spec;
+  btRigidBody& child = *bodies_[static_cast<std::size_t>(spec.child)]->rb;
+  btRigidBody& parent =
+      spec.parent >= 0 ? *bodies_[static_cast<std::size_t>(spec.parent)]->rb : btTypedConstraint::getFixedBody();
+  const btTransform in_child = fromRaw(joint.in_child);
+  const btTransform in_parent = fromRaw(joint.in_parent);
   switch (spec.kind) {
     case JointSpec::Kind::Hinge: {
       // the frames' z axes are the hinge's; Bullet's angle is its first body's relative to its
@@ -66,21 +106,71 @@ int BulletEngine::addJoint(const EngineJoint& spec) {
     case JointSpec::Kind::Rigid:
       break;
   }
-  if (spec.parent >= 0) {
-    const int keep = std::min(articulation_[static_cast<std::size_t>(spec.child)],
-                              articulation_[static_cast<std::size_t>(spec.parent)]);
-    const int drop = std::max(articulation_[static_cast<std::size_t>(spec.child)],
-                              articulation_[static_cast<std::size_t>(spec.parent)]);
-    for (int& a : articulation_)
-      if (a == drop) a = keep;
+}
+
+void BulletEngine::removeJoint(int index) {
+  const auto k = static_cast<std::size_t>(index);
+  if (!sealed_ || index < 0 || k < scene_joints_ || k >= joints_.size() || joints_[k].removed)
+    throw Error("bullet: joint " + std::to_string(index) + " is not a run-time joint in place (only those can be removed)");
+  joints_[k].constraint.reset();
+  joints_[k].removed = true;
+  --live_joints_;
+  labels_stale_ = true;
+}
+
+void BulletEngine::saveJoints(StateWriter& out) const {
+  const std::size_t first = sealed_ ? scene_joints_ : joints_.size();
+  out.write(static_cast<std::uint64_t>(joints_.size() - first));
+  for (std::size_t k = first; k < joints_.size(); ++k) {
+    const Joint& j = joints_[k];
+    out.write(static_cast<std::uint8_t>(j.removed ? 1 : 0));
+    if (j.removed) continue;
+    out.write(static_cast<std::uint8_t>(j.spec.kind));
+    out.write(static_cast<std::int32_t>(j.spec.parent));
+    out.write(static_cast<std::int32_t>(j.spec.child));
+    out.write(j.spec.frame);
+    out.write(j.spec.lower);
+    out.write(j.spec.upper);
+    out.write(j.velocity);
+    out.write(j.max_effort);
+    out.bytes(j.in_child, sizeof j.in_child);
+    out.bytes(j.in_parent, sizeof j.in_parent);
   }
-  joints_.push_back(std::move(joint));
-  proxies_stale_ = true;
-  return static_cast<int>(joints_.size() - 1);
+}
+
+std::vector<BulletEngine::Joint> BulletEngine::loadJoints(StateReader& in) const {
+  std::vector<Joint> out(in.count(1));
+  const auto bodies = static_cast<int>(bodies_.size());
+  for (Joint& j : out) {
+    if (in.get<std::uint8_t>() != 0) {
+      j.removed = true;
+      continue;
+    }
+    const auto kind = in.get<std::uint8_t>();
+    j.spec.parent = in.get<std::int32_t>();
+    j.spec.child = in.get<std::int32_t>();
+    in.read(j.spec.frame);
+    in.read(j.spec.lower);
+    in.read(j.spec.upper);
+    in.read(j.velocity);
+    in.read(j.max_effort);
+    in.bytes(j.in_child, sizeof j.in_child);
+    in.bytes(j.in_parent, sizeof j.in_parent);
+    bool finite = std::isfinite(j.velocity) && std::isfinite(j.max_effort) && j.max_effort >= 0;
+    for (const double v : j.in_child) finite = finite && std::isfinite(v);
+    for (const double v : j.in_parent) finite = finite && std::isfinite(v);
+    if (!finite || kind > static_cast<std::uint8_t>(JointSpec::Kind::Fixed) ||
+        kind == static_cast<std::uint8_t>(JointSpec::Kind::Rigid) || j.spec.child < 0 || j.spec.child >= bodies ||
+        j.spec.parent < -1 || j.spec.parent >= bodies || j.spec.parent == j.spec.child)
+      throw StateError("bullet: a run-time joint in the saved state does not fit this world (corrupted)");
+    j.spec.kind = static_cast<JointSpec::Kind>(kind);
+  }
+  return out;
 }
 
 void BulletEngine::setJointMotor(int index, double velocity, double max_effort) {
   Joint& joint = joints_.at(static_cast<std::size_t>(index));
+  if (joint.removed) throw Error("bullet: joint " + std::to_string(index) + " was removed");
   joint.velocity = velocity;
   joint.max_effort = max_effort;
 }
@@ -88,6 +178,7 @@ void BulletEngine::setJointMotor(int index, double velocity, double max_effort) 
 void BulletEngine::setMotors(double h) {
   // Bullet's hinge takes the motor's limit as an impulse per substep, its slider as a force
   for (Joint& j : joints_) {
+    if (j.removed) continue;
     const bool on = j.max_effort > 0;
     if (j.spec.kind == JointSpec::Kind::Hinge)
       static_cast<btHingeConstraint&>(*j.constraint).enableAngularMotor(on, j.velocity, j.max_effort * h);

@@ -1,4 +1,6 @@
 #include "ode/ode_engine.hpp"
+
+#include "articulations.hpp"
 #include "state_checks.hpp"
 
 #include <ssx/error.hpp>
@@ -245,7 +247,6 @@ int OdeEngine::addBody(const MassProperties& mass, const std::vector<Shape>& sha
   }
   p.order.push_back(index);
   bodies_.push_back(std::move(body));
-  articulation_.push_back(index);
   proxies_stale_ = true;
   setState(index, state);
   return index;
@@ -372,13 +373,22 @@ void OdeEngine::step(Nanoseconds dt, std::span<const Wrench> wrenches) {
   const int substeps = std::max(1, settings_.substeps);
   const double h = toSeconds(dt) / substeps;
   contact_count_ = 0;
+  seal();
   if (group_.size() != bodies_.size()) group_.assign(bodies_.size(), -1);
+  if (labels_stale_ || articulation_.size() != bodies_.size()) {
+    articulation_.resize(bodies_.size());
+    labelArticulations(articulation_, joints_.size(), [this](std::size_t k) {
+      const Joint& j = joints_[k];
+      return j.removed ? std::pair{-1, -1} : std::pair{j.spec.child, j.spec.parent};
+    });
+    labels_stale_ = false;
+  }
   for (int k = 0; k < substeps; ++k) {
     // contacts in one space over every world, then the groups they make into one world each
     collide();
     groupContacts();
     for (Partition& p : partitions_) p.has_joints = false;
-    partitions_[0].has_joints = !joints_.empty();  // (the joined bodies' world: see ode_engine.hpp)
+    partitions_[0].has_joints = live_joints_ > 0;  // (the joined bodies' world: see ode_engine.hpp)
     for (const dContact& c : contacts_) {
       const auto owner_a = reinterpret_cast<std::intptr_t>(dGeomGetData(c.geom.g1));
       const auto owner_b = reinterpret_cast<std::intptr_t>(dGeomGetData(c.geom.g2));
@@ -437,6 +447,7 @@ void OdeEngine::saveState(StateWriter& out) const {
     readOdeBits(body.id, bits);
     out.bytes(bits, sizeof bits);
   }
+  saveJoints(out);
 }
 
 void OdeEngine::restoreState(StateReader& in) {
@@ -485,12 +496,21 @@ void OdeEngine::restoreState(StateReader& in) {
       for (int c = 0; c < 3; ++c)
         if (std::abs(v[7 + 4 * r + c] - expected(r, c)) > 1e-9) throw bad("has a rotation matrix that is not its quaternion's");
   }
+  seal();
+  std::vector<Joint> run_time = loadJoints(in);
   ensureThreadData();
   // the joints let go of their bodies, made again once the bodies are
   for (Joint& j : joints_) {
-    dJointDestroy(j.id);
+    if (j.id != nullptr) dJointDestroy(j.id);
     j.id = nullptr;
   }
+  // the run-time joints the state has, in place of this engine's
+  joints_.resize(scene_joints_);
+  for (Joint& j : run_time) joints_.push_back(std::move(j));
+  live_joints_ = 0;
+  for (const Joint& j : joints_) live_joints_ += j.removed ? 0 : 1;
+  repin(false);
+  labels_stale_ = true;
   // every body created again in its saved world and order, so that ODE lists them as it did
   for (Partition& p : partitions_) p.order.clear();
   away_.clear();

@@ -22,7 +22,10 @@
 // taken when it was set up. So a contact group with a pinned body in it is solved in world 0, and
 // articulated robots step there, one after another, while free bodies still step in parallel. A
 // restored engine makes each joint again with its bodies put back where they were when it was
-// first made, so that ODE computes the same frames to the bit.
+// first made, so that ODE computes the same frames to the bit. A joint made between steps (a
+// gripper closing) pins its bodies from then on; once the last joint holding a body is removed it
+// goes back to its home world at the next step, as a body leaving a contact group does. Run-time
+// joints, with their bodies' states when made, are part of the saved state.
 
 #include "grid_broadphase.hpp"
 
@@ -55,7 +58,8 @@ class OdeEngine final : public PhysicEngine {
   std::size_t contactCount() const override { return contact_count_; }
   int addJoint(const EngineJoint& joint) override;
   void setJointMotor(int joint, double velocity, double max_effort) override;
-  std::size_t jointCount() const override { return joints_.size(); }
+  void removeJoint(int joint) override;
+  std::size_t jointCount() const override { return live_joints_; }
   void prepareRayQueries() override;
   void castRays(std::span<const Ray> rays, std::span<RayHit> hits, int ignore_begin, int ignore_end) const override;
 
@@ -91,6 +95,7 @@ class OdeEngine final : public PhysicEngine {
     dJointID id = nullptr;
     std::vector<dReal> child_bits, parent_bits;  // the bodies' states when it was first made
     double velocity = 0.0, max_effort = 0.0;     // the motor (off: 0 effort)
+    bool removed = false;                        // a run-time joint let go of (its slot reusable)
   };
 
   dGeomID createGeom(const Shape& shape);
@@ -99,6 +104,16 @@ class OdeEngine final : public PhysicEngine {
   // recreates every joint, its bodies put back where they were when it was first made (restore)
   void recreateJoints();
   void applyMotor(const Joint& joint);
+  // the joints made so far are the scene's (at the first step or restore)
+  void seal() {
+    if (!sealed_) scene_joints_ = joints_.size();
+    sealed_ = true;
+  }
+  // pins the bodies some joint holds (into world 0) and lets the others go home
+  void repin(bool move);
+  void saveJoints(StateWriter& out) const;
+  // reads the run-time joints of a saved state (checked; nothing changed yet)
+  std::vector<Joint> loadJoints(StateReader& in) const;
   // the root of a contact group from two roots: a pinned one first, else the lower
   int firstOf(int a, int b) const {
     const bool pa = bodies_[static_cast<std::size_t>(a)].pinned, pb = bodies_[static_cast<std::size_t>(b)].pinned;
@@ -124,6 +139,10 @@ class OdeEngine final : public PhysicEngine {
   std::vector<Body> bodies_;
   std::vector<Joint> joints_;
   std::vector<int> articulation_;  // per body: the lowest body it is joined to (itself when none)
+  bool labels_stale_ = false;      // joints came or went since articulation_ was computed
+  std::size_t scene_joints_ = 0;   // joints_[0, scene_joints_) are the scene's (once sealed_)
+  bool sealed_ = false;
+  std::size_t live_joints_ = 0;
   std::size_t contacts_per_pair_ = 8;
   std::vector<dContact> contacts_;  // found in this substep, in a fixed order
   // the grid broadphase: one box per geom (the bodies' geoms in body order, then static ones),

@@ -1,9 +1,10 @@
 // The ODE engine's joints: hinge, slider, ball and fixed joints between bodies pinned to world 0
-// (see ode_engine.hpp), their limits and motors.
+// (see ode_engine.hpp), their limits and motors; joints made and removed between steps, saved.
 #include "ode/ode_engine.hpp"
 
 #include <ssx/error.hpp>
 
+#include <algorithm>
 #include <cmath>
 
 namespace ssx::detail {
@@ -14,7 +15,13 @@ int OdeEngine::addJoint(const EngineJoint& spec) {
   if (spec.child < 0 || spec.child >= bodies || spec.parent >= bodies || spec.parent == spec.child ||
       spec.kind == JointSpec::Kind::Rigid)
     throw Error("ode: a joint needs a kind and two different bodies (or a body and the world)");
-  // both bodies in world 0 for good (see ode_engine.hpp)
+  if (spec.run_time)
+    seal();
+  else if (sealed_)
+    throw Error("ode: the scene's joints come before any step and any run-time joint");
+  Joint joint;
+  joint.spec = spec;
+  // both bodies in world 0 for good (see ode_engine.hpp), before ODE joins them there
   for (const int b : {spec.child, spec.parent}) {
     if (b < 0) continue;
     Body& body = bodies_[static_cast<std::size_t>(b)];
@@ -22,17 +29,6 @@ int OdeEngine::addJoint(const EngineJoint& spec) {
     body.home = 0;
     if (body.partition != 0) moveBody(b, 0);
   }
-  // one articulation: the lower label wins
-  if (spec.parent >= 0) {
-    const int keep = std::min(articulation_[static_cast<std::size_t>(spec.child)],
-                              articulation_[static_cast<std::size_t>(spec.parent)]);
-    const int drop = std::max(articulation_[static_cast<std::size_t>(spec.child)],
-                              articulation_[static_cast<std::size_t>(spec.parent)]);
-    for (int& a : articulation_)
-      if (a == drop) a = keep;
-  }
-  Joint joint;
-  joint.spec = spec;
   joint.child_bits.resize(kOdeBodyReals);
   readOdeBits(bodies_[static_cast<std::size_t>(spec.child)].id, joint.child_bits.data());
   if (spec.parent >= 0) {
@@ -40,9 +36,51 @@ int OdeEngine::addJoint(const EngineJoint& spec) {
     readOdeBits(bodies_[static_cast<std::size_t>(spec.parent)].id, joint.parent_bits.data());
   }
   createJoint(joint);
-  joints_.push_back(std::move(joint));
-  proxies_stale_ = true;
-  return static_cast<int>(joints_.size() - 1);
+  // a run-time joint takes the first slot one let go of
+  std::size_t slot = joints_.size();
+  for (std::size_t k = scene_joints_; sealed_ && k < joints_.size(); ++k)
+    if (joints_[k].removed) {
+      slot = k;
+      break;
+    }
+  if (slot == joints_.size())
+    joints_.push_back(std::move(joint));
+  else
+    joints_[slot] = std::move(joint);
+  ++live_joints_;
+  labels_stale_ = true;
+  return static_cast<int>(slot);
+}
+
+void OdeEngine::removeJoint(int index) {
+  const auto k = static_cast<std::size_t>(index);
+  if (!sealed_ || index < 0 || k < scene_joints_ || k >= joints_.size() || joints_[k].removed)
+    throw Error("ode: joint " + std::to_string(index) + " is not a run-time joint in place (only those can be removed)");
+  dJointDestroy(joints_[k].id);
+  joints_[k].id = nullptr;
+  joints_[k].removed = true;
+  --live_joints_;
+  repin(true);
+  labels_stale_ = true;
+}
+
+void OdeEngine::repin(bool move) {
+  std::vector<char> held(bodies_.size(), 0);
+  for (const Joint& j : joints_) {
+    if (j.removed) continue;
+    held[static_cast<std::size_t>(j.spec.child)] = 1;
+    if (j.spec.parent >= 0) held[static_cast<std::size_t>(j.spec.parent)] = 1;
+  }
+  for (std::size_t i = 0; i < bodies_.size(); ++i) {
+    Body& body = bodies_[i];
+    body.pinned = held[i] != 0;
+    body.home = body.pinned ? 0 : homeOf(static_cast<int>(i));
+    if (!move) continue;
+    if (body.pinned && body.partition != 0) moveBody(static_cast<int>(i), 0);
+    // let go: home at the next step unless a contact group keeps it (as groupContacts does)
+    if (!body.pinned && body.partition != body.home && std::find(away_.begin(), away_.end(), static_cast<int>(i)) == away_.end())
+      away_.push_back(static_cast<int>(i));
+  }
 }
 
 void OdeEngine::createJoint(Joint& joint) {
@@ -91,6 +129,7 @@ void OdeEngine::recreateJoints() {
   // each joint's bodies where they were when it was first made, so that ODE takes the same frames;
   // the caller then writes every body's saved state
   for (Joint& joint : joints_) {
+    if (joint.removed) continue;
     writeOdeBits(bodies_[static_cast<std::size_t>(joint.spec.child)].id, joint.child_bits.data());
     if (joint.spec.parent >= 0)
       writeOdeBits(bodies_[static_cast<std::size_t>(joint.spec.parent)].id, joint.parent_bits.data());
@@ -101,6 +140,7 @@ void OdeEngine::recreateJoints() {
 
 void OdeEngine::setJointMotor(int index, double velocity, double max_effort) {
   Joint& joint = joints_.at(static_cast<std::size_t>(index));
+  if (joint.removed) throw Error("ode: joint " + std::to_string(index) + " was removed");
   joint.velocity = velocity;
   joint.max_effort = max_effort;
   applyMotor(joint);
@@ -115,6 +155,63 @@ void OdeEngine::applyMotor(const Joint& joint) {
     dJointSetSliderParam(joint.id, dParamVel, joint.velocity);
     dJointSetSliderParam(joint.id, dParamFMax, joint.max_effort);
   }
+}
+
+void OdeEngine::saveJoints(StateWriter& out) const {
+  // the run-time joints, each with what makes it again to the bit: its bodies' states when made
+  const std::size_t first = sealed_ ? scene_joints_ : joints_.size();
+  out.write(static_cast<std::uint64_t>(joints_.size() - first));
+  for (std::size_t k = first; k < joints_.size(); ++k) {
+    const Joint& j = joints_[k];
+    out.write(static_cast<std::uint8_t>(j.removed ? 1 : 0));
+    if (j.removed) continue;
+    out.write(static_cast<std::uint8_t>(j.spec.kind));
+    out.write(static_cast<std::int32_t>(j.spec.parent));
+    out.write(static_cast<std::int32_t>(j.spec.child));
+    out.write(j.spec.frame);
+    out.write(j.spec.lower);
+    out.write(j.spec.upper);
+    out.write(j.velocity);
+    out.write(j.max_effort);
+    out.bytes(j.child_bits.data(), j.child_bits.size() * sizeof(dReal));
+    if (j.spec.parent >= 0) out.bytes(j.parent_bits.data(), j.parent_bits.size() * sizeof(dReal));
+  }
+}
+
+std::vector<OdeEngine::Joint> OdeEngine::loadJoints(StateReader& in) const {
+  std::vector<Joint> out(in.count(1));
+  const auto bodies = static_cast<int>(bodies_.size());
+  for (Joint& j : out) {
+    if (in.get<std::uint8_t>() != 0) {
+      j.removed = true;
+      continue;
+    }
+    const auto kind = in.get<std::uint8_t>();
+    j.spec.parent = in.get<std::int32_t>();
+    j.spec.child = in.get<std::int32_t>();
+    in.read(j.spec.frame);
+    in.read(j.spec.lower);
+    in.read(j.spec.upper);
+    in.read(j.velocity);
+    in.read(j.max_effort);
+    if (kind > static_cast<std::uint8_t>(JointSpec::Kind::Fixed) || kind == static_cast<std::uint8_t>(JointSpec::Kind::Rigid) ||
+        j.spec.child < 0 || j.spec.child >= bodies || j.spec.parent < -1 || j.spec.parent >= bodies ||
+        j.spec.parent == j.spec.child || !std::isfinite(j.velocity) || !(j.max_effort >= 0) ||
+        !std::isfinite(j.max_effort) || !j.spec.frame.position.allFinite() ||
+        !j.spec.frame.orientation.coeffs().allFinite())
+      throw StateError("ode: a run-time joint in the saved state does not fit this world (corrupted)");
+    j.spec.kind = static_cast<JointSpec::Kind>(kind);
+    j.child_bits.resize(kOdeBodyReals);
+    in.bytes(j.child_bits.data(), kOdeBodyReals * sizeof(dReal));
+    if (j.spec.parent >= 0) {
+      j.parent_bits.resize(kOdeBodyReals);
+      in.bytes(j.parent_bits.data(), kOdeBodyReals * sizeof(dReal));
+    }
+    for (const auto* bits : {&j.child_bits, &j.parent_bits})
+      for (const dReal v : *bits)
+        if (!std::isfinite(v)) throw StateError("ode: a run-time joint in the saved state has a NaN (corrupted)");
+  }
+  return out;
 }
 
 }  // namespace ssx::detail
