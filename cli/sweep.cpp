@@ -109,6 +109,9 @@ void check(const Spec& spec) {
             if (const auto* m = dynamic_cast<const MetricSource*>(&art.sensor(s)))
               for (auto& n : m->metricNames()) published.insert(n);
         }
+        for (const auto& name : env.extensionNames())
+          if (const auto* m = dynamic_cast<const MetricSource*>(env.extension(name)))
+            for (auto& n : m->metricNames()) published.insert(n);
         std::string list;
         for (const auto& n : published) list += (list.empty() ? "" : ", ") + n;
         for (const auto& m : spec.metrics) {
@@ -174,6 +177,8 @@ struct Collector {
       for (std::size_t i = 0; i < art.sensorCount(); ++i)
         if (const auto* m = dynamic_cast<const MetricSource*>(&art.sensor(i))) sources.push_back(m);
     }
+    for (const auto& name : env.extensionNames())
+      if (const auto* m = dynamic_cast<const MetricSource*>(env.extension(name))) sources.push_back(m);
     track_sum.assign(trackers.size(), 0);
     track_max.assign(trackers.size(), 0);
     track_n.assign(trackers.size(), 0);

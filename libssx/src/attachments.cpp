@@ -1,7 +1,8 @@
 // Joints made and broken at run time (PhysicNode::attach, release, detach): a gripper closing on
 // an object, an object let go. Asked for during a step by an artifact's own driver, they are
-// carried out before the next step's physics, artifact by artifact in the order asked (so the
-// outcome does not depend on the thread count); asked for between steps, at once.
+// carried out when the drivers phase ends, artifact by artifact in the order asked (so the outcome
+// does not depend on the thread count), at the poses the drivers saw: before an extension's
+// afterStep or the program could move a body; asked for between steps, at once.
 #include "phase_guard.hpp"
 #include "phases.hpp"
 #include "world.hpp"
@@ -105,21 +106,9 @@ void loadAttachments(World& world, StateReader& in) {
     x.engine = in.get<std::int32_t>();
     if (x.holder >= nodes || x.held >= nodes || x.engine < 0 || world.nodes[x.holder].body < 0) throw bad();
   }
-  std::vector<AttachRequest> requests(in.count(9));
-  for (AttachRequest& r : requests) {
-    const auto kind = in.get<std::uint8_t>();
-    in.read(r.node);
-    in.read(r.other);
-    if (kind > static_cast<std::uint8_t>(AttachRequest::Kind::Detach) || r.node >= nodes || r.other >= nodes) throw bad();
-    r.kind = static_cast<AttachRequest::Kind>(kind);
-  }
   world.attachments = std::move(attachments);
   std::fill(world.attached.begin(), world.attached.end(), std::uint16_t{0});
   for (const Attachment& x : world.attachments) count(world, x, 1);
-  for (ArtifactData& a : world.artifact_data) a.attach_requests.clear();
-  for (const AttachRequest& r : requests)
-    world.artifact_data[world.node_handles[r.node].artifact().index()].attach_requests.push_back(r);
-  world.attach_pending.store(!requests.empty(), std::memory_order_relaxed);
 }
 
 }  // namespace detail

@@ -243,6 +243,12 @@ SimulationExtension* Environment::extension(std::string_view name) const {
   return nullptr;
 }
 
+std::vector<std::string> Environment::extensionNames() const {
+  std::vector<std::string> out;
+  for (const auto& e : extensions_) out.push_back(e.name);
+  return out;
+}
+
 const PhysicEngine& Environment::physics() const {
   if (!physics_) throw Error("the physics engine exists only while the environment runs");
   return *physics_;

@@ -19,10 +19,10 @@ void buildJoints(World& world, PhysicEngine& engine);
 /// Before a physics step: sets the motors' velocities; returns the wrenches to apply (the drivers',
 /// or a copy with the joints' damping added).
 const Wrench* applyJoints(World& world, PhysicEngine& engine);
-/// Before a physics step: carries out the run-time joints the drivers asked for in the last step
-/// (attachments.cpp), artifact by artifact.
+/// After the drivers phase: carries out the run-time joints the drivers asked for (attachments.cpp),
+/// artifact by artifact.
 void applyAttachRequests(World& world, PhysicEngine& engine);
-/// Reads the run-time joints and requests saveState wrote (after the engine restored its joints);
+/// Reads the run-time joints saveState wrote (after the engine restored its joints);
 /// throws StateError for what does not fit the world.
 void loadAttachments(World& world, StateReader& in);
 /// A hinge's angle or slider's displacement from the snapshot (0 before start).

@@ -197,7 +197,6 @@ void Environment::step() {
   auto t = Clock::now();
   const double t_next = toSeconds((w.steps + 1) * settings_.timestep);
   try {
-    if (w.attach_pending.load(std::memory_order_relaxed)) detail::applyAttachRequests(w, *physics_);
     if (!ghosts_->empty()) ghosts_->beforePhysics(w, *physics_, t_next, toSeconds(settings_.timestep));
     const Wrench* applied = w.joints.empty() ? w.wrenches.data() : detail::applyJoints(w, *physics_);
     physics_->step(settings_.timestep, {applied, w.wrenches.size()});
@@ -252,6 +251,8 @@ void Environment::step() {
   pool_->parallelFor(n, chunk, drivers);
   timing.drivers = since(t);
   raiseFirstError("drivers");
+  // the joints the drivers asked for, at the poses they saw (before anything else moves a body)
+  if (w.attach_pending.load(std::memory_order_relaxed)) detail::applyAttachRequests(w, *physics_);
 
   // render, when due
   if (settings_.render.period_steps > 0 && w.current_step % settings_.render.period_steps == 0) {

@@ -67,7 +67,7 @@ struct Attachment {
   int engine = -1;  // the engine's index of the joint
 };
 
-/// What a driver asked for during a step, carried out before the next step's physics.
+/// What a driver asked for during a step, carried out as the drivers phase ends.
 struct AttachRequest {
   enum class Kind : std::uint8_t { Attach, Release, Detach };
   Kind kind = Kind::Attach;
@@ -122,7 +122,7 @@ struct ArtifactData {
   std::uint32_t sensor_begin = 0, sensor_end = 0;
   std::uint32_t inbox_begin = 0, inbox_end = 0;
   bool silent = false;             // a lost ghost: its sensors do not measure
-  std::vector<AttachRequest> attach_requests;  // its driver's, until the next step's physics
+  std::vector<AttachRequest> attach_requests;  // its driver's, until its drivers phase ends
   int body_begin = 0;               // bodies [body_begin, body_end) in the body arrays
   int body_end = 0;
   // where its nodes and plugin slots are in the world's tables, for prefetching: [first, end)

@@ -4,8 +4,8 @@
 // Layout: "SSXSTATE", format version (u32), reserved (u32), scene fingerprint (u64), payload size
 // (u64), FNV-1a of the payload (u64); then the payload: step count, the engine's block, the
 // snapshot (body states with accelerations, the velocities before the last step), the command
-// buffers, the joints' motor commands, the run-time joints and the requests for them, every plugin's random stream (the world's plugin table, in order), then one block per
-// plugin (driver first, then sensors, artifact by artifact: what it saved) and one per extension.
+// buffers, the joints' motor commands, the run-time joints, every plugin's random stream (the
+// world's plugin table, in order), then one block per plugin (driver first, then sensors, artifact by artifact: what it saved) and one per extension.
 #include "ghosts.hpp"
 #include "phases.hpp"
 #include "neighbor_index.hpp"
@@ -109,22 +109,13 @@ std::vector<std::byte> Environment::saveState() const {
     out.write(static_cast<std::uint8_t>(j.mode));
     out.write(j.target);
   }
-  // the run-time joints (the engine's block has what makes them again) and those asked for
+  // the run-time joints (the engine's block has what makes them again)
   out.write(static_cast<std::uint64_t>(w.attachments.size()));
   for (const auto& x : w.attachments) {
     out.write(x.holder);
     out.write(x.held);
     out.write(static_cast<std::int32_t>(x.engine));
   }
-  std::uint64_t requests = 0;
-  for (const auto& a : w.artifact_data) requests += a.attach_requests.size();
-  out.write(requests);
-  for (const auto& a : w.artifact_data)
-    for (const auto& r : a.attach_requests) {
-      out.write(static_cast<std::uint8_t>(r.kind));
-      out.write(r.node);
-      out.write(r.other);
-    }
   // the random streams, then each plugin's own state (driver first, then sensors, by artifact)
   for (const Random& r : w.randoms) r.save(out);
   for (const auto& a : w.artifact_data) {

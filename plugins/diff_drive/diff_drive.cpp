@@ -22,7 +22,18 @@
 // waits `wait_max * c^2 / (c^2 + cue_theta)` s, c the darkness its first ground sensor reads
 // (1 - grey), then turns on the spot by a random angle and wanders again. Robots meeting on a dark
 // spot wait long there: they gather on it.
-// A command from outside takes over from either controller.
+//
+// `controller="foraging"`: central-place foraging. Items broadcast `item_code` as the first byte
+// of their range-and-bearing payload (range_and_bearing `data`); the nest is floor its ground
+// sensor reads at least `nest_level` on. The robot wanders (diffusion) until it hears an item that
+// nobody holds, steers to it, and within `grab_range` holds it by a fixed joint (PhysicNode::attach);
+// then it heads home by path integration (the mean of where its odometry had it in the nest), lets
+// go once in the nest, turns away and goes back to where it found the item (site fidelity, as
+// foraging ants do), searching from there. Obstacles seen on the way make it diffuse.
+//
+// `controller="twist"`: drives at a constant `twist` (forward speed and yaw rate) from the start: a
+// circle, or a straight line (a scripted ground robot for air-ground scenes).
+// A command from outside takes over from any controller.
 //
 // Parameters: kParameters below, or `ssx plugins --params diff_drive`.
 #include <ssx/artifact.hpp>
@@ -74,9 +85,12 @@ class DiffDrive final : public Driver, public CommandInterface, public OdometryI
                   "swarm model: the largest torque driving its yaw rate; 0: max_force times half the axle length"),
       param::real("encoder_noise", "0", "rad/s", param::nonNegative(),
                   "standard deviation of each wheel speed the encoders measure, per driver step"),
-      param::choice("controller", "none", "none diffusion beeclust",
+      param::choice("controller", "none", "none diffusion beeclust foraging twist",
                     "none: commands from outside; diffusion: wander, turning away from what the proximity sensor "
-                    "sees; beeclust: wander, and wait where robots meet, longer on darker floor"),
+                    "sees; beeclust: wander, and wait where robots meet, longer on darker floor; foraging: carry "
+                    "items heard over range-and-bearing to the nest; twist: drive at a constant twist"),
+      param::vec3("twist", "0 0 0", "", param::any(),
+                  "twist: 'V W 0', forward speed (m/s) and yaw rate (rad/s) from the start"),
       param::real("cruise_speed", "0", "rad/s", param::nonNegative(),
                   "diffusion: wheel speed going straight (0: max_wheel_speed)"),
       param::real("diffusion_delta", "0.1", "", param::positive(), "diffusion: obstacle vector length that makes it turn"),
@@ -85,16 +99,20 @@ class DiffDrive final : public Driver, public CommandInterface, public OdometryI
       param::real("meet_range", "0.1", "m", param::positive(), "beeclust: a robot heard nearer than this is met"),
       param::real("wait_max", "60", "s", param::nonNegative(), "beeclust: the longest wait, on the darkest floor"),
       param::real("cue_theta", "0.1", "", param::positive(), "beeclust: the darkness squared at which it waits half as long"),
+      param::integer("item_code", "1", param::between(1, 255), "foraging: the first payload byte items send"),
+      param::real("grab_range", "0.07", "m", param::positive(), "foraging: an item heard nearer than this is taken"),
+      param::real("nest_level", "0.9", "", param::between(0, 1), "foraging: the grey level (at least) of the nest's floor"),
   };
 
   static void validate(const Descriptor& params, const PluginContext& context) {
     const Artifact& a = *context.artifact;
     if (a.rootCount() == 0 || a.root().isStatic()) throw params.error("diff_drive needs a dynamic physic root");
     const std::string controller = params.get<std::string>("controller");
-    if (controller != "none" && sensorOf<ProximityMeasurement>(a) < 0)
+    if (controller != "none" && controller != "twist" && sensorOf<ProximityMeasurement>(a) < 0)
       throw params.errorAt("controller", "the " + controller + " controller needs a proximity sensor on the artifact");
-    if (controller == "beeclust" && (sensorOf<RangeBearingMeasurement>(a) < 0 || sensorOf<GroundMeasurement>(a) < 0))
-      throw params.errorAt("controller", "the beeclust controller needs a range_and_bearing and a ground sensor on the artifact");
+    if ((controller == "beeclust" || controller == "foraging") &&
+        (sensorOf<RangeBearingMeasurement>(a) < 0 || sensorOf<GroundMeasurement>(a) < 0))
+      throw params.errorAt("controller", "the " + controller + " controller needs a range_and_bearing and a ground sensor on the artifact");
     if (params.get<std::string>("model") != "full") return;
     for (const char* key : {"left_wheel", "right_wheel"}) {
       const std::string name = params.get<std::string>(key, "");
@@ -126,8 +144,16 @@ class DiffDrive final : public Driver, public CommandInterface, public OdometryI
       left_ = a.node(params.get<std::string>("left_wheel"));
       right_ = a.node(params.get<std::string>("right_wheel"));
     }
-    diffusion_ = params.get<std::string>("controller") != "none";
+    diffusion_ = params.get<std::string>("controller") != "none" && params.get<std::string>("controller") != "twist";
+    if (params.get<std::string>("controller") == "twist") {
+      const Vec3 twist = params.get<Vec3>("twist");
+      setWheels((twist.x() - twist.y() * axle_ / 2) / radius_, (twist.x() + twist.y() * axle_ / 2) / radius_);
+    }
     beeclust_ = params.get<std::string>("controller") == "beeclust";
+    foraging_ = params.get<std::string>("controller") == "foraging";
+    item_code_ = static_cast<std::uint8_t>(params.get<std::int64_t>("item_code"));
+    grab_range_ = params.get<double>("grab_range");
+    nest_level_ = params.get<double>("nest_level");
     meet_range_ = params.get<double>("meet_range");
     wait_max_ = params.get<double>("wait_max");
     theta_ = params.get<double>("cue_theta");
@@ -181,6 +207,14 @@ class DiffDrive final : public Driver, public CommandInterface, public OdometryI
     out.write(until_);
     out.write(turn_);
     out.bytes(&odometry_, sizeof odometry_);
+    out.write(static_cast<std::int64_t>(carrying_));
+    out.write(home_x_);
+    out.write(home_y_);
+    out.write(has_home_);
+    out.write(site_x_);
+    out.write(site_y_);
+    out.write(has_site_);
+    out.write(lost_until_);
   }
   void loadState(StateReader& in) override {
     in.read(left_cmd_);
@@ -191,11 +225,21 @@ class DiffDrive final : public Driver, public CommandInterface, public OdometryI
     in.read(until_);
     in.read(turn_);
     in.bytes(&odometry_, sizeof odometry_);
+    carrying_ = in.get<std::int64_t>();
+    in.read(home_x_);
+    in.read(home_y_);
+    in.read(has_home_);
+    in.read(site_x_);
+    in.read(site_y_);
+    in.read(has_site_);
+    in.read(lost_until_);
   }
 
   void step(const StepInfo& info) override {
     const double dt = toSeconds(info.period);
-    if (beeclust_ && diffusion_) {
+    if (foraging_ && diffusion_) {
+      forage(toSeconds(info.time));
+    } else if (beeclust_ && diffusion_) {
       beeclust(toSeconds(info.time));
     } else if (diffusion_) {
       diffuse();
@@ -243,8 +287,85 @@ class DiffDrive final : public Driver, public CommandInterface, public OdometryI
     setWheels(0, 0);
   }
 
-  // ARGoS's diffusion: the readings as vectors along their rays, summed
-  void diffuse() {
+  // foraging: search (wander, steer to an item heard), carry it home, let go in the nest
+  void forage(double t) {
+    const auto& floor = static_cast<const GroundMeasurement&>(artifact().sensor(static_cast<std::size_t>(ground_)).latest());
+    const bool in_nest = !floor.readings.empty() && floor.readings[0] >= nest_level_;
+    if (in_nest) {
+      // home: a running mean of where odometry had it in the nest (its middle, as it saw it)
+      const double a = has_home_ ? 0.02 : 1.0;
+      home_x_ += a * (odometry_.x - home_x_);
+      home_y_ += a * (odometry_.y - home_y_);
+      has_home_ = true;
+    }
+    PhysicNode& hand = artifact().root();
+    if (carrying_ >= 0) {
+      // two robots took one item in the same step: each lets go at random until one holds it
+      const PhysicNode& item = environment().artifact(static_cast<std::size_t>(carrying_)).root();
+      const bool shared = item.attachments() > 1 && random().uniform() < 0.5;
+      if (in_nest || shared || (hand.attachments() == 0 && t >= until_)) {
+        hand.release();
+        carrying_ = -1;
+        if (in_nest) {  // delivered: turn about, roughly, and search again
+          phase_ = Phase::Turn;
+          turn_ = random().uniform() < 0.5 ? 1.0 : -1.0;
+          until_ = t + random().uniform(0.6 * kPi, kPi) * axle_ / (2 * radius_ * cruise_);
+        }
+        return setWheels(0, 0);
+      }
+      const double dx = home_x_ - odometry_.x, dy = home_y_ - odometry_.y;
+      // at the nest as it remembers it but not in it (odometry drifts when it is pushed): it
+      // wanders for a while before it heads there again
+      if (has_home_ && std::hypot(dx, dy) < 0.05) lost_until_ = t + 10.0;
+      if (!has_home_ || t < lost_until_ || avoid()) return diffuse();
+      return steer(wrap(std::atan2(dy, dx) - odometry_.yaw));
+    }
+    if (phase_ == Phase::Turn) {
+      if (t < until_) return setWheels(-turn_ * cruise_, turn_ * cruise_);
+      phase_ = Phase::Walk;
+    }
+    // the nearest item heard that nobody holds (none taken in the nest: it is being delivered)
+    const auto& heard = static_cast<const RangeBearingMeasurement&>(artifact().sensor(static_cast<std::size_t>(board_)).latest());
+    const RangeBearingMeasurement::Message* nearest = nullptr;
+    for (const auto& m : heard.messages) {
+      if (m.data.empty() || m.data[0] != item_code_ || (nearest != nullptr && m.range >= nearest->range)) continue;
+      if (environment().artifact(m.sender).root().attachments() == 0) nearest = &m;
+    }
+    if (nearest == nullptr || in_nest) {
+      // back to where the last item was found, then search about there
+      if (has_site_ && std::hypot(site_x_ - odometry_.x, site_y_ - odometry_.y) < 0.1) has_site_ = false;
+      if (!has_site_ || avoid()) return diffuse();
+      return steer(wrap(std::atan2(site_y_ - odometry_.y, site_x_ - odometry_.x) - odometry_.yaw));
+    }
+    if (nearest->range < grab_range_) {
+      hand.attach(environment().artifact(nearest->sender).root());
+      site_x_ = odometry_.x;
+      site_y_ = odometry_.y;
+      has_site_ = true;
+      carrying_ = static_cast<std::int64_t>(nearest->sender);
+      until_ = t + 0.1;  // (the hold is made before the next step's physics)
+      return setWheels(0, 0);
+    }
+    if (avoid()) return diffuse();
+    steer(nearest->bearing);
+  }
+
+  // toward a bearing (rad, positive: left): on the spot when far off, else in an arc
+  void steer(double bearing) {
+    if (std::abs(bearing) > 0.6) return setWheels(bearing > 0 ? -cruise_ : cruise_, bearing > 0 ? cruise_ : -cruise_);
+    const double k = bearing / 0.6;
+    setWheels(cruise_ * (1 - k), cruise_ * (1 + k));
+  }
+
+  // whether the proximity sensor sees something diffusion would turn from
+  bool avoid() const {
+    double angle = 0, length = 0;
+    obstacle(angle, length);
+    return !(std::abs(angle) <= straight_ && length < delta_);
+  }
+
+  // the readings as vectors along their rays, summed: their direction and mean length
+  void obstacle(double& angle, double& length) const {
     const auto& m = static_cast<const ProximityMeasurement&>(artifact().sensor(static_cast<std::size_t>(proximity_)).latest());
     double x = 0, y = 0;
     for (std::size_t k = 0; k < m.readings.size() && k < m.angles.size(); ++k) {
@@ -252,10 +373,15 @@ class DiffDrive final : public Driver, public CommandInterface, public OdometryI
       y += m.readings[k] * std::sin(m.angles[k]);
     }
     const double n = static_cast<double>(std::max<std::size_t>(1, m.readings.size()));
-    x /= n;
-    y /= n;
-    const double angle = std::atan2(y, x);
-    if (std::abs(angle) <= straight_ && std::hypot(x, y) < delta_) {
+    angle = std::atan2(y, x);
+    length = std::hypot(x, y) / n;
+  }
+
+  // ARGoS's diffusion: the readings as vectors along their rays, summed
+  void diffuse() {
+    double angle = 0, length = 0;
+    obstacle(angle, length);
+    if (std::abs(angle) <= straight_ && length < delta_) {
       setWheels(cruise_, cruise_);
     } else if (angle > 0) {
       setWheels(cruise_, 0);  // something on the left: turn right
@@ -335,6 +461,15 @@ class DiffDrive final : public Driver, public CommandInterface, public OdometryI
   bool full_ = false;
   bool diffusion_ = false;  // a controller drives it (diffusion, or beeclust with it)
   bool beeclust_ = false;
+  bool foraging_ = false;
+  std::uint8_t item_code_ = 1;
+  double grab_range_ = 0, nest_level_ = 0;
+  std::int64_t carrying_ = -1;  // the item's artifact index, or -1
+  double home_x_ = 0, home_y_ = 0;  // where odometry last had it in the nest
+  bool has_home_ = false;
+  double site_x_ = 0, site_y_ = 0;  // where odometry had it when it last took an item
+  bool has_site_ = false;
+  double lost_until_ = 0;  // carrying, it wanders until then (it did not find the nest where it thought)
   enum class Phase : std::uint8_t { Walk, Wait, Turn };
   Phase phase_ = Phase::Walk;
   double until_ = 0, turn_ = 1, meet_range_ = 0, wait_max_ = 0, theta_ = 0;

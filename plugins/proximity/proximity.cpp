@@ -28,7 +28,7 @@ class ProximitySensor final : public SensorOf<ProximityMeasurement> {
       param::text("angles", "", "each ray's direction, deg from the node's x axis toward y, separated by spaces"),
       param::real("range", "0.1", "m", param::positive() & param::atMost(1000), "how far a ray reaches"),
       param::real("radius", "0", "m", param::nonNegative() & param::atMost(1000),
-                  "rays start this far from the node's z axis (the robot's body radius)"),
+                  "the sensors sit this far from the node's z axis (the robot's body radius): distances are from there, anything nearer reads 0"),
       param::real("height", "0", "m", param::between(-1000, 1000), "rays lie this far above the node's origin"),
       param::choice("response", "argos", "argos linear", "argos: exp(-d) (ARGoS's); linear: 1 - d/range"),
       param::real("noise", "0", "", param::between(0, 1), "uniform noise in [-noise, noise] added to each reading"),
@@ -65,11 +65,14 @@ class ProximitySensor final : public SensorOf<ProximityMeasurement> {
     linear_ = params.get<std::string>("response") == "linear";
     noise_ = params.get<double>("noise");
     node_ = &artifact().nodeFromParameter(params, "node");
-    const double radius = params.get<double>("radius"), height = params.get<double>("height");
+    radius_ = params.get<double>("radius");
+    const double height = params.get<double>("height");
+    // each ray is cast from the node's axis, its first `radius` inside the robot (its own shapes
+    // are not hit): what is closer than the radius (a wall the robot is pressed against, whose
+    // face a ray starting at the radius would start behind) reads as touching
     for (const double angle : a) {
-      const Vec3 dir(std::cos(angle), std::sin(angle), 0);
-      starts_.push_back(radius * dir + Vec3(0, 0, height));
-      directions_.push_back(dir);
+      starts_.push_back(Vec3(0, 0, height));
+      directions_.push_back(Vec3(std::cos(angle), std::sin(angle), 0));
     }
     rays_.resize(a.size());
     hits_.resize(a.size());
@@ -83,13 +86,13 @@ class ProximitySensor final : public SensorOf<ProximityMeasurement> {
     const Pose pose = node_->pose();
     for (std::size_t k = 0; k < rays_.size(); ++k) {
       rays_[k].from = pose.transformPoint(starts_[k]);
-      rays_[k].to = rays_[k].from + range_ * (pose.orientation * directions_[k]);
+      rays_[k].to = rays_[k].from + (radius_ + range_) * (pose.orientation * directions_[k]);
     }
     environment().castRays(rays_, hits_, &artifact());
     ProximityMeasurement& m = output();
     for (std::size_t k = 0; k < rays_.size(); ++k) {
-      const bool seen = hits_[k].hit && hits_[k].distance <= range_;
-      const double d = seen ? hits_[k].distance : std::numeric_limits<double>::infinity();
+      const bool seen = hits_[k].hit && hits_[k].distance <= radius_ + range_;
+      const double d = seen ? std::max(0.0, hits_[k].distance - radius_) : std::numeric_limits<double>::infinity();
       double reading = !seen ? 0.0 : linear_ ? 1.0 - d / range_ : std::exp(-d);
       if (noise_ > 0) reading += random().uniform(-noise_, noise_);
       m.readings[k] = std::clamp(reading, 0.0, 1.0);
@@ -109,7 +112,7 @@ class ProximitySensor final : public SensorOf<ProximityMeasurement> {
  private:
   const ProximityMeasurement& latestReadings() const { return static_cast<const ProximityMeasurement&>(latest()); }
   const PhysicNode* node_ = nullptr;
-  double range_ = 0, noise_ = 0;
+  double range_ = 0, noise_ = 0, radius_ = 0;
   bool linear_ = false;
   std::vector<Vec3> starts_, directions_;  // in the node's frame
   std::vector<Ray> rays_;

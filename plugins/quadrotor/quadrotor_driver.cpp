@@ -153,6 +153,11 @@ void QuadrotorDriver::validate(const Descriptor& params, const PluginContext& co
     if (firstSensorOf<RangeMeasurement>(a) == nullptr)
       throw params.error("reference=\"formation\" needs a range sensor on the artifact");
   }
+  if (config.reference.reference == "follow") {
+    const Artifact* followed = context.environment->findArtifact(config.reference.follow);
+    if (followed == nullptr || followed->rootCount() == 0 || followed == &a)
+      throw params.errorAt("follow", "no other artifact with a physic root is named '" + config.reference.follow + "'");
+  }
 }
 
 void QuadrotorDriver::configure(const Descriptor& params, PluginSetup& setup) {
@@ -247,6 +252,14 @@ void QuadrotorDriver::step(const StepInfo& info) {
   }
   else
     controller_.step(info.step / periodSteps(), t, *this, std::span(commanded_speeds_).first(n));
+  if (references_.source() == References::Source::Follow) {
+    // down on the robot it follows: the motors stop for good (it rides on the deck)
+    Pose at;
+    Vec3 velocity;
+    position(at, velocity);
+    landed_ = landed_ || references_.touchedDown(at.position, t);
+    if (landed_) std::fill(commanded_speeds_.begin(), commanded_speeds_.begin() + static_cast<std::ptrdiff_t>(n), 0.0);
+  }
   vehicle_.stepMotors(period, std::span(commanded_speeds_).first(n));
   PhysicNode& body = artifact().root();
   const BodyState s = body.state();
@@ -271,10 +284,12 @@ void QuadrotorDriver::step(const StepInfo& info) {
 
 std::vector<std::string> QuadrotorDriver::metricNames() const {
   if (references_.source() == References::Source::Formation) return {"formation_error"};
+  if (references_.source() == References::Source::Follow) return {"landed"};
   return {};
 }
 
 void QuadrotorDriver::metrics(std::vector<Metric>& out) const {
+  if (references_.source() == References::Source::Follow) out.push_back({"landed", landed_ ? 1.0 : 0.0});
   if (references_.source() != References::Source::Formation) return;
   out.push_back({"formation_error", references_.formationError()});
 }
@@ -289,6 +304,7 @@ void QuadrotorDriver::saveState(StateWriter& out) const {
   references_.saveState(out);
   wind_.saveState(out);
   ssx::save(out, pose_);
+  out.write(landed_);
 }
 
 void QuadrotorDriver::loadState(StateReader& in) {
@@ -303,6 +319,7 @@ void QuadrotorDriver::loadState(StateReader& in) {
   references_.loadState(in);
   wind_.loadState(in);
   ssx::load(in, pose_);
+  in.read(landed_);
 }
 
 }  // namespace ssx::quadrotor

@@ -58,7 +58,8 @@ class QuadrotorDriver final : public Driver, public CommandInterface, public Met
   Setpoint currentSetpoint() const override { return flight().currentSetpoint(); }
   /// In formation: `formation_error`, the mean over the members its range sensor sees whose
   /// places on the sphere are within sensing range of its own, of | distance - desired distance |
-  /// (m), as of its latest range measurement (NaN when it sees none).
+  /// (m), as of its latest range measurement (NaN when it sees none). Following a robot: `landed`,
+  /// 1 once it came down on it and stopped its motors, else 0.
   std::vector<std::string> metricNames() const override;
   void metrics(std::vector<Metric>& out) const override;
 
@@ -95,6 +96,7 @@ class QuadrotorDriver final : public Driver, public CommandInterface, public Met
   std::unique_ptr<CrazyfliePidController> crazyflie_;  // controller="crazyflie_pid" (every step asks)
   TeleKybController controller_;
   std::array<double, kMaxRotors> commanded_speeds_{};  // the first rotorCount() in use
+  bool landed_ = false;  // reference="follow": it came down on the robot it follows, motors stopped
   Vehicle vehicle_;
   PoseMeasurement pose_;
   References references_;

@@ -104,6 +104,14 @@ ReferenceParams::ReferenceParams(const Descriptor& params) {
       path = std::filesystem::path(file->where.file).parent_path() / path;
     trajectory = std::make_shared<const Trajectory>(Trajectory::read(path));
   }
+  follow = params.get<std::string>("follow", "");
+  if (reference == "follow" && follow.empty())
+    throw params.errorAt("reference", "reference=\"follow\" needs follow=\"ARTIFACT\" (the robot to follow)");
+  follow_offset = params.get<Vec3>("follow_offset");
+  follow_height = params.get<double>("follow_height");
+  land_time = params.get<double>("land_time");
+  descent_speed = params.get<double>("descent_speed");
+  follow_lead = params.get<double>("follow_lead");
   formation_size = static_cast<std::size_t>(params.get<std::int64_t>("formation_size"));
   formation_radius = params.get<double>("formation_radius");
   formation_center = params.get<Vec3>("formation_center");
@@ -158,6 +166,16 @@ void References::configure(const ReferenceParams& c, const Descriptor& params, c
     desired_distance_.reserve(std::min(kTypicalNeighbours, formation_.size));
     virtual_point_ = start + c.offset;
     own_target_ = formation_.target(formation_index_);
+  } else if (c.reference == "follow") {
+    source_ = Source::Follow;
+    followed_ = a.environment().findArtifact(c.follow);
+    if (followed_ == nullptr || followed_->rootCount() == 0 || followed_ == &a)
+      throw params.errorAt("follow", "no other artifact with a physic root is named '" + c.follow + "'");
+    follow_offset_ = c.follow_offset;
+    follow_height_ = c.follow_height;
+    land_time_ = c.land_time;
+    descent_speed_ = c.descent_speed;
+    follow_lead_ = c.follow_lead;
   } else {
     source_ = Source::External;
     external_ = hover_;
@@ -190,6 +208,23 @@ Setpoint References::at(double t, double dt) {
       }
       return eight_.at(t - start_time_);
     }
+    case Source::Follow: {
+      // above the point on the followed robot, moving with it; from land_time down onto it (and
+      // 2 cm into it, so that it presses on the deck until its motors stop)
+      const BodyState r = followed_->state();
+      const Vec3 point = r.pose.transformPoint(follow_offset_);
+      double height = follow_height_, sink = 0;
+      if (land_time_ >= 0 && t >= land_time_) {
+        height = std::max(-0.02, follow_height_ - descent_speed_ * (t - land_time_));
+        if (height > -0.02) sink = descent_speed_;
+      }
+      const Vec3 moving = r.linear_velocity + r.angular_velocity.cross(point - r.pose.position);
+      Setpoint s;
+      s.position = point + follow_lead_ * moving + Vec3(0, 0, height);
+      s.velocity = moving - Vec3(0, 0, sink);
+      s.yaw = hover_.yaw;
+      return s;
+    }
     case Source::Trajectory: {
       const std::size_t row = trajectory_->rowAt(t - start_time_);
       Setpoint s;
@@ -199,6 +234,12 @@ Setpoint References::at(double t, double dt) {
     }
   }
   return hover_;
+}
+
+bool References::touchedDown(const Vec3& position, double t) const {
+  if (source_ != Source::Follow || land_time_ < 0 || t < land_time_) return false;
+  const Vec3 d = position - followed_->state().pose.transformPoint(follow_offset_);
+  return d.z() < 0.015 && d.head<2>().norm() < 0.03;
 }
 
 // d* to a member: computed the first time it is seen, then looked up (neighbours change slowly)

@@ -1,7 +1,7 @@
 #pragma once
 // Where a rotorcraft's position-level set-point comes from: hover at a point, the fidelity study's
-// figure eights, the sphere formation (range sensing), a trajectory file, or external commands
-// (Python, a bridge, a program). Parameters: kReferenceParameters.
+// figure eights, the sphere formation (range sensing), a trajectory file, another robot to follow
+// and land on, or external commands (Python, a bridge, a program). Parameters: kReferenceParameters.
 #include "quadrotor_model.hpp"
 
 #include <ssx/ssx.hpp>
@@ -17,7 +17,7 @@
 namespace ssx::quadrotor {
 
 inline constexpr ssx_plugin_param kReferenceParameters[] = {
-    param::choice("reference", "hover", "hover eight_horizontal eight_vertical external formation trajectory",
+    param::choice("reference", "hover", "hover eight_horizontal eight_vertical external formation trajectory follow",
                   "where the set-point comes from"),
     param::vec3("target", "", "m", param::any(), "hover point (default: the start plus offset)"),
     param::vec3("offset", "0 0 0", "m", param::any(), "hover point, or the formation's start, relative to the start"),
@@ -41,6 +41,17 @@ inline constexpr ssx_plugin_param kReferenceParameters[] = {
     param::real("formation_anchor_gain", "0.5", "1/s", param::nonNegative(), "pull towards the own target"),
     param::real("obstacle_distance", "0.5", "m", param::positive(), "obstacles repel inside it"),
     param::real("obstacle_saturation", "0.2", "m", param::positive(), "the repulsion is saturated inside it"),
+    param::text("follow", "", "reference=\"follow\": the artifact it follows (and lands on)"),
+    param::vec3("follow_offset", "0 0 0", "m", param::any(),
+                "follow: where its origin rests when landed, in the followed artifact's frame (on its deck)"),
+    param::real("follow_height", "0.5", "m", param::nonNegative(), "follow: how far above that point it flies"),
+    param::real("land_time", "-1", "s", param::any(),
+                "follow: when it descends onto the point at descent_speed and, once there, stops its motors; "
+                "negative: it never lands"),
+    param::real("descent_speed", "0.2", "m/s", param::positive(), "follow: how fast it descends to land"),
+    param::real("follow_lead", "0", "s", param::between(0, 10),
+                "follow: the set-point leads the point by the robot's velocity times this (a position loop without "
+                "feed-forward, as the crazyflie's PID, lags a moving point by speed / gain: 0.5 s at its gain of 2)"),
 };
 
 /// A trajectory file's rows: times (s, increasing) with positions and, if the file has a fifth
@@ -68,12 +79,15 @@ struct ReferenceParams {
   double formation_radius;
   Vec3 formation_center;
   double formation_gain, formation_max_speed, formation_anchor_gain, obstacle_distance, obstacle_saturation;
+  std::string follow;  ///< reference="follow": the artifact followed
+  Vec3 follow_offset;
+  double follow_height, land_time, descent_speed, follow_lead;
   explicit ReferenceParams(const Descriptor& params);
 };
 
 class References {
  public:
-  enum class Source { Hover, Eight, External, Formation, Trajectory };
+  enum class Source { Hover, Eight, External, Formation, Trajectory, Follow };
   /// `range`: the range sensor's latest measurement (the formation needs one).
   void configure(const ReferenceParams& c, const Descriptor& params, const Artifact& a, const RangeMeasurement* range);
   Source source() const { return source_; }
@@ -87,6 +101,9 @@ class References {
     external_ = setpoint;
     source_ = Source::External;
   }
+  /// Following: whether a vehicle at `position` has come down on the followed robot's deck (t past
+  /// land_time, within 1.5 cm above the landing point and 3 cm beside it): its motors may stop.
+  bool touchedDown(const Vec3& position, double t) const;
   /// In formation: the mean | distance - desired distance | to the members it sees whose places
   /// on the sphere are within sensing range of its own (NaN: none).
   double formationError() const;
@@ -110,6 +127,10 @@ class References {
   Setpoint external_;
   FigureEight eight_;
   std::shared_ptr<const Trajectory> trajectory_;
+  // following
+  const Artifact* followed_ = nullptr;
+  Vec3 follow_offset_ = Vec3::Zero();
+  double follow_height_ = 0, land_time_ = -1, descent_speed_ = 0, follow_lead_ = 0;
   // the formation
   const RangeMeasurement* range_ = nullptr;  // the range sensor's latest measurement
   std::size_t formation_index_ = 0, formation_base_ = 0;

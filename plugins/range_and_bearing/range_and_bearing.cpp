@@ -18,6 +18,8 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <sstream>
+#include <string>
 #include <vector>
 
 namespace ssx::plugins {
@@ -37,6 +39,8 @@ class RangeAndBearing final : public SensorOf<RangeBearingMeasurement>, public R
   static constexpr ssx_plugin_param kParameters[] = {
       param::real("range", "0.8", "m", param::positive() & param::atMost(1e4), "how far messages reach"),
       param::integer("payload", "4", param::between(0, 65536), "bytes each robot sends"),
+      param::text("data", "", "the payload sent until a driver sets one: bytes 0..255 separated by spaces (the rest 0); "
+                              "a beacon without a driver (an item, a nest) sends it for good"),
       param::real("loss", "0", "", param::between(0, 1), "probability that a message is lost"),
       param::real("range_noise", "0", "m", param::nonNegative(), "standard deviation of the range received"),
       param::real("bearing_noise", "0", "rad", param::nonNegative(), "standard deviation of bearing and elevation"),
@@ -47,11 +51,28 @@ class RangeAndBearing final : public SensorOf<RangeBearingMeasurement>, public R
   static void validate(const Descriptor& params, const PluginContext& context) {
     if (context.artifact->rootCount() == 0 || context.artifact->root().isStatic())
       throw params.error("a range_and_bearing sensor needs a dynamic root");
+    (void)initialData(params);
+  }
+
+  // `data`: at most `payload` bytes, each 0..255
+  static std::vector<std::uint8_t> initialData(const Descriptor& params) {
+    std::vector<std::uint8_t> out(static_cast<std::size_t>(params.get<std::int64_t>("payload")), 0);
+    std::istringstream in(params.get<std::string>("data", ""));
+    std::string word;
+    for (std::size_t k = 0; in >> word; ++k) {
+      char* end = nullptr;
+      const long v = std::strtol(word.c_str(), &end, 10);
+      if (*end != '\0' || v < 0 || v > 255) throw params.errorAt("data", "'" + word + "' is not a byte (0..255)");
+      if (k >= out.size())
+        throw params.errorAt("data", "more bytes than the payload holds (" + std::to_string(out.size()) + ")");
+      out[k] = static_cast<std::uint8_t>(v);
+    }
+    return out;
   }
 
   void configure(const Descriptor& params, PluginSetup& setup) override {
     range_ = params.get<double>("range");
-    data_.assign(static_cast<std::size_t>(params.get<std::int64_t>("payload")), 0);
+    data_ = initialData(params);
     loss_ = params.get<double>("loss");
     range_noise_ = params.get<double>("range_noise");
     bearing_noise_ = params.get<double>("bearing_noise");

@@ -119,6 +119,16 @@ class PyEnvironment {
       for (const auto& v : values) m[py::str(v.name)] = v.value;
       out[py::str(a.name())] = m;
     }
+    for (const auto& name : env_.extensionNames()) {  // (extension names: scene-unique, as artifact names)
+      const auto* source = dynamic_cast<const ssx::MetricSource*>(env_.extension(name));
+      if (source == nullptr) continue;
+      values.clear();
+      source->metrics(values);
+      if (values.empty()) continue;
+      py::dict m;
+      for (const auto& v : values) m[py::str(v.name)] = v.value;
+      out[py::str(name)] = m;
+    }
     return out;
   }
   // contact points the physics engine found in the last step
@@ -510,8 +520,8 @@ PYBIND11_MODULE(_ssx, m) {
            "What happened to the robots so far (every 10th step): airborne, landed, crashed, impacts, collisions between "
            "robots (count, first time and pair), closest approach, mean distance flown; 'text' says it in a line.")
       .def("metrics", &PyEnvironment::metrics,
-           "Every metric the drivers publish now (ssx::MetricSource, e.g. the formation's formation_error), as "
-           "{artifact: {metric: value}}.")
+           "Every metric the drivers and extensions publish now (ssx::MetricSource, e.g. the formation's formation_error), as "
+           "{artifact or extension: {metric: value}}.")
       .def("contacts", &PyEnvironment::contacts, "Contact points the physics engine found in the last step.")
       .def("save_state", &PyEnvironment::saveState, "Everything that determines the future, as bytes.")
       .def("restore_state", &PyEnvironment::restoreState, py::arg("state"),

@@ -74,7 +74,7 @@ class Environment:
     def flight_summary(self) -> Dict[str, Any]:
         """What happened to the robots so far: airborne, landed, crashed, impacts, collisions, closest approach, distance flown."""
     def metrics(self) -> Dict[str, Dict[str, float]]:
-        """Every metric the drivers publish now, as {artifact: {metric: value}}."""
+        """Every metric the drivers and extensions publish now, as {artifact or extension: {metric: value}}."""
     def set_external_pose(self, artifact: str, position: _Rows, orientation: Optional[_Rows] = None,
                           stamp: Optional[float] = None) -> None:
         """A pose of ghost `artifact` (a real robot) measured at simulated time `stamp` (None: now); orientation (w, x, y, z)."""

@@ -34,7 +34,7 @@ endif()
 set(root ${WORK_DIR}/root)
 run(dpkg-deb -x ${debs} ${root})
 foreach(f usr/bin/ssx usr/bin/ssx_rt_study usr/bin/ssx_fidelity_eight usr/share/ssx/artifacts/mk_quad.xml
-          usr/share/ssx/scenes/quad_swarm.xml usr/lib/ssx/plugins/libssx_quadrotor.so)
+          usr/share/ssx/scenes/quad_swarm.xml usr/share/ssx/ground/foraging.xml usr/lib/ssx/plugins/libssx_quadrotor.so)
   if(NOT EXISTS ${root}/${f})
     message(FATAL_ERROR "the package has no /${f}")
   endif()

@@ -35,3 +35,12 @@ def test_e_pucks_take_wheel_and_velocity_commands_from_python():
     assert env.angular_velocities()[a][2] == pytest.approx(0.5, rel=0.01)
     with pytest.raises(ValueError, match="2 \\(left, right wheel speed\\)"):
         env.set_commands("wheels", np.array([[1.0, 2.0, 3.0]]), robots=["a"])
+
+
+def test_foraging_metrics_reach_python():
+    # the foraging extension's count, read from Python as the drivers' metrics are
+    env = ssx.load_scene(ssx.data_directory() / "ground" / "foraging.xml", threads=1)
+    env.step(50)
+    m = env.metrics()
+    assert set(m["foraging"]) == {"items_delivered", "items_per_minute"}
+    assert m["foraging"]["items_delivered"] == 0  # nobody reaches an item and the nest in a second

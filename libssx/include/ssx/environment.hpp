@@ -280,6 +280,8 @@ class SSX_EXPORT Environment {
                                                std::string_view purpose) const;
   /// Extension by name, or nullptr.
   SimulationExtension* extension(std::string_view name) const;
+  /// Every extension's name, in the order added.
+  std::vector<std::string> extensionNames() const;
   /// Extension by name as a T, or nullptr (no such extension, or one of another type).
   template <class T>
   T* extension(std::string_view name) const {

@@ -200,20 +200,20 @@ class SSX_EXPORT PhysicNode {
   /// Holds `other`'s body to this node's body by a fixed joint, as the two are when it is made (a
   /// gripper closing on an object, two robots docking): they then move as one and do not collide
   /// with each other. `other` may be static: this node's body is then held in place. Asked for by
-  /// the artifact's own driver during a step, it is made before the next step's physics (requests
-  /// are carried out artifact by artifact, each artifact's in the order asked); by the program
-  /// between steps, at once. A pair already joined this way stays as it is. Part of the saved
-  /// state. Throws Error before start, for two nodes of one body, for a static node holding and for
-  /// a ghost.
+  /// the artifact's own driver during a step, it is made as the drivers phase ends, at the poses
+  /// the drivers saw (requests are carried out artifact by artifact, each artifact's in the order
+  /// asked); by the program between steps, at once. A pair already joined this way stays as it is.
+  /// Part of the saved state. Throws Error before start, for two nodes of one body, for a static
+  /// node holding and for a ghost.
   void attach(const PhysicNode& other);
-  /// Lets go of every body this node holds (its attach calls), as attach: before the next step's
-  /// physics, or at once between steps.
+  /// Lets go of every body this node holds (its attach calls), as attach: as the drivers phase
+  /// ends, or at once between steps.
   void release();
   /// Frees this node's body of every run-time joint on it, whoever made it (an object taken out of
   /// a gripper before the program moves it), as release.
   void detach();
-  /// How many run-time joints (attach) hold this node's body or are held by it, as of now: a
-  /// request made during this step counts from the next.
+  /// How many run-time joints (attach) hold this node's body or are held by it: a driver's
+  /// request counts once its drivers phase has ended.
   std::size_t attachments() const noexcept;
 
  private:

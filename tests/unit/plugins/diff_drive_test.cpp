@@ -165,3 +165,15 @@ TEST_CASE("diff_drive: e-pucks of both models continue with the same bits after 
   (void)unused;
   CHECK(restored == expected);
 }
+
+TEST_CASE("diff_drive: controller=\"twist\" drives a constant forward speed and yaw rate from the start",
+          "[diff_drive]") {
+  Scene scene = groundScene("ode", R"(<artifact name="r" type="epuck" xyz="0 0 0">
+    <driver controller="twist" twist="0.1 0.5 0"/></artifact>)");
+  Environment& env = *scene.environment;
+  const Artifact& r = *env.findArtifact("r");
+  env.step(3000);  // 6 s of a circle of 0.2 m radius about (0, 0.2)
+  CHECK((r.root().pose().position - Vec3(0, 0.2, r.root().pose().position.z())).norm() == Approx(0.2).epsilon(0.02));
+  CHECK(odometry(env, "r").forward == Approx(0.1).epsilon(0.02));
+  CHECK(odometry(env, "r").yaw_rate == Approx(0.5).epsilon(0.02));
+}

@@ -125,3 +125,23 @@ TEST_CASE("proximity: without angles, count rays are spread evenly from straight
   CHECK(std::isinf(m.distances[2]));
   CHECK(std::isinf(m.distances[3]));
 }
+
+TEST_CASE("proximity: a robot pressed against a wall reads it as touching, though its sensors sit inside the wall",
+          "[proximity]") {
+  const std::string engine = GENERATE(as<std::string>{}, "ode", "bullet");
+  INFO(engine);
+  // pressed into the wall: the front rays (0.036 m out, 17 deg off ahead) would start behind its face
+  Scene s = scene(engine);
+  Environment& env = *s.environment;
+  env.start();
+  Artifact& me = *env.findArtifact("me");
+  BodyState pressed = env.bodyState(me.root().bodyIndex());
+  pressed.pose.position.x() += 0.037;  // 2 mm into the wall: a step of contact leaves it most of that
+  env.setBodyState(me.root().bodyIndex(), pressed);
+  env.step();
+  const ProximityMeasurement& m = reading(env, "me");
+  CHECK(m.distances[0] == 0.0);  // ps0 and ps7, 17 deg either side of ahead
+  CHECK(m.distances[7] == 0.0);
+  CHECK(m.readings[0] == 1.0);
+  CHECK(m.readings[7] == 1.0);
+}

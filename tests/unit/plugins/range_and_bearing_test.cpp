@@ -101,3 +101,15 @@ TEST_CASE("range_and_bearing: messages are lost at their probability, the same o
   CHECK(mean == Approx(std::hypot(0.3, 0.3)).margin(0.002));
   CHECK(run(2).second == ranges);
 }
+
+TEST_CASE("range_and_bearing: a board without a driver sends its `data` for good (a beacon); bad bytes are refused",
+          "[range_and_bearing]") {
+  Scene s = scene(R"(<sensor index="1" data="1 200"/>)");
+  Environment& env = *s.environment;
+  env.step(2);
+  const RangeBearingMeasurement& m = received(env, "a");
+  REQUIRE(m.messages.size() == 1);  // from b
+  CHECK(m.messages[0].data == std::vector<std::uint8_t>{1, 200, 0, 0});
+  CHECK_THROWS_WITH(scene(R"(<sensor index="1" data="1 256"/>)"), Contains("'256' is not a byte"));
+  CHECK_THROWS_WITH(scene(R"(<sensor index="1" data="1 2 3 4 5"/>)"), Contains("more bytes than the payload holds (4)"));
+}
