@@ -193,26 +193,25 @@ class Viewer final : public SimulationExtension {
 
   void afterStep(Environment& env) override {
     if (!begun_) {
-      // the bodies exist from the first step on: each artifact's first dynamic root, as the
-      // recorder has them; the pages get the scene with them now
+      // the bodies exist from the first step on: each artifact's dynamic roots and joined parts,
+      // as the recorder has them; the pages get the scene with them now
       begun_ = true;
       std::lock_guard lock(mutex_);  // (pages' commands look the bodies up)
-      for (std::size_t i = 0; i < env.artifactCount(); ++i) {
-        const Artifact& a = std::as_const(env).artifact(i);
-        for (std::size_t r = 0; r < a.rootCount(); ++r) {
-          const PhysicNode& root = a.root(r);
-          if (root.isStatic() || root.bodyIndex() < 0) continue;
-          nodes_.push_back(&root);
-          names_.push_back(r == 0 ? a.name() : a.name() + "/" + root.name());
-          const Pose& in_body = root.poseInBody();
-          // (which drivers take velocity commands, known once: a page's command looks it up)
-          auto* driver = dynamic_cast<CommandInterface*>(env.artifact(i).driver());
-          CommandInterface* steer = driver != nullptr && driver->acceptsCommand(CommandLevel::Velocity) ? driver : nullptr;
-          steerable_ += steer != nullptr;
-          bodies_.push_back({root.bodyIndex(), in_body,
-                             in_body.position.isZero(0) && in_body.orientation.coeffs() == Quat::Identity().coeffs(), steer});
-          break;
-        }
+      recorded_ = recordedBodies(env);
+      for (const RecordedBody& b : recorded_) {
+        const PhysicNode& head = *b.node;
+        nodes_.push_back(&head);
+        names_.push_back(b.name);
+        const Pose& in_body = head.poseInBody();
+        // (which drivers take velocity commands, known once: a page's command looks it up; a
+        // page steers an artifact by its first body)
+        auto* driver = dynamic_cast<CommandInterface*>(env.artifact(head.artifact().index()).driver());
+        const bool first = b.name == head.artifact().name();
+        CommandInterface* steer =
+            first && driver != nullptr && driver->acceptsCommand(CommandLevel::Velocity) ? driver : nullptr;
+        steerable_ += steer != nullptr;
+        bodies_.push_back({head.bodyIndex(), in_body,
+                           in_body.position.isZero(0) && in_body.orientation.coeffs() == Quat::Identity().coeffs(), steer});
       }
       if (recording_ && names_ != recording_->names())
         throw Error("viewer: the recording's " + std::to_string(recording_->names().size()) +
@@ -453,13 +452,14 @@ class Viewer final : public SimulationExtension {
   // the scene for a page: the models (render trees, each in its body's frame), the bodies with
   // their model, and what is fixed in the world
   std::string sceneJson(const Environment& env) const {
-    std::map<const RenderNodeSpec*, std::size_t> model_of;  // a render tree shared by a swarm's members: one model
+    // a render tree shared by a swarm's members: one model per body of it (its root, each joined part)
+    std::map<std::pair<const RenderNodeSpec*, const PhysicNodeSpec*>, std::size_t> model_of;
     std::string models, bodies, world;
     bool first_world = true;
     for (std::size_t b = 0; b < nodes_.size(); ++b) {
       const Artifact& a = nodes_[b]->artifact();
       std::size_t model = 0;
-      const RenderNodeSpec* key = a.renderRoots().empty() ? nullptr : a.renderRoots().front().get();
+      const std::pair key{a.renderRoots().empty() ? nullptr : a.renderRoots().front().get(), &nodes_[b]->spec()};
       if (const auto it = model_of.find(key); it != model_of.end()) {
         model = it->second;
       } else {
@@ -470,8 +470,9 @@ class Viewer final : public SimulationExtension {
         for (const auto& tree : a.renderRoots()) {
           const PhysicNode* follow = tree->follow.empty() ? nullptr : a.node(tree->follow);
           if (follow == nullptr) continue;  // drawn with the world below
-          // a part joined to the root (a wheel) moves on its own: not drawn yet (one body per artifact)
-          if (follow->bodyIndex() != nodes_[b]->bodyIndex()) continue;
+          // the trees that move with this body, in its head's frame
+          const RecordedBody* body = recordedBodyOf(recorded_, *follow);
+          if (body == nullptr || body->node != nodes_[b]) continue;
           shapes(list, *tree, nodes_[b]->poseInBody().inverse() * follow->poseInBody(), first);
         }
         models += (models.empty() ? "" : ",") + std::string("[") + list + "]";
@@ -508,6 +509,7 @@ class Viewer final : public SimulationExtension {
   std::unique_ptr<viewer::Server> server_;
   RunControl* control_ = nullptr;
   std::vector<const PhysicNode*> nodes_;
+  std::vector<RecordedBody> recorded_;  // nodes_ with their names, to find the body a node moves with
   std::vector<std::string> names_;
   struct Body {  // each node's body, the node's pose in it, and its driver if it takes velocity commands
     int index = -1;

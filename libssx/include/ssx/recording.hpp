@@ -41,6 +41,21 @@
 namespace ssx {
 
 class Environment;
+class PhysicNode;
+
+/// One body as recordings and the viewer list it.
+struct RecordedBody {
+  std::string name;                 ///< the artifact's name for its first body, else "artifact/node"
+  const PhysicNode* node = nullptr;  ///< the node at the body's head: a dynamic root or a joined node
+};
+
+/// Every body of a running environment in recording order: artifact by artifact, its first
+/// dynamic root (named as the artifact), then its other dynamic roots and its joined nodes (a wheel
+/// on a hinge) in node order, as csv_logger's bodies="all". Empty before start.
+SSX_EXPORT std::vector<RecordedBody> recordedBodies(const Environment& env);
+/// The recorded body a node moves with: itself if it heads a body, else the nearest ancestor that
+/// does; nullptr for a node of a static tree. `bodies` as recordedBodies gives them.
+SSX_EXPORT const RecordedBody* recordedBodyOf(const std::vector<RecordedBody>& bodies, const PhysicNode& node);
 
 /// What to record, and how.
 struct RecordOptions {

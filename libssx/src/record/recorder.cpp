@@ -128,7 +128,8 @@ struct Recorder::Impl {
   std::int64_t period_steps = 1;
   Nanoseconds next_state = 0;
   std::vector<std::string> names;
-  std::vector<const PhysicNode*> nodes;  // the root node of each name
+  std::vector<const PhysicNode*> nodes;  // the node heading each name's body
+  std::vector<RecordedBody> bodies;
   std::uint16_t poses_channel = 0;
   int tf_channel = -1, timing_channel = -1, sensors_channel = -1, commands_channel = -1;  // -1: not recorded
   std::vector<Extra> extras;                                     // since the last sample
@@ -155,6 +156,40 @@ struct Recorder::Impl {
   void loop();
 };
 
+std::vector<RecordedBody> recordedBodies(const Environment& env) {
+  std::vector<RecordedBody> out;
+  if (env.state() != Environment::State::Running) return out;
+  for (std::size_t i = 0; i < env.artifactCount(); ++i) {
+    const Artifact& a = env.artifact(i);
+    const PhysicNode* first = nullptr;
+    for (std::size_t r = 0; r < a.rootCount() && first == nullptr; ++r)
+      if (!a.root(r).isStatic() && a.root(r).bodyIndex() >= 0) first = &a.root(r);
+    if (first == nullptr) continue;
+    out.push_back({a.name(), first});
+    for (std::size_t k = 0; k < a.nodeCount(); ++k) {
+      const PhysicNode& n = a.nodeAt(k);
+      if (&n == first || n.isStatic() || n.bodyIndex() < 0) continue;
+      if (n.parent() == nullptr || n.joint().isBody()) out.push_back({a.name() + "/" + n.name(), &n});
+    }
+  }
+  return out;
+}
+
+const RecordedBody* recordedBodyOf(const std::vector<RecordedBody>& bodies, const PhysicNode& node) {
+  for (const PhysicNode* n = &node; n != nullptr; n = n->parent()) {
+    if (n->parent() != nullptr && !n->joint().isBody()) continue;  // rigidly part of its parent
+    // (the bodies are in artifact order: its artifact's first, then a few more)
+    const std::size_t artifact = n->artifact().index();
+    auto it = std::lower_bound(bodies.begin(), bodies.end(), artifact, [](const RecordedBody& b, std::size_t i) {
+      return b.node->artifact().index() < i;
+    });
+    for (; it != bodies.end() && it->node->artifact().index() == artifact; ++it)
+      if (it->node == n) return &*it;
+    return nullptr;
+  }
+  return nullptr;
+}
+
 void Recorder::Impl::begin() {
   begun = true;
   const Nanoseconds tau = env->timestep();
@@ -163,17 +198,11 @@ void Recorder::Impl::begin() {
                      : 1;
   // the bodies: each artifact's dynamic roots, in artifact order (none known before the start:
   // a recording finished before any step holds the scene and no samples)
-  const bool running = env->state() == Environment::State::Running;
-  for (std::size_t i = 0; running && i < env->artifactCount(); ++i) {
-    const Artifact& a = std::as_const(*env).artifact(i);
-    bool first = true;
-    for (std::size_t r = 0; r < a.rootCount(); ++r) {
-      const PhysicNode& root = a.root(r);
-      if (root.isStatic() || root.bodyIndex() < 0) continue;
-      names.push_back(first ? a.name() : a.name() + "/" + root.name());
-      nodes.push_back(&root);
-      first = false;
-    }
+  // (and each joined part: a wheel on a hinge is a body of its own)
+  bodies = recordedBodies(*env);
+  for (const RecordedBody& b : bodies) {
+    names.push_back(b.name);
+    nodes.push_back(b.node);
   }
   summary.bodies = static_cast<std::int64_t>(names.size());
   std::string joined;
@@ -225,18 +254,13 @@ std::string Recorder::Impl::sceneJson() const {
     const Artifact& a = std::as_const(*env).artifact(i);
     for (const auto& tree : a.renderRoots()) {
       const PhysicNode* follow = tree->follow.empty() ? nullptr : a.node(tree->follow);
-      const PhysicNode* root = follow;
-      while (root != nullptr && root->parent() != nullptr) root = root->parent();
-      const auto body = std::find(nodes.begin(), nodes.end(), root);
-      // a part joined to its root (a wheel) moves on its own: not recorded yet (one body per artifact)
-      if (follow != nullptr && follow->bodyIndex() != root->bodyIndex()) continue;
+      const RecordedBody* body = follow != nullptr ? recordedBodyOf(bodies, *follow) : nullptr;
       if (follow == nullptr) {
         add(add, *tree, detail::kWorldFrame, a.placement());
-      } else if (body == nodes.end()) {  // a static root: where it is now, for good
+      } else if (body == nullptr) {  // a static root: where it is now, for good
         add(add, *tree, detail::kWorldFrame, follow->pose());
-      } else {  // the followed node in its root's frame (children are rigidly part of their root)
-        add(add, *tree, names[static_cast<std::size_t>(body - nodes.begin())],
-            root->poseInBody().inverse() * follow->poseInBody());
+      } else {  // the followed node in the frame of its body's head (both fixed in that body)
+        add(add, *tree, body->name, body->node->poseInBody().inverse() * follow->poseInBody());
       }
     }
   }

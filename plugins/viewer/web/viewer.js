@@ -155,7 +155,8 @@ function buildScene(msg) {
     }
     return { parts, points, full: new Int32Array(members[m]), far: new Int32Array(members[m]) };
   });
-  document.getElementById("robots").textContent = msg.bodies.length;
+  // (a robot's joined parts, "robot/wheel", are bodies of their own but not robots)
+  document.getElementById("robots").textContent = msg.bodies.filter((b) => !b.name.includes("/")).length;
   state.framed = false;
   state.dirty = true;
   // a recording played (ssx replay --view): a time slider, and nothing to steer

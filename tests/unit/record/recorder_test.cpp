@@ -196,3 +196,35 @@ TEST_CASE("recorder: /ssx/commands says each quadrotor's command level and value
   CHECK(commands[1].second.find(R"("q1":{"level":"rotors","values":[400,410,420,430]})") != std::string::npos);
   CHECK(commands[1].second.find(R"("q0":{"level":"position")") != std::string::npos);
 }
+
+TEST_CASE("recorder: a robot's joined parts (wheels on hinges) are bodies of their own, each with its shapes",
+          "[record][recorder][joints]") {
+  const fs::path file = fs::current_path() / "recorder_burger.mcap";
+  const char* xml = R"(<scene><environment timestep="0.002" seed="1"/><type name="burger" file="turtlebot3_burger.xml"/>
+    <ground/><artifact name="burger" type="burger" xyz="0 0 0"><driver controller="twist" twist="0.1 0.5 0"/></artifact>
+    </scene>)";
+  Scene scene = loadSceneFromString(xml, "burger.xml", kArtifacts, testOptions());
+  Environment& env = *scene.environment;
+  Recorder recorder(env, options(file, scene));
+  env.step(500);  // 1 s
+  CHECK(recorder.finish().bodies == 4);
+  const Recording r(file);
+  CHECK(r.names() == std::vector<std::string>{"burger", "burger/left_wheel", "burger/right_wheel", "burger/caster"});
+  // each body's pose is its head node's, to the float: the wheels where they turned to
+  const Artifact& burger = *env.findArtifact("burger");
+  const std::vector<float> positions = r.positions(r.times().size() - 1);
+  const std::vector<float> orientations = r.orientations(r.times().size() - 1);
+  for (std::size_t i = 1; i < 3; ++i) {
+    const Pose wheel = burger.node(r.names()[i].substr(7))->pose();
+    for (Eigen::Index k = 0; k < 3; ++k) CHECK(positions[3 * i + static_cast<std::size_t>(k)] == static_cast<float>(wheel.position[k]));
+    const Quat& q = wheel.orientation;
+    const double dot = orientations[4 * i] * q.w() + orientations[4 * i + 1] * q.x() + orientations[4 * i + 2] * q.y() +
+                       orientations[4 * i + 3] * q.z();
+    CHECK(std::abs(dot) > 1 - 1e-6);
+  }
+  // the wheels' cylinders move with the wheels, the chassis' box with the chassis
+  const auto update = r.messages("/scene");
+  REQUIRE(update.size() == 1);
+  for (const char* frame : {R"("frame_id":"burger")", R"("frame_id":"burger/left_wheel")", R"("frame_id":"burger/right_wheel")"})
+    CHECK(update[0].second.find(frame) != std::string::npos);
+}
