@@ -148,9 +148,19 @@ ArtifactType SceneLoader::parseArtifact(const Descriptor& root) {
       PhysicNodeSpec spec = readPhysicNode(c);
       try {
         validatePhysicTree(spec);
-        for (const auto& other : t.physic)
-          if (!spec.name.empty() && other->name == spec.name)
-            throw ConfigError(spec.where, "physic node '" + spec.name + "': duplicate node name in this artifact");
+        // a node's name is unique in its artifact: across its trees too (a second root named as a
+        // node of the first)
+        auto names = [](auto& self, const PhysicNodeSpec& n, std::vector<const PhysicNodeSpec*>& out) -> void {
+          if (!n.name.empty()) out.push_back(&n);
+          for (const auto& c : n.children) self(self, c, out);
+        };
+        std::vector<const PhysicNodeSpec*> mine, theirs;
+        names(names, spec, mine);
+        for (const auto& other : t.physic) names(names, *other, theirs);
+        for (const PhysicNodeSpec* n : mine)
+          for (const PhysicNodeSpec* o : theirs)
+            if (n->name == o->name)
+              throw ConfigError(n->where, "physic node '" + n->name + "': duplicate node name in this artifact");
       } catch (const ConfigError& e) {
         record(e);
       }

@@ -118,6 +118,27 @@ TEST_CASE("artifact files: each wrong shape or root is reported at its own line"
   }
 }
 
+TEST_CASE("artifact files: a second root named as a node of the first is reported at its line, not thrown later",
+          "[scene][artifact_reader]") {
+  // (found by the artifact fuzzer: the loader let the artifact's own check throw past it)
+  const fs::path dir = writeType("two_roots.xml", R"(<artifact>
+  <physic name="body" mass="1">
+    <box size="0.2 0.2 0.06"/>
+    <physic name="arm_x"><box size="0.1 0.1 0.1"/></physic>
+  </physic>
+  <physic name="arm_x" mass="1"><box size="0.1 0.1 0.1"/></physic>
+</artifact>
+)");
+  try {
+    (void)loadSceneFromString(R"(<scene><type name="t" file="two_roots.xml"/>
+      <swarm type="t" count="2" name="a{i}" layout="grid" spacing="1"/></scene>)",
+                              "s.xml", dir, {});
+    FAIL("loaded");
+  } catch (const SceneError& e) {
+    CHECK_THAT(e.what(), Contains("two_roots.xml:6: error: physic node 'arm_x': duplicate node name in this artifact"));
+  }
+}
+
 TEST_CASE("artifact files: joints are read as written; what does not fit a joint is said at its line",
           "[scene][artifact_reader][joints]") {
   const fs::path dir = writeType("arm.xml", R"(<artifact>
