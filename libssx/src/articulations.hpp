@@ -1,19 +1,31 @@
 #pragma once
-// Which bodies are joined to each other, directly or through others: both engines skip contacts
-// between them and solve them together. Labels are recomputed whole whenever joints come or go
-// (union-find, linear in bodies and joints), so that letting go of a joint splits a chain again.
+// What both engines do alike with their joints (each engine's Joint has `spec`, `velocity`,
+// `max_effort` and `removed`):
+// - which bodies are joined to each other, directly or through others (contacts between them are
+//   skipped, they are solved together): labels recomputed whole whenever joints come or go
+//   (union-find, linear in bodies and joints), so that letting go of a joint splits a chain again;
+// - a run-time joint's slot (the first one a removed joint left);
+// - the run-time joints' records in the engine's saved state, with what each engine needs to make
+//   one again to the bit (`extra`: ODE's body states when made, Bullet's frames).
 
+#include <ssx/error.hpp>
+#include <ssx/physic_engine.hpp>
+#include <ssx/state.hpp>
+
+#include <cmath>
 #include <cstddef>
+#include <cstdint>
 #include <numeric>
+#include <string>
 #include <utility>
 #include <vector>
 
 namespace ssx::detail {
 
-// label[i] becomes the lowest body joined to i (i itself when none). `pair(k)` gives joint k's two
-// bodies; a negative one (the static world, or a joint no longer there) joins nothing.
-template <class Pair>
-void labelArticulations(std::vector<int>& label, std::size_t joints, Pair&& pair) {
+// label[i] becomes the lowest body joined to i by a joint in place (i itself when none)
+template <class Joint>
+void labelArticulations(std::vector<int>& label, std::size_t bodies, const std::vector<Joint>& joints) {
+  label.resize(bodies);
   std::iota(label.begin(), label.end(), 0);
   auto find = [&label](int x) {
     while (label[static_cast<std::size_t>(x)] != x) {
@@ -23,14 +35,77 @@ void labelArticulations(std::vector<int>& label, std::size_t joints, Pair&& pair
     }
     return x;
   };
-  for (std::size_t k = 0; k < joints; ++k) {
-    const auto [a, b] = pair(k);
-    if (a < 0 || b < 0) continue;
-    const int ra = find(a), rb = find(b);
+  for (const Joint& j : joints) {
+    if (j.removed || j.spec.parent < 0) continue;  // (a joint to the static world joins nothing)
+    const int ra = find(j.spec.child), rb = find(j.spec.parent);
     // the lower root stays the root: a set's root is its lowest body
     if (ra != rb) label[static_cast<std::size_t>(std::max(ra, rb))] = std::min(ra, rb);
   }
   for (std::size_t i = 0; i < label.size(); ++i) label[i] = find(static_cast<int>(i));
+}
+
+// puts a new joint in the first slot a removed run-time joint left (at or after `first`, once
+// sealed), else at the end; returns its index
+template <class Joint>
+std::size_t placeJoint(std::vector<Joint>& joints, Joint&& joint, std::size_t first, bool sealed) {
+  for (std::size_t k = first; sealed && k < joints.size(); ++k)
+    if (joints[k].removed) {
+      joints[k] = std::move(joint);
+      return k;
+    }
+  joints.push_back(std::move(joint));
+  return joints.size() - 1;
+}
+
+// joints[first, end): removed ones as a flag, the others with their spec, motor and `extra(out, j)`
+template <class Joint, class Extra>
+void saveRunTimeJoints(StateWriter& out, const std::vector<Joint>& joints, std::size_t first, Extra&& extra) {
+  out.write(static_cast<std::uint64_t>(joints.size() - first));
+  for (std::size_t k = first; k < joints.size(); ++k) {
+    const Joint& j = joints[k];
+    out.write(static_cast<std::uint8_t>(j.removed ? 1 : 0));
+    if (j.removed) continue;
+    out.write(static_cast<std::uint8_t>(j.spec.kind));
+    out.write(static_cast<std::int32_t>(j.spec.parent));
+    out.write(static_cast<std::int32_t>(j.spec.child));
+    out.write(j.spec.frame);
+    out.write(j.spec.lower);
+    out.write(j.spec.upper);
+    out.write(j.velocity);
+    out.write(j.max_effort);
+    extra(out, j);
+  }
+}
+
+// reads what saveRunTimeJoints wrote, `extra(in, j)` after each joint's spec (it returns whether
+// what it read is finite); throws StateError, naming `engine`, for a record that does not fit a
+// world of `bodies` bodies. Nothing is changed.
+template <class Joint, class Extra>
+std::vector<Joint> loadRunTimeJoints(StateReader& in, int bodies, const char* engine, Extra&& extra) {
+  std::vector<Joint> out(in.count(1));
+  for (Joint& j : out) {
+    if (in.get<std::uint8_t>() != 0) {
+      j.removed = true;
+      continue;
+    }
+    const auto kind = in.get<std::uint8_t>();
+    j.spec.parent = in.get<std::int32_t>();
+    j.spec.child = in.get<std::int32_t>();
+    in.read(j.spec.frame);
+    in.read(j.spec.lower);
+    in.read(j.spec.upper);
+    in.read(j.velocity);
+    in.read(j.max_effort);
+    const bool finite = extra(in, j);
+    if (!finite || kind > static_cast<std::uint8_t>(JointSpec::Kind::Fixed) ||
+        kind == static_cast<std::uint8_t>(JointSpec::Kind::Rigid) || j.spec.child < 0 || j.spec.child >= bodies ||
+        j.spec.parent < -1 || j.spec.parent >= bodies || j.spec.parent == j.spec.child || !std::isfinite(j.velocity) ||
+        !(j.max_effort >= 0) || !std::isfinite(j.max_effort) || !j.spec.frame.position.allFinite() ||
+        !j.spec.frame.orientation.coeffs().allFinite())
+      throw StateError(std::string(engine) + ": a run-time joint in the saved state does not fit this world (corrupted)");
+    j.spec.kind = static_cast<JointSpec::Kind>(kind);
+  }
+  return out;
 }
 
 }  // namespace ssx::detail

@@ -108,27 +108,21 @@ class PyEnvironment {
     InUse use(busy_);
     py::dict out;
     std::vector<ssx::Metric> values;
-    for (std::size_t i = 0; i < env_.artifactCount(); ++i) {
-      const ssx::Artifact& a = std::as_const(env_).artifact(i);
-      const auto* source = dynamic_cast<const ssx::MetricSource*>(a.driver());
-      if (source == nullptr) continue;
+    auto add = [&](const std::string& name, const ssx::MetricSource* source) {
+      if (source == nullptr) return;
       values.clear();
       source->metrics(values);
-      if (values.empty()) continue;
-      py::dict m;
-      for (const auto& v : values) m[py::str(v.name)] = v.value;
-      out[py::str(a.name())] = m;
-    }
-    for (const auto& name : env_.extensionNames()) {  // (extension names: scene-unique, as artifact names)
-      const auto* source = dynamic_cast<const ssx::MetricSource*>(env_.extension(name));
-      if (source == nullptr) continue;
-      values.clear();
-      source->metrics(values);
-      if (values.empty()) continue;
+      if (values.empty()) return;
       py::dict m;
       for (const auto& v : values) m[py::str(v.name)] = v.value;
       out[py::str(name)] = m;
+    };
+    for (std::size_t i = 0; i < env_.artifactCount(); ++i) {
+      const ssx::Artifact& a = std::as_const(env_).artifact(i);
+      add(a.name(), dynamic_cast<const ssx::MetricSource*>(a.driver()));
     }
+    // (extension names are scene-unique, as artifact names)
+    for (const auto& name : env_.extensionNames()) add(name, dynamic_cast<const ssx::MetricSource*>(env_.extension(name)));
     return out;
   }
   // contact points the physics engine found in the last step

@@ -194,11 +194,7 @@ void BulletEngine::step(Nanoseconds dt, std::span<const Wrench> wrenches) {
   contact_count_ = 0;
   seal();
   if (labels_stale_ || articulation_.size() != bodies_.size()) {
-    articulation_.resize(bodies_.size());
-    labelArticulations(articulation_, joints_.size(), [this](std::size_t k) {
-      const Joint& j = joints_[k];
-      return j.removed ? std::pair{-1, -1} : std::pair{j.spec.child, j.spec.parent};
-    });
+    labelArticulations(articulation_, bodies_.size(), joints_);
     labels_stale_ = false;
   }
   if (live_joints_ > 0) setMotors(h);

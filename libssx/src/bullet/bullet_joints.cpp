@@ -3,6 +3,8 @@
 // removed between steps, saved with their frames.
 #include "bullet/bullet_parts.hpp"
 
+#include "articulations.hpp"
+
 #include <ssx/error.hpp>
 
 #include <cmath>
@@ -50,16 +52,7 @@ int BulletEngine::addJoint(const EngineJoint& spec) {
         joint.in_parent);
   makeConstraint(joint);
   // a run-time joint takes the first slot one let go of
-  std::size_t slot = joints_.size();
-  for (std::size_t k = scene_joints_; sealed_ && k < joints_.size(); ++k)
-    if (joints_[k].removed) {
-      slot = k;
-      break;
-    }
-  if (slot == joints_.size())
-    joints_.push_back(std::move(joint));
-  else
-    joints_[slot] = std::move(joint);
+  const std::size_t slot = placeJoint(joints_, std::move(joint), scene_joints_, sealed_);
   ++live_joints_;
   labels_stale_ = true;
   return static_cast<int>(slot);
@@ -119,53 +112,22 @@ void BulletEngine::removeJoint(int index) {
 }
 
 void BulletEngine::saveJoints(StateWriter& out) const {
-  const std::size_t first = sealed_ ? scene_joints_ : joints_.size();
-  out.write(static_cast<std::uint64_t>(joints_.size() - first));
-  for (std::size_t k = first; k < joints_.size(); ++k) {
-    const Joint& j = joints_[k];
-    out.write(static_cast<std::uint8_t>(j.removed ? 1 : 0));
-    if (j.removed) continue;
-    out.write(static_cast<std::uint8_t>(j.spec.kind));
-    out.write(static_cast<std::int32_t>(j.spec.parent));
-    out.write(static_cast<std::int32_t>(j.spec.child));
-    out.write(j.spec.frame);
-    out.write(j.spec.lower);
-    out.write(j.spec.upper);
-    out.write(j.velocity);
-    out.write(j.max_effort);
-    out.bytes(j.in_child, sizeof j.in_child);
-    out.bytes(j.in_parent, sizeof j.in_parent);
-  }
+  // the run-time joints, each with its frames in both bodies
+  saveRunTimeJoints(out, joints_, sealed_ ? scene_joints_ : joints_.size(), [](StateWriter& w, const Joint& j) {
+    w.bytes(j.in_child, sizeof j.in_child);
+    w.bytes(j.in_parent, sizeof j.in_parent);
+  });
 }
 
 std::vector<BulletEngine::Joint> BulletEngine::loadJoints(StateReader& in) const {
-  std::vector<Joint> out(in.count(1));
-  const auto bodies = static_cast<int>(bodies_.size());
-  for (Joint& j : out) {
-    if (in.get<std::uint8_t>() != 0) {
-      j.removed = true;
-      continue;
-    }
-    const auto kind = in.get<std::uint8_t>();
-    j.spec.parent = in.get<std::int32_t>();
-    j.spec.child = in.get<std::int32_t>();
-    in.read(j.spec.frame);
-    in.read(j.spec.lower);
-    in.read(j.spec.upper);
-    in.read(j.velocity);
-    in.read(j.max_effort);
-    in.bytes(j.in_child, sizeof j.in_child);
-    in.bytes(j.in_parent, sizeof j.in_parent);
-    bool finite = std::isfinite(j.velocity) && std::isfinite(j.max_effort) && j.max_effort >= 0;
+  return loadRunTimeJoints<Joint>(in, static_cast<int>(bodies_.size()), "bullet", [](StateReader& r, Joint& j) {
+    r.bytes(j.in_child, sizeof j.in_child);
+    r.bytes(j.in_parent, sizeof j.in_parent);
+    bool finite = true;
     for (const double v : j.in_child) finite = finite && std::isfinite(v);
     for (const double v : j.in_parent) finite = finite && std::isfinite(v);
-    if (!finite || kind > static_cast<std::uint8_t>(JointSpec::Kind::Fixed) ||
-        kind == static_cast<std::uint8_t>(JointSpec::Kind::Rigid) || j.spec.child < 0 || j.spec.child >= bodies ||
-        j.spec.parent < -1 || j.spec.parent >= bodies || j.spec.parent == j.spec.child)
-      throw StateError("bullet: a run-time joint in the saved state does not fit this world (corrupted)");
-    j.spec.kind = static_cast<JointSpec::Kind>(kind);
-  }
-  return out;
+    return finite;
+  });
 }
 
 void BulletEngine::setJointMotor(int index, double velocity, double max_effort) {

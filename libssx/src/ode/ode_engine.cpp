@@ -376,11 +376,7 @@ void OdeEngine::step(Nanoseconds dt, std::span<const Wrench> wrenches) {
   seal();
   if (group_.size() != bodies_.size()) group_.assign(bodies_.size(), -1);
   if (labels_stale_ || articulation_.size() != bodies_.size()) {
-    articulation_.resize(bodies_.size());
-    labelArticulations(articulation_, joints_.size(), [this](std::size_t k) {
-      const Joint& j = joints_[k];
-      return j.removed ? std::pair{-1, -1} : std::pair{j.spec.child, j.spec.parent};
-    });
+    labelArticulations(articulation_, bodies_.size(), joints_);
     labels_stale_ = false;
   }
   for (int k = 0; k < substeps; ++k) {

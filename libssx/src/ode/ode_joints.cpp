@@ -2,6 +2,8 @@
 // (see ode_engine.hpp), their limits and motors; joints made and removed between steps, saved.
 #include "ode/ode_engine.hpp"
 
+#include "articulations.hpp"
+
 #include <ssx/error.hpp>
 
 #include <algorithm>
@@ -37,16 +39,7 @@ int OdeEngine::addJoint(const EngineJoint& spec) {
   }
   createJoint(joint);
   // a run-time joint takes the first slot one let go of
-  std::size_t slot = joints_.size();
-  for (std::size_t k = scene_joints_; sealed_ && k < joints_.size(); ++k)
-    if (joints_[k].removed) {
-      slot = k;
-      break;
-    }
-  if (slot == joints_.size())
-    joints_.push_back(std::move(joint));
-  else
-    joints_[slot] = std::move(joint);
+  const std::size_t slot = placeJoint(joints_, std::move(joint), scene_joints_, sealed_);
   ++live_joints_;
   labels_stale_ = true;
   return static_cast<int>(slot);
@@ -159,59 +152,23 @@ void OdeEngine::applyMotor(const Joint& joint) {
 
 void OdeEngine::saveJoints(StateWriter& out) const {
   // the run-time joints, each with what makes it again to the bit: its bodies' states when made
-  const std::size_t first = sealed_ ? scene_joints_ : joints_.size();
-  out.write(static_cast<std::uint64_t>(joints_.size() - first));
-  for (std::size_t k = first; k < joints_.size(); ++k) {
-    const Joint& j = joints_[k];
-    out.write(static_cast<std::uint8_t>(j.removed ? 1 : 0));
-    if (j.removed) continue;
-    out.write(static_cast<std::uint8_t>(j.spec.kind));
-    out.write(static_cast<std::int32_t>(j.spec.parent));
-    out.write(static_cast<std::int32_t>(j.spec.child));
-    out.write(j.spec.frame);
-    out.write(j.spec.lower);
-    out.write(j.spec.upper);
-    out.write(j.velocity);
-    out.write(j.max_effort);
-    out.bytes(j.child_bits.data(), j.child_bits.size() * sizeof(dReal));
-    if (j.spec.parent >= 0) out.bytes(j.parent_bits.data(), j.parent_bits.size() * sizeof(dReal));
-  }
+  saveRunTimeJoints(out, joints_, sealed_ ? scene_joints_ : joints_.size(), [](StateWriter& w, const Joint& j) {
+    w.bytes(j.child_bits.data(), j.child_bits.size() * sizeof(dReal));
+    if (j.spec.parent >= 0) w.bytes(j.parent_bits.data(), j.parent_bits.size() * sizeof(dReal));
+  });
 }
 
 std::vector<OdeEngine::Joint> OdeEngine::loadJoints(StateReader& in) const {
-  std::vector<Joint> out(in.count(1));
-  const auto bodies = static_cast<int>(bodies_.size());
-  for (Joint& j : out) {
-    if (in.get<std::uint8_t>() != 0) {
-      j.removed = true;
-      continue;
+  return loadRunTimeJoints<Joint>(in, static_cast<int>(bodies_.size()), "ode", [](StateReader& r, Joint& j) {
+    bool finite = true;
+    for (auto* bits : {&j.child_bits, &j.parent_bits}) {
+      if (bits == &j.parent_bits && j.spec.parent < 0) break;
+      bits->resize(kOdeBodyReals);
+      r.bytes(bits->data(), kOdeBodyReals * sizeof(dReal));
+      for (const dReal v : *bits) finite = finite && std::isfinite(v);
     }
-    const auto kind = in.get<std::uint8_t>();
-    j.spec.parent = in.get<std::int32_t>();
-    j.spec.child = in.get<std::int32_t>();
-    in.read(j.spec.frame);
-    in.read(j.spec.lower);
-    in.read(j.spec.upper);
-    in.read(j.velocity);
-    in.read(j.max_effort);
-    if (kind > static_cast<std::uint8_t>(JointSpec::Kind::Fixed) || kind == static_cast<std::uint8_t>(JointSpec::Kind::Rigid) ||
-        j.spec.child < 0 || j.spec.child >= bodies || j.spec.parent < -1 || j.spec.parent >= bodies ||
-        j.spec.parent == j.spec.child || !std::isfinite(j.velocity) || !(j.max_effort >= 0) ||
-        !std::isfinite(j.max_effort) || !j.spec.frame.position.allFinite() ||
-        !j.spec.frame.orientation.coeffs().allFinite())
-      throw StateError("ode: a run-time joint in the saved state does not fit this world (corrupted)");
-    j.spec.kind = static_cast<JointSpec::Kind>(kind);
-    j.child_bits.resize(kOdeBodyReals);
-    in.bytes(j.child_bits.data(), kOdeBodyReals * sizeof(dReal));
-    if (j.spec.parent >= 0) {
-      j.parent_bits.resize(kOdeBodyReals);
-      in.bytes(j.parent_bits.data(), kOdeBodyReals * sizeof(dReal));
-    }
-    for (const auto* bits : {&j.child_bits, &j.parent_bits})
-      for (const dReal v : *bits)
-        if (!std::isfinite(v)) throw StateError("ode: a run-time joint in the saved state has a NaN (corrupted)");
-  }
-  return out;
+    return finite;
+  });
 }
 
 }  // namespace ssx::detail
