@@ -16,7 +16,13 @@ usage: peer.py COUNT [TIMEOUT_S]   (robots q0 .. q<COUNT-1>; exit 0 on success, 
                                        simulated time (the robots took off from the ground before), then 0;
                                        exit 0 once every robot moved 0.7-1.3 m along x from 4 s to 8 s and
                                        its odometry reached 0.4 m/s)
+       peer.py COUNT TIMEOUT_S --drive V W  (as a ROS user drives a wheeled robot: a Twist of V m/s forward
+                                       and W rad/s about z for 2 s of simulated time (from 1 s or once
+                                       connected), then 0; exit 0 once every robot's odometry went 2 V
+                                       along its path (within 15 %), turned by 2 W (within 10 %, unwrapped)
+                                       and stood 4 s after the start)
 """
+import math
 import sys
 import threading
 import time
@@ -60,6 +66,58 @@ def fly_by_velocity(names, timeout):
             return 0 if ok else 1
         time.sleep(0.05)
     print("peer: cmd_vel: timed out")
+    return 1
+
+
+def drive(names, timeout, v, w):
+    """Twists in the robots' frame: v forward, w about z for 2 s of simulated time, from the first
+    odometry at or after 1 s that came once ssx was connected to the robot's cmd_vel (a ROS 1
+    subscriber connects to a new publisher some time after it appears)."""
+    lock = threading.Lock()
+    path, turned, last, latest, result, go = {}, {}, {}, {}, {}, {}
+    pubs = {n: rospy.Publisher("/%s/cmd_vel" % n, Twist, queue_size=10) for n in names}
+
+    def on_odom(msg, name):
+        t = msg.header.stamp.to_sec()
+        p, q = msg.pose.pose.position, msg.pose.pose.orientation
+        yaw = math.atan2(2 * (q.w * q.z + q.x * q.y), 1 - 2 * (q.y * q.y + q.z * q.z))
+        with lock:
+            latest[name] = t
+            if name not in go and t >= 1.0 and pubs[name].get_num_connections() > 0:
+                go[name] = t
+                path[name], turned[name] = 0.0, 0.0
+            elif name in go and name not in result:
+                x, y, a = last[name]
+                path[name] += math.hypot(p.x - x, p.y - y)
+                turned[name] += math.remainder(yaw - a, 2 * math.pi)
+                if t >= go[name] + 4.0:
+                    lin = msg.twist.twist.linear
+                    result[name] = (path[name], turned[name], math.hypot(lin.x, lin.y))
+            last[name] = (p.x, p.y, yaw)
+
+    subs = [rospy.Subscriber("/%s/odom" % n, Odometry, on_odom, callback_args=n, tcp_nodelay=True) for n in names]
+    start = time.time()
+    while time.time() - start < timeout:
+        with lock:
+            stamps = {n: (t, go.get(n)) for n, t in latest.items()}
+            done = dict(result)
+        for n, (t, t0) in stamps.items():
+            m = Twist()
+            if t0 is not None and t0 <= t < t0 + 2.0:
+                m.linear.x, m.angular.z = v, w
+            pubs[n].publish(m)
+        if len(done) == len(names):
+            ok = True
+            for n in names:
+                driven, angle, speed = done[n]
+                good = (abs(driven - 2 * v) <= 0.15 * abs(2 * v) + 1e-3 and abs(angle - 2 * w) <= 0.1 * abs(2 * w) + 1e-2
+                        and speed <= 0.01)
+                ok &= good
+                print("peer: %s: path %.4f m (%.4f asked), turned %.4f rad (%.4f asked), %.4f m/s 4 s after the start%s"
+                      % (n, driven, 2 * v, angle, 2 * w, speed, "" if good else "  FAILED"))
+            return 0 if ok else 1
+        time.sleep(0.01)
+    print("peer: drive: timed out")
     return 1
 
 
@@ -133,6 +191,9 @@ def main():
 
     if "--cmd-vel" in sys.argv:
         return fly_by_velocity(names, timeout)
+    if "--drive" in sys.argv:
+        i = sys.argv.index("--drive")
+        return drive(names, timeout, float(sys.argv[i + 1]), float(sys.argv[i + 2]))
     subs = [rospy.Subscriber("/%s/odom" % n, Odometry, on_odom, callback_args=n, tcp_nodelay=True) for n in names]
     clock_stamps = []
     clock_sub = rospy.Subscriber("/clock", Clock, lambda m: clock_stamps.append(m.clock.to_sec()), queue_size=1000)

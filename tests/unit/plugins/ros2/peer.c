@@ -13,6 +13,12 @@
  *   peer COUNT TIMEOUT_S --cmd-vel       velocity commands: 0.5 m/s forward (a Twist, the robot's
  *                                        frame) for 2 s of simulated time, then 0; success once every
  *                                        robot moved 0.7-1.3 m along x and its odometry reached 0.4 m/s
+ *   peer COUNT TIMEOUT_S --drive V W     as a ROS user drives a wheeled robot: a Twist of V m/s forward
+ *                                        and W rad/s about z for 2 s of simulated time (from 1 s, once
+ *                                        the writer matched ssx's reader), then 0; success once every
+ *                                        robot's odometry went 2 V along its path (within 15 %), turned by
+ *                                        2 W (within 10 %, unwrapped) and then stood (below 1 cm/s 4 s
+ *                                        after the start); no IMU is asked for
  *   peer COUNT TIMEOUT_S --lockstep      answers each odometry message after 0-30 ms with a set-point
  *                                        stamped like it; no odometry of a round may arrive before
  *                                        every robot's answer to the round before was sent; answers
@@ -93,16 +99,17 @@ static int checkPublisher(dds_entity_t reader, const char* type, int reliable) {
 
 int main(int argc, char** argv) {
   if (argc < 3) {
-    fprintf(stderr, "usage: peer COUNT TIMEOUT_S [--lockstep|--cmd-vel] [--vanish-after S]\n");
+    fprintf(stderr, "usage: peer COUNT TIMEOUT_S [--lockstep|--cmd-vel|--drive V W] [--vanish-after S]\n");
     return 2;
   }
   const int count = atoi(argv[1]);
   const double timeout = atof(argv[2]);
-  int lockstep = 0, cmd_vel = 0, bench = 0;
-  double vanish = -1;
+  int lockstep = 0, cmd_vel = 0, bench = 0, drive = 0;
+  double vanish = -1, drive_v = 0.5, drive_w = 0; /* the Twist sent from 1 s to 3 s */
   for (int i = 3; i < argc; ++i) {
     if (strcmp(argv[i], "--lockstep") == 0) lockstep = 1;
     else if (strcmp(argv[i], "--cmd-vel") == 0) cmd_vel = 1;
+    else if (strcmp(argv[i], "--drive") == 0 && i + 2 < argc) cmd_vel = drive = 1, drive_v = atof(argv[i + 1]), drive_w = atof(argv[i + 2]), i += 2;
     else if (strcmp(argv[i], "--bench") == 0) bench = lockstep = 1;
     else if (strcmp(argv[i], "--vanish-after") == 0 && i + 1 < argc) vanish = atof(argv[++i]);
   }
@@ -139,6 +146,7 @@ int main(int argc, char** argv) {
 
   double start_x[MAX_ROBOTS], start_y[MAX_ROBOTS], start_z[MAX_ROBOTS], latest_t[MAX_ROBOTS], held_since[MAX_ROBOTS];
   double fastest[MAX_ROBOTS], x_at_go[MAX_ROBOTS], answered[MAX_ROBOTS];
+  double go[MAX_ROBOTS], path[MAX_ROBOTS], turned[MAX_ROBOTS], last_x[MAX_ROBOTS], last_y[MAX_ROBOTS], last_yaw[MAX_ROBOTS];
   int have_start[MAX_ROBOTS], done[MAX_ROBOTS];
   double pending_due[MAX_ROBOTS], pending_stamp[MAX_ROBOTS];
   for (int i = 0; i < count; ++i) {
@@ -148,6 +156,8 @@ int main(int argc, char** argv) {
     x_at_go[i] = NAN;
     answered[i] = -1;
     pending_due[i] = -1;
+    path[i] = turned[i] = 0;
+    go[i] = NAN;
   }
   double last_clock = -1, imu_seen = 0, last_odom_wall = wall();
   long odom_messages = 0, clock_messages = 0, rounds = 0, violations = 0, per_robot[MAX_ROBOTS] = {0};
@@ -189,7 +199,31 @@ int main(int argc, char** argv) {
           last_odom_wall = wall();
           const double x = m->pose.pose.position.x, y = m->pose.pose.position.y, z = m->pose.pose.position.z;
           if (!have_start[i]) start_x[i] = x, start_y[i] = y, start_z[i] = z, have_start[i] = 1;
-          if (cmd_vel) {
+          if (drive) {
+            const double qw = m->pose.pose.orientation.w, qx = m->pose.pose.orientation.x, qy = m->pose.pose.orientation.y,
+                         qz = m->pose.pose.orientation.z;
+            const double yaw = atan2(2 * (qw * qz + qx * qy), 1 - 2 * (qy * qy + qz * qz));
+            dds_publication_matched_status_t matched;
+            if (isnan(go[i]) && t >= 1.0 && dds_get_publication_matched_status(twist[i], &matched) == 0 && matched.current_count > 0)
+              go[i] = t;
+            else if (!isnan(go[i]) && !done[i]) {
+              path[i] += hypot(x - last_x[i], y - last_y[i]);
+              turned[i] += remainder(yaw - last_yaw[i], 2 * M_PI);
+            }
+            last_x[i] = x, last_y[i] = y, last_yaw[i] = yaw;
+            if (t >= go[i] + 4.0 && !done[i]) {
+              const double speed = hypot(m->twist.twist.linear.x, m->twist.twist.linear.y);
+              char line[200];
+              snprintf(line, sizeof line, "q%d: path %.4f m (%.4f asked), turned %.4f rad (%.4f asked), %.4f m/s 4 s after the start", i,
+                       path[i], 2 * drive_v, turned[i], 2 * drive_w, speed);
+              if (fabs(path[i] - 2 * drive_v) > 0.15 * fabs(2 * drive_v) + 1e-3 ||
+                  fabs(turned[i] - 2 * drive_w) > 0.1 * fabs(2 * drive_w) + 1e-2 || speed > 0.01)
+                fail(line);
+              else
+                printf("peer: %s\n", line);
+              done[i] = 1;
+            }
+          } else if (cmd_vel) {
             if (t >= 1.0 && isnan(x_at_go[i])) x_at_go[i] = x;
             if (m->twist.twist.linear.x > fastest[i]) fastest[i] = m->twist.twist.linear.x;
             if (t >= 5.0 && !done[i]) {
@@ -226,7 +260,11 @@ int main(int argc, char** argv) {
         if (latest_t[i] < 0) continue;
         geometry_msgs_msg_dds__Twist_ tw;
         memset(&tw, 0, sizeof tw);
-        tw.linear.x = latest_t[i] >= 1.0 && latest_t[i] < 3.0 ? 0.5 : 0.0;
+        /* --drive: from its first odometry at or after 1 s once this writer matched ssx's reader */
+        const double from = drive ? go[i] : 1.0;
+        const int moving = latest_t[i] >= from && latest_t[i] < from + 2.0;
+        tw.linear.x = moving ? drive_v : 0.0;
+        tw.angular.z = moving ? drive_w : 0.0;
         dds_write(twist[i], &tw);
         continue;
       }
@@ -267,9 +305,9 @@ int main(int argc, char** argv) {
       if (info[0].valid_data) ++imu_seen;
       dds_return_loan(imu, samples, 1);
     }
-    if (!types_checked && odom_messages > 0 && clock_messages > 0 && imu_seen > 0) {
+    if (!types_checked && odom_messages > 0 && clock_messages > 0 && (imu_seen > 0 || drive)) {
       checkPublisher(odom[0], "nav_msgs::msg::dds_::Odometry_", 1);
-      checkPublisher(imu, "sensor_msgs::msg::dds_::Imu_", 0);
+      if (!drive) checkPublisher(imu, "sensor_msgs::msg::dds_::Imu_", 0);
       checkPublisher(clock_reader, "rosgraph_msgs::msg::dds_::Clock_", 0);
       dds_subscription_matched_status_t st;
       dds_get_subscription_matched_status(imu_reliable, &st);
@@ -291,9 +329,9 @@ int main(int argc, char** argv) {
     dds_delete(participant);
     return 0;
   }
-  if (!types_checked) fail("never saw odometry, clock and IMU together");
+  if (!types_checked) fail(drive ? "never saw odometry and clock together" : "never saw odometry, clock and IMU together");
   /* the IMU at 100 Hz against the odometry's 50 (best effort: a few may be lost) */
-  if (per_robot[0] > 100 && (imu_seen < 1.8 * per_robot[0] || imu_seen > 2.2 * per_robot[0])) {
+  if (!drive && per_robot[0] > 100 && (imu_seen < 1.8 * per_robot[0] || imu_seen > 2.2 * per_robot[0])) {
     char line[160];
     snprintf(line, sizeof line, "q0: %.0f IMU messages against %ld odometry (twice as many expected)", imu_seen, per_robot[0]);
     fail(line);
