@@ -1,6 +1,7 @@
 // What happened to the robots of a run (ssx/flight_summary.hpp).
 #include <ssx/environment.hpp>
 #include <ssx/flight_summary.hpp>
+#include <ssx/odometry.hpp>
 #include <ssx/spatial_index.hpp>
 
 #include <algorithm>
@@ -31,6 +32,7 @@ double reach(const PhysicNodeSpec& node, const Pose& pose) {
 
 constexpr double kCrashedTilt = 0.5;  // cos 60 degrees: the body's up axis at most this far up
 constexpr double kSearch = 5.0;       // m: closest approaches are looked for within this
+constexpr double kRestingSpeed = 0.1;  // m/s: at rest on the ground, or moving with what it rests on
 
 }  // namespace
 
@@ -49,7 +51,9 @@ void FlightRecorder::start(const Environment& env) {
       }
       continue;
     }
-    robots_.push_back({i, reach(root.spec(), Pose{}), root.pose().position, root.state().linear_velocity, 0.0});
+    Robot r{i, reach(root.spec(), Pose{}), root.pose().position, root.state().linear_velocity};
+    r.wheeled = dynamic_cast<const OdometryInterface*>(a.driver()) != nullptr;
+    robots_.push_back(r);
   }
   summary_.robots = static_cast<std::int64_t>(robots_.size());
   last_time_ = toSeconds(env.time());
@@ -93,6 +97,7 @@ void FlightRecorder::observe(const Environment& env) {
   SpatialIndex index(search);
   index.rebuild(points, ids);
   std::vector<std::pair<std::size_t, std::size_t>> touching;
+  std::vector<char> resting(robots_.size(), 0);  // on another robot: touching it, above it, moving with it
   std::vector<SpatialIndex::Hit> hits;
   const double t = toSeconds(env.time());
   for (std::size_t k = 0; k < robots_.size(); ++k) {
@@ -109,6 +114,8 @@ void FlightRecorder::observe(const Environment& env) {
         summary_.closest_pair = pair();
       }
       if (d < robots_[k].radius + robots_[h.id].radius) {
+        const std::size_t upper = points[k].z() > h.point.z() ? k : h.id, lower = upper == k ? h.id : k;
+        if ((robots_[upper].last_velocity - robots_[lower].last_velocity).norm() < kRestingSpeed) resting[upper] = 1;
         touching.emplace_back(k, h.id);
         if (std::find(touching_.begin(), touching_.end(), touching.back()) == touching_.end()) {
           ++summary_.collisions;
@@ -122,17 +129,20 @@ void FlightRecorder::observe(const Environment& env) {
   }
   touching_ = std::move(touching);
   // the end states, as of now
-  summary_.airborne = summary_.landed = summary_.crashed = 0;
+  summary_.airborne = summary_.landed = summary_.on_wheels = summary_.crashed = 0;
   summary_.crashed_names.clear();
-  for (const Robot& r : robots_) {
+  for (std::size_t k = 0; k < robots_.size(); ++k) {
+    const Robot& r = robots_[k];
     const Artifact& a = env.artifact(r.artifact);
     const BodyState s = a.root().state();
     const double up = (s.pose.orientation * Vec3::UnitZ()).z();
     const bool down = has_ground_ && s.pose.position.z() - ground_z_ < r.radius + 0.05;
-    if (up < kCrashedTilt || (down && r.hit)) {
+    if (up < kCrashedTilt || (down && r.hit && !r.wheeled)) {
       ++summary_.crashed;
       if (summary_.crashed_names.size() < 10) summary_.crashed_names.push_back(a.name());
-    } else if (down && s.linear_velocity.norm() < 0.1) {
+    } else if (r.wheeled) {
+      ++summary_.on_wheels;
+    } else if ((down && s.linear_velocity.norm() < kRestingSpeed) || resting[k]) {
       ++summary_.landed;
     } else {
       ++summary_.airborne;
@@ -150,10 +160,11 @@ FlightSummary FlightRecorder::summary() const {
 
 std::string FlightSummary::str() const {
   char text[160];
-  std::snprintf(text, sizeof text, "robots %lld: airborne %lld, landed %lld, crashed %lld",
-                static_cast<long long>(robots), static_cast<long long>(airborne), static_cast<long long>(landed),
-                static_cast<long long>(crashed));
+  std::snprintf(text, sizeof text, "robots %lld: airborne %lld, landed %lld", static_cast<long long>(robots),
+                static_cast<long long>(airborne), static_cast<long long>(landed));
   std::string out = text;
+  if (on_wheels > 0) out += ", on wheels " + std::to_string(on_wheels);
+  out += ", crashed " + std::to_string(crashed);
   if (!crashed_names.empty()) {
     out += " (";
     for (std::size_t i = 0; i < crashed_names.size(); ++i) out += (i ? ", " : "") + crashed_names[i];

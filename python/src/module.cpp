@@ -511,7 +511,7 @@ PYBIND11_MODULE(_ssx, m) {
       .def("range", &PyEnvironment::range, py::arg("artifact"), py::arg("sensor") = py::none(),
            "The latest range measurement of an artifact: detections as arrays, nearest first.")
       .def("flight_summary", &PyEnvironment::flightSummary,
-           "What happened to the robots so far (every 10th step): airborne, landed, crashed, impacts, collisions between "
+           "What happened to the robots so far (every 10th step): airborne, landed, on wheels, crashed, impacts, collisions between "
            "robots (count, first time and pair), closest approach, mean distance flown; 'text' says it in a line.")
       .def("metrics", &PyEnvironment::metrics,
            "Every metric the drivers and extensions publish now (ssx::MetricSource, e.g. the formation's formation_error), as "

@@ -72,7 +72,7 @@ class Environment:
     def range(self, artifact: str, sensor: Optional[int] = None) -> Dict[str, Any]:
         """The latest range measurement of an artifact: detections as arrays, nearest first."""
     def flight_summary(self) -> Dict[str, Any]:
-        """What happened to the robots so far: airborne, landed, crashed, impacts, collisions, closest approach, distance flown."""
+        """What happened to the robots so far: airborne, landed, on wheels, crashed, impacts, collisions, closest approach, distance flown."""
     def metrics(self) -> Dict[str, Dict[str, float]]:
         """Every metric the drivers and extensions publish now, as {artifact or extension: {metric: value}}."""
     def set_external_pose(self, artifact: str, position: _Rows, orientation: Optional[_Rows] = None,

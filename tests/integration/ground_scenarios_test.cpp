@@ -185,8 +185,10 @@ TEST_CASE("ground scenarios: landing: a Crazyflie follows a TurtleBot3 Burger dr
   auto fromDeck = [&] { return Vec3(cf.root().pose().position - burger.root().pose().transformPoint(Vec3(-0.032, 0, 0.195))); };
   double worst_follow = 0, worst_ride = 0, first_landed = -1;
   Vec3 landed_at = Vec3::Zero();
+  FlightRecorder recorder;
   for (int k = 1; k <= 300; ++k) {  // 30 s, looked at every 0.1 s
     env.step(50);
+    recorder.observe(env);
     const double t = 0.1 * k;
     const Vec3 d = fromDeck();
     if (t >= 3 && t < 8) {  // following 0.4 m above the deck
@@ -211,4 +213,9 @@ TEST_CASE("ground scenarios: landing: a Crazyflie follows a TurtleBot3 Burger dr
   CHECK(worst_ride < 0.015);
   // the Burger carried it along its circle (1 m radius at 0.1 m/s: 1.8 m of arc in 18 s)
   CHECK((burger.root().pose().position - landed_at).norm() > 1.2);
+  // the run's summary: the Burger on its wheels, the Crazyflie landed (on the Burger's deck, 0.2 m up)
+  const FlightSummary summary = recorder.summary();
+  CHECK(summary.on_wheels == 1);
+  CHECK(summary.landed == 1);
+  CHECK(summary.airborne == 0);
 }

@@ -35,6 +35,10 @@ def test_e_pucks_take_wheel_and_velocity_commands_from_python():
     assert env.angular_velocities()[a][2] == pytest.approx(0.5, rel=0.01)
     with pytest.raises(ValueError, match="2 \\(left, right wheel speed\\)"):
         env.set_commands("wheels", np.array([[1.0, 2.0, 3.0]]), robots=["a"])
+    # the run's summary counts them as on their wheels, not as landed quadrotors
+    s = env.flight_summary()
+    assert (s["robots"], s["on_wheels"], s["landed"], s["airborne"]) == (2, 2, 0, 0)
+    assert s["text"].startswith("robots 2: airborne 0, landed 0, on wheels 2, crashed 0")
 
 
 def test_foraging_metrics_reach_python():

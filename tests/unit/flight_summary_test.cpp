@@ -140,3 +140,47 @@ TEST_CASE("flight summary: a robot that bumps an obstacle in flight and flies on
   CHECK(s.airborne == 1);  // not on the ground: an impact alone is not a crash
   CHECK(s.crashed == 0);
 }
+
+namespace {
+
+// a wheeled robot's driver, as diff_drive (the summary recognises one by OdometryInterface)
+class Wheels final : public Driver, public OdometryInterface {
+ public:
+  void step(const StepInfo&) override {}
+  Odometry odometry() const override { return {}; }
+};
+
+}  // namespace
+
+TEST_CASE("flight summary: wheeled robots are on wheels, not landed or airborne, whatever their height; tipped over "
+          "they crashed; a robot resting on another landed",
+          "[flight_summary]") {
+  Environment env;
+  env.addGround();
+  addBox(env, "on_floor", at(0, 0, 0.1)).setDriver(std::make_unique<Wheels>());
+  // on a table (a static box 0.5 m high): a quadrotor's rule would call it airborne
+  Artifact& table = env.addArtifact("table", at(3, 0, 0.25));
+  PhysicNodeSpec top;
+  top.name = "top";
+  top.is_static = true;
+  top.shapes.push_back(Shape::box(Vec3(1, 1, 0.5)));
+  table.addPhysicRoot(std::move(top));
+  addBox(env, "on_table", at(3, 0, 0.6)).setDriver(std::make_unique<Wheels>());
+  addBox(env, "tipped", {Vec3(6, 0, 0.1), Quat(Eigen::AngleAxisd(std::numbers::pi / 2, Vec3::UnitX()))})
+      .setDriver(std::make_unique<Wheels>());
+  addBox(env, "box", at(9, 0, 0.1));  // no driver: landed, as before
+  addBox(env, "stacked", at(9, 0, 0.3));  // resting on "box": landed too, 0.2 m above the ground
+  FlightRecorder recorder;
+  for (int k = 0; k < 50; ++k) {
+    env.step(10);
+    recorder.observe(env);
+  }
+  const FlightSummary s = recorder.summary();
+  CHECK(s.robots == 5);
+  CHECK(s.on_wheels == 2);
+  CHECK(s.landed == 2);
+  CHECK(s.airborne == 0);
+  CHECK(s.crashed == 1);
+  CHECK(s.crashed_names == std::vector<std::string>{"tipped"});
+  CHECK_THAT(s.str(), Catch::StartsWith("robots 5: airborne 0, landed 2, on wheels 2, crashed 1 (tipped); "));
+}

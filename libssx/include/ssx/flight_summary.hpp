@@ -19,7 +19,9 @@ class Environment;
 /// The end state of one robot.
 enum class RobotState : std::uint8_t {
   Airborne,  ///< above the ground, upright
-  Landed,    ///< at rest on the ground (within 5 cm of touching it), upright
+  /// upright and at rest on the ground (within 5 cm of touching it), or resting on another robot:
+  /// touching it, above its centre, moving with it (within 0.1 m/s)
+  Landed,
   /// tilted more than 60 degrees from upright, or on the ground after an impact: a change of
   /// velocity between two observations larger, by more than kImpactSpeed, than 4 g could make
   Crashed,
@@ -29,8 +31,11 @@ enum class RobotState : std::uint8_t {
 struct SSX_EXPORT FlightSummary {
   std::int64_t robots = 0;    ///< artifacts with a dynamic physic root
   std::int64_t airborne = 0;  ///< of those, flying at the last observation
-  std::int64_t landed = 0;    ///< at rest on the ground
-  std::int64_t crashed = 0;   ///< tilted over, or down after an impact
+  std::int64_t landed = 0;    ///< at rest on the ground, or on another robot (RobotState::Landed)
+  /// wheeled robots (their driver implements OdometryInterface) that are upright: neither flying
+  /// nor landed, whatever their height (printed only when there are any)
+  std::int64_t on_wheels = 0;
+  std::int64_t crashed = 0;   ///< tilted over, or down after an impact (a wheeled robot: tilted over)
   std::vector<std::string> crashed_names;  ///< the first ten that crashed, by name
   /// Impacts: a robot's velocity changed between two observations by more than kImpactSpeed
   /// beyond what 4 g could do (a hit on the ground, an obstacle or another robot), counted once
@@ -48,7 +53,8 @@ struct SSX_EXPORT FlightSummary {
   double mean_distance_flown_m = 0;       ///< path length per robot, from sample to sample
   std::int64_t samples = 0;               ///< observations the summary is made of
   /// "robots 25: airborne 24, landed 0, crashed 1 (q7); collisions 1, first at 3.20 s (q7 and q8);
-  /// closest approach 0.18 m (q7 and q8); mean distance flown 4.20 m"
+  /// closest approach 0.18 m (q7 and q8); mean distance flown 4.20 m"; with wheeled robots
+  /// "robots 17: airborne 1, landed 0, on wheels 16, crashed 0; ..."
   std::string str() const;
 };
 
@@ -75,6 +81,7 @@ class SSX_EXPORT FlightRecorder {
     double flown = 0;
     bool hit = false;       // had an impact
     bool hitting = false;   // in one at the last observation (counted once per hit)
+    bool wheeled = false;   // its driver implements OdometryInterface
   };
   void start(const Environment& env);
 
