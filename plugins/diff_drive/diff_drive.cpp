@@ -264,7 +264,10 @@ class DiffDrive final : public Driver, public CommandInterface, public OdometryI
   // BEECLUST: wander; on meeting a robot, wait as long as the floor is dark; then turn away
   void beeclust(double t) {
     if (phase_ == Phase::Wait) {
-      if (t < until_) return setWheels(0, 0);
+      if (t < until_) {
+        setWheels(0, 0);
+        return;
+      }
       // a random turn on the spot, either way, up to half a turn
       phase_ = Phase::Turn;
       const double angle = random().uniform(-kPi, kPi);
@@ -272,14 +275,20 @@ class DiffDrive final : public Driver, public CommandInterface, public OdometryI
       until_ = t + std::abs(angle) * axle_ / (2 * radius_ * cruise_);
     }
     if (phase_ == Phase::Turn) {
-      if (t < until_) return setWheels(-turn_ * cruise_, turn_ * cruise_);
+      if (t < until_) {
+        setWheels(-turn_ * cruise_, turn_ * cruise_);
+        return;
+      }
       phase_ = Phase::Walk;
       until_ = t + 1.0;  // walks on for a second before it can stop again (leaves whom it met)
     }
     const auto& heard = static_cast<const RangeBearingMeasurement&>(artifact().sensor(static_cast<std::size_t>(board_)).latest());
     const bool met = t >= until_ && std::any_of(heard.messages.begin(), heard.messages.end(),
                                                  [&](const RangeBearingMeasurement::Message& m) { return m.range < meet_range_; });
-    if (!met) return diffuse();
+    if (!met) {
+      diffuse();
+      return;
+    }
     const auto& floor = static_cast<const GroundMeasurement&>(artifact().sensor(static_cast<std::size_t>(ground_)).latest());
     const double cue = floor.readings.empty() ? 0.0 : 1.0 - floor.readings[0];
     phase_ = Phase::Wait;
@@ -311,17 +320,24 @@ class DiffDrive final : public Driver, public CommandInterface, public OdometryI
           turn_ = random().uniform() < 0.5 ? 1.0 : -1.0;
           until_ = t + random().uniform(0.6 * kPi, kPi) * axle_ / (2 * radius_ * cruise_);
         }
-        return setWheels(0, 0);
+        setWheels(0, 0);
+        return;
       }
       const double dx = home_x_ - odometry_.x, dy = home_y_ - odometry_.y;
       // at the nest as it remembers it but not in it (odometry drifts when it is pushed): it
       // wanders for a while before it heads there again
       if (has_home_ && std::hypot(dx, dy) < 0.05) lost_until_ = t + 10.0;
-      if (!has_home_ || t < lost_until_ || avoid()) return diffuse();
-      return steer(wrap(std::atan2(dy, dx) - odometry_.yaw));
+      if (!has_home_ || t < lost_until_)
+        diffuse();
+      else if (!turnFromObstacle())
+        steer(wrap(std::atan2(dy, dx) - odometry_.yaw));
+      return;
     }
     if (phase_ == Phase::Turn) {
-      if (t < until_) return setWheels(-turn_ * cruise_, turn_ * cruise_);
+      if (t < until_) {
+        setWheels(-turn_ * cruise_, turn_ * cruise_);
+        return;
+      }
       phase_ = Phase::Walk;
     }
     // the nearest item heard that nobody holds (none taken in the nest: it is being delivered)
@@ -334,8 +350,11 @@ class DiffDrive final : public Driver, public CommandInterface, public OdometryI
     if (nearest == nullptr || in_nest) {
       // back to where the last item was found, then search about there
       if (has_site_ && std::hypot(site_x_ - odometry_.x, site_y_ - odometry_.y) < 0.1) has_site_ = false;
-      if (!has_site_ || avoid()) return diffuse();
-      return steer(wrap(std::atan2(site_y_ - odometry_.y, site_x_ - odometry_.x) - odometry_.yaw));
+      if (!has_site_)
+        diffuse();
+      else if (!turnFromObstacle())
+        steer(wrap(std::atan2(site_y_ - odometry_.y, site_x_ - odometry_.x) - odometry_.yaw));
+      return;
     }
     if (nearest->range < grab_range_) {
       hand.attach(environment().artifact(nearest->sender).root());
@@ -344,24 +363,20 @@ class DiffDrive final : public Driver, public CommandInterface, public OdometryI
       has_site_ = true;
       carrying_ = static_cast<std::int64_t>(nearest->sender);
       until_ = t + 0.1;  // (the hold is made before the next step's physics)
-      return setWheels(0, 0);
+      setWheels(0, 0);
+      return;
     }
-    if (avoid()) return diffuse();
-    steer(nearest->bearing);
+    if (!turnFromObstacle()) steer(nearest->bearing);
   }
 
   // toward a bearing (rad, positive: left): on the spot when far off, else in an arc
   void steer(double bearing) {
-    if (std::abs(bearing) > 0.6) return setWheels(bearing > 0 ? -cruise_ : cruise_, bearing > 0 ? cruise_ : -cruise_);
+    if (std::abs(bearing) > 0.6) {
+      setWheels(bearing > 0 ? -cruise_ : cruise_, bearing > 0 ? cruise_ : -cruise_);
+      return;
+    }
     const double k = bearing / 0.6;
     setWheels(cruise_ * (1 - k), cruise_ * (1 + k));
-  }
-
-  // whether the proximity sensor sees something diffusion would turn from
-  bool avoid() const {
-    double angle = 0, length = 0;
-    obstacle(angle, length);
-    return !(std::abs(angle) <= straight_ && length < delta_);
   }
 
   // the readings as vectors along their rays, summed: their direction and mean length
@@ -377,17 +392,22 @@ class DiffDrive final : public Driver, public CommandInterface, public OdometryI
     length = std::hypot(x, y) / n;
   }
 
-  // ARGoS's diffusion: the readings as vectors along their rays, summed
+  // ARGoS's diffusion: turns from what the proximity sensor sees (the readings as vectors along
+  // their rays, summed), else straight on
   void diffuse() {
+    if (!turnFromObstacle()) setWheels(cruise_, cruise_);
+  }
+  // turns away, as diffusion does, when the proximity sensor sees something ahead or near; false
+  // (the wheels left alone) when the way is clear
+  bool turnFromObstacle() {
     double angle = 0, length = 0;
     obstacle(angle, length);
-    if (std::abs(angle) <= straight_ && length < delta_) {
-      setWheels(cruise_, cruise_);
-    } else if (angle > 0) {
+    if (std::abs(angle) <= straight_ && length < delta_) return false;
+    if (angle > 0)
       setWheels(cruise_, 0);  // something on the left: turn right
-    } else {
+    else
       setWheels(0, cruise_);
-    }
+    return true;
   }
 
   // wheel speeds within the limit; both scaled alike, so that the path's curvature is kept

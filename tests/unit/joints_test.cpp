@@ -31,11 +31,17 @@ EnvironmentSettings settings(const std::string& engine, int threads = 1, double 
   return s;
 }
 
-// a static base with one bob hanging `length` below a hinge about y, turned `angle` from vertical
-PhysicNodeSpec pendulum(double length, double angle, double radius = 0.05, double mass = 1.0) {
+// an immovable node that joints hang from
+PhysicNodeSpec staticBase() {
   PhysicNodeSpec base;
   base.name = "base";
   base.is_static = true;
+  return base;
+}
+
+// a static base with one bob hanging `length` below a hinge about y, turned `angle` from vertical
+PhysicNodeSpec pendulum(double length, double angle, double radius = 0.05, double mass = 1.0) {
+  PhysicNodeSpec base = staticBase();
   PhysicNodeSpec arm;
   arm.name = "arm";
   arm.pose.orientation = Quat(Eigen::AngleAxisd(angle, Vec3::UnitY()));
@@ -112,9 +118,7 @@ TEST_CASE("joints: a hinge motor holds its speed under a load below its torque a
     EnvironmentSettings s = settings(engine);
     s.physics.gravity = Vec3::Zero();
     Environment env(s);
-    PhysicNodeSpec base;
-    base.name = "base";
-    base.is_static = true;
+    PhysicNodeSpec base = staticBase();
     PhysicNodeSpec wheel;
     wheel.name = "wheel";
     wheel.joint.kind = JointSpec::Kind::Hinge;
@@ -148,9 +152,7 @@ TEST_CASE("joints: a slider stops at its limits, under gravity and pushed by its
   const std::string engine = GENERATE(as<std::string>{}, "ode", "bullet");
   INFO(engine);
   Environment env(settings(engine));
-  PhysicNodeSpec base;
-  base.name = "base";
-  base.is_static = true;
+  PhysicNodeSpec base = staticBase();
   PhysicNodeSpec lift;
   lift.name = "lift";
   lift.joint.kind = JointSpec::Kind::Slider;
@@ -182,9 +184,7 @@ TEST_CASE("joints: a damped hinge slows as exp(-d t / I)", "[joints]") {
   EnvironmentSettings s = settings(engine);
   s.physics.gravity = Vec3::Zero();
   Environment env(s);
-  PhysicNodeSpec base;
-  base.name = "base";
-  base.is_static = true;
+  PhysicNodeSpec base = staticBase();
   PhysicNodeSpec wheel;
   wheel.name = "wheel";
   wheel.joint.kind = JointSpec::Kind::Hinge;
@@ -209,9 +209,7 @@ TEST_CASE("joints: a double pendulum keeps its energy; a chain keeps its joints 
   Environment env(settings(engine));
   // links of 0.3 m capsules, each hinged about y at the end of the one before, the first to a
   // static base; laid out horizontally, so that they fall and swing
-  PhysicNodeSpec base;
-  base.name = "base";
-  base.is_static = true;
+  PhysicNodeSpec base = staticBase();
   PhysicNodeSpec* parent = &base;
   const double length = 0.3;
   for (int k = 0; k < links; ++k) {
@@ -340,9 +338,7 @@ TEST_CASE("joints: a tree joined by every kind of joint runs the same bits on 1,
 }
 
 TEST_CASE("joints: what does not make sense is refused before anything runs, naming the node", "[joints]") {
-  PhysicNodeSpec base;
-  base.name = "base";
-  base.is_static = true;
+  PhysicNodeSpec base = staticBase();
   PhysicNodeSpec arm;
   arm.name = "arm";
   arm.shapes.push_back(Shape::sphere(0.1));

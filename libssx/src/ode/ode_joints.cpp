@@ -76,6 +76,17 @@ void OdeEngine::repin(bool move) {
   }
 }
 
+namespace {
+
+// ODE's hinge and slider take the same parameters (stops, motor), each through its own setter;
+// other joints have none
+void setAxisParam(JointSpec::Kind kind, dJointID j, int param, double value) {
+  if (kind == JointSpec::Kind::Hinge) dJointSetHingeParam(j, param, value);
+  if (kind == JointSpec::Kind::Slider) dJointSetSliderParam(j, param, value);
+}
+
+}  // namespace
+
 void OdeEngine::createJoint(Joint& joint) {
   const EngineJoint& s = joint.spec;
   const dWorldID world = partitions_[0].world;
@@ -92,15 +103,11 @@ void OdeEngine::createJoint(Joint& joint) {
       dJointAttach(j, child, parent);
       dJointSetHingeAnchor(j, o.x(), o.y(), o.z());
       dJointSetHingeAxis(j, z.x(), z.y(), z.z());
-      if (std::isfinite(s.lower)) dJointSetHingeParam(j, dParamLoStop, s.lower);
-      if (std::isfinite(s.upper)) dJointSetHingeParam(j, dParamHiStop, s.upper);
       break;
     case JointSpec::Kind::Slider:
       j = dJointCreateSlider(world, nullptr);
       dJointAttach(j, child, parent);
       dJointSetSliderAxis(j, z.x(), z.y(), z.z());
-      if (std::isfinite(s.lower)) dJointSetSliderParam(j, dParamLoStop, s.lower);
-      if (std::isfinite(s.upper)) dJointSetSliderParam(j, dParamHiStop, s.upper);
       break;
     case JointSpec::Kind::Ball:
       j = dJointCreateBall(world, nullptr);
@@ -115,6 +122,8 @@ void OdeEngine::createJoint(Joint& joint) {
     case JointSpec::Kind::Rigid:
       break;
   }
+  if (std::isfinite(s.lower)) setAxisParam(s.kind, j, dParamLoStop, s.lower);
+  if (std::isfinite(s.upper)) setAxisParam(s.kind, j, dParamHiStop, s.upper);
   joint.id = j;
 }
 
@@ -140,14 +149,8 @@ void OdeEngine::setJointMotor(int index, double velocity, double max_effort) {
 }
 
 void OdeEngine::applyMotor(const Joint& joint) {
-  if (joint.spec.kind == JointSpec::Kind::Hinge) {
-    dJointSetHingeParam(joint.id, dParamVel, joint.velocity);
-    dJointSetHingeParam(joint.id, dParamFMax, joint.max_effort);
-  }
-  if (joint.spec.kind == JointSpec::Kind::Slider) {
-    dJointSetSliderParam(joint.id, dParamVel, joint.velocity);
-    dJointSetSliderParam(joint.id, dParamFMax, joint.max_effort);
-  }
+  setAxisParam(joint.spec.kind, joint.id, dParamVel, joint.velocity);
+  setAxisParam(joint.spec.kind, joint.id, dParamFMax, joint.max_effort);
 }
 
 void OdeEngine::saveJoints(StateWriter& out) const {
