@@ -7,6 +7,7 @@
 #include "commands.hpp"
 #include "convert.hpp"
 #include "ghosts.hpp"
+#include "joints.hpp"
 #include "recording.hpp"
 #include "view.hpp"
 
@@ -549,6 +550,7 @@ PYBIND11_MODULE(_ssx, m) {
       .def("__repr__", &PyEnvironment::repr);
 
   ssx_python::bindGhostsAndOperators(environment);
+  ssx_python::bindJoints(environment);
   ssx_python::bindRecording(m);
 
   m.def(

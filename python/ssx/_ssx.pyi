@@ -86,6 +86,22 @@ class Environment:
         """Steers the robots of operator extension `operator` as one (m/s, rad/s in its frame); the dead-man rule stops them."""
     def operator_force(self, operator: str) -> npt.NDArray[np.float64]:
         """The force (N, world frame) operator `operator` should feel now, by its law."""
+    def attach(self, holder: str, held: str) -> None:
+        """Holds node `held` by node `holder` ('artifact' or 'artifact/node') with a fixed joint, as the two are now."""
+    def release(self, holder: str) -> None:
+        """Lets go of every body node `holder` holds."""
+    def detach(self, node: str) -> None:
+        """Frees node `node`'s body of every run-time joint on it, whoever made it."""
+    def attachments(self, node: str) -> int:
+        """How many run-time joints hold node `node`'s body or are held by it."""
+    def joint_position(self, node: str) -> float:
+        """The position (rad or m) of the joint joining node 'artifact/node' to its parent."""
+    def joint_velocity(self, node: str) -> float:
+        """That joint's velocity, rad/s or m/s."""
+    def set_joint_velocity(self, node: str, velocity: float) -> None:
+        """Drives that joint's motor toward a velocity, held until changed."""
+    def set_joint_position(self, node: str, position: float) -> None:
+        """Drives that joint's motor toward a position, held until changed."""
     def contacts(self) -> int:
         """Contact points the physics engine found in the last step."""
     def save_state(self) -> bytes:
