@@ -154,7 +154,7 @@ TEST_CASE("ssx: memory running out while loading is a message and status 1, not 
   CHECK_THAT(r.err, Contains("ssx: error: out of memory"));
 }
 
-TEST_CASE("ssx run: numbers are decimal and in range, with the range said plainly; one seed range everywhere",
+TEST_CASE("ssx run: numbers are decimal and in range, with the range said plainly, one seed range everywhere",
           "[cli]") {
   const std::string scene = (kExamples / "scenes" / "hover_swarm.xml").string();
   const auto err = [&](const std::string& option, const std::string& value) {
@@ -266,7 +266,7 @@ TEST_CASE("ssx run never writes its inputs, nor two outputs onto one file, and c
   fs::remove_all(dir);
 }
 
-TEST_CASE("ssx validate and ssx plugins name the engines; --physics chooses one and checks the scene for it",
+TEST_CASE("ssx validate and ssx plugins name the engines, --physics chooses one and checks the scene for it",
           "[cli][cross_engine]") {
   CHECK_THAT(run({"plugins"}).out, Contains("physics engines: ode, bullet") && Contains("render engines: null"));
   const std::string scene = (kExamples / "scenes" / "hover_swarm.xml").string();
@@ -422,7 +422,7 @@ TEST_CASE("ssx run: a log file that cannot be written fails the run with status 
   CHECK_FALSE(Contains("step time ms").match(r.out));  // no summary of a failed run
 }
 
-TEST_CASE("ssx run --rt-priority: out of range or with --fast refused; refused before anything is written "
+TEST_CASE("ssx run --rt-priority: out of range or with --fast refused, refused before anything is written "
           "where it is not permitted, else used", "[cli]") {
   const std::string scene = (kExamples / "scenes" / "hover_swarm.xml").string();
   CHECK(run({"run", scene, "--rt-priority", "0", "--steps", "5"}).status == 2);

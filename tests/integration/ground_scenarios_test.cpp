@@ -82,7 +82,7 @@ TEST_CASE("ground scenarios: diffusion: 1,000 e-pucks spread from a packed squar
   }
 }
 
-TEST_CASE("ground scenarios: aggregation: BEECLUST gathers 60 e-pucks on the dark spot in 3 minutes; robots that "
+TEST_CASE("ground scenarios: aggregation: BEECLUST gathers 60 e-pucks on the dark spot in 3 minutes, robots that "
           "never wait do not gather", "[scenario][aggregation]") {
   // the scene as written, and the same robots told never to wait (a control run)
   std::ifstream file(kGround / "aggregation.xml");
@@ -112,7 +112,7 @@ TEST_CASE("ground scenarios: aggregation: BEECLUST gathers 60 e-pucks on the dar
   CHECK(control < 0.2);
 }
 
-TEST_CASE("ground scenarios: foraging: 16 e-pucks carry items to the nest, each held by a fixed joint; robots "
+TEST_CASE("ground scenarios: foraging: 16 e-pucks carry items to the nest, each held by a fixed joint, robots "
           "that do not carry deliver next to none", "[scenario][foraging]") {
   std::ifstream file(kGround / "foraging.xml");
   const std::string xml((std::istreambuf_iterator<char>(file)), std::istreambuf_iterator<char>());

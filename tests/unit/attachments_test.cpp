@@ -138,7 +138,7 @@ TEST_CASE("attachments: the same bits on 1 and 2 threads and after save/restore,
   CHECK(late->stateHash() == expected);
 }
 
-TEST_CASE("attachments: between steps the program's requests take effect at once; nonsense is refused",
+TEST_CASE("attachments: between steps the program's requests take effect at once, nonsense is refused",
           "[attachments][joints]") {
   const std::string engine = GENERATE(as<std::string>{}, "ode", "bullet");
   INFO(engine);

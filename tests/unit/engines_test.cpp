@@ -30,7 +30,7 @@ TEST_CASE("engines: every physics engine offered by name is made under that name
   CHECK_THROWS_WITH(createPhysicEngine(wrong), Contains("unknown physics engine 'physx' (available: ode, bullet)"));
 }
 
-TEST_CASE("engines: the null renderer draws no pixels; unknown renderers list those there are", "[engines][render]") {
+TEST_CASE("engines: the null renderer draws no pixels, unknown renderers list those there are", "[engines][render]") {
   const auto names = renderEngineNames();
   REQUIRE(std::find(names.begin(), names.end(), "null") != names.end());
   RenderSettings settings;
@@ -74,7 +74,7 @@ TEST_CASE("engines: a kinematic body moves at its set velocity, whatever pushes 
   CHECK(engine->contactCount() == 0);  // kinematic against static, kinematic against kinematic: nothing
 }
 
-TEST_CASE("engines: what rests on a kinematic platform is carried; what hits a kinematic wall stops, the wall does not",
+TEST_CASE("engines: what rests on a kinematic platform is carried, what hits a kinematic wall stops, the wall does not",
           "[engines][kinematic]") {
   const std::string name = GENERATE(as<std::string>{}, "ode", "bullet");
   INFO(name);

@@ -81,7 +81,7 @@ TEST_CASE("flight summary: robots that come within reach of each other touch, on
   CHECK_THAT(f.str(), Catch::Contains("collisions 1, first at 0.8") && Catch::Contains("(a and b)"));
 }
 
-TEST_CASE("flight summary: a robot dropped onto the ground crashed, one set down gently landed; an impact counts once",
+TEST_CASE("flight summary: a robot dropped onto the ground crashed, one set down gently landed, an impact counts once",
           "[flight_summary]") {
   Environment env;
   env.addGround();
@@ -152,8 +152,8 @@ class Wheels final : public Driver, public OdometryInterface {
 
 }  // namespace
 
-TEST_CASE("flight summary: wheeled robots are on wheels, not landed or airborne, whatever their height; tipped over "
-          "they crashed; a robot resting on another landed",
+TEST_CASE("flight summary: wheeled robots are on wheels, not landed or airborne, whatever their height, tipped over "
+          "they crashed, a robot resting on another landed",
           "[flight_summary]") {
   Environment env;
   env.addGround();

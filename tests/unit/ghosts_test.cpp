@@ -164,7 +164,7 @@ TEST_CASE("ghosts: a ghost whose samples stop is lost after its timeout, its sen
   CHECK_THAT(log[1], Contains("ghost 'real' tracked again at t=0.702 s"));
 }
 
-TEST_CASE("ghosts: a ghost's range sensor sees a virtual pillar; simulated robots see the ghost", "[ghosts]") {
+TEST_CASE("ghosts: a ghost's range sensor sees a virtual pillar, simulated robots see the ghost", "[ghosts]") {
   Scene scene = ghostScene();
   Environment& env = *scene.environment;
   Pose p;
@@ -186,7 +186,7 @@ TEST_CASE("ghosts: a ghost's range sensor sees a virtual pillar; simulated robot
   CHECK(other[0].relative.isApprox(Vec3(0.5, -1, 0)));
 }
 
-TEST_CASE("ghosts: a simulated box rests on a rising ghost and is carried; nothing pushes the ghost", "[ghosts]") {
+TEST_CASE("ghosts: a simulated box rests on a rising ghost and is carried, nothing pushes the ghost", "[ghosts]") {
   const std::string engine = GENERATE(as<std::string>{}, "ode", "bullet");
   INFO(engine);
   const std::string xml = R"(<scene><environment timestep="0.002"/><physics engine=")" + engine + R"("/>)" + types() + R"(

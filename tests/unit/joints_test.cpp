@@ -201,7 +201,7 @@ TEST_CASE("joints: a damped hinge slows as exp(-d t / I)", "[joints]") {
   CHECK(w.jointVelocity() == Approx(5 * std::exp(-0.02 * 1.0 / inertia)).epsilon(0.01));
 }
 
-TEST_CASE("joints: a double pendulum keeps its energy; a chain keeps its joints together", "[joints]") {
+TEST_CASE("joints: a double pendulum keeps its energy, a chain keeps its joints together", "[joints]") {
   const std::string engine = GENERATE(as<std::string>{}, "ode", "bullet");
   INFO(engine);
   const int links = GENERATE(2, 8);

@@ -46,7 +46,7 @@ TEST_CASE("measurements: a NaN or infinity in any number makes a measurement not
   CHECK_FALSE(range.finite());
 }
 
-TEST_CASE("measurements: a camera image with depth +infinity where nothing was hit is finite; its pose must be",
+TEST_CASE("measurements: a camera image with depth +infinity where nothing was hit is finite, its pose must be",
           "[measurements]") {
   CameraMeasurement camera;
   camera.image.width = 2;
@@ -58,7 +58,7 @@ TEST_CASE("measurements: a camera image with depth +infinity where nothing was h
   CHECK_FALSE(camera.finite());
 }
 
-TEST_CASE("measurements as JSON: IMU and range readings with their kind and stamp; none for a clock", "[measurements]") {
+TEST_CASE("measurements as JSON: IMU and range readings with their kind and stamp, none for a clock", "[measurements]") {
   const Environment env;
   ImuMeasurement imu;
   imu.stamp = 1'500'000'000;

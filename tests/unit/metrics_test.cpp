@@ -10,7 +10,7 @@
 
 using namespace ssx;
 
-TEST_CASE("metrics: a formation quadrotor publishes its formation error; a hovering one publishes nothing",
+TEST_CASE("metrics: a formation quadrotor publishes its formation error, a hovering one publishes nothing",
           "[metrics]") {
   Scene scene = loadSceneFromString(R"(<scene><environment timestep="0.002" seed="2"/>
     <type name="f" file="mk_quad_formation.xml"/><type name="h" file="mk_quad.xml"/><ground/>

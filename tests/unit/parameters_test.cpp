@@ -195,7 +195,7 @@ TEST_CASE("one plugin instance belongs to one artifact", "[parameters]") {
                     Catch::Contains("belongs to artifact 'a' already; create one instance per artifact"));
 }
 
-TEST_CASE("PluginContext::shared makes a value once per type and key; a failing make leaves nothing", "[parameters]") {
+TEST_CASE("PluginContext::shared makes a value once per type and key, a failing make leaves nothing", "[parameters]") {
   PluginContext::SharedValues table;
   PluginContext context;
   context.shared_values = &table;

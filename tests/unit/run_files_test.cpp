@@ -60,7 +60,7 @@ TEST_CASE("two outputs onto one file are refused, however the second is spelled"
   CHECK_THAT(files.claimOutput(existing, "--out"), Catch::Contains("writes already"));
 }
 
-TEST_CASE("outputs must be regular or new files in an existing directory; streams may be special when allowed",
+TEST_CASE("outputs must be regular or new files in an existing directory, streams may be special when allowed",
           "[run_files]") {
   Dir d;
   RunFiles files;
@@ -84,7 +84,7 @@ TEST_CASE("a frames directory may not hold an input of the run", "[run_files]") 
   CHECK(files.claimOutputDirectory(d.path / "frames", "camera 'c': frames").empty());
 }
 
-TEST_CASE("input files: regular files up to the limit are read whole; anything else is refused saying why",
+TEST_CASE("input files: regular files up to the limit are read whole, anything else is refused saying why",
           "[run_files]") {
   const Dir dir;
   const fs::path small = dir.file("small.xml", std::string(1000, 'a'));

@@ -38,7 +38,7 @@ void burn(std::chrono::microseconds d) {
 
 }  // namespace
 
-TEST_CASE("real time paces 50 steps of 10 ms to at least 0.5 s; fast mode does not wait", "[run]") {
+TEST_CASE("real time paces 50 steps of 10 ms to at least 0.5 s, fast mode does not wait", "[run]") {
   EnvironmentSettings s;
   s.timestep = toNanoseconds(0.010);
   Environment rt(s);

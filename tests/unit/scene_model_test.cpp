@@ -68,7 +68,7 @@ TEST_CASE("a scene model prints back to XML that parses to an equal model, and b
   }
 }
 
-TEST_CASE("two loads of one file give equal models; a changed value gives another", "[scene][model]") {
+TEST_CASE("two loads of one file give equal models, a changed value gives another", "[scene][model]") {
   const fs::path file = kExamples / "scenes" / "formation_sphere.xml";
   CHECK(parseScene(file, testOptions()) == parseScene(file, testOptions()));
   SceneOptions seeded = testOptions();
@@ -108,7 +108,7 @@ TEST_CASE("the model holds every default and what the file says, with where it s
   CHECK(xml.find("<swarm type=\"ball\" count=\"4\" name=\"b{i}\" first_index=\"10\" layout=\"grid\"") != std::string::npos);
 }
 
-TEST_CASE("parsing loads no plugin; building reports what the plugins say", "[scene][model]") {
+TEST_CASE("parsing loads no plugin, building reports what the plugins say", "[scene][model]") {
   // a plugin that does not exist, and a parameter a plugin declares out of range: neither is the
   // file's own problem, so the model parses; building finds both
   const std::string xml =
@@ -144,7 +144,7 @@ TEST_CASE("parsing loads no plugin; building reports what the plugins say", "[sc
   }
 }
 
-TEST_CASE("a model made in code builds; a placement of a type it lacks is reported", "[scene][model]") {
+TEST_CASE("a model made in code builds, a placement of a type it lacks is reported", "[scene][model]") {
   SceneModel model = parseScene(kData / "valid" / "layouts.xml", testOptions());
   PlacementModel extra;
   extra.kind = PlacementModel::Kind::Artifact;

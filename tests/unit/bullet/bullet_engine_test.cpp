@@ -41,7 +41,7 @@ TEST_CASE("bullet: a state set is read back to the bit", "[physics][bullet]") {
   CHECK(r.pose.orientation.angularDistance(s.pose.orientation) < 1e-15);
 }
 
-TEST_CASE("bullet: a restored engine continues bitwise; the other engine's state is refused", "[physics][bullet][state]") {
+TEST_CASE("bullet: a restored engine continues bitwise, the other engine's state is refused", "[physics][bullet][state]") {
   auto build = [] {
     auto e = makeEngine("bullet");
     e->addStatic({Shape::plane()}, Pose{});

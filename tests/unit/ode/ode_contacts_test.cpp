@@ -35,7 +35,7 @@ TEST_CASE("ode contacts: a box resting on a face touches at its four corners, at
   CHECK(two->contactCount() == 2);
 }
 
-TEST_CASE("ode contacts: without friction a sliding box keeps its speed; with friction mu it stops", "[physics][ode]") {
+TEST_CASE("ode contacts: without friction a sliding box keeps its speed, with friction mu it stops", "[physics][ode]") {
   auto slide = [](double friction) {
     PhysicsSettings settings;
     settings.friction = friction;

@@ -77,7 +77,7 @@ TEST_CASE("diff_drive: an e-puck drives straight and turns in place at the speed
   CHECK((r.root().pose().position - at).norm() < 0.005);  // in place
 }
 
-TEST_CASE("diff_drive: velocity commands drive a circle of radius v / w; too fast, both wheels are slowed alike",
+TEST_CASE("diff_drive: velocity commands drive a circle of radius v / w, too fast, both wheels are slowed alike",
           "[diff_drive]") {
   const std::string engine = GENERATE(as<std::string>{}, "ode", "bullet");
   INFO(engine);

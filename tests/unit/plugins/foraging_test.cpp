@@ -35,7 +35,7 @@ double delivered(const Environment& env) {
 
 }  // namespace
 
-TEST_CASE("foraging: an item in the nest that nobody holds is delivered and put back in the area; a held one waits",
+TEST_CASE("foraging: an item in the nest that nobody holds is delivered and put back in the area, a held one waits",
           "[foraging]") {
   Scene s = scene();
   Environment& env = *s.environment;

@@ -44,7 +44,7 @@ std::vector<Vec3> positions(const Environment& env) {
 
 }  // namespace
 
-TEST_CASE("operator: a velocity command moves every steered robot as one; the dead-man rule stops them",
+TEST_CASE("operator: a velocity command moves every steered robot as one, the dead-man rule stops them",
           "[operator]") {
   Scene scene = steered(R"(max_speed="0.6" deadman_s="0.5")");
   Environment& env = *scene.environment;

@@ -102,7 +102,7 @@ TEST_CASE("range_and_bearing: messages are lost at their probability, the same o
   CHECK(run(2).second == ranges);
 }
 
-TEST_CASE("range_and_bearing: a board without a driver sends its `data` for good (a beacon); bad bytes are refused",
+TEST_CASE("range_and_bearing: a board without a driver sends its `data` for good (a beacon), bad bytes are refused",
           "[range_and_bearing]") {
   Scene s = scene(R"(<sensor index="1" data="1 200"/>)");
   Environment& env = *s.environment;

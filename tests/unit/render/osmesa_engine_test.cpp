@@ -139,7 +139,7 @@ Darker darker(const Image& plain, const Image& shaded) {
 
 }  // namespace
 
-TEST_CASE("render: a robot casts a shadow on the ground below it, fainter the higher it flies; without ground none",
+TEST_CASE("render: a robot casts a shadow on the ground below it, fainter the higher it flies, without ground none",
           "[render][shadows]") {
   REQUIRE(haveOsmesa());
   auto engine = osmesaEngine();

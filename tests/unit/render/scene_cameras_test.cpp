@@ -105,7 +105,7 @@ TEST_CASE("render: a camera that frames the scene keeps every robot in the image
   env.stop();
 }
 
-TEST_CASE("render: scene camera frames show the simulated time of their step and the robots' shadows; either can be "
+TEST_CASE("render: scene camera frames show the simulated time of their step and the robots' shadows, either can be "
           "turned off", "[render][time_stamp][shadows]") {
   REQUIRE(haveOsmesa());
   auto snapshot = [](const std::string& flags, const std::string& name) {

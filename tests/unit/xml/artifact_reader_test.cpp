@@ -139,7 +139,7 @@ TEST_CASE("artifact files: a second root named as a node of the first is reporte
   }
 }
 
-TEST_CASE("artifact files: joints are read as written; what does not fit a joint is said at its line",
+TEST_CASE("artifact files: joints are read as written, what does not fit a joint is said at its line",
           "[scene][artifact_reader][joints]") {
   const fs::path dir = writeType("arm.xml", R"(<artifact>
   <physic name="base" static="true">

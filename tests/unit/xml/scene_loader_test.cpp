@@ -138,7 +138,7 @@ TEST_CASE("the default demo scene loads without warnings", "[scene]") {
   CHECK(scene.duration == toNanoseconds(20.0));
 }
 
-TEST_CASE("a type named without a file is the installed artifact type; a given file or directory wins", "[scene]") {
+TEST_CASE("a type named without a file is the installed artifact type, a given file or directory wins", "[scene]") {
   // the build tree mirrors the installation: <build>/share/ssx/artifacts
   const fs::path data = installedDataDirectory();
   REQUIRE_FALSE(data.empty());
@@ -190,7 +190,7 @@ TEST_CASE("a type named without a file is the installed artifact type; a given f
   fs::remove_all(dir);
 }
 
-TEST_CASE("a timestep finer than a nanosecond is a warning saying what it became; seeds are 0 to 2^64 - 1", "[scene]") {
+TEST_CASE("a timestep finer than a nanosecond is a warning saying what it became, seeds are 0 to 2^64 - 1", "[scene]") {
   Scene scene = loadSceneFromString(R"(<scene>
     <environment timestep="1.5e-9" seed="18446744073709551615"/></scene>)", "t.xml", kData);
   REQUIRE(scene.warnings.size() == 1);

@@ -75,7 +75,7 @@ TEST_CASE("bridge transport: staged messages go out in order, on its own thread,
   CHECK(t.sent().size() == 4);
 }
 
-TEST_CASE("bridge transport: what arrives, in order, with its round trip; lock-step's waits", "[bridge]") {
+TEST_CASE("bridge transport: what arrives, in order, with its round trip, lock-step's waits", "[bridge]") {
   Recording t(twoRobots());
   CHECK(t.latestSetpoint(0).count == 0);
   CHECK(t.waitForSetpoints(0.0, 0.01) == std::vector<std::string>{"a", "b"});

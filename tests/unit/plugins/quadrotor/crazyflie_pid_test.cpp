@@ -137,7 +137,7 @@ TEST_CASE("crazyflie_pid: the mixer rolls with the left motors, gives up collect
   CHECK((m[0] + m[3]) / 2 < 65000);  // the collective given up
 }
 
-TEST_CASE("crazyflie_pid: a saved state continues identically; velocity commands", "[quadrotor][crazyflie]") {
+TEST_CASE("crazyflie_pid: a saved state continues identically, velocity commands", "[quadrotor][crazyflie]") {
   const CrazyfliePidGains gains;
   Standing in;
   in.pose.position = Vec3(0.3, -0.2, 0.9);

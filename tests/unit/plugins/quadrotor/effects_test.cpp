@@ -31,7 +31,7 @@ TEST_CASE("the wind alone: the mean, and a gust that rises and falls as 1 - cos"
   CHECK_FALSE(calm.active());
 }
 
-TEST_CASE("the scene's wind pushes every quadrotor downwind; an artifact's own wind overrides it",
+TEST_CASE("the scene's wind pushes every quadrotor downwind, an artifact's own wind overrides it",
           "[quadrotor][parts]") {
   Scene s = sceneOf("<wind mean=\"4 0 0\"/>" + quad("a", "0 0 1") + quad("b", "0 3 1") +
                     quad("calm", "0 6 1", "wind=\"0 0 0\""));

@@ -338,7 +338,7 @@ TEST_CASE("ground effect in flight: a quadrotor low over the ground gets the gai
   }
 }
 
-TEST_CASE("battery: thrust at a fixed command follows (U - 7.575 V); the voltage sags with current", "[quadrotor][fidelity]") {
+TEST_CASE("battery: thrust at a fixed command follows (U - 7.575 V), the voltage sags with current", "[quadrotor][fidelity]") {
   BatteryParams bp;
   Battery battery(bp);
   RotorModel model(plusRotors(0.225), *preset("mk_quad"));

@@ -56,7 +56,7 @@ TEST_CASE("a refused command leaves the quadrotor as it was", "[quadrotor][comma
   CHECK(f.input.rotorCount() == 4);
 }
 
-TEST_CASE("attitude level: level attitude at thrust m g holds the vehicle level; its height follows the motors' resolution",
+TEST_CASE("attitude level: level attitude at thrust m g holds the vehicle level, its height follows the motors' resolution",
           "[quadrotor][commands]") {
   // The mk_quad's motors take 8-bit commands, so m g is delivered as the thrust of the nearest
   // commandable speed: the vehicle climbs or sinks at the constant acceleration that rounding makes
