@@ -25,7 +25,7 @@ void count(World& world, const Attachment& a, int delta) {
     if (b >= 0) world.attached[static_cast<std::size_t>(b)] = static_cast<std::uint16_t>(world.attached[static_cast<std::size_t>(b)] + delta);
 }
 
-void attach(World& world, PhysicEngine& engine, std::uint32_t holder, std::uint32_t held) {
+void attach(World& world, PhysicEngine& engine, std::uint32_t holder, std::uint32_t held, JointSpec::Kind kind) {
   const int a = bodyOf(world, holder), b = bodyOf(world, held);
   // a pair already joined at run time stays as it is
   for (const Attachment& x : world.attachments) {
@@ -33,12 +33,14 @@ void attach(World& world, PhysicEngine& engine, std::uint32_t holder, std::uint3
     if ((xa == a && xb == b) || (xa == b && xb == a)) return;
   }
   EngineJoint joint;
-  joint.kind = JointSpec::Kind::Fixed;
+  joint.kind = kind;
   joint.run_time = true;
-  // held fixed in the holder's body where it is now (a static node: the holder fixed in the world)
+  // held fixed in the holder's body where it is now (a static node: the holder fixed in the world);
+  // a ball joint's anchor is the holder node's origin
   joint.parent = b >= 0 ? a : -1;
   joint.child = b >= 0 ? b : a;
-  joint.frame = world.states[static_cast<std::size_t>(joint.child)].pose;
+  joint.frame = kind == JointSpec::Kind::Ball ? world.node_handles[holder].pose()
+                                              : world.states[static_cast<std::size_t>(joint.child)].pose;
   Attachment x{holder, held, engine.addJoint(joint)};
   count(world, x, 1);
   world.attachments.push_back(x);
@@ -61,7 +63,7 @@ void remove(World& world, PhysicEngine& engine, Match&& match) {
 void carryOut(World& world, PhysicEngine& engine, const AttachRequest& r) {
   switch (r.kind) {
     case AttachRequest::Kind::Attach:
-      attach(world, engine, r.node, r.other);
+      attach(world, engine, r.node, r.other, r.joint);
       break;
     case AttachRequest::Kind::Release:
       remove(world, engine, [&](const Attachment& x) { return x.holder == r.node; });
@@ -119,18 +121,20 @@ std::string who(const PhysicNode& n) { return "artifact '" + n.artifact().name()
 
 }  // namespace
 
-void PhysicNode::attach(const PhysicNode& other) {
+void PhysicNode::attach(const PhysicNode& other, JointSpec::Kind joint) {
   requireWritable();
   if (world_->engine == nullptr || !world_->started()) throw Error(who(*this) + ": attach once the environment has started");
   if (other.world_ != world_) throw Error(who(*this) + ": attach: '" + other.name() + "' is of another environment");
   const int a = bodyIndex(), b = other.bodyIndex();
   if (a < 0) throw Error(who(*this) + ": a static node cannot hold anything (attach the other way round)");
   if (a == b) throw Error(who(*this) + ": attach: '" + other.name() + "' is part of the same body");
+  if (joint != JointSpec::Kind::Fixed && joint != JointSpec::Kind::Ball)
+    throw Error(who(*this) + ": attach holds by a fixed or a ball joint");
   for (const int body : {a, b})
     if (body >= 0 && world_->engine->isKinematic(body))
       throw Error(who(*this) + ": attach: a ghost (a kinematic body) cannot hold or be held");
   detail::request(*world_, {detail::AttachRequest::Kind::Attach, static_cast<std::uint32_t>(index_),
-                            static_cast<std::uint32_t>(other.index_)});
+                            static_cast<std::uint32_t>(other.index_), joint});
 }
 
 void PhysicNode::release() {

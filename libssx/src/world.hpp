@@ -73,6 +73,7 @@ struct AttachRequest {
   Kind kind = Kind::Attach;
   std::uint32_t node = 0;   // the node that asked
   std::uint32_t other = 0;  // attach: the node to hold
+  JointSpec::Kind joint = JointSpec::Kind::Fixed;  // attach: fixed, or a ball at the node's origin
 };
 
 /// One attached driver or sensor: who it is and when it runs (its random stream is in

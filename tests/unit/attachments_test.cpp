@@ -183,3 +183,43 @@ TEST_CASE("attachments: between steps the program's requests take effect at once
   CHECK((na.pose().position - before).norm() < 5e-3);
   CHECK(na.state().linear_velocity.norm() < 1e-3);
 }
+
+TEST_CASE("attachments: held by a ball joint, a body hangs from the holder's node origin and swings about it",
+          "[attachments][joints]") {
+  const std::string engine = GENERATE(as<std::string>{}, "ode", "bullet");
+  INFO(engine);
+  EnvironmentSettings s = settings(engine, 1);
+  s.physics.gravity = Vec3(0, 0, -9.81);
+  Environment env(s);
+  // a hook held in place by the static world, a 0.5 m bar beside it whose end is at the hook's origin
+  Artifact& post = env.addArtifact("post", ssx::test::at(0, 0, 2));
+  PhysicNodeSpec p = ssx::test::boxBody(Vec3(0.1, 0.1, 0.1), 1.0);
+  p.is_static = true;
+  post.addPhysicRoot(p);
+  Artifact& hook = env.addArtifact("hook", ssx::test::at(0, 0, 1));
+  hook.addPhysicRoot(ssx::test::boxBody(Vec3(0.05, 0.05, 0.05), 1.0));
+  Artifact& bar = env.addArtifact("bar", ssx::test::at(0.25, 0, 1));
+  bar.addPhysicRoot(ssx::test::boxBody(Vec3(0.5, 0.02, 0.02), 0.1));
+  Artifact& fixed = env.addArtifact("fixed", ssx::test::at(0, 3, 1));
+  fixed.addPhysicRoot(ssx::test::boxBody(Vec3(0.05, 0.05, 0.05), 1.0));
+  Artifact& beam = env.addArtifact("beam", ssx::test::at(0.25, 3, 1));
+  beam.addPhysicRoot(ssx::test::boxBody(Vec3(0.5, 0.02, 0.02), 0.1));
+  env.start();
+  CHECK_THROWS_WITH(hook.root().attach(bar.root(), JointSpec::Kind::Hinge), Contains("fixed or a ball joint"));
+  hook.root().attach(post.root());  // the hook and the other holder stay where they are
+  fixed.root().attach(post.root());
+  hook.root().attach(bar.root(), JointSpec::Kind::Ball);
+  fixed.root().attach(beam.root());  // fixed: stays level
+  double lowest = 1, worst = 0;
+  for (int k = 0; k < 500; ++k) {  // 1 s: a quarter swing of a 0.5 m bar takes about 0.35 s
+    env.step();
+    // the bar's end stays at the hook's origin
+    const Vec3 end = bar.root().pose().transformPoint(Vec3(-0.25, 0, 0));
+    worst = std::max(worst, (end - hook.root().pose().position).norm());
+    lowest = std::min(lowest, bar.root().pose().position.z());
+  }
+  INFO("the bar's end within " << worst * 1e3 << " mm of the hook; its centre down to z " << lowest);
+  CHECK(worst < 2e-3);
+  CHECK(lowest < 1 - 0.24);  // it swung down to hang below the hook
+  CHECK((beam.root().pose().position - Vec3(0.25, 3, 1)).norm() < 5e-3);
+}

@@ -199,13 +199,15 @@ class SSX_EXPORT PhysicNode {
 
   /// Holds `other`'s body to this node's body by a fixed joint, as the two are when it is made (a
   /// gripper closing on an object, two robots docking): they then move as one and do not collide
-  /// with each other. `other` may be static: this node's body is then held in place. Asked for by
+  /// with each other. With `joint` JointSpec::Kind::Ball, by a ball joint at this node's origin
+  /// instead (a hook, a tether's end): `other` keeps its distance from that point and turns freely
+  /// about it. `other` may be static: this node's body is then held in place. Asked for by
   /// the artifact's own driver during a step, it is made as the drivers phase ends, at the poses
   /// the drivers saw (requests are carried out artifact by artifact, each artifact's in the order
   /// asked); by the program between steps, at once. A pair already joined this way stays as it is.
   /// Part of the saved state. Throws Error before start, for two nodes of one body, for a static
-  /// node holding and for a ghost.
-  void attach(const PhysicNode& other);
+  /// node holding, for a ghost and for a joint other than fixed or ball.
+  void attach(const PhysicNode& other, JointSpec::Kind joint = JointSpec::Kind::Fixed);
   /// Lets go of every body this node holds (its attach calls), as attach: as the drivers phase
   /// ends, or at once between steps.
   void release();
