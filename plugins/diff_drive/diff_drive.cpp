@@ -36,6 +36,8 @@
 // A command from outside takes over from any controller.
 //
 // Parameters: kParameters below, or `ssx plugins --params diff_drive`.
+#include "../common/hold.hpp"
+
 #include <ssx/artifact.hpp>
 #include <ssx/command.hpp>
 #include <ssx/environment.hpp>
@@ -68,7 +70,7 @@ class DiffDrive final : public Driver, public CommandInterface, public OdometryI
  public:
   static constexpr const char* kDoc =
       "a differential-drive ground robot: wheels on hinge motors (full) or one body driven to the wheels' twist (swarm)";
-  static constexpr ssx_plugin_param kParameters[] = {
+  static constexpr ssx_plugin_param kDriveParameters[] = {
       param::choice("model", "swarm", "swarm full",
                     "full: wheel bodies on hinge motors, rolling with friction; swarm: one body driven to the wheels' "
                     "twist with limited force and torque"),
@@ -103,6 +105,7 @@ class DiffDrive final : public Driver, public CommandInterface, public OdometryI
       param::real("grab_range", "0.07", "m", param::positive(), "foraging: an item heard nearer than this is taken"),
       param::real("nest_level", "0.9", "", param::between(0, 1), "foraging: the grey level (at least) of the nest's floor"),
   };
+  static constexpr auto kParameters = param::join(param::part("drive", kDriveParameters), param::part("hold", kHoldParameters));
 
   static void validate(const Descriptor& params, const PluginContext& context) {
     const Artifact& a = *context.artifact;
@@ -125,6 +128,7 @@ class DiffDrive final : public Driver, public CommandInterface, public OdometryI
   }
 
   void configure(const Descriptor& params, PluginSetup&) override {
+    hold_.configure(params, artifact());
     Artifact& a = artifact();
     full_ = params.get<std::string>("model") == "full";
     radius_ = params.get<double>("wheel_radius");
@@ -236,6 +240,7 @@ class DiffDrive final : public Driver, public CommandInterface, public OdometryI
   }
 
   void step(const StepInfo& info) override {
+    hold_.step(info);
     const double dt = toSeconds(info.period);
     if (foraging_ && diffusion_) {
       forage(toSeconds(info.time));
@@ -504,6 +509,7 @@ class DiffDrive final : public Driver, public CommandInterface, public OdometryI
   PhysicNode* right_ = nullptr;
   double left_cmd_ = 0, right_cmd_ = 0;
   CommandLevel level_ = CommandLevel::Wheels;
+  Hold hold_;
   Odometry odometry_;
 };
 

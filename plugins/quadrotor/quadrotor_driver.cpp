@@ -199,6 +199,7 @@ void QuadrotorDriver::configure(const Descriptor& params, PluginSetup& setup) {
   const Sensor* range = firstSensorOf<RangeMeasurement>(a);
   references_.configure(c.reference, params, a,
                         range != nullptr ? static_cast<const RangeMeasurement*>(&range->latest()) : nullptr);
+  hold_.configure(params, a);
 
   // a vehicle placed in the air starts with its rotors at hover speed
   commanded_speeds_.fill(0.0);
@@ -242,6 +243,7 @@ void QuadrotorDriver::position(Pose& pose, Vec3& velocity) const {
 }
 
 void QuadrotorDriver::step(const StepInfo& info) {
+  hold_.step(info);
   const double period = info.periodSeconds();
   const double t = toSeconds(info.time);
   const std::size_t n = vehicle_.rotorCount();

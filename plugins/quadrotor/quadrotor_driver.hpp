@@ -17,6 +17,7 @@
 // sensor producing ssx::PoseMeasurement (a motion-capture stand-in) for position and velocity,
 // else the ground truth. The formation needs a `range` sensor; its members must be one swarm
 // (consecutive artifacts), member i at artifact index (own - own i + i).
+#include "../common/hold.hpp"
 #include "controller.hpp"
 #include "crazyflie_pid.hpp"
 #include "effects.hpp"
@@ -41,7 +42,8 @@ class QuadrotorDriver final : public Driver, public CommandInterface, public Met
       param::join(param::part("vehicle", kVehicleParameters), param::part("ground effect", kGroundEffectParameters),
                   param::part("wind", kWindParameters), param::part("downwash", kDownwashParameters),
                   param::part("controller", kControllerChoiceParameters),
-                  param::part("controller (TeleKyb)", kTeleKybParameters), param::part("references", kReferenceParameters));
+                  param::part("controller (TeleKyb)", kTeleKybParameters), param::part("references", kReferenceParameters),
+                  param::part("hold", plugins::kHoldParameters));
   static void validate(const Descriptor& params, const PluginContext& context);
   void configure(const Descriptor& params, PluginSetup& setup) override;
   void step(const StepInfo& info) override;
@@ -100,6 +102,7 @@ class QuadrotorDriver final : public Driver, public CommandInterface, public Met
   Vehicle vehicle_;
   PoseMeasurement pose_;
   References references_;
+  plugins::Hold hold_;  // hold="ARTIFACT": takes it at hold_time (a gripper, a hook)
   Wind wind_;
   std::optional<Downwash> downwash_;
   double ground_z_ = 0;  // the ground plane's height (-inf: none)

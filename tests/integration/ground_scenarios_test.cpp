@@ -17,8 +17,9 @@ namespace {
 
 const std::filesystem::path kGround = std::filesystem::path(SSX_EXAMPLES_DIR) / "ground";
 
-Scene groundExample(const std::string& file) {
+Scene groundExample(const std::string& file, std::vector<AttributeOverride> overrides = {}) {
   SceneOptions options = testOptions();
+  options.overrides = std::move(overrides);
   return loadScene(kGround / file, options);
 }
 
@@ -218,4 +219,55 @@ TEST_CASE("ground scenarios: landing: a Crazyflie follows a TurtleBot3 Burger dr
   CHECK(summary.on_wheels == 1);
   CHECK(summary.landed == 1);
   CHECK(summary.airborne == 0);
+}
+
+TEST_CASE("ground scenarios: carry: a Crazyflie and a TurtleBot3 Burger carry a rod together, each holding an end by "
+          "a ball joint", "[scenario][carry]") {
+  Scene scene = groundExample("carry.xml");
+  Environment& env = *scene.environment;
+  const Artifact& burger = *std::as_const(env).findArtifact("burger");
+  const Artifact& cf = *std::as_const(env).findArtifact("cf");
+  const Artifact& rod = *std::as_const(env).findArtifact("rod");
+  const Vec3 deck(-0.032, 0, 0.21);  // the Burger's hold_node, in its frame
+  const Vec3 start = rod.root().pose().position;
+  // where each anchor lies in the rod's frame: the holds keep these points there
+  const Vec3 near_end = rod.root().pose().inverse().transformPoint(burger.root().pose().transformPoint(deck));
+  const Vec3 far_end = rod.root().pose().inverse().transformPoint(cf.root().pose().position);
+  double worst_joint = 0, worst_follow = 0, lowest = 1, highest = 0, least_up = 1;
+  FlightRecorder recorder;
+  for (int k = 1; k <= 300; ++k) {  // 30 s, looked at every 0.1 s
+    env.step(50);
+    recorder.observe(env);
+    CHECK(rod.root().attachments() == 2);
+    const Pose r = rod.root().pose();
+    worst_joint = std::max({worst_joint, (r.transformPoint(near_end) - burger.root().pose().transformPoint(deck)).norm(),
+                            (r.transformPoint(far_end) - cf.root().pose().position).norm()});
+    if (0.1 * k >= 3) {  // settled: the Crazyflie at its point behind the Burger, the rod level
+      const Vec3 point = burger.root().pose().transformPoint(Vec3(-0.462, 0, 0.21));
+      worst_follow = std::max(worst_follow, (cf.root().pose().position - point).norm());
+      lowest = std::min(lowest, r.position.z());
+      highest = std::max(highest, r.position.z());
+    }
+    least_up = std::min(least_up, (cf.root().pose().orientation * Vec3::UnitZ()).z());
+  }
+  INFO("joints within " << worst_joint * 1e3 << " mm; the Crazyflie within " << worst_follow * 1e3
+                        << " mm of its point; the rod's middle between z " << lowest << " and " << highest);
+  CHECK(worst_joint < 0.002);
+  CHECK(worst_follow < 0.05);
+  CHECK(lowest > 0.19);
+  CHECK(highest < 0.23);
+  CHECK(least_up > 0.9);  // the Crazyflie never tipped
+  // carried along the Burger's circle (0.1 m/s for 30 s: 3 m of arc)
+  CHECK((rod.root().pose().position - start).norm() > 1.5);
+  CHECK(recorder.summary().crashed == 0);
+}
+
+TEST_CASE("ground scenarios: carry: without the Crazyflie's hold, the rod's end falls", "[scenario][carry]") {
+  Scene scene = groundExample("carry.xml", {{"artifact[name=cf]/driver@hold", "", {}}});
+  Environment& env = *scene.environment;
+  const Artifact& rod = *std::as_const(env).findArtifact("rod");
+  env.step(1000);  // 2 s
+  CHECK(rod.root().attachments() == 1);
+  // hanging from the Burger's plate (0.21 m up), the rod's far end is on the floor
+  CHECK(rod.root().pose().transformPoint(Vec3(-0.19, 0, 0)).z() < 0.02);
 }

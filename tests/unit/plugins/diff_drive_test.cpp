@@ -177,3 +177,26 @@ TEST_CASE("diff_drive: controller=\"twist\" drives a constant forward speed and 
   CHECK(odometry(env, "r").forward == Approx(0.1).epsilon(0.02));
   CHECK(odometry(env, "r").yaw_rate == Approx(0.5).epsilon(0.02));
 }
+
+TEST_CASE("diff_drive: hold takes an item at hold_time by a fixed joint and carries it, an unknown one is refused",
+          "[diff_drive][hold]") {
+  const std::string engine = GENERATE(as<std::string>{}, "ode", "bullet");
+  INFO(engine);
+  Scene s = groundScene(engine, R"(<type name="item" file=")" + (kArtifacts / "item.xml").string() + R"("/>
+    <artifact name="puck" type="item" xyz="0.06 0 0"/>
+    <artifact name="a" type="epuck"><driver controller="twist" twist="0.05 0 0" hold="puck" hold_time="0.5"/></artifact>)");
+  Environment& env = *s.environment;
+  const PhysicNode& puck = env.findArtifact("puck")->root();
+  const PhysicNode& a = env.findArtifact("a")->root();
+  env.step(240);  // 0.48 s: pushing it, not holding it
+  CHECK(puck.attachments() == 0);
+  env.step(20);
+  CHECK(puck.attachments() == 1);
+  const Vec3 offset = a.pose().inverse().transformPoint(puck.pose().position);
+  env.step(500);
+  CHECK((a.pose().inverse().transformPoint(puck.pose().position) - offset).norm() < 1e-3);
+  // (the artifacts it may name can come later in the scene: checked as the environment starts)
+  Scene bad = groundScene(engine, R"(<artifact name="a" type="epuck"><driver hold="nothing"/></artifact>)");
+  CHECK_THROWS_WITH(bad.environment->start(),
+                    Contains("ground.xml:") && Contains("no other artifact with a physic root is named 'nothing'"));
+}
