@@ -271,3 +271,22 @@ TEST_CASE("ground scenarios: carry: without the Crazyflie's hold, the rod's end 
   // hanging from the Burger's plate (0.21 m up), the rod's far end is on the floor
   CHECK(rod.root().pose().transformPoint(Vec3(-0.19, 0, 0)).z() < 0.02);
 }
+
+TEST_CASE("ground scenarios: carry: the same bits on 1 and 2 threads and after a restore while both hold the rod",
+          "[scenario][carry]") {
+  auto run = [](int threads) {
+    SceneOptions options = testOptions();
+    options.threads = threads;
+    Scene scene = loadScene(kGround / "carry.xml", options);
+    Environment& env = *scene.environment;
+    env.step(1500);  // 3 s: held since the first step
+    const auto state = env.saveState();
+    env.step(1500);
+    Scene again = loadScene(kGround / "carry.xml", options);
+    again.environment->restoreState(state);
+    again.environment->step(1500);
+    CHECK(again.environment->stateHash() == env.stateHash());
+    return env.stateHash();
+  };
+  CHECK(run(1) == run(2));
+}
