@@ -25,13 +25,16 @@ inline constexpr ssx_plugin_param kHoldParameters[] = {
 
 class Hold {
  public:
-  // what it will hold; ConfigError at `hold` when no other artifact with a physic root has that name
+  // what it will hold; ConfigError at `hold` when no other artifact with a physic root has that
+  // name, or it is a ghost (a real robot: nothing holds it)
   void configure(const Descriptor& params, Artifact& self) {
     const std::string name = params.get<std::string>("hold", "");
     if (name.empty()) return;
     target_ = self.environment().findArtifact(name);
     if (target_ == nullptr || target_->rootCount() == 0 || target_ == &self)
       throw params.errorAt("hold", "no other artifact with a physic root is named '" + name + "'");
+    if (self.environment().isGhost(*target_))
+      throw params.errorAt("hold", "'" + name + "' is a ghost (a real robot): it cannot be held");
     hand_ = &self.nodeFromParameter(params, "hold_node");
     time_ = toNanoseconds(params.get<double>("hold_time"));
     ball_ = params.get<std::string>("hold_joint") == "ball";

@@ -178,7 +178,7 @@ TEST_CASE("diff_drive: controller=\"twist\" drives a constant forward speed and 
   CHECK(odometry(env, "r").yaw_rate == Approx(0.5).epsilon(0.02));
 }
 
-TEST_CASE("diff_drive: hold takes an item at hold_time by a fixed joint and carries it, an unknown one is refused",
+TEST_CASE("diff_drive: hold takes an item at hold_time by a fixed joint and carries it, an unknown one or a ghost is refused",
           "[diff_drive][hold]") {
   const std::string engine = GENERATE(as<std::string>{}, "ode", "bullet");
   INFO(engine);
@@ -199,4 +199,7 @@ TEST_CASE("diff_drive: hold takes an item at hold_time by a fixed joint and carr
   Scene bad = groundScene(engine, R"(<artifact name="a" type="epuck"><driver hold="nothing"/></artifact>)");
   CHECK_THROWS_WITH(bad.environment->start(),
                     Contains("ground.xml:") && Contains("no other artifact with a physic root is named 'nothing'"));
+  Scene ghost = groundScene(engine, R"(<artifact name="g" type="epuck" xyz="1 0 0"><ghost/></artifact>
+    <artifact name="a" type="epuck"><driver hold="g"/></artifact>)");
+  CHECK_THROWS_WITH(ghost.environment->start(), Contains("ground.xml:") && Contains("'g' is a ghost"));
 }
