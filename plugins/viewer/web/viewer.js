@@ -223,7 +223,7 @@ function frameBodies(n) {
   for (let i = 0; i < n; ++i) box.expandByPoint(at.set(p[7 * i], p[7 * i + 1], p[7 * i + 2]));
   state.framed = true;
   if (n === 0) return;
-  const centre = box.getCenter(new THREE.Vector3()), radius = Math.max(2, 0.5 * box.getSize(new THREE.Vector3()).length());
+  const centre = box.getCenter(new THREE.Vector3()), radius = Math.max(1, 0.5 * box.getSize(new THREE.Vector3()).length());
   const distance = radius / Math.sin((camera.fov * Math.PI) / 360);
   controls.target.copy(centre);
   camera.position.copy(centre).add(new THREE.Vector3(-0.6, -0.6, 0.5).normalize().multiplyScalar(distance));
