@@ -29,7 +29,11 @@ class Hold {
   // name, or it is a ghost (a real robot: nothing holds it)
   void configure(const Descriptor& params, Artifact& self) {
     const std::string name = params.get<std::string>("hold", "");
-    if (name.empty()) return;
+    if (name.empty()) {
+      for (const char* key : {"hold_time", "hold_joint", "hold_node"})
+        if (params.has(key)) throw params.errorAt(key, std::string(key) + " is for hold=\"ARTIFACT\", which is not given");
+      return;
+    }
     target_ = self.environment().findArtifact(name);
     if (target_ == nullptr || target_->rootCount() == 0 || target_ == &self)
       throw params.errorAt("hold", "no other artifact with a physic root is named '" + name + "'");

@@ -202,4 +202,6 @@ TEST_CASE("diff_drive: hold takes an item at hold_time by a fixed joint and carr
   Scene ghost = groundScene(engine, R"(<artifact name="g" type="epuck" xyz="1 0 0"><ghost/></artifact>
     <artifact name="a" type="epuck"><driver hold="g"/></artifact>)");
   CHECK_THROWS_WITH(ghost.environment->start(), Contains("ground.xml:") && Contains("'g' is a ghost"));
+  Scene alone = groundScene(engine, R"(<artifact name="a" type="epuck"><driver hold_joint="ball"/></artifact>)");
+  CHECK_THROWS_WITH(alone.environment->start(), Contains("hold_joint is for hold=\"ARTIFACT\", which is not given"));
 }
