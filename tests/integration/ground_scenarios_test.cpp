@@ -263,7 +263,8 @@ TEST_CASE("ground scenarios: carry: a Crazyflie and a TurtleBot3 Burger carry a 
 }
 
 TEST_CASE("ground scenarios: carry: without the Crazyflie's hold, the rod's end falls", "[scenario][carry]") {
-  Scene scene = groundExample("carry.xml", {{"artifact[name=cf]/driver@hold", "", {}}});
+  // (the Crazyflie would take hold at 100 s)
+  Scene scene = groundExample("carry.xml", {{"artifact[name=cf]/driver@hold_time", "100", {}}});
   Environment& env = *scene.environment;
   const Artifact& rod = *std::as_const(env).findArtifact("rod");
   env.step(1000);  // 2 s
