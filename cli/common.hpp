@@ -31,6 +31,11 @@ constexpr double kDefaultMaxInputMb = 64.0;
 constexpr double kMostMaxInputMb = 1 << 20;  // 1 TiB: beyond it, a file is no scene
 inline std::uintmax_t maxInputBytes(double mb) { return static_cast<std::uintmax_t>(mb * (1 << 20)); }
 
+// where a scene's relative outputs go: --out, else ssx-out/<scene's name>/
+inline std::filesystem::path outputDirectory(const std::string& scene, const std::string& out) {
+  return out.empty() ? std::filesystem::path("ssx-out") / std::filesystem::path(scene).stem() : std::filesystem::path(out);
+}
+
 inline std::string joined(const std::vector<std::string>& names) {
   std::string out;
   for (const auto& n : names) out += (out.empty() ? "" : ", ") + n;

@@ -134,8 +134,7 @@ std::vector<std::byte> readFile(const std::string& path, std::uintmax_t max_byte
 // written beside the target and renamed over it: a failed write never leaves a short file
 void writeFileAtomically(const std::string& path, const std::vector<std::byte>& bytes) {
   const std::string partial = path + ".partial";
-  std::FILE* f = std::fopen(partial.c_str(), "wb");
-  if (f == nullptr) throw std::runtime_error("cannot write '" + partial + "': " + std::strerror(errno));
+  std::FILE* f = ssx::openOutputFile(partial);  // (locked: a second run saving to the same file is refused)
   const bool written = std::fwrite(bytes.data(), 1, bytes.size(), f) == bytes.size();
   const bool closed = std::fclose(f) == 0;
   if (!written || !closed) {
@@ -169,7 +168,7 @@ int commandRun(const RunArgs& args, bool realtime_given) {
   options.allow_special_outputs = args.allow_special_outputs;
   options.max_input_bytes = maxInputBytes(args.max_input_mb);
   // the scene's own outputs into a directory of this run, never the working directory unasked
-  const fs::path out_dir = args.out.empty() ? fs::path("ssx-out") / fs::path(args.scene).stem() : fs::path(args.out);
+  const fs::path out_dir = outputDirectory(args.scene, args.out);
   options.output_directory = out_dir;
   // settings of this process for drawing with Mesa's llvmpipe (the library leaves the process
   // alone; a program that embeds it chooses these itself, see docs/library.md, Rendering):
@@ -390,6 +389,8 @@ int commandValidate(const std::string& file, const std::vector<std::string>& plu
   ssx::SceneOptions options;
   options.plugin_path = pluginPath(plugin_path);
   options.max_input_bytes = maxInputBytes(max_input_mb);
+  // (outputs resolved as `ssx run` resolves them: the same checks, the same messages)
+  options.output_directory = outputDirectory(file, "");
   if (!physics.empty()) options.physics_engine = physics;
   try {
     const ssx::Scene scene = ssx::loadScene(file, options);

@@ -138,6 +138,37 @@ int draw(const Recording& r, const ReplayArgs& args) {
                  "--resimulate-from)\n";
     return kExitBadInput;
   }
+  const Nanoseconds from = toNanoseconds(args.from);
+  const Nanoseconds to = args.to >= 0 ? toNanoseconds(args.to) : std::numeric_limits<Nanoseconds>::max();
+  // the samples drawn, one per frame: every one at --speed 1; at another speed the frames keep the
+  // recording's rate and each shows the sample at or before its time (repeated in slow motion).
+  // Made one at a time (a slow replay of a long recording is many frames); the times ascend
+  // (Recording checks it), so the frames end
+  const auto& times = r.times();
+  const auto first = std::lower_bound(times.begin(), times.end(), from);
+  const Nanoseconds end = times.empty() ? 0 : std::min(to, times.back());
+  if (first == times.end() || *first > end) {
+    std::cerr << "ssx: error: nothing to draw from " << seconds(from) << (args.to >= 0 ? " to " + seconds(to) : std::string())
+              << ": the recording's samples run from " << (times.empty() ? std::string("(none)") : seconds(times.front()))
+              << " to " << (times.empty() ? std::string("(none)") : seconds(times.back())) << '\n';
+    return kExitBadInput;
+  }
+  const double frame_step = times.size() > 1 ? toSeconds(times[1] - times[0]) * args.speed : 0;
+  std::int64_t frame = 0;
+  // the next frame's sample, or false at the end
+  auto nextFrame = [&](std::size_t& k) {
+    if (args.speed == 1 || times.size() < 2) {
+      const auto it = first + frame;
+      if (it == times.end() || *it > end) return false;
+      k = static_cast<std::size_t>(it - times.begin());
+    } else {
+      const Nanoseconds t = *first + toNanoseconds(static_cast<double>(frame) * frame_step);
+      if (t > end) return false;
+      k = static_cast<std::size_t>(std::upper_bound(times.begin(), times.end(), t) - times.begin() - 1);
+    }
+    ++frame;
+    return true;
+  };
   int status = 0;
   Scene scene = buildRecorded(r, args, true, &status);
   if (status != 0) return status;
@@ -145,26 +176,8 @@ int draw(const Recording& r, const ReplayArgs& args) {
   env.start();
   const std::vector<const PhysicNode*> nodes = recordedNodes(env, r);
   if (nodes.size() != r.names().size()) return kExitBadInput;
-  const Nanoseconds from = toNanoseconds(args.from);
-  const Nanoseconds to = args.to >= 0 ? toNanoseconds(args.to) : std::numeric_limits<Nanoseconds>::max();
   std::int64_t drawn = 0;
   std::vector<CameraSpec> cameras;
-  // the samples drawn, one per frame: every one at --speed 1; at another speed the frames keep the
-  // recording's rate and each shows the sample at or before its time (repeated in slow motion)
-  std::vector<std::size_t> frames;
-  const auto& times = r.times();
-  const auto first = std::lower_bound(times.begin(), times.end(), from);
-  if (first != times.end() && args.speed == 1) {
-    for (auto it = first; it != times.end() && *it <= to; ++it) frames.push_back(static_cast<std::size_t>(it - times.begin()));
-  } else if (first != times.end() && times.size() > 1) {
-    const double step = toSeconds(times[1] - times[0]) * args.speed;
-    const Nanoseconds end = std::min(to, times.back());
-    for (std::int64_t f = 0;; ++f) {
-      const Nanoseconds t = *first + toNanoseconds(static_cast<double>(f) * step);
-      if (t > end) break;
-      frames.push_back(static_cast<std::size_t>(std::upper_bound(times.begin(), times.end(), t) - times.begin() - 1));
-    }
-  }
   // trails: a dot at each recorded position of the last --trails seconds, a tenth of the robot's
   // width across, in the robot's colour (the first shape it draws)
   std::vector<RenderNodeSpec> dots(nodes.size());
@@ -190,7 +203,7 @@ int draw(const Recording& r, const ReplayArgs& args) {
   }
   const Nanoseconds trail = toNanoseconds(args.trails);
   try {
-    for (const std::size_t k : frames) {
+    for (std::size_t k = 0; nextFrame(k);) {
       const Nanoseconds t = times[k];
       overlay.clear();
       for (std::size_t j = k; args.trails > 0 && j-- > 0 && times[j] >= t - trail;) {
@@ -284,37 +297,30 @@ int resimulate(const Recording& r, const ReplayArgs& args) {
     }
   }
   Nanoseconds at = 0;
+  const Nanoseconds from = toNanoseconds(args.resimulate_from);
   std::unique_ptr<Recorder> recorder;
   try {
     // the saved state at or before the time asked for; before the first one, the first
     const std::vector<Nanoseconds> times = r.stateTimes();
-    const Nanoseconds from = toNanoseconds(args.resimulate_from);
     const std::vector<std::byte> state =
         r.stateAtOrBefore(!times.empty() && from < times.front() ? times.front() : from, &at);
     env.checkState(state);
-    if (!args.record.empty()) {
-      RecordOptions o;
-      o.file = args.record;
-      o.scene_xml = scene.model->toXml();
-      o.scene_label = r.sceneLabel();
-      recorder = std::make_unique<Recorder>(env, o);
-    }
     env.start();
     env.restoreState(state);
   } catch (const std::exception& e) {
     std::cerr << "ssx: error: " << e.what() << '\n';
     return kExitBadInput;
   }
-  const Nanoseconds end = args.duration > 0 ? at + toNanoseconds(args.duration) : r.times().empty() ? at : r.times().back();
-  // step, comparing each recorded sample on the way
+  // step, comparing each recorded sample on the way: from the saved state to the time asked for
+  // (as recorded, but for --set), then on from there, recorded (--record) and for --duration
   const std::vector<const PhysicNode*> nodes = recordedNodes(env, r);
   if (nodes.size() != r.names().size()) return kExitBadInput;
   std::size_t compared = 0, equal = 0;
   double largest = 0;
   std::string largest_at, first_difference;
-  try {
-    std::size_t k = 0;
-    while (k < r.times().size() && r.times()[k] <= at) ++k;
+  std::size_t k = 0;
+  while (k < r.times().size() && r.times()[k] <= at) ++k;
+  auto stepTo = [&](Nanoseconds end) {
     while (env.time() < end) {
       env.step();
       if (k < r.times().size() && r.times()[k] == env.time()) {
@@ -340,14 +346,29 @@ int resimulate(const Recording& r, const ReplayArgs& args) {
         ++k;
       }
     }
+  };
+  Nanoseconds start = at, end = at;
+  try {
+    stepTo(from);
+    start = env.time();  // the time asked for (to the step)
+    end = args.duration > 0 ? start + toNanoseconds(args.duration) : std::max(start, r.times().empty() ? start : r.times().back());
+    if (!args.record.empty()) {
+      RecordOptions o;
+      o.file = args.record;
+      o.scene_xml = scene.model->toXml();
+      o.scene_label = r.sceneLabel();
+      recorder = std::make_unique<Recorder>(env, o);
+    }
+    stepTo(end);
     if (recorder) std::cout << recorder->finish().str(args.record) << '\n';
     env.stop();
   } catch (const std::exception& e) {
     std::cerr << "ssx: error: " << e.what() << '\n';
     return kExitRunFailure;
   }
-  std::cout << "re-simulated from the saved state at " << seconds(at) << " (asked for "
-            << seconds(toNanoseconds(args.resimulate_from)) << ") to " << seconds(end) << ": " << compared << " recorded samples compared, ";
+  std::cout << "re-simulated from " << seconds(start) << " (stepped from the saved state at " << seconds(at)
+            << (args.set.empty() || start == at ? "" : ", with the --set values from there") << ") to " << seconds(end)
+            << ": " << compared << " recorded samples compared, ";
   if (equal == compared)
     std::cout << "every one equal to the recording bit for bit\n";
   else
@@ -410,17 +431,27 @@ int commandInspect(const InspectArgs& args) {
 }
 
 int commandReplay(const ReplayArgs& args) {
-  // never written over: the recording itself
-  const fs::path recording = fs::weakly_canonical(fs::absolute(args.file));
-  for (const auto& [path, what] :
-       {std::pair{args.snapshot, "--snapshot"}, std::pair{args.video, "--video"}, std::pair{args.record, "--record"}}) {
-    if (path.empty()) continue;
-    std::error_code ec;
-    const fs::path out = fs::weakly_canonical(fs::absolute(path), ec);
-    if (!ec && out == recording) {
-      std::cerr << "ssx: error: " << what << " " << path << " would write over the recording being replayed: name another\n";
-      return kExitBadInput;
+  // never written over: the recording itself (by any name: a hard or symbolic link is the same
+  // file), and no output over another
+  {
+    RunFiles files;
+    files.addInput(args.file);
+    for (const auto& [path, what] : {std::pair{args.snapshot, "--snapshot"}, std::pair{args.video, "--video"},
+                                     std::pair{args.record, "--record"}}) {
+      if (path.empty()) continue;
+      std::string problem = files.claimOutput(path, what, std::string(what) == "--record");
+      if (problem.find("which this run reads") != std::string::npos)
+        problem = std::string(what) + " " + path + " would write over the recording being replayed: name another";
+      if (!problem.empty()) {
+        std::cerr << "ssx: error: " << problem << '\n';
+        return kExitBadInput;
+      }
     }
+    if (!args.frames.empty())
+      if (const std::string problem = files.claimOutputDirectory(args.frames, "--frames"); !problem.empty()) {
+        std::cerr << "ssx: error: " << problem << '\n';
+        return kExitBadInput;
+      }
   }
   try {
     const Recording r(args.file);

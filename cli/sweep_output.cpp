@@ -108,8 +108,7 @@ Output::Output(const Spec& spec, fs::path file, fs::path robots_file)
       rows_.push_back(std::move(fields));
     }
   }
-  out_ = std::fopen(file_.c_str(), resume ? "ab" : "wb");
-  if (out_ == nullptr) throw std::runtime_error("cannot write '" + file_.string() + "': " + std::strerror(errno));
+  out_ = ssx::openOutputFile(file_, resume);  // (locked: a second sweep writing it is refused)
   if (!resume) {
     std::fprintf(out_, "%s\n%s\n", fingerprint.c_str(), header.c_str());
     check(out_, file_);
@@ -126,9 +125,7 @@ Output::Output(const Spec& spec, fs::path file, fs::path robots_file)
         if (run && *run < spec.runCount() && done_[static_cast<std::size_t>(*run)]) kept.push_back(line);
       }
     }
-    robots_ = std::fopen(robots_file_.c_str(), "wb");
-    if (robots_ == nullptr)
-      throw std::runtime_error("cannot write '" + robots_file_.string() + "': " + std::strerror(errno));
+    robots_ = ssx::openOutputFile(robots_file_);
     std::fprintf(robots_, "%s\n", kRobotHeader);
     for (const auto& line : kept) std::fprintf(robots_, "%s\n", line.c_str());
     check(robots_, robots_file_);
@@ -193,8 +190,7 @@ fs::path Output::writeSummary() const {
   fs::path file = file_;
   file.replace_extension(".summary.csv");
   const fs::path partial = file.string() + ".partial";
-  std::FILE* f = std::fopen(partial.c_str(), "wb");
-  if (f == nullptr) throw std::runtime_error("cannot write '" + partial.string() + "': " + std::strerror(errno));
+  std::FILE* f = ssx::openOutputFile(partial);
   std::fprintf(f, "%s\n", join(header).c_str());
   for (std::size_t point = 0; point < spec_.points.size(); ++point) {
     std::vector<std::string> line{std::to_string(point)};

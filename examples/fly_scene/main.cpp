@@ -6,14 +6,24 @@
 #include <numbers>
 #include <vector>
 
-int main(int argc, char** argv) {
-  // a scene file, or the installed quad_hover.xml (three quadrotors)
-  ssx::Scene scene = ssx::loadScene(argc > 1 ? std::filesystem::path(argv[1])
-                                             : ssx::installedDataDirectory() / "scenes" / "quad_hover.xml");
+namespace {
+
+int fly(const std::filesystem::path& file) {
+  ssx::Scene scene = ssx::loadScene(file);
   ssx::Environment& env = *scene.environment;
+  // the robots this program can fly: drivers that take position and velocity commands
   std::vector<ssx::Artifact*> quads;
   for (ssx::Artifact* a : env.selectArtifacts("*"))
-    if (dynamic_cast<ssx::CommandInterface*>(a->driver()) != nullptr) quads.push_back(a);
+    if (const auto* d = dynamic_cast<ssx::CommandInterface*>(a->driver());
+        d != nullptr && d->acceptsCommand(ssx::CommandLevel::Position) && d->acceptsCommand(ssx::CommandLevel::Velocity))
+      quads.push_back(a);
+  if (quads.empty()) {
+    std::fprintf(stderr,
+                 "ssx_fly_scene: %s has no robot whose driver takes position and velocity commands (quadrotors do): "
+                 "nothing to fly\n",
+                 file.c_str());
+    return 2;
+  }
   env.step(1500);  // 3 s: they take off to their hover points
 
   // position level: each to its place on a circle of 1.5 m at 2 m height, facing the centre
@@ -37,4 +47,17 @@ int main(int argc, char** argv) {
   const double z0 = quads[0]->pose().position.z();
   env.step(1000);
   std::printf("%s climbed %.2f m in 2 s\n", quads[0]->name().c_str(), quads[0]->pose().position.z() - z0);
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  // a scene file, or the installed quad_hover.xml (three quadrotors)
+  try {
+    return fly(argc > 1 ? std::filesystem::path(argv[1]) : ssx::installedDataDirectory() / "scenes" / "quad_hover.xml");
+  } catch (const std::exception& e) {  // a scene that does not load (its diagnostics), a run that fails
+    std::fprintf(stderr, "ssx_fly_scene: %s\n", e.what());
+    return 2;
+  }
 }

@@ -5,6 +5,7 @@
 #include <ssx/operator.hpp>
 
 #include <cmath>
+#include <cstdio>
 #include <numbers>
 #include <stdexcept>
 #include <utility>
@@ -19,7 +20,11 @@ constexpr double kMaxAngle = 80.0 * std::numbers::pi / 180.0;
 
 bool finite(const Vec3& v) { return v.allFinite(); }
 
-std::string number(double v) { return std::to_string(v); }
+std::string number(double v) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.6g", v);
+  return text;
+}
 
 }  // namespace
 
@@ -159,6 +164,10 @@ std::vector<double> Command::toRow() const {
 }
 
 std::string Command::problem() const {
+  for (const double v : toRow())
+    if (std::isfinite(v) && std::abs(v) > kMaxCommandValue)
+      return std::string("a ") + commandLevelName(level) + " command holds " + number(v) +
+             ", beyond any command (at most 1e6 in magnitude)";
   switch (level) {
     case CommandLevel::Position:
       if (!finite(setpoint.position) || !finite(setpoint.velocity) || !finite(setpoint.acceleration) ||

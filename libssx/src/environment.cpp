@@ -151,6 +151,14 @@ SimulationExtension& Environment::addExtension(std::string name, SimulationExten
   return extension;
 }
 
+bool Environment::removeExtension(std::string_view name) {
+  requireSetup("extensions can be removed");
+  const auto it = std::find_if(extensions_.begin(), extensions_.end(), [&](const ExtensionSlot& e) { return e.name == name; });
+  if (it == extensions_.end()) return false;
+  extensions_.erase(it);
+  return true;
+}
+
 void Environment::subscribe(const Sensor& sensor, Artifact& subscriber,
                             std::function<void(const Measurement&)> callback) {
   requireOutsidePhases("subscribe");
@@ -271,7 +279,19 @@ void Environment::checkDeclaredParameters() {
     const ssx_plugin_class* type = loader_->classOf(instance);
     if (type == nullptr) return;
     const PluginContext context{this, a, period, settings_.timestep, {}};
-    for (const auto& d : checkParameters({type->params, type->param_count}, params, context, what()))
+    std::vector<Diagnostic> found = checkParameters({type->params, type->param_count}, params, context, what());
+    // and the class's own checks (what a scene's plugins get from the loader), before anything is
+    // initialised: a plugin added by a program is refused with the environment still in setup
+    const bool declared_ok = std::none_of(found.begin(), found.end(), [](const Diagnostic& d) {
+      return d.severity == Diagnostic::Severity::Error;
+    });
+    if (declared_ok && type->validate != nullptr) {
+      std::vector<Diagnostic> own;
+      type->validate(&params, &context, &own);
+      for (auto& d : own) d.message = what() + ": " + d.message;
+      found.insert(found.end(), own.begin(), own.end());
+    }
+    for (const auto& d : found)
       if (d.severity == Diagnostic::Severity::Error) errors += (errors.empty() ? "" : "\n") + d.str();
   };
   for (auto& e : extensions_)

@@ -53,7 +53,7 @@ void Ghosts::start(World& world, PhysicEngine& engine) {
     g.body = data.body_begin;
     g.root_in_body = world.nodes[a.root().nodeIndex()].pose_in_body;
     engine.setKinematic(g.body);
-    const auto e = g.stream.at(0.0);
+    const auto e = g.stream.dueAt(0.0);
     g.lost = !e || e->lost;
     data.silent = g.lost;
     if (!g.lost) {
@@ -65,7 +65,7 @@ void Ghosts::start(World& world, PhysicEngine& engine) {
 
 void Ghosts::beforePhysics(World& world, PhysicEngine& engine, double t_next, double dt) {
   for (Ghost& g : ghosts_) {
-    const auto e = g.stream.at(t_next);
+    const auto e = g.stream.dueAt(t_next);
     const BodyState& now = world.states[static_cast<std::size_t>(g.body)];
     if (!e || e->lost) {
       BodyState held;  // where it is, still
@@ -90,7 +90,7 @@ void Ghosts::beforePhysics(World& world, PhysicEngine& engine, double t_next, do
 
 void Ghosts::afterPhysics(World& world, PhysicEngine& engine, double t_next, const Environment& env) {
   for (Ghost& g : ghosts_) {
-    const auto e = g.stream.at(t_next);
+    const auto e = g.stream.dueAt(t_next);
     const bool lost = !e || e->lost;
     if (lost != g.lost) setLost(g, lost, world, env, t_next);
     if (lost) continue;
@@ -187,7 +187,7 @@ Environment::GhostStatus Environment::ghostStatus(const Artifact& artifact) cons
   if (g == nullptr) throw Error("ghostStatus: '" + artifact.name() + "' is not a ghost");
   GhostStatus s;
   s.samples = g->stream.size();
-  const auto e = g->stream.at(toSeconds(time()));
+  const auto e = g->stream.dueAt(toSeconds(time()));
   s.lost = world_->started() ? g->lost : (!e || e->lost);
   s.age = e ? e->age : 0;
   return s;

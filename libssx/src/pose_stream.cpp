@@ -19,6 +19,8 @@ void PoseStream::add(double stamp, const Pose& pose) {
   if (!std::isfinite(stamp)) throw std::invalid_argument("pose stream: the stamp is not finite");
   if (!pose.position.allFinite() || !pose.orientation.coeffs().allFinite())
     throw std::invalid_argument("pose stream: the pose is not finite");
+  if (pose.position.cwiseAbs().maxCoeff() > kMaxCoordinate)
+    throw std::invalid_argument("pose stream: a position beyond 1e6 m from the origin (a corrupted sample)");
   const double norm = pose.orientation.norm();
   if (std::abs(norm - 1) > 1e-3)
     throw std::invalid_argument("pose stream: the orientation is not a unit quaternion (norm " + std::to_string(norm) + ")");
@@ -38,11 +40,50 @@ std::optional<double> PoseStream::newest() const {
   return samples_.back().stamp;
 }
 
+std::optional<PoseStream::Estimate> PoseStream::dueAt(double t) const {
+  // the newest sample stamped at or before t (almost always the newest: a search from the back)
+  std::size_t n = samples_.size();
+  while (n > 0 && samples_[n - 1].stamp > t) --n;
+  if (n == 0) return std::nullopt;
+  // the next sample close behind (a replay fed ahead of time): interpolated towards; one further
+  // off than the timeout waits until it is due
+  if (n < samples_.size() && samples_[n].stamp - samples_[n - 1].stamp <= settings_.timeout)
+    return between(samples_[n - 1], samples_[n], t);
+  return fromNewest(n, t);
+}
+
 std::optional<PoseStream::Estimate> PoseStream::at(double t) const {
   if (samples_.empty()) return std::nullopt;
+  if (t >= samples_.back().stamp) return fromNewest(samples_.size(), t);
+  // the first sample after t, and the one before it
+  const auto after = std::upper_bound(samples_.begin(), samples_.end(), t,
+                                      [](double time, const Sample& s) { return time < s.stamp; });
+  if (after == samples_.begin()) {  // before the oldest kept
+    Estimate e;
+    e.pose = after->pose;
+    e.age = 0;
+    return e;
+  }
+  return between(*std::prev(after), *after, t);
+}
+
+PoseStream::Estimate PoseStream::between(const Sample& a, const Sample& b, double t) {
   Estimate e;
-  const Sample& last = samples_.back();
-  if (t >= last.stamp) {
+  const double span = b.stamp - a.stamp;
+  const double u = (t - a.stamp) / span;
+  e.pose.position = a.pose.position + u * (b.pose.position - a.pose.position);
+  e.pose.orientation = a.pose.orientation.slerp(u, b.pose.orientation).normalized();
+  e.linear_velocity = (b.pose.position - a.pose.position) / span;
+  e.angular_velocity = rotationBetween(a.pose.orientation, b.pose.orientation) / span;
+  e.age = t - a.stamp;
+  return e;
+}
+
+// at t, at or past sample n - 1 (the newest of the first n)
+PoseStream::Estimate PoseStream::fromNewest(std::size_t n, double t) const {
+  Estimate e;
+  const Sample& last = samples_[n - 1];
+  {
     // past the newest: its velocity from the last two, for at most the horizon, then held
     e.age = t - last.stamp;
     e.extrapolated = t > last.stamp;
@@ -50,8 +91,8 @@ std::optional<PoseStream::Estimate> PoseStream::at(double t) const {
     e.pose = last.pose;
     // (the last two samples' velocity, unless a gap longer than the timeout lies between them: a
     // body found again is not extrapolated from where it was before it was lost)
-    if (samples_.size() >= 2 && last.stamp - samples_[samples_.size() - 2].stamp <= settings_.timeout) {
-      const Sample& before = samples_[samples_.size() - 2];
+    if (n >= 2 && last.stamp - samples_[n - 2].stamp <= settings_.timeout) {
+      const Sample& before = samples_[n - 2];
       const double dt = last.stamp - before.stamp;
       e.linear_velocity = (last.pose.position - before.pose.position) / dt;
       e.angular_velocity = rotationBetween(before.pose.orientation, last.pose.orientation) / dt;
@@ -64,25 +105,7 @@ std::optional<PoseStream::Estimate> PoseStream::at(double t) const {
       }
       if (e.age > settings_.horizon) e.linear_velocity = e.angular_velocity = Vec3::Zero();  // held
     }
-    return e;
   }
-  // the first sample after t, and the one before it
-  const auto after = std::upper_bound(samples_.begin(), samples_.end(), t,
-                                      [](double time, const Sample& s) { return time < s.stamp; });
-  if (after == samples_.begin()) {  // before the oldest kept
-    e.pose = after->pose;
-    e.age = 0;
-    return e;
-  }
-  const Sample& a = *std::prev(after);
-  const Sample& b = *after;
-  const double span = b.stamp - a.stamp;
-  const double u = (t - a.stamp) / span;
-  e.pose.position = a.pose.position + u * (b.pose.position - a.pose.position);
-  e.pose.orientation = a.pose.orientation.slerp(u, b.pose.orientation).normalized();
-  e.linear_velocity = (b.pose.position - a.pose.position) / span;
-  e.angular_velocity = rotationBetween(a.pose.orientation, b.pose.orientation) / span;
-  e.age = t - a.stamp;
   return e;
 }
 

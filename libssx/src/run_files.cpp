@@ -1,7 +1,10 @@
 #include <ssx/error.hpp>
 #include <ssx/run_files.hpp>
 
+#include <fcntl.h>
+#include <sys/file.h>
 #include <sys/stat.h>
+#include <unistd.h>
 
 #include <cerrno>
 #include <cstdio>
@@ -41,6 +44,33 @@ std::string readInputFile(const fs::path& file, std::uintmax_t max_bytes) {
   }
   if (std::ferror(f.get()) != 0) throw ConfigError(where, std::string("cannot read it: ") + std::strerror(errno));
   return text;
+}
+
+std::FILE* openOutputFile(const fs::path& file, bool append) {
+  const int fd = ::open(file.c_str(), O_WRONLY | O_CREAT | O_CLOEXEC | (append ? O_APPEND : 0), 0644);
+  if (fd < 0) throw Error("cannot create '" + file.string() + "': " + std::strerror(errno));
+  struct stat st {};
+  const bool regular = ::fstat(fd, &st) == 0 && S_ISREG(st.st_mode);
+  if (regular && ::flock(fd, LOCK_EX | LOCK_NB) != 0) {
+    const int error = errno;
+    ::close(fd);
+    if (error == EWOULDBLOCK)
+      throw Error("'" + file.string() + "' is being written by another run now (it holds the file's lock): wait for "
+                  "it to end, or give this run another file");
+    throw Error("cannot lock '" + file.string() + "': " + std::strerror(error));
+  }
+  if (regular && !append && ::ftruncate(fd, 0) != 0) {
+    const int error = errno;
+    ::close(fd);
+    throw Error("cannot empty '" + file.string() + "' to write it: " + std::strerror(error));
+  }
+  std::FILE* f = ::fdopen(fd, append ? "ab" : "wb");
+  if (f == nullptr) {
+    const int error = errno;
+    ::close(fd);
+    throw Error("cannot write '" + file.string() + "': " + std::strerror(error));
+  }
+  return f;
 }
 
 bool RunFiles::Identity::operator==(const Identity& o) const {
@@ -110,12 +140,20 @@ std::string RunFiles::claimOutputDirectory(const fs::path& dir, const std::strin
   std::error_code ec;
   const fs::file_status link = fs::symlink_status(dir, ec);
   if (fs::exists(link) && !fs::is_directory(fs::status(dir, ec))) return named + " is not a directory";
-  const Identity id = identify(dir);
+  // ("frames/" is "frames")
+  const Identity id = identify(dir.has_filename() || !dir.has_parent_path() ? dir : dir.parent_path());
   const std::string prefix = id.path + "/";
   for (std::size_t i = 0; i < input_ids_.size(); ++i)
     if (input_ids_[i].path.rfind(prefix, 0) == 0)
       return named + " holds '" + inputs_[i].string() + "', which this run reads: write frames into a directory "
                      "of their own";
+  // two writers of numbered frames in one directory would write over each other's files
+  for (std::size_t i = 0; i < directory_ids_.size(); ++i)
+    if (directory_ids_[i] == id)
+      return named + " is '" + directories_[i].string() + "', which this run writes frames into already: give each "
+                     "camera a directory of its own";
+  directories_.push_back(dir);
+  directory_ids_.push_back(id);
   return {};
 }
 

@@ -1,4 +1,5 @@
 #include <ssx/error.hpp>
+#include <ssx/run_files.hpp>
 #include <ssx/timing.hpp>
 
 #include <algorithm>
@@ -6,6 +7,7 @@
 #include <cstdio>
 #include <fstream>
 #include <ostream>
+#include <sstream>
 
 namespace ssx {
 
@@ -123,11 +125,17 @@ void TimingRecorder::writeCsv(std::ostream& out) const {
 }
 
 void TimingRecorder::writeCsv(const std::string& path) const {
-  std::ofstream out(path);
-  if (!out) throw Error("cannot write timing CSV '" + path + "': check the directory exists and is writable");
+  std::FILE* f = nullptr;
+  try {
+    f = openOutputFile(path);  // (locked while written: a second run writing it is refused)
+  } catch (const Error& e) {
+    throw Error(std::string("cannot write timing CSV: ") + e.what());
+  }
+  std::ostringstream out;
   writeCsv(out);
-  out.close();
-  if (!out) throw Error("error while writing timing CSV '" + path + "' (disk full?)");
+  const std::string text = out.str();
+  const bool written = std::fwrite(text.data(), 1, text.size(), f) == text.size();
+  if (std::fclose(f) != 0 || !written) throw Error("error while writing timing CSV '" + path + "' (disk full?)");
 }
 
 }  // namespace ssx

@@ -16,26 +16,32 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <map>
 #include <memory>
+#include <stdexcept>
 #include <sstream>
 #include <string>
 #include <vector>
 
 namespace ssx::bridge {
 
+/// Rates up to 1e9 Hz (every step of any timestep; the parameters' own check refuses a rate in
+/// (0, 1e-6) Hz).
+inline constexpr double kMaxRateHz = 1e9;
+
 /// The parameters both bridges take, with the same meaning (the part "bridge" of their tables).
 inline constexpr ssx_plugin_param kBridgeParameters[] = {
     param::text("artifacts", "*", "artifact names separated by spaces, or * for every artifact with a dynamic root"),
-    param::real("odom_rate_hz", "50", "Hz", param::nonNegative(), "odometry rate in simulated time; 0: every step"),
-    param::real("imu_rate_hz", "100", "Hz", param::nonNegative(), "IMU rate in simulated time; 0: no IMU topics"),
-    param::real("clock_rate_hz", "100", "Hz", param::nonNegative(), "/clock rate in simulated time; 0: every step"),
+    param::real("odom_rate_hz", "50", "Hz", param::nonNegative() & param::atMost(kMaxRateHz), "odometry rate in simulated time; 0: every step"),
+    param::real("imu_rate_hz", "100", "Hz", param::nonNegative() & param::atMost(kMaxRateHz), "IMU rate in simulated time; 0: no IMU topics"),
+    param::real("clock_rate_hz", "100", "Hz", param::nonNegative() & param::atMost(kMaxRateHz), "/clock rate in simulated time; 0: every step"),
     param::flag("lockstep", "false", "wait after each odometry message until every robot answered with a set-point"),
     param::real("lockstep_timeout_s", "2", "s", param::positive() & param::atMost(86400), "longest wait for the set-points of one step"),
     param::real("lockstep_connect_timeout_s", "10", "s", param::positive() & param::atMost(86400),
                 "how long the first step waits for every robot's controller to connect, and for their first answers"),
-    param::real("range_rate_hz", "10", "Hz", param::nonNegative(),
+    param::real("range_rate_hz", "10", "Hz", param::nonNegative() & param::atMost(kMaxRateHz),
                 "rate of /<robot>/range (what a range sensor sees, as a PoseArray) in simulated time; 0: none"),
-    param::real("image_rate_hz", "10", "Hz", param::nonNegative(),
+    param::real("image_rate_hz", "10", "Hz", param::nonNegative() & param::atMost(kMaxRateHz),
                 "rate of /<robot>/image (what a camera sensor sees, rgb8) in simulated time; 0: none"),
     param::text("operators", "", "operator extensions bridged: names separated by spaces (/<name>/cmd_vel and "
                 "/<name>/joy in, /<name>/force out)"),
@@ -49,6 +55,10 @@ class BridgeExtension : public SimulationExtension {
   // what is bridged exists before the transport is started
   static void validate(const Descriptor& params, const PluginContext& context) {
     (void)context.environment->selectArtifacts(params, "artifacts", "bridge");
+    (void)operatorsOf(params, *context.environment);
+    if (params.get<bool>("lockstep") && params.get<std::string>("pose_stamps") == "wall")
+      throw params.error("pose_stamps=\"wall\" cannot be lock-stepped (the wall clock is not the same twice): use "
+                         "pose_stamps=\"sim\" with lockstep=\"true\"");
   }
 
   void init(Environment& env, const Descriptor& params) override {
@@ -64,10 +74,7 @@ class BridgeExtension : public SimulationExtension {
     if (params.get<double>("range_rate_hz") == 0) range_rate_.period = 0;
     image_rate_ = rateOf(params, "image_rate_hz", env.timestep());
     if (params.get<double>("image_rate_hz") == 0) image_rate_.period = 0;
-    wall_stamps_ = params.get<std::string>("pose_stamps") == "wall";
-    if (lockstep_ && wall_stamps_)
-      throw params.error("pose_stamps=\"wall\" cannot be lock-stepped (the wall clock is not the same twice): use "
-                         "pose_stamps=\"sim\" with lockstep=\"true\"");
+    wall_stamps_ = params.get<std::string>("pose_stamps") == "wall";  // (not with lockstep: validate)
     std::vector<RobotTopics> topics;
     for (Artifact* a : env.selectArtifacts(params, "artifacts", "bridge")) {
       Robot r;
@@ -88,14 +95,10 @@ class BridgeExtension : public SimulationExtension {
       robots_.push_back(r);
     }
     // operators after the robots, their topics under their own names
-    std::istringstream names(params.get<std::string>("operators", ""));
-    for (std::string n; names >> n;) {
-      auto* op = dynamic_cast<OperatorInterface*>(env.extension(n));
-      if (op == nullptr)
-        throw params.error("operators: '" + n + "' is not an operator extension (<extension name=\"" + n +
-                           "\" plugin=\"operator\" .../> before this one)");
+    for (const auto& [n, op] : operatorsOf(params, env)) {
       Operator o;
       o.op = op;  // (its force rate is read at the first step: it may be initialised after this one)
+      operator_names_.push_back(n);
       operators_.push_back(o);
       RobotTopics t{n, false, false, true};
       t.odom = false;
@@ -157,8 +160,20 @@ class BridgeExtension : public SimulationExtension {
       const bool new_joy = j.count != o.joys && (!lockstep_ || j.stamp <= cutoff_ + 1e-9);
       o.velocities = v.count;
       if (new_joy) o.joys = j.count;
-      auto velocity = [&] { o.op->command(Vec3(v.linear[0], v.linear[1], v.linear[2]), v.angular[2]); };
-      auto joy = [&] { o.op->joy(j.axes, j.buttons); };
+      // (a command the operator refuses, not finite or absurd, is dropped and counted: one bad
+      // message never stops the run)
+      const std::string& who = operator_names_[k];
+      auto velocity = [&] {
+        guarded(env, who, "cmd_vel", [&] { o.op->command(Vec3(v.linear[0], v.linear[1], v.linear[2]), v.angular[2]); });
+      };
+      auto joy = [&] {
+        for (const float a : j.axes)
+          if (!std::isfinite(a) || std::abs(a) > 1e6f) {
+            drop(env, who, "joy", "an axis that is not finite or absurd");
+            return;
+          }
+        guarded(env, who, "joy", [&] { o.op->joy(j.axes, j.buttons); });
+      };
       if (new_velocity && new_joy && j.order < v.order) joy();
       if (new_velocity) velocity();
       if (new_joy && !(new_velocity && j.order < v.order)) joy();
@@ -179,9 +194,12 @@ class BridgeExtension : public SimulationExtension {
       const bool new_setpoint = s.count != r.setpoints, new_velocity = v.count != r.velocities;
       r.setpoints = s.count;
       r.velocities = v.count;
-      if (new_velocity && new_setpoint && v.order < s.order) applyVelocity(r, v);
-      if (new_setpoint) applySetpoint(r, s);
-      if (new_velocity && !(new_setpoint && v.order < s.order)) applyVelocity(r, v);
+      const std::string& who = r.artifact->name();
+      auto setpoint = [&] { guarded(env, who, "setpoint", [&] { applySetpoint(r, s); }); };
+      auto velocity = [&] { guarded(env, who, "cmd_vel", [&] { applyVelocity(r, v); }); };
+      if (new_velocity && new_setpoint && v.order < s.order) velocity();
+      if (new_setpoint) setpoint();
+      if (new_velocity && !(new_setpoint && v.order < s.order)) velocity();
     }
   }
 
@@ -241,7 +259,8 @@ class BridgeExtension : public SimulationExtension {
     for (std::size_t k = 0; k < operators_.size(); ++k) {
       Operator& o = operators_[k];
       if (o.force_rate.period == 0) {
-        o.force_rate.period = o.op->forceRateHz() > 0 ? toNanoseconds(1.0 / o.op->forceRateHz()) : env.timestep();
+        o.force_rate.period =
+            o.op->forceRateHz() > 0 ? std::max(env.timestep(), toNanoseconds(1.0 / o.op->forceRateHz())) : env.timestep();
         o.force_rate.next = now;
       }
       if (o.force_rate.due(now)) transport_->publishForce(robots_.size() + k, t, array3(o.op->force()));
@@ -334,10 +353,26 @@ class BridgeExtension : public SimulationExtension {
     held_.resize(kept);  // (only lock-stepped, so never wall-clock stamps: converted once)
   }
 
+  // the operator extensions named, each before this one in the scene
+  static std::vector<std::pair<std::string, OperatorInterface*>> operatorsOf(const Descriptor& params,
+                                                                             const Environment& env) {
+    std::vector<std::pair<std::string, OperatorInterface*>> out;
+    std::istringstream names(params.get<std::string>("operators", ""));
+    for (std::string n; names >> n;) {
+      auto* op = dynamic_cast<OperatorInterface*>(env.extension(n));
+      if (op == nullptr)
+        throw params.errorAt("operators", "operators: '" + n + "' is not an operator extension (<extension name=\"" + n +
+                                              "\" plugin=\"operator\" .../> before this one)");
+      out.emplace_back(n, op);
+    }
+    return out;
+  }
+
   static Rate rateOf(const Descriptor& params, const char* key, Nanoseconds every_step) {
     const double hz = params.get<double>(key);
     Rate r;
-    r.period = hz > 0 ? toNanoseconds(1.0 / hz) : every_step;
+    // (a rate above the step rate publishes every step)
+    r.period = hz > 0 ? std::max(every_step, toNanoseconds(1.0 / hz)) : every_step;
     return r;
   }
   static std::array<double, 3> array3(const Vec3& v) { return {v.x(), v.y(), v.z()}; }
@@ -347,9 +382,12 @@ class BridgeExtension : public SimulationExtension {
     ssx::Setpoint sp;
     sp.position = Vec3(s.position[0], s.position[1], s.position[2]);
     const Quat q(s.orientation[0], s.orientation[1], s.orientation[2], s.orientation[3]);
+    if (!q.coeffs().allFinite() || q.norm() < 1e-6) throw Error("its orientation is not a rotation (a zero or non-finite quaternion)");
     sp.yaw = std::atan2(2 * (q.w() * q.z() + q.x() * q.y()), 1 - 2 * (q.y() * q.y() + q.z() * q.z()));
-    if (!sp.position.allFinite() || !std::isfinite(sp.yaw))
-      throw Error("set-point for '" + r.artifact->name() + "' is not finite");
+    Command c;
+    c.level = CommandLevel::Position;
+    c.setpoint = sp;
+    if (const std::string why = c.problem(); !why.empty()) throw Error(why);
     r.tracker->setSetpoint(sp);
   }
   // a Twist in the robot's frame (x forward): turned by its heading into the world's
@@ -359,12 +397,36 @@ class BridgeExtension : public SimulationExtension {
     const Vec3 world(std::cos(yaw) * v.linear[0] - std::sin(yaw) * v.linear[1],
                      std::sin(yaw) * v.linear[0] + std::cos(yaw) * v.linear[1], v.linear[2]);
     const Command c = Command::velocityYawRate(world, v.angular[2]);
-    if (const std::string why = r.commands->refusal(c); !why.empty())
-      throw Error("velocity command for '" + r.artifact->name() + "': " + why);
+    // (checked before it is turned: an absurd speed overflows in the turn)
+    const Command raw = Command::velocityYawRate(Vec3(v.linear[0], v.linear[1], v.linear[2]), v.angular[2]);
+    if (const std::string why = raw.problem(); !why.empty()) throw Error(why);
+    if (const std::string why = r.commands->refusal(c); !why.empty()) throw Error(why);
     r.commands->setCommand(c);
   }
 
+  // a message that cannot be used is dropped and counted, with a warning naming its topic the
+  // first time (and a count per topic at the end): one bad message never stops the run
+  void drop(Environment& env, const std::string& who, const char* topic, const std::string& why) {
+    const std::string name = "/" + who + "/" + topic;
+    if (dropped_[name]++ == 0)
+      env.log(LogLevel::Warning, std::string(this->name()) + ": a message on " + name + " was dropped (" + why +
+                                     "); later ones are counted at the end");
+  }
+  template <class F>
+  void guarded(Environment& env, const std::string& who, const char* topic, F&& apply) {
+    try {
+      apply();
+    } catch (const Error& e) {
+      drop(env, who, topic, e.what());
+    } catch (const std::invalid_argument& e) {
+      drop(env, who, topic, e.what());
+    }
+  }
+
   void logSummary(Environment& env) const {
+    for (const auto& [topic, count] : dropped_)
+      env.log(LogLevel::Warning, std::string(name()) + ": " + std::to_string(count) + " message(s) on " + topic +
+                                     " dropped (not finite, absurd, or not for this robot)");
     if (poses_applied_ > 0 || transport_->posesDropped() + held_dropped_ > 0) {
       std::uint64_t bad = 0;
       for (const Robot& r : robots_) bad += r.bad_poses;
@@ -402,6 +464,8 @@ class BridgeExtension : public SimulationExtension {
   std::unique_ptr<Transport> transport_;
   std::vector<Robot> robots_;
   std::vector<Operator> operators_;  // their topics follow the robots'
+  std::vector<std::string> operator_names_;
+  std::map<std::string, std::uint64_t> dropped_;  // messages dropped, by topic
   Rate odom_rate_, imu_rate_, clock_rate_, range_rate_, image_rate_;
   bool wall_stamps_ = false;
   double cutoff_ = -1;                 // lock-step: poses stamped later wait

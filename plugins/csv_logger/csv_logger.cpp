@@ -8,7 +8,9 @@
 // child's as "artifact/node" (the pose of the node the body begins at).
 #include <ssx/environment.hpp>
 #include <ssx/plugin_abi.hpp>
+#include <ssx/run_files.hpp>
 
+#include <algorithm>
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
@@ -27,7 +29,7 @@ class CsvLogger final : public SimulationExtension {
       param::text("artifacts", "*", "artifact names separated by spaces, or * for every artifact with a dynamic root"),
       param::choice("bodies", "root", "root all",
                     "root: one row per artifact (its first root); all: one per body, joined children as artifact/node"),
-      param::real("rate_hz", "0", "Hz", param::nonNegative(),
+      param::real("rate_hz", "0", "Hz", param::nonNegative() & param::atMost(1e9),
                   "rows per artifact per simulated second; 0 writes one every step"),
       param::real("flush_s", "1", "s", param::positive() & param::atMost(1e9),
                   "simulated time between flushes to the file (and at the end of the run)"),
@@ -45,13 +47,16 @@ class CsvLogger final : public SimulationExtension {
     path_ = params.get<std::string>("file");
     names_ = params.get<std::string>("artifacts");
     const double rate = params.get<double>("rate_hz");
-    period_ = rate > 0 ? toNanoseconds(1.0 / rate) : env.timestep();
+    period_ = rate > 0 ? std::max(env.timestep(), toNanoseconds(1.0 / rate)) : env.timestep();
     next_ = period_;  // rows at period, 2 period, ... of simulated time
     flush_period_ = toNanoseconds(params.get<double>("flush_s"));
     next_flush_ = flush_period_;
     resolve(env, params);
-    file_ = std::fopen(path_.c_str(), "w");
-    if (file_ == nullptr) throw params.error("cannot open '" + path_ + "' for writing: " + std::strerror(errno));
+    try {
+      file_ = openOutputFile(path_);  // (locked while written: a second run writing it is refused)
+    } catch (const Error& e) {
+      throw params.error(e.what());
+    }
     check(std::fputs("time_s,artifact,x,y,z,qw,qx,qy,qz,vx,vy,vz,wx,wy,wz\n", file_) >= 0);
   }
 

@@ -57,7 +57,8 @@ class Operator final : public SimulationExtension, public OperatorInterface {
       param::real("force_range", "1.5", "m", param::positive(), "obstacles and robots nearer push back"),
       param::real("force_gain", "2", "N", param::nonNegative(), "the push of one at zero distance"),
       param::real("force_max", "5", "N", param::positive(), "the force's largest magnitude"),
-      param::real("force_rate_hz", "100", "Hz", param::nonNegative(), "how often the bridges send it; 0: every step"),
+      param::real("force_rate_hz", "100", "Hz", param::nonNegative() & param::atMost(1e9),
+                  "how often the bridges send it; 0: every step"),
   };
 
   static void validate(const Descriptor& params, const PluginContext& context) {
@@ -114,6 +115,7 @@ class Operator final : public SimulationExtension, public OperatorInterface {
   }
 
   void command(const Vec3& velocity, double yaw_rate) override {
+    if (env_ == nullptr) throw Error("operator: the run has not started: commands are taken from the first step on");
     if (!velocity.allFinite() || !std::isfinite(yaw_rate)) throw Error("operator: a command that is not finite");
     Vec3 v = velocity;
     if (v.norm() > max_speed_) v *= max_speed_ / v.norm();
@@ -131,6 +133,7 @@ class Operator final : public SimulationExtension, public OperatorInterface {
   }
 
   void joy(std::span<const float> axes, std::span<const int> buttons) override {
+    if (env_ == nullptr) throw Error("operator: the run has not started: commands are taken from the first step on");
     if (deadman_button_ >= 0 &&
         (static_cast<std::size_t>(deadman_button_) >= buttons.size() || buttons[static_cast<std::size_t>(deadman_button_)] == 0)) {
       if (moving_) stop();
@@ -142,6 +145,7 @@ class Operator final : public SimulationExtension, public OperatorInterface {
 
   Vec3 force() const override {
     Vec3 f = Vec3::Zero();
+    if (env_ == nullptr) return f;
     auto push = [&](const Vec3& p, const Vec3& q) {
       const Vec3 away = p - q;
       const double d = away.norm();

@@ -40,8 +40,11 @@
 #include <ssx/plugin_abi.hpp>
 #include <ssx/recording.hpp>
 
+#include <arpa/inet.h>
+
 #include <algorithm>
 #include <chrono>
+#include <filesystem>
 #include <condition_variable>
 #include <cmath>
 #include <cstring>
@@ -128,6 +131,24 @@ class Viewer final : public SimulationExtension {
                   "play this recording (MCAP) on the page instead of the run, as ssx replay FILE --view does; "
                   "default: none"),
   };
+
+  // before anything is opened or bound: the address is one address (civetweb would take "+" or a
+  // list of ports in it and listen wider than asked), the recording a regular file
+  static void validate(const Descriptor& params, const PluginContext&) {
+    const std::string bind = params.get<std::string>("bind");
+    in_addr address{};
+    if (bind != "localhost" && inet_pton(AF_INET, bind.c_str(), &address) != 1)
+      throw params.error("bind must be one IPv4 address (127.0.0.1, 0.0.0.0 for every interface, or an interface's "
+                         "address) or localhost, got '" + bind + "'");
+    if (const std::string file = params.has("recording") ? params.get<std::string>("recording") : ""; !file.empty()) {
+      std::error_code ec;
+      const auto status = std::filesystem::status(file, ec);
+      if (!std::filesystem::exists(status)) throw params.error("recording '" + file + "' does not exist");
+      if (!std::filesystem::is_regular_file(status))
+        throw params.error("recording '" + file + "' is not a regular file (a directory, a FIFO, a device or a "
+                           "socket): give a recording (.mcap) file");
+    }
+  }
 
   void init(Environment& env, const Descriptor& params) override {
     control_ = &env.runControl();

@@ -28,7 +28,10 @@ std::string startViewer(ssx::Environment& env, int port, const std::string& bind
   try {
     env.start();
   } catch (...) {
+    // refused (a bad rate, a port in use): the environment as it was, so that another view() and
+    // step() work
     env.setLogSink(toLogging);
+    if (env.state() == ssx::Environment::State::Setup) env.removeExtension("viewer");
     throw;
   }
   env.setLogSink(toLogging);

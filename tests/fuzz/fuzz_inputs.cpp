@@ -244,16 +244,29 @@ void recordingInput(std::span<const std::uint8_t> data) {
   std::vector<std::byte> bytes(data.size());
   if (!data.empty()) std::memcpy(bytes.data(), data.data(), data.size());
   try {
-    const detail::McapFile f = detail::parseMcap(std::move(bytes), "fuzz.mcap");
+    const detail::McapFile f = detail::parseMcap(bytes, "fuzz.mcap");
     const int poses = f.channelId("/ssx/poses");
     std::vector<float> p, q;
     for (const auto& m : f.messages) {
       if (m.channel != poses) continue;
       try {
-        detail::decodePoses(m.data, &p, &q);
+        detail::decodePoses(f.data(m), &p, &q);
       } catch (const Error&) {
       }
     }
+  } catch (const Error&) {
+  }
+  // the recording as every reader takes it (times in order, pose lengths checked): once read,
+  // reading any of its samples, messages or states never fails
+  try {
+    const Recording r(std::move(bytes), "fuzz.mcap");
+    for (std::size_t k = 0; k < r.times().size(); ++k) {
+      (void)r.positions(k);
+      (void)r.orientations(k);
+      if (k > 0 && r.times()[k] <= r.times()[k - 1]) std::abort();
+    }
+    for (const auto& [topic, count] : r.channels()) (void)r.messages(topic);
+    for (const Nanoseconds t : r.stateTimes()) (void)r.stateAtOrBefore(t);
   } catch (const Error&) {
   }
 }

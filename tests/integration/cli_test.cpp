@@ -504,7 +504,7 @@ TEST_CASE("ssx run --record, inspect and replay: a run kept, looked at, drawn ag
       w.addMetadata(name, values);
     }
     for (const auto& a : f.attachments) w.addAttachment(a.name, a.media_type, a.log_time, a.data);
-    for (const auto& m : f.messages) w.addMessage(channels.at(m.channel), m.log_time, m.data);
+    for (const auto& m : f.messages) w.addMessage(channels.at(m.channel), m.log_time, f.data(m));
     w.close();
     const Result old_version = run({"replay", other.string(), "--snapshot", (dir / "old.png").string()});
     CHECK(old_version.status == 0);
@@ -541,4 +541,97 @@ TEST_CASE("ssx run --record, inspect and replay: a run kept, looked at, drawn ag
   CHECK(foreign.status == 2);
   CHECK_THAT(foreign.err, Catch::Contains(scene + ": byte 0: not an MCAP file"));
   fs::remove_all(dir);
+}
+
+TEST_CASE("ssx validate and ssx run agree on the whole invalid corpus: the same first error, exit 2, nothing run",
+          "[cli]") {
+  const auto firstError = [](const std::string& err) {
+    const auto at = err.find(": error: ");
+    if (at == std::string::npos) return std::string("(no error)");
+    const auto begin = err.rfind('\n', at);
+    return err.substr(begin == std::string::npos ? 0 : begin + 1, err.find('\n', at) - (begin == std::string::npos ? 0 : begin + 1));
+  };
+  int files = 0;
+  for (const auto& entry : fs::directory_iterator(kData / "invalid")) {
+    if (entry.path().extension() != ".xml") continue;
+    ++files;
+    INFO(entry.path().filename().string());
+    const Result validate = run({"validate", entry.path().string(), "--plugin-path", SSX_TEST_PLUGIN_DIR});
+    const Result ran =
+        run({"run", entry.path().string(), "--steps", "1", "--fast", "--quiet", "--plugin-path", SSX_TEST_PLUGIN_DIR});
+    CHECK(validate.status == 2);
+    CHECK(ran.status == 2);
+    CHECK(firstError(validate.err) == firstError(ran.err));
+    CHECK(firstError(validate.err) != "(no error)");
+  }
+  CHECK(files >= 80);
+  CHECK_FALSE(fs::exists("marker_ran.txt"));
+  CHECK_FALSE(fs::exists("ssx-out"));  // (where a run would have written)
+}
+
+TEST_CASE("ssx: empty output names, options without the one they need, and empty windows are errors", "[cli]") {
+  const std::string scene = (kExamples / "scenes" / "quad_hover.xml").string();
+  for (const auto& option : {"--record", "--save-state", "--stats-csv", "--snapshot", "--video", "--frames", "--out"}) {
+    INFO(option);
+    const Result r = run({"run", scene, "--steps", "1", "--fast", "--quiet", option, ""});
+    CHECK(r.status == 2);
+    CHECK_THAT(r.err, Contains("an empty name: give a file or directory name"));
+  }
+  const Result rate = run({"run", scene, "--steps", "1", "--fast", "--quiet", "--record-rate", "10"});
+  CHECK(rate.status == 2);
+  CHECK_THAT(rate.err, Contains("--record-rate requires --record"));
+  CHECK(run({"run", scene, "--steps", "1", "--fast", "--quiet", "--record-states", "1"}).status == 2);
+  CHECK(run({"run", scene, "--steps", "1", "--fast", "--quiet", "--record-channels", "timing"}).status == 2);
+  const fs::path dir = fs::current_path() / "cli_windows";
+  fs::create_directories(dir);
+  const std::string rec = (dir / "r.mcap").string();
+  const Result tiny = run({"run", scene, "--duration", "1", "--fast", "--quiet", "--record", rec, "--record-rate", "1e-17"});
+  CHECK(tiny.status == 2);
+  CHECK_THAT(tiny.err, Contains("is below 1e-6 Hz"));
+  REQUIRE(run({"run", scene, "--duration", "1", "--fast", "--quiet", "--record", rec}).status == 0);
+  const Result backwards = run({"replay", rec, "--from", "3", "--to", "1", "--snapshot", (dir / "w.png").string()});
+  CHECK(backwards.status == 2);
+  CHECK_THAT(backwards.err, Contains("an empty window (--to comes before --from)"));
+  const Result beyond = run({"replay", rec, "--from", "5", "--snapshot", (dir / "w.png").string()});
+  CHECK(beyond.status == 2);
+  CHECK_THAT(beyond.err, Contains("nothing to draw from 5.000 s: the recording's samples run from 0.040 s to 1.000 s"));
+  CHECK_FALSE(fs::exists(dir / "w.png"));
+  for (const auto& bind : {"127.0.0.1+", "127.0.0.1:80,0.0.0.0", "256.0.0.1", "1.2.3", "", "example.org"}) {
+    INFO(bind);
+    const Result r = run({"run", scene, "--steps", "1", "--fast", "--quiet", "--view", "0", "--view-bind", bind});
+    CHECK(r.status == 2);
+    CHECK_THAT(r.err, Contains("must be one IPv4 address"));
+  }
+}
+
+TEST_CASE("ssx replay and inspect: a hard link to the recording is the recording, a FIFO is refused, not waited on",
+          "[cli]") {
+  const std::string scene = (kExamples / "scenes" / "quad_hover.xml").string();
+  const fs::path dir = fs::current_path() / "cli_links";
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  const fs::path rec = dir / "r.mcap";
+  REQUIRE(run({"run", scene, "--duration", "0.5", "--fast", "--quiet", "--record", rec.string()}).status == 0);
+  const auto before = fs::file_size(rec);
+  fs::create_hard_link(rec, dir / "hard.mcap");
+  for (const auto& option : {"--snapshot", "--video"}) {
+    const Result r = run({"replay", rec.string(), option, (dir / "hard.mcap").string()});
+    CHECK(r.status == 2);
+    CHECK_THAT(r.err, Contains("would write over the recording being replayed"));
+  }
+  const Result resim = run({"replay", rec.string(), "--resimulate-from", "0", "--record", (dir / "hard.mcap").string()});
+  CHECK(resim.status == 2);
+  CHECK(fs::file_size(rec) == before);
+  const Result into = run({"replay", rec.string(), "--frames", dir.string()});
+  CHECK(into.status == 2);
+  CHECK_THAT(into.err, Contains("which this run reads"));
+  const fs::path fifo = dir / "f.mcap";
+  REQUIRE(mkfifo(fifo.c_str(), 0600) == 0);
+  for (const auto& command : {std::vector<std::string>{"inspect", fifo.string()},
+                              std::vector<std::string>{"replay", fifo.string(), "--snapshot", (dir / "x.png").string()},
+                              std::vector<std::string>{"replay", fifo.string(), "--view", "0"}}) {
+    const Result r = run(command);
+    CHECK(r.status == 2);
+    CHECK_THAT(r.err, Contains("not a regular file"));
+  }
 }

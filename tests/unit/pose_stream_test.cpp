@@ -130,3 +130,43 @@ TEST_CASE("pose stream: the ages of the poses used, summarised to 0.1 ms in boun
   CHECK(one.summary().median == Approx(0.00234).margin(1e-4));
   CHECK(one.summary().median >= 0.00234);
 }
+
+TEST_CASE("pose stream: a sample stamped ahead is held until it is due, the age truthful, lost after the timeout",
+          "[pose_stream]") {
+  PoseStream s({0.05, 0.5, 64});
+  s.add(0.0, onCircle(0.0));
+  s.add(0.01, onCircle(0.01));
+  s.add(100.0, onCircle(100.0));  // a hundred seconds ahead (a clock that is wrong, a hostile peer)
+  // not moved towards it, and the age counts from the newest sample due
+  const auto e = s.dueAt(0.2);
+  REQUIRE(e);
+  CHECK((e->pose.position - onCircle(0.01).position).norm() < 0.06);  // extrapolated 50 ms at most, then held
+  CHECK(e->age == Approx(0.19));
+  CHECK_FALSE(e->lost);
+  const auto later = s.dueAt(1.0);
+  REQUIRE(later);
+  CHECK(later->lost);  // nothing due for more than the timeout
+  CHECK(later->age == Approx(0.99));
+  // when it is due, it is the pose
+  const auto due = s.dueAt(100.0);
+  REQUIRE(due);
+  CHECK((due->pose.position - onCircle(100.0).position).norm() < 1e-12);
+  CHECK_FALSE(due->lost);
+  // only samples ahead: nothing yet
+  PoseStream ahead;
+  ahead.add(5.0, onCircle(5.0));
+  CHECK_FALSE(ahead.dueAt(1.0).has_value());
+  // a replay fed ahead of time, samples 10 ms apart: interpolated as at() does
+  CHECK(s.dueAt(0.005)->pose.position == s.at(0.005)->pose.position);
+}
+
+TEST_CASE("pose stream: a position farther than 1e6 m is refused (a corrupted sample), nothing changed",
+          "[pose_stream]") {
+  PoseStream s;
+  Pose p = onCircle(0.0);
+  p.position.x() = 1e300;
+  CHECK_THROWS_AS(s.add(0.0, p), std::invalid_argument);
+  p.position.x() = 1e7;
+  CHECK_THROWS_AS(s.add(0.0, p), std::invalid_argument);
+  CHECK(s.size() == 0);
+}

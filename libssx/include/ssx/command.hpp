@@ -91,10 +91,15 @@ struct SSX_EXPORT Command {
   /// Its values as one row in the column order above (position: all 11), as fromRow reads them.
   std::vector<double> toRow() const;
 
-  /// What is wrong with it whatever the vehicle (a value not finite, a negative thrust or rotor
-  /// speed, a roll or pitch beyond 80 degrees), or an empty string.
+  /// What is wrong with it whatever the vehicle (a value not finite or beyond kMaxCommandValue, a
+  /// negative thrust or rotor speed, a roll or pitch beyond 80 degrees), or an empty string.
   std::string problem() const;
 };
+
+/// The largest magnitude any value of a command may have (m, m/s, m/s^2, rad/s, N): a position
+/// 1,000 km away, a speed of 1,000 km/s. Beyond it a value is a corrupted or hostile message, not
+/// a command (and squared, as controllers do, it would overflow to infinity).
+inline constexpr double kMaxCommandValue = 1e6;
 
 /// Implemented by drivers that take commands at one or more levels. Call only between steps, or
 /// from an extension's hooks, never from another artifact's driver or sensor (the parallel phases).

@@ -193,6 +193,10 @@ class SSX_EXPORT Environment {
                                     Descriptor params = {});
   /// Same, for an extension owned elsewhere (by classLoader()).
   SimulationExtension& addExtension(std::string name, SimulationExtension& extension, Descriptor params);
+  /// Takes the extension added under `name` out again, before the environment starts (a start that
+  /// failed leaves it in setup): the environment is as it was before it was added. False when there
+  /// is none by that name.
+  bool removeExtension(std::string_view name);
   /// The loader for plugin libraries; it owns what it creates, and the environment destroys
   /// those instances right after its plugins' destroy() and before anything else.
   ClassLoader& classLoader() noexcept { return *loader_; }

@@ -51,6 +51,15 @@ class SSX_EXPORT PoseStream {
   /// last two samples' velocities for at most `horizon`, then held (held at once when the last two
   /// are more than `timeout` apart); `lost` once t is more than `timeout` past the newest.
   std::optional<Estimate> at(double t) const;
+  /// The same from the samples due by `t` (stamped at or before it): the next sample is
+  /// interpolated towards only when it follows the newest due one within `timeout` (a replay fed
+  /// ahead of time); one further ahead is held until t reaches it, so a pose stamped in the future
+  /// does not move the body early, and the body is lost once the due samples are older than the
+  /// timeout. `age` is t minus the newest due sample's stamp; nothing while no sample is due. What
+  /// a ghost uses as the simulation steps.
+  std::optional<Estimate> dueAt(double t) const;
+  /// Positions farther than this from the origin on any axis are refused (m).
+  static constexpr double kMaxCoordinate = 1e6;
   /// The samples kept.
   std::size_t size() const noexcept { return samples_.size(); }
   /// The newest stamp (no value before the first sample).
@@ -68,6 +77,8 @@ class SSX_EXPORT PoseStream {
     double stamp;
     Pose pose;
   };
+  Estimate fromNewest(std::size_t n, double t) const;
+  static Estimate between(const Sample& a, const Sample& b, double t);
   Settings settings_;
   std::deque<Sample> samples_;  // by stamp, oldest first
 };

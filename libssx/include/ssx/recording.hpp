@@ -41,6 +41,9 @@
 namespace ssx {
 
 class Environment;
+namespace detail {
+struct McapFile;
+}
 class PhysicNode;
 
 /// One body as recordings and the viewer list it.
@@ -120,9 +123,13 @@ class SSX_EXPORT Recorder {
 class SSX_EXPORT Recording {
  public:
   /// Reads `file`. Throws Error naming the file and the byte offset when it is not an ssx
-  /// recording or is corrupted; a file cut short (a killed run) is read up to its last complete
-  /// chunk (complete() is then false).
+  /// recording or is corrupted, when its pose samples' times go back or repeat, or when it is not
+  /// a regular file (a FIFO or a device is refused before it is opened); a file cut short (a
+  /// killed run) is read up to its last complete chunk (complete() is then false). Reading is
+  /// bounded: a chunk is decompressed again when its samples are asked for, one at a time.
   explicit Recording(const std::filesystem::path& file);
+  /// The same from bytes in memory; `label` names them in messages.
+  Recording(std::vector<std::byte> bytes, const std::filesystem::path& label);
   ~Recording();
   /// Moves the recording read (its memory) into a new one.
   Recording(Recording&&) noexcept;
@@ -164,6 +171,7 @@ class SSX_EXPORT Recording {
   std::uint64_t size() const noexcept;
 
  private:
+  explicit Recording(detail::McapFile file);
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };

@@ -89,6 +89,7 @@ struct CameraSpec {
   Vec3 look_at = Vec3::Zero();  ///< the point at the centre of the picture, same frame
   std::string follow;  ///< artifact name; empty: fixed
   SourceLocation follow_from;  ///< where `follow` was given (a camera of a scene file)
+  SourceLocation where;        ///< where the camera was given (its element in a scene file)
   bool frame_scene = false;  ///< set position and look_at at start so that every artifact is in view
   double fov_deg = 60.0;  ///< horizontal field of view, degrees
   std::filesystem::path frames_dir;  ///< PNG per frame (frame_000000.png, ...); empty: none

@@ -11,6 +11,7 @@
 #include <ssx/export.hpp>
 
 #include <cstdint>
+#include <cstdio>
 #include <filesystem>
 #include <string>
 #include <vector>
@@ -26,6 +27,14 @@ inline constexpr std::uintmax_t kDefaultMaxInputBytes = std::uintmax_t{64} << 20
 /// /dev/zero, or a directory is refused: they have no end or no content) of at most `max_bytes`.
 /// Throws ConfigError at the file (line 0) saying what is wrong and what to do.
 SSX_EXPORT std::string readInputFile(const std::filesystem::path& file, std::uintmax_t max_bytes = kDefaultMaxInputBytes);
+
+/// Opens `file` to write a run's output into (binary), creating it when new, under an advisory
+/// lock (flock) held until it is closed: a second run writing the same file at the same time is
+/// refused with an Error saying so, before anything in the file changes, rather than both writing
+/// it and one run's output being lost. Then the file is emptied (unless `append`). A FIFO or a
+/// device (an output allowed to be one) is opened as it is, without a lock. The caller closes it
+/// (std::fclose releases the lock).
+SSX_EXPORT std::FILE* openOutputFile(const std::filesystem::path& file, bool append = false);
 
 /// The files one run reads and writes, checked against each other before anything is opened:
 /// no output is an input or another output (however spelled: symlinks and `..` resolved), and
@@ -44,8 +53,8 @@ class SSX_EXPORT RunFiles {
   /// (`makes_directory`: its writer creates the directory it goes in, so that need not exist yet.)
   std::string claimOutput(const std::filesystem::path& path, const std::string& what, bool replaced = false,
                           bool makes_directory = false);
-  /// Claims a directory the run writes files into (PNG frames): it may exist or be new, and must
-  /// hold no input of the run. Returns what is wrong ("" when nothing is).
+  /// Claims a directory the run writes files into (PNG frames): it may exist or be new, must hold
+  /// no input of the run, and must not be claimed twice. Returns what is wrong ("" when nothing is).
   std::string claimOutputDirectory(const std::filesystem::path& dir, const std::string& what);
   /// The inputs added, as given.
   const std::vector<std::filesystem::path>& inputs() const { return inputs_; }
@@ -60,8 +69,8 @@ class SSX_EXPORT RunFiles {
     bool operator==(const Identity& o) const;
   };
   static Identity identify(const std::filesystem::path& file);
-  std::vector<std::filesystem::path> inputs_, outputs_;
-  std::vector<Identity> input_ids_, output_ids_;
+  std::vector<std::filesystem::path> inputs_, outputs_, directories_;
+  std::vector<Identity> input_ids_, output_ids_, directory_ids_;
   bool allow_special_ = false;
 };
 

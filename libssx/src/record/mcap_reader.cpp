@@ -44,7 +44,9 @@ class In {
     return std::string(reinterpret_cast<const char*>(s.data()), s.size());
   }
   std::map<std::string, std::string> map() {
-    In inner(take(num<std::uint32_t>()), offset(), f_);
+    const auto length = num<std::uint32_t>();
+    const std::uint64_t at = offset();
+    In inner(take(length), at, f_);
     std::map<std::string, std::string> m;
     while (inner.left() > 0) {
       std::string k = inner.str();
@@ -64,50 +66,78 @@ Nanoseconds toTime(std::uint64_t t) {
   return static_cast<Nanoseconds>(std::min<std::uint64_t>(t, static_cast<std::uint64_t>(INT64_MAX)));
 }
 
-// one record's body, by opcode (messages, schemas, channels: in a chunk or the data section)
-void readRecord(McapFile& f, std::uint8_t op, In& in, bool in_chunk);
+// what the file may still decompress to, and how many messages it may still index
+struct Budget {
+  std::uint64_t bytes = 0;
+  std::uint64_t messages = 0;
+};
 
-void readChunk(McapFile& f, In& in) {
+// one record's body, by opcode (messages, schemas, channels: in a chunk or the data section)
+void readRecord(McapFile& f, std::uint8_t op, In& in, std::uint32_t chunk, std::uint64_t data_base, Budget& budget);
+
+// decompresses chunk `k` into `out` (its CRC checked); throws Error at its offset
+void decompress(const McapFile& f, const McapFile::Chunk& c, std::vector<std::byte>& out) {
+  const auto fail = [&](const std::string& what) {
+    throw Error(f.file.string() + ": byte " + std::to_string(c.at) + ": " + what);
+  };
+  if (!c.zstd) {
+    out.assign(c.records.begin(), c.records.end());
+  } else {
+    // the frame says what it holds: it must be the chunk's size (before anything is allocated)
+    const unsigned long long content = ZSTD_getFrameContentSize(c.records.data(), c.records.size());
+    if (content == ZSTD_CONTENTSIZE_ERROR || (content != ZSTD_CONTENTSIZE_UNKNOWN && content != c.size))
+      fail("a chunk does not decompress (corrupted)");
+    out.resize(static_cast<std::size_t>(c.size));
+    const std::size_t got = ZSTD_decompress(out.data(), out.size(), c.records.data(), c.records.size());
+    if (ZSTD_isError(got) || got != c.size) fail("a chunk does not decompress (corrupted)");
+  }
+  if (c.crc != 0 && crc32(out) != c.crc) fail("a chunk's CRC does not match (corrupted)");
+}
+
+void readChunk(McapFile& f, In& in, Budget& budget, std::vector<std::byte>& scratch) {
   in.num<std::uint64_t>();  // message start time
   in.num<std::uint64_t>();  // message end time
-  const auto size = in.num<std::uint64_t>();
-  const auto crc = in.num<std::uint32_t>();
+  McapFile::Chunk c;
+  c.size = in.num<std::uint64_t>();
+  c.crc = in.num<std::uint32_t>();
   const std::string compression = in.str();
-  const std::uint64_t at = in.offset();
-  const auto records = in.take(in.num<std::uint64_t>());
+  c.at = in.offset();
+  c.records = in.take(in.num<std::uint64_t>());
   // writers make chunks of a few MiB (ssx: 1 MiB); a size far beyond is a corrupted one, not memory to give
-  constexpr std::uint64_t kMaxChunk = std::uint64_t{256} << 20;
-  if (size > kMaxChunk)
-    in.fail("a chunk of " + std::to_string(size) + " bytes uncompressed (ssx reads chunks of at most 256 MiB)");
-  std::vector<std::byte> data;
+  if (c.size > kMaxChunkBytes)
+    in.fail("a chunk of " + std::to_string(c.size) + " bytes uncompressed (ssx reads chunks of at most " +
+            std::to_string(kMaxChunkBytes >> 20) + " MiB)");
   if (compression.empty()) {
-    if (records.size() != size) in.fail("an uncompressed chunk whose size disagrees with its length (corrupted)");
-    data.assign(records.begin(), records.end());
+    if (c.records.size() != c.size) in.fail("an uncompressed chunk whose size disagrees with its length (corrupted)");
   } else if (compression == "zstd") {
-    // the frame says what it holds: it must be the chunk's size (before anything is allocated)
-    const unsigned long long content = ZSTD_getFrameContentSize(records.data(), records.size());
-    if (content == ZSTD_CONTENTSIZE_ERROR || (content != ZSTD_CONTENTSIZE_UNKNOWN && content != size))
-      throw Error(f.file.string() + ": byte " + std::to_string(at) + ": a chunk does not decompress (corrupted)");
-    data.resize(static_cast<std::size_t>(size));
-    const std::size_t got = ZSTD_decompress(data.data(), data.size(), records.data(), records.size());
-    if (ZSTD_isError(got) || got != size)
-      throw Error(f.file.string() + ": byte " + std::to_string(at) + ": a chunk does not decompress (corrupted)");
+    c.zstd = true;
   } else {
     in.fail("a chunk compressed with '" + compression + "' (ssx reads zstd and uncompressed chunks)");
   }
-  if (crc != 0 && crc32(data) != crc)
-    throw Error(f.file.string() + ": byte " + std::to_string(at) + ": a chunk's CRC does not match (corrupted)");
+  if (c.zstd && c.size > budget.bytes)
+    throw Error(f.file.string() + ": byte " + std::to_string(c.at) + ": the file decompresses to more than " +
+                std::to_string(std::max(kMinDecompressedBytes, kMaxExpansion * f.size) >> 20) +
+                " MiB (a reader takes the larger of " + std::to_string(kMinDecompressedBytes >> 20) + " MiB and " +
+                std::to_string(kMaxExpansion) + " times a file's size; ssx's own recordings stay far below): a "
+                "corrupted or hostile file");
+  budget.bytes -= c.zstd ? c.size : 0;
+  decompress(f, c, scratch);
+  if (f.chunk_list.size() >= McapFile::kNoChunk) in.fail("too many chunks");
+  const auto index = static_cast<std::uint32_t>(f.chunk_list.size());
+  f.chunk_list.push_back(c);
   ++f.chunks;
-  const std::vector<std::byte>& kept = f.decompressed.emplace_back(std::move(data));
-  In c(kept, at, f);
-  while (c.left() > 0) {
-    const auto op = c.num<std::uint8_t>();
-    In body(c.take(c.num<std::uint64_t>()), c.offset(), f);
-    readRecord(f, op, body, true);
+  In r(scratch, c.at, f);
+  while (r.left() > 0) {
+    const auto op = r.num<std::uint8_t>();
+    const auto length = r.num<std::uint64_t>();
+    const std::uint64_t body_file = r.offset();
+    In body(r.take(length), body_file, f);
+    readRecord(f, op, body, index, body_file - c.at, budget);
   }
 }
 
-void readRecord(McapFile& f, std::uint8_t op, In& in, bool in_chunk) {
+void readRecord(McapFile& f, std::uint8_t op, In& in, std::uint32_t chunk, std::uint64_t data_base, Budget& budget) {
+  const bool in_chunk = chunk != McapFile::kNoChunk;
   switch (op) {
     case kSchema: {
       const auto id = in.num<std::uint16_t>();
@@ -132,20 +162,29 @@ void readRecord(McapFile& f, std::uint8_t op, In& in, bool in_chunk) {
     }
     case kMessage: {
       McapFile::Message m;
+      m.where = in.offset();
       m.channel = in.num<std::uint16_t>();
       in.num<std::uint32_t>();  // sequence
       m.log_time = toTime(in.num<std::uint64_t>());
       in.num<std::uint64_t>();  // publish time
-      m.data = in.take(in.left());
+      if (in.left() > UINT32_MAX) in.fail("a message of more than 4 GiB");
+      m.size = static_cast<std::uint32_t>(in.left());
+      // (in a chunk, `in` counts from the chunk's file offset: its place in the chunk's data is data_base + 22)
+      m.at = in_chunk ? data_base + 22 : in.offset();
+      m.chunk = chunk;
+      in.take(in.left());
       if (!f.channels.contains(m.channel)) in.fail("a message on channel " + std::to_string(m.channel) + ", which comes nowhere before it");
+      if (budget.messages == 0)
+        in.fail("more messages than this reader indexes for a file of this size (a corrupted or hostile file)");
+      --budget.messages;
       f.messages.push_back(m);
       break;
     }
     case kChunk:
       if (in_chunk) in.fail("a chunk inside a chunk");
-      readChunk(f, in);
-      break;
+      break;  // (read by the caller)
     case kAttachment: {
+      if (in_chunk) break;  // (chunks hold schemas, channels and messages only)
       McapFile::Attachment a;
       a.log_time = toTime(in.num<std::uint64_t>());
       in.num<std::uint64_t>();  // create time
@@ -157,6 +196,7 @@ void readRecord(McapFile& f, std::uint8_t op, In& in, bool in_chunk) {
       break;
     }
     case kMetadata: {
+      if (in_chunk) break;
       std::string name = in.str();
       f.metadata[std::move(name)] = in.map();
       break;
@@ -174,6 +214,16 @@ int McapFile::channelId(const std::string& topic) const {
   return -1;
 }
 
+std::span<const std::byte> McapFile::data(const Message& m) const {
+  if (m.chunk == kNoChunk) return std::span<const std::byte>(raw).subspan(m.at, m.size);
+  if (cached_chunk != m.chunk) {
+    cached_chunk = kNoChunk;
+    decompress(*this, chunk_list.at(m.chunk), cache);
+    cached_chunk = m.chunk;
+  }
+  return std::span<const std::byte>(cache).subspan(m.at, m.size);
+}
+
 McapFile parseMcap(std::vector<std::byte> bytes, const std::filesystem::path& label) {
   McapFile f;
   f.file = label;
@@ -183,15 +233,20 @@ McapFile parseMcap(std::vector<std::byte> bytes, const std::filesystem::path& la
   if (all.size() < sizeof kMagic || std::memcmp(all.data(), kMagic, sizeof kMagic) != 0)
     throw Error(label.string() + ": byte 0: not an MCAP file (it does not begin with the MCAP magic)");
   In file(all.subspan(sizeof kMagic), sizeof kMagic, f);
+  Budget budget;
+  budget.bytes = std::max(kMinDecompressedBytes, kMaxExpansion * f.size);
+  // an index entry per message: at most max(64 MiB, 16 x the file's size) of them
+  budget.messages = std::max(std::uint64_t{64} << 20, 16 * f.size) / sizeof(McapFile::Message);
+  std::vector<std::byte> scratch;
   bool first = true;
   f.data_end = sizeof kMagic;
   while (file.left() > 0) {
     if (file.left() < 9) break;  // a record cut off in its opcode and length: the file ends early
-    const std::uint64_t start = file.offset();
     const auto op = file.num<std::uint8_t>();
     const auto length = file.num<std::uint64_t>();
     if (length > file.left()) break;  // cut off: read up to here
-    In body(file.take(length), file.offset() - length, f);
+    const std::uint64_t body_at = file.offset();
+    In body(file.take(length), body_at, f);
     if (first && op != kHeader) body.fail("the first record is not a header (corrupted)");
     if (op == kHeader) {
       if (!first) body.fail("a second header (corrupted)");
@@ -204,10 +259,11 @@ McapFile parseMcap(std::vector<std::byte> bytes, const std::filesystem::path& la
       f.complete = !tail.empty() && static_cast<std::uint8_t>(tail[0]) == kFooter &&
                    std::memcmp(all.data() + all.size() - 8, kMagic, 8) == 0;
       return f;
+    } else if (op == kChunk) {
+      readChunk(f, body, budget, scratch);
     } else {
-      readRecord(f, op, body, false);
+      readRecord(f, op, body, McapFile::kNoChunk, 0, budget);
     }
-    (void)start;
     first = false;
     f.data_end = file.offset();
   }
@@ -216,8 +272,16 @@ McapFile parseMcap(std::vector<std::byte> bytes, const std::filesystem::path& la
 }
 
 McapFile readMcap(const std::filesystem::path& file, std::uint64_t max_bytes) {
+  // never opened unless a regular file: a FIFO would block the open, a device never end
+  std::error_code ec;
+  const auto status = std::filesystem::status(file, ec);
+  if (!std::filesystem::exists(status)) throw Error("cannot open the recording " + file.string() + " (does it exist?)");
+  if (std::filesystem::is_directory(status)) throw Error(file.string() + ": a directory, not a recording: give an .mcap file");
+  if (!std::filesystem::is_regular_file(status))
+    throw Error(file.string() + ": not a regular file (a FIFO, a device or a socket has no end or no fixed content): "
+                "give a recording (.mcap) file");
   std::ifstream in(file, std::ios::binary | std::ios::ate);
-  if (!in) throw Error("cannot open the recording " + file.string() + " (does it exist?)");
+  if (!in) throw Error("cannot open the recording " + file.string() + " (is it readable?)");
   const auto size = static_cast<std::uint64_t>(in.tellg());
   if (size > max_bytes)
     throw Error(file.string() + ": " + std::to_string(size) + " bytes, more than the " + std::to_string(max_bytes) +

@@ -2,6 +2,7 @@
 #include "record/mcap_format.hpp"
 
 #include <ssx/error.hpp>
+#include <ssx/run_files.hpp>
 
 #include <zlib.h>
 #include <zstd.h>
@@ -31,9 +32,11 @@ std::uint32_t crc32(std::span<const std::byte> data, std::uint32_t crc) {
 McapWriter::McapWriter(const std::filesystem::path& file, const std::string& profile, const std::string& library,
                        std::size_t chunk_bytes, int zstd_level)
     : file_(file), chunk_bytes_(chunk_bytes), zstd_level_(zstd_level) {
-  out_ = std::fopen(file.c_str(), "wb");
-  if (out_ == nullptr)
-    throw Error("cannot create the recording " + file.string() + ": " + std::strerror(errno));
+  try {
+    out_ = openOutputFile(file);  // (locked while written: a second run recording into it is refused)
+  } catch (const Error& e) {
+    throw Error(std::string("the recording: ") + e.what());
+  }
   write(kMagic);
   std::vector<std::byte> header;
   Out{header}.str(profile).str(library);

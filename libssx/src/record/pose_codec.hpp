@@ -27,6 +27,9 @@ void encodePoses(std::span<const PhysicNode* const> nodes, std::vector<std::byte
 /// Error when the message's size does not fit its count.
 void decodePoses(std::span<const std::byte> message, std::vector<float>* positions, std::vector<float>* orientations);
 
+/// The bytes a message of `bodies` bodies takes.
+constexpr std::size_t poseBytes(std::size_t bodies) { return 4 + bodies * (3 * 4 + 4 * 2); }
+
 /// The body count a message holds (0 when it is too short to say).
 std::size_t poseCount(std::span<const std::byte> message);
 

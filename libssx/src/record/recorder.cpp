@@ -135,6 +135,7 @@ struct Recorder::Impl {
   std::vector<Extra> extras;                                     // since the last sample
   std::vector<float> tf_positions, tf_orientations;              // the writer thread's
   Nanoseconds first_time = -1, last_time = 0;
+  bool went_back = false;  // said once: the time went back (a state restored while recording)
   // shared with the writer thread
   mutable std::mutex mutex;
   std::condition_variable changed;
@@ -313,6 +314,13 @@ void Recorder::Impl::observe() {
     }
   }
   detail::encodePoses(nodes, job.bytes);
+  if (first_time >= 0 && now <= last_time && !went_back) {
+    went_back = true;
+    env->log(LogLevel::Warning, "recorder: the time went back from " + std::to_string(toSeconds(last_time)) + " s to " +
+                                    std::to_string(toSeconds(now)) + " s (a state restored to an earlier time) while "
+                                    "recording " + options.file.string() + ": ssx replay and ssx.Recording refuse a "
+                                    "recording whose times go back; record each episode into a file of its own");
+  }
   if (first_time < 0) first_time = now;
   last_time = now;
   push(std::move(job));
@@ -380,6 +388,10 @@ Recorder::Recorder(Environment& env, RecordOptions options) : impl_(std::make_un
   if (m.options.file.empty()) throw ConfigError({}, "record: no file given");
   if (!(m.options.rate_hz >= 0 && std::isfinite(m.options.rate_hz)))
     throw ConfigError({}, "record: rate_hz must be 0 (every step) or positive");
+  // (a rate so low that its period overflowed would record every step instead)
+  if (m.options.rate_hz > 0 && m.options.rate_hz < 1e-6)
+    throw ConfigError({}, "record: rate_hz " + std::to_string(m.options.rate_hz) +
+                              " is below 1e-6 Hz (one sample in 11.6 days): give 0 (every step) or at least 1e-6");
   if (!(m.options.state_every_s >= 0 && std::isfinite(m.options.state_every_s)))
     throw ConfigError({}, "record: state_every_s must be 0 (the first only) or positive");
   if (m.options.queue_samples < 1) throw ConfigError({}, "record: queue_samples must be at least 1");

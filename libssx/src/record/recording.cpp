@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <charconv>
+#include <mutex>
 
 namespace ssx {
 
@@ -15,7 +16,8 @@ struct Recording::Impl {
   detail::McapFile file;
   std::vector<std::string> names;
   std::vector<Nanoseconds> times;
-  std::vector<std::span<const std::byte>> samples;
+  std::vector<std::size_t> samples;  // indexes into file.messages
+  std::mutex mutex;                  // file.data() keeps one chunk: one reader at a time
   std::string scene_xml, scene_label, version;
   std::uint64_t seed = 0;
   std::vector<std::pair<Nanoseconds, std::span<const std::byte>>> states;
@@ -29,10 +31,16 @@ namespace {
 
 }  // namespace
 
-Recording::Recording(const std::filesystem::path& path) : impl_(std::make_unique<Impl>()) {
+Recording::Recording(const std::filesystem::path& path) : Recording(detail::readMcap(path)) {}
+
+Recording::Recording(std::vector<std::byte> bytes, const std::filesystem::path& label)
+    : Recording(detail::parseMcap(std::move(bytes), label)) {}
+
+Recording::Recording(detail::McapFile file) : impl_(std::make_unique<Impl>()) {
   Impl& m = *impl_;
-  m.file = detail::readMcap(path);
+  m.file = std::move(file);
   const detail::McapFile& f = m.file;
+  const std::filesystem::path& path = f.file;
   if (f.profile != "ssx") notRecording(path, "its profile is '" + f.profile + "', not 'ssx'");
   const auto meta = f.metadata.find("ssx");
   if (meta == f.metadata.end()) notRecording(path, "it has no 'ssx' metadata");
@@ -65,14 +73,27 @@ Recording::Recording(const std::filesystem::path& path) : impl_(std::make_unique
   std::sort(m.states.begin(), m.states.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
   const int channel = f.channelId("/ssx/poses");
   if (channel < 0) notRecording(path, "it has no /ssx/poses channel");
-  for (const auto& msg : f.messages) {
+  // every pose sample checked once here, so that reading one later cannot fail: its length, and
+  // its time after the one before (the order every reader of a recording relies on)
+  const auto at = [&](const detail::McapFile::Message& msg) {
+    return path.string() + ": byte " + std::to_string(msg.where) + ": ";
+  };
+  for (std::size_t i = 0; i < f.messages.size(); ++i) {
+    const detail::McapFile::Message& msg = f.messages[i];
     if (msg.channel != channel) continue;
-    if (detail::poseCount(msg.data) != m.names.size())
-      throw Error(path.string() + ": a pose sample at " + std::to_string(msg.log_time) + " ns holds " +
-                  std::to_string(detail::poseCount(msg.data)) + " bodies, the recording names " +
-                  std::to_string(m.names.size()) + " (corrupted)");
+    const std::span<const std::byte> data = f.data(msg);
+    if (detail::poseCount(data) != m.names.size() || data.size() != detail::poseBytes(m.names.size()))
+      throw Error(at(msg) + "a pose sample at " + std::to_string(toSeconds(msg.log_time)) + " s of " +
+                  std::to_string(data.size()) + " bytes, holding " + std::to_string(detail::poseCount(data)) +
+                  " bodies; the recording names " + std::to_string(m.names.size()) + ", which take " +
+                  std::to_string(detail::poseBytes(m.names.size())) + " bytes (corrupted)");
+    if (!m.times.empty() && msg.log_time <= m.times.back())
+      throw Error(at(msg) + "a pose sample at " + std::to_string(toSeconds(msg.log_time)) +
+                  " s follows one at " + std::to_string(toSeconds(m.times.back())) +
+                  " s: its times go back or repeat (a state restored to an earlier time while recording), "
+                  "which ssx cannot play; record each episode into a file of its own");
     m.times.push_back(msg.log_time);
-    m.samples.push_back(msg.data);
+    m.samples.push_back(i);
   }
 }
 
@@ -91,13 +112,15 @@ std::uint64_t Recording::size() const noexcept { return impl_->file.size; }
 
 std::vector<float> Recording::positions(std::size_t k) const {
   std::vector<float> out;
-  detail::decodePoses(impl_->samples.at(k), &out, nullptr);
+  const std::lock_guard lock(impl_->mutex);
+  detail::decodePoses(impl_->file.data(impl_->file.messages[impl_->samples.at(k)]), &out, nullptr);
   return out;
 }
 
 std::vector<float> Recording::orientations(std::size_t k) const {
   std::vector<float> out;
-  detail::decodePoses(impl_->samples.at(k), nullptr, &out);
+  const std::lock_guard lock(impl_->mutex);
+  detail::decodePoses(impl_->file.data(impl_->file.messages[impl_->samples.at(k)]), nullptr, &out);
   return out;
 }
 
@@ -131,7 +154,7 @@ void completeRecording(const std::filesystem::path& damaged, const std::filesyst
     channel_ids[id] = w.addChannel(c.schema == 0 ? 0 : schema_ids.at(c.schema), c.topic, c.encoding, c.metadata);
   for (const auto& [name, values] : f.metadata) w.addMetadata(name, values);
   for (const auto& a : f.attachments) w.addAttachment(a.name, a.media_type, a.log_time, a.data);
-  for (const auto& m : f.messages) w.addMessage(channel_ids.at(m.channel), m.log_time, m.data);
+  for (const auto& m : f.messages) w.addMessage(channel_ids.at(m.channel), m.log_time, f.data(m));
   w.close();
 }
 
@@ -156,9 +179,12 @@ std::vector<std::pair<Nanoseconds, std::string>> Recording::messages(const std::
     throw Error(f.file.string() + ": no channel '" + topic + "' (there are: " + there + ")");
   }
   std::vector<std::pair<Nanoseconds, std::string>> out;
+  const std::lock_guard lock(impl_->mutex);
   for (const auto& msg : f.messages)
-    if (msg.channel == channel)
-      out.emplace_back(msg.log_time, std::string(reinterpret_cast<const char*>(msg.data.data()), msg.data.size()));
+    if (msg.channel == channel) {
+      const std::span<const std::byte> data = f.data(msg);
+      out.emplace_back(msg.log_time, std::string(reinterpret_cast<const char*>(data.data()), data.size()));
+    }
   return out;
 }
 

@@ -1,6 +1,7 @@
 #include "render/frame_output.hpp"
 
 #include <ssx/error.hpp>
+#include <ssx/run_files.hpp>
 
 #include <fcntl.h>
 #include <png.h>
@@ -24,8 +25,7 @@ void writePng(const std::filesystem::path& file, const Image& image) {
   if (image.width <= 0 || image.height <= 0 ||
       image.rgb.size() != static_cast<std::size_t>(image.width) * image.height * 3)
     throw Error("cannot write " + file.string() + ": the image is empty or its size does not match its pixels");
-  std::FILE* f = std::fopen(file.c_str(), "wb");
-  if (f == nullptr) throw Error("cannot write " + file.string() + ": " + std::strerror(errno));
+  std::FILE* f = openOutputFile(file);  // (locked: a second run writing the same picture is refused)
   png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, nullptr, nullptr, nullptr);
   png_infop info = png != nullptr ? png_create_info_struct(png) : nullptr;
   if (info == nullptr || setjmp(png_jmpbuf(png))) {

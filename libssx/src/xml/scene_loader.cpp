@@ -322,6 +322,7 @@ void SceneLoader::readRender(const Descriptor& d) {
     cam.look_at = read<Vec3>(*c, "look_at", cam.look_at);
     cam.follow = read<std::string>(*c, "follow", "");
     if (!cam.follow.empty()) cam.follow_from = c->find("follow")->where;
+    cam.where = c->where();
     cam.fov_deg = read<double>(*c, "fov_deg", cam.fov_deg);
     if (!validFieldOfView(cam.fov_deg)) {
       error(c->find("fov_deg")->where, "<camera>: fov_deg must be in (0, 180)");
@@ -504,7 +505,7 @@ Scene SceneLoader::build(const SceneModel& model, bool report_missing_types) {
   stage_ = stage(3);
   // what the cameras write, with the plugins' outputs
   for (const CameraSpec& cam : model.settings.render.cameras) {
-    const SourceLocation where{model.file.string(), 0};
+    const SourceLocation where = cam.where.file.empty() ? SourceLocation{model.file.string(), 0} : cam.where;
     const std::string who = "camera '" + cam.name + "': ";
     if (!cam.snapshot.empty())
       if (auto problem = files_.claimOutput(cam.snapshot, who + "snapshot", false, true); !problem.empty()) error(where, problem);

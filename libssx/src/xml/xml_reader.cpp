@@ -54,8 +54,14 @@ Descriptor convert(const pugi::xml_node& node, std::string_view text, const Line
     throw ConfigError({file, lines.line(offset)}, "<" + std::string(node.name()) + ">: elements are nested more than " +
                                                       std::to_string(kMaxDepth) + " levels deep");
   Descriptor d(node.name(), {file, lines.line(offset)});
-  for (const auto& a : node.attributes())
+  for (const auto& a : node.attributes()) {
+    // (XML forbids it and pugixml keeps both: which one a reader took would be an accident)
+    if (d.has(a.name()))
+      throw ConfigError({file, lines.line(attributeOffset(text, offset, a.name()))},
+                        "<" + std::string(node.name()) + ">: attribute '" + a.name() +
+                            "' is given twice: keep one");
     d.set(a.name(), a.value(), {file, lines.line(attributeOffset(text, offset, a.name()))});
+  }
   for (const auto& child : node.children())
     if (child.type() == pugi::node_element) d.addChild(convert(child, text, lines, file, depth + 1));
   return d;

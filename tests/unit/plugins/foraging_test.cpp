@@ -23,7 +23,8 @@ Scene scene(const std::string& extension = R"(nest="0 0 0.3" area="2 -1 3 1")") 
     <artifact name="r" type="epuck" xyz="-0.1 0 0"/>
     <artifact name="item_in" type="item" xyz="0.1 0 0"/>
     <artifact name="item_out" type="item" xyz="1 0 0"/>
-    <extension name="foraging" plugin="foraging" items="item_" )" + extension + R"(/></scene>)";
+    <extension name="foraging" plugin="foraging" )" +
+                          (extension.find("items=") == std::string::npos ? "items=\"item_\" " : "") + extension + R"(/></scene>)";
   return loadSceneFromString(xml, "foraging.xml", kArtifacts, testOptions());
 }
 

@@ -7,6 +7,10 @@
 
 #include <catch2/catch.hpp>
 
+#include <sys/stat.h>
+
+#include <cstring>
+
 #include <filesystem>
 #include <fstream>
 #include <string>
@@ -92,4 +96,72 @@ TEST_CASE("mcap reader: foreign and corrupted files are errors at a byte offset"
   }
   CHECK(readMcap(fs::current_path() / "reader_bad.mcap").messages.size() == 40);
   CHECK_THROWS_WITH(readMcap(fs::current_path() / "no_such.mcap"), Catch::Contains("cannot open the recording"));
+}
+
+TEST_CASE("mcap reader: messages are read back from their chunks one chunk at a time, each byte as written",
+          "[record][mcap]") {
+  const std::vector<std::byte> whole = sample(fs::current_path() / "reader_lazy.mcap");
+  const McapFile f = parseMcap(whole, "lazy.mcap");
+  REQUIRE(f.messages.size() == 40);
+  CHECK(f.chunk_list.size() >= 4);  // chunks of about 300 bytes
+  // in order, back to front and in a stride: every message's bytes are its own
+  auto text = [&](std::size_t i) {
+    const auto d = f.data(f.messages[i]);
+    return std::string(reinterpret_cast<const char*>(d.data()), d.size());
+  };
+  for (std::size_t i = 0; i < 40; ++i) CHECK(text(i) == "message number " + std::to_string(i));
+  for (std::size_t i = 40; i-- > 0;) CHECK(text(i) == "message number " + std::to_string(i));
+  for (std::size_t i = 0; i < 40; i += 7) CHECK(text(i) == "message number " + std::to_string(i));
+}
+
+TEST_CASE("mcap reader: a small file cannot make it decompress or keep gigabytes", "[record][mcap]") {
+  // chunks of 48 MiB of zeros each compress to a few KiB: twelve of them (576 MiB) in a file of
+  // about 30 KiB are more than it may decompress to (the larger of 256 MiB and 1,024 times its size)
+  const fs::path file = fs::current_path() / "reader_bomb.mcap";
+  {
+    McapWriter w(file, "test", "t", std::size_t{1} << 20);
+    const auto c = w.addChannel(0, "/zeros", "bytes");
+    const std::vector<std::byte> zeros(std::size_t{48} << 20);
+    for (int i = 0; i < 12; ++i) w.addMessage(c, i, zeros);
+    w.close();
+  }
+  CHECK(fs::file_size(file) < 100'000);
+  CHECK_THROWS_WITH(readMcap(file), Catch::StartsWith(file.string() + ": byte ") &&
+                                        Catch::Contains("the file decompresses to more than 256 MiB"));
+  // four of them (192 MiB) are read, and a message's bytes come back when asked for
+  const fs::path fewer = fs::current_path() / "reader_zeros.mcap";
+  {
+    McapWriter w(fewer, "test", "t", std::size_t{1} << 20);
+    const auto c = w.addChannel(0, "/zeros", "bytes");
+    const std::vector<std::byte> zeros(std::size_t{48} << 20);
+    for (int i = 0; i < 4; ++i) w.addMessage(c, i, zeros);
+    w.close();
+  }
+  const McapFile f = readMcap(fewer);
+  REQUIRE(f.messages.size() == 4);
+  CHECK(f.data(f.messages[3]).size() == std::size_t{48} << 20);
+  CHECK(f.cache.size() == (std::size_t{48} << 20) + 31);  // one chunk kept: its one message record
+  // a chunk that says it holds more than 64 MiB is refused before anything is allocated
+  std::vector<std::byte> big = readMcap(fewer).raw;
+  // (records from the header on: opcode, length, body; the first chunk's uncompressed size follows its two times)
+  std::size_t at = 8;
+  while (static_cast<std::uint8_t>(big.at(at)) != 0x06) {
+    std::uint64_t length = 0;
+    std::memcpy(&length, big.data() + at + 1, 8);
+    at += 9 + length;
+  }
+  const std::uint64_t huge = std::uint64_t{65} << 20;
+  std::memcpy(big.data() + at + 1 + 8 + 16, &huge, 8);
+  CHECK_THROWS_WITH(parseMcap(big, "big.mcap"), Catch::Contains("(ssx reads chunks of at most 64 MiB)"));
+}
+
+TEST_CASE("mcap reader: a FIFO, a device or a directory is refused before it is opened", "[record][mcap]") {
+  const fs::path fifo = fs::current_path() / "reader_fifo.mcap";
+  fs::remove(fifo);
+  REQUIRE(::mkfifo(fifo.c_str(), 0600) == 0);
+  // (opening a FIFO for reading would block until a writer came: the check comes first)
+  CHECK_THROWS_WITH(readMcap(fifo), Catch::Contains("not a regular file (a FIFO, a device or a socket"));
+  CHECK_THROWS_WITH(readMcap("/dev/zero"), Catch::Contains("not a regular file"));
+  CHECK_THROWS_WITH(readMcap(fs::current_path()), Catch::Contains("a directory, not a recording"));
+  fs::remove(fifo);
 }

@@ -57,7 +57,7 @@ TEST_CASE("mcap writer: schemas, channels, messages over many chunks, attachment
   for (int i = 0; i < 100; ++i) {
     CHECK(f.messages[static_cast<std::size_t>(i)].log_time == 1000 * i);
     CHECK(f.messages[static_cast<std::size_t>(i)].channel == (i % 2 == 0 ? 0 : 1));
-    CHECK(text(f.messages[static_cast<std::size_t>(i)].data) == "message " + std::to_string(i));
+    CHECK(text(f.data(f.messages[static_cast<std::size_t>(i)])) == "message " + std::to_string(i));
   }
   REQUIRE(f.attachments.size() == 1);
   CHECK(f.attachments[0].name == "notes.txt");
@@ -78,7 +78,7 @@ TEST_CASE("mcap writer: a write that fails is an error naming the file", "[recor
   } catch (const Error& e) {
     CHECK_THAT(e.what(), Catch::Contains("cannot write the recording /dev/full"));
   }
-  CHECK_THROWS_WITH(McapWriter("/no/such/dir/x.mcap", "t", "t"), Catch::Contains("cannot create the recording /no/such/dir/x.mcap"));
+  CHECK_THROWS_WITH(McapWriter("/no/such/dir/x.mcap", "t", "t"), Catch::Contains("the recording: cannot create '/no/such/dir/x.mcap'"));
 }
 
 TEST_CASE("crc32 is the CRC-32 of zlib, PNG and MCAP", "[record][mcap]") {

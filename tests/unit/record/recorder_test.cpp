@@ -3,6 +3,8 @@
 #include <ssx/ssx.hpp>
 
 #include "record/foxglove.hpp"
+#include "record/mcap_reader.hpp"
+#include "record/mcap_writer.hpp"
 #include "scene_util.hpp"
 #include "test_util.hpp"
 
@@ -10,6 +12,7 @@
 
 #include <cstring>
 #include <filesystem>
+#include <map>
 
 using namespace ssx;
 using namespace ssx::test;
@@ -227,4 +230,82 @@ TEST_CASE("recorder: a robot's joined parts (wheels on hinges) are bodies of the
   REQUIRE(update.size() == 1);
   for (const char* frame : {R"("frame_id":"burger")", R"("frame_id":"burger/left_wheel")", R"("frame_id":"burger/right_wheel")"})
     CHECK(update[0].second.find(frame) != std::string::npos);
+}
+
+TEST_CASE("recording: times that go back (a state restored while recording) are said at once and refused when read, "
+          "at their byte",
+          "[record][recorder]") {
+  const fs::path file = fs::current_path() / "recorder_back.mcap";
+  Scene scene = loadSceneFromString(kQuads, "quads.xml", kArtifacts, testOptions());
+  Environment& env = *scene.environment;
+  std::vector<std::string> warnings;
+  env.setLogSink([&](LogLevel level, std::string_view text) {
+    if (level == LogLevel::Warning) warnings.emplace_back(text);
+  });
+  Recorder recorder(env, options(file, scene));
+  env.step(100);
+  const std::vector<std::byte> early = env.saveState();
+  env.step(100);
+  env.restoreState(early);  // a reset loop for learning does this
+  env.step(100);
+  recorder.finish();
+  REQUIRE(warnings.size() == 1);
+  CHECK_THAT(warnings[0], Catch::Contains("the time went back from 0.400000 s to 0.240000 s") &&
+                              Catch::Contains("record each episode into a file of its own"));
+  CHECK_THROWS_WITH(Recording(file), Catch::StartsWith(file.string() + ": byte ") &&
+                                         Catch::Contains("a pose sample at 0.240000 s follows one at 0.400000 s") &&
+                                         Catch::Contains("go back or repeat"));
+}
+
+TEST_CASE("recording: a pose sample of the wrong length is refused when read, with the file and its byte",
+          "[record][recorder]") {
+  const fs::path file = fs::current_path() / "recorder_length.mcap";
+  Scene scene = loadSceneFromString(kQuads, "quads.xml", kArtifacts, testOptions());
+  {
+    Recorder recorder(*scene.environment, options(file, scene));
+    scene.environment->step(100);
+  }
+  // the same file with the third pose sample one byte short, its count unchanged
+  const ssx::detail::McapFile f = ssx::detail::readMcap(file);
+  const fs::path bad = fs::current_path() / "recorder_length_bad.mcap";
+  {
+    ssx::detail::McapWriter w(bad, f.profile, f.library);
+    std::map<std::uint16_t, std::uint16_t> schemas, channels;
+    for (const auto& [id, sc] : f.schemas) schemas[id] = w.addSchema(sc.name, sc.encoding, sc.data);
+    for (const auto& [id, c] : f.channels)
+      channels[id] = w.addChannel(c.schema == 0 ? 0 : schemas.at(c.schema), c.topic, c.encoding, c.metadata);
+    for (const auto& [name, values] : f.metadata) w.addMetadata(name, values);
+    for (const auto& a : f.attachments) w.addAttachment(a.name, a.media_type, a.log_time, a.data);
+    int poses = 0;
+    for (const auto& m : f.messages) {
+      std::span<const std::byte> data = f.data(m);
+      if (f.channels.at(m.channel).topic == "/ssx/poses" && ++poses == 3) data = data.first(data.size() - 1);
+      w.addMessage(channels.at(m.channel), m.log_time, data);
+    }
+    w.close();
+  }
+  CHECK(Recording(file).times().size() == 5);
+  CHECK_THROWS_WITH(Recording(bad), Catch::StartsWith(bad.string() + ": byte ") &&
+                                        Catch::Contains("a pose sample at 0.120000 s of 83 bytes, holding 4 bodies") &&
+                                        Catch::Contains("which take 84 bytes (corrupted)"));
+}
+
+TEST_CASE("recorder: a second run recording into the file another is writing is refused, the first unharmed",
+          "[record][recorder]") {
+  const fs::path file = fs::current_path() / "recorder_twice.mcap";
+  Scene first = loadSceneFromString(kQuads, "quads.xml", kArtifacts, testOptions());
+  Scene second = loadSceneFromString(kQuads, "quads.xml", kArtifacts, testOptions());
+  Recorder recorder(*first.environment, options(file, first));
+  first.environment->step(50);
+  CHECK_THROWS_WITH(Recorder(*second.environment, options(file, second)),
+                    Catch::Contains("is being written by another run now") && Catch::Contains(file.string()));
+  first.environment->step(50);
+  recorder.finish();
+  const Recording r(file);
+  CHECK(r.complete());
+  CHECK(r.times().size() == 5);
+  // once it is closed, the file may be written again
+  Recorder again(*second.environment, options(file, second));
+  second.environment->step(50);
+  CHECK(again.finish().samples == 2);
 }
