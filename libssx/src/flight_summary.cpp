@@ -30,6 +30,28 @@ double reach(const PhysicNodeSpec& node, const Pose& pose) {
   return r;
 }
 
+// the farthest point of a node tree's shapes from the root's vertical axis (a ground robot's
+// footprint): a shape's own horizontal extent is its bounding sphere's unless it is a cylinder or
+// capsule standing upright, whose extent is its radius
+double footprint(const PhysicNodeSpec& node, const Pose& pose) {
+  double r = 0;
+  for (const Shape& s : node.shapes) {
+    const Pose at = pose * s.pose;
+    const bool upright = std::abs((at.orientation * Vec3::UnitZ()).z()) > 1 - 1e-9;
+    double own = 0;
+    switch (s.kind) {
+      case Shape::Kind::Box: own = 0.5 * s.size.norm(); break;
+      case Shape::Kind::Sphere: own = s.radius; break;
+      case Shape::Kind::Cylinder: own = upright ? s.radius : std::hypot(s.radius, 0.5 * s.length); break;
+      case Shape::Kind::Capsule: own = upright ? s.radius : 0.5 * s.length + s.radius; break;
+      case Shape::Kind::Plane: continue;
+    }
+    r = std::max(r, at.position.head<2>().norm() + own);
+  }
+  for (const PhysicNodeSpec& c : node.children) r = std::max(r, footprint(c, pose * c.pose));
+  return r;
+}
+
 constexpr double kCrashedTilt = 0.5;  // cos 60 degrees: the body's up axis at most this far up
 constexpr double kSearch = 5.0;       // m: closest approaches are looked for within this
 constexpr double kRestingSpeed = 0.1;  // m/s: at rest on the ground, or moving with what it rests on
@@ -51,8 +73,10 @@ void FlightRecorder::start(const Environment& env) {
       }
       continue;
     }
-    Robot r{i, reach(root.spec(), Pose{}), root.pose().position, root.state().linear_velocity};
+    Robot r{i, reach(root.spec(), Pose{}), footprint(root.spec(), Pose{}), root.pose().position,
+            root.state().linear_velocity};
     r.wheeled = dynamic_cast<const OdometryInterface*>(a.driver()) != nullptr;
+    summary_.wheeled += r.wheeled ? 1 : 0;
     robots_.push_back(r);
   }
   summary_.robots = static_cast<std::int64_t>(robots_.size());
@@ -113,7 +137,12 @@ void FlightRecorder::observe(const Environment& env) {
         summary_.closest_approach_m = d;
         summary_.closest_pair = pair();
       }
-      if (d < robots_[k].radius + robots_[h.id].radius) {
+      // two ground robots touch side by side: their centres' horizontal distance against their
+      // footprints (their bounding spheres reach far above and below what can touch)
+      const bool ground = robots_[k].wheeled && robots_[h.id].wheeled;
+      const bool touch = ground ? (points[k] - h.point).head<2>().norm() < robots_[k].footprint + robots_[h.id].footprint
+                                : d < robots_[k].radius + robots_[h.id].radius;
+      if (touch) {
         const std::size_t upper = points[k].z() > h.point.z() ? k : h.id, lower = upper == k ? h.id : k;
         if ((robots_[upper].last_velocity - robots_[lower].last_velocity).norm() < kRestingSpeed) resting[upper] = 1;
         touching.emplace_back(k, h.id);
@@ -185,7 +214,8 @@ std::string FlightSummary::str() const {
                   hardest_impact_mps);
     out += text + hardest_impact_robot + ")";
   }
-  std::snprintf(text, sizeof text, "; mean distance flown %.2f m", mean_distance_flown_m);
+  std::snprintf(text, sizeof text, "; mean distance %s %.2f m",
+                wheeled == 0 ? "flown" : wheeled == robots ? "driven" : "travelled", mean_distance_flown_m);
   return out + text;
 }
 

@@ -33,6 +33,7 @@ py::dict flightSummaryDict(const ssx::FlightSummary& s) {
   d["airborne"] = s.airborne;
   d["landed"] = s.landed;
   d["on_wheels"] = s.on_wheels;
+  d["wheeled"] = s.wheeled;
   d["crashed"] = s.crashed;
   d["crashed_names"] = s.crashed_names;
   d["impacts"] = s.impacts;

@@ -184,3 +184,35 @@ TEST_CASE("flight summary: wheeled robots are on wheels, not landed or airborne,
   CHECK(s.crashed_names == std::vector<std::string>{"tipped"});
   CHECK_THAT(s.str(), Catch::StartsWith("robots 5: airborne 0, landed 2, on wheels 2, crashed 1 (tipped); "));
 }
+
+TEST_CASE("flight summary: ground robots touch by their footprints, not their bounding spheres, and drive",
+          "[flight_summary]") {
+  // e-puck-like robots: an upright cylinder 7 cm wide, 5 cm high, its centre 3 cm above the root
+  // (bounding sphere 7.3 cm from the root), on wheels
+  Environment env;
+  env.addGround();
+  auto puck = [&](const std::string& name, double x, double y) {
+    Artifact& a = env.addArtifact(name, at(x, y, 0.0));
+    PhysicNodeSpec body;
+    body.name = "body";
+    body.mass = 0.2;
+    Shape c = Shape::cylinder(0.035, 0.05);
+    c.pose.position = Vec3(0, 0, 0.03);
+    body.shapes.push_back(c);
+    a.addPhysicRoot(std::move(body));
+    a.setDriver(std::make_unique<Wheels>());
+  };
+  puck("near", 0, 0);
+  puck("apart", 0.0925, 0);    // 9.25 cm centre to centre: 2.25 cm of air between them
+  puck("touching", 0, 0.069);  // 6.9 cm: touching "near"
+  FlightRecorder recorder;
+  for (int k = 0; k < 20; ++k) {
+    env.step(5);
+    recorder.observe(env);
+  }
+  const FlightSummary s = recorder.summary();
+  CHECK(s.wheeled == 3);
+  CHECK(s.collisions == 1);
+  CHECK(s.first_collision_pair == "near and touching");
+  CHECK_THAT(s.str(), Catch::Contains("; mean distance driven "));
+}

@@ -44,17 +44,20 @@ struct SSX_EXPORT FlightSummary {
   double hardest_impact_mps = 0;     ///< the largest such change, m/s (0: none)
   std::string hardest_impact_robot;  ///< whose it was
   /// Robots touching: two robots closer than the sum of their radii (the farthest point of each one's
-  /// shapes from its centre), counted once per pair and touch.
+  /// shapes from its centre; for two wheeled robots, side by side on the ground, the horizontal
+  /// distance against their footprints' radii), counted once per pair and touch.
   std::int64_t collisions = 0;
   double first_collision_s = -1;          ///< simulated time of the first, or -1
   std::string first_collision_pair;       ///< "a and b"
   double closest_approach_m = -1;         ///< between two robots' centres, over the samples; -1: fewer than two
   std::string closest_pair;               ///< "a and b"
-  double mean_distance_flown_m = 0;       ///< path length per robot, from sample to sample
+  double mean_distance_flown_m = 0;       ///< path length per robot (flown or driven), from sample to sample
+  std::int64_t wheeled = 0;               ///< robots on wheels (their drivers have odometry)
   std::int64_t samples = 0;               ///< observations the summary is made of
   /// "robots 25: airborne 24, landed 0, crashed 1 (q7); collisions 1, first at 3.20 s (q7 and q8);
   /// closest approach 0.18 m (q7 and q8); mean distance flown 4.20 m"; with wheeled robots
-  /// "robots 17: airborne 1, landed 0, on wheels 16, crashed 0; ..."
+  /// "robots 17: airborne 1, landed 0, on wheels 16, crashed 0; ...; mean distance travelled 1.20 m"
+  /// ("driven" when every robot is on wheels)
   std::string str() const;
 };
 
@@ -76,6 +79,7 @@ class SSX_EXPORT FlightRecorder {
   struct Robot {
     std::size_t artifact = 0;
     double radius = 0;
+    double footprint = 0;  // the farthest point of its shapes from its vertical axis (wheeled robots)
     Vec3 last = Vec3::Zero();
     Vec3 last_velocity = Vec3::Zero();
     double flown = 0;
