@@ -164,10 +164,28 @@ std::vector<double> Command::toRow() const {
 }
 
 std::string Command::problem() const {
-  for (const double v : toRow())
-    if (std::isfinite(v) && std::abs(v) > kMaxCommandValue)
-      return std::string("a ") + commandLevelName(level) + " command holds " + number(v) +
-             ", beyond any command (at most 1e6 in magnitude)";
+  // (no allocation: a batch of commands is checked one by one)
+  double largest = 0;
+  const auto look = [&largest](double v) {
+    if (std::isfinite(v) && std::abs(v) > std::abs(largest)) largest = v;
+  };
+  const auto look3 = [&look](const Vec3& v) { look(v.x()), look(v.y()), look(v.z()); };
+  switch (level) {
+    case CommandLevel::Position:
+      look3(setpoint.position), look3(setpoint.velocity), look3(setpoint.acceleration);
+      look(setpoint.yaw), look(setpoint.yaw_rate);
+      break;
+    case CommandLevel::Velocity: look3(velocity), look(yaw_rate); break;
+    case CommandLevel::Attitude: look(roll), look(pitch), look(yaw_rate), look(thrust); break;
+    case CommandLevel::Rates: look3(body_rates), look(thrust); break;
+    case CommandLevel::Rotors:
+      for (const double w : rotor_speeds) look(w);
+      break;
+    case CommandLevel::Wheels: look(left_wheel), look(right_wheel); break;
+  }
+  if (std::abs(largest) > kMaxCommandValue)
+    return std::string("a ") + commandLevelName(level) + " command holds " + number(largest) +
+           ", beyond any command (at most 1e6 in magnitude)";
   switch (level) {
     case CommandLevel::Position:
       if (!finite(setpoint.position) || !finite(setpoint.velocity) || !finite(setpoint.acceleration) ||

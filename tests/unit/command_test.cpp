@@ -56,3 +56,20 @@ TEST_CASE("a command as JSON: its level's name and its row", "[command]") {
         R"({"level":"velocity","values":[0.5,-1,0.25,0.1]})");
   CHECK(commandJson(Command::rotors({400, 410.5})) == R"({"level":"rotors","values":[400,410.5]})");
 }
+
+TEST_CASE("a command holding a value beyond 1e6 is refused whatever the level, with the value", "[command]") {
+  CHECK(Command::velocityYawRate(Vec3(1e6, 0, 0)).problem().empty());
+  CHECK_THAT(Command::velocityYawRate(Vec3(0, 1e300, 0)).problem(),
+             Catch::Contains("a velocity command holds 1e+300, beyond any command"));
+  CHECK_THAT(Command::velocityYawRate(Vec3::Zero(), -2e6).problem(), Catch::Contains("holds -2e+06"));
+  Command far;
+  far.level = CommandLevel::Position;
+  far.setpoint.position = Vec3(0, 0, 1e7);
+  CHECK_THAT(far.problem(), Catch::Contains("a position command holds 1e+07"));
+  Command wheels;
+  wheels.level = CommandLevel::Wheels;
+  wheels.left_wheel = 1e9;
+  CHECK_FALSE(wheels.problem().empty());
+  // not finite is said as before
+  CHECK_THAT(Command::velocityYawRate(Vec3(NAN, 0, 0)).problem(), Catch::Contains("NaN or an infinity"));
+}
