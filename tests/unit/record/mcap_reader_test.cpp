@@ -117,26 +117,21 @@ TEST_CASE("mcap reader: messages are read back from their chunks one chunk at a 
 TEST_CASE("mcap reader: a small file cannot make it decompress or keep gigabytes", "[record][mcap]") {
   // chunks of 48 MiB of zeros each compress to a few KiB: twelve of them (576 MiB) in a file of
   // about 30 KiB are more than it may decompress to (the larger of 256 MiB and 1,024 times its size)
-  const fs::path file = fs::current_path() / "reader_bomb.mcap";
-  {
+  const auto zeros = [](const fs::path& file, int chunks) {
     McapWriter w(file, "test", "t", std::size_t{1} << 20);
     const auto c = w.addChannel(0, "/zeros", "bytes");
-    const std::vector<std::byte> zeros(std::size_t{48} << 20);
-    for (int i = 0; i < 12; ++i) w.addMessage(c, i, zeros);
+    const std::vector<std::byte> bytes(std::size_t{48} << 20);
+    for (int i = 0; i < chunks; ++i) w.addMessage(c, i, bytes);
     w.close();
-  }
+  };
+  const fs::path file = fs::current_path() / "reader_bomb.mcap";
+  zeros(file, 12);
   CHECK(fs::file_size(file) < 100'000);
   CHECK_THROWS_WITH(readMcap(file), Catch::StartsWith(file.string() + ": byte ") &&
                                         Catch::Contains("the file decompresses to more than 256 MiB"));
   // four of them (192 MiB) are read, and a message's bytes come back when asked for
   const fs::path fewer = fs::current_path() / "reader_zeros.mcap";
-  {
-    McapWriter w(fewer, "test", "t", std::size_t{1} << 20);
-    const auto c = w.addChannel(0, "/zeros", "bytes");
-    const std::vector<std::byte> zeros(std::size_t{48} << 20);
-    for (int i = 0; i < 4; ++i) w.addMessage(c, i, zeros);
-    w.close();
-  }
+  zeros(fewer, 4);
   const McapFile f = readMcap(fewer);
   REQUIRE(f.messages.size() == 4);
   CHECK(f.data(f.messages[3]).size() == std::size_t{48} << 20);
