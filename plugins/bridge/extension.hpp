@@ -98,7 +98,7 @@ class BridgeExtension : public SimulationExtension {
     for (const auto& [n, op] : operatorsOf(params, env)) {
       Operator o;
       o.op = op;  // (its force rate is read at the first step: it may be initialised after this one)
-      operator_names_.push_back(n);
+      o.name = n;
       operators_.push_back(o);
       RobotTopics t{n, false, false, true};
       t.odom = false;
@@ -162,18 +162,10 @@ class BridgeExtension : public SimulationExtension {
       if (new_joy) o.joys = j.count;
       // (a command the operator refuses, not finite or absurd, is dropped and counted: one bad
       // message never stops the run)
-      const std::string& who = operator_names_[k];
       auto velocity = [&] {
-        guarded(env, who, "cmd_vel", [&] { o.op->command(Vec3(v.linear[0], v.linear[1], v.linear[2]), v.angular[2]); });
+        guarded(env, o.name, "cmd_vel", [&] { o.op->command(Vec3(v.linear[0], v.linear[1], v.linear[2]), v.angular[2]); });
       };
-      auto joy = [&] {
-        for (const float a : j.axes)
-          if (!std::isfinite(a) || std::abs(a) > 1e6f) {
-            drop(env, who, "joy", "an axis that is not finite or absurd");
-            return;
-          }
-        guarded(env, who, "joy", [&] { o.op->joy(j.axes, j.buttons); });
-      };
+      auto joy = [&] { guarded(env, o.name, "joy", [&] { o.op->joy(j.axes, j.buttons); }); };
       if (new_velocity && new_joy && j.order < v.order) joy();
       if (new_velocity) velocity();
       if (new_joy && !(new_velocity && j.order < v.order)) joy();
@@ -259,8 +251,7 @@ class BridgeExtension : public SimulationExtension {
     for (std::size_t k = 0; k < operators_.size(); ++k) {
       Operator& o = operators_[k];
       if (o.force_rate.period == 0) {
-        o.force_rate.period =
-            o.op->forceRateHz() > 0 ? std::max(env.timestep(), toNanoseconds(1.0 / o.op->forceRateHz())) : env.timestep();
+        o.force_rate.period = periodOf(o.op->forceRateHz(), env.timestep());
         o.force_rate.next = now;
       }
       if (o.force_rate.due(now)) transport_->publishForce(robots_.size() + k, t, array3(o.op->force()));
@@ -318,6 +309,7 @@ class BridgeExtension : public SimulationExtension {
     OperatorInterface* op = nullptr;
     Rate force_rate;
     std::uint64_t velocities = 0, joys = 0;  // applied so far
+    std::string name;                        // its extension's: its topics' namespace
   };
 
   // the ghosts' poses that arrived, in arrival order, stamped in simulated time. Lock-stepped,
@@ -369,11 +361,13 @@ class BridgeExtension : public SimulationExtension {
   }
 
   static Rate rateOf(const Descriptor& params, const char* key, Nanoseconds every_step) {
-    const double hz = params.get<double>(key);
     Rate r;
-    // (a rate above the step rate publishes every step)
-    r.period = hz > 0 ? std::max(every_step, toNanoseconds(1.0 / hz)) : every_step;
+    r.period = periodOf(params.get<double>(key), every_step);
     return r;
+  }
+  // a rate's period; 0 Hz, or one above the step rate, is every step
+  static Nanoseconds periodOf(double hz, Nanoseconds every_step) {
+    return hz > 0 ? std::max(every_step, toNanoseconds(1.0 / hz)) : every_step;
   }
   static std::array<double, 3> array3(const Vec3& v) { return {v.x(), v.y(), v.z()}; }
   static std::array<double, 4> array4(const Quat& q) { return {q.w(), q.x(), q.y(), q.z()}; }
@@ -464,7 +458,6 @@ class BridgeExtension : public SimulationExtension {
   std::unique_ptr<Transport> transport_;
   std::vector<Robot> robots_;
   std::vector<Operator> operators_;  // their topics follow the robots'
-  std::vector<std::string> operator_names_;
   std::map<std::string, std::uint64_t> dropped_;  // messages dropped, by topic
   Rate odom_rate_, imu_rate_, clock_rate_, range_rate_, image_rate_;
   bool wall_stamps_ = false;

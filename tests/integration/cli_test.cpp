@@ -492,20 +492,10 @@ TEST_CASE("ssx run --record, inspect and replay: a run kept, looked at, drawn ag
   CHECK_THAT(again.err, !Catch::Contains("was recorded by ssx"));
   {
     // the same recording said to be of another version: the replay says so before it draws
-    const ssx::detail::McapFile f = ssx::detail::readMcap(rec);
     const fs::path other = dir / "other_version.mcap";
-    ssx::detail::McapWriter w(other, f.profile, f.library);
-    std::map<std::uint16_t, std::uint16_t> schemas, channels;
-    for (const auto& [id, sc] : f.schemas) schemas[id] = w.addSchema(sc.name, sc.encoding, sc.data);
-    for (const auto& [id, c] : f.channels)
-      channels[id] = w.addChannel(c.schema == 0 ? 0 : schemas.at(c.schema), c.topic, c.encoding, c.metadata);
-    for (auto [name, values] : f.metadata) {
+    ssx::detail::rewriteMcap(ssx::detail::readMcap(rec), other, {}, [](const std::string& name, auto& values) {
       if (name == "ssx") values["version"] = "0.0.1";
-      w.addMetadata(name, values);
-    }
-    for (const auto& a : f.attachments) w.addAttachment(a.name, a.media_type, a.log_time, a.data);
-    for (const auto& m : f.messages) w.addMessage(channels.at(m.channel), m.log_time, f.data(m));
-    w.close();
+    });
     const Result old_version = run({"replay", other.string(), "--snapshot", (dir / "old.png").string()});
     CHECK(old_version.status == 0);
     CHECK_THAT(old_version.err, Catch::Contains("was recorded by ssx 0.0.1, this is ssx " SSX_VERSION_STRING));

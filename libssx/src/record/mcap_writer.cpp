@@ -1,5 +1,6 @@
 #include "record/mcap_writer.hpp"
 #include "record/mcap_format.hpp"
+#include "record/mcap_reader.hpp"
 
 #include <ssx/error.hpp>
 #include <ssx/run_files.hpp>
@@ -258,6 +259,28 @@ void McapWriter::close() {
     throw Error("cannot write the recording " + file_.string() + ": " + std::strerror(errno));
   }
   out_ = nullptr;
+}
+
+void rewriteMcap(const McapFile& f, const std::filesystem::path& out,
+                 const std::function<std::span<const std::byte>(std::size_t, std::span<const std::byte>)>& message,
+                 const std::function<void(const std::string&, std::map<std::string, std::string>&)>& metadata) {
+  McapWriter w(out, f.profile, f.library);
+  // schemas and channels get their ids in order, as the writer gave them: re-added in id order
+  std::map<std::uint16_t, std::uint16_t> schema_ids, channel_ids;
+  for (const auto& [id, s] : f.schemas) schema_ids[id] = w.addSchema(s.name, s.encoding, s.data);
+  for (const auto& [id, c] : f.channels)
+    channel_ids[id] = w.addChannel(c.schema == 0 ? 0 : schema_ids.at(c.schema), c.topic, c.encoding, c.metadata);
+  for (auto [name, values] : f.metadata) {
+    if (metadata) metadata(name, values);
+    w.addMetadata(name, values);
+  }
+  for (const auto& a : f.attachments) w.addAttachment(a.name, a.media_type, a.log_time, a.data);
+  for (std::size_t i = 0; i < f.messages.size(); ++i) {
+    const McapFile::Message& m = f.messages[i];
+    const std::span<const std::byte> data = f.data(m);
+    w.addMessage(channel_ids.at(m.channel), m.log_time, message ? message(i, data) : data);
+  }
+  w.close();
 }
 
 }  // namespace ssx::detail

@@ -13,6 +13,7 @@
 #include <cstdint>
 #include <cstdio>
 #include <filesystem>
+#include <functional>
 #include <map>
 #include <span>
 #include <string>
@@ -94,5 +95,15 @@ class McapWriter {
 
 /// CRC-32 (the one MCAP, zlib and PNG use) of `data`, continuing from `crc` (0 for a new one).
 std::uint32_t crc32(std::span<const std::byte> data, std::uint32_t crc = 0);
+
+struct McapFile;
+
+/// Writes what `f` holds (schemas, channels, metadata, attachments, messages in file order) into a
+/// complete new file `out`: a recording cut short made whole, or a test's altered copy. `message`
+/// may give a message other bytes (it gets the message's index and bytes), `metadata` may change a
+/// metadata record's values.
+void rewriteMcap(const McapFile& f, const std::filesystem::path& out,
+                 const std::function<std::span<const std::byte>(std::size_t, std::span<const std::byte>)>& message = {},
+                 const std::function<void(const std::string&, std::map<std::string, std::string>&)>& metadata = {});
 
 }  // namespace ssx::detail

@@ -145,17 +145,7 @@ std::vector<std::byte> Recording::stateAtOrBefore(Nanoseconds time, Nanoseconds*
 }
 
 void completeRecording(const std::filesystem::path& damaged, const std::filesystem::path& out) {
-  const detail::McapFile f = detail::readMcap(damaged);
-  detail::McapWriter w(out, f.profile, f.library);
-  // schemas and channels get their ids in order, as the writer gave them: re-added in id order
-  std::map<std::uint16_t, std::uint16_t> schema_ids, channel_ids;
-  for (const auto& [id, s] : f.schemas) schema_ids[id] = w.addSchema(s.name, s.encoding, s.data);
-  for (const auto& [id, c] : f.channels)
-    channel_ids[id] = w.addChannel(c.schema == 0 ? 0 : schema_ids.at(c.schema), c.topic, c.encoding, c.metadata);
-  for (const auto& [name, values] : f.metadata) w.addMetadata(name, values);
-  for (const auto& a : f.attachments) w.addAttachment(a.name, a.media_type, a.log_time, a.data);
-  for (const auto& m : f.messages) w.addMessage(channel_ids.at(m.channel), m.log_time, f.data(m));
-  w.close();
+  detail::rewriteMcap(detail::readMcap(damaged), out);
 }
 
 std::vector<std::pair<std::string, std::uint64_t>> Recording::channels() const {

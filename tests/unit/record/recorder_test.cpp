@@ -268,22 +268,11 @@ TEST_CASE("recording: a pose sample of the wrong length is refused when read, wi
   // the same file with the third pose sample one byte short, its count unchanged
   const ssx::detail::McapFile f = ssx::detail::readMcap(file);
   const fs::path bad = fs::current_path() / "recorder_length_bad.mcap";
-  {
-    ssx::detail::McapWriter w(bad, f.profile, f.library);
-    std::map<std::uint16_t, std::uint16_t> schemas, channels;
-    for (const auto& [id, sc] : f.schemas) schemas[id] = w.addSchema(sc.name, sc.encoding, sc.data);
-    for (const auto& [id, c] : f.channels)
-      channels[id] = w.addChannel(c.schema == 0 ? 0 : schemas.at(c.schema), c.topic, c.encoding, c.metadata);
-    for (const auto& [name, values] : f.metadata) w.addMetadata(name, values);
-    for (const auto& a : f.attachments) w.addAttachment(a.name, a.media_type, a.log_time, a.data);
-    int poses = 0;
-    for (const auto& m : f.messages) {
-      std::span<const std::byte> data = f.data(m);
-      if (f.channels.at(m.channel).topic == "/ssx/poses" && ++poses == 3) data = data.first(data.size() - 1);
-      w.addMessage(channels.at(m.channel), m.log_time, data);
-    }
-    w.close();
-  }
+  int poses = 0;
+  ssx::detail::rewriteMcap(f, bad, [&](std::size_t i, std::span<const std::byte> data) {
+    const bool third = f.channels.at(f.messages[i].channel).topic == "/ssx/poses" && ++poses == 3;
+    return third ? data.first(data.size() - 1) : data;
+  });
   CHECK(Recording(file).times().size() == 5);
   CHECK_THROWS_WITH(Recording(bad), Catch::StartsWith(bad.string() + ": byte ") &&
                                         Catch::Contains("a pose sample at 0.120000 s of 83 bytes, holding 4 bodies") &&
