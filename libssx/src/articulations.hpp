@@ -44,6 +44,21 @@ void labelArticulations(std::vector<int>& label, std::size_t bodies, const std::
   for (std::size_t i = 0; i < label.size(); ++i) label[i] = find(static_cast<int>(i));
 }
 
+// hangs[i]: the static group that body i's articulation is joined to (EngineJoint::static_group of
+// a joint to the static world in it; the first such joint's), else -1; `label` from
+// labelArticulations. Contacts between the two are skipped, as between joined bodies.
+template <class Joint>
+void labelStaticParents(std::vector<int>& hangs, const std::vector<int>& label, const std::vector<Joint>& joints) {
+  hangs.assign(label.size(), -1);
+  std::vector<int> of_root(label.size(), -1);
+  for (const Joint& j : joints)
+    if (!j.removed && j.spec.parent < 0 && j.spec.static_group >= 0) {
+      int& g = of_root[static_cast<std::size_t>(label[static_cast<std::size_t>(j.spec.child)])];
+      if (g < 0) g = j.spec.static_group;
+    }
+  for (std::size_t i = 0; i < label.size(); ++i) hangs[i] = of_root[static_cast<std::size_t>(label[i])];
+}
+
 // puts a new joint in the first slot a removed run-time joint left (at or after `first`, once
 // sealed), else at the end; returns its index
 template <class Joint>

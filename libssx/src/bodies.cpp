@@ -50,7 +50,9 @@ void buildBodies(World& world, PhysicEngine& engine, std::vector<Environment::St
         }
       }
       if (top.isStatic()) {
-        engine.addStatic(shapes, top_data.pose);
+        const int group = engine.addStatic(shapes, top_data.pose);
+        for (std::size_t k = h; k < count; ++k)
+          if (head[k] == h) world.nodes[offset + k].static_group = group;
         continue;
       }
       const MassProperties mass = bodyMass(top.spec());

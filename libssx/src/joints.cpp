@@ -97,6 +97,7 @@ void buildJoints(World& world, PhysicEngine& engine) {
     e.kind = spec.kind;
     e.parent = j.parent_body;
     e.child = j.child_body;
+    if (j.parent_body < 0) e.static_group = world.nodes[parent.nodeIndex()].static_group;
     e.frame = frame;
     e.lower = spec.lower;
     e.upper = spec.upper;

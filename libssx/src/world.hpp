@@ -32,6 +32,7 @@ namespace ssx::detail {
 struct NodeData {
   Pose pose_in_body;  // node frame in the body's centre-of-mass frame
   int body = -1;      // -1: static, or not started
+  int static_group = -1;  // static: its shapes' group in the engine (PhysicEngine::addStatic)
   bool is_static = false;
   bool at_body = false;  // pose_in_body is exactly the identity: the node's state is its body's
 };

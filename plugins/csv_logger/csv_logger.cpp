@@ -5,7 +5,8 @@
 //
 // Columns: time_s,artifact,x,y,z,qw,qx,qy,qz,vx,vy,vz,wx,wy,wz (world frame, SI units). With
 // bodies="all", one row per body of each artifact: its root's named as the artifact, each joined
-// child's as "artifact/node" (the pose of the node the body begins at).
+// child's as "artifact/node" (the pose of the node the body begins at); with artifacts="*", the
+// joined children of static-rooted articulations (a door, an arm on a table) too.
 #include <ssx/environment.hpp>
 #include <ssx/plugin_abi.hpp>
 #include <ssx/run_files.hpp>
@@ -16,6 +17,7 @@
 #include <cstring>
 #include <filesystem>
 #include <sstream>
+#include <utility>
 #include <vector>
 
 namespace ssx::plugins {
@@ -115,8 +117,20 @@ class CsvLogger final : public SimulationExtension {
 
   void resolve(Environment& env, const Descriptor& params) {
     const bool all = params.get<std::string>("bodies") == "all";
-    for (const Artifact* a : env.selectArtifacts(params, "artifacts", "log")) {
-      rows_.push_back({a, nullptr, field(a->name())});
+    const std::vector<Artifact*> named = env.selectArtifacts(params, "artifacts", "log");
+    std::vector<const Artifact*> chosen(named.begin(), named.end());
+    if (all && names_ == "*") {
+      // every body: a static-rooted articulation's (a door, an arm on a table) too, without its root
+      chosen.clear();
+      for (std::size_t i = 0; i < env.artifactCount(); ++i) {
+        const Artifact& a = std::as_const(env).artifact(i);
+        bool moves = false;
+        for (std::size_t k = 0; k < a.nodeCount() && !moves; ++k) moves = !a.nodeAt(k).isStatic();
+        if (moves) chosen.push_back(&a);
+      }
+    }
+    for (const Artifact* a : chosen) {
+      if (!(all && names_ == "*" && a->root().isStatic())) rows_.push_back({a, nullptr, field(a->name())});
       if (!all) continue;
       for (std::size_t k = 0; k < a->nodeCount(); ++k) {
         const PhysicNode& n = a->nodeAt(k);

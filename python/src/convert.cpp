@@ -98,6 +98,33 @@ void toLogging(ssx::LogLevel level, std::string_view message) {
   }
 }
 
+namespace {
+std::vector<ssx::RecordedBody> startedBodies(const ssx::Environment& env) {
+  if (env.state() != ssx::Environment::State::Running)
+    throw std::runtime_error("ssx: the run has not started: its bodies are known from the first step on");
+  return ssx::recordedBodies(env);
+}
+}  // namespace
+
+std::vector<std::string> bodyNames(const ssx::Environment& env) {
+  std::vector<std::string> out;
+  for (const auto& b : startedBodies(env)) out.push_back(b.name);
+  return out;
+}
+
+py::array_t<double> bodyPoses(const ssx::Environment& env) {
+  const std::vector<ssx::RecordedBody> bodies = startedBodies(env);
+  py::array_t<double> out({static_cast<py::ssize_t>(bodies.size()), static_cast<py::ssize_t>(7)});
+  double* p = out.mutable_data();
+  for (const auto& b : bodies) {
+    const ssx::Pose pose = b.node->pose();
+    const double row[7] = {pose.position.x(), pose.position.y(), pose.position.z(), pose.orientation.w(),
+                           pose.orientation.x(), pose.orientation.y(), pose.orientation.z()};
+    p = std::copy(row, row + 7, p);
+  }
+  return out;
+}
+
 ssx::SceneOptions sceneOptions(std::optional<std::uint64_t> seed, std::optional<int> threads,
                                const std::vector<fs::path>& plugin_path, const std::optional<std::string>& physics) {
   ssx::SceneOptions o;

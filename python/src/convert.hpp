@@ -49,6 +49,10 @@ py::array_t<std::int32_t> counts(const std::array<std::int32_t, N>& c) {
   for (std::size_t i = 0; i < N; ++i) r(static_cast<py::ssize_t>(i)) = c[i];
   return a;
 }
+/// Every moving body as recordings and the viewer list them (ssx::recordedBodies): names, and
+/// poses as N x 7 (x, y, z, qw, qx, qy, qz); RuntimeError before the first step.
+std::vector<std::string> bodyNames(const ssx::Environment& env);
+py::array_t<double> bodyPoses(const ssx::Environment& env);
 /// What happened to the robots (FlightRecorder) as a dict of its fields, with 'text'.
 py::dict flightSummaryDict(const ssx::FlightSummary& s);
 /// The ghosts' pose ages as a dict: count, median, p99, max.

@@ -486,6 +486,11 @@ PYBIND11_MODULE(_ssx, m) {
            "The artifacts whose driver follows set-points: the rows of set_setpoints().")
       .def("state_hash", [](PyEnvironment& e) { return e.guarded([&] { return e.env().stateHash(); }); },
            "64-bit hash of every body's pose and velocities, bit for bit, and the time.")
+      .def("body_names", [](PyEnvironment& e) { return e.guarded([&] { return ssx_python::bodyNames(e.env()); }); },
+           "Every moving body, as recordings and the viewer list them: each dynamic artifact's first root "
+           "named as the artifact, then its other bodies as 'artifact/node' (static-rooted arms and doors too).")
+      .def("body_poses", [](PyEnvironment& e) { return e.guarded([&] { return ssx_python::bodyPoses(e.env()); }); },
+           "N x 7 poses of body_names() (x, y, z in m; qw, qx, qy, qz), world frame.")
       .def("positions", &PyEnvironment::positions, "N x 3 positions (m, world) of the dynamic artifacts' first roots.")
       .def("orientations", &PyEnvironment::orientations, "N x 4 orientations as quaternions (w, x, y, z).")
       .def("linear_velocities", &PyEnvironment::linearVelocities, "N x 3, m/s, world frame.")

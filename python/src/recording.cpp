@@ -1,6 +1,8 @@
 // ssx.Recording (recording.hpp).
 #include "recording.hpp"
 
+#include "convert.hpp"
+
 #include <ssx/ssx.hpp>
 
 #include <pybind11/numpy.h>
@@ -8,6 +10,11 @@
 #include <pybind11/stl/filesystem.h>
 
 #include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <system_error>
+
+#include <unistd.h>
 #include <string>
 #include <vector>
 
@@ -31,6 +38,47 @@ py::array_t<float> allSamples(const ssx::Recording& r, std::vector<float> (ssx::
     std::copy(v.begin(), v.end(), dst + k * v.size());
   }
   return out;
+}
+
+// the state at `t` (seconds): the saved one there, else re-simulated from the one before it in the
+// recorded scene, its outputs in a temporary folder removed after; the first before the first
+py::tuple snapshot(const ssx::Recording& r, double t, const std::vector<fs::path>& plugin_path) {
+  if (!std::isfinite(t)) throw py::value_error("ssx: snapshot(t): t must be finite, got " + std::to_string(t));
+  const std::vector<ssx::Nanoseconds> saved = r.stateTimes();
+  if (saved.empty()) throw py::value_error("ssx: the recording holds no saved state (recorded with states every 0 s)");
+  const ssx::Nanoseconds want = std::max(ssx::toNanoseconds(t), saved.front());
+  if (!r.times().empty() && want > r.times().back())
+    throw py::value_error("ssx: snapshot(" + std::to_string(t) + "): the recording ends at " +
+                          std::to_string(ssx::toSeconds(r.times().back())) + " s");
+  ssx::Nanoseconds at = 0;
+  std::vector<std::byte> state = r.stateAtOrBefore(want, &at);
+  if (at < want) {
+    std::error_code ec;
+    const fs::path out = fs::temp_directory_path() / ("ssx-snapshot-" + std::to_string(::getpid()) + "-" +
+                                                      std::to_string(reinterpret_cast<std::uintptr_t>(&state)));
+    ssx::SceneOptions options = sceneOptions(std::nullopt, std::nullopt, plugin_path, std::nullopt);
+    options.output_directory = out;
+    struct Cleanup {
+      fs::path dir;
+      ~Cleanup() {
+        std::error_code ignored;
+        fs::remove_all(dir, ignored);
+      }
+    } cleanup{out};
+    py::gil_scoped_release release;
+    ssx::Scene scene = ssx::loadSceneFromString(r.sceneXml(), r.sceneLabel().empty() ? std::string("recorded scene") : r.sceneLabel(),
+                                                fs::current_path(), options);
+    ssx::Environment& env = *scene.environment;
+    env.checkState(state);
+    fs::create_directories(out, ec);
+    env.start();
+    env.restoreState(state);
+    while (env.time() < want) env.step();
+    state = env.saveState();
+    env.stop();
+    at = env.time();
+  }
+  return py::make_tuple(ssx::toSeconds(at), py::bytes(reinterpret_cast<const char*>(state.data()), state.size()));
 }
 
 }  // namespace
@@ -90,15 +138,11 @@ void bindRecording(py::module_& m) {
           },
           "Times of the saved states, s.")
       .def(
-          "snapshot",
-          [](const ssx::Recording& r, double t) {
-            ssx::Nanoseconds at = 0;
-            const std::vector<std::byte> s = r.stateAtOrBefore(ssx::toNanoseconds(t), &at);
-            return py::make_tuple(ssx::toSeconds(at), py::bytes(reinterpret_cast<const char*>(s.data()), s.size()));
-          },
-          py::arg("t"),
-          "The saved state at or before t seconds: (its time, bytes for Environment.restore_state of the recorded "
-          "scene, e.g. load_scene_string(recording.scene_xml)).")
+          "snapshot", &snapshot, py::arg("t"), py::arg("plugin_path") = std::vector<fs::path>{},
+          "The state at t seconds: (t, bytes for Environment.restore_state of the recorded scene, e.g. "
+          "load_scene_string(recording.scene_xml)). Between two saved states, the recorded scene is re-simulated "
+          "from the one before t (its extensions run, their outputs in a temporary folder removed after), as "
+          "ssx replay --resimulate-from t does; before the first saved state, the first.")
       .def(
           "channels", [](const ssx::Recording& r) {
             py::dict d;

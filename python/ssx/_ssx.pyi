@@ -51,6 +51,10 @@ class Environment:
         """The artifacts whose driver follows set-points: the rows of set_setpoints()."""
     def state_hash(self) -> int:
         """64-bit hash of every body's pose and velocities, bit for bit, and the time."""
+    def body_names(self) -> List[str]:
+        """Every moving body, as recordings and the viewer list them: each dynamic artifact's first root named as the artifact, then its other bodies as 'artifact/node' (static-rooted arms and doors too)."""
+    def body_poses(self) -> npt.NDArray[np.float64]:
+        """N x 7 poses of body_names() (x, y, z in m; qw, qx, qy, qz), world frame."""
     def positions(self) -> npt.NDArray[np.float64]:
         """N x 3 positions (m, world) of the dynamic artifacts' first roots."""
     def orientations(self) -> npt.NDArray[np.float64]:
@@ -169,8 +173,8 @@ class Recording:
         """Times of the saved states, s."""
     def channel(self, name: str) -> List[Any]:
         """The messages of a channel as (time in s, message): JSON channels decoded, others as bytes."""
-    def snapshot(self, t: float) -> Any:
-        """The saved state at or before t: (its time, bytes for Environment.restore_state)."""
+    def snapshot(self, t: float, plugin_path: Sequence[_Path] = ...) -> Any:
+        """The state at t: (t, bytes for Environment.restore_state); between saved states, re-simulated from the one before."""
     def channels(self) -> Dict[str, int]:
         """Every channel's topic and message count."""
     def __len__(self) -> int: ...

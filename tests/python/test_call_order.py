@@ -28,6 +28,7 @@ CALLS = [
     ("time", "env.time; env.time_ns; env.timestep; env.step_count; env.duration; env.seed; env.threads"),
     ("names", "env.artifact_names(); env.dynamic_names(); env.setpoint_names()"),
     ("state_hash", "env.state_hash()"),
+    ("bodies", "env.body_names(); env.body_poses()"),
     ("arrays", "env.positions(); env.orientations(); env.linear_velocities(); env.angular_velocities()"),
     ("set_setpoints", "env.set_setpoints([[0, 0, 1], [1, 0, 1]])"),
     ("set_commands", "env.set_commands('velocity', [[0, 0, 0, 0]], robots=['q0'])"),

@@ -35,14 +35,19 @@ def test_a_recording_read_back_into_numpy_and_continued_from_its_state(tmp_path)
     with pytest.raises(RuntimeError, match="no channel '/imu'"):
         r.channel("/imu")
 
-    # the recorded scene from its state at 1.02 s: the recorded poses again, bit for bit
+    # the recorded scene from its state at 1.5 s (re-simulated from the one saved at 1.02 s): the
+    # recorded poses again, bit for bit
     at, state = r.snapshot(1.5)
-    assert at == pytest.approx(1.02)
+    assert at == pytest.approx(1.5)
     again = ssx.load_scene_string(r.scene_xml, threads=1)
     again.restore_state(state)
-    for k in range(51, 150):
+    assert again.time == pytest.approx(1.5)
+    for k in range(75, 150):
         again.step(10)
         assert np.array_equal(again.positions().astype(np.float32), p[k]), f"sample {k}"
+    assert r.snapshot(1.02)[0] == pytest.approx(1.02) and r.snapshot(0)[0] == pytest.approx(0.02)
+    with pytest.raises(ValueError, match="the recording ends at 3"):
+        r.snapshot(3.5)
 
 
 def test_run_records_and_refuses_what_it_must_not_write(tmp_path):

@@ -99,6 +99,26 @@ def test_state_arrays_are_the_bodies_in_artifact_order():
     assert m["orientation"].shape == (4,)
 
 
+def test_body_poses_include_the_moving_parts_of_a_static_rooted_arm(tmp_path):
+    (tmp_path / "pendulum.xml").write_text("""<artifact>
+  <physic name="base" static="true"><box size="0.1 0.1 0.1"/>
+    <physic name="arm" joint="hinge" axis="0 1 0" rpy="0 1 0" mass="1"><sphere radius="0.05" xyz="0 0 -1"/></physic>
+  </physic>
+</artifact>""")
+    env = ssx.load_scene_string("""<scene><environment timestep="0.01"/><type name="p" file="pendulum.xml"/>
+      <artifact name="p" type="p" xyz="0 0 2"/><artifact name="ball" type="p" xyz="3 0 2"/></scene>""", base_dir=tmp_path)
+    with pytest.raises(RuntimeError, match="from the first step on"):
+        env.body_names()
+    env.step(50)
+    assert env.dynamic_names() == []  # no artifact's root moves
+    assert env.body_names() == ["p/arm", "ball/arm"]
+    poses = env.body_poses()
+    assert poses.shape == (2, 7)
+    assert np.allclose(poses[:, :3], [[0, 0, 2], [3, 0, 2]], atol=0.05)  # the arms' nodes: at their pivots
+    # the arm turned from 1 rad about y towards the bottom: its quaternion's angle is below 1 rad
+    assert 2 * np.arccos(abs(poses[0, 3])) < 0.9
+
+
 def test_same_seed_same_bits_on_any_thread_count():
     a, b = hover(threads=1), hover(threads=2)
     a.step(300)

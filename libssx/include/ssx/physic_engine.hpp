@@ -76,6 +76,9 @@ struct EngineJoint {
   JointSpec::Kind kind = JointSpec::Kind::Fixed;  ///< hinge, slider, ball or fixed (not Rigid)
   int parent = -1;  ///< a body, or -1: the static world
   int child = 0;    ///< a body
+  /// When `parent` is -1: the static shapes the child hangs from (addStatic's group), or -1. The
+  /// child's articulation never collides with them, as joined bodies never collide.
+  int static_group = -1;
   /// The joint's frame in the world where the bodies are now (their initial states): its origin
   /// is the anchor, its z axis the hinge's or slider's axis. Position 0 is this configuration.
   Pose frame;
@@ -159,8 +162,9 @@ class SSX_EXPORT PhysicEngine {
   /// engine's own ray queries; hits[i] is the first shape rays[i] meets. Read only, so safe from
   /// several threads at once between prepareRayQueries and the next step.
   virtual void castRays(std::span<const Ray> rays, std::span<RayHit> hits, int ignore_begin, int ignore_end) const = 0;
-  /// Adds shapes fixed in the world at `pose`.
-  virtual void addStatic(const std::vector<Shape>& shapes, const Pose& pose) = 0;
+  /// Adds shapes fixed in the world at `pose`; returns their group (0, 1, ... in the order of the
+  /// calls), which a joint to the static world names in EngineJoint::static_group.
+  virtual int addStatic(const std::vector<Shape>& shapes, const Pose& pose) = 0;
   /// Integrates one timestep (in the configured substeps), with `wrenches[i]` applied to body i
   /// throughout.
   virtual void step(Nanoseconds dt, std::span<const Wrench> wrenches) = 0;

@@ -54,7 +54,8 @@ struct RecordedBody {
 
 /// Every body of a running environment in recording order: artifact by artifact, its first
 /// dynamic root (named as the artifact), then its other dynamic roots and its joined nodes (a wheel
-/// on a hinge) in node order, as csv_logger's bodies="all". Empty before start.
+/// on a hinge) in node order, as csv_logger's bodies="all". A static-rooted articulation (a door on
+/// its frame, an arm on a table) has its joined nodes only. Empty before start.
 SSX_EXPORT std::vector<RecordedBody> recordedBodies(const Environment& env);
 /// The recorded body a node moves with: itself if it heads a body, else the nearest ancestor that
 /// does; nullptr for a node of a static tree. `bodies` as recordedBodies gives them.

@@ -97,6 +97,12 @@ void BulletEngine::narrowphase(Context& context, Chunk& chunk, int a, int b, dou
       articulation_[static_cast<std::size_t>(pa.body)] ==
           articulation_[static_cast<std::size_t>(proxies_[static_cast<std::size_t>(b)].body)])
     return;
+  // nor between an articulation and the static shapes it hangs from
+  if (const int hangs = pa.body >= 0 ? hangs_from_[static_cast<std::size_t>(pa.body)] : -1; hangs >= 0) {
+    const int stat = b < 0 ? planes_[static_cast<std::size_t>(-1 - b)]
+                           : proxies_[static_cast<std::size_t>(b)].static_index;
+    if (stat >= 0 && statics_[static_cast<std::size_t>(stat)]->group == hangs) return;
+  }
   const btCollisionObject* object_b;
   const btCollisionShape* shape_b;
   const btTransform* pose_b;

@@ -129,10 +129,12 @@ void BulletEngine::setKinematic(int index) {
 
 bool BulletEngine::isKinematic(int index) const { return bodies_.at(static_cast<std::size_t>(index))->kinematic; }
 
-void BulletEngine::addStatic(const std::vector<Shape>& shapes, const Pose& pose) {
+int BulletEngine::addStatic(const std::vector<Shape>& shapes, const Pose& pose) {
+  const int group = static_groups_++;
   for (const auto& s : shapes) {
     const Pose world = pose * s.pose;
     auto object = std::make_unique<StaticObject>();
+    object->group = group;
     if (s.kind == Shape::Kind::Plane) {
       object->plane = true;
       object->normal = world.orientation * Vec3::UnitZ();
@@ -152,6 +154,7 @@ void BulletEngine::addStatic(const std::vector<Shape>& shapes, const Pose& pose)
     statics_.push_back(std::move(object));
   }
   proxies_stale_ = true;
+  return group;
 }
 
 void BulletEngine::solve(double h) {
@@ -195,6 +198,7 @@ void BulletEngine::step(Nanoseconds dt, std::span<const Wrench> wrenches) {
   seal();
   if (labels_stale_ || articulation_.size() != bodies_.size()) {
     labelArticulations(articulation_, bodies_.size(), joints_);
+    labelStaticParents(hangs_from_, articulation_, joints_);
     labels_stale_ = false;
   }
   if (live_joints_ > 0) setMotors(h);

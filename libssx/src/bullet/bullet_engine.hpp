@@ -54,7 +54,7 @@ class BulletEngine final : public PhysicEngine {
   int addBody(const MassProperties& mass, const std::vector<Shape>& shapes, const BodyState& state) override;
   void setKinematic(int body) override;
   bool isKinematic(int body) const override;
-  void addStatic(const std::vector<Shape>& shapes, const Pose& pose) override;
+  int addStatic(const std::vector<Shape>& shapes, const Pose& pose) override;
   void setTaskRunner(TaskRunner* runner) override { runner_ = runner; }
   void step(Nanoseconds dt, std::span<const Wrench> wrenches) override;
   void readStates(std::span<BodyState> out) const override;
@@ -127,7 +127,9 @@ class BulletEngine final : public PhysicEngine {
   std::vector<std::unique_ptr<StaticObject>> statics_;
   std::vector<Joint> joints_;
   std::vector<int> articulation_;  // per body: the lowest body it is joined to (itself when none)
+  std::vector<int> hangs_from_;    // per body: the static group its articulation hangs from, or -1
   bool labels_stale_ = false;      // joints came or went since articulation_ was computed
+  int static_groups_ = 0;          // addStatic's calls so far
   std::size_t scene_joints_ = 0;   // joints_[0, scene_joints_) are the scene's (once sealed_)
   bool sealed_ = false;
   std::size_t live_joints_ = 0;

@@ -37,6 +37,7 @@ struct BulletEngine::StaticObject {
   bool plane = false;
   Vec3 normal = Vec3::UnitZ();
   double offset = 0.0;  // plane: normal . x = offset
+  int group = 0;        // addStatic's
 };
 
 struct BulletEngine::Context {

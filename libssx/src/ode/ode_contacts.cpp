@@ -78,15 +78,21 @@ void OdeEngine::collidePair(dGeomID a, dGeomID b, std::vector<dContact>& out, st
   // nothing between two things that cannot move (static shapes and kinematic bodies)
   auto movable = [this](dGeomID g) {
     const auto owner = reinterpret_cast<std::intptr_t>(dGeomGetData(g));
-    return owner != 0 && !bodies_[static_cast<std::size_t>(owner - 1)].kinematic;
+    return owner > 0 && !bodies_[static_cast<std::size_t>(owner - 1)].kinematic;
   };
   if (!movable(a) && !movable(b)) return;
-  // nothing between bodies joined to each other
+  // nothing between bodies joined to each other, nor between an articulation and the static
+  // shapes it hangs from
   const auto owner_a = reinterpret_cast<std::intptr_t>(dGeomGetData(a));
   const auto owner_b = reinterpret_cast<std::intptr_t>(dGeomGetData(b));
-  if (owner_a != 0 && owner_b != 0 &&
+  if (owner_a > 0 && owner_b > 0 &&
       articulation_[static_cast<std::size_t>(owner_a - 1)] == articulation_[static_cast<std::size_t>(owner_b - 1)])
     return;
+  if ((owner_a > 0) != (owner_b > 0)) {
+    const auto body = static_cast<std::size_t>(std::max(owner_a, owner_b) - 1);
+    const auto group = static_cast<int>(-1 - std::min(owner_a, owner_b));
+    if (hangs_from_[body] == group) return;
+  }
   const int n = dCollide(a, b, static_cast<int>(scratch.size()), &scratch[0].geom, sizeof(dContact));
   const PhysicsSettings& s = settings_;
   for (int i = 0; i < n; ++i) {
@@ -171,7 +177,7 @@ void OdeEngine::collide() {
   for (const dContact& c : contacts_) {
     const auto owner_a = reinterpret_cast<std::intptr_t>(dGeomGetData(c.geom.g1));
     const auto owner_b = reinterpret_cast<std::intptr_t>(dGeomGetData(c.geom.g2));
-    if (owner_a == 0 || owner_b == 0) continue;
+    if (owner_a <= 0 || owner_b <= 0) continue;
     const int ra = find(static_cast<int>(owner_a - 1));
     const int rb = find(static_cast<int>(owner_b - 1));
     if (ra == rb) continue;

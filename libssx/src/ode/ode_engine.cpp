@@ -241,7 +241,7 @@ int OdeEngine::addBody(const MassProperties& mass, const std::vector<Shape>& sha
     dQuaternion q;
     toOde(s.pose.orientation, q);
     dRfromQ(g.offset_rotation, q);
-    // which body a geom belongs to, for the contact callback (static geoms: 0)
+    // which body a geom belongs to, for the contact callback (static geoms: -1 - their group)
     dGeomSetData(g.id, reinterpret_cast<void*>(static_cast<std::intptr_t>(index) + 1));
     body.geoms.push_back(g);
   }
@@ -262,13 +262,16 @@ void OdeEngine::setKinematic(int index) {
 
 bool OdeEngine::isKinematic(int index) const { return bodies_.at(static_cast<std::size_t>(index)).kinematic; }
 
-void OdeEngine::addStatic(const std::vector<Shape>& shapes, const Pose& pose) {
+int OdeEngine::addStatic(const std::vector<Shape>& shapes, const Pose& pose) {
   ensureThreadData();
+  const int group = static_groups_++;
+  void* const data = reinterpret_cast<void*>(static_cast<std::intptr_t>(-1 - group));
   for (const auto& s : shapes) {
     const Pose world = pose * s.pose;
     if (s.kind == Shape::Kind::Plane) {
       const Vec3 n = world.orientation * Vec3::UnitZ();
       dGeomID plane = dCreatePlane(nullptr, n.x(), n.y(), n.z(), n.dot(world.position));
+      dGeomSetData(plane, data);
       static_geoms_.push_back(plane);
       planes_.push_back(plane);
       continue;
@@ -278,9 +281,11 @@ void OdeEngine::addStatic(const std::vector<Shape>& shapes, const Pose& pose) {
     toOde(world.orientation, q);
     dGeomSetPosition(g, world.position.x(), world.position.y(), world.position.z());
     dGeomSetQuaternion(g, q);
+    dGeomSetData(g, data);
     static_geoms_.push_back(g);
   }
   proxies_stale_ = true;
+  return group;
 }
 
 // A body's state bit for bit: position, quaternion, rotation matrix (ODE keeps both; R is not
@@ -377,6 +382,7 @@ void OdeEngine::step(Nanoseconds dt, std::span<const Wrench> wrenches) {
   if (group_.size() != bodies_.size()) group_.assign(bodies_.size(), -1);
   if (labels_stale_ || articulation_.size() != bodies_.size()) {
     labelArticulations(articulation_, bodies_.size(), joints_);
+    labelStaticParents(hangs_from_, articulation_, joints_);
     labels_stale_ = false;
   }
   for (int k = 0; k < substeps; ++k) {
@@ -388,9 +394,9 @@ void OdeEngine::step(Nanoseconds dt, std::span<const Wrench> wrenches) {
     for (const dContact& c : contacts_) {
       const auto owner_a = reinterpret_cast<std::intptr_t>(dGeomGetData(c.geom.g1));
       const auto owner_b = reinterpret_cast<std::intptr_t>(dGeomGetData(c.geom.g2));
-      const dBodyID a = owner_a != 0 ? bodies_[static_cast<std::size_t>(owner_a - 1)].id : nullptr;
-      const dBodyID b = owner_b != 0 ? bodies_[static_cast<std::size_t>(owner_b - 1)].id : nullptr;
-      const int owner = static_cast<int>((owner_a != 0 ? owner_a : owner_b) - 1);
+      const dBodyID a = owner_a > 0 ? bodies_[static_cast<std::size_t>(owner_a - 1)].id : nullptr;
+      const dBodyID b = owner_b > 0 ? bodies_[static_cast<std::size_t>(owner_b - 1)].id : nullptr;
+      const int owner = static_cast<int>((owner_a > 0 ? owner_a : owner_b) - 1);
       Partition& p = partitions_[static_cast<std::size_t>(bodies_[static_cast<std::size_t>(owner)].partition)];
       dJointID j = dJointCreateContact(p.world, p.contacts, &c);
       dJointAttach(j, a, b);

@@ -47,7 +47,7 @@ class OdeEngine final : public PhysicEngine {
   int addBody(const MassProperties& mass, const std::vector<Shape>& shapes, const BodyState& state) override;
   void setKinematic(int body) override;
   bool isKinematic(int body) const override;
-  void addStatic(const std::vector<Shape>& shapes, const Pose& pose) override;
+  int addStatic(const std::vector<Shape>& shapes, const Pose& pose) override;
   void setTaskRunner(TaskRunner* runner) override { runner_ = runner; }
   void step(Nanoseconds dt, std::span<const Wrench> wrenches) override;
   void readStates(std::span<BodyState> out) const override;
@@ -139,6 +139,7 @@ class OdeEngine final : public PhysicEngine {
   std::vector<Body> bodies_;
   std::vector<Joint> joints_;
   std::vector<int> articulation_;  // per body: the lowest body it is joined to (itself when none)
+  std::vector<int> hangs_from_;    // per body: the static group its articulation hangs from, or -1
   bool labels_stale_ = false;      // joints came or went since articulation_ was computed
   std::size_t scene_joints_ = 0;   // joints_[0, scene_joints_) are the scene's (once sealed_)
   bool sealed_ = false;
@@ -148,6 +149,7 @@ class OdeEngine final : public PhysicEngine {
   // the grid broadphase: one box per geom (the bodies' geoms in body order, then static ones),
   // the planes apart; contacts found per chunk, joined in chunk order
   std::vector<dGeomID> static_geoms_;
+  int static_groups_ = 0;  // addStatic's calls so far
   std::vector<dGeomID> planes_;
   std::vector<dGeomID> proxy_geoms_;
   std::vector<GridBroadphase::Box> boxes_;

@@ -165,8 +165,9 @@ std::vector<RecordedBody> recordedBodies(const Environment& env) {
     const PhysicNode* first = nullptr;
     for (std::size_t r = 0; r < a.rootCount() && first == nullptr; ++r)
       if (!a.root(r).isStatic() && a.root(r).bodyIndex() >= 0) first = &a.root(r);
-    if (first == nullptr) continue;
-    out.push_back({a.name(), first});
+    // (a static-rooted articulation, a door or an arm on a table: its moving parts only, each named
+    // for its node, its first not standing for the artifact)
+    if (first != nullptr) out.push_back({a.name(), first});
     for (std::size_t k = 0; k < a.nodeCount(); ++k) {
       const PhysicNode& n = a.nodeAt(k);
       if (&n == first || n.isStatic() || n.bodyIndex() < 0) continue;

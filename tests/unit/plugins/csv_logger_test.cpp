@@ -6,6 +6,7 @@
 #include <catch2/catch.hpp>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <fstream>
 
@@ -105,4 +106,41 @@ TEST_CASE("csv_logger: bodies=\"all\" logs every body of an artifact, joined chi
   double t, x, y, z;
   REQUIRE(std::sscanf(rows[100].c_str(), "%lf,%63[^,],%lf,%lf,%lf", &t, name, &x, &y, &z) == 5);
   CHECK(Vec3(x, y, z).isApprox(arm, 1e-6));
+}
+
+TEST_CASE("csv_logger, recorder: a static-rooted articulation's moving parts are logged and recorded, its base not",
+          "[scene][csv][joints][record]") {
+  // a pendulum on a fixed pivot (a door, an arm on a table): before, artifacts="*" and recordings
+  // left out the whole artifact, since its root does not move
+  fs::create_directories("csv_static_root");
+  std::ofstream("csv_static_root/pendulum.xml") << R"(<artifact>
+  <physic name="base" static="true"><box size="0.1 0.1 0.1"/>
+    <physic name="arm" joint="hinge" axis="0 1 0" rpy="0 1 0" mass="1"><sphere radius="0.05" xyz="0 0 -1"/></physic>
+  </physic>
+</artifact>
+)";
+  Scene scene = loadSceneFromString(R"(<scene><environment timestep="0.01"/><type name="p" file="pendulum.xml"/>
+    <artifact name="p" type="p" xyz="0 0 2"/>
+    <extension name="log" plugin="csv_logger" file="moving.csv" bodies="all"/></scene>)",
+                                    "memory.xml", fs::current_path() / "csv_static_root");
+  Environment& env = *scene.environment;
+  RecordOptions record;
+  record.file = fs::current_path() / "csv_static_root" / "moving.mcap";
+  record.scene_xml = scene.model->toXml();
+  record.rate_hz = 100;  // every step
+  Recorder recorder(env, record);
+  env.step(50);
+  const PhysicNode& arm = *env.findArtifact("p")->node("arm");
+  CHECK(recorder.finish().bodies == 1);
+  env.stop();
+  const auto rows = fileLines("moving.csv");
+  REQUIRE(rows.size() == 1 + 50);  // the arm's row each step, none for the base
+  REQUIRE(rows[50].rfind("0.5,p/arm,", 0) == 0);
+  const Recording r(record.file);
+  REQUIRE(r.names() == std::vector<std::string>{"p/arm"});
+  // the arm as it turned: it swung (from where it was placed, 1 rad out) and the recording has it
+  CHECK(arm.jointPosition() < -0.1);
+  const std::vector<float> q = r.orientations(r.times().size() - 1);
+  const Quat& o = arm.pose().orientation;
+  CHECK(std::abs(q[0] * o.w() + q[1] * o.x() + q[2] * o.y() + q[3] * o.z()) > 1 - 1e-6);
 }
