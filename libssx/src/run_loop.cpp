@@ -161,6 +161,14 @@ TimingSummary Environment::run(const RunOptions& options) {
     throw ConfigError({}, "real-time priority must be from " + std::to_string(kMinRealtimePriority) + " to " +
                               std::to_string(kMaxRealtimePriority) + " (0: off)");
   if (state() == State::Setup) start();
+  // the stop flag, for plugins that wait (stopRequested), while this run runs
+  struct StopFlag {
+    std::atomic<const std::atomic<bool>*>& slot;
+    StopFlag(std::atomic<const std::atomic<bool>*>& s, const std::atomic<bool>* flag) : slot(s) { slot = flag; }
+    ~StopFlag() { slot = nullptr; }
+    StopFlag(const StopFlag&) = delete;
+    StopFlag& operator=(const StopFlag&) = delete;
+  } stop_flag(run_stop_, options.stop);
   // wake within 1 ns of the deadline, not the default 50 us; the slack is the calling thread's,
   // so it is put back when the run ends, however it ends
   struct TimerSlack {

@@ -114,9 +114,12 @@ class BridgeExtension : public SimulationExtension {
   }
 
   void beforeStep(Environment& env) override {
+    // (a Ctrl-C while waiting ends the wait; the run ends after this step)
+    const auto stop = [&env] { return env.stopRequested(); };
     if (lockstep_ && !connected_) {
       // before the first step: the controllers must be connected, or the first odometry is lost
-      const auto missing = transport_->waitForPeers(connect_timeout_);
+      const auto missing = transport_->waitForPeers(connect_timeout_, stop);
+      if (!missing.empty() && env.stopRequested()) return;
       if (!missing.empty())
         throw Error("lock-step: no controller connected within " + std::to_string(connect_timeout_) +
                     " s (subscribed to /<robot>/odom and publishing /<robot>/setpoint) for " +
@@ -128,7 +131,8 @@ class BridgeExtension : public SimulationExtension {
       // not have heard the first odometry yet (and one matched may be a peer that just left, whose
       // endpoints DDS still lists until their lease runs out)
       const double wait = answered_ ? lockstep_timeout_ : std::max(lockstep_timeout_, connect_timeout_);
-      const auto missing = transport_->waitForSetpoints(waiting_for_, wait);
+      const auto missing = transport_->waitForSetpoints(waiting_for_, wait, stop);
+      if (!missing.empty() && env.stopRequested()) return;
       if (!missing.empty()) {
         std::string names;
         for (std::size_t i = 0; i < missing.size() && i < 5; ++i) names += (i ? ", " : "") + missing[i];

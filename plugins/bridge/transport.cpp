@@ -264,20 +264,26 @@ std::vector<std::string> Transport::missingSetpoints(double time) const {
   return names;
 }
 
-std::vector<std::string> Transport::waitForSetpoints(double time, double timeout_s) const {
+std::vector<std::string> Transport::waitForSetpoints(double time, double timeout_s,
+                                                     const std::function<bool()>& stop) const {
+  const auto deadline = std::chrono::steady_clock::now() +
+                        std::chrono::duration_cast<std::chrono::steady_clock::duration>(std::chrono::duration<double>(timeout_s));
   std::unique_lock<std::mutex> lock(mutex_);
-  arrived_.wait_for(lock, std::chrono::duration<double>(timeout_s), [&] { return missingSetpoints(time).empty(); });
+  // (in slices, between which the stop flag, which nobody notifies, is looked at)
+  while (!missingSetpoints(time).empty() && std::chrono::steady_clock::now() < deadline && !stop())
+    arrived_.wait_until(lock, std::min(deadline, std::chrono::steady_clock::now() + std::chrono::milliseconds(20)),
+                        [&] { return missingSetpoints(time).empty(); });
   return missingSetpoints(time);
 }
 
-std::vector<std::string> Transport::waitForPeers(double timeout_s) const {
+std::vector<std::string> Transport::waitForPeers(double timeout_s, const std::function<bool()>& stop) const {
   const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(timeout_s);
   std::vector<std::string> missing;
   for (;;) {
     missing.clear();
     for (std::size_t i = 0; i < robots_.size(); ++i)
       if ((robots_[i].setpoint || robots_[i].ghost || robots_[i].joy) && !connected(i)) missing.push_back(robots_[i].name);
-    if (missing.empty() || std::chrono::steady_clock::now() >= deadline) return missing;
+    if (missing.empty() || std::chrono::steady_clock::now() >= deadline || stop()) return missing;
     std::this_thread::sleep_for(std::chrono::milliseconds(20));
   }
 }

@@ -14,6 +14,7 @@
 #include <chrono>
 #include <condition_variable>
 #include <cstdint>
+#include <functional>
 #include <map>
 #include <mutex>
 #include <string>
@@ -132,11 +133,12 @@ class Transport {
   std::uint64_t posesDropped() const;
   // Waits until every robot with a set-point topic has one stamped at or after `time` (seconds),
   // every ghost a pose and every operator a joystick state, at most `timeout_s`; returns the names
-  // of those still missing (empty: all there).
-  std::vector<std::string> waitForSetpoints(double time, double timeout_s) const;
+  // of those still missing (empty: all there). Gives up early when `stop` (looked at every 20 ms)
+  // says so: a Ctrl-C ends a run waiting here.
+  std::vector<std::string> waitForSetpoints(double time, double timeout_s, const std::function<bool()>& stop) const;
   // Waits until every robot that takes set-points or poses, and every operator, has its peers (connected()), at most
-  // `timeout_s`; returns the names of the robots still unconnected.
-  std::vector<std::string> waitForPeers(double timeout_s) const;
+  // `timeout_s` or until `stop`; returns the names of the robots still unconnected.
+  std::vector<std::string> waitForPeers(double timeout_s, const std::function<bool()>& stop) const;
   // Round trips in wall-clock seconds: from sending the odometry of time t (robot 0's) to receiving
   // a set-point stamped t (one sample per set-point that answers an odometry message).
   std::vector<double> roundTrips() const;

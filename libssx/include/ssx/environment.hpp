@@ -417,6 +417,13 @@ class SSX_EXPORT Environment {
 
   /// Pausing, single steps and the real-time factor of run(), from any thread.
   RunControl& runControl() noexcept { return *run_control_; }
+  /// Whether run() is running with a stop flag (RunOptions::stop) that is now set (a Ctrl-C): a
+  /// plugin that waits on something outside the simulation (a bridge in lock-step waiting for its
+  /// controllers) stops waiting, so that the run ends after the step. Safe from any thread.
+  bool stopRequested() const noexcept {
+    const std::atomic<bool>* stop = run_stop_.load();
+    return stop != nullptr && stop->load();
+  }
   /// Per-step timing of every step taken so far.
   TimingRecorder& timing() noexcept { return timing_; }
   /// @copydoc timing()
@@ -460,6 +467,7 @@ class SSX_EXPORT Environment {
   std::vector<std::pair<std::size_t, std::function<void(const Environment&)>>> listeners_;
   std::size_t next_listener_ = 0;
   std::unique_ptr<RunControl> run_control_ = std::make_unique<RunControl>();
+  std::atomic<const std::atomic<bool>*> run_stop_{nullptr};  // RunOptions::stop while run() runs
 };
 
 template <class M>

@@ -9,12 +9,16 @@
 #include <catch2/catch.hpp>
 
 #include <atomic>
+#include <chrono>
+#include <functional>
 #include <mutex>
 #include <thread>
 
 using namespace ssx::bridge;
 
 namespace {
+
+const std::function<bool()> kNever = [] { return false; };
 
 class Recording final : public Transport {
  public:
@@ -78,10 +82,10 @@ TEST_CASE("bridge transport: staged messages go out in order, on its own thread,
 TEST_CASE("bridge transport: what arrives, in order, with its round trip, lock-step's waits", "[bridge]") {
   Recording t(twoRobots());
   CHECK(t.latestSetpoint(0).count == 0);
-  CHECK(t.waitForSetpoints(0.0, 0.01) == std::vector<std::string>{"a", "b"});
-  CHECK(t.waitForPeers(0.01) == std::vector<std::string>{"a", "b"});
+  CHECK(t.waitForSetpoints(0.0, 0.01, kNever) == std::vector<std::string>{"a", "b"});
+  CHECK(t.waitForPeers(0.01, kNever) == std::vector<std::string>{"a", "b"});
   t.peer = true;
-  CHECK(t.waitForPeers(0.01).empty());
+  CHECK(t.waitForPeers(0.01, kNever).empty());
 
   Odometry o;
   o.time = 0.02;
@@ -98,12 +102,29 @@ TEST_CASE("bridge transport: what arrives, in order, with its round trip, lock-s
   CHECK(v.order < s.order);  // the velocity came first
   CHECK(t.roundTrips().size() == 1);  // the set-point stamped 0.02 answered the odometry of 0.02
   // b has not answered yet: the wait names it, then returns as soon as it does
-  CHECK(t.waitForSetpoints(0.02, 0.01) == std::vector<std::string>{"b"});
+  CHECK(t.waitForSetpoints(0.02, 0.01, kNever) == std::vector<std::string>{"b"});
   std::thread answer([&] { t.receivedSetpoint(1, 0.02, {0, 0, 1}, {1, 0, 0, 0}); });
-  CHECK(t.waitForSetpoints(0.02, 5.0).empty());
+  CHECK(t.waitForSetpoints(0.02, 5.0, kNever).empty());
   answer.join();
   // an older stamp does not answer a newer odometry
-  CHECK(t.waitForSetpoints(0.04, 0.01) == std::vector<std::string>{"a", "b"});
+  CHECK(t.waitForSetpoints(0.04, 0.01, kNever) == std::vector<std::string>{"a", "b"});
+}
+
+TEST_CASE("bridge transport: lock-step's waits end when the run is stopped (Ctrl-C), not at their timeout", "[bridge]") {
+  Recording t(twoRobots());
+  std::atomic<bool> stop{false};
+  const std::function<bool()> stopped = [&] { return stop.load(); };
+  for (int which = 0; which < 2; ++which) {
+    INFO((which == 0 ? "waiting for set-points" : "waiting for peers"));
+    stop = false;
+    const auto began = std::chrono::steady_clock::now();
+    std::thread ctrl_c([&] { stop = true; });
+    // an hour's timeout: it returns once the flag is seen, naming who is still missing
+    const auto missing = which == 0 ? t.waitForSetpoints(0.02, 3600, stopped) : t.waitForPeers(3600, stopped);
+    ctrl_c.join();
+    CHECK(missing == std::vector<std::string>{"a", "b"});
+    CHECK(std::chrono::steady_clock::now() - began < std::chrono::seconds(60));
+  }
 }
 
 TEST_CASE("bridge transport: a ghost's poses are all kept, in arrival order, bounded", "[bridge]") {
@@ -124,9 +145,9 @@ TEST_CASE("bridge transport: a ghost's poses are all kept, in arrival order, bou
   // lock-step waits for a ghost's pose as for a set-point
   t.receivedSetpoint(0, 0.04, {0, 0, 0}, {1, 0, 0, 0});
   t.receivedSetpoint(1, 0.04, {0, 0, 0}, {1, 0, 0, 0});
-  CHECK(t.waitForSetpoints(0.04, 0.01) == std::vector<std::string>{"b"});
+  CHECK(t.waitForSetpoints(0.04, 0.01, kNever) == std::vector<std::string>{"b"});
   t.receivedPose(1, 0.04, {0, 0, 0}, {1, 0, 0, 0});
-  CHECK(t.waitForSetpoints(0.04, 0.01).empty());
+  CHECK(t.waitForSetpoints(0.04, 0.01, kNever).empty());
   t.takePoses(got);
   // nobody takes them: at most 1,024 wait, the oldest dropped and counted (from another thread)
   std::thread flood([&] {

@@ -6,7 +6,9 @@
 # (2) A peer that vanishes mid-run: the run stops with the lock-step message, inside its timeout.
 # (3) Without a peer the run fails, inside its connect timeout, with the documented message.
 # (4) A domain ROS 2 cannot use is refused before anything runs. (5) So is a run whose DDS cannot
-# start (network="system" with a broken CYCLONEDDS_URI), with the reason.
+# start (network="system" with a broken CYCLONEDDS_URI), with the reason. (6) Ctrl-C (SIGINT) or
+# SIGTERM while lock-step waits for a controller that never comes ends the run at once, with 130
+# or 143, not at the wait's timeout (an hour here).
 #
 # usage: plugin_test.sh SSX_BINARY PEER_BINARY
 set -u
@@ -67,3 +69,21 @@ cat "$work/system.err"
 echo "(5) DDS cannot start: ssx run exit $status"
 [ $status -ne 0 ] || exit 1
 grep -q "system.xml:[0-9]*: error: .*ros2: joining DDS domain 62 .*failed" "$work/system.err" || exit 1
+
+sed -e 's|lockstep_connect_timeout_s="2"|lockstep_connect_timeout_s="3600"|' "$work/alone.xml" > "$work/hour.xml"
+for sig in INT TERM; do
+  "$ssx" run "$work/hour.xml" --fast 2> "$work/hour.err" &
+  ssx_pid=$!
+  # once the run has begun (its summary line printed), it waits for a controller
+  for _ in $(seq 1 300); do grep -q "artifacts," "$work/hour.err" && break; sleep 0.1; done
+  start=$(date +%s)
+  kill -s "$sig" "$ssx_pid"
+  wait "$ssx_pid"
+  status=$?
+  elapsed=$(( $(date +%s) - start ))
+  cat "$work/hour.err"
+  echo "(6) SIG$sig while waiting for a controller: ssx exit $status after ${elapsed} s"
+  expected=130; [ "$sig" = TERM ] && expected=143
+  [ $status -eq $expected ] || exit 1
+  [ $elapsed -lt 30 ] || exit 1
+done
