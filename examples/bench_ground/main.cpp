@@ -1,4 +1,4 @@
-// ssx_bench_ground: the cost of ground swarms, beside ARGoS's figures (issue 39).
+// ssx_bench_ground: the cost of ground swarms, beside the figures ARGoS gave on this machine.
 //
 // The diffusion scene (examples/ground/diffusion.xml's e-pucks, swarm model, eight proximity rays
 // and a range-and-bearing board each; 50 control steps and 500 physics steps per simulated second)
@@ -89,7 +89,7 @@ int main(int argc, char** argv) {
   }
   if (quick) ticks = 20;
   std::printf("swarm model: e-pucks, 8 proximity rays + range-and-bearing each, 20 ms ticks of 10 physics steps\n");
-  std::printf("ARGoS on this machine (issue 39): 1,000 foot-bots 22.9 ms/tick on 1 thread, 17.2 on 2, 11.4 best;"
+  std::printf("ARGoS on this machine: 1,000 foot-bots 22.9 ms/tick on 1 thread, 17.2 on 2, 11.4 best;"
               " 10,000: 365, 265, 201\n\n");
   std::printf("%8s %8s %12s %10s %14s %10s\n", "robots", "threads", "median ms", "p95 ms", "us per robot", "physics");
   const std::vector<int> counts = quick ? std::vector<int>{100, 1000} : std::vector<int>{100, 1000, 10000};

@@ -5,16 +5,20 @@
 /// One step (`step()`), advancing simulated time by one timestep:
 ///   1. extensions' beforeStep (calling thread)
 ///   2. physics: the engine integrates the timestep (in `substeps` parts) with the forces the
-///      drivers wrote before; no plugin code runs
+///      drivers wrote before and the joints' motors; ghosts move to their next poses; no plugin
+///      code runs
 ///   3. snapshot: every body's new pose, velocities and accelerations are published read-only and
-///      checked for NaN / infinity
+///      checked for NaN / infinity; the neighbour index is marked stale (rebuilt by the first
+///      query that needs it) and the engine readies its ray queries; then the images the sensors
+///      asked for last step (camera requests) are rendered
 ///   4. sensors, in parallel over artifacts: each due sensor reads the snapshot and writes its
 ///      own measurement
 ///   5. drivers, in parallel over artifacts: each artifact's subscribed callbacks get the fresh
 ///      measurements (ordered by source artifact, sensor, subscription), then its driver runs
-///      if due and writes its own command buffer
+///      if due and writes its own command buffer; then the joints the drivers asked for (attach
+///      requests) are made, at the poses they saw
 ///   6. render, when due: render items are posed from the snapshot and a frame is drawn
-///   7. extensions' afterStep (calling thread)
+///   7. extensions' afterStep (calling thread), then the step listeners (addStepListener)
 /// A plugin that throws, or a non-finite state, abandons the step with a StepError; the
 /// environment is then failed and refuses further steps. `step()` never sleeps: pacing is in
 /// `run()`.
@@ -337,8 +341,9 @@ class SSX_EXPORT Environment {
 
   /// Neighbour queries. A plugin that wants them calls enableNeighborQueries from configure (never
   /// from sense, step or a callback: those run in parallel with the queries); from
-  /// then on the index of every artifact's first dynamic root position is rebuilt once per step,
-  /// in the snapshot phase (the smallest cell size asked for wins).
+  /// then on the index of every artifact's first dynamic root position is rebuilt when first
+  /// queried after a step (a step without a query builds none; the smallest cell size asked for
+  /// wins).
   void enableNeighborQueries(double cell_size);
   /// Whether a plugin enabled neighbour queries.
   bool neighborQueriesEnabled() const noexcept;
