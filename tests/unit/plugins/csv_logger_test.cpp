@@ -9,6 +9,7 @@
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <string>
 
 using namespace ssx;
 using ssx::test::kData;
@@ -18,6 +19,17 @@ namespace fs = std::filesystem;
 using ssx::test::fileLines;
 
 namespace {
+// dir/pendulum.xml: an arm hinged about y to a static base (with `base_shapes`), turned 1 rad,
+// its 1 kg bob 1 m below the pivot
+void writePendulum(const fs::path& dir, const std::string& base_shapes) {
+  fs::create_directories(dir);
+  std::ofstream(dir / "pendulum.xml") << R"(<artifact>
+  <physic name="base" static="true">)" << base_shapes << R"(
+    <physic name="arm" joint="hinge" axis="0 1 0" rpy="0 1 0" mass="1"><sphere radius="0.05" xyz="0 0 -1"/></physic>
+  </physic>
+</artifact>
+)";
+}
 std::string loggerScene(const std::string& file, const std::string& flush_s) {
   return R"(<scene><environment timestep="0.01"/><type name="ball" file="ball.xml"/>
     <artifact name="b" type="ball" xyz="0 0 1"/>
@@ -82,13 +94,7 @@ TEST_CASE("csv_logger: a write that fails stops the run naming the file", "[scen
 }
 
 TEST_CASE("csv_logger: bodies=\"all\" logs every body of an artifact, joined children as artifact/node", "[scene][csv][joints]") {
-  fs::create_directories("csv_joints");
-  std::ofstream("csv_joints/pendulum.xml") << R"(<artifact>
-  <physic name="base" static="true">
-    <physic name="arm" joint="hinge" axis="0 1 0" rpy="0 1 0" mass="1"><sphere radius="0.05" xyz="0 0 -1"/></physic>
-  </physic>
-</artifact>
-)";
+  writePendulum("csv_joints", "");
   Scene scene = loadSceneFromString(R"(<scene><environment timestep="0.01"/><type name="p" file="pendulum.xml"/>
     <artifact name="p" type="p" xyz="0 0 2"/>
     <extension name="log" plugin="csv_logger" file="bodies.csv" bodies="all" artifacts="p"/></scene>)",
@@ -112,13 +118,7 @@ TEST_CASE("csv_logger, recorder: a static-rooted articulation's moving parts are
           "[scene][csv][joints][record]") {
   // a pendulum on a fixed pivot (a door, an arm on a table): before, artifacts="*" and recordings
   // left out the whole artifact, since its root does not move
-  fs::create_directories("csv_static_root");
-  std::ofstream("csv_static_root/pendulum.xml") << R"(<artifact>
-  <physic name="base" static="true"><box size="0.1 0.1 0.1"/>
-    <physic name="arm" joint="hinge" axis="0 1 0" rpy="0 1 0" mass="1"><sphere radius="0.05" xyz="0 0 -1"/></physic>
-  </physic>
-</artifact>
-)";
+  writePendulum("csv_static_root", R"(<box size="0.1 0.1 0.1"/>)");
   Scene scene = loadSceneFromString(R"(<scene><environment timestep="0.01"/><type name="p" file="pendulum.xml"/>
     <artifact name="p" type="p" xyz="0 0 2"/>
     <extension name="log" plugin="csv_logger" file="moving.csv" bodies="all"/></scene>)",
