@@ -68,6 +68,14 @@ py::tuple snapshot(const ssx::Recording& r, double t, const std::vector<fs::path
     py::gil_scoped_release release;
     ssx::Scene scene = ssx::loadSceneFromString(r.sceneXml(), r.sceneLabel().empty() ? std::string("recorded scene") : r.sceneLabel(),
                                                 fs::current_path(), options);
+    // (a file the scene names outside the temporary folder, by an absolute path, is the user's)
+    for (const fs::path& file : scene.files.outputs()) {
+      const fs::path rel = file.lexically_relative(out);
+      if (rel.empty() || *rel.begin() == "..")
+        throw py::value_error("ssx: snapshot(" + std::to_string(t) + ") re-simulates the recorded scene, which writes " +
+                              file.string() + ": it would be written over; take a saved state (state_times) or "
+                              "re-simulate with ssx replay --resimulate-from");
+    }
     ssx::Environment& env = *scene.environment;
     env.checkState(state);
     fs::create_directories(out, ec);

@@ -88,3 +88,21 @@ def test_optional_channels_from_python(tmp_path):
     assert t == pytest.approx(0.2) and set(sensors) == {"mk", "hb", "cf"}
     kinds = sorted(m["kind"] for m in sensors["mk"].values())
     assert "imu" in kinds and "pose" in kinds
+
+
+def test_snapshot_between_saved_states_never_writes_over_the_scenes_absolute_outputs(tmp_path):
+    log = tmp_path / "poses.csv"
+    box = ssx.data_directory() / "artifacts" / "box.xml"
+    env = ssx.load_scene_string(f"""<scene><environment timestep="0.01"/><type name="b" file="{box}"/>
+      <artifact name="b" type="b" xyz="0 0 1"/>
+      <extension name="log" plugin="csv_logger" file="{log}"/></scene>""")
+    env.record(tmp_path / "run.mcap", state_every_s=1.0)
+    env.step(150)
+    env.close()
+    written = log.read_bytes()
+    r = ssx.Recording(tmp_path / "run.mcap")
+    saved = r.state_times[1]
+    assert r.snapshot(saved)[0] == pytest.approx(saved)  # a saved state: nothing re-simulated
+    with pytest.raises(ValueError, match="poses.csv: it would be written over"):
+        r.snapshot(1.2)
+    assert log.read_bytes() == written
