@@ -201,6 +201,7 @@ void placement(std::ostringstream& out, const PlacementModel& p) {
     case PlacementModel::Kind::Artifact: {
       Element e(out, "artifact", 1);
       e("name", p.name)("type", p.type)("xyz", vec(p.xyz))("rpy", vec(p.rpy));
+      if (p.allow_overlap) e("allow_overlap", "true");
       overrides(out, p, e);
       break;
     }
@@ -212,6 +213,7 @@ void placement(std::ostringstream& out, const PlacementModel& p) {
       if (p.layout == "random") e("min", vec(p.min))("max", vec(p.max))("min_distance", num(p.min_distance));
       if (p.layout == "sphere") e("radius", num(p.radius));
       if (p.random_yaw) e("random_yaw", "true");
+      if (p.allow_overlap) e("allow_overlap", "true");
       overrides(out, p, e);
       break;
     }

@@ -28,7 +28,7 @@ TEST_CASE("render: drawing frames and camera images does not change the simulati
     xml += R"(</render><ground/>
       <type name="post" file="camera_post.xml"/><type name="ball" file="yellow_ball.xml"/>
       <type name="quad" file=")" + std::string(SSX_EXAMPLES_DIR) + R"(/artifacts/mk_quad.xml"/>
-      <swarm type="quad" count="6" name="q{i}" spacing="1.5"/>)";
+      <swarm type="quad" count="6" name="q{i}" spacing="1.5" xyz="0 0 0.04"/>)";
     if (cameras) xml += R"(<artifact name="eye" type="post" xyz="-3 0 1"/>)";
     xml += R"(<artifact name="ball" type="ball" xyz="2 3 2"/>)";
     Scene s = loadRenderScene(xml);

@@ -22,7 +22,7 @@ TEST_CASE("a plugin's validate works out what a swarm's members share once per s
   const std::string xml = R"(<scene>
     <type name="spinner" file="spinner.xml"/>
     <swarm type="spinner" count="5" name="a{i}" spacing="1"><driver torque="0.2"/></swarm>
-    <swarm type="spinner" count="3" name="b{i}" spacing="1"><driver torque="1.{i}"/></swarm>
+    <swarm type="spinner" count="3" name="b{i}" spacing="1" xyz="0 10 0"><driver torque="1.{i}"/></swarm>
   </scene>)";
   const int before = made();
   (void)loadSceneFromString(xml, "memory.xml", kData / "valid", testOptions());

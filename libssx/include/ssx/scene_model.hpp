@@ -77,6 +77,10 @@ struct SSX_EXPORT PlacementModel {
   // a swarm
   std::int64_t count = 1;        ///< swarm: how many members
   std::int64_t first_index = 0;  ///< swarm: the first member's {i}
+  /// `allow_overlap="true"` (artifacts, swarms, obstacles): it may start overlapping other
+  /// artifacts (a robot in its dock). Otherwise a robot that starts inside another, an obstacle
+  /// or the ground is an error, found when the scene is built.
+  bool allow_overlap = false;
   std::string layout = "grid";  ///< grid, random or sphere
   double spacing = 1.0;         ///< grid
   std::int64_t columns = 0;     ///< grid: members per row (parsing fills in ceil(sqrt(count)) when not given)

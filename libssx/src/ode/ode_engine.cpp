@@ -53,22 +53,6 @@ std::atomic<bool> g_ode_poisoned{false};
   throw Error("ode internal error " + std::to_string(code) + ": " + text);
 }
 
-void acquireOde() {
-  std::lock_guard lock(g_ode_mutex);
-  if (g_ode_users++ == 0) {
-    dInitODE2(0);
-    dSetErrorHandler(&throwOdeError);
-    dSetDebugHandler(&throwOdeError);
-    ++g_ode_generation;
-  }
-}
-
-void releaseOde() {
-  std::lock_guard lock(g_ode_mutex);
-  if (--g_ode_users == 0 && !g_ode_poisoned) dCloseODE();
-}
-
-
 void toOde(const Quat& q, dQuaternion out) {
   out[0] = q.w();
   out[1] = q.x();
@@ -101,6 +85,21 @@ bool seedIsPerWorld() {
 }
 
 }  // namespace
+
+void acquireOde() {
+  std::lock_guard lock(g_ode_mutex);
+  if (g_ode_users++ == 0) {
+    dInitODE2(0);
+    dSetErrorHandler(&throwOdeError);
+    dSetDebugHandler(&throwOdeError);
+    ++g_ode_generation;
+  }
+}
+
+void releaseOde() {
+  std::lock_guard lock(g_ode_mutex);
+  if (--g_ode_users == 0 && !g_ode_poisoned) dCloseODE();
+}
 
 // every thread that calls into ODE needs its own collision data
 void ensureThreadData() {

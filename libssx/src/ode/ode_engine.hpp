@@ -173,6 +173,11 @@ class OdeEngine final : public PhysicEngine {
   mutable std::vector<dGeomID> free_rays_;
 };
 
+// ODE's process-wide initialisation, reference-counted (ode_engine.cpp): each acquireOde is
+// matched by one releaseOde
+void acquireOde();
+void releaseOde();
+
 // every thread that calls into ODE needs its own collision data (ode_engine.cpp)
 void ensureThreadData();
 

@@ -139,6 +139,7 @@ void SceneLoader::readPlacements() {
       p.type = require(d, "type");
       p.xyz = read<Vec3>(d, "xyz", Vec3::Zero());
       p.rpy = read<Vec3>(d, "rpy", Vec3::Zero());
+      p.allow_overlap = read<bool>(d, "allow_overlap", false);
       checkUnknown(d, {"driver", "sensor", "ghost"});
       ok = !p.name.empty() && !p.type.empty() && readOverrides(d, p);
     } else if (d.name() == "swarm") {
@@ -262,6 +263,7 @@ bool SceneLoader::readSwarm(const Descriptor& d, PlacementModel& p, std::size_t 
     p.radius = readPositive(d, "radius", 1.0);
     p.positions = detail::sphereLayout(count, p.radius);
   }
+  p.allow_overlap = read<bool>(d, "allow_overlap", false);
   p.random_yaw = read<bool>(d, "random_yaw", false);
   if (p.random_yaw) {
     // a stream of its own, apart from the random layout's
@@ -283,6 +285,7 @@ bool SceneLoader::readObstacle(const Descriptor& d, PlacementModel& p) {
   p.name = require(d, "name");
   p.xyz = read<Vec3>(d, "xyz", Vec3::Zero());
   p.rpy = read<Vec3>(d, "rpy", Vec3::Zero());
+  p.allow_overlap = read<bool>(d, "allow_overlap", false);
   (void)readColor(d, {0.55f, 0.55f, 0.6f, 1.0f});
   bool shapes = false;
   for (const Descriptor& c : d.children()) {

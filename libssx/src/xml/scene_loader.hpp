@@ -245,6 +245,9 @@ class SceneLoader {
   void buildExtensions(Environment& env, const SceneModel& model);
   void buildObstacle(Environment& env, const PlacementModel& p);
   void buildSwarm(Environment& env, const PlacementModel& p, const ArtifactTypeModel& type);
+  // reports every robot that starts inside another artifact (xml/start_overlaps.cpp);
+  // placement_of[a]: the placement that made artifact a
+  void checkStartOverlaps(const Environment& env, const SceneModel& model, const std::vector<std::size_t>& placement_of);
   // returns false when it reported an error
   bool place(Environment& env, const std::string& name, const PlacementModel& p, const ArtifactTypeModel& type,
              const Pose& pose, const std::string& index = {});

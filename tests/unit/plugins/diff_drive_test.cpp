@@ -146,7 +146,7 @@ TEST_CASE("diff_drive: e-pucks of both models continue with the same bits after 
   for (int k = 0; k < 12; ++k)
     robots += "<artifact name=\"r" + std::to_string(k) + "\" type=\"" + (k % 2 ? "epuck_full" : "epuck") + "\" xyz=\"" +
               std::to_string(0.06 * k) + " " + std::to_string(0.03 * (k % 3)) + " 0\" rpy=\"0 0 " + std::to_string(0.5 * k) +
-              "\"/>";
+              "\" allow_overlap=\"true\"/>";  // 3 mm into their neighbours: in contact from the start
   auto run = [&](int steps, const std::vector<std::byte>* restore) {
     Scene scene = groundScene(engine, robots);
     Environment& env = *scene.environment;

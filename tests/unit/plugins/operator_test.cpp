@@ -126,7 +126,7 @@ TEST_CASE("operator: the force points away from what is near, grows as it nears,
   CHECK(both.y() == Approx(2 * (1 - 1.0 / 1.5)));
   CHECK(both.x() == Approx(mid.x()));
   // saturated
-  CHECK(force(0.05, R"(force_gain="100" force_max="3")").norm() == Approx(3));
+  CHECK(force(0.1, R"(force_gain="100" force_max="3")").norm() == Approx(3));
 }
 
 TEST_CASE("operator: what cannot be steered, and a malformed joystick map, are refused before anything runs",
