@@ -1,0 +1,218 @@
+// The ODE engine's collision: geoms placed and boxed, the grid broadphase, contacts found in
+// parallel chunks and joined in a fixed order, and bodies in contact grouped into one world.
+#include "engines/ode/ode_engine.hpp"
+
+#include <ssx/error.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+
+namespace ssx::detail {
+
+void OdeEngine::placeGeoms(std::size_t begin, std::size_t end) {
+  // what ODE's dxGeom::computePosr does for a geom offset from its body, bit for bit
+  for (std::size_t i = begin; i < end; ++i) {
+    const Body& body = bodies_[i];
+    if (body.geoms.empty()) continue;
+    const dReal* p = dBodyGetPosition(body.id);
+    const dReal* r = dBodyGetRotation(body.id);
+    for (std::size_t k = 0; k < body.geoms.size(); ++k) {
+      const Geom& g = body.geoms[k];
+      dVector3 position;
+      dMatrix3 rotation;
+      dMultiply0_331(position, r, g.offset_position);
+      position[0] += p[0];
+      position[1] += p[1];
+      position[2] += p[2];
+      dMultiply0_333(rotation, r, g.offset_rotation);
+      dGeomSetPosition(g.id, position[0], position[1], position[2]);
+      dGeomSetRotation(g.id, rotation);
+      dReal aabb[6];
+      dGeomGetAABB(g.id, aabb);
+      GridBroadphase::Box& box = boxes_[first_proxy_[i] + k];
+      box.min = Vec3(aabb[0], aabb[2], aabb[4]);
+      box.max = Vec3(aabb[1], aabb[3], aabb[5]);
+    }
+  }
+}
+
+void OdeEngine::indexGeoms() {
+  // the grid's boxes: the bodies' geoms in body order, then the static ones but the planes
+  proxies_stale_ = false;
+  proxy_geoms_.clear();
+  boxes_.clear();
+  first_proxy_.assign(bodies_.size(), 0);
+  for (std::size_t i = 0; i < bodies_.size(); ++i) {
+    first_proxy_[i] = static_cast<std::uint32_t>(proxy_geoms_.size());
+    for (const Geom& g : bodies_[i].geoms) {
+      proxy_geoms_.push_back(g.id);
+      boxes_.push_back({Vec3::Zero(), Vec3::Zero(), static_cast<int>(i)});
+    }
+  }
+  dynamic_proxies_ = proxy_geoms_.size();
+  std::vector<double> diameters;
+  for (const Body& b : bodies_)
+    for (const Geom& g : b.geoms) diameters.push_back(g.diameter);
+  if (!diameters.empty()) {
+    auto middle = diameters.begin() + static_cast<std::ptrdiff_t>(diameters.size() / 2);
+    std::nth_element(diameters.begin(), middle, diameters.end());
+    cell_ = std::max(2.0 * *middle, 1e-3);
+  }
+  // room for what a step usually needs, so that steps do not allocate: every body resting on
+  // something with a few contacts, a contact group's bookkeeping for every body
+  contacts_.reserve(4 * bodies_.size() + 64);
+  touched_.reserve(bodies_.size());
+  away_.reserve(bodies_.size());
+  for (dGeomID g : static_geoms_) {
+    if (dGeomGetClass(g) == dPlaneClass) continue;
+    dReal aabb[6];
+    dGeomGetAABB(g, aabb);
+    proxy_geoms_.push_back(g);
+    boxes_.push_back({Vec3(aabb[0], aabb[2], aabb[4]), Vec3(aabb[1], aabb[3], aabb[5]), -1});
+  }
+}
+
+
+void OdeEngine::collidePair(dGeomID a, dGeomID b, std::vector<dContact>& out, std::vector<dContact>& scratch) const {
+  // nothing between two things that cannot move (static shapes and kinematic bodies)
+  auto movable = [this](dGeomID g) {
+    const auto owner = reinterpret_cast<std::intptr_t>(dGeomGetData(g));
+    return owner > 0 && !bodies_[static_cast<std::size_t>(owner - 1)].kinematic;
+  };
+  if (!movable(a) && !movable(b)) return;
+  // nothing between bodies joined to each other, nor between an articulation and the static
+  // shapes it hangs from
+  const auto owner_a = reinterpret_cast<std::intptr_t>(dGeomGetData(a));
+  const auto owner_b = reinterpret_cast<std::intptr_t>(dGeomGetData(b));
+  if (owner_a > 0 && owner_b > 0 &&
+      articulation_[static_cast<std::size_t>(owner_a - 1)] == articulation_[static_cast<std::size_t>(owner_b - 1)])
+    return;
+  if ((owner_a > 0) != (owner_b > 0)) {
+    const auto body = static_cast<std::size_t>(std::max(owner_a, owner_b) - 1);
+    const auto group = static_cast<int>(-1 - std::min(owner_a, owner_b));
+    if (hangs_from_[body] == group) return;
+  }
+  const int n = dCollide(a, b, static_cast<int>(scratch.size()), &scratch[0].geom, sizeof(dContact));
+  const PhysicsSettings& s = settings_;
+  for (int i = 0; i < n; ++i) {
+    dContact c = scratch[static_cast<std::size_t>(i)];
+    // ODE's narrowphase can report a contact with no direction (two cylinders touching along a
+    // line give a zero normal): its solver would fail on it inside the step, so it is dropped
+    const dContactGeom& g = c.geom;
+    const double length2 = g.normal[0] * g.normal[0] + g.normal[1] * g.normal[1] + g.normal[2] * g.normal[2];
+    if (!(length2 > 0.5 && length2 < 2.0) || !std::isfinite(g.depth) || !std::isfinite(g.pos[0]) ||
+        !std::isfinite(g.pos[1]) || !std::isfinite(g.pos[2]))
+      continue;
+    c.surface.mode = dContactApprox1 | dContactSoftCFM | dContactSoftERP;
+    c.surface.mu = s.friction;
+    c.surface.soft_cfm = s.ode.contact_soft_cfm;
+    c.surface.soft_erp = s.ode.contact_soft_erp;
+    if (s.restitution > 0) {
+      c.surface.mode |= dContactBounce;
+      c.surface.bounce = s.restitution;
+      c.surface.bounce_vel = 0.01;
+    }
+    out.push_back(c);
+  }
+}
+
+void OdeEngine::collide() {
+  contacts_.clear();
+  if (proxies_stale_) indexGeoms();
+  // pose the geoms, in chunks of bodies
+  constexpr std::size_t kBodiesPerChunk = 256;
+  forEach((bodies_.size() + kBodiesPerChunk - 1) / kBodiesPerChunk, [&](std::size_t c) {
+    placeGeoms(c * kBodiesPerChunk, std::min(bodies_.size(), (c + 1) * kBodiesPerChunk));
+  });
+  grid_.build(boxes_, cell_);
+  // pairs and their contacts, in chunks: the dynamic geoms against each plane (their number
+  // fixed by the scene: each chunk keeps the room it needs), then the grid's
+  constexpr std::size_t kGeomsPerPlaneChunk = 512;
+  const std::size_t grid_chunks = grid_.chunkCount();
+  const std::size_t plane_chunks =
+      planes_.empty() ? 0 : (dynamic_proxies_ + kGeomsPerPlaneChunk - 1) / kGeomsPerPlaneChunk;
+  if (chunks_.size() < grid_chunks + plane_chunks) {
+    const std::size_t had = chunks_.size();
+    chunks_.resize(grid_chunks + plane_chunks);
+    for (std::size_t c = had; c < chunks_.size(); ++c) {
+      chunks_[c].scratch.resize(contacts_per_pair_);
+      chunks_[c].pairs.reserve(c < plane_chunks ? 0 : 256);
+      chunks_[c].contacts.reserve(c < plane_chunks ? 4 * kGeomsPerPlaneChunk : 64);
+    }
+  }
+  forEach(grid_chunks + plane_chunks, [&](std::size_t c) {
+    Chunk& chunk = chunks_[c];
+    chunk.contacts.clear();
+    if (c < plane_chunks) {
+      const std::size_t begin = c * kGeomsPerPlaneChunk;
+      const std::size_t end = std::min(dynamic_proxies_, begin + kGeomsPerPlaneChunk);
+      for (std::size_t k = begin; k < end; ++k)
+        for (dGeomID plane : planes_) collidePair(proxy_geoms_[k], plane, chunk.contacts, chunk.scratch);
+      return;
+    }
+    chunk.pairs.clear();
+    grid_.pairs(c - plane_chunks, chunk.pairs);
+    for (const auto& [a, b] : chunk.pairs)
+      collidePair(proxy_geoms_[static_cast<std::size_t>(a)], proxy_geoms_[static_cast<std::size_t>(b)], chunk.contacts,
+                  chunk.scratch);
+  });
+  for (std::size_t c = 0; c < grid_chunks + plane_chunks; ++c)
+    contacts_.insert(contacts_.end(), chunks_[c].contacts.begin(), chunks_[c].contacts.end());
+
+  // contact groups: union-find over the bodies that touch each other (a pinned body as the root
+  // if there is one, else the lowest)
+  auto find = [&](int x) {
+    if (group_[static_cast<std::size_t>(x)] < 0) {
+      group_[static_cast<std::size_t>(x)] = x;
+      touched_.push_back(x);
+    }
+    while (group_[static_cast<std::size_t>(x)] != x) {
+      const int up = group_[static_cast<std::size_t>(group_[static_cast<std::size_t>(x)])];
+      group_[static_cast<std::size_t>(x)] = up;
+      x = up;
+    }
+    return x;
+  };
+  for (const dContact& c : contacts_) {
+    const auto owner_a = reinterpret_cast<std::intptr_t>(dGeomGetData(c.geom.g1));
+    const auto owner_b = reinterpret_cast<std::intptr_t>(dGeomGetData(c.geom.g2));
+    if (owner_a <= 0 || owner_b <= 0) continue;
+    const int ra = find(static_cast<int>(owner_a - 1));
+    const int rb = find(static_cast<int>(owner_b - 1));
+    if (ra == rb) continue;
+    const int root = firstOf(ra, rb);
+    group_[static_cast<std::size_t>(root == ra ? rb : ra)] = root;
+  }
+}
+
+void OdeEngine::groupContacts() {
+  // where each body steps this substep: a body in contact with others in the home world of the
+  // group's root (world 0 when a pinned body is in it), every other body at home
+  for (const int i : touched_) {
+    int r = i;
+    while (group_[static_cast<std::size_t>(r)] != r) r = group_[static_cast<std::size_t>(r)];
+    const int target = bodies_[static_cast<std::size_t>(r)].home;
+    if (bodies_[static_cast<std::size_t>(i)].partition != target) {
+      if (bodies_[static_cast<std::size_t>(i)].partition == bodies_[static_cast<std::size_t>(i)].home) away_.push_back(i);
+      moveBody(i, target);
+    }
+  }
+  // the bodies away from home whose group no longer needs them there go back, lowest first
+  std::sort(away_.begin(), away_.end());
+  std::size_t kept = 0;
+  for (const int i : away_) {
+    Body& body = bodies_[static_cast<std::size_t>(i)];
+    if (body.partition == body.home) continue;
+    if (group_[static_cast<std::size_t>(i)] >= 0) {
+      away_[kept++] = i;
+      continue;
+    }
+    moveBody(i, body.home);
+  }
+  away_.resize(kept);
+  for (const int i : touched_) group_[static_cast<std::size_t>(i)] = -1;
+  touched_.clear();
+}
+
+}  // namespace ssx::detail

@@ -1,0 +1,205 @@
+#pragma once
+// The ODE backend of PhysicEngine. Private: nothing of ODE leaves libssx.
+//
+// Parallel and deterministic: the bodies are spread over `partitions` ODE worlds, stepped at the
+// same time on the environment's worker pool. One collision space holds every geom, so contacts
+// are found as in one world; before the solver runs, bodies that touch are moved into one world
+// (the home world of the lowest-numbered body of their contact group), and back home once they
+// no longer touch. A body's home world follows from its index alone (blocks of kBlock bodies,
+// dealt round the worlds), so which world steps which body never depends on the thread count.
+// A free body's step does not depend on its world at all; a contact group is solved in one world
+// as ODE would solve it anywhere, with that world's own copy of ODE's random seed.
+//
+// The geoms are not attached to ODE bodies: ODE's step would mark them moved in a shared space
+// from every world's thread at once. They are posed from their body before each collision pass,
+// with ODE's own arithmetic for a geom offset from its body, so contacts are what they would be.
+// They are in no ODE space at all: posing them, finding the pairs (GridBroadphase, linear in the
+// bodies however they are laid out, where ODE's sweep-and-prune is quadratic in a grid) and the
+// contacts (dCollide) run in parallel chunks too.
+//
+// Joined bodies (addJoint) are pinned to world 0: an ODE joint belongs to one world and cannot
+// follow its bodies into another, and keeps frames (anchors, axes, the hinge's reference rotation)
+// taken when it was set up. So a contact group with a pinned body in it is solved in world 0, and
+// articulated robots step there, one after another, while free bodies still step in parallel. A
+// restored engine makes each joint again with its bodies put back where they were when it was
+// first made, so that ODE computes the same frames to the bit. A joint made between steps (a
+// gripper closing) pins its bodies from then on; once the last joint holding a body is removed it
+// goes back to its home world at the next step, as a body leaving a contact group does. Run-time
+// joints, with their bodies' states when made, are part of the saved state.
+
+#include "engines/grid_broadphase.hpp"
+
+#include <ssx/physic_engine.hpp>
+
+#include <ode/ode.h>
+
+#include <mutex>
+#include <vector>
+
+namespace ssx::detail {
+
+class OdeEngine final : public PhysicEngine {
+ public:
+  explicit OdeEngine(const PhysicsSettings& settings);
+  ~OdeEngine() override;
+
+  std::string name() const override { return "ode"; }
+  int addBody(const MassProperties& mass, const std::vector<Shape>& shapes, const BodyState& state) override;
+  void setKinematic(int body) override;
+  bool isKinematic(int body) const override;
+  int addStatic(const std::vector<Shape>& shapes, const Pose& pose) override;
+  void setTaskRunner(TaskRunner* runner) override { runner_ = runner; }
+  void step(Nanoseconds dt, std::span<const Wrench> wrenches) override;
+  void readStates(std::span<BodyState> out) const override;
+  void setState(int body, const BodyState& state) override;
+  std::size_t bodyCount() const override { return bodies_.size(); }
+  void saveState(StateWriter& out) const override;
+  void restoreState(StateReader& in) override;
+  std::size_t contactCount() const override { return contact_count_; }
+  int addJoint(const EngineJoint& joint) override;
+  void setJointMotor(int joint, double velocity, double max_effort) override;
+  void removeJoint(int joint) override;
+  std::size_t jointCount() const override { return live_joints_; }
+  void prepareRayQueries() override;
+  void castRays(std::span<const Ray> rays, std::span<RayHit> hits, int ignore_begin, int ignore_end) const override;
+
+  static constexpr int kBlock = 64;  // consecutive bodies that share a home world
+
+ private:
+  struct Partition {
+    dWorldID world = nullptr;
+    dJointGroupID contacts = nullptr;
+    dThreadingImplementationID threading = nullptr;
+    unsigned long rand_seed = 0;  // this world's own copy of ODE's process-wide dRand seed
+    std::vector<int> order;       // its bodies in creation order (ODE lists them newest first)
+    bool has_joints = false;      // joints in this substep (contacts, or the joints of world 0)
+  };
+  struct Geom {
+    dGeomID id;
+    dVector3 offset_position;  // in the body frame
+    dMatrix3 offset_rotation;
+    double diameter;  // of a sphere around it: its box is never longer, however it turns
+  };
+  struct Body {
+    dBodyID id = nullptr;
+    int partition = 0;
+    int home = 0;
+    bool kinematic = false;  // moved only by setState (dBodySetKinematic)
+    bool pinned = false;     // joined to another body or the world: always in world 0
+    dMass mass;
+    std::vector<Geom> geoms;
+  };
+
+  struct Joint {
+    EngineJoint spec;
+    dJointID id = nullptr;
+    std::vector<dReal> child_bits, parent_bits;  // the bodies' states when it was first made
+    double velocity = 0.0, max_effort = 0.0;     // the motor (off: 0 effort)
+    bool removed = false;                        // a run-time joint let go of (its slot reusable)
+  };
+
+  dGeomID createGeom(const Shape& shape);
+  // makes joint j's ODE joint in world 0 from the bodies' current states
+  void createJoint(Joint& joint);
+  // recreates every joint, its bodies put back where they were when it was first made (restore)
+  void recreateJoints();
+  void applyMotor(const Joint& joint);
+  // the joints made so far are the scene's (at the first step or restore)
+  void seal() {
+    if (!sealed_) scene_joints_ = joints_.size();
+    sealed_ = true;
+  }
+  // pins the bodies some joint holds (into world 0) and lets the others go home
+  void repin(bool move);
+  void saveJoints(StateWriter& out) const;
+  // reads the run-time joints of a saved state (checked; nothing changed yet)
+  std::vector<Joint> loadJoints(StateReader& in) const;
+  // the root of a contact group from two roots: a pinned one first, else the lower
+  int firstOf(int a, int b) const {
+    const bool pa = bodies_[static_cast<std::size_t>(a)].pinned, pb = bodies_[static_cast<std::size_t>(b)].pinned;
+    return pa != pb ? (pa ? a : b) : std::min(a, b);
+  }
+  // appends the contacts between two geoms, with the surface settings
+  void collidePair(dGeomID a, dGeomID b, std::vector<dContact>& out, std::vector<dContact>& scratch) const;
+  void collide();
+  void indexGeoms();
+  // runs task(i) for i in [0, n) on the pool when the world is large enough, else here
+  template <class F>
+  void forEach(std::size_t n, F&& task);
+  int homeOf(int body) const { return (body / kBlock) % static_cast<int>(partitions_.size()); }
+  // recreates body i in partition p, bit for bit, last in its creation order
+  void moveBody(int body, int partition);
+  void groupContacts();
+  void placeGeoms(std::size_t begin, std::size_t end);
+  void stepPartition(Partition& p, double h, std::span<const Wrench> wrenches);
+
+  PhysicsSettings settings_;
+  TaskRunner* runner_ = nullptr;
+  std::vector<Partition> partitions_;
+  std::vector<Body> bodies_;
+  std::vector<Joint> joints_;
+  std::vector<int> articulation_;  // per body: the lowest body it is joined to (itself when none)
+  std::vector<int> hangs_from_;    // per body: the static group its articulation hangs from, or -1
+  bool labels_stale_ = false;      // joints came or went since articulation_ was computed
+  std::size_t scene_joints_ = 0;   // joints_[0, scene_joints_) are the scene's (once sealed_)
+  bool sealed_ = false;
+  std::size_t live_joints_ = 0;
+  std::size_t contacts_per_pair_ = 8;
+  std::vector<dContact> contacts_;  // found in this substep, in a fixed order
+  // the grid broadphase: one box per geom (the bodies' geoms in body order, then static ones),
+  // the planes apart; contacts found per chunk, joined in chunk order
+  std::vector<dGeomID> static_geoms_;
+  int static_groups_ = 0;  // addStatic's calls so far
+  std::vector<dGeomID> planes_;
+  std::vector<dGeomID> proxy_geoms_;
+  std::vector<GridBroadphase::Box> boxes_;
+  std::vector<std::uint32_t> first_proxy_;  // per body
+  std::size_t dynamic_proxies_ = 0;
+  bool proxies_stale_ = true;
+  double cell_ = 1.0;  // the grid's: twice the median geom diameter (fixed by the scene)
+  GridBroadphase grid_;
+  struct Chunk {
+    std::vector<std::pair<int, int>> pairs;
+    std::vector<dContact> contacts;
+    std::vector<dContact> scratch;
+  };
+  std::vector<Chunk> chunks_;
+  std::vector<int> group_;          // union-find over bodies, for contact groups (-1: untouched)
+  std::vector<int> touched_;        // bodies in a body-body contact this substep, first seen first
+  std::vector<int> away_;           // bodies not in their home world
+  std::size_t contact_count_ = 0;
+  // ray geoms for castRays, one per query running at once
+  mutable std::mutex rays_mutex_;
+  mutable std::vector<dGeomID> free_rays_;
+};
+
+// ODE's process-wide initialisation, reference-counted (ode_engine.cpp): each acquireOde is
+// matched by one releaseOde
+void acquireOde();
+void releaseOde();
+
+// every thread that calls into ODE needs its own collision data (ode_engine.cpp)
+void ensureThreadData();
+
+// a body's state bit for bit (ode_engine.cpp): kOdeBodyReals values
+inline constexpr std::size_t kOdeBodyReals = 3 + 4 + 12 + 3 + 3;
+void readOdeBits(dBodyID b, dReal* out);
+void writeOdeBits(dBodyID b, const dReal* in);
+
+template <class F>
+void OdeEngine::forEach(std::size_t n, F&& task) {
+  constexpr std::size_t kParallelFrom = 2 * kBlock;  // bodies
+  if (runner_ == nullptr || runner_->threads() < 2 || bodies_.size() < kParallelFrom || n < 2) {
+    for (std::size_t i = 0; i < n; ++i) task(i);
+    return;
+  }
+  runner_->forEach(
+      n,
+      [](void* context, std::size_t i) {
+        ensureThreadData();
+        (*static_cast<F*>(context))(i);
+      },
+      &task);
+}
+
+}  // namespace ssx::detail

@@ -1,0 +1,230 @@
+// Artifact files: physic and render node trees, shapes, and the driver and sensors they declare.
+#include "scene/xml/scene_loader.hpp"
+#include "scene/xml/xml_reader.hpp"
+
+namespace ssx::detail {
+
+Shape SceneLoader::readShape(const Descriptor& d) {
+  Shape s;
+  const std::string& n = d.name();
+  if (n == "box") {
+    s = Shape::box(read<Vec3>(d, "size", Vec3::Ones()));
+    if (!d.has("size")) error(d.where(), "<box>: missing attribute 'size'");
+  } else if (n == "sphere") {
+    s = Shape::sphere(readPositive(d, "radius", 0.5));
+  } else {
+    const double r = readPositive(d, "radius", 0.5);
+    const double l = n == "cylinder" ? readPositive(d, "length", 1.0) : read<double>(d, "length", 0.0);
+    s = n == "cylinder" ? Shape::cylinder(r, l) : Shape::capsule(r, l);
+    if (n == "capsule" && l < 0) error(d.where(), "<capsule>: length must not be negative");
+  }
+  if (n == "box" && !(s.size.array() > 0).all()) error(d.where(), "<box>: every size must be positive");
+  s.pose = readPose(d);
+  s.density = readPositive(d, "density", s.density);
+  checkUnknown(d);
+  return s;
+}
+
+void SceneLoader::readJoint(const Descriptor& d, JointSpec& j) {
+  const std::string kind = read<std::string>(d, "joint", "");
+  static const std::map<std::string, JointSpec::Kind> kinds = {{"hinge", JointSpec::Kind::Hinge},
+                                                               {"slider", JointSpec::Kind::Slider},
+                                                               {"ball", JointSpec::Kind::Ball},
+                                                               {"fixed", JointSpec::Kind::Fixed}};
+  if (!kind.empty()) {
+    const auto it = kinds.find(kind);
+    if (it == kinds.end())
+      error(d.where(), "<physic>: joint must be hinge, slider, ball or fixed, got '" + kind + "'");
+    else
+      j.kind = it->second;
+  }
+  for (const char* key : {"axis", "lower", "upper", "damping", "max_torque", "max_force"})
+    if (d.has(key) && !j.hasPosition()) {
+      error(d.where(), std::string("<physic>: '") + key + "' belongs to a hinge or slider joint" +
+                           (kind.empty() ? " (this node has no joint attribute)" : ", and this joint is a " + kind));
+      return;
+    }
+  const Vec3 axis = read<Vec3>(d, "axis", Vec3::UnitZ());
+  if (!axis.allFinite() || !(axis.norm() > 1e-9))
+    error(d.where(), "<physic>: axis must be a non-zero vector (the joint's axis in this node's frame)");
+  else
+    j.axis = axis.normalized();
+  j.lower = read<double>(d, "lower", j.lower);
+  j.upper = read<double>(d, "upper", j.upper);
+  j.damping = read<double>(d, "damping", 0.0);
+  const char* motor = j.kind == JointSpec::Kind::Slider ? "max_force" : "max_torque";
+  const char* other = j.kind == JointSpec::Kind::Slider ? "max_torque" : "max_force";
+  if (d.has(other))
+    error(d.where(), std::string("<physic>: a ") + kind + "'s motor takes " + motor + ", not " + other);
+  j.max_effort = read<double>(d, motor, 0.0);
+}
+
+PhysicNodeSpec SceneLoader::readPhysicNode(const Descriptor& d) {
+  PhysicNodeSpec n;
+  n.where = d.where();
+  n.name = read<std::string>(d, "name", "");
+  n.pose = readPose(d);
+  n.mass = readOptional<double>(d, "mass");
+  if (auto diag = readOptional<Vec3>(d, "inertia")) {
+    Mat3 j = diag->asDiagonal();
+    const Vec3 products = read<Vec3>(d, "inertia_products", Vec3::Zero());  // ixy ixz iyz
+    j(0, 1) = j(1, 0) = products.x();
+    j(0, 2) = j(2, 0) = products.y();
+    j(1, 2) = j(2, 1) = products.z();
+    n.inertia = j;
+  }
+  n.center_of_mass = read<Vec3>(d, "com", Vec3::Zero());
+  n.is_static = read<bool>(d, "static", false);  // validatePhysicTree refuses it below the root
+  readJoint(d, n.joint);
+  for (const Descriptor& c : d.children()) {
+    if (kShapeElements.contains(c.name()))
+      n.shapes.push_back(readShape(c));
+    else if (c.name() == "physic")
+      n.children.push_back(readPhysicNode(c));
+  }
+  std::set<std::string> allowed = kShapeElements;
+  allowed.insert("physic");
+  checkUnknown(d, allowed);
+  return n;
+}
+
+RenderNodeSpec SceneLoader::readRenderNode(const Descriptor& d, bool is_root) {
+  RenderNodeSpec n;
+  n.name = read<std::string>(d, "name", "");
+  n.pose = readPose(d);
+  n.color = readColor(d, n.color);
+  if (is_root) n.follow = read<std::string>(d, "follow", "");
+  const std::string& kind = d.name();
+  if (kind == "box") {
+    n.primitive = RenderNodeSpec::Primitive::Box;
+    n.size = read<Vec3>(d, "size", Vec3::Ones());
+  } else if (kind == "sphere") {
+    n.primitive = RenderNodeSpec::Primitive::Sphere;
+    n.radius = readPositive(d, "radius", 0.5);
+  } else if (kind == "cylinder" || kind == "capsule") {
+    n.primitive = kind == "cylinder" ? RenderNodeSpec::Primitive::Cylinder : RenderNodeSpec::Primitive::Capsule;
+    n.radius = readPositive(d, "radius", 0.5);
+    n.length = readPositive(d, "length", 1.0);
+  } else if (kind == "plane") {
+    n.primitive = RenderNodeSpec::Primitive::Plane;
+    n.size = read<Vec3>(d, "size", Vec3(10, 10, 0));
+  }
+  for (const Descriptor& c : d.children())
+    if (kShapeElements.contains(c.name()) || c.name() == "plane" || c.name() == "render")
+      n.children.push_back(readRenderNode(c, false));
+  std::set<std::string> allowed = kShapeElements;
+  allowed.insert({"plane", "render"});
+  checkUnknown(d, allowed);
+  return n;
+}
+
+std::optional<PluginDecl> SceneLoader::readPluginDecl(const Descriptor& d) {
+  PluginDecl decl;
+  decl.plugin = require(d, "plugin");
+  decl.class_name = read<std::string>(d, "class", decl.plugin);
+  decl.period = readCount(d, "period", 1, 1);
+  if (const auto* a = d.find("period")) decl.period_from = a->where;
+  // the element is the parameter set, without what the loader itself reads: a plugin never
+  // mistakes its period in steps for a parameter of its own (periodSteps() tells it)
+  decl.params = d;
+  decl.params.erase("plugin").erase("class").erase("period");
+  // a plugin's own parameters are checked when it is configured; element children are not allowed
+  for (const auto& c : d.children())
+    warning(c.where(), "unknown element <" + c.name() + "> in <" + d.name() + "> (ignored)");
+  if (decl.plugin.empty()) return std::nullopt;
+  return decl;
+}
+
+ArtifactType SceneLoader::parseArtifact(const Descriptor& root) {
+  ArtifactType t;
+  if (root.name() != "artifact") {
+    error(root.where(), "the root element of an artifact file must be <artifact>, got <" + root.name() + ">");
+    t.ok = false;
+    return t;
+  }
+  const std::size_t errors_before = diagnostics_.size();
+  for (const Descriptor& c : root.children()) {
+    if (c.name() == "physic") {
+      PhysicNodeSpec spec = readPhysicNode(c);
+      try {
+        validatePhysicTree(spec);
+        // a node's name is unique in its artifact: across its trees too (a second root named as a
+        // node of the first)
+        auto names = [](auto& self, const PhysicNodeSpec& n, std::vector<const PhysicNodeSpec*>& out) -> void {
+          if (!n.name.empty()) out.push_back(&n);
+          for (const auto& c : n.children) self(self, c, out);
+        };
+        std::vector<const PhysicNodeSpec*> mine, theirs;
+        names(names, spec, mine);
+        for (const auto& other : t.physic) names(names, *other, theirs);
+        for (const PhysicNodeSpec* n : mine)
+          for (const PhysicNodeSpec* o : theirs)
+            if (n->name == o->name)
+              throw ConfigError(n->where, "physic node '" + n->name + "': duplicate node name in this artifact");
+      } catch (const ConfigError& e) {
+        record(e);
+      }
+      t.physic.push_back(std::make_shared<const PhysicNodeSpec>(std::move(spec)));
+    } else if (c.name() == "render") {
+      t.render.push_back(std::make_shared<const RenderNodeSpec>(readRenderNode(c, true)));
+    } else if (c.name() == "driver") {
+      if (t.driver) {
+        error(c.where(), "<driver>: an artifact has at most one driver");
+        continue;
+      }
+      t.driver = readPluginDecl(c);
+    } else if (c.name() == "sensor") {
+      if (auto decl = readPluginDecl(c)) t.sensors.push_back(std::move(*decl));
+    }
+  }
+  // render roots follow physic nodes by name
+  for (std::size_t i = 0; i < t.render.size(); ++i) {
+    const std::string& follow = t.render[i]->follow;
+    if (follow.empty()) continue;
+    bool found = false;
+    auto search = [&](auto& self, const PhysicNodeSpec& n) -> void {
+      found = found || n.name == follow;
+      for (const auto& c : n.children) self(self, c);
+    };
+    for (const auto& p : t.physic) search(search, *p);
+    if (!found) {
+      const Descriptor& rd = *root.childrenNamed("render")[i];
+      error(rd.where(), "<render>: follows unknown physic node '" + follow + "'");
+    }
+  }
+  checkUnknown(root, {"physic", "render", "driver", "sensor"});
+  for (std::size_t i = errors_before; i < diagnostics_.size(); ++i)
+    if (diagnostics_[i].severity == Diagnostic::Severity::Error) t.ok = false;
+  return t;
+}
+
+const ArtifactType* SceneLoader::artifactType(const std::string& name, const SourceLocation& where) {
+  if (auto it = types_.find(name); it != types_.end()) return it->second.ok ? &it->second : nullptr;
+  const auto decl = type_decls_.find(name);
+  if (decl == type_decls_.end()) {
+    std::string known;
+    for (const auto& [k, v] : type_decls_) known += (known.empty() ? "" : ", ") + k;
+    error(where,
+          "unknown artifact type '" + name + "' (declared with <type>: " + (known.empty() ? "none" : known) + ")");
+    types_[name].ok = false;
+    return nullptr;
+  }
+  ArtifactType& t = types_[name];
+  try {
+    model_.files.push_back(decl->second.file);
+    documents_.push_back(readXmlFile(decl->second.file, options_.max_input_bytes));
+    t = parseArtifact(documents_.back());
+    t.name = name;
+    t.file = decl->second.file;
+    t.where = decl->second.where;
+  } catch (const ConfigError& e) {
+    if (e.where().line == 0)
+      error(decl->second.where, "<type>: artifact file '" + decl->second.file.string() + "': " + e.detail());
+    else
+      record(e);
+    t.ok = false;
+  }
+  return t.ok ? &t : nullptr;
+}
+
+}  // namespace ssx::detail

@@ -1,0 +1,41 @@
+#pragma once
+// The phases of a step as functions over the world state (environment.hpp documents the order).
+// Environment::start and Environment::step call them; bodies.cpp and step_phases.cpp define them.
+
+#include "world/world.hpp"
+
+#include <ssx/environment.hpp>
+
+#include <cstddef>
+#include <vector>
+
+namespace ssx::detail {
+
+/// Flattens every artifact's node trees into rigid bodies of `engine` (static roots become static
+/// shapes, listed in `static_shapes`), fills the nodes' body indices and the body arrays.
+void buildBodies(World& world, PhysicEngine& engine, std::vector<Environment::StaticShape>& static_shapes);
+/// Makes the engine's joints from the node trees (the end of buildBodies; joints.cpp).
+void buildJoints(World& world, PhysicEngine& engine);
+/// Before a physics step: sets the motors' velocities; returns the wrenches to apply (the drivers',
+/// or a copy with the joints' damping added).
+const Wrench* applyJoints(World& world, PhysicEngine& engine);
+/// After the drivers phase: carries out the run-time joints the drivers asked for (attachments.cpp),
+/// artifact by artifact.
+void applyAttachRequests(World& world, PhysicEngine& engine);
+/// Reads the run-time joints saveState wrote (after the engine restored its joints);
+/// throws StateError for what does not fit the world.
+void loadAttachments(World& world, StateReader& in);
+/// A hinge's angle or slider's displacement from the snapshot (0 before start).
+double jointPosition(const World& world, const JointData& joint);
+/// A hinge's or slider's rate from the snapshot (0 before start).
+double jointVelocity(const World& world, const JointData& joint);
+/// Reads the engine's states into the snapshot, with accelerations (not on the first), and checks
+/// them; a diverged body fails the world and throws StepError.
+void publishSnapshot(World& world, const PhysicEngine& engine, bool first);
+/// Clears the command buffers of artifacts without a driver (nothing holds their forces).
+void clearUndrivenCommands(World& world);
+/// The sensors and drivers phases over artifacts [begin, end); failures go to world.errors.
+void runSensors(World& world, std::size_t begin, std::size_t end);
+void runDrivers(World& world, std::size_t begin, std::size_t end);
+
+}  // namespace ssx::detail
