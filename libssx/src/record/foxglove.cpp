@@ -99,33 +99,6 @@ const char* const kSceneUpdateSchema =
     R"j(}}},"cylinders":{"type":"array","items":)j" SSX_JSON_SHAPE
     R"j(,"bottom_scale":{"type":"number"},"top_scale":{"type":"number"}}}}}}}}})j";
 
-void appendNumber(std::string& out, double value) {
-  if (!std::isfinite(value)) {  // JSON has no NaN or infinity
-    out += "null";
-    return;
-  }
-  char text[32];
-  const auto r = std::to_chars(text, text + sizeof text, static_cast<float>(value));
-  out.append(text, r.ptr);
-}
-
-void appendString(std::string& out, std::string_view text) {
-  out += '"';
-  for (const char c : text) {
-    if (c == '"' || c == '\\') {
-      out += '\\';
-      out += c;
-    } else if (static_cast<unsigned char>(c) < 0x20) {
-      char escaped[8];
-      std::snprintf(escaped, sizeof escaped, "\\u%04x", static_cast<unsigned>(c));
-      out += escaped;
-    } else {
-      out += c;
-    }
-  }
-  out += '"';
-}
-
 std::string frameTransforms(Nanoseconds time, std::span<const std::string> names, std::span<const float> positions,
                             std::span<const float> orientations) {
   std::string stamp;

@@ -6,6 +6,8 @@
 //   their body's frame (or to "world" when fixed).
 // JSON rather than protobuf: no new dependency, readable in any tool, and Foxglove decodes both.
 
+#include "base/json.hpp"
+
 #include <ssx/render.hpp>
 #include <ssx/types.hpp>
 
@@ -21,11 +23,6 @@ inline constexpr const char* kWorldFrame = "world";
 /// JSON Schemas of the two messages (only the fields written), kept in the file with each channel.
 extern const char* const kFrameTransformsSchema;
 extern const char* const kSceneUpdateSchema;
-
-/// Appends a number as the shortest text that reads back to the same float.
-void appendNumber(std::string& out, double value);
-/// Appends a JSON string (quoted, escaped).
-void appendString(std::string& out, std::string_view text);
 
 /// foxglove.FrameTransforms for one sample: positions (N x 3) and orientations (N x 4, w x y z),
 /// as Recording decodes them, of the bodies `names`.

@@ -1,4 +1,4 @@
-#include "record/foxglove.hpp"
+#include "base/json.hpp"
 
 #include <ssx/command.hpp>
 #include <ssx/odometry.hpp>

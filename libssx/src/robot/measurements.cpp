@@ -1,5 +1,5 @@
 // The measurements sensors produce: each one's check that its numbers are finite, and each as JSON.
-#include "record/foxglove.hpp"
+#include "base/json.hpp"
 
 #include <ssx/environment.hpp>
 #include <ssx/measurements.hpp>

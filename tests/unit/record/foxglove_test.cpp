@@ -20,22 +20,6 @@ std::size_t count(const std::string& text, const std::string& what) {
 
 }  // namespace
 
-TEST_CASE("foxglove: numbers read back as the same float, JSON has no NaN, strings are escaped", "[record][foxglove]") {
-  for (const double v : {0.0, -1.5, 0.1, 1e-7, 123456.789, -3.4e38}) {
-    std::string text;
-    appendNumber(text, v);
-    float back = 0;
-    std::from_chars(text.data(), text.data() + text.size(), back);
-    CHECK(back == static_cast<float>(v));
-  }
-  std::string nan;
-  appendNumber(nan, std::nan(""));
-  CHECK(nan == "null");
-  std::string s;
-  appendString(s, "a\"b\\c\nd");
-  CHECK(s == R"("a\"b\\c\u000ad")");
-}
-
 TEST_CASE("foxglove: FrameTransforms, one transform from the world to each body", "[record][foxglove]") {
   const std::vector<std::string> names{"q0", "q1"};
   const std::vector<float> p{1, 2, 3, -1, 0.5f, 0};
