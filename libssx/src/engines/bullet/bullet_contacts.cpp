@@ -55,8 +55,8 @@ void BulletEngine::indexGeoms() {
     poses_[k].transform = proxies_[k].object->getWorldTransform();
   // room for what a substep usually needs, so that steps do not allocate: every body in contact
   // with a few others
-  group_.assign(bodies_.size(), -1);
-  touched_.reserve(bodies_.size());
+  groups_.resize(bodies_.size());
+  groups_.reserve(bodies_.size());
   members_.reserve(bodies_.size());
   island_bodies_.reserve(bodies_.size());
   islands_.reserve(bodies_.size());
@@ -227,18 +227,7 @@ void BulletEngine::collide(double h) {
 
 void BulletEngine::buildIslands() {
   // union-find over the bodies that touch each other (the smallest index as the root)
-  auto find = [&](int x) {
-    if (group_[static_cast<std::size_t>(x)] < 0) {
-      group_[static_cast<std::size_t>(x)] = x;
-      touched_.push_back(x);
-    }
-    while (group_[static_cast<std::size_t>(x)] != x) {
-      const int up = group_[static_cast<std::size_t>(group_[static_cast<std::size_t>(x)])];
-      group_[static_cast<std::size_t>(x)] = up;
-      x = up;
-    }
-    return x;
-  };
+  auto find = [this](int x) { return groups_.find(x); };
   auto bodyOf = [](const btCollisionObject* o) { return o->getUserIndex(); };
   // a manifold's body: a dynamic one of its two objects (the other may be static)
   auto ownerOf = [&](const btPersistentManifold* m) {
@@ -246,30 +235,25 @@ void BulletEngine::buildIslands() {
     return a >= 0 ? a : bodyOf(m->getBody1());
   };
   // joined bodies are one island, contacts or not
-  auto unite = [&](int a, int b) {
-    const int ra = find(a), rb = find(b);
-    if (ra != rb) group_[static_cast<std::size_t>(std::max(ra, rb))] = std::min(ra, rb);
-  };
   for (const Joint& j : joints_) {
     if (j.removed) continue;
     if (j.spec.parent >= 0)
-      unite(j.spec.child, j.spec.parent);
+      groups_.unite(j.spec.child, j.spec.parent);
     else
       (void)find(j.spec.child);
   }
   for (const btPersistentManifold* m : manifolds_) {
     const int a = bodyOf(m->getBody0());
     const int b = bodyOf(m->getBody1());
-    const int ra = find(a >= 0 ? a : b);
-    if (a >= 0 && b >= 0) {
-      const int rb = find(b);
-      if (ra != rb) group_[static_cast<std::size_t>(std::max(ra, rb))] = std::min(ra, rb);
-    }
+    if (a >= 0 && b >= 0)
+      groups_.unite(a, b);
+    else
+      (void)find(a >= 0 ? a : b);
   }
   // islands in the order of their lowest body; bodies ascending, manifolds in pair order
   std::vector<std::pair<int, int>>& members = members_;  // (root, body)
   members.clear();
-  for (const int i : touched_) members.emplace_back(find(i), i);
+  for (const int i : groups_.touched()) members.emplace_back(find(i), i);
   std::sort(members.begin(), members.end());
   islands_.clear();
   island_bodies_.clear();
@@ -306,9 +290,8 @@ void BulletEngine::buildIslands() {
   }
   free_bodies_.clear();
   for (std::size_t i = 0; i < bodies_.size(); ++i)
-    if (group_[i] < 0) free_bodies_.push_back(bodies_[i]->rb.get());
-  for (const int i : touched_) group_[static_cast<std::size_t>(i)] = -1;
-  touched_.clear();
+    if (!groups_.grouped(static_cast<int>(i))) free_bodies_.push_back(bodies_[i]->rb.get());
+  groups_.clear();
 }
 
 }  // namespace ssx::detail

@@ -25,6 +25,7 @@
 // when made; they keep nothing from step to step that the solver uses (no warm start either). A
 // joint made between steps is saved with its frames and made again from them on restore.
 
+#include "engines/contact_groups.hpp"
 #include "engines/grid_broadphase.hpp"
 
 #include <ssx/physic_engine.hpp>
@@ -158,8 +159,7 @@ class BulletEngine final : public PhysicEngine {
   GridBroadphase grid_;
   std::vector<Chunk> chunks_;
   std::vector<btPersistentManifold*> manifolds_;  // this substep's with contacts, in pair order
-  std::vector<int> group_;                         // union-find over bodies (-1: in no contact)
-  std::vector<int> touched_;
+  ContactGroups groups_;  // bodies in contact this substep (joined ones too), grouped into islands
   std::vector<std::pair<int, int>> members_;                // (island root, body)
   std::vector<std::pair<int, std::size_t>> manifold_order_;  // (island root, manifold)
   std::vector<btCollisionObject*> island_bodies_;

@@ -62,7 +62,7 @@ void OdeEngine::indexGeoms() {
   // room for what a step usually needs, so that steps do not allocate: every body resting on
   // something with a few contacts, a contact group's bookkeeping for every body
   contacts_.reserve(4 * bodies_.size() + 64);
-  touched_.reserve(bodies_.size());
+  groups_.reserve(bodies_.size());
   away_.reserve(bodies_.size());
   for (dGeomID g : static_geoms_) {
     if (dGeomGetClass(g) == dPlaneClass) continue;
@@ -162,36 +162,20 @@ void OdeEngine::collide() {
 
   // contact groups: union-find over the bodies that touch each other (a pinned body as the root
   // if there is one, else the lowest)
-  auto find = [&](int x) {
-    if (group_[static_cast<std::size_t>(x)] < 0) {
-      group_[static_cast<std::size_t>(x)] = x;
-      touched_.push_back(x);
-    }
-    while (group_[static_cast<std::size_t>(x)] != x) {
-      const int up = group_[static_cast<std::size_t>(group_[static_cast<std::size_t>(x)])];
-      group_[static_cast<std::size_t>(x)] = up;
-      x = up;
-    }
-    return x;
-  };
   for (const dContact& c : contacts_) {
     const auto owner_a = reinterpret_cast<std::intptr_t>(dGeomGetData(c.geom.g1));
     const auto owner_b = reinterpret_cast<std::intptr_t>(dGeomGetData(c.geom.g2));
     if (owner_a <= 0 || owner_b <= 0) continue;
-    const int ra = find(static_cast<int>(owner_a - 1));
-    const int rb = find(static_cast<int>(owner_b - 1));
-    if (ra == rb) continue;
-    const int root = firstOf(ra, rb);
-    group_[static_cast<std::size_t>(root == ra ? rb : ra)] = root;
+    groups_.unite(static_cast<int>(owner_a - 1), static_cast<int>(owner_b - 1),
+                  [this](int ra, int rb) { return firstOf(ra, rb); });
   }
 }
 
 void OdeEngine::groupContacts() {
   // where each body steps this substep: a body in contact with others in the home world of the
   // group's root (world 0 when a pinned body is in it), every other body at home
-  for (const int i : touched_) {
-    int r = i;
-    while (group_[static_cast<std::size_t>(r)] != r) r = group_[static_cast<std::size_t>(r)];
+  for (const int i : groups_.touched()) {
+    const int r = groups_.rootOf(i);
     const int target = bodies_[static_cast<std::size_t>(r)].home;
     if (bodies_[static_cast<std::size_t>(i)].partition != target) {
       if (bodies_[static_cast<std::size_t>(i)].partition == bodies_[static_cast<std::size_t>(i)].home) away_.push_back(i);
@@ -204,15 +188,14 @@ void OdeEngine::groupContacts() {
   for (const int i : away_) {
     Body& body = bodies_[static_cast<std::size_t>(i)];
     if (body.partition == body.home) continue;
-    if (group_[static_cast<std::size_t>(i)] >= 0) {
+    if (groups_.grouped(i)) {
       away_[kept++] = i;
       continue;
     }
     moveBody(i, body.home);
   }
   away_.resize(kept);
-  for (const int i : touched_) group_[static_cast<std::size_t>(i)] = -1;
-  touched_.clear();
+  groups_.clear();
 }
 
 }  // namespace ssx::detail

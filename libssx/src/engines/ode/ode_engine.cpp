@@ -378,7 +378,7 @@ void OdeEngine::step(Nanoseconds dt, std::span<const Wrench> wrenches) {
   const double h = toSeconds(dt) / substeps;
   contact_count_ = 0;
   seal();
-  if (group_.size() != bodies_.size()) group_.assign(bodies_.size(), -1);
+  if (groups_.size() != bodies_.size()) groups_.resize(bodies_.size());
   if (labels_stale_ || articulation_.size() != bodies_.size()) {
     labelArticulations(articulation_, bodies_.size(), joints_);
     labelStaticParents(hangs_from_, articulation_, joints_);

@@ -27,6 +27,7 @@
 // goes back to its home world at the next step, as a body leaving a contact group does. Run-time
 // joints, with their bodies' states when made, are part of the saved state.
 
+#include "engines/contact_groups.hpp"
 #include "engines/grid_broadphase.hpp"
 
 #include <ssx/physic_engine.hpp>
@@ -164,8 +165,7 @@ class OdeEngine final : public PhysicEngine {
     std::vector<dContact> scratch;
   };
   std::vector<Chunk> chunks_;
-  std::vector<int> group_;          // union-find over bodies, for contact groups (-1: untouched)
-  std::vector<int> touched_;        // bodies in a body-body contact this substep, first seen first
+  ContactGroups groups_;            // bodies in body-body contact this substep, grouped
   std::vector<int> away_;           // bodies not in their home world
   std::size_t contact_count_ = 0;
   // ray geoms for castRays, one per query running at once
