@@ -8,6 +8,7 @@ Run by ctest as the setup and cleanup of a fixture that every test requires, so 
 is made once every test has finished. Entries already there before the run (a developer's own
 edits) are not held against the tests. Outside a git checkout (a source archive) it says so and passes.
 """
+import os
 import pathlib
 import subprocess
 import sys
@@ -28,11 +29,13 @@ def main():
         print(f"{root}: not a git checkout; nothing to compare")
         return 0
     # the build tree may be inside the source tree (ignored): what is written there is its own
-    build = pathlib.Path(sys.argv[4]).resolve() if len(sys.argv) > 4 else None
+    # (paths compared as written, not resolved: a link the tests made in the build tree, to the
+    # source's docs say, is the build tree's entry, wherever it points)
+    build = pathlib.Path(os.path.abspath(sys.argv[4])) if len(sys.argv) > 4 else None
     def inside_build(entry):
         if build is None:
             return False
-        path = (root / entry[3:].strip('"')).resolve()
+        path = pathlib.Path(os.path.abspath(root / entry[3:].strip('"')))
         return path == build or build in path.parents or path in build.parents
     now = {e for e in now if not inside_build(e)}
     if mode == "before":
