@@ -189,7 +189,7 @@ OdeEngine::~OdeEngine() {
   releaseOde();
 }
 
-dGeomID OdeEngine::createGeom(const Shape& s) {
+dGeomID createOdeGeom(const Shape& s) {
   switch (s.kind) {
     case Shape::Kind::Box:
       return dCreateBox(nullptr, s.size.x(), s.size.y(), s.size.z());
@@ -224,7 +224,7 @@ int OdeEngine::addBody(const MassProperties& mass, const std::vector<Shape>& sha
       for (const Geom& g : body.geoms) dGeomDestroy(g.id);
       throw Error("ode: a plane cannot belong to a dynamic body");
     }
-    Geom g{createGeom(s), {}, {}, 0.0};
+    Geom g{createOdeGeom(s), {}, {}, 0.0};
     switch (s.kind) {
       case Shape::Kind::Box: g.diameter = s.size.norm(); break;
       case Shape::Kind::Sphere: g.diameter = 2 * s.radius; break;
@@ -275,7 +275,7 @@ int OdeEngine::addStatic(const std::vector<Shape>& shapes, const Pose& pose) {
       planes_.push_back(plane);
       continue;
     }
-    dGeomID g = createGeom(s);
+    dGeomID g = createOdeGeom(s);
     dQuaternion q;
     toOde(world.orientation, q);
     dGeomSetPosition(g, world.position.x(), world.position.y(), world.position.z());

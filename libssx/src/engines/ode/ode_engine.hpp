@@ -99,7 +99,6 @@ class OdeEngine final : public PhysicEngine {
     bool removed = false;                        // a run-time joint let go of (its slot reusable)
   };
 
-  dGeomID createGeom(const Shape& shape);
   // makes joint j's ODE joint in world 0 from the bodies' current states
   void createJoint(Joint& joint);
   // recreates every joint, its bodies put back where they were when it was first made (restore)
@@ -172,6 +171,9 @@ class OdeEngine final : public PhysicEngine {
   mutable std::mutex rays_mutex_;
   mutable std::vector<dGeomID> free_rays_;
 };
+
+// an ODE geom in no space for a shape that is not a plane (ode_engine.cpp)
+dGeomID createOdeGeom(const Shape& shape);
 
 // ODE's process-wide initialisation, reference-counted (ode_engine.cpp): each acquireOde is
 // matched by one releaseOde

@@ -22,23 +22,7 @@ dGeomID makeGeom(const PosedShape& s) {
     const Vec3 n = s.world.orientation * Vec3::UnitZ();
     return dCreatePlane(nullptr, n.x(), n.y(), n.z(), n.dot(s.world.position));
   }
-  dGeomID g = nullptr;
-  switch (shape.kind) {
-    case Shape::Kind::Box:
-      g = dCreateBox(nullptr, shape.size.x(), shape.size.y(), shape.size.z());
-      break;
-    case Shape::Kind::Sphere:
-      g = dCreateSphere(nullptr, shape.radius);
-      break;
-    case Shape::Kind::Cylinder:
-      g = dCreateCylinder(nullptr, shape.radius, shape.length);
-      break;
-    case Shape::Kind::Capsule:
-      g = dCreateCapsule(nullptr, shape.radius, shape.length);
-      break;
-    case Shape::Kind::Plane:
-      break;
-  }
+  dGeomID g = createOdeGeom(shape);
   const Quat& q = s.world.orientation;
   const dQuaternion oq = {q.w(), q.x(), q.y(), q.z()};
   dGeomSetPosition(g, s.world.position.x(), s.world.position.y(), s.world.position.z());

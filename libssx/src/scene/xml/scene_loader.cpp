@@ -472,11 +472,10 @@ Scene SceneLoader::build(const SceneModel& model, bool report_missing_types) {
   if (options_.search_installed_plugins) env.classLoader().addSearchDirectory(ClassLoader::installedPluginDirectory());
   buildExtensions(env, model);
 
-  std::vector<std::size_t> placement_of;  // per artifact
+  std::vector<std::size_t> placement_of;  // per artifact: the placement that made it
   for (std::size_t k = 0; k < model.placements.size(); ++k) {
-    placement_of.resize(env.artifactCount(), k == 0 ? 0 : k - 1);
     const PlacementModel& p = model.placements[k];
-    stage_ = (k < placement_stage_.size() ? placement_stage_[k] : stage(2, 2 * static_cast<std::int64_t>(k))) + 1;
+    stage_ = placementStage(k);
     switch (p.kind) {
       case PlacementModel::Kind::Artifact:
       case PlacementModel::Kind::Swarm: {
@@ -503,8 +502,8 @@ Scene SceneLoader::build(const SceneModel& model, bool report_missing_types) {
         buildObstacle(env, p);
         break;
     }
+    placement_of.resize(env.artifactCount(), k);
   }
-  placement_of.resize(env.artifactCount(), model.placements.empty() ? 0 : model.placements.size() - 1);
   // robots inside one another or an obstacle (checked once every artifact is built as asked)
   if (errorCount() == 0) checkStartOverlaps(env, model, placement_of);
   stage_ = stage(3);

@@ -245,6 +245,10 @@ class SceneLoader {
   void buildExtensions(Environment& env, const SceneModel& model);
   void buildObstacle(Environment& env, const PlacementModel& p);
   void buildSwarm(Environment& env, const PlacementModel& p, const ArtifactTypeModel& type);
+  // the diagnostics stage of building placement k: after its parse, so in document order
+  std::int64_t placementStage(std::size_t k) const {
+    return (k < placement_stage_.size() ? placement_stage_[k] : stage(2, 2 * static_cast<std::int64_t>(k))) + 1;
+  }
   // reports every robot that starts inside another artifact (xml/start_overlaps.cpp);
   // placement_of[a]: the placement that made artifact a
   void checkStartOverlaps(const Environment& env, const SceneModel& model, const std::vector<std::size_t>& placement_of);

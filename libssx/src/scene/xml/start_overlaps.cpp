@@ -53,10 +53,7 @@ void SceneLoader::checkStartOverlaps(const Environment& env, const SceneModel& m
   }
   if (!any_dynamic) return;
   std::map<std::pair<std::size_t, std::size_t>, int> reported;  // by pair of placements
-  // in document order, with the placement's own diagnostics
-  const auto stage_of = [this](std::size_t k) {
-    return (k < placement_stage_.size() ? placement_stage_[k] : stage(2, 2 * static_cast<std::int64_t>(k))) + 1;
-  };
+
   for (const ShapeOverlap& o : findShapeOverlaps(shapes, kStartOverlapTolerance)) {
     const std::size_t ia = shapes[o.first].owner;
     const std::size_t ib = shapes[o.second].owner;
@@ -75,7 +72,7 @@ void SceneLoader::checkStartOverlaps(const Environment& env, const SceneModel& m
     const std::size_t ok = at_b ? placement_of[ia] : placement_of[ib];
     int& count = reported[{rk, ok}];
     if (++count > kReportsPerPair) continue;
-    stage_ = stage_of(rk);
+    stage_ = placementStage(rk);
     const std::string& other_name = env.artifact(other).name();
     const bool ground = op.kind == PlacementModel::Kind::Ground;
     std::string message = "'" + env.artifact(robot).name() + "' starts " + millimetres(o.depth) + " inside '" +
@@ -89,7 +86,7 @@ void SceneLoader::checkStartOverlaps(const Environment& env, const SceneModel& m
   for (const auto& [pair, count] : reported) {
     if (count <= kReportsPerPair) continue;
     const PlacementModel& rp = model.placements.at(pair.first);
-    stage_ = stage_of(pair.first);
+    stage_ = placementStage(pair.first);
     const PlacementModel& op = model.placements.at(pair.second);
     const std::string kind = rp.kind == PlacementModel::Kind::Swarm ? "<swarm>" : "<artifact>";
     const std::string more = "... and " + std::to_string(count - kReportsPerPair) + " more overlaps ";
