@@ -96,6 +96,10 @@ CommandLine parseCommandLine(int argc, const char* const* argv, std::ostream& ou
   run_cmd->add_option("--render", c.run.render, "render engine (overrides the scene's): null or osmesa");
   run_cmd->add_option("--physics", c.run.physics, "physics engine (overrides the scene's): ode or bullet")
       ->check(CLI::IsMember(ssx::physicEngineNames()));
+  run_cmd->add_option("--switch-physics", c.run.switch_physics,
+                      "continue the run on another physics engine from a time on, SECONDS:ENGINE (repeatable: "
+                      "1.5:bullet 3:ode); bodies, joints and the robots' state carry over")
+      ->check(switchSpec());
   run_cmd->add_option("--snapshot", c.run.snapshot, "write the first camera's last frame as PNG to FILE")->check(path());
   run_cmd->add_option("--video", c.run.video, "write the first camera's frames as MP4 to FILE (needs ffmpeg)")->check(path());
   run_cmd->add_option("--frames", c.run.frames, "write the first camera's frames as PNG files into DIR")->check(path());

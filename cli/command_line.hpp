@@ -38,6 +38,7 @@ struct RunArgs {
   bool allow_special_outputs = false;
   bool duration_given = false;
   int rt_priority = 0;
+  std::vector<std::string> switch_physics;  // --switch-physics SECONDS:ENGINE, each
 };
 
 struct ValidateArgs {

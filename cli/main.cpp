@@ -3,6 +3,7 @@
 // Exit status: 0 success, 2 bad input (scene, arguments, plugins), 1 failure while running.
 #include "common.hpp"
 #include "command_line.hpp"
+#include "number_options.hpp"
 #include "plugins_command.hpp"
 #include "recording_commands.hpp"
 #include "sweep.hpp"
@@ -118,6 +119,18 @@ std::string formatFactor(double f) {
 // "ode, bullet"
 
 // a saved state: a regular file of at most max_bytes (ssx::readInputFile)
+// "physics: ode, then bullet from 1.5 s, then ode from 3 s"
+std::string physicsSwitchesLine(const ssx::Environment& env) {
+  const auto& switches = env.physicsSwitches();
+  std::string line = "physics: " + switches.front().from;
+  for (const auto& s : switches) {
+    char at[48];
+    std::snprintf(at, sizeof at, "%.6g s", ssx::toSeconds(s.time));
+    line += ", then " + s.to + " from " + at;
+  }
+  return line;
+}
+
 std::vector<std::byte> readFile(const std::string& path, std::uintmax_t max_bytes) {
   std::string text;
   try {
@@ -307,6 +320,10 @@ int commandRun(const RunArgs& args, bool realtime_given) {
   try {
     env.start();
     if (!loaded.empty()) env.restoreState(loaded);
+    for (const std::string& spec : args.switch_physics) {
+      const auto [at, engine] = *parseSwitch(spec);
+      env.switchPhysicsAt(ssx::toNanoseconds(at), engine);
+    }
     if (!args.quiet)
       std::cerr << "ssx: " << scene.file.string() << ": " << env.artifactCount() << " artifacts, " << env.threadCount()
                 << " thread(s), timestep " << ssx::toSeconds(env.timestep()) * 1e3 << " ms, "
@@ -353,6 +370,7 @@ int commandRun(const RunArgs& args, bool realtime_given) {
   }
   if (status == 0) {
     if (!args.quiet) std::cout << summary.str() << '\n' << flights.summary().str() << '\n';
+    if (!args.quiet && !env.physicsSwitches().empty()) std::cout << physicsSwitchesLine(env) << '\n';
     if (!args.quiet && !recorded.empty()) std::cout << recorded << '\n';
   }
   // where the pictures went

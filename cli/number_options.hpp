@@ -3,15 +3,20 @@
 // no hex, no trailing text), checked against their range before CLI11 converts them (its own
 // conversion reads hex and clamps integers beyond 64 bits), with the bounds said as a person writes
 // them.
+#include <ssx/environment.hpp>
+#include <ssx/physic_engine.hpp>
 #include <ssx/random.hpp>
 
 #include <CLI/CLI.hpp>
 
+#include <algorithm>
 #include <charconv>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
+#include <optional>
 #include <string>
+#include <utility>
 
 namespace ssx::cli {
 
@@ -65,6 +70,36 @@ inline CLI::Validator realNumber(double min, double max, bool open_min = false) 
         return {};
       },
       "NUMBER " + range);
+}
+
+/// A switch of physics engine at a time: `SECONDS:ENGINE` (seconds of simulated time from 0 to
+/// kMaxDurationSeconds, an engine of physicEngineNames()); parseSwitch reads it.
+inline std::optional<std::pair<double, std::string>> parseSwitch(const std::string& text) {
+  const auto colon = text.find(':');
+  if (colon == std::string::npos) return std::nullopt;
+  double v = 0;
+  const char* begin = text.data();
+  const char* end = begin + colon;
+  const auto [ptr, ec] = std::from_chars(begin, end, v, std::chars_format::general);
+  if (colon == 0 || ptr != end || ec != std::errc() || !std::isfinite(v) || v < 0 || v > ssx::kMaxDurationSeconds)
+    return std::nullopt;
+  const std::string engine = text.substr(colon + 1);
+  const auto names = ssx::physicEngineNames();
+  if (std::find(names.begin(), names.end(), engine) == names.end()) return std::nullopt;
+  return std::make_pair(v, engine);
+}
+
+/// A switch of physics engine as --switch-physics takes it.
+inline CLI::Validator switchSpec() {
+  std::string engines;
+  for (const auto& n : ssx::physicEngineNames()) engines += (engines.empty() ? "" : ", ") + n;
+  return CLI::Validator(
+      [engines](std::string& text) -> std::string {
+        return parseSwitch(text) ? std::string()
+                                 : "must be SECONDS:ENGINE (seconds of simulated time from 0, an engine of " + engines +
+                                       "), got '" + text + "'";
+      },
+      "SECONDS:ENGINE");
 }
 
 }  // namespace ssx::cli

@@ -307,6 +307,10 @@ int resimulate(const Recording& r, const ReplayArgs& args) {
     env.checkState(state);
     env.start();
     env.restoreState(state);
+    // the recorded run's switches of physics engine from there on, at their times (a state saved
+    // at a switch's time was saved before it: states are taken at the end of a step)
+    for (const ssx::PhysicsSwitch& x : r.physicsSwitches())
+      if (x.time >= at) env.switchPhysicsAt(x.time, x.to);
   } catch (const std::exception& e) {
     std::cerr << "ssx: error: " << e.what() << '\n';
     return kExitBadInput;

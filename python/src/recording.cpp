@@ -81,6 +81,8 @@ py::tuple snapshot(const ssx::Recording& r, double t, const std::vector<fs::path
     fs::create_directories(out, ec);
     env.start();
     env.restoreState(state);
+    for (const ssx::PhysicsSwitch& x : r.physicsSwitches())  // (made again at their times)
+      if (x.time >= at) env.switchPhysicsAt(x.time, x.to);
     while (env.time() < want) env.step();
     state = env.saveState();
     env.stop();
@@ -137,6 +139,15 @@ void bindRecording(py::module_& m) {
       .def_property_readonly("seed", &ssx::Recording::seed, "The recorded run's seed.")
       .def_property_readonly("complete", &ssx::Recording::complete, "False for a file cut short (a killed run).")
       .def_property_readonly("size", &ssx::Recording::size, "Bytes in the file.")
+      .def_property_readonly(
+          "physics_switches",
+          [](const ssx::Recording& r) {
+            py::list out;
+            for (const ssx::PhysicsSwitch& x : r.physicsSwitches())
+              out.append(py::make_tuple(ssx::toSeconds(x.time), x.from, x.to));
+            return out;
+          },
+          "The switches of physics engine made while recording: (time s, from, to) each, in order.")
       .def_property_readonly(
           "state_times",
           [](const ssx::Recording& r) {

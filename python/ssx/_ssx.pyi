@@ -2,7 +2,7 @@
 
 tests/python/test_stubs.py checks that these name exactly what the module has."""
 import os
-from typing import Any, Dict, List, Optional, Sequence, Union
+from typing import Any, Dict, List, Optional, Sequence, Tuple, Union
 
 import numpy as np
 import numpy.typing as npt
@@ -108,6 +108,14 @@ class Environment:
         """Drives that joint's motor toward a position, held until changed."""
     def contacts(self) -> int:
         """Contact points the physics engine found in the last step."""
+    def switch_physics(self, engine: str) -> None:
+        """Continues the run on another physics engine ("ode", "bullet") from the next step: bodies, joints, attachments, ghosts and the robots' own state carry over, contacts are found again. Before the first step: the engine the run starts with. Raises for an unknown engine."""
+    @property
+    def physics_engine(self) -> str:
+        """The physics engine stepping now."""
+    @property
+    def physics_switches(self) -> List[Tuple[float, str, str]]:
+        """The switches of physics engine so far: (time s, from, to) each, in order."""
     def save_state(self) -> bytes:
         """Everything that determines the future."""
     def restore_state(self, state: bytes) -> None:
@@ -168,6 +176,9 @@ class Recording:
     @property
     def size(self) -> int:
         """Bytes in the file."""
+    @property
+    def physics_switches(self) -> List[Tuple[float, str, str]]:
+        """The switches of physics engine made while recording: (time s, from, to) each, in order."""
     @property
     def state_times(self) -> List[float]:
         """Times of the saved states, s."""

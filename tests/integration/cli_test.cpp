@@ -533,6 +533,36 @@ TEST_CASE("ssx run --record, inspect and replay: a run kept, looked at, drawn ag
   fs::remove_all(dir);
 }
 
+TEST_CASE("ssx run --switch-physics: the run goes on on the other engine, and its recording re-simulates bit for bit",
+          "[cli][record][switch_physics]") {
+  const fs::path dir = fs::temp_directory_path() / ("ssx_switch_cli_" + std::to_string(getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  const std::string scene = (kExamples / "scenes" / "quad_hover.xml").string();
+  const std::string rec = (dir / "switched.mcap").string();
+  // an engine that is not there, or no time: refused before anything is written
+  for (const char* bad : {"1:mujoco", "bullet", "-1:bullet", "x:ode"}) {
+    const Result refused = run({"run", scene, "--steps", "10", "--fast", "--switch-physics", bad, "--record", rec});
+    CHECK(refused.status == 2);
+    CHECK_THAT(refused.err, Catch::Contains("--switch-physics") && Catch::Contains("SECONDS:ENGINE"));
+    CHECK_FALSE(fs::exists(rec));
+  }
+  const Result ran = run({"run", scene, "--steps", "1500", "--fast", "--switch-physics", "1:bullet", "--switch-physics",
+                          "2:ode", "--record", rec, "--record-states", "0.5", "--out", (dir / "out").string()});
+  REQUIRE(ran.status == 0);
+  CHECK_THAT(ran.out, Catch::Contains("physics: ode, then bullet from 1 s, then ode from 2 s"));
+  CHECK_THAT(ran.out, Catch::Contains(", crashed 0"));
+  // from the start, from a state saved on ODE just before the first switch (1 s), from one saved
+  // on Bullet (1.5 s): the switches are made again at their times, and every sample is as recorded
+  for (const char* from : {"0", "1.2", "1.7"}) {
+    INFO("from " << from);
+    const Result again = run({"replay", rec, "--resimulate-from", from});
+    CHECK(again.status == 0);
+    CHECK_THAT(again.out, Catch::Contains("every one equal to the recording bit for bit"));
+  }
+  fs::remove_all(dir);
+}
+
 TEST_CASE("ssx validate and ssx run agree on the whole invalid corpus: the same first error, exit 2, nothing run",
           "[cli]") {
   const auto firstError = [](const std::string& err) {

@@ -106,3 +106,29 @@ def test_snapshot_between_saved_states_never_writes_over_the_scenes_absolute_out
     with pytest.raises(ValueError, match="poses.csv: it would be written over"):
         r.snapshot(1.2)
     assert log.read_bytes() == written
+
+
+def test_a_run_switched_between_engines_records_its_switches_and_snapshots_make_them_again(tmp_path):
+    env = ssx.load_scene(ssx.data_directory() / "scenes" / "quad_hover.xml")
+    assert env.physics_engine == "ode"
+    env.record(tmp_path / "switched.mcap", rate_hz=50, state_every_s=1)
+    env.step(600)  # 1.2 s on ODE
+    env.switch_physics("bullet")
+    assert env.physics_engine == "bullet"
+    env.step(600)  # 1.2 s on Bullet
+    env.switch_physics("ode")
+    env.step(300)
+    env.stop_recording()
+    assert env.physics_switches == [(pytest.approx(1.2), "ode", "bullet"), (pytest.approx(2.4), "bullet", "ode")]
+    with pytest.raises(ssx.ConfigError, match="unknown physics engine 'physx'"):
+        env.switch_physics("physx")
+    r = ssx.Recording(tmp_path / "switched.mcap")
+    assert r.physics_switches == env.physics_switches
+    # between two saved states across a switch (1.02 s on ODE, the switch at 1.2 s): re-simulated
+    # with the switch made again, the poses are the recorded ones bit for bit
+    t, state = r.snapshot(1.8)
+    again = ssx.load_scene_string(r.scene_xml)
+    again.restore_state(state)
+    assert again.physics_engine == "bullet"
+    _, p, _ = r.at(1.8)
+    assert np.array_equal(again.positions().astype(np.float32), p)

@@ -3,6 +3,7 @@
 /// Environment: owns the engines, the artifacts and the extensions; steps and paces them.
 ///
 /// One step (`step()`), advancing simulated time by one timestep:
+///   0. the switches of physics engine due by now (switchPhysicsAt), in the order given
 ///   1. extensions' beforeStep (calling thread)
 ///   2. physics: the engine integrates the timestep (in `substeps` parts) with the forces the
 ///      drivers wrote before and the joints' motors; ghosts move to their next poses; no plugin
@@ -245,15 +246,38 @@ class SSX_EXPORT Environment {
   /// (another scene, another format) throws StateError and leaves the state as it was.
   /// Not saved: camera images (drawn again when due) and the outside world of extensions.
   void restoreState(std::span<const std::byte> state);
+  /// A saved state names the engine that saved it: restoring it continues on that engine
+  /// (switching to it, as switchPhysics does, when another one is stepping).
   /// The checks restoreState makes before it changes anything (format, size, checksum, the scene
   /// it was saved from), without starting the environment. Throws StateError.
   void checkState(std::span<const std::byte> state) const;
   /// Where the environment is in its life.
   State state() const noexcept;
 
+  // --- exchanging the physics engine while running ------------------------------------------
+
+  /// Continues the run on another physics engine (one of physicEngineNames()), between two
+  /// steps: every body's pose and velocities, the joints of the scene and those made at run time
+  /// (attachments) with their motors' commands, the ghosts, the drivers' and sensors' state and
+  /// the commands held for the next step carry over; the new engine finds the contacts again in
+  /// its first step (what an engine keeps between steps for itself, ODE's partitions and their
+  /// random seeds, starts afresh). Deterministic: the same switches at the same steps give the
+  /// same bits on any thread count. Before start it chooses the engine the run starts with; the
+  /// engine already stepping changes nothing. ConfigError for an unknown engine; Error from the
+  /// parallel phases or configure, or once the environment failed or stopped.
+  void switchPhysics(const std::string& engine);
+  /// The same, carried out just before the first step that starts at or after `time` (ns of
+  /// simulated time; now or earlier: before the next step): for a command line's
+  /// `--switch-physics` and a re-simulation replaying a recorded run's switches. Several at one
+  /// time are carried out in the order given. ConfigError for an unknown engine or a negative time.
+  void switchPhysicsAt(Nanoseconds time, const std::string& engine);
+  /// The switches switchPhysics and switchPhysicsAt made so far, in order (restoring a state
+  /// saved by another engine is not one: the state says its engine).
+  const std::vector<PhysicsSwitch>& physicsSwitches() const noexcept { return switches_; }
+
   // --- queries -------------------------------------------------------------------------------
 
-  /// The settings it was made with.
+  /// The settings it was made with; `physics.engine` is the engine stepping now (switchPhysics).
   const EnvironmentSettings& settings() const noexcept { return settings_; }
   /// The physics timestep tau, ns.
   Nanoseconds timestep() const noexcept { return settings_.timestep; }
@@ -444,6 +468,8 @@ class SSX_EXPORT Environment {
   void fail();
   void warnUnusedParameters() const;
   void runExtensionHook(void (SimulationExtension::*hook)(Environment&), const char* what);
+  void exchangePhysics(const std::string& engine);
+  void runScheduledSwitches();
 
   struct ExtensionSlot {
     std::string name;
@@ -466,6 +492,8 @@ class SSX_EXPORT Environment {
   bool rays_enabled_ = false;
   mutable bool rays_stale_ = true;  // the engine's shapes are not where the snapshot has the bodies
   std::vector<StaticShape> static_shapes_;
+  std::vector<PhysicsSwitch> switches_;    // made so far
+  std::vector<PhysicsSwitch> scheduled_;   // switchPhysicsAt's, by time (`from` unused)
   TimingRecorder timing_{settings_.timing_samples};
   LogSink log_;
   // step listeners (addStepListener), after the members plugins' inline accessors read

@@ -185,6 +185,13 @@ class SSX_EXPORT PhysicEngine {
   virtual void restoreState(StateReader& in) = 0;
 };
 
+/// A change of physics engine while a run goes on (Environment::switchPhysics).
+struct PhysicsSwitch {
+  Nanoseconds time = 0;  ///< simulated time of the switch: the next step was the new engine's first
+  std::string from;      ///< the engine that stepped until then
+  std::string to;        ///< the engine that steps from then on
+};
+
 /// The physics engines in this build of ssx ("ode", "bullet").
 SSX_EXPORT std::vector<std::string> physicEngineNames();
 /// Creates the engine `settings.engine` names; throws ConfigError for an unknown name.

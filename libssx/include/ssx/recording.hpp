@@ -14,6 +14,8 @@
 ///   value at (the field's start) + b * N + i (the schema's text says the same);
 /// - attachments `state/<nanoseconds>`: saved states (Environment::saveState) at the first sample and
 ///   then every `state_every_s` of simulated time, from which a run can be continued bitwise;
+/// - attachments `physics/<nanoseconds>`: each switch of physics engine (Environment::switchPhysics)
+///   at that time, as text: the engine before, a newline, the engine after;
 /// - for Foxglove and Lichtblick (RecordOptions::foxglove), in their well-known schemas, JSON-encoded:
 ///   channel `/tf` (foxglove.FrameTransforms: "world" to each body, at every pose sample) and
 ///   channel `/scene` (foxglove.SceneUpdate, once: the render trees' shapes, an entity per body
@@ -28,6 +30,7 @@
 /// dropped) and a run as fast as possible waits for the writer (nothing is dropped).
 
 #include <ssx/export.hpp>
+#include <ssx/physic_engine.hpp>
 #include <ssx/types.hpp>
 
 #include <cstddef>
@@ -158,6 +161,9 @@ class SSX_EXPORT Recording {
   /// The saved state at or before `time` (its time in `at`), for Environment::restoreState.
   /// Throws Error when there is none that early.
   std::vector<std::byte> stateAtOrBefore(Nanoseconds time, Nanoseconds* at = nullptr) const;
+  /// The switches of physics engine made while recording, in order (a re-simulation makes them
+  /// again at their times).
+  std::vector<PhysicsSwitch> physicsSwitches() const;
   /// Whether the file ends as a finished recording does (summary and footer).
   bool complete() const noexcept;
   /// The messages of channel `topic` (log time in ns, the message's bytes), in the file's order

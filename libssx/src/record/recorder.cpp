@@ -55,6 +55,7 @@ struct Extra {
 struct Job {
   Nanoseconds time = 0;
   bool state = false;
+  std::string attachment;  // a switch of physics engine: the attachment's name (bytes: its text)
   std::vector<std::byte> bytes;
   std::vector<Extra> extras;
 };
@@ -135,6 +136,7 @@ struct Recorder::Impl {
   std::vector<Extra> extras;                                     // since the last sample
   std::vector<float> tf_positions, tf_orientations;              // the writer thread's
   Nanoseconds first_time = -1, last_time = 0;
+  std::size_t switches_seen = 0;  // of the environment's switches of physics engine: those written
   bool went_back = false;  // said once: the time went back (a state restored while recording)
   // shared with the writer thread
   mutable std::mutex mutex;
@@ -278,7 +280,7 @@ void Recorder::Impl::push(Job job) {
   std::unique_lock lock(mutex);
   if (error) std::rethrow_exception(error);
   if (queue.size() >= options.queue_samples) {
-    if (options.drop_when_behind && !job.state && job.time >= 0) {
+    if (options.drop_when_behind && !job.state && job.attachment.empty() && job.time >= 0) {
       ++summary.dropped;
       spare.push_back(std::move(job.bytes));
       return;
@@ -299,6 +301,16 @@ void Recorder::Impl::observe() {
     if (timing.size() >= 2 && timing[timing.size() - 2].step + 1 == timing[timing.size() - 1].step)
       takeTiming(timing[timing.size() - 2]);
     contacts = env->physics().contactCount();  // this step's, sent with its timing at the next
+  }
+  // the switches of physics engine since the last step, each in an attachment of its own
+  for (const auto& all = env->physicsSwitches(); switches_seen < all.size(); ++switches_seen) {
+    const PhysicsSwitch& x = all[switches_seen];
+    Job job;
+    job.time = x.time;
+    job.attachment = "physics/" + std::to_string(x.time);
+    const std::string text = x.from + "\n" + x.to;
+    job.bytes.assign(reinterpret_cast<const std::byte*>(text.data()), reinterpret_cast<const std::byte*>(text.data()) + text.size());
+    push(std::move(job));
   }
   if (env->stepCount() % period_steps != 0) return;
   Job job;
@@ -355,7 +367,9 @@ void Recorder::Impl::loop() {
       // the optional channels' messages first: they are stamped at or before the sample
       for (const Extra& e : job.extras)
         writer->addMessage(e.channel, e.time, std::as_bytes(std::span(e.json.data(), e.json.size())));
-      if (job.state) {
+      if (!job.attachment.empty()) {
+        writer->addAttachment(job.attachment, "text/plain", job.time, job.bytes);
+      } else if (job.state) {
         writer->addAttachment("state/" + std::to_string(job.time), "application/x-ssx-state", job.time, job.bytes);
       } else if (job.time >= 0) {
         writer->addMessage(poses_channel, job.time, job.bytes);
@@ -375,7 +389,7 @@ void Recorder::Impl::loop() {
     std::lock_guard lock(mutex);
     if (job.state)
       ++summary.states;
-    else if (job.time >= 0)
+    else if (job.time >= 0 && job.attachment.empty())
       ++summary.samples;
     summary.bytes = writer->bytesWritten();
     spare.push_back(std::move(job.bytes));
@@ -399,6 +413,7 @@ Recorder::Recorder(Environment& env, RecordOptions options) : impl_(std::make_un
   if (m.options.writer_nice < 0 || m.options.writer_nice > 19)
     throw ConfigError({}, "record: writer_nice must be 0 (unchanged) to 19 (a lower priority than the stepping threads)");
   m.writer = std::make_unique<detail::McapWriter>(m.options.file, "ssx", std::string("ssx ") + SSX_VERSION_STRING);
+  m.switches_seen = env.physicsSwitches().size();  // (made before: the saved states say the engine)
   m.listener = env.addStepListener([&m](const Environment&) { m.observe(); });
   m.listening = true;
 }

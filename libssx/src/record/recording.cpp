@@ -21,6 +21,7 @@ struct Recording::Impl {
   std::string scene_xml, scene_label, version;
   std::uint64_t seed = 0;
   std::vector<std::pair<Nanoseconds, std::span<const std::byte>>> states;
+  std::vector<PhysicsSwitch> switches;  // in the file's order (the order made)
 };
 
 namespace {
@@ -68,9 +69,16 @@ Recording::Recording(detail::McapFile file) : impl_(std::make_unique<Impl>()) {
       m.scene_xml.assign(reinterpret_cast<const char*>(a.data.data()), a.data.size());
     } else if (a.name.rfind("state/", 0) == 0) {
       m.states.emplace_back(a.log_time, a.data);
+    } else if (a.name.rfind("physics/", 0) == 0) {
+      const std::string text(reinterpret_cast<const char*>(a.data.data()), a.data.size());
+      const auto newline = text.find('\n');
+      if (newline == std::string::npos || newline == 0 || newline + 1 == text.size())
+        notRecording(path, "its attachment '" + a.name + "' is not two engine names on two lines (corrupted)");
+      m.switches.push_back({a.log_time, text.substr(0, newline), text.substr(newline + 1)});
     }
   }
   std::sort(m.states.begin(), m.states.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+  std::stable_sort(m.switches.begin(), m.switches.end(), [](const auto& a, const auto& b) { return a.time < b.time; });
   const int channel = f.channelId("/ssx/poses");
   if (channel < 0) notRecording(path, "it has no /ssx/poses channel");
   // every pose sample checked once here, so that reading one later cannot fail: its length, and
@@ -123,6 +131,8 @@ std::vector<float> Recording::orientations(std::size_t k) const {
   detail::decodePoses(impl_->file.data(impl_->file.messages[impl_->samples.at(k)]), nullptr, &out);
   return out;
 }
+
+std::vector<PhysicsSwitch> Recording::physicsSwitches() const { return impl_->switches; }
 
 std::vector<Nanoseconds> Recording::stateTimes() const {
   std::vector<Nanoseconds> out;

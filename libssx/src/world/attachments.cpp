@@ -41,7 +41,7 @@ void attach(World& world, PhysicEngine& engine, std::uint32_t holder, std::uint3
   joint.child = b >= 0 ? b : a;
   joint.frame = kind == JointSpec::Kind::Ball ? world.node_handles[holder].pose()
                                               : world.states[static_cast<std::size_t>(joint.child)].pose;
-  Attachment x{holder, held, engine.addJoint(joint)};
+  Attachment x{holder, held, engine.addJoint(joint), kind};
   count(world, x, 1);
   world.attachments.push_back(x);
 }
@@ -98,15 +98,27 @@ void applyAttachRequests(World& world, PhysicEngine& engine) {
   }
 }
 
+void reattach(World& world, PhysicEngine& engine) {
+  // held where they are now: the same relative poses as when they were made (joints keep them)
+  std::vector<Attachment> made = std::move(world.attachments);
+  world.attachments.clear();
+  std::fill(world.attached.begin(), world.attached.end(), std::uint16_t{0});
+  for (const Attachment& x : made) attach(world, engine, x.holder, x.held, x.kind);
+}
+
 void loadAttachments(World& world, StateReader& in) {
   const auto nodes = world.nodes.size();
   auto bad = [] { return StateError("saved state: a run-time joint (attach) does not fit this world (corrupted)"); };
-  std::vector<Attachment> attachments(in.count(12));
+  std::vector<Attachment> attachments(in.count(13));
   for (Attachment& x : attachments) {
     in.read(x.holder);
     in.read(x.held);
     x.engine = in.get<std::int32_t>();
+    const auto kind = in.get<std::uint8_t>();
     if (x.holder >= nodes || x.held >= nodes || x.engine < 0 || world.nodes[x.holder].body < 0) throw bad();
+    if (kind != static_cast<std::uint8_t>(JointSpec::Kind::Fixed) && kind != static_cast<std::uint8_t>(JointSpec::Kind::Ball))
+      throw bad();
+    x.kind = static_cast<JointSpec::Kind>(kind);
   }
   world.attachments = std::move(attachments);
   std::fill(world.attached.begin(), world.attached.end(), std::uint16_t{0});

@@ -12,7 +12,7 @@ namespace ssx {
 
 namespace detail {
 
-void buildBodies(World& world, PhysicEngine& engine, std::vector<Environment::StaticShape>& static_shapes) {
+void buildBodies(World& world, PhysicEngine& engine, std::vector<Environment::StaticShape>* static_shapes) {
   // each node tree becomes one rigid body whose frame is its centre-of-mass frame, and one more for
   // each joined child (with its rigid descendants)
   std::vector<std::size_t> head;  // per node of the artifact: the node its body begins at
@@ -46,7 +46,7 @@ void buildBodies(World& world, PhysicEngine& engine, std::vector<Environment::St
         for (Shape s : artifact->nodeAt(k).spec().shapes) {
           s.pose = n.pose_in_body * s.pose;
           shapes.push_back(s);
-          if (n.is_static) static_shapes.push_back({s, top_data.pose * s.pose, artifact->index()});
+          if (n.is_static && static_shapes != nullptr) static_shapes->push_back({s, top_data.pose * s.pose, artifact->index()});
         }
       }
       if (top.isStatic()) {
@@ -64,15 +64,18 @@ void buildBodies(World& world, PhysicEngine& engine, std::vector<Environment::St
       const int body = engine.addBody(mass, shapes, initial);
       for (std::size_t k = h; k < count; ++k)
         if (head[k] == h) world.nodes[offset + k].body = body;
+      if (static_shapes == nullptr) continue;  // (made again: the arrays are as they were)
       world.body_owner.push_back(static_cast<std::uint32_t>(artifact->index()));
       world.wrench_limits.push_back(wrenchLimit(mass, world.settings.physics, world.settings.timestep));
     }
     data.body_end = static_cast<int>(engine.bodyCount());
   }
-  world.states.assign(engine.bodyCount(), BodyState{});
-  world.previous_linear.assign(world.states.size(), Vec3::Zero());
-  world.previous_angular.assign(world.states.size(), Vec3::Zero());
-  world.wrenches.assign(world.states.size(), Wrench{});
+  if (static_shapes != nullptr) {
+    world.states.assign(engine.bodyCount(), BodyState{});
+    world.previous_linear.assign(world.states.size(), Vec3::Zero());
+    world.previous_angular.assign(world.states.size(), Vec3::Zero());
+    world.wrenches.assign(world.states.size(), Wrench{});
+  }
   buildJoints(world, engine);
 }
 

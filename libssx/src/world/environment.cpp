@@ -323,7 +323,7 @@ void Environment::start() {
     physics_ = createPhysicEngine(settings_.physics);
     w.engine = physics_.get();
     renderer_ = createRenderEngine(settings_.render);
-    detail::buildBodies(w, *physics_, static_shapes_);
+    detail::buildBodies(w, *physics_, &static_shapes_);
     ghosts_->start(w, *physics_);
     detail::publishSnapshot(w, *physics_, true);
     // (queries enabled before start, by an extension's init, see the first snapshot too)

@@ -63,6 +63,10 @@ void Ghosts::start(World& world, PhysicEngine& engine) {
   }
 }
 
+void Ghosts::adopt(PhysicEngine& engine) const {
+  for (const Ghost& g : ghosts_) engine.setKinematic(g.body);
+}
+
 void Ghosts::beforePhysics(World& world, PhysicEngine& engine, double t_next, double dt) {
   for (Ghost& g : ghosts_) {
     const auto e = g.stream.dueAt(t_next);

@@ -39,6 +39,8 @@ class Ghosts {
 
   // start: the bodies made kinematic and placed where their streams say at time 0
   void start(World& world, PhysicEngine& engine);
+  // makes the ghosts' bodies kinematic in another engine (switching engines)
+  void adopt(PhysicEngine& engine) const;
   // around the physics step that ends at `t_next`: the velocity that takes each body there, and
   // the exact pose there afterwards (before the snapshot is read)
   void beforePhysics(World& world, PhysicEngine& engine, double t_next, double dt);

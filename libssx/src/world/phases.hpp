@@ -12,8 +12,10 @@
 namespace ssx::detail {
 
 /// Flattens every artifact's node trees into rigid bodies of `engine` (static roots become static
-/// shapes, listed in `static_shapes`), fills the nodes' body indices and the body arrays.
-void buildBodies(World& world, PhysicEngine& engine, std::vector<Environment::StaticShape>& static_shapes);
+/// shapes, listed in `static_shapes`), fills the nodes' body indices and the body arrays. With
+/// `static_shapes` null, makes the same bodies and joints again in another engine (switching
+/// engines): the body arrays and the snapshot are left as they are.
+void buildBodies(World& world, PhysicEngine& engine, std::vector<Environment::StaticShape>* static_shapes);
 /// Makes the engine's joints from the node trees (the end of buildBodies; joints.cpp).
 void buildJoints(World& world, PhysicEngine& engine);
 /// Before a physics step: sets the motors' velocities; returns the wrenches to apply (the drivers',
@@ -25,6 +27,8 @@ void applyAttachRequests(World& world, PhysicEngine& engine);
 /// Reads the run-time joints saveState wrote (after the engine restored its joints);
 /// throws StateError for what does not fit the world.
 void loadAttachments(World& world, StateReader& in);
+/// Makes the run-time joints again in another engine (switching engines), where the bodies are now.
+void reattach(World& world, PhysicEngine& engine);
 /// A hinge's angle or slider's displacement from the snapshot (0 before start).
 double jointPosition(const World& world, const JointData& joint);
 /// A hinge's or slider's rate from the snapshot (0 before start).

@@ -186,6 +186,7 @@ void Environment::step() {
   if (w.state != State::Running)
     throw Error(w.state == State::Failed ? "the environment failed in an earlier step; it cannot step again"
                                         : "the environment is stopped");
+  if (!scheduled_.empty() && scheduled_.front().time <= time()) runScheduledSwitches();
   const auto t_step = Clock::now();
   StepTiming timing;
   w.current_step = w.steps;

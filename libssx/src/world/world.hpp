@@ -66,6 +66,7 @@ struct Attachment {
   std::uint32_t holder = 0;  // node indices
   std::uint32_t held = 0;
   int engine = -1;  // the engine's index of the joint
+  JointSpec::Kind kind = JointSpec::Kind::Fixed;  // fixed or ball
 };
 
 /// What a driver asked for during a step, carried out as the drivers phase ends.

@@ -2,7 +2,7 @@
 // checksummed buffer.
 //
 // Layout: "SSXSTATE", format version (u32), reserved (u32), scene fingerprint (u64), payload size
-// (u64), FNV-1a of the payload (u64); then the payload: step count, the engine's block, the
+// (u64), FNV-1a of the payload (u64); then the payload: step count, the engine's name and its block, the
 // snapshot (body states with accelerations, the velocities before the last step), the command
 // buffers, the joints' motor commands, the run-time joints, every plugin's random stream (the
 // world's plugin table, in order), then one block per plugin (driver first, then sensors, artifact by artifact: what it saved) and one per extension.
@@ -16,6 +16,7 @@
 #include <ssx/environment.hpp>
 #include <ssx/hash.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 
@@ -24,7 +25,9 @@ namespace ssx {
 namespace {
 
 constexpr char kMagic[8] = {'S', 'S', 'X', 'S', 'T', 'A', 'T', 'E'};
-constexpr std::uint32_t kFormatVersion = 4;  // 4: run-time joints (PhysicNode::attach)
+// 4: run-time joints (PhysicNode::attach); 5: the engine's name (states restore on the engine that
+// saved them), the run-time joints' kinds
+constexpr std::uint32_t kFormatVersion = 5;
 constexpr std::size_t kHeaderSize = 8 + 4 + 4 + 8 + 8 + 8;
 
 void writeBody(StateWriter& out, const BodyState& s) {
@@ -69,9 +72,7 @@ std::uint64_t Environment::sceneFingerprint() const {
   std::uint64_t h = fnv1a("ssx scene", kFnv1aBasis);
   auto mix = [&h](std::string_view s) { h = fnv1a(s, fnv1a("|", h)); };
   mix(std::to_string(settings_.timestep));
-  // the engine's block is the engine's own format (left out for ODE, so that states saved before
-  // there was a second engine still fit)
-  if (settings_.physics.engine != "ode") mix("physics " + settings_.physics.engine);
+  // (not the engine: a state names its own, and restoring it switches to that one)
   for (const auto& a : world_->artifacts) {
     mix(a->name());
     // each dynamic root is one body, and each joined child (known before the engine is built)
@@ -95,6 +96,7 @@ std::vector<std::byte> Environment::saveState() const {
   std::vector<std::byte> buffer(kHeaderSize);
   StateWriter out(buffer);
   out.write(w.steps);
+  out.write(physics_->name());
   writeBlock(out, [&] { physics_->saveState(out); });
   out.write(static_cast<std::uint64_t>(w.states.size()));
   for (const auto& s : w.states) writeBody(out, s);
@@ -115,6 +117,7 @@ std::vector<std::byte> Environment::saveState() const {
     out.write(x.holder);
     out.write(x.held);
     out.write(static_cast<std::int32_t>(x.engine));
+    out.write(static_cast<std::uint8_t>(x.kind));
   }
   // the random streams, then each plugin's own state (driver first, then sensors, by artifact)
   for (const Random& r : w.randoms) r.save(out);
@@ -159,8 +162,8 @@ void Environment::checkState(std::span<const std::byte> state) const {
   if (fnv1a(state.data() + kHeaderSize, payload) != checksum)
     throw StateError("restoreState: the saved state is corrupted (checksum mismatch)");
   if (fingerprint != sceneFingerprint())
-    throw StateError("restoreState: the state was saved from a different scene (timestep, physics engine, bodies, "
-                     "artifacts or their plugins differ): load the scene it was saved from");
+    throw StateError("restoreState: the state was saved from a different scene (timestep, bodies, artifacts or "
+                     "their plugins differ): load the scene it was saved from");
 }
 
 void Environment::restoreState(std::span<const std::byte> state) {
@@ -190,6 +193,12 @@ void Environment::applyState(std::span<const std::byte> payload) {
   if (steps > static_cast<std::int64_t>(kMaxDurationSeconds * 1e9) / settings_.timestep)
     throw StateError("saved state: a step count of " + std::to_string(steps) +
                      " is beyond the longest run (1e9 s of simulated time; corrupted?)");
+  std::string engine;
+  in.read(engine);
+  const auto names = physicEngineNames();
+  if (std::find(names.begin(), names.end(), engine) == names.end())
+    throw StateError("saved state: saved by physics engine '" + engine + "', which this build of ssx does not have");
+  if (engine != physics_->name()) exchangePhysics(engine);
   readBlock(in, "the physics engine's state", [&](StateReader& block) { physics_->restoreState(block); });
   const std::size_t bodies = in.count(1);
   detail::World& w = *world_;

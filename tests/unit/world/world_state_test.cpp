@@ -36,9 +36,14 @@ TEST_CASE("a truncated, corrupted or foreign state is refused and changes nothin
   CHECK_THROWS_WITH(env.restoreState(truncated), Catch::Contains("truncated"));
   CHECK_THROWS_WITH(env.restoreState(corrupted), Catch::Contains("corrupted (checksum mismatch)"));
   CHECK_THROWS_WITH(env.restoreState(foreign), Catch::Contains("saved from a different scene"));
-  // the same scene on the other engine: its physics state is another engine's
+  // the same scene loaded on the other engine: the state names its engine, and the restore
+  // switches to it and goes on as the run that saved it
   Scene on_bullet = loadStateScene(2, "", "bullet");
-  CHECK_THROWS_WITH(on_bullet.environment->restoreState(saved), Catch::Contains("physics engine"));
+  on_bullet.environment->restoreState(saved);
+  CHECK(on_bullet.environment->physics().name() == "ode");
+  CHECK(on_bullet.environment->physicsSwitches().empty());  // (the state says its engine: no switch asked for)
+  on_bullet.environment->step(50);
+  CHECK(on_bullet.environment->saveState() == at150);
   CHECK_THROWS_WITH(env.restoreState(std::vector<std::byte>(10)), Catch::Contains("not an ssx saved state"));
   // nothing moved: the world is still at step 150 and goes on as it would have
   CHECK(env.stepCount() == 150);
