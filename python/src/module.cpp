@@ -8,6 +8,7 @@
 #include "convert.hpp"
 #include "ghosts.hpp"
 #include "joints.hpp"
+#include "physics.hpp"
 #include "recording.hpp"
 #include "view.hpp"
 
@@ -124,16 +125,6 @@ class PyEnvironment {
     }
     // (extension names are scene-unique, as artifact names)
     for (const auto& name : env_.extensionNames()) add(name, dynamic_cast<const ssx::MetricSource*>(env_.extension(name)));
-    return out;
-  }
-  void switchPhysics(const std::string& engine) {
-    InUse use(busy_);
-    env_.switchPhysics(engine);
-  }
-  std::string physicsEngine() const { return env_.settings().physics.engine; }
-  py::list physicsSwitches() const {
-    py::list out;
-    for (const ssx::PhysicsSwitch& x : env_.physicsSwitches()) out.append(py::make_tuple(ssx::toSeconds(x.time), x.from, x.to));
     return out;
   }
   // contact points the physics engine found in the last step
@@ -533,13 +524,6 @@ PYBIND11_MODULE(_ssx, m) {
            "Every metric the drivers and extensions publish now (ssx::MetricSource, e.g. the formation's formation_error), as "
            "{artifact or extension: {metric: value}}.")
       .def("contacts", &PyEnvironment::contacts, "Contact points the physics engine found in the last step.")
-      .def("switch_physics", &PyEnvironment::switchPhysics, py::arg("engine"),
-           "Continues the run on another physics engine (\"ode\", \"bullet\") from the next step: bodies, joints, "
-           "attachments, ghosts and the robots' own state carry over, contacts are found again. Before the first step: "
-           "the engine the run starts with. Raises for an unknown engine.")
-      .def_property_readonly("physics_engine", &PyEnvironment::physicsEngine, "The physics engine stepping now.")
-      .def_property_readonly("physics_switches", &PyEnvironment::physicsSwitches,
-                             "The switches of physics engine so far: (time s, from, to) each, in order.")
       .def("save_state", &PyEnvironment::saveState, "Everything that determines the future, as bytes.")
       .def("restore_state", &PyEnvironment::restoreState, py::arg("state"),
            "Continues from save_state() bytes: the next steps are bitwise those of the saving run.")
@@ -573,6 +557,7 @@ PYBIND11_MODULE(_ssx, m) {
 
   ssx_python::bindGhostsAndOperators(environment);
   ssx_python::bindJoints(environment);
+  ssx_python::bindPhysics(environment);
   ssx_python::bindRecording(m);
 
   m.def(
