@@ -412,6 +412,12 @@ int commandInspect(const InspectArgs& args) {
       o << "},\"first_time_ns\":" << (r.times().empty() ? 0 : r.times().front())
         << ",\"last_time_ns\":" << (r.times().empty() ? 0 : r.times().back()) << ",\"states_ns\":[";
       for (std::size_t i = 0; i < states.size(); ++i) o << (i ? "," : "") << states[i];
+      o << "],\"physics_switches\":[";
+      const std::vector<PhysicsSwitch> switches = r.physicsSwitches();
+      for (std::size_t i = 0; i < switches.size(); ++i) {
+        const PhysicsSwitch& x = switches[i];
+        o << (i ? "," : "") << "{\"time_ns\":" << x.time << ",\"from\":" << jsonString(x.from) << ",\"to\":" << jsonString(x.to) << "}";
+      }
       o << "]}";
       std::cout << o.str() << '\n';
       return 0;
@@ -426,6 +432,8 @@ int commandInspect(const InspectArgs& args) {
     std::cout << "saved states: " << states.size();
     for (std::size_t i = 0; i < states.size(); ++i) std::cout << (i ? ", " : " at ") << seconds(states[i]);
     std::cout << '\n';
+    for (const PhysicsSwitch& x : r.physicsSwitches())
+      std::cout << "physics: " << x.from << " to " << x.to << " at " << seconds(x.time) << '\n';
     if (!args.complete.empty()) std::cout << "complete copy written to " << args.complete << '\n';
   } catch (const std::exception& e) {
     std::cerr << "ssx: error: " << e.what() << '\n';

@@ -552,6 +552,10 @@ TEST_CASE("ssx run --switch-physics: the run goes on on the other engine, and it
   REQUIRE(ran.status == 0);
   CHECK_THAT(ran.out, Catch::Contains("physics: ode, then bullet from 1 s, then ode from 2 s"));
   CHECK_THAT(ran.out, Catch::Contains(", crashed 0"));
+  const Result inspected = run({"inspect", rec});
+  CHECK_THAT(inspected.out, Catch::Contains("physics: ode to bullet at 1.000 s\nphysics: bullet to ode at 2.000 s"));
+  const Result as_json = run({"inspect", rec, "--json"});
+  CHECK_THAT(as_json.out, Catch::Contains("\"physics_switches\":[{\"time_ns\":1000000000,\"from\":\"ode\",\"to\":\"bullet\"},"));
   // from the start, from a state saved on ODE just before the first switch (1 s), from one saved
   // on Bullet (1.5 s): the switches are made again at their times, and every sample is as recorded
   for (const char* from : {"0", "1.2", "1.7"}) {
