@@ -115,10 +115,6 @@ std::string formatFactor(double f) {
   return buf;
 }
 
-
-// "ode, bullet"
-
-// a saved state: a regular file of at most max_bytes (ssx::readInputFile)
 // "physics: ode, then bullet from 1.5 s, then ode from 3 s"
 std::string physicsSwitchesLine(const ssx::Environment& env) {
   const auto& switches = env.physicsSwitches();
@@ -131,6 +127,7 @@ std::string physicsSwitchesLine(const ssx::Environment& env) {
   return line;
 }
 
+// a saved state: a regular file of at most max_bytes (ssx::readInputFile)
 std::vector<std::byte> readFile(const std::string& path, std::uintmax_t max_bytes) {
   std::string text;
   try {
