@@ -1,8 +1,10 @@
 #include <ssx/random.hpp>
 #include <ssx/state.hpp>
 
+#include <algorithm>
 #include <charconv>
 #include <cmath>
+#include <iterator>
 
 namespace ssx {
 
@@ -61,9 +63,21 @@ void Random::save(StateWriter& out) const {
 }
 
 void Random::load(StateReader& in) {
-  for (std::uint64_t& word : s_) in.read(word);
-  in.read(spare_);
-  in.read(has_spare_);
+  // read whole and checked before anything changes: xoshiro never reaches the all-zero state (it
+  // would stay there, and the polar method would draw for ever), and a kept number is finite
+  std::uint64_t words[4];
+  for (std::uint64_t& word : words) in.read(word);
+  double spare = 0;
+  bool has_spare = false;
+  in.read(spare);
+  in.read(has_spare);
+  if ((words[0] | words[1] | words[2] | words[3]) == 0)
+    throw StateError(in.what() + ": a random stream's state is all zero, which no stream reaches (corrupted)");
+  if (has_spare && !std::isfinite(spare))
+    throw StateError(in.what() + ": a random stream keeps a number that is not finite (corrupted)");
+  std::copy(std::begin(words), std::end(words), std::begin(s_));
+  spare_ = spare;
+  has_spare_ = has_spare;
 }
 
 }  // namespace ssx
