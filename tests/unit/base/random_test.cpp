@@ -83,7 +83,7 @@ TEST_CASE("normal draws follow the normal distribution, tails included", "[rando
   CHECK(z.back() > 4.0);
 }
 
-TEST_CASE("a saved stream reads back to the same numbers; an all-zero or non-finite one is refused unchanged",
+TEST_CASE("a saved stream reads back to the same numbers, and an all-zero or non-finite one is refused unchanged",
           "[random][state]") {
   using ssx::Random, ssx::StateReader, ssx::StateWriter;
   Random a(42);
