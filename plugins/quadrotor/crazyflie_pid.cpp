@@ -1,6 +1,8 @@
 // The Crazyflie firmware's default controller (crazyflie_pid.hpp).
 #include "crazyflie_pid.hpp"
 
+#include <ssx/error.hpp>
+
 #include <algorithm>
 #include <cmath>
 #include <numbers>
@@ -137,11 +139,24 @@ void CrazyfliePidController::setCommand(const Command& command, const Vec3&) {
   } else if (command.level == CommandLevel::Velocity) {
     command_velocity_ = command.velocity;
     command_yaw_rate_ = command.yaw_rate;
+  } else if (command.level == CommandLevel::Attitude || command.level == CommandLevel::Rates) {
+    // the position and velocity loops rest; the attitude loop (or the rate loop alone) takes these
+    thrust_ = std::clamp(command.thrust / 4 / curve_.thrust_max * 65535.0, 0.0, 65535.0);
+    if (command.level == CommandLevel::Attitude) {
+      roll_deg_ = command.roll * kDeg;
+      pitch_deg_ = command.pitch * kDeg;
+      command_yaw_rate_ = command.yaw_rate;
+    } else {
+      command_rates_ = command.body_rates;
+    }
   }
 }
 
 Command CrazyfliePidController::command() const {
   if (level_ == CommandLevel::Velocity) return Command::velocityYawRate(command_velocity_, command_yaw_rate_);
+  const double thrust = thrust_ / 65535.0 * curve_.thrust_max * 4;
+  if (level_ == CommandLevel::Attitude) return Command::attitude(roll_deg_ / kDeg, pitch_deg_ / kDeg, command_yaw_rate_, thrust);
+  if (level_ == CommandLevel::Rates) return Command::rates(command_rates_, thrust);
   return FlightController::command();
 }
 
@@ -197,10 +212,17 @@ void CrazyfliePidController::attitudeLoop(FlightInputs& in) {
     motors_.fill(0);
     return;
   }
-  const double yaw_rate = level_ == CommandLevel::Velocity ? command_yaw_rate_ : current_.yaw_rate;
-  if (level_ == CommandLevel::Velocity || !in.holdsHeading()) yaw_target_deg_ = wrap180(yaw_target_deg_ + yaw_rate * kDeg * dt);
-  const Vec3 rates_desired(att_[0].update(roll_deg_, euler.x(), dt), att_[1].update(pitch_deg_, euler.y(), dt),
-                           att_[2].update(yaw_target_deg_, euler.z(), dt, true));
+  const bool commanded_yaw_rate = level_ == CommandLevel::Velocity || level_ == CommandLevel::Attitude;
+  const double yaw_rate = commanded_yaw_rate ? command_yaw_rate_ : current_.yaw_rate;
+  if (commanded_yaw_rate || !in.holdsHeading()) yaw_target_deg_ = wrap180(yaw_target_deg_ + yaw_rate * kDeg * dt);
+  Vec3 rates_desired;
+  if (level_ == CommandLevel::Rates) {
+    rates_desired = command_rates_ * kDeg;
+    yaw_target_deg_ = euler.z();  // a later attitude or velocity command holds the heading flown to
+  } else {
+    rates_desired = Vec3(att_[0].update(roll_deg_, euler.x(), dt), att_[1].update(pitch_deg_, euler.y(), dt),
+                         att_[2].update(yaw_target_deg_, euler.z(), dt, true));
+  }
   const Vec3& gyro = gyro_deg_;
   const double roll = rate_[0].update(rates_desired.x(), gyro.x(), dt);
   const double pitch = rate_[1].update(rates_desired.y(), gyro.y(), dt);
@@ -220,7 +242,8 @@ void CrazyfliePidController::attitudeLoop(FlightInputs& in) {
 void CrazyfliePidController::step(std::int64_t run, double t, FlightInputs& in, std::span<double> speeds) {
   const Vec3 rates = in.bodyRates() * kDeg;
   for (int k = 0; k < 3; ++k) gyro_deg_[k] = gyro_filter_[k].apply(rates[k]);
-  if (run % position_every_ == 0) positionLoop(t, in);
+  const bool high_level = level_ == CommandLevel::Position || level_ == CommandLevel::Velocity;
+  if (high_level && run % position_every_ == 0) positionLoop(t, in);
   if (run % attitude_every_ == 0) attitudeLoop(in);
   for (std::size_t i = 0; i < 4 && i < speeds.size(); ++i) speeds[i] = std::sqrt(motorThrust(motors_[i]) / thrust_coefficient_);
 }
@@ -231,7 +254,8 @@ void CrazyfliePidController::saveState(StateWriter& out) const {
   for (const double v : {current_.position.x(), current_.position.y(), current_.position.z(), current_.yaw,
                          current_.yaw_rate, command_velocity_.x(), command_velocity_.y(), command_velocity_.z(),
                          command_yaw_rate_, velocity_desired_.x(), velocity_desired_.y(), velocity_desired_.z(), roll_deg_,
-                         pitch_deg_, yaw_target_deg_, thrust_, filter_.volts(), motor_volts_})
+                         pitch_deg_, yaw_target_deg_, thrust_, filter_.volts(), motor_volts_, command_rates_.x(),
+                         command_rates_.y(), command_rates_.z()})
     out.write(v);
   out.write(yaw_target_set_);
   for (const double m : motors_) out.write(m);
@@ -242,12 +266,15 @@ void CrazyfliePidController::loadState(StateReader& in) {
   for (int k = 0; k < 3; ++k) pos_[k].load(in), vel_[k].load(in), att_[k].load(in), rate_[k].load(in);
   std::uint8_t level = 0;
   in.read(level);
+  if (level > static_cast<std::uint8_t>(CommandLevel::Rates) || !accepts(static_cast<CommandLevel>(level)))
+    throw StateError("crazyflie_pid: a saved command level this controller does not take (" + std::to_string(level) + ")");
   level_ = static_cast<CommandLevel>(level);
   double filtered = 0;
   double* fields[] = {&current_.position.x(), &current_.position.y(), &current_.position.z(), &current_.yaw,
                       &current_.yaw_rate, &command_velocity_.x(), &command_velocity_.y(), &command_velocity_.z(),
                       &command_yaw_rate_, &velocity_desired_.x(), &velocity_desired_.y(), &velocity_desired_.z(),
-                      &roll_deg_, &pitch_deg_, &yaw_target_deg_, &thrust_, &filtered, &motor_volts_};
+                      &roll_deg_, &pitch_deg_, &yaw_target_deg_, &thrust_, &filtered, &motor_volts_,
+                      &command_rates_.x(), &command_rates_.y(), &command_rates_.z()};
   for (double* f : fields) in.read(*f);
   filter_.reset(filtered);
   in.read(yaw_target_set_);

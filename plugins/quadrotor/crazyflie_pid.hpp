@@ -124,8 +124,14 @@ class CrazyfliePidController final : public FlightController {
   /// first step, as it would after hovering a while.
   void startInAir(double weight);
 
+  /// Position and velocity (the commander's high-level modes), attitude (cmd_rpyt: roll and pitch
+  /// absolute, a yaw rate, a thrust) and body rates (the rate mode of the firmware's controller:
+  /// the attitude loop bypassed). An attitude or rates command's collective thrust in N becomes
+  /// the motor command that asks for a quarter of it per motor (the battery compensation's
+  /// meaning of a command), at most 65535.
   bool accepts(CommandLevel level) const override {
-    return level == CommandLevel::Position || level == CommandLevel::Velocity;
+    return level == CommandLevel::Position || level == CommandLevel::Velocity || level == CommandLevel::Attitude ||
+           level == CommandLevel::Rates;
   }
   CommandLevel level() const override { return level_; }
   void setCommand(const Command& command, const Vec3& position) override;
@@ -164,6 +170,7 @@ class CrazyfliePidController final : public FlightController {
   Setpoint current_;
   Vec3 command_velocity_ = Vec3::Zero();
   double command_yaw_rate_ = 0;  // rad/s
+  Vec3 command_rates_ = Vec3::Zero();  // rad/s, body frame (rates level)
   // the loops
   Pid pos_[3], vel_[3], att_[3], rate_[3];
   LowPass2 gyro_filter_[3];

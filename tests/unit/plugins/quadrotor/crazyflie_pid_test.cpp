@@ -158,7 +158,9 @@ TEST_CASE("crazyflie_pid: a saved state continues identically, velocity commands
     CHECK(sa == sb);
   }
   CHECK(a.accepts(CommandLevel::Velocity));
-  CHECK_FALSE(a.accepts(CommandLevel::Attitude));
+  CHECK(a.accepts(CommandLevel::Attitude));
+  CHECK(a.accepts(CommandLevel::Rates));
+  CHECK_FALSE(a.accepts(CommandLevel::Rotors));
   a.setCommand(Command::velocityYawRate(Vec3(0.5, 0, 0), 0), in.pose.position);
   a.step(20, 0.04, in, sa);
   CHECK(a.desiredVelocity().x() == Approx(0.5));
@@ -256,4 +258,50 @@ TEST_CASE("crazyflie_pid: closed on a rigid Crazyflie it hovers, and follows a m
   CHECK(aside < 0.02);
   CHECK(f.velocity.dot(along) == Approx(0.5).margin(0.02));
   CHECK(max_tilt <= 20);
+}
+
+TEST_CASE("crazyflie_pid: attitude and body-rate commands fly the rigid Crazyflie, and survive a saved state",
+          "[quadrotor][crazyflie]") {
+  const double weight = 0.029 * 9.81;
+  Flight f;
+  f.pose.position = Vec3(0, 0, 1);
+  f.path = [](double) { return Setpoint{}; };
+  std::int64_t run = 0;
+  // level, with the weight's thrust: it neither climbs nor sinks fast, nor drifts
+  f.controller.setCommand(Command::attitude(0, 0, 0, weight), f.pose.position);
+  f.speeds.fill(std::sqrt(weight / 4 / f.rotor.thrust_coefficient));  // the motors spinning for hover already
+  double t = f.fly(0, 1, run, [](double) {});
+  INFO("velocity " << f.velocity.transpose());
+  CHECK(std::abs(f.velocity.z()) < 0.05);
+  CHECK(Vec3(f.velocity.x(), f.velocity.y(), 0).norm() < 0.02);
+  CHECK(f.controller.command().level == CommandLevel::Attitude);
+  CHECK(f.controller.command().thrust == Approx(weight));
+  // pitched 0.1 rad (ssx's signs: towards +x) with the thrust that keeps its height: it
+  // accelerates along +x at about g tan(0.1), and holds the pitch asked for
+  f.controller.setCommand(Command::attitude(0, 0.1, 0, weight / std::cos(0.1)), f.pose.position);
+  const double vx = f.velocity.x();
+  t = f.fly(t, t + 1, run, [](double) {});
+  CHECK(f.velocity.x() - vx == Approx(9.81 * std::tan(0.1)).epsilon(0.25));
+  const double pitch = std::asin(2 * (f.pose.orientation.w() * f.pose.orientation.y() -
+                                      f.pose.orientation.z() * f.pose.orientation.x()));
+  CHECK(pitch == Approx(0.1).margin(0.01));
+  // a roll rate of 1 rad/s: the rate loop alone makes the body turn at it
+  f.controller.setCommand(Command::rates(Vec3(1, 0, 0), weight), f.pose.position);
+  t = f.fly(t, t + 0.3, run, [](double) {});
+  CHECK(f.rates.x() == Approx(1).margin(0.1));
+  CHECK(std::abs(f.rates.y()) < 0.1);
+  CHECK(f.controller.command().body_rates.x() == 1);
+  // the rates level is in a saved state: a copy goes on identically
+  const CrazyfliePidGains gains;
+  CrazyfliePidController copy(gains, xFrame(), crazyflieRotors());
+  std::vector<std::byte> saved;
+  StateWriter out(saved);
+  f.controller.saveState(out);
+  StateReader back(saved);
+  copy.loadState(back);
+  CHECK(copy.command().level == CommandLevel::Rates);
+  std::array<double, 4> a{}, b{};
+  f.controller.step(run, t, f, a);
+  copy.step(run, t, f, b);
+  CHECK(a == b);
 }
