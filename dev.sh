@@ -20,8 +20,10 @@ packages=(build-essential cmake ninja-build pkg-config ccache
           libcivetweb-dev libjs-three cyclonedds-dev cyclonedds-tools
           python3-dev python3-numpy pybind11-dev libopenmpi-dev openmpi-bin)
 # for `test` also pytest and matplotlib (the Python module's tests and examples), doxygen (the
-# API reference and its check), and Chromium with selenium and websockets (the viewer's tests)
-python_test_packages=(python3-pytest python3-matplotlib doxygen chromium chromium-driver python3-selenium python3-websockets)
+# API reference and its check), Chromium with selenium and websockets (the viewer's tests), and
+# torch (ssx.learn's training example and its test)
+python_test_packages=(python3-pytest python3-matplotlib doxygen chromium chromium-driver python3-selenium python3-websockets
+                      python3-torch)
 # for `test` also ROS 1 (Debian's), so that the ros1 extension is built and tested against a real master
 ros_packages=(libroscpp-dev libgeometry-msgs-dev libsensor-msgs-dev libnav-msgs-dev
               python3-rosmaster python3-rospy python3-rostopic python3-geometry-msgs python3-nav-msgs)

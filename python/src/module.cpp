@@ -8,6 +8,7 @@
 #include "convert.hpp"
 #include "ghosts.hpp"
 #include "joints.hpp"
+#include "learn.hpp"
 #include "physics.hpp"
 #include "recording.hpp"
 #include "view.hpp"
@@ -559,6 +560,7 @@ PYBIND11_MODULE(_ssx, m) {
   ssx_python::bindJoints(environment);
   ssx_python::bindPhysics(environment);
   ssx_python::bindRecording(m);
+  ssx_python::bindLearn(m);
 
   m.def(
       "load_scene",

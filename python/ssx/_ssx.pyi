@@ -190,6 +190,47 @@ class Recording:
         """Every channel's topic and message count."""
     def __len__(self) -> int: ...
 
+class VectorEnvironment:
+    """num_envs copies of one scene, each a world of its own, stepped together on a pool of threads
+    (the GIL released): the core of ssx.learn.VectorEnv (C++: ssx::VectorEnvironment)."""
+
+    def __init__(self, xml: str, num_envs: int, base_dir: _Path = ..., seed: Optional[int] = None,
+                 threads: Optional[int] = None, label: str = "<string>", plugin_path: Sequence[_Path] = ...,
+                 physics: Optional[str] = None) -> None:
+        """Reads the scene once and builds num_envs copies of it, each on one thread, started."""
+    @property
+    def num_envs(self) -> int:
+        """How many copies."""
+    @property
+    def robot_names(self) -> List[str]:
+        """The robots of every copy (drivers that take set-points), in artifact order."""
+    @property
+    def timestep(self) -> float:
+        """Physics timestep, s."""
+    @property
+    def threads(self) -> int:
+        """Threads stepping the copies."""
+    def step(self, n: int = 1, active: Optional[npt.ArrayLike] = None) -> None:
+        """Steps every copy n times (or only those flagged in active, one flag per copy)."""
+    def robot_states(self, out: Optional[npt.NDArray[np.float64]] = None) -> npt.NDArray[np.float64]:
+        """(num_envs, robots, 13): x y z, qw qx qy qz, vx vy vz, wx wy wz (world frame), into out= when given."""
+    def imu(self, out: Optional[npt.NDArray[np.float64]] = None) -> npt.NDArray[np.float64]:
+        """(num_envs, robots, 6): each robot's first IMU, accelerometer (m/s^2) then gyroscope (rad/s)."""
+    def set_commands(self, level: str, values: npt.ArrayLike) -> None:
+        """One command level for every robot of every copy: values (num_envs, robots, columns), checked whole."""
+    def save_state(self, index: int = 0) -> bytes:
+        """Copy index's state."""
+    def reset(self, indices: Sequence[int], state: bytes, seeds: Sequence[int]) -> None:
+        """Restores the copies named to state and reseeds their random streams, one seed each."""
+    def move_robots(self, indices: Sequence[int], offsets: npt.ArrayLike, velocities: Optional[npt.ArrayLike] = None) -> None:
+        """Moves every robot of the copies named by offsets (len(indices), robots, 3), at velocities (or at rest)."""
+    def state_hashes(self) -> npt.NDArray[np.uint64]:
+        """Each copy's state hash."""
+    def times(self) -> npt.NDArray[np.float64]:
+        """Each copy's simulated time, s."""
+    def close(self) -> None:
+        """Stops and frees every copy."""
+
 def load_scene(path: _Path, seed: Optional[int] = None, threads: Optional[int] = None,
                plugin_path: Sequence[_Path] = ..., physics: Optional[str] = None) -> Environment:
     """Loads a scene file; raises SceneError (every file:line: error: line) before anything starts."""

@@ -17,6 +17,7 @@ BELOW = {
     "world": {"base", "plugin", "robot", "engines", "render"},
     "record": {"base"},
     "scene": {"base", "plugin", "robot", "engines", "render", "world", "record"},
+    "learn": {"base", "plugin", "robot", "engines", "render", "world", "record", "scene"},
 }
 
 root = pathlib.Path(sys.argv[1])

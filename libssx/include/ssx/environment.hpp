@@ -253,6 +253,12 @@ class SSX_EXPORT Environment {
   void checkState(std::span<const std::byte> state) const;
   /// Where the environment is in its life.
   State state() const noexcept;
+  /// Restarts every plugin's random stream (sensor noise, wind gusts, a driver's draws) as a scene
+  /// loaded with `seed` would start it: stream (artifact i, plugin j) from deriveSeed(seed, i, j).
+  /// Between two steps, after restoreState for instance, so that episodes started from one saved
+  /// state draw other noise (a learning environment's reset). What the streams already drew, and
+  /// the scene's placement and settings().seed, stay as they are.
+  void reseed(std::uint64_t seed);
 
   // --- exchanging the physics engine while running ------------------------------------------
 

@@ -166,6 +166,11 @@ void Environment::checkState(std::span<const std::byte> state) const {
                      "their plugins differ): load the scene it was saved from");
 }
 
+void Environment::reseed(std::uint64_t seed) {
+  for (std::size_t i = 0; i < world_->plugins.size(); ++i)
+    world_->randoms[i].reseed(deriveSeed(seed, world_->plugins[i].artifact, world_->plugins[i].index));
+}
+
 void Environment::restoreState(std::span<const std::byte> state) {
   checkState(state);  // before anything starts
   if (world_->state == State::Setup) start();

@@ -1,0 +1,127 @@
+#!/usr/bin/env python3
+"""What ssx.learn delivers per second from Python on this machine, beside the published figures
+of other CPU learning environments.
+
+    PYTHONPATH=build/python python3 examples/learn/bench_learn.py [--envs 1024] [--batches 100]
+
+Prints, for the Crazyflie `goto` task (actions at 50 Hz over 500 Hz physics, observations of pose,
+velocity and IMU) and for `formation` (64 environments of 16 robots): agent steps per second,
+the part of a step spent in Python (everything but the C++ stepping), the time to reset one
+environment, whether the batch allocates per step (tracemalloc, Python side), and what a
+Crazyflie's step costs as a world of its own against one world of many.
+"""
+import argparse
+import os
+import time
+import tracemalloc
+
+import numpy as np
+
+import ssx.learn as learn
+
+PEERS = [
+    ("EnvPool, MuJoCo, per core", "about 12,000 steps/s"),
+    ("QuadSwarm, 16 cores", "62,000 samples/s"),
+    ("gym-pybullet-drones", "about 15,000 robot steps/s"),
+]
+TARGET = 150_000
+
+
+def measure(env, batches, agents_per_env):
+    env.reset(seed=1)
+    actions = np.zeros(env.action_space.shape, dtype=np.float32)
+    for _ in range(5):
+        env.step(actions)
+    # a whole step, then the C++ stepping alone, in turns (the machine's speed drifts between minutes)
+    sim, n = env._b.sim, env._b.steps_per_action
+    total = core = 0.0
+    for _ in range(batches):
+        start = time.perf_counter()
+        env.step(actions)
+        middle = time.perf_counter()
+        sim.step(n)
+        total += middle - start
+        core += time.perf_counter() - middle
+    rate = env.num_envs * agents_per_env * batches / total
+    return rate, total / batches, (total - core) / batches
+
+
+def allocations(env, batches=20):
+    actions = np.zeros(env.action_space.shape, dtype=np.float32)
+    env.step(actions)
+    tracemalloc.start()
+    env.step(actions)
+    first = tracemalloc.get_traced_memory()[0]
+    for _ in range(batches):
+        env.step(actions)
+    grown = tracemalloc.get_traced_memory()[0] - first
+    tracemalloc.stop()
+    return grown
+
+
+def per_world_cost(robots=256, steps=500):
+    """us per Crazyflie step on one thread: as `robots` worlds of one, and as one world of `robots`."""
+    import ssx
+
+    task = learn.GoTo()
+    copies = ssx._ssx.VectorEnvironment(task.scene(), robots, base_dir=ssx.data_directory(), threads=1)
+    task.robots = robots
+    world = ssx.load_scene_string(task.scene(), base_dir=ssx.data_directory(), threads=1)
+    for sim in (copies, world):
+        sim.step(200)
+    separate = together = 0.0
+    for _ in range(4):  # in turns
+        start = time.perf_counter()
+        copies.step(steps)
+        middle = time.perf_counter()
+        world.step(steps)
+        separate += middle - start
+        together += time.perf_counter() - middle
+    copies.close()
+    world.close()
+    return separate / (4 * steps * robots) * 1e6, together / (4 * steps * robots) * 1e6
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    parser.add_argument("--envs", type=int, default=1024)
+    parser.add_argument("--batches", type=int, default=100)
+    parser.add_argument("--threads", type=int, default=None)
+    args = parser.parse_args()
+    print(f"machine: {os.cpu_count()} cores")
+    for name, figure in PEERS:
+        print(f"  peer: {name}: {figure}")
+
+    env = learn.VectorEnv("goto", num_envs=args.envs, threads=args.threads)
+    rate, batch, python = measure(env, args.batches, 1)
+    print(f"goto, {args.envs} Crazyflies, attitude actions at 50 Hz over 500 Hz physics, on {env._b.sim.threads} threads:")
+    print(f"  {rate:,.0f} agent steps/s (target {TARGET:,}); {batch * 1e3:.2f} ms a batch step, "
+          f"of which {python * 1e3:.2f} ms in Python ({python / args.envs * 1e6:.2f} us per agent step)")
+    sim, state = env._b, env._b.start_state
+    start = time.perf_counter()
+    for k in range(200):
+        sim.reset_copies([k % args.envs])
+    whole = (time.perf_counter() - start) / 200
+    start = time.perf_counter()
+    for k in range(200):
+        sim.sim.reset([k % args.envs], state, [k])
+    core = (time.perf_counter() - start) / 200
+    print(f"  reset of one environment: {whole * 1e6:.0f} us (target under 50 us), of which {core * 1e6:.0f} us "
+          f"restoring and reseeding the copy (C++), the rest in Python (the task's draw, moving the robots)")
+    print(f"  Python memory grown over 20 batch steps: {allocations(env)} bytes")
+    env.close()
+
+    separate, together = per_world_cost()
+    print(f"a Crazyflie's step on one thread: {separate:.2f} us as a world of its own, {together:.2f} us as one "
+          f"of 256 in one world")
+
+    env = learn.VectorEnv("formation", num_envs=64, robots=16, threads=args.threads)
+    rate, batch, python = measure(env, max(10, args.batches // 2), 16)
+    print(f"formation, 64 environments of 16 Crazyflies, velocity actions at 50 Hz over 500 Hz physics:")
+    print(f"  {rate:,.0f} agent steps/s (target {TARGET:,}); {batch * 1e3:.2f} ms a batch step, "
+          f"of which {python * 1e3:.2f} ms in Python")
+    env.close()
+
+
+if __name__ == "__main__":
+    main()

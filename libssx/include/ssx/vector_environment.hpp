@@ -1,0 +1,100 @@
+#pragma once
+/// @file
+/// Many copies of one scene stepped together: the core of learning environments (Python's
+/// `ssx.learn.VectorEnv`), usable from C++ alike.
+///
+/// Each copy is a world of its own (an Environment on one thread): copies cannot touch or sense
+/// each other, a copy's trajectory does not depend on its index or on what the other copies do,
+/// and resetting one changes no bit of the others. The copies are spread over a pool of worker
+/// threads, so a batch is bit for bit the same on any number of threads.
+
+#include <ssx/command.hpp>
+#include <ssx/environment.hpp>
+#include <ssx/export.hpp>
+#include <ssx/scene.hpp>
+
+#include <cstddef>
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <span>
+#include <string>
+#include <vector>
+
+namespace ssx {
+
+/// The state of one robot as a learning environment reads it, in the order of its 13 numbers.
+inline constexpr std::size_t kRobotStateSize = 13;  ///< x y z, qw qx qy qz, vx vy vz, wx wy wz
+
+/// Copies of one scene, each a world of its own on one thread, stepped together on a pool of
+/// worker threads; reset, reseeded, read and commanded as one batch (see the file comment).
+class SSX_EXPORT VectorEnvironment {
+ public:
+  /// `count` copies, copy i made by `load(i)` (a scene loaded with one thread: SceneOptions::threads
+  /// = 1; ConfigError otherwise), started; all copies must have the same robots (the artifacts whose
+  /// driver takes set-points, by name, in order: ConfigError naming the first that differs).
+  /// `threads`: worker threads that step the copies (0: one per core).
+  VectorEnvironment(const std::function<Scene(std::size_t)>& load, std::size_t count, int threads = 0);
+  ~VectorEnvironment();
+  VectorEnvironment(const VectorEnvironment&) = delete;
+  VectorEnvironment& operator=(const VectorEnvironment&) = delete;
+
+  /// How many copies.
+  std::size_t size() const noexcept { return envs_.size(); }
+  /// Copy `i` (std::out_of_range past size()).
+  Environment& operator[](std::size_t i);
+  /// Worker threads stepping the copies (the calling thread included).
+  unsigned threadCount() const noexcept;
+  /// The robots of every copy: the artifacts whose driver takes set-points, in artifact order.
+  const std::vector<std::string>& robotNames() const noexcept { return robot_names_; }
+
+  /// Steps every copy `n` times, in parallel: copy i ends as `(*this)[i].step(n)` alone would.
+  /// `active`, when not empty, has one flag per copy: only the copies flagged non-zero step (the
+  /// others stay where they are: a learning environment's copies being reset). A step that throws
+  /// in copy i throws StepError "copy i: ..." (the first copy that failed, by index) once every
+  /// copy has stopped; the copies that did not fail went on to the end.
+  void step(std::int64_t n, std::span<const std::uint8_t> active = {});
+  /// Calls `fn(i)` for every copy i in parallel, on the worker threads (each i once).
+  void forEach(const std::function<void(std::size_t)>& fn);
+
+  /// Restores copy `which[k]` to `state` (saved from any copy: they are the same scene) and
+  /// reseeds its random streams with `seeds[k]` (Environment::reseed), in parallel. StateError for
+  /// a state of another scene, before any copy changes.
+  void reset(std::span<const std::size_t> which, std::span<const std::byte> state,
+             std::span<const std::uint64_t> seeds);
+
+  /// Every robot of every copy into `out` (size() x robots x kRobotStateSize doubles, in that
+  /// order): its root's position, orientation, linear and angular velocity (world frame), as
+  /// published after the last step.
+  void robotStates(std::span<double> out) const;
+  /// Every robot's latest IMU reading into `out` (size() x robots x 6 doubles: accelerometer in
+  /// m/s^2, gyroscope in rad/s, body frame, noise and all), from its first IMU sensor. ConfigError
+  /// naming the first robot that has none.
+  void imuReadings(std::span<double> out) const;
+  /// Moves every robot of copy `which[k]` by `offsets` (which.size() x robots x 3, m, world frame)
+  /// and sets its linear velocity to `velocities` (the same shape, m/s; empty: at rest), its
+  /// angular velocity to zero; its orientation stays. Every body of a robot moves together. For
+  /// start states drawn at reset. ConfigError for a wrong size or a number not finite, before
+  /// any body moves; Error when Environment::setBodyState refuses a state (beyond the speed guards).
+  void moveRobots(std::span<const std::size_t> which, std::span<const double> offsets,
+                  std::span<const double> velocities);
+  /// The same command level for every robot of every copy: `values` holds size() x robots rows of
+  /// `columns` numbers (the order of ssx/command.hpp). Every row is checked (its size, finite, what
+  /// its robot takes) before any robot gets one; ConfigError "copy i, robot 'name': ..." otherwise.
+  void setCommands(CommandLevel level, std::span<const double> values, std::size_t columns);
+
+ private:
+  struct Pool;
+  std::vector<Scene> scenes_;
+  std::vector<Environment*> envs_;
+  std::vector<std::string> robot_names_;
+  // per copy, per robot: the root node read by robotStates and the driver commanded
+  std::vector<const PhysicNode*> roots_;
+  std::vector<SetpointInterface*> setpoints_;
+  std::vector<CommandInterface*> commands_;
+  std::vector<std::vector<int>> bodies_;
+  std::vector<const Sensor*> imus_;  // per copy, per robot: its first IMU sensor, or nullptr  // per copy, per robot: its moving bodies
+  std::unique_ptr<Pool> pool_;
+};
+
+}  // namespace ssx

@@ -1,0 +1,302 @@
+// Many copies of one scene stepped together (ssx/vector_environment.hpp).
+#include "base/worker_pool.hpp"
+
+#include <ssx/command.hpp>
+#include <ssx/error.hpp>
+#include <ssx/measurements.hpp>
+#include <ssx/vector_environment.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <exception>
+#include <stdexcept>
+#include <string>
+#include <thread>
+
+namespace ssx {
+
+struct VectorEnvironment::Pool {
+  Pool(unsigned threads, std::size_t copies) : workers(threads), errors(copies) {}
+  detail::WorkerPool workers;
+  std::vector<std::exception_ptr> errors;  // per copy, of the current forEach
+};
+
+namespace {
+
+unsigned poolSize(int threads, std::size_t copies) {
+  if (threads < 0) throw ConfigError({}, "a vector environment needs threads >= 0 (0: one per core), got " + std::to_string(threads));
+  unsigned n = threads > 0 ? static_cast<unsigned>(threads) : std::max(1u, std::thread::hardware_concurrency());
+  if (copies > 0 && n > copies) n = static_cast<unsigned>(copies);
+  return std::max(1u, n);
+}
+
+// the message of the exception held, for "copy i: ..."
+std::string messageOf(const std::exception_ptr& error) {
+  try {
+    std::rethrow_exception(error);
+  } catch (const std::exception& e) {
+    return e.what();
+  } catch (...) {
+    return "an exception that is not a std::exception";
+  }
+}
+
+}  // namespace
+
+VectorEnvironment::VectorEnvironment(const std::function<Scene(std::size_t)>& load, std::size_t count, int threads) {
+  if (count == 0) throw ConfigError({}, "a vector environment needs at least one copy");
+  const unsigned pool_threads = poolSize(threads, count);
+  scenes_.reserve(count);
+  envs_.reserve(count);
+  std::vector<const Artifact*> robot_artifacts;  // per copy, per robot
+  for (std::size_t i = 0; i < count; ++i) {
+    scenes_.push_back(load(i));
+    Environment& env = *scenes_.back().environment;
+    if (env.settings().threads != 1)
+      throw ConfigError({}, "copy " + std::to_string(i) + " of a vector environment steps on " +
+                        std::to_string(env.settings().threads) +
+                        " threads; load each copy with one (SceneOptions::threads = 1): the copies are what runs in parallel");
+    std::vector<std::string> names;
+    for (std::size_t a = 0; a < env.artifactCount(); ++a) {
+      Artifact& artifact = env.artifact(a);
+      auto* setpoint = dynamic_cast<SetpointInterface*>(artifact.driver());
+      if (setpoint == nullptr) continue;
+      names.push_back(artifact.name());
+      roots_.push_back(&std::as_const(artifact).root());
+      setpoints_.push_back(setpoint);
+      commands_.push_back(dynamic_cast<CommandInterface*>(setpoint));
+      robot_artifacts.push_back(&artifact);
+      const Sensor* imu = nullptr;
+      for (std::size_t k = 0; k < artifact.sensorCount() && imu == nullptr; ++k)
+        if (dynamic_cast<const ImuMeasurement*>(&std::as_const(artifact).sensor(k).latest()) != nullptr)
+          imu = &std::as_const(artifact).sensor(k);
+      imus_.push_back(imu);
+    }
+    if (i == 0) {
+      robot_names_ = std::move(names);
+    } else if (names != robot_names_) {
+      std::size_t k = 0;
+      while (k < names.size() && k < robot_names_.size() && names[k] == robot_names_[k]) ++k;
+      throw ConfigError({}, "copy " + std::to_string(i) + " of a vector environment has other robots than copy 0: robot " +
+                        std::to_string(k) + " is '" + (k < names.size() ? names[k] : std::string("(none)")) +
+                        "' there and '" + (k < robot_names_.size() ? robot_names_[k] : std::string("(none)")) +
+                        "' in copy 0; every copy must be the same scene");
+    }
+    envs_.push_back(&env);
+  }
+  pool_ = std::make_unique<Pool>(pool_threads, count);
+  forEach([&](std::size_t i) { envs_[i]->start(); });
+  // bodies are numbered at start
+  for (const Artifact* artifact : robot_artifacts) {
+    std::vector<int> bodies;
+    for (std::size_t k = 0; k < artifact->nodeCount(); ++k) {
+      const int b = artifact->nodeAt(k).bodyIndex();
+      if (b >= 0 && !artifact->nodeAt(k).isStatic() && std::find(bodies.begin(), bodies.end(), b) == bodies.end())
+        bodies.push_back(b);
+    }
+    bodies_.push_back(std::move(bodies));
+  }
+}
+
+VectorEnvironment::~VectorEnvironment() = default;
+
+Environment& VectorEnvironment::operator[](std::size_t i) {
+  if (i >= envs_.size())
+    throw std::out_of_range("ssx: copy " + std::to_string(i) + " of a vector environment of " +
+                            std::to_string(envs_.size()));
+  return *envs_[i];
+}
+
+unsigned VectorEnvironment::threadCount() const noexcept { return pool_->workers.size(); }
+
+void VectorEnvironment::forEach(const std::function<void(std::size_t)>& fn) {
+  // every copy is attempted; the first failure by index is rethrown after the barrier, so which
+  // error a caller sees does not depend on the threads' timing
+  std::vector<std::exception_ptr>& errors = pool_->errors;  // kept: no allocation per step
+  auto body = [&](std::size_t begin, std::size_t end) {
+    for (std::size_t i = begin; i < end; ++i) {
+      try {
+        fn(i);
+      } catch (...) {
+        errors[i] = std::current_exception();
+      }
+    }
+  };
+  pool_->workers.parallelFor(envs_.size(), 1, body);
+  const auto first = std::find_if(errors.begin(), errors.end(), [](const auto& e) { return static_cast<bool>(e); });
+  if (first == errors.end()) return;
+  std::vector<std::exception_ptr> failed;
+  failed.swap(errors);
+  errors.resize(envs_.size());
+  for (std::size_t i = 0; i < failed.size(); ++i)
+    if (failed[i]) {
+      try {
+        std::rethrow_exception(failed[i]);
+      } catch (const StateError& e) {
+        throw StateError("copy " + std::to_string(i) + ": " + e.what());
+      } catch (const ConfigError& e) {
+        throw ConfigError(e.where(), "copy " + std::to_string(i) + ": " + e.detail());
+      } catch (const StepError& e) {
+        // the same failure, said to be copy i's (what() less the prefix StepError puts before it)
+        const std::string prefix =
+            "step " + std::to_string(e.step()) + ": artifact '" + e.artifact() + "', " + e.plugin() + ": ";
+        const std::string what = e.what();
+        throw StepError(e.artifact(), e.plugin(), e.step(),
+                        (what.starts_with(prefix) ? what.substr(prefix.size()) : what) + " (copy " + std::to_string(i) +
+                            " of the vector environment)");
+      } catch (...) {
+        throw Error("copy " + std::to_string(i) + ": " + messageOf(failed[i]));
+      }
+    }
+}
+
+void VectorEnvironment::step(std::int64_t n, std::span<const std::uint8_t> active) {
+  if (n < 0) throw ConfigError({}, "a vector environment steps n >= 0 times, got " + std::to_string(n));
+  if (!active.empty() && active.size() != envs_.size())
+    throw ConfigError({}, "a vector environment of " + std::to_string(envs_.size()) + " copies was given " +
+                      std::to_string(active.size()) + " flags of which copies step");
+  if (n == 0) return;
+  forEach([&](std::size_t i) {
+    if (active.empty() || active[i] != 0) envs_[i]->step(n);
+  });
+}
+
+void VectorEnvironment::reset(std::span<const std::size_t> which, std::span<const std::byte> state,
+                              std::span<const std::uint64_t> seeds) {
+  if (seeds.size() != which.size())
+    throw ConfigError({}, "a reset names " + std::to_string(which.size()) + " copies and gives " +
+                      std::to_string(seeds.size()) + " seeds; one seed per copy");
+  std::vector<bool> chosen(envs_.size(), false);
+  for (const std::size_t i : which) {
+    if (i >= envs_.size())
+      throw ConfigError({}, "a reset names copy " + std::to_string(i) + " of " + std::to_string(envs_.size()));
+    if (chosen[i]) throw ConfigError({}, "a reset names copy " + std::to_string(i) + " twice");
+    chosen[i] = true;
+  }
+  if (which.empty()) return;
+  envs_[which[0]]->checkState(state);  // the copies are one scene: a state fits all or none
+  std::vector<std::size_t> order(which.begin(), which.end());
+  // (forEach over the chosen ones: an index into `order`)
+  std::vector<std::exception_ptr> errors(order.size());
+  auto body = [&](std::size_t begin, std::size_t end) {
+    for (std::size_t k = begin; k < end; ++k) {
+      try {
+        envs_[order[k]]->restoreState(state);
+        envs_[order[k]]->reseed(seeds[k]);
+      } catch (...) {
+        errors[k] = std::current_exception();
+      }
+    }
+  };
+  pool_->workers.parallelFor(order.size(), 1, body);
+  for (std::size_t k = 0; k < errors.size(); ++k)
+    if (errors[k]) throw StateError("copy " + std::to_string(order[k]) + ": " + messageOf(errors[k]));
+}
+
+void VectorEnvironment::robotStates(std::span<double> out) const {
+  const std::size_t robots = robot_names_.size();
+  if (out.size() != envs_.size() * robots * kRobotStateSize)
+    throw ConfigError({}, "robotStates needs " + std::to_string(envs_.size()) + " x " + std::to_string(robots) + " x " +
+                      std::to_string(kRobotStateSize) + " numbers, got " + std::to_string(out.size()));
+  double* p = out.data();
+  for (const PhysicNode* node : roots_) {
+    const BodyState& s = node->state();
+    const Vec3& x = s.pose.position;
+    const Quat& q = s.pose.orientation;
+    const Vec3& v = s.linear_velocity;
+    const Vec3& w = s.angular_velocity;
+    p[0] = x.x(), p[1] = x.y(), p[2] = x.z();
+    p[3] = q.w(), p[4] = q.x(), p[5] = q.y(), p[6] = q.z();
+    p[7] = v.x(), p[8] = v.y(), p[9] = v.z();
+    p[10] = w.x(), p[11] = w.y(), p[12] = w.z();
+    p += kRobotStateSize;
+  }
+}
+
+void VectorEnvironment::imuReadings(std::span<double> out) const {
+  const std::size_t robots = robot_names_.size();
+  if (out.size() != envs_.size() * robots * 6)
+    throw ConfigError({}, "imuReadings needs " + std::to_string(envs_.size()) + " x " + std::to_string(robots) +
+                      " x 6 numbers, got " + std::to_string(out.size()));
+  for (std::size_t r = 0; r < robots; ++r)
+    if (imus_[r] == nullptr)
+      throw ConfigError({}, "robot '" + robot_names_[r] + "' has no IMU sensor to read (add <sensor plugin=\"imu\"/> to its type)");
+  double* p = out.data();
+  for (const Sensor* sensor : imus_) {
+    const auto& m = static_cast<const ImuMeasurement&>(sensor->latest());
+    for (int k = 0; k < 3; ++k) p[k] = m.accelerometer[k], p[3 + k] = m.gyroscope[k];
+    p += 6;
+  }
+}
+
+void VectorEnvironment::moveRobots(std::span<const std::size_t> which, std::span<const double> offsets,
+                                   std::span<const double> velocities) {
+  const std::size_t robots = robot_names_.size();
+  const std::size_t numbers = which.size() * robots * 3;
+  if (offsets.size() != numbers || (!velocities.empty() && velocities.size() != numbers))
+    throw ConfigError({}, "moving the robots of " + std::to_string(which.size()) + " copies needs " +
+                      std::to_string(which.size()) + " x " + std::to_string(robots) +
+                      " x 3 offsets (and velocities, when given)");
+  for (const double x : offsets)
+    if (!std::isfinite(x)) throw ConfigError({}, "a robot's offset holds a NaN or an infinity");
+  for (const double x : velocities)
+    if (!std::isfinite(x) || std::abs(x) > kMaxCommandValue)
+      throw ConfigError({}, "a robot's start velocity is not finite or beyond 1e6 m/s");
+  for (const std::size_t i : which)
+    if (i >= envs_.size())
+      throw ConfigError({}, "moving robots of copy " + std::to_string(i) + " of " + std::to_string(envs_.size()));
+  for (std::size_t k = 0; k < which.size(); ++k) {
+    Environment& env = *envs_[which[k]];
+    for (std::size_t r = 0; r < robots; ++r) {
+      const std::size_t row = k * robots + r;
+      const Vec3 offset(offsets[3 * row], offsets[3 * row + 1], offsets[3 * row + 2]);
+      const Vec3 velocity = velocities.empty() ? Vec3::Zero()
+                                               : Vec3(velocities[3 * row], velocities[3 * row + 1], velocities[3 * row + 2]);
+      for (const int b : bodies_[which[k] * robots + r]) {
+        BodyState s = env.bodyState(b);
+        s.pose.position += offset;
+        s.linear_velocity = velocity;
+        s.angular_velocity = Vec3::Zero();
+        env.setBodyState(b, s);
+      }
+    }
+  }
+}
+
+void VectorEnvironment::setCommands(CommandLevel level, std::span<const double> values, std::size_t columns) {
+  const std::size_t robots = robot_names_.size();
+  const std::size_t rows = envs_.size() * robots;
+  if (values.size() != rows * columns)
+    throw ConfigError({}, "commands for a vector environment need " + std::to_string(envs_.size()) + " x " +
+                      std::to_string(robots) + " rows of " + std::to_string(columns) + " numbers, got " +
+                      std::to_string(values.size()) + " numbers");
+  // every row checked before any robot gets one; the commands built here are what is sent
+  thread_local std::vector<Command> commands;
+  commands.resize(rows);
+  for (std::size_t r = 0; r < rows; ++r) {
+    auto who = [&] {
+      return "copy " + std::to_string(r / robots) + ", robot '" + robot_names_[r % robots] + "'";
+    };
+    CommandInterface* target = commands_[r];
+    if (target == nullptr && level != CommandLevel::Position)
+      throw ConfigError({}, who() + " takes set-points only, no commands at the " + commandLevelName(level) + " level");
+    const std::size_t rotors = target != nullptr ? target->rotorCount() : 0;
+    if (!Command::rowSizeFits(level, columns, rotors))
+      throw ConfigError({}, "a " + std::string(commandLevelName(level)) + " command for " + who() + " has " +
+                        Command::rowSizes(level, rotors) + " values, got " + std::to_string(columns));
+    const std::span<const double> row = values.subspan(r * columns, columns);
+    for (const double x : row)
+      if (!std::isfinite(x)) throw ConfigError({}, "the command for " + who() + " holds a NaN or an infinity");
+    commands[r] = Command::fromRow(level, row);
+    const std::string why = target != nullptr ? target->refusal(commands[r]) : commands[r].problem();
+    if (!why.empty()) throw ConfigError({}, who() + ": " + why);
+  }
+  for (std::size_t r = 0; r < rows; ++r) {
+    if (commands_[r] != nullptr)
+      commands_[r]->setCommand(commands[r]);
+    else
+      setpoints_[r]->setSetpoint(commands[r].setpoint);
+  }
+}
+
+}  // namespace ssx

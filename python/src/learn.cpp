@@ -1,0 +1,250 @@
+// ssx._ssx.VectorEnvironment (learn.hpp).
+#include "learn.hpp"
+
+#include "convert.hpp"
+
+#include <ssx/scene_model.hpp>
+#include <ssx/ssx.hpp>
+#include <ssx/vector_environment.hpp>
+
+#include <pybind11/numpy.h>
+#include <pybind11/stl.h>
+#include <pybind11/stl/filesystem.h>
+
+#include <atomic>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace ssx_python {
+
+namespace {
+
+namespace py = pybind11;
+namespace fs = std::filesystem;
+using Doubles = py::array_t<double, py::array::c_style | py::array::forcecast>;
+constexpr std::size_t kTimingSamples = 1024;
+
+class PyVectorEnvironment {
+ public:
+  PyVectorEnvironment(const std::string& xml, std::size_t count, const fs::path& base_dir,
+                      std::optional<std::uint64_t> seed, std::optional<int> threads, const std::string& label,
+                      const std::vector<fs::path>& plugin_path, const std::optional<std::string>& physics) {
+    if (count == 0) throw py::value_error("ssx: a VectorEnvironment needs num_envs >= 1");
+    if (threads && *threads < 0) throw py::value_error("ssx: threads must be >= 0 (0: one per core)");
+    const ssx::SceneOptions options = sceneOptions(seed, 1, plugin_path, physics);
+    py::gil_scoped_release release;
+    // read once, built num_envs times; each copy keeps the timing of its last steps only (the
+    // default ring, 16 MiB a copy, would be 16 GiB for a thousand copies)
+    ssx::SceneModel model = ssx::parseSceneString(xml, label, base_dir, options);
+    model.settings.threads = 1;
+    model.settings.timing_samples = kTimingSamples;
+    envs_ = std::make_unique<ssx::VectorEnvironment>(
+        [&](std::size_t i) {
+          ssx::Scene scene = ssx::buildScene(model, options);
+          scene.environment->setLogSink(toLogging);
+          // what loading had to say, once (every copy is the same scene)
+          if (i == 0)
+            for (const auto& w : scene.warnings) toLogging(ssx::LogLevel::Warning, w.str());
+          return scene;
+        },
+        count, threads.value_or(0));
+  }
+
+  ssx::VectorEnvironment& envs() {
+    if (!envs_) throw std::runtime_error("ssx: this VectorEnvironment is closed");
+    return *envs_;
+  }
+  std::size_t size() { return envs().size(); }
+  std::size_t robots() { return envs().robotNames().size(); }
+
+  void step(std::int64_t n, const py::object& active) {
+    if (n < 0) throw py::value_error("ssx: step(n) needs n >= 0, got " + std::to_string(n));
+    InUse use(busy_);
+    ssx::VectorEnvironment& v = envs();
+    using Flags = py::array_t<std::uint8_t, py::array::c_style | py::array::forcecast>;
+    Flags flags;
+    if (!active.is_none()) {
+      flags = Flags::ensure(active);
+      if (!flags || flags.ndim() != 1 || flags.shape(0) != static_cast<py::ssize_t>(v.size()))
+        throw py::value_error("ssx: active must be one flag per environment, shape (" + std::to_string(v.size()) + ",)");
+    }
+    const std::span<const std::uint8_t> mask =
+        active.is_none() ? std::span<const std::uint8_t>() : std::span<const std::uint8_t>(flags.data(), v.size());
+    py::gil_scoped_release release;
+    v.step(n, mask);
+  }
+
+  // an (E, R, cols) float64 array: `out` when given (checked: shape, dtype, C order, writable), else a new one
+  py::array_t<double> output(const py::object& out, std::size_t cols, const char* what) {
+    const std::vector<py::ssize_t> shape{static_cast<py::ssize_t>(size()), static_cast<py::ssize_t>(robots()),
+                                         static_cast<py::ssize_t>(cols)};
+    if (out.is_none()) return py::array_t<double>(shape);
+    if (!py::isinstance<py::array_t<double>>(out))
+      throw py::type_error(std::string("ssx: ") + what + "(out=) needs a float64 numpy array");
+    auto a = py::reinterpret_borrow<py::array_t<double>>(out);
+    const bool ok = a.ndim() == 3 && a.shape(0) == shape[0] && a.shape(1) == shape[1] && a.shape(2) == shape[2] &&
+                    (a.flags() & py::array::c_style) != 0 && a.writeable();
+    if (!ok)
+      throw py::value_error(std::string("ssx: ") + what + "(out=) needs a writable C-ordered float64 array of shape (" +
+                            std::to_string(shape[0]) + ", " + std::to_string(shape[1]) + ", " +
+                            std::to_string(shape[2]) + ")");
+    return a;
+  }
+
+  py::array_t<double> robotStates(const py::object& out) {
+    InUse use(busy_);
+    py::array_t<double> a = output(out, ssx::kRobotStateSize, "robot_states");
+    envs().robotStates(std::span<double>(a.mutable_data(), static_cast<std::size_t>(a.size())));
+    return a;
+  }
+  py::array_t<double> imu(const py::object& out) {
+    InUse use(busy_);
+    py::array_t<double> a = output(out, 6, "imu");
+    envs().imuReadings(std::span<double>(a.mutable_data(), static_cast<std::size_t>(a.size())));
+    return a;
+  }
+
+  void setCommands(const std::string& level_name, const py::handle& values) {
+    InUse use(busy_);
+    const auto level = ssx::commandLevelFromName(level_name);
+    if (!level)
+      throw py::value_error("ssx: unknown command level '" + level_name +
+                            "': position, velocity, attitude, rates, rotors or wheels");
+    const Doubles a = Doubles::ensure(values);
+    if (!a) throw py::type_error("ssx: values must be an array of numbers");
+    if (a.ndim() != 3 || a.shape(0) != static_cast<py::ssize_t>(size()) ||
+        a.shape(1) != static_cast<py::ssize_t>(robots()))
+      throw py::value_error("ssx: values must have shape (num_envs, robots, columns) = (" + std::to_string(size()) +
+                            ", " + std::to_string(robots()) + ", columns)");
+    try {
+      envs().setCommands(*level, std::span<const double>(a.data(), static_cast<std::size_t>(a.size())),
+                         static_cast<std::size_t>(a.shape(2)));
+    } catch (const ssx::ConfigError& e) {
+      throw py::value_error(std::string("ssx: ") + e.what());
+    }
+  }
+
+  std::vector<std::size_t> indices(const py::handle& which) {
+    std::vector<std::size_t> out;
+    for (const py::handle item : py::reinterpret_borrow<py::sequence>(which)) {
+      const auto i = py::int_(py::reinterpret_borrow<py::object>(item)).cast<long long>();
+      if (i < 0 || static_cast<std::size_t>(i) >= size())
+        throw py::index_error("ssx: environment index " + std::to_string(i) + " is outside 0.." +
+                              std::to_string(size() - 1));
+      out.push_back(static_cast<std::size_t>(i));
+    }
+    return out;
+  }
+
+  py::bytes saveState(std::size_t i) {
+    InUse use(busy_);
+    ssx::Environment& env = envs()[i];
+    std::vector<std::byte> state;
+    {
+      py::gil_scoped_release release;
+      state = env.saveState();
+    }
+    return {reinterpret_cast<const char*>(state.data()), state.size()};
+  }
+
+  void reset(const py::handle& which, const py::bytes& state, const std::vector<std::uint64_t>& seeds) {
+    InUse use(busy_);
+    const std::vector<std::size_t> chosen = indices(which);
+    const std::string_view view = state;
+    const std::span<const std::byte> bytes(reinterpret_cast<const std::byte*>(view.data()), view.size());
+    ssx::VectorEnvironment& v = envs();
+    try {
+      py::gil_scoped_release release;
+      v.reset(chosen, bytes, seeds);
+    } catch (const ssx::ConfigError& e) {
+      throw py::value_error(std::string("ssx: ") + e.what());
+    }
+  }
+
+  void moveRobots(const py::handle& which, const py::handle& offsets, const py::handle& velocities) {
+    InUse use(busy_);
+    const std::vector<std::size_t> chosen = indices(which);
+    const auto rows = static_cast<py::ssize_t>(chosen.size());
+    auto check = [&](const py::handle& h, const char* what) {
+      Doubles a = Doubles::ensure(h);
+      if (!a || a.ndim() != 3 || a.shape(0) != rows || a.shape(1) != static_cast<py::ssize_t>(robots()) || a.shape(2) != 3)
+        throw py::value_error(std::string("ssx: ") + what + " must have shape (" + std::to_string(rows) + ", " +
+                              std::to_string(robots()) + ", 3): one row per robot of each environment named");
+      return a;
+    };
+    const Doubles off = check(offsets, "offsets");
+    std::optional<Doubles> vel;
+    if (!velocities.is_none()) vel = check(velocities, "velocities");
+    try {
+      envs().moveRobots(chosen, std::span<const double>(off.data(), static_cast<std::size_t>(off.size())),
+                        vel ? std::span<const double>(vel->data(), static_cast<std::size_t>(vel->size()))
+                            : std::span<const double>());
+    } catch (const ssx::ConfigError& e) {
+      throw py::value_error(std::string("ssx: ") + e.what());
+    }
+  }
+
+  py::array_t<std::uint64_t> stateHashes() {
+    InUse use(busy_);
+    py::array_t<std::uint64_t> out(static_cast<py::ssize_t>(size()));
+    for (std::size_t i = 0; i < size(); ++i) out.mutable_data()[i] = envs()[i].stateHash();
+    return out;
+  }
+  py::array_t<double> times() {
+    InUse use(busy_);
+    py::array_t<double> out(static_cast<py::ssize_t>(size()));
+    for (std::size_t i = 0; i < size(); ++i) out.mutable_data()[i] = ssx::toSeconds(envs()[i].time());
+    return out;
+  }
+  double timestep() { return ssx::toSeconds(envs()[0].timestep()); }
+  unsigned threads() { return envs().threadCount(); }
+  std::vector<std::string> robotNames() { return envs().robotNames(); }
+  void close() {
+    InUse use(busy_);
+    py::gil_scoped_release release;
+    envs_.reset();
+  }
+
+ private:
+  std::unique_ptr<ssx::VectorEnvironment> envs_;
+  std::atomic<bool> busy_{false};
+};
+
+}  // namespace
+
+void bindLearn(py::module_& m) {
+  py::class_<PyVectorEnvironment>(m, "VectorEnvironment",
+                                  "num_envs copies of one scene, each a world of its own, stepped together on a pool "
+                                  "of threads (the GIL released): the core of ssx.learn.VectorEnv.")
+      .def(py::init<const std::string&, std::size_t, const fs::path&, std::optional<std::uint64_t>, std::optional<int>,
+                    const std::string&, const std::vector<fs::path>&, const std::optional<std::string>&>(),
+           py::arg("xml"), py::arg("num_envs"), py::arg("base_dir") = fs::path("."), py::arg("seed") = py::none(),
+           py::arg("threads") = py::none(), py::arg("label") = "<string>",
+           py::arg("plugin_path") = std::vector<fs::path>{}, py::arg("physics") = py::none())
+      .def_property_readonly("num_envs", &PyVectorEnvironment::size)
+      .def_property_readonly("robot_names", &PyVectorEnvironment::robotNames,
+                             "The robots of every copy (drivers that take set-points), in artifact order.")
+      .def_property_readonly("timestep", &PyVectorEnvironment::timestep, "Physics timestep, s.")
+      .def_property_readonly("threads", &PyVectorEnvironment::threads, "Threads stepping the copies.")
+      .def("step", &PyVectorEnvironment::step, py::arg("n") = 1, py::arg("active") = py::none(),
+           "Steps every copy n times (GIL released); active: one flag per copy, only those flagged step.")
+      .def("robot_states", &PyVectorEnvironment::robotStates, py::arg("out") = py::none(),
+           "(num_envs, robots, 13): x y z, qw qx qy qz, vx vy vz, wx wy wz (world frame); into out= when given.")
+      .def("imu", &PyVectorEnvironment::imu, py::arg("out") = py::none(),
+           "(num_envs, robots, 6): each robot's first IMU, accelerometer (m/s^2) then gyroscope (rad/s).")
+      .def("set_commands", &PyVectorEnvironment::setCommands, py::arg("level"), py::arg("values"),
+           "One command level for every robot: values (num_envs, robots, columns), checked whole first.")
+      .def("save_state", &PyVectorEnvironment::saveState, py::arg("index") = 0, "Copy index's state, as bytes.")
+      .def("reset", &PyVectorEnvironment::reset, py::arg("indices"), py::arg("state"), py::arg("seeds"),
+           "Restores the copies named to state and reseeds their random streams, one seed each (GIL released).")
+      .def("move_robots", &PyVectorEnvironment::moveRobots, py::arg("indices"), py::arg("offsets"),
+           py::arg("velocities") = py::none(),
+           "Moves every robot of the copies named by offsets (len(indices), robots, 3), at velocities (or at rest).")
+      .def("state_hashes", &PyVectorEnvironment::stateHashes, "Each copy's state hash (uint64).")
+      .def("times", &PyVectorEnvironment::times, "Each copy's simulated time, s.")
+      .def("close", &PyVectorEnvironment::close, "Stops and frees every copy.");
+}
+
+}  // namespace ssx_python

@@ -1,0 +1,343 @@
+"""ssx.learn: vectorised, deterministic learning environments on ssx.
+
+    import numpy as np
+    import ssx.learn
+
+    envs = ssx.learn.VectorEnv("goto", num_envs=64)          # 64 Crazyflies, each in a world of its own
+    obs, infos = envs.reset(seed=1)
+    for _ in range(100):
+        actions = envs.action_space.sample()                  # (64, 4) in [-1, 1]
+        obs, rewards, terminations, truncations, infos = envs.step(actions)
+    envs.close()
+
+`VectorEnv` speaks Gymnasium 1.x's vector API (and is a `gymnasium.vector.VectorEnv` when
+gymnasium is importable); `ParallelEnv` speaks PettingZoo's parallel API, one agent per robot of
+one world. Each copy of the scene is a world of its own (ssx::VectorEnvironment): copies cannot
+touch or sense each other, a copy's trajectory depends only on its own seed and actions, and the
+copies are stepped in C++ on a pool of threads with the GIL released. See docs/learning.md.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from . import _ssx
+from .spaces import Box, Dict, box  # noqa: F401  (re-exported)
+from .tasks import Formation, GoTo, Hover, Task  # noqa: F401  (re-exported)
+
+try:  # Gymnasium when it is there (Debian 12 does not package it): the class is then one of its
+    import gymnasium as _gymnasium
+
+    _VectorBase = _gymnasium.vector.VectorEnv
+    try:
+        from gymnasium.vector import AutoresetMode as _AutoresetMode
+
+        _MODES = {"next_step": _AutoresetMode.NEXT_STEP, "same_step": _AutoresetMode.SAME_STEP}
+    except ImportError:  # gymnasium 1.0 names the mode with a string
+        _MODES = {"next_step": "next_step", "same_step": "same_step"}
+except ImportError:
+    _gymnasium = None
+    _VectorBase = object
+    _MODES = {"next_step": "next_step", "same_step": "same_step"}
+
+TASKS = {"hover": Hover, "goto": GoTo, "formation": Formation}
+
+
+def make_task(task, **options):
+    """A Task from a name of TASKS (with its options) or a Task given as it is."""
+    if isinstance(task, Task):
+        if options:
+            raise TypeError("ssx.learn: options go to a task named by a string; this task is made already")
+        return task
+    if task not in TASKS:
+        raise ValueError(f"ssx.learn: unknown task {task!r}: one of {', '.join(sorted(TASKS))}, or a Task")
+    return TASKS[task](**options)
+
+
+def _sim_seed(rng):
+    """A 64-bit seed for a copy's random streams, drawn from its episode generator."""
+    return int(rng.integers(0, 2**63, dtype=np.int64))
+
+
+class _Batch:
+    """What VectorEnv and ParallelEnv share: the copies, the task, the episodes' generators, the
+    buffers every step reuses (no array is made per step on the C++ side)."""
+
+    def __init__(self, task, num_envs, action_period, threads, physics):
+        self.task = task
+        self.num_envs = int(num_envs)
+        if self.num_envs < 1:
+            raise ValueError("ssx.learn: num_envs must be at least 1")
+        self.sim = _ssx.VectorEnvironment(task.scene(), self.num_envs, threads=threads, label=f"task {task.name}",
+                                          physics=physics, base_dir=_ssx.data_directory())
+        self.robots = len(self.sim.robot_names)
+        if self.robots != task.robots:
+            raise ValueError(f"ssx.learn: task {task.name}'s scene has {self.robots} robots, the task says {task.robots}")
+        steps = action_period / self.sim.timestep
+        self.steps_per_action = int(round(steps))
+        if self.steps_per_action < 1 or abs(steps - self.steps_per_action) > 1e-9 * steps:
+            raise ValueError(f"ssx.learn: action_period {action_period} s is not a whole number of physics "
+                             f"timesteps ({self.sim.timestep} s)")
+        self.action_period = self.steps_per_action * self.sim.timestep
+        # the start state: every copy's robots taken off and hovering where the task puts them
+        self.sim.set_commands("position", task.takeoff_commands(self.sim.robot_states(), self.num_envs))
+        self.sim.step(int(round(task.takeoff_seconds / self.sim.timestep)))
+        self.start_state = self.sim.save_state(0)
+        self.states = np.empty((self.num_envs, self.robots, 13))
+        self.imu = np.empty((self.num_envs, self.robots, 6)) if task.reads_imu else None
+        self.rngs = [np.random.default_rng() for _ in range(self.num_envs)]
+        self.steps = np.zeros(self.num_envs, dtype=np.int64)
+        self.read()
+        task.bind(self.num_envs, self.action_period, self.states)
+
+    def read(self):
+        self.sim.robot_states(out=self.states)
+        if self.imu is not None:
+            self.sim.imu(out=self.imu)
+
+    def seed_all(self, seed):
+        """Gymnasium's convention: an int seeds copy i with seed + i, a list one seed per copy,
+        None with fresh entropy."""
+        if seed is None:
+            seeds = [None] * self.num_envs
+        elif isinstance(seed, (int, np.integer)):
+            seeds = [int(seed) + i for i in range(self.num_envs)]
+        else:
+            seeds = list(seed)
+            if len(seeds) != self.num_envs:
+                raise ValueError(f"ssx.learn: reset(seed=) has {len(seeds)} seeds for {self.num_envs} environments")
+        for i, s in enumerate(seeds):
+            if s is not None and (not isinstance(s, (int, np.integer)) or s < 0):
+                raise ValueError(f"ssx.learn: seed {s!r} (environment {i}) is not a whole number >= 0")
+            self.rngs[i] = np.random.default_rng(s)
+
+    def reset_copies(self, ids):
+        """Restores the copies `ids` to the start state, reseeds their streams from their episode
+        generators, draws their episodes (the task: start offsets, goals) and moves the robots."""
+        ids = [int(i) for i in ids]
+        if not ids:
+            return
+        rngs = [self.rngs[i] for i in ids]
+        self.sim.reset(ids, self.start_state, [_sim_seed(rng) for rng in rngs])
+        offsets, velocities = self.task.draw(ids, rngs)
+        self.sim.move_robots(ids, offsets, velocities)
+        self.steps[ids] = 0
+
+
+class VectorEnv(_VectorBase):
+    """`num_envs` copies of a task's scene, stepped together (Gymnasium 1.x vector API).
+
+    task: "hover", "goto", "formation" or a Task; options go to the named task. action_period:
+    how long an action is held, s of simulated time (a whole number of physics steps).
+    autoreset_mode: "next_step" (Gymnasium's default: the step after an episode ended resets that
+    copy and returns its first observation, reward 0) or "same_step" (reset at once; the last
+    observation in infos["final_obs"]). threads: threads stepping the copies (None: one per core).
+    """
+
+    def __init__(self, task="goto", num_envs=16, action_period=0.02, autoreset_mode="next_step", threads=None,
+                 physics=None, **task_options):
+        if autoreset_mode not in _MODES:
+            raise ValueError(f"ssx.learn: autoreset_mode must be 'next_step' or 'same_step', got {autoreset_mode!r}")
+        self.task = make_task(task, **task_options)
+        self._b = _Batch(self.task, num_envs, action_period, threads, physics)
+        self.num_envs = self._b.num_envs
+        self.action_period = self._b.action_period
+        self.metadata = {"autoreset_mode": _MODES[autoreset_mode], "render_modes": []}
+        self.render_mode = None
+        self._same_step = autoreset_mode == "same_step"
+        self.single_observation_space = self.task.observation_space()
+        self.single_action_space = self.task.action_space()
+        self.observation_space = box(self.single_observation_space, self.num_envs)
+        self.action_space = box(self.single_action_space, self.num_envs)
+        self._autoreset = np.zeros(self.num_envs, dtype=bool)
+        self._active = np.ones(self.num_envs, dtype=np.uint8)
+        self._obs = np.zeros(self.observation_space.shape, dtype=np.float32)
+        self._started = False
+        self.closed = False
+
+    @property
+    def unwrapped(self):
+        return self
+
+    @property
+    def robot_names(self):
+        return self._b.sim.robot_names
+
+    def reset(self, seed=None, options=None):
+        """Every copy to a new episode: (observations, infos). `seed`: int (copy i gets seed + i),
+        a list of one per copy, or None. options={"reset_mask": bool array} resets only those copies."""
+        b = self._b
+        ids = np.arange(self.num_envs)
+        if options and "reset_mask" in options:
+            mask = np.asarray(options["reset_mask"], dtype=bool)
+            if mask.shape != (self.num_envs,):
+                raise ValueError(f"ssx.learn: reset_mask must have shape ({self.num_envs},)")
+            ids = np.flatnonzero(mask)
+            if seed is not None:
+                raise ValueError("ssx.learn: seed and reset_mask together are not supported: seed the copies first")
+        else:
+            b.seed_all(seed)
+        b.reset_copies(ids)
+        self._autoreset[ids] = False
+        self._started = True
+        b.read()
+        self.task.observe(b.states, b.imu, self._obs)
+        return self._obs.copy(), {}
+
+    def step(self, actions):
+        """Holds the actions for action_period: (observations, rewards, terminations, truncations, infos)."""
+        if not self._started:
+            raise RuntimeError("ssx.learn: call reset() before step()")
+        b, task = self._b, self.task
+        actions = np.asarray(actions, dtype=np.float64)
+        if actions.shape != self.action_space.shape:
+            raise ValueError(f"ssx.learn: actions must have shape {self.action_space.shape}, got {actions.shape}")
+        if not np.all(np.isfinite(actions)):
+            raise ValueError("ssx.learn: actions hold a NaN or an infinity")
+        b.sim.set_commands(task.level, task.commands(actions))
+        resetting = np.flatnonzero(self._autoreset)
+        if len(resetting):
+            b.reset_copies(resetting)
+        np.logical_not(self._autoreset, out=self._active.view(bool))
+        b.sim.step(b.steps_per_action, self._active if len(resetting) else None)
+        b.steps += self._active
+        b.read()
+        task.observe(b.states, b.imu, self._obs)
+        rewards, terminated, infos = task.evaluate(b.states, b.imu, actions)
+        truncated = b.steps >= task.horizon
+        if len(resetting):
+            rewards[resetting] = 0.0
+            terminated[resetting] = False
+            truncated[resetting] = False
+        done = terminated | truncated
+        obs = self._obs.copy()
+        if self._same_step:
+            ended = np.flatnonzero(done)
+            if len(ended):
+                infos["final_obs"] = np.array([obs[i] if done[i] else None for i in range(self.num_envs)], dtype=object)
+                infos["_final_obs"] = done.copy()
+                b.reset_copies(ended)
+                b.read()
+                task.observe(b.states, b.imu, self._obs)
+                obs[ended] = self._obs[ended]
+        else:
+            self._autoreset = done
+        return obs, rewards.astype(np.float64), terminated, truncated, infos
+
+    def close(self, **kwargs):
+        if not self.closed:
+            self._b.sim.close()
+            self.closed = True
+
+    def state_hashes(self):
+        """Each copy's state hash: for determinism checks."""
+        return self._b.sim.state_hashes()
+
+    def __repr__(self):
+        return f"ssx.learn.VectorEnv({self.task.name!r}, num_envs={self.num_envs})"
+
+
+class ParallelEnv:
+    """A swarm in one world, one agent per robot (PettingZoo's parallel API). Agents whose robot
+    crashed or left the bounds leave `agents`; the episode ends for all at the horizon."""
+
+    metadata = {"name": "ssx_parallel_v0", "render_modes": []}
+
+    def __init__(self, task="formation", action_period=0.02, threads=1, physics=None, **task_options):
+        self.task = make_task(task, **task_options)
+        self._b = _Batch(self.task, 1, action_period, threads, physics)
+        self.possible_agents = list(self._b.sim.robot_names)
+        self.agents = []
+        self.render_mode = None
+        self._obs_space = self.task.observation_space(per_agent=True)
+        self._act_space = self.task.action_space(per_agent=True)
+        self._obs = np.zeros((1,) + self.task.observation_space().shape, dtype=np.float32)
+        self._alive = np.zeros(len(self.possible_agents), dtype=bool)
+
+    def observation_space(self, agent):
+        return self._obs_space
+
+    def action_space(self, agent):
+        return self._act_space
+
+    @property
+    def num_agents(self):
+        return len(self.agents)
+
+    @property
+    def max_num_agents(self):
+        return len(self.possible_agents)
+
+    def reset(self, seed=None, options=None):
+        b = self._b
+        b.seed_all(None if seed is None else [seed])
+        b.reset_copies([0])
+        self._alive[:] = True
+        self.agents = list(self.possible_agents)
+        b.read()
+        self.task.observe(b.states, b.imu, self._obs)
+        return {a: self._obs[0, k].copy() for k, a in enumerate(self.possible_agents)}, {a: {} for a in self.agents}
+
+    def step(self, actions):
+        b, task = self._b, self.task
+        if not self.agents:
+            raise RuntimeError("ssx.learn: every agent is done: call reset()")
+        act = np.zeros((1,) + task.action_space().shape)
+        for k, a in enumerate(self.possible_agents):
+            if a in actions:
+                act[0, k] = actions[a]
+            elif self._alive[k]:
+                raise KeyError(f"ssx.learn: no action for agent {a!r}")
+        b.sim.set_commands(task.level, task.commands(act))
+        b.sim.step(b.steps_per_action)
+        b.steps += 1
+        b.read()
+        task.observe(b.states, b.imu, self._obs)
+        rewards, terminated, infos = task.evaluate(b.states, b.imu, act)
+        truncate = bool(b.steps[0] >= task.horizon)
+        agent_done = task.agent_terminations(b.states)[0]
+        obs, rew, term, trunc, info = {}, {}, {}, {}, {}
+        for k, a in enumerate(self.possible_agents):
+            if not self._alive[k]:
+                continue
+            obs[a] = self._obs[0, k].copy()
+            rew[a] = float(task.agent_rewards(rewards)[0, k])
+            term[a] = bool(agent_done[k])
+            trunc[a] = truncate
+            info[a] = {key: value[0] for key, value in infos.items() if not key.startswith("_")}
+            if term[a] or trunc[a]:
+                self._alive[k] = False
+        self.agents = [a for k, a in enumerate(self.possible_agents) if self._alive[k]]
+        return obs, rew, term, trunc, info
+
+    def state(self):
+        return self._obs[0].copy()
+
+    def close(self):
+        self._b.sim.close()
+
+
+class TorchVectorEnv:
+    """A VectorEnv whose observations, rewards and flags come as torch tensors sharing memory with
+    the numpy arrays (torch.from_numpy), and whose actions may be tensors."""
+
+    def __init__(self, env):
+        import torch  # noqa: F401  (torch is needed; ImportError says so)
+
+        self.env = env
+
+    def __getattr__(self, name):
+        return getattr(self.env, name)
+
+    def reset(self, seed=None, options=None):
+        import torch
+
+        obs, infos = self.env.reset(seed=seed, options=options)
+        return torch.from_numpy(obs), infos
+
+    def step(self, actions):
+        import torch
+
+        if isinstance(actions, torch.Tensor):
+            actions = actions.detach().cpu().numpy()
+        obs, rew, term, trunc, infos = self.env.step(actions)
+        return (torch.from_numpy(obs), torch.from_numpy(rew), torch.from_numpy(term), torch.from_numpy(trunc), infos)

@@ -1,0 +1,320 @@
+"""Tasks of ssx.learn: what a learning environment observes, how actions become commands, the
+reward, when an episode ends. Every hook works on the whole batch at once (numpy arrays whose
+first axis is the environment), so a task adds little per step however many environments run.
+
+A task of your own subclasses Task (or GoTo, Formation) and overrides the hooks; see
+docs/learning.md.
+"""
+from __future__ import annotations
+
+import math
+import xml.etree.ElementTree as ElementTree
+
+import numpy as np
+
+from . import _ssx
+from .spaces import make_box
+
+VEHICLES = ("crazyflie", "mk_quad", "hummingbird")
+LEVELS = ("attitude", "rates", "velocity")
+GRAVITY = 9.81
+
+
+def vehicle_mass(vehicle):
+    """The mass (kg) of an installed vehicle type: the sum of its artifact file's physic masses."""
+    path = _ssx.data_directory() / "artifacts" / f"{vehicle}.xml"
+    root = ElementTree.parse(path).getroot()
+    return sum(float(p.get("mass", "0")) for p in root.iter("physic"))
+
+
+class Task:
+    """The hooks a learning environment calls. Arrays: E environments, R robots each.
+
+    states (E, R, 13): x y z, qw qx qy qz, vx vy vz, wx wy wz (world frame); imu (E, R, 6):
+    accelerometer (m/s^2), gyroscope (rad/s), body frame, or None when reads_imu is False.
+    """
+
+    name = "task"
+    robots = 1
+    level = "attitude"  # the command level actions become (ssx/command.hpp)
+    reads_imu = True
+    takeoff_seconds = 3.0
+    horizon = 250  # actions per episode (set by bind from horizon_seconds)
+
+    def scene(self):
+        """The scene of one environment, as XML (files resolve against ssx.data_directory())."""
+        raise NotImplementedError
+
+    def takeoff_commands(self, states, num_envs):
+        """(E, R, 4) position commands flown for takeoff_seconds before the start state is saved."""
+        raise NotImplementedError
+
+    def bind(self, num_envs, action_period, states):
+        """Called once the start state is saved: `states` are the robots hovering in it."""
+
+    def draw(self, ids, rngs):
+        """A new episode for environments `ids`, each drawing from its own generator `rngs[k]`:
+        returns the robots' start offsets and velocities, (len(ids), R, 3) each."""
+        raise NotImplementedError
+
+    def observation_space(self, per_agent=False):
+        raise NotImplementedError
+
+    def action_space(self, per_agent=False):
+        raise NotImplementedError
+
+    def observe(self, states, imu, out):
+        """Writes the observations of every environment into `out` (E, ...) float32."""
+        raise NotImplementedError
+
+    def commands(self, actions):
+        """(E, R, columns) commands at `level` from the actions (E, ...)."""
+        raise NotImplementedError
+
+    def evaluate(self, states, imu, actions):
+        """(rewards (E,), terminated (E,) bool, infos dict of (E,) arrays) after a step."""
+        raise NotImplementedError
+
+    def agent_rewards(self, rewards):
+        """Per robot (E, R), for ParallelEnv; by default every robot gets its environment's."""
+        return np.repeat(np.asarray(rewards)[:, None], self.robots, axis=1)
+
+    def agent_terminations(self, states):
+        """Per robot (E, R) bool, for ParallelEnv: crashed, tilted over or out of bounds."""
+        return self._crashed(states)
+
+
+class _Flight(Task):
+    """What the quadrotor tasks share: a vehicle, a command level, actions in [-1, 1] scaled to
+    it, crash, tilt and bounds checks."""
+
+    def __init__(self, vehicle="crazyflie", level="attitude", robots=1, hover_height=1.0, spacing=1.0,
+                 horizon_seconds=5.0, max_tilt=0.5, max_rate=4.0, max_yaw_rate=1.0, thrust_range=0.6, max_speed=1.0,
+                 bounds=3.0, max_tilt_crash=70.0, timestep=0.002):
+        if vehicle not in VEHICLES:
+            raise ValueError(f"ssx.learn: vehicle must be one of {', '.join(VEHICLES)}, got {vehicle!r}")
+        if level not in LEVELS:
+            raise ValueError(f"ssx.learn: level must be one of {', '.join(LEVELS)}, got {level!r}")
+        self.vehicle, self.level, self.robots = vehicle, level, int(robots)
+        self.hover_height, self.spacing, self.timestep = hover_height, spacing, timestep
+        self.horizon_seconds = horizon_seconds
+        self.max_tilt, self.max_rate, self.max_yaw_rate = max_tilt, max_rate, max_yaw_rate
+        self.thrust_range, self.max_speed, self.bounds = thrust_range, max_speed, bounds
+        self.cos_crash = math.cos(math.radians(max_tilt_crash))
+        self.weight = vehicle_mass(vehicle) * GRAVITY
+        self._commands = None
+
+    def scene(self):
+        return f"""<scene>
+  <environment timestep="{self.timestep}" seed="1"/>
+  <type name="{self.vehicle}" file="artifacts/{self.vehicle}.xml"/>
+  <ground/>
+  <swarm type="{self.vehicle}" count="{self.robots}" name="r{{i}}" spacing="{self.spacing}" xyz="0 0 0.05">
+    <driver reference="external"/>
+  </swarm>
+</scene>"""
+
+    def takeoff_commands(self, states, num_envs):
+        c = np.zeros((num_envs, self.robots, 4))
+        c[:, :, :2] = states[:, :, :2]
+        c[:, :, 2] = self.hover_height
+        return c
+
+    def bind(self, num_envs, action_period, states):
+        self.num_envs = num_envs
+        self.horizon = max(1, int(round(self.horizon_seconds / action_period)))
+        self.home = states[0, :, :3].copy()  # every copy hovers at the same place in the start state
+        self._commands = np.zeros((num_envs, self.robots, 4))
+
+    def action_space(self, per_agent=False):
+        shape = (4,) if per_agent or self.robots == 1 else (self.robots, 4)
+        return make_box(-1.0, 1.0, shape, np.float32)
+
+    def commands(self, actions):
+        a = np.clip(np.asarray(actions, dtype=np.float64).reshape(self.num_envs, self.robots, 4), -1.0, 1.0)
+        c = self._commands[: a.shape[0]]
+        if self.level == "velocity":
+            c[..., :3] = a[..., :3] * self.max_speed
+            c[..., 3] = a[..., 3] * self.max_yaw_rate
+        else:
+            if self.level == "attitude":
+                c[..., :2] = a[..., :2] * self.max_tilt
+                c[..., 2] = a[..., 2] * self.max_yaw_rate
+            else:
+                c[..., :3] = a[..., :3] * self.max_rate
+                c[..., 2] = a[..., 2] * self.max_yaw_rate
+            c[..., 3] = self.weight * (1.0 + self.thrust_range * a[..., 3])
+        return c
+
+    def _crashed(self, states):
+        """(E, R) bool: below 8 cm (on the ground), tilted beyond the crash angle, or out of bounds."""
+        up_z = 1.0 - 2.0 * (states[..., 4] ** 2 + states[..., 5] ** 2)
+        away = np.abs(states[..., :3] - self.home).max(axis=-1)
+        return (states[..., 2] < 0.08) | (up_z < self.cos_crash) | (away > self.bounds)
+
+
+class GoTo(_Flight):
+    """One quadrotor (a Crazyflie by default) must reach a goal drawn per episode and hold there.
+
+    Start: hovering within `start_range` m of its home (1 m up; half that vertically), moving at up
+    to `start_speed` m/s along each axis.
+    Goal: within `goal_range` m of home (half that vertically). Observation (16, float32): the goal
+    relative to the robot (m), its velocity (m/s, / 2), its orientation (qw >= 0), the IMU's gyro
+    (rad/s, / 10) and accelerometer (m/s^2, / 10). Action (4, in [-1, 1]): at `level` "attitude"
+    roll and pitch (times max_tilt rad), yaw rate (times max_yaw_rate) and thrust (the weight times
+    1 + thrust_range a); "rates": body rates (times max_rate rad/s, yaw max_yaw_rate) and thrust;
+    "velocity": m/s (times max_speed) and yaw rate. Reward: exp(-distance / 0.5) per action, minus
+    0.02 per rad/s of body rate; an episode ends (terminated) on a crash, a tilt over 70 degrees or
+    leaving `bounds` m around home, and is truncated after horizon_seconds. infos: "distance" (m)
+    and "success" (within success_radius)."""
+
+    name = "goto"
+
+    def __init__(self, vehicle="crazyflie", level="attitude", goal_range=1.0, start_range=0.3, start_speed=0.2,
+                 success_radius=0.1, **options):
+        super().__init__(vehicle=vehicle, level=level, robots=options.pop("robots", 1), **options)
+        self.goal_range, self.start_range, self.start_speed = goal_range, start_range, start_speed
+        self.success_radius = success_radius
+
+    def bind(self, num_envs, action_period, states):
+        super().bind(num_envs, action_period, states)
+        self.goals = np.repeat(self.home[None], num_envs, axis=0)
+        self._start_scale = np.array([self.start_range, self.start_range, 0.5 * self.start_range])
+        self._goal_scale = np.array([self.goal_range, self.goal_range, 0.5 * self.goal_range])
+
+    def _goals(self, starts, u):
+        """Goals for episodes starting at `starts` (k, R, 3) from uniform numbers u in [-1, 1) (k, R, 3)."""
+        goals = self.home + u * self._goal_scale
+        np.maximum(goals[..., 2], 0.3, out=goals[..., 2])
+        return goals
+
+    def draw(self, ids, rngs):
+        # one call per environment to its own generator (9 numbers a robot), the rest for all at once
+        u = np.array([rng.random((self.robots, 9)) for rng in rngs])
+        u *= 2.0
+        u -= 1.0  # (k, R, 9) in [-1, 1)
+        offsets = u[..., 0:3] * self._start_scale
+        self.goals[ids] = self._goals(self.home + offsets, u[..., 6:9])
+        return offsets, u[..., 3:6] * self.start_speed
+
+    def observation_space(self, per_agent=False):
+        shape = (16,) if per_agent or self.robots == 1 else (self.robots, 16)
+        return make_box(-10.0, 10.0, shape, np.float32)
+
+    def observe(self, states, imu, out):
+        o = out.reshape(len(states), self.robots, 16)
+        o[..., 0:3] = self.goals[: len(states)] - states[..., 0:3]
+        o[..., 3:6] = states[..., 7:10] * 0.5
+        q = states[..., 3:7]
+        o[..., 6:10] = np.where(q[..., :1] < 0, -q, q)
+        o[..., 10:13] = imu[..., 3:6] * 0.1
+        o[..., 13:16] = imu[..., 0:3] * 0.1
+        np.clip(o, -10.0, 10.0, out=o)
+
+    def evaluate(self, states, imu, actions):
+        distance = np.linalg.norm(self.goals[: len(states)] - states[..., 0:3], axis=-1)  # (E, R)
+        spin = np.linalg.norm(states[..., 10:13], axis=-1)
+        crashed = self._crashed(states)
+        reward = np.exp(-distance / 0.5) - 0.02 * spin
+        reward = np.where(crashed, -1.0, reward).mean(axis=1)
+        terminated = crashed.any(axis=1)
+        infos = {"distance": distance.mean(axis=1), "success": (distance < self.success_radius).all(axis=1)}
+        return reward, terminated, infos
+
+
+class Hover(GoTo):
+    """GoTo whose goal is where the episode starts: hold a hover against a random start velocity."""
+
+    name = "hover"
+
+    def __init__(self, vehicle="crazyflie", level="attitude", start_speed=0.5, **options):
+        options.pop("goal_range", None)
+        super().__init__(vehicle=vehicle, level=level, goal_range=0.0, start_speed=start_speed, **options)
+
+    def _goals(self, starts, u):
+        return starts
+
+
+class Formation(_Flight):
+    """A swarm of `robots` quadrotors (8 Crazyflies by default) must form a ring of `radius` m at
+    their home height, turned by an angle drawn per episode, robot k at slot k, without collisions.
+
+    Observation per robot (15): its slot relative to it (m), its velocity (/ 2), the positions of
+    its 3 nearest neighbours relative to it (m). Action per robot (4, in [-1, 1]): a velocity
+    command (times max_speed m/s; yaw rate times max_yaw_rate). Reward per robot: exp(-distance /
+    0.5) minus `collision_penalty` while a neighbour is closer than `collision_distance` m; the
+    environment's reward is the robots' mean. A robot that crashes ends the episode (VectorEnv) or
+    leaves `agents` (ParallelEnv). infos: "distance" (mean, m), "collisions" (pairs closer than
+    collision_distance at this step)."""
+
+    name = "formation"
+    reads_imu = False
+    neighbours = 3
+
+    def __init__(self, robots=8, vehicle="crazyflie", radius=1.0, start_range=0.2, collision_distance=0.15,
+                 collision_penalty=1.0, horizon_seconds=10.0, **options):
+        options.setdefault("level", "velocity")
+        options.setdefault("spacing", 0.8)
+        super().__init__(vehicle=vehicle, robots=robots, horizon_seconds=horizon_seconds, **options)
+        if self.robots < self.neighbours + 1:
+            raise ValueError(f"ssx.learn: a formation needs at least {self.neighbours + 1} robots")
+        self.radius, self.start_range = radius, start_range
+        self.collision_distance, self.collision_penalty = collision_distance, collision_penalty
+
+    def bind(self, num_envs, action_period, states):
+        super().bind(num_envs, action_period, states)
+        self.centre = self.home.mean(axis=0)
+        self.slots = np.repeat(self.home[None], num_envs, axis=0)
+
+    def draw(self, ids, rngs):
+        u = np.array([rng.random(2 * self.robots + 1) for rng in rngs])  # (k, 2R + 1) in [0, 1)
+        offsets = np.zeros((len(ids), self.robots, 3))
+        offsets[..., :2] = (u[:, :-1].reshape(len(ids), self.robots, 2) * 2.0 - 1.0) * self.start_range
+        phase = u[:, -1:] * 2 * np.pi + 2 * np.pi * np.arange(self.robots) / self.robots  # (k, R)
+        self.slots[ids, :, 0] = self.centre[0] + self.radius * np.cos(phase)
+        self.slots[ids, :, 1] = self.centre[1] + self.radius * np.sin(phase)
+        self.slots[ids, :, 2] = self.centre[2]
+        return offsets, np.zeros_like(offsets)
+
+    def observation_space(self, per_agent=False):
+        shape = (15,) if per_agent else (self.robots, 15)
+        return make_box(-10.0, 10.0, shape, np.float32)
+
+    def action_space(self, per_agent=False):
+        return make_box(-1.0, 1.0, (4,) if per_agent else (self.robots, 4), np.float32)
+
+    def _pairs(self, states):
+        """(E, R, R) relative positions (j - i) and distances, the diagonal at infinity."""
+        p = states[..., 0:3]
+        rel = p[:, None, :, :] - p[:, :, None, :]
+        dist = np.linalg.norm(rel, axis=-1)
+        idx = np.arange(self.robots)
+        dist[:, idx, idx] = np.inf
+        return rel, dist
+
+    def observe(self, states, imu, out):
+        o = out.reshape(len(states), self.robots, 15)
+        o[..., 0:3] = self.slots[: len(states)] - states[..., 0:3]
+        o[..., 3:6] = states[..., 7:10] * 0.5
+        rel, dist = self._pairs(states)
+        nearest = np.argsort(dist, axis=-1, kind="stable")[..., : self.neighbours]  # (E, R, 3)
+        picked = np.take_along_axis(rel, nearest[..., None], axis=2)  # (E, R, 3, 3)
+        o[..., 6:15] = picked.reshape(len(states), self.robots, 3 * self.neighbours)
+        np.clip(o, -10.0, 10.0, out=o)
+
+    def _agent_rewards(self, states):
+        distance = np.linalg.norm(self.slots[: len(states)] - states[..., 0:3], axis=-1)
+        _, dist = self._pairs(states)
+        close = dist < self.collision_distance
+        crashed = self._crashed(states)
+        reward = np.exp(-distance / 0.5) - self.collision_penalty * close.any(axis=-1)
+        return np.where(crashed, -1.0, reward), distance, close, crashed
+
+    def evaluate(self, states, imu, actions):
+        reward, distance, close, crashed = self._agent_rewards(states)
+        self._last_agent_rewards = reward
+        infos = {"distance": distance.mean(axis=1), "collisions": close.sum(axis=(1, 2)) // 2, "agent_rewards": reward}
+        return reward.mean(axis=1), crashed.any(axis=1), infos
+
+    def agent_rewards(self, rewards):
+        return self._last_agent_rewards

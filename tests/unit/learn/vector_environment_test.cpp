@@ -1,0 +1,165 @@
+// Copies of one scene stepped together (ssx/vector_environment.hpp): a copy ends as it would
+// alone, on 1 and 2 threads, whatever its index or its neighbours; copies left out of a step or a
+// reset keep every bit; a reset with a seed draws the same noise again and another seed other
+// noise; states and IMU readings come out in one array; commands go in checked whole; moving
+// robots moves them; nonsense is refused with the copy and robot named.
+#include "scene_util.hpp"
+#include "test_util.hpp"
+
+#include <ssx/ssx.hpp>
+#include <ssx/vector_environment.hpp>
+
+#include <catch2/catch.hpp>
+
+#include <array>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+using namespace ssx;
+using Catch::Contains;
+using ssx::test::kArtifacts;
+
+namespace {
+
+// `robots` Crazyflies taking off to 1 m; copy `seed` differs when seeds are given per copy
+Scene crazyflies(std::size_t robots = 1, std::uint64_t seed = 4, const char* name = "cf{i}") {
+  SceneOptions options;
+  options.threads = 1;
+  return loadSceneFromString(
+      "<scene><environment timestep=\"0.002\" seed=\"" + std::to_string(seed) + "\"/><type name=\"cf\" file=\"" +
+          (kArtifacts / "crazyflie.xml").string() + "\"/><ground/><swarm type=\"cf\" count=\"" +
+          std::to_string(robots) + "\" name=\"" + name +
+          "\" spacing=\"1\" xyz=\"0 0 0.05\"><driver offset=\"0 0 1\"/></swarm></scene>",
+      "cf.xml", kArtifacts, options);
+}
+
+std::vector<std::uint64_t> hashes(VectorEnvironment& v) {
+  std::vector<std::uint64_t> out;
+  for (std::size_t i = 0; i < v.size(); ++i) out.push_back(v[i].stateHash());
+  return out;
+}
+
+}  // namespace
+
+TEST_CASE("vector environment: a copy ends as it would alone, on 1 and 2 threads, whatever its index",
+          "[learn]") {
+  // copies with seeds 4, 5, 6: each one's end state is that of its scene stepped alone
+  auto seeded = [](std::size_t i) { return crazyflies(2, 4 + i); };
+  std::vector<std::uint64_t> alone;
+  for (std::size_t i = 0; i < 3; ++i) {
+    Scene s = seeded(i);
+    s.environment->step(300);
+    alone.push_back(s.environment->stateHash());
+  }
+  CHECK(alone[0] != alone[1]);
+  for (const int threads : {1, 2}) {
+    VectorEnvironment v(seeded, 3, threads);
+    CHECK(v.threadCount() == static_cast<unsigned>(threads));
+    v.step(100);
+    v.step(200);
+    CHECK(hashes(v) == alone);
+  }
+  // the copies in the other order: the same states, permuted
+  VectorEnvironment reversed([&](std::size_t i) { return seeded(2 - i); }, 3, 2);
+  reversed.step(300);
+  CHECK(hashes(reversed) == std::vector<std::uint64_t>{alone[2], alone[1], alone[0]});
+  CHECK(reversed.robotNames() == std::vector<std::string>{"cf0", "cf1"});
+}
+
+TEST_CASE("vector environment: copies left out of a step or a reset keep every bit, a reset's seed decides the noise",
+          "[learn]") {
+  VectorEnvironment v([](std::size_t) { return crazyflies(); }, 4, 2);
+  v.step(400);  // hovering
+  const std::vector<std::byte> start = v[0].saveState();
+  const auto before = hashes(v);
+  const std::array<std::uint8_t, 4> active{1, 0, 1, 0};
+  v.step(50, active);
+  auto after = hashes(v);
+  CHECK(after[1] == before[1]);
+  CHECK(after[3] == before[3]);
+  CHECK(after[0] != before[0]);
+  CHECK(after[0] == after[2]);
+  // copies 0 and 2 back to the start, reseeded alike; copy 1 with another seed; copy 3 untouched
+  const std::array<std::size_t, 3> which{0, 1, 2};
+  const std::array<std::uint64_t, 3> seeds{11, 12, 11};
+  v.reset(which, start, seeds);
+  CHECK(hashes(v)[0] == before[0]);
+  CHECK(v[0].stepCount() == 400);
+  CHECK(hashes(v)[3] == after[3]);
+  v.step(200);
+  after = hashes(v);
+  CHECK(after[0] == after[2]);  // the same seed: the same noise, the same flight
+  CHECK(after[0] != after[1]);  // another seed: the pose sensor's noise differs, so does the flight
+  // a state that is not this scene's: refused before any copy changes
+  Scene other = crazyflies(2);
+  other.environment->start();
+  const std::vector<std::byte> foreign = other.environment->saveState();
+  const std::array<std::size_t, 1> first{0};
+  const std::array<std::uint64_t, 1> one{1};
+  CHECK_THROWS_AS(v.reset(first, foreign, one), StateError);
+  CHECK(hashes(v) == after);
+  const std::array<std::size_t, 2> twice{1, 1};
+  const std::array<std::uint64_t, 2> two{1, 2};
+  CHECK_THROWS_WITH(v.reset(twice, start, two), Contains("copy 1 twice"));
+  CHECK_THROWS_WITH(v.reset(first, start, two), Contains("one seed per copy"));
+}
+
+TEST_CASE("vector environment: states and IMU readings in one array, commands checked whole, robots moved",
+          "[learn]") {
+  VectorEnvironment v([](std::size_t) { return crazyflies(2); }, 3, 2);
+  v.step(1500);
+  std::vector<double> states(3 * 2 * kRobotStateSize), imu(3 * 2 * 6);
+  v.robotStates(states);
+  v.imuReadings(imu);
+  for (std::size_t c = 0; c < 3; ++c)
+    for (std::size_t r = 0; r < 2; ++r) {
+      const double* s = &states[(c * 2 + r) * kRobotStateSize];
+      const BodyState truth = v[c].findArtifact(v.robotNames()[r])->state();
+      CHECK(s[0] == truth.pose.position.x());
+      CHECK(s[2] == truth.pose.position.z());
+      CHECK(s[3] == truth.pose.orientation.w());
+      CHECK(s[9] == truth.linear_velocity.z());
+      CHECK(s[2] == Approx(1.05).margin(0.25));          // taken off to about 1 m up
+      CHECK(imu[(c * 2 + r) * 6 + 2] == Approx(9.81).margin(1.0));  // the accelerometer reads +g
+    }
+  CHECK_THROWS_WITH(v.robotStates(std::span<double>(states).first(5)), Contains("3 x 2 x 13"));
+  // velocity commands for all six robots; a NaN in the last row refuses the whole batch
+  std::vector<double> commands(3 * 2 * 4, 0.0);
+  commands[0] = 0.5;  // copy 0, robot cf0: 0.5 m/s along x
+  commands.back() = std::nan("");
+  CHECK_THROWS_WITH(v.setCommands(CommandLevel::Velocity, commands, 4), Contains("copy 2, robot 'cf1'"));
+  commands.back() = 0;
+  CHECK_THROWS_WITH(v.setCommands(CommandLevel::Rotors, commands, 4), Contains("copy 0, robot 'cf0'"));
+  CHECK_THROWS_WITH(v.setCommands(CommandLevel::Velocity, commands, 3), Contains("rows of 3"));
+  v.setCommands(CommandLevel::Velocity, commands, 4);
+  v.step(500);
+  v.robotStates(states);
+  CHECK(states[7] == Approx(0.5).margin(0.1));    // copy 0, cf0 flies at 0.5 m/s
+  CHECK(std::abs(states[kRobotStateSize + 7]) < 0.05);  // cf1 holds
+  // copy 1's robots moved 0.2 m up and set moving at 0.3 m/s along y
+  std::vector<double> before(states);
+  const std::array<std::size_t, 1> which{1};
+  const std::vector<double> offsets{0, 0, 0.2, 0, 0, 0.2}, velocities{0, 0.3, 0, 0, 0.3, 0};
+  v.moveRobots(which, offsets, velocities);
+  v.robotStates(states);
+  const std::size_t copy1 = 2 * kRobotStateSize;
+  CHECK(states[copy1 + 2] == Approx(before[copy1 + 2] + 0.2));
+  CHECK(states[copy1 + 8] == 0.3);
+  CHECK(states[2] == before[2]);  // copy 0 unmoved
+  CHECK_THROWS_WITH(v.moveRobots(which, std::vector<double>(3, 0.0), {}), Contains("1 x 2 x 3"));
+}
+
+TEST_CASE("vector environment: copies must be one scene, each on one thread", "[learn]") {
+  CHECK_THROWS_WITH(VectorEnvironment([](std::size_t i) { return crazyflies(1, 4, i == 0 ? "cf{i}" : "other{i}"); }, 2),
+                    Contains("copy 1 of a vector environment has other robots than copy 0: robot 0 is 'other0'"));
+  CHECK_THROWS_WITH(VectorEnvironment(
+                        [](std::size_t) {
+                          SceneOptions options;
+                          options.threads = 2;
+                          return loadSceneFromString("<scene><ground/></scene>", "two.xml", ".", options);
+                        },
+                        1),
+                    Contains("load each copy with one"));
+  CHECK_THROWS_AS(VectorEnvironment([](std::size_t) { return crazyflies(); }, 0), ConfigError);
+}
