@@ -8,8 +8,8 @@ goto: one Crazyflie per environment at the attitude level (roll, pitch, yaw rate
 50 Hz), 64 environments; afterwards 100 episodes with goals it never trained on (seeds from
 1,000,000 on), its success rate (within 10 cm of the goal at the episode's end) printed.
 formation: 8 Crazyflies per environment at the velocity level, one policy shared by the robots,
-16 environments; afterwards 20 held-out episodes, their mean distance to the slots and the
-collisions counted.
+16 environments; afterwards 20 held-out episodes, their mean distance to the slots at the end and
+how often two robots came closer than 15 cm (pairs times steps).
 The learning curve goes to DIR/curve.csv and DIR/curve.png (DIR must not exist yet, or be empty).
 """
 import argparse
@@ -85,9 +85,9 @@ def main():
         print(f"held-out goals: {result['success'].mean() * 100:.0f} % reached within 10 cm "
               f"(median final distance {np.nanmedian(result['distance']) * 100:.1f} cm, {result['crashed'].sum()} crashed)")
     else:
-        print(f"held-out formations: mean distance to the slots {np.nanmean(result['distance']) * 100:.1f} cm, "
-              f"{int(result['collisions'].sum())} robot pairs closer than 15 cm over {setup['held_out']} episodes, "
-              f"{result['crashed'].sum()} episodes ended by a crash")
+        print(f"held-out formations: mean distance to the slots {np.nanmean(result['distance']) * 100:.1f} cm at the end, "
+              f"a pair of robots closer than 15 cm at {int(result['collisions'].sum())} (pair, step)s over "
+              f"{setup['held_out']} episodes, {result['crashed'].sum()} episodes ended by a crash")
     print(f"curve: {out / 'curve.csv'}, {out / 'curve.png'}")
 
 
