@@ -48,6 +48,7 @@ class SwarmReachEnv:
 
     def reset(self, seed=0):
         self.sim.restore_state(self.initial)
+        self.sim.reseed(seed)  # the sensors' noise and the wind of this episode: the seed's, not the saved state's
         rng = np.random.default_rng(seed)
         home = self.sim.positions()
         self.goals = home + rng.uniform([-1.5, -1.5, 0.0], [1.5, 1.5, 1.0], size=(self.n, 3))

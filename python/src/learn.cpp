@@ -214,7 +214,7 @@ class PyVectorEnvironment {
 
 }  // namespace
 
-void bindLearn(py::module_& m) {
+void bindVectorEnvironment(py::module_& m) {
   py::class_<PyVectorEnvironment>(m, "VectorEnvironment",
                                   "num_envs copies of one scene, each a world of its own, stepped together on a pool "
                                   "of threads (the GIL released): the core of ssx.learn.VectorEnv.")

@@ -560,7 +560,7 @@ PYBIND11_MODULE(_ssx, m) {
   ssx_python::bindJoints(environment);
   ssx_python::bindPhysics(environment);
   ssx_python::bindRecording(m);
-  ssx_python::bindLearn(m);
+  ssx_python::bindLearn(m, environment);
 
   m.def(
       "load_scene",

@@ -116,6 +116,8 @@ class Environment:
     @property
     def physics_switches(self) -> List[Tuple[float, str, str]]:
         """The switches of physics engine so far: (time s, from, to) each, in order."""
+    def reseed(self, seed: int) -> None:
+        """Restarts every random stream (sensor noise, wind gusts) as a scene loaded with this seed would start it."""
     def save_state(self) -> bytes:
         """Everything that determines the future."""
     def restore_state(self, state: bytes) -> None:

@@ -265,3 +265,23 @@ def test_vector_environment_core_reads_into_given_arrays():
     sim.close()
     with pytest.raises(RuntimeError, match="closed"):
         sim.step()
+
+
+def test_environment_reseed_after_restore_draws_the_seeds_noise():
+    env = ssx.load_scene(ssx.data_directory() / "scenes" / "quad_hover.xml", seed=3, threads=1)
+    env.step(100)
+    saved = env.save_state()
+
+    def episode(seed):
+        env.restore_state(saved)
+        if seed is not None:
+            env.reseed(seed)
+        env.step(50)
+        return env.imu("cf")["accelerometer"].copy(), env.state_hash()
+
+    plain_a, plain_b = episode(None), episode(None)
+    assert np.array_equal(plain_a[0], plain_b[0])  # restoring restores the noise streams too
+    one, one_again, two = episode(1), episode(1), episode(2)
+    assert np.array_equal(one[0], one_again[0]) and one[1] == one_again[1]
+    assert not np.array_equal(one[0], two[0])
+    env.close()
