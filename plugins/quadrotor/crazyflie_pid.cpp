@@ -155,7 +155,8 @@ void CrazyfliePidController::setCommand(const Command& command, const Vec3&) {
 Command CrazyfliePidController::command() const {
   if (level_ == CommandLevel::Velocity) return Command::velocityYawRate(command_velocity_, command_yaw_rate_);
   const double thrust = thrust_ / 65535.0 * curve_.thrust_max * 4;
-  if (level_ == CommandLevel::Attitude) return Command::attitude(roll_deg_ / kDeg, pitch_deg_ / kDeg, command_yaw_rate_, thrust);
+  if (level_ == CommandLevel::Attitude)
+    return Command::attitude(roll_deg_ / kDeg, pitch_deg_ / kDeg, command_yaw_rate_, thrust);
   if (level_ == CommandLevel::Rates) return Command::rates(command_rates_, thrust);
   return FlightController::command();
 }
@@ -267,7 +268,8 @@ void CrazyfliePidController::loadState(StateReader& in) {
   std::uint8_t level = 0;
   in.read(level);
   if (level > static_cast<std::uint8_t>(CommandLevel::Rates) || !accepts(static_cast<CommandLevel>(level)))
-    throw StateError("crazyflie_pid: a saved command level this controller does not take (" + std::to_string(level) + ")");
+    throw StateError("crazyflie_pid: a saved command level this controller does not take (" +
+                     std::to_string(level) + ")");
   level_ = static_cast<CommandLevel>(level);
   double filtered = 0;
   double* fields[] = {&current_.position.x(), &current_.position.y(), &current_.position.z(), &current_.yaw,

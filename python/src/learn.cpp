@@ -68,7 +68,8 @@ class PyVectorEnvironment {
     if (!active.is_none()) {
       flags = Flags::ensure(active);
       if (!flags || flags.ndim() != 1 || flags.shape(0) != static_cast<py::ssize_t>(v.size()))
-        throw py::value_error("ssx: active must be one flag per environment, shape (" + std::to_string(v.size()) + ",)");
+        throw py::value_error("ssx: active must be one flag per environment, shape (" + std::to_string(v.size()) +
+                              ",)");
     }
     const std::span<const std::uint8_t> mask =
         active.is_none() ? std::span<const std::uint8_t>() : std::span<const std::uint8_t>(flags.data(), v.size());
@@ -169,7 +170,8 @@ class PyVectorEnvironment {
     const auto rows = static_cast<py::ssize_t>(chosen.size());
     auto check = [&](const py::handle& h, const char* what) {
       Doubles a = Doubles::ensure(h);
-      if (!a || a.ndim() != 3 || a.shape(0) != rows || a.shape(1) != static_cast<py::ssize_t>(robots()) || a.shape(2) != 3)
+      if (!a || a.ndim() != 3 || a.shape(0) != rows || a.shape(1) != static_cast<py::ssize_t>(robots()) ||
+          a.shape(2) != 3)
         throw py::value_error(std::string("ssx: ") + what + " must have shape (" + std::to_string(rows) + ", " +
                               std::to_string(robots()) + ", 3): one row per robot of each environment named");
       return a;

@@ -93,7 +93,8 @@ class SSX_EXPORT VectorEnvironment {
   std::vector<SetpointInterface*> setpoints_;
   std::vector<CommandInterface*> commands_;
   std::vector<std::vector<int>> bodies_;
-  std::vector<const Sensor*> imus_;  // per copy, per robot: its first IMU sensor, or nullptr  // per copy, per robot: its moving bodies
+  std::vector<const Sensor*>
+      imus_;  // per copy, per robot: its first IMU sensor, or nullptr  // per copy, per robot: its moving bodies
   std::unique_ptr<Pool> pool_;
 };
 

@@ -24,7 +24,8 @@ struct VectorEnvironment::Pool {
 namespace {
 
 unsigned poolSize(int threads, std::size_t copies) {
-  if (threads < 0) throw ConfigError({}, "a vector environment needs threads >= 0 (0: one per core), got " + std::to_string(threads));
+  if (threads < 0)
+    throw ConfigError({}, "a vector environment needs threads >= 0 (0: one per core), got " + std::to_string(threads));
   unsigned n = threads > 0 ? static_cast<unsigned>(threads) : std::max(1u, std::thread::hardware_concurrency());
   if (copies > 0 && n > copies) n = static_cast<unsigned>(copies);
   return std::max(1u, n);
@@ -53,9 +54,10 @@ VectorEnvironment::VectorEnvironment(const std::function<Scene(std::size_t)>& lo
     scenes_.push_back(load(i));
     Environment& env = *scenes_.back().environment;
     if (env.settings().threads != 1)
-      throw ConfigError({}, "copy " + std::to_string(i) + " of a vector environment steps on " +
-                        std::to_string(env.settings().threads) +
-                        " threads; load each copy with one (SceneOptions::threads = 1): the copies are what runs in parallel");
+      throw ConfigError(
+          {},
+          "copy " + std::to_string(i) + " of a vector environment steps on " + std::to_string(env.settings().threads) +
+              " threads; load each copy with one (SceneOptions::threads = 1): the copies are what runs in parallel");
     std::vector<std::string> names;
     for (std::size_t a = 0; a < env.artifactCount(); ++a) {
       Artifact& artifact = env.artifact(a);
@@ -77,10 +79,11 @@ VectorEnvironment::VectorEnvironment(const std::function<Scene(std::size_t)>& lo
     } else if (names != robot_names_) {
       std::size_t k = 0;
       while (k < names.size() && k < robot_names_.size() && names[k] == robot_names_[k]) ++k;
-      throw ConfigError({}, "copy " + std::to_string(i) + " of a vector environment has other robots than copy 0: robot " +
-                        std::to_string(k) + " is '" + (k < names.size() ? names[k] : std::string("(none)")) +
-                        "' there and '" + (k < robot_names_.size() ? robot_names_[k] : std::string("(none)")) +
-                        "' in copy 0; every copy must be the same scene");
+      throw ConfigError({}, "copy " + std::to_string(i) +
+                                " of a vector environment has other robots than copy 0: robot " + std::to_string(k) +
+                                " is '" + (k < names.size() ? names[k] : std::string("(none)")) + "' there and '" +
+                                (k < robot_names_.size() ? robot_names_[k] : std::string("(none)")) +
+                                "' in copy 0; every copy must be the same scene");
     }
     envs_.push_back(&env);
   }
@@ -154,7 +157,7 @@ void VectorEnvironment::step(std::int64_t n, std::span<const std::uint8_t> activ
   if (n < 0) throw ConfigError({}, "a vector environment steps n >= 0 times, got " + std::to_string(n));
   if (!active.empty() && active.size() != envs_.size())
     throw ConfigError({}, "a vector environment of " + std::to_string(envs_.size()) + " copies was given " +
-                      std::to_string(active.size()) + " flags of which copies step");
+                              std::to_string(active.size()) + " flags of which copies step");
   if (n == 0) return;
   forEach([&](std::size_t i) {
     if (active.empty() || active[i] != 0) envs_[i]->step(n);
@@ -165,7 +168,7 @@ void VectorEnvironment::reset(std::span<const std::size_t> which, std::span<cons
                               std::span<const std::uint64_t> seeds) {
   if (seeds.size() != which.size())
     throw ConfigError({}, "a reset names " + std::to_string(which.size()) + " copies and gives " +
-                      std::to_string(seeds.size()) + " seeds; one seed per copy");
+                              std::to_string(seeds.size()) + " seeds; one seed per copy");
   std::vector<bool> chosen(envs_.size(), false);
   for (const std::size_t i : which) {
     if (i >= envs_.size())
@@ -197,7 +200,7 @@ void VectorEnvironment::robotStates(std::span<double> out) const {
   const std::size_t robots = robot_names_.size();
   if (out.size() != envs_.size() * robots * kRobotStateSize)
     throw ConfigError({}, "robotStates needs " + std::to_string(envs_.size()) + " x " + std::to_string(robots) + " x " +
-                      std::to_string(kRobotStateSize) + " numbers, got " + std::to_string(out.size()));
+                              std::to_string(kRobotStateSize) + " numbers, got " + std::to_string(out.size()));
   double* p = out.data();
   for (const PhysicNode* node : roots_) {
     const BodyState& s = node->state();
@@ -217,10 +220,11 @@ void VectorEnvironment::imuReadings(std::span<double> out) const {
   const std::size_t robots = robot_names_.size();
   if (out.size() != envs_.size() * robots * 6)
     throw ConfigError({}, "imuReadings needs " + std::to_string(envs_.size()) + " x " + std::to_string(robots) +
-                      " x 6 numbers, got " + std::to_string(out.size()));
+                              " x 6 numbers, got " + std::to_string(out.size()));
   for (std::size_t r = 0; r < robots; ++r)
     if (imus_[r] == nullptr)
-      throw ConfigError({}, "robot '" + robot_names_[r] + "' has no IMU sensor to read (add <sensor plugin=\"imu\"/> to its type)");
+      throw ConfigError(
+          {}, "robot '" + robot_names_[r] + "' has no IMU sensor to read (add <sensor plugin=\"imu\"/> to its type)");
   double* p = out.data();
   for (const Sensor* sensor : imus_) {
     const auto& m = static_cast<const ImuMeasurement&>(sensor->latest());
@@ -235,8 +239,8 @@ void VectorEnvironment::moveRobots(std::span<const std::size_t> which, std::span
   const std::size_t numbers = which.size() * robots * 3;
   if (offsets.size() != numbers || (!velocities.empty() && velocities.size() != numbers))
     throw ConfigError({}, "moving the robots of " + std::to_string(which.size()) + " copies needs " +
-                      std::to_string(which.size()) + " x " + std::to_string(robots) +
-                      " x 3 offsets (and velocities, when given)");
+                              std::to_string(which.size()) + " x " + std::to_string(robots) +
+                              " x 3 offsets (and velocities, when given)");
   for (const double x : offsets)
     if (!std::isfinite(x)) throw ConfigError({}, "a robot's offset holds a NaN or an infinity");
   for (const double x : velocities)
@@ -250,8 +254,9 @@ void VectorEnvironment::moveRobots(std::span<const std::size_t> which, std::span
     for (std::size_t r = 0; r < robots; ++r) {
       const std::size_t row = k * robots + r;
       const Vec3 offset(offsets[3 * row], offsets[3 * row + 1], offsets[3 * row + 2]);
-      const Vec3 velocity = velocities.empty() ? Vec3::Zero()
-                                               : Vec3(velocities[3 * row], velocities[3 * row + 1], velocities[3 * row + 2]);
+      const Vec3 velocity = velocities.empty()
+                                ? Vec3::Zero()
+                                : Vec3(velocities[3 * row], velocities[3 * row + 1], velocities[3 * row + 2]);
       for (const int b : bodies_[which[k] * robots + r]) {
         BodyState s = env.bodyState(b);
         s.pose.position += offset;
@@ -268,22 +273,20 @@ void VectorEnvironment::setCommands(CommandLevel level, std::span<const double> 
   const std::size_t rows = envs_.size() * robots;
   if (values.size() != rows * columns)
     throw ConfigError({}, "commands for a vector environment need " + std::to_string(envs_.size()) + " x " +
-                      std::to_string(robots) + " rows of " + std::to_string(columns) + " numbers, got " +
-                      std::to_string(values.size()) + " numbers");
+                              std::to_string(robots) + " rows of " + std::to_string(columns) + " numbers, got " +
+                              std::to_string(values.size()) + " numbers");
   // every row checked before any robot gets one; the commands built here are what is sent
   thread_local std::vector<Command> commands;
   commands.resize(rows);
   for (std::size_t r = 0; r < rows; ++r) {
-    auto who = [&] {
-      return "copy " + std::to_string(r / robots) + ", robot '" + robot_names_[r % robots] + "'";
-    };
+    auto who = [&] { return "copy " + std::to_string(r / robots) + ", robot '" + robot_names_[r % robots] + "'"; };
     CommandInterface* target = commands_[r];
     if (target == nullptr && level != CommandLevel::Position)
       throw ConfigError({}, who() + " takes set-points only, no commands at the " + commandLevelName(level) + " level");
     const std::size_t rotors = target != nullptr ? target->rotorCount() : 0;
     if (!Command::rowSizeFits(level, columns, rotors))
       throw ConfigError({}, "a " + std::string(commandLevelName(level)) + " command for " + who() + " has " +
-                        Command::rowSizes(level, rotors) + " values, got " + std::to_string(columns));
+                                Command::rowSizes(level, rotors) + " values, got " + std::to_string(columns));
     const std::span<const double> row = values.subspan(r * columns, columns);
     for (const double x : row)
       if (!std::isfinite(x)) throw ConfigError({}, "the command for " + who() + " holds a NaN or an infinity");

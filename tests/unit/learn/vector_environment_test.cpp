@@ -26,12 +26,11 @@ namespace {
 Scene crazyflies(std::size_t robots = 1, std::uint64_t seed = 4, const char* name = "cf{i}") {
   SceneOptions options;
   options.threads = 1;
-  return loadSceneFromString(
-      "<scene><environment timestep=\"0.002\" seed=\"" + std::to_string(seed) + "\"/><type name=\"cf\" file=\"" +
-          (kArtifacts / "crazyflie.xml").string() + "\"/><ground/><swarm type=\"cf\" count=\"" +
-          std::to_string(robots) + "\" name=\"" + name +
-          "\" spacing=\"1\" xyz=\"0 0 0.05\"><driver offset=\"0 0 1\"/></swarm></scene>",
-      "cf.xml", kArtifacts, options);
+  return loadSceneFromString("<scene><environment timestep=\"0.002\" seed=\"" + std::to_string(seed) +
+                                 "\"/><type name=\"cf\" file=\"" + (kArtifacts / "crazyflie.xml").string() +
+                                 "\"/><ground/><swarm type=\"cf\" count=\"" + std::to_string(robots) + "\" name=\"" +
+                                 name + "\" spacing=\"1\" xyz=\"0 0 0.05\"><driver offset=\"0 0 1\"/></swarm></scene>",
+                             "cf.xml", kArtifacts, options);
 }
 
 std::vector<std::uint64_t> hashes(VectorEnvironment& v) {
@@ -42,8 +41,7 @@ std::vector<std::uint64_t> hashes(VectorEnvironment& v) {
 
 }  // namespace
 
-TEST_CASE("vector environment: a copy ends as it would alone, on 1 and 2 threads, whatever its index",
-          "[learn]") {
+TEST_CASE("vector environment: a copy ends as it would alone, on 1 and 2 threads, whatever its index", "[learn]") {
   // copies with seeds 4, 5, 6: each one's end state is that of its scene stepped alone
   auto seeded = [](std::size_t i) { return crazyflies(2, 4 + i); };
   std::vector<std::uint64_t> alone;
@@ -105,8 +103,7 @@ TEST_CASE("vector environment: copies left out of a step or a reset keep every b
   CHECK_THROWS_WITH(v.reset(first, start, two), Contains("one seed per copy"));
 }
 
-TEST_CASE("vector environment: states and IMU readings in one array, commands checked whole, robots moved",
-          "[learn]") {
+TEST_CASE("vector environment: states and IMU readings in one array, commands checked whole, robots moved", "[learn]") {
   VectorEnvironment v([](std::size_t) { return crazyflies(2); }, 3, 2);
   v.step(1500);
   std::vector<double> states(3 * 2 * kRobotStateSize), imu(3 * 2 * 6);
@@ -120,7 +117,7 @@ TEST_CASE("vector environment: states and IMU readings in one array, commands ch
       CHECK(s[2] == truth.pose.position.z());
       CHECK(s[3] == truth.pose.orientation.w());
       CHECK(s[9] == truth.linear_velocity.z());
-      CHECK(s[2] == Approx(1.05).margin(0.25));          // taken off to about 1 m up
+      CHECK(s[2] == Approx(1.05).margin(0.25));                     // taken off to about 1 m up
       CHECK(imu[(c * 2 + r) * 6 + 2] == Approx(9.81).margin(1.0));  // the accelerometer reads +g
     }
   CHECK_THROWS_WITH(v.robotStates(std::span<double>(states).first(5)), Contains("3 x 2 x 13"));
@@ -135,7 +132,7 @@ TEST_CASE("vector environment: states and IMU readings in one array, commands ch
   v.setCommands(CommandLevel::Velocity, commands, 4);
   v.step(500);
   v.robotStates(states);
-  CHECK(states[7] == Approx(0.5).margin(0.1));    // copy 0, cf0 flies at 0.5 m/s
+  CHECK(states[7] == Approx(0.5).margin(0.1));          // copy 0, cf0 flies at 0.5 m/s
   CHECK(std::abs(states[kRobotStateSize + 7]) < 0.05);  // cf1 holds
   // copy 1's robots moved 0.2 m up and set moving at 0.3 m/s along y
   std::vector<double> before(states);
