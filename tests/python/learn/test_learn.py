@@ -285,3 +285,29 @@ def test_environment_reseed_after_restore_draws_the_seeds_noise():
     assert np.array_equal(one[0], one_again[0]) and one[1] == one_again[1]
     assert not np.array_equal(one[0], two[0])
     env.close()
+
+
+def test_spaces_without_gymnasium_sample_contain_and_seed():
+    from ssx.spaces import Box, Dict
+
+    box = Box(-1.0, 1.0, (3, 2), np.float32, seed=4)
+    a = box.sample()
+    assert a.shape == (3, 2) and a.dtype == np.float32 and box.contains(a) and a in box
+    assert not box.contains(np.full((3, 2), 2.0, dtype=np.float32))
+    assert not box.contains(np.zeros((2, 3), dtype=np.float32))
+    box.seed(9)
+    first = box.sample()
+    box.seed(9)
+    assert np.array_equal(first, box.sample())
+    half = Box([0.0, -np.inf], [1.0, 0.0], dtype=np.float64, seed=1)  # one bound infinite
+    assert all(half.contains(half.sample()) for _ in range(20))
+    with pytest.raises(ValueError, match="low above high"):
+        Box(1.0, 0.0, (2,))
+    both = Dict({"pose": Box(-1, 1, (3,)), "speed": Box(0, 2, (1,))}, seed=3)
+    sample = both.sample()
+    assert set(sample) == {"pose", "speed"} and both.contains(sample)
+    assert not both.contains({"pose": sample["pose"]})
+    both.seed(5)
+    again = both.sample()
+    both.seed(5)
+    assert all(np.array_equal(again[k], v) for k, v in both.sample().items())
