@@ -27,21 +27,28 @@ PEERS = [
 TARGET = 150_000
 
 
+def in_turns(first, second, rounds):
+    """Seconds spent in `first()` and in `second()`, called in turns `rounds` times (the machine's
+    speed drifts between minutes: timings compared are taken in the same minutes)."""
+    a = b = 0.0
+    for _ in range(rounds):
+        start = time.perf_counter()
+        first()
+        middle = time.perf_counter()
+        second()
+        a += middle - start
+        b += time.perf_counter() - middle
+    return a, b
+
+
 def measure(env, batches, agents_per_env):
     env.reset(seed=1)
     actions = np.zeros(env.action_space.shape, dtype=np.float32)
     for _ in range(5):
         env.step(actions)
-    # a whole step, then the C++ stepping alone, in turns (the machine's speed drifts between minutes)
+    # a whole step, then the C++ stepping alone
     sim, n = env._b.sim, env._b.steps_per_action
-    total = core = 0.0
-    for _ in range(batches):
-        start = time.perf_counter()
-        env.step(actions)
-        middle = time.perf_counter()
-        sim.step(n)
-        total += middle - start
-        core += time.perf_counter() - middle
+    total, core = in_turns(lambda: env.step(actions), lambda: sim.step(n), batches)
     rate = env.num_envs * agents_per_env * batches / total
     return rate, total / batches, (total - core) / batches
 
@@ -69,14 +76,7 @@ def per_world_cost(robots=256, steps=500):
     world = ssx.load_scene_string(task.scene(), base_dir=ssx.data_directory(), threads=1)
     for sim in (copies, world):
         sim.step(200)
-    separate = together = 0.0
-    for _ in range(4):  # in turns
-        start = time.perf_counter()
-        copies.step(steps)
-        middle = time.perf_counter()
-        world.step(steps)
-        separate += middle - start
-        together += time.perf_counter() - middle
+    separate, together = in_turns(lambda: copies.step(steps), lambda: world.step(steps), 4)
     copies.close()
     world.close()
     return separate / (4 * steps * robots) * 1e6, together / (4 * steps * robots) * 1e6

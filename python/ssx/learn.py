@@ -295,12 +295,13 @@ class ParallelEnv:
         rewards, terminated, infos = task.evaluate(b.states, b.imu, act)
         truncate = bool(b.steps[0] >= task.horizon)
         agent_done = task.agent_terminations(b.states)[0]
+        per_agent = infos.get("agent_rewards", np.repeat(rewards[:, None], task.robots, axis=1))
         obs, rew, term, trunc, info = {}, {}, {}, {}, {}
         for k, a in enumerate(self.possible_agents):
             if not self._alive[k]:
                 continue
             obs[a] = self._obs[0, k].copy()
-            rew[a] = float(task.agent_rewards(rewards)[0, k])
+            rew[a] = float(per_agent[0, k])
             term[a] = bool(agent_done[k])
             trunc[a] = truncate
             info[a] = {key: value[0] for key, value in infos.items() if not key.startswith("_")}

@@ -72,12 +72,10 @@ class Task:
         raise NotImplementedError
 
     def evaluate(self, states, imu, actions):
-        """(rewards (E,), terminated (E,) bool, infos dict of (E,) arrays) after a step."""
+        """(rewards (E,), terminated (E,) bool, infos dict of (E,) arrays) after a step. A task
+        with several robots may give each robot's reward as infos["agent_rewards"] (E, R): what
+        ParallelEnv hands each agent (else every robot gets its environment's)."""
         raise NotImplementedError
-
-    def agent_rewards(self, rewards):
-        """Per robot (E, R), for ParallelEnv; by default every robot gets its environment's."""
-        return np.repeat(np.asarray(rewards)[:, None], self.robots, axis=1)
 
     def agent_terminations(self, states):
         """Per robot (E, R) bool, for ParallelEnv: crashed, tilted over or out of bounds."""
@@ -312,9 +310,5 @@ class Formation(_Flight):
 
     def evaluate(self, states, imu, actions):
         reward, distance, close, crashed = self._agent_rewards(states)
-        self._last_agent_rewards = reward
         infos = {"distance": distance.mean(axis=1), "collisions": close.sum(axis=(1, 2)) // 2, "agent_rewards": reward}
         return reward.mean(axis=1), crashed.any(axis=1), infos
-
-    def agent_rewards(self, rewards):
-        return self._last_agent_rewards

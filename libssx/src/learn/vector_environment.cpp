@@ -1,4 +1,5 @@
 // Many copies of one scene stepped together (ssx/vector_environment.hpp).
+#include "base/exceptions.hpp"
 #include "base/worker_pool.hpp"
 
 #include <ssx/command.hpp>
@@ -29,17 +30,6 @@ unsigned poolSize(int threads, std::size_t copies) {
   unsigned n = threads > 0 ? static_cast<unsigned>(threads) : std::max(1u, std::thread::hardware_concurrency());
   if (copies > 0 && n > copies) n = static_cast<unsigned>(copies);
   return std::max(1u, n);
-}
-
-// the message of the exception held, for "copy i: ..."
-std::string messageOf(const std::exception_ptr& error) {
-  try {
-    std::rethrow_exception(error);
-  } catch (const std::exception& e) {
-    return e.what();
-  } catch (...) {
-    return "an exception that is not a std::exception";
-  }
 }
 
 }  // namespace
@@ -148,7 +138,7 @@ void VectorEnvironment::forEach(const std::function<void(std::size_t)>& fn) {
                         (what.starts_with(prefix) ? what.substr(prefix.size()) : what) + " (copy " + std::to_string(i) +
                             " of the vector environment)");
       } catch (...) {
-        throw Error("copy " + std::to_string(i) + ": " + messageOf(failed[i]));
+        throw Error("copy " + std::to_string(i) + ": " + detail::describe(failed[i]));
       }
     }
 }
@@ -178,22 +168,13 @@ void VectorEnvironment::reset(std::span<const std::size_t> which, std::span<cons
   }
   if (which.empty()) return;
   envs_[which[0]]->checkState(state);  // the copies are one scene: a state fits all or none
-  std::vector<std::size_t> order(which.begin(), which.end());
-  // (forEach over the chosen ones: an index into `order`)
-  std::vector<std::exception_ptr> errors(order.size());
-  auto body = [&](std::size_t begin, std::size_t end) {
-    for (std::size_t k = begin; k < end; ++k) {
-      try {
-        envs_[order[k]]->restoreState(state);
-        envs_[order[k]]->reseed(seeds[k]);
-      } catch (...) {
-        errors[k] = std::current_exception();
-      }
-    }
-  };
-  pool_->workers.parallelFor(order.size(), 1, body);
-  for (std::size_t k = 0; k < errors.size(); ++k)
-    if (errors[k]) throw StateError("copy " + std::to_string(order[k]) + ": " + messageOf(errors[k]));
+  std::vector<const std::uint64_t*> seed_of(envs_.size(), nullptr);  // per copy: its seed, if reset
+  for (std::size_t k = 0; k < which.size(); ++k) seed_of[which[k]] = &seeds[k];
+  forEach([&](std::size_t i) {
+    if (seed_of[i] == nullptr) return;
+    envs_[i]->restoreState(state);
+    envs_[i]->reseed(*seed_of[i]);
+  });
 }
 
 void VectorEnvironment::robotStates(std::span<double> out) const {

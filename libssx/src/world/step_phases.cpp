@@ -6,6 +6,7 @@
 #include "world/phases.hpp"
 #include "render/scene_cameras.hpp"
 #include "engines/state_checks.hpp"
+#include "base/exceptions.hpp"
 #include "base/worker_pool.hpp"
 
 #include <ssx/environment.hpp>
@@ -37,16 +38,6 @@ Nanoseconds lap(Clock::time_point& t) {
   const Nanoseconds elapsed = std::chrono::duration_cast<std::chrono::nanoseconds>(now - t).count();
   t = now;
   return elapsed;
-}
-
-std::string describe(const std::exception_ptr& e) {
-  try {
-    std::rethrow_exception(e);
-  } catch (const std::exception& ex) {
-    return ex.what();
-  } catch (...) {
-    return "unknown exception";
-  }
 }
 
 }  // namespace
