@@ -66,6 +66,18 @@ def allocations(env, batches=20):
     return grown
 
 
+RANDOMIZE = {"mass": (0.9, 1.1), "thrust_coefficient": (0.95, 1.05), "time_constant_up": (0.8, 1.25),
+             "gyro_noise": (0.5, 2.0), "wind_x": (-0.5, 0.5)}
+
+
+def reset_one(env, count=200):
+    """Seconds per reset of one environment (the task's draw and the domain randomisation included)."""
+    start = time.perf_counter()
+    for k in range(count):
+        env._b.reset_copies([k % env.num_envs])
+    return (time.perf_counter() - start) / count
+
+
 def per_world_cost(robots=256, steps=500):
     """us per Crazyflie step on one thread: as `robots` worlds of one, and as one world of `robots`."""
     import ssx
@@ -110,6 +122,14 @@ def main():
           f"restoring and reseeding the copy (C++), the rest in Python (the task's draw, moving the robots)")
     print(f"  Python memory grown over 20 batch steps: {allocations(env)} bytes")
     env.close()
+    randomized = learn.VectorEnv("goto", num_envs=args.envs, threads=args.threads, randomize=RANDOMIZE)
+    plain = learn.VectorEnv("goto", num_envs=args.envs, threads=args.threads)
+    # five rounds of 200 resets each, in turns
+    with_draws, without = in_turns(lambda: reset_one(randomized), lambda: reset_one(plain), 5)
+    print(f"  reset of one environment with {len(RANDOMIZE)} constants drawn: {with_draws / 1000 * 1e6:.0f} us, "
+          f"{without / 1000 * 1e6:.0f} us without (in turns)")
+    randomized.close()
+    plain.close()
 
     separate, together = per_world_cost()
     print(f"a Crazyflie's step on one thread: {separate:.2f} us as a world of its own, {together:.2f} us as one "

@@ -27,6 +27,7 @@ struct Channel {
   double noise_density = 0, bias_random_walk = 0, correlation_time = 1, turn_on = 0, scale = 1, lsb = 1, range = 1;
   // discrete-time terms for the sensor's period
   double white_sigma = 0, bias_phi = 1, bias_sigma = 0;
+  double white_configured = 0, bias_configured = 0;  // as configured: noiseFactor scales them
   double max_count = 1;  // counts at full scale, each way: floor(range / lsb)
   Vec3 turn_on_bias = Vec3::Zero();
   Vec3 bias = Vec3::Zero();
@@ -52,8 +53,16 @@ struct Channel {
     turn_on_bias.setZero();
     if (noise)
       for (int i = 0; i < 3; ++i) turn_on_bias[i] = rng.normal() * turn_on;
+    white_configured = white_sigma;
+    bias_configured = bias_sigma;
     bias.setZero();
     max_count = static_cast<double>(static_cast<std::int64_t>(std::floor(range / lsb)));
+  }
+
+  // white noise and bias walk at `factor` times the configured ones (a learning episode's draw)
+  void noiseFactor(double factor) {
+    white_sigma = factor * white_configured;
+    bias_sigma = factor * bias_configured;
   }
 
   // one reading: returns the value and writes the counts
@@ -76,7 +85,7 @@ struct Channel {
 
 }  // namespace
 
-class ImuSensor final : public SensorOf<ImuMeasurement> {
+class ImuSensor final : public SensorOf<ImuMeasurement>, public VariationInterface {
  public:
   static constexpr const char* kDoc = "accelerometer and gyroscope with noise, bias, scale, quantisation and range";
   static constexpr ssx_plugin_param kParameters[] = {
@@ -162,6 +171,16 @@ class ImuSensor final : public SensorOf<ImuMeasurement> {
     m.gyroscope = gyro_.measure(to_imu * s.angular_velocity, random(), m.gyroscope_counts);
     m.accelerometer = accel_.measure(to_imu * (s.linear_acceleration - gravity_), random(), m.accelerometer_counts);
   }
+
+  // domain randomisation (ssx/variation.hpp): how noisy this unit is
+  std::span<const Variable> variables() const override {
+    static constexpr Variable kVariables[] = {
+        {"gyro_noise", 1.0, 0.0, 100.0, "factor on the gyroscope's white noise and bias random walk"},
+        {"accel_noise", 1.0, 0.0, 100.0, "factor on the accelerometer's white noise and bias random walk"},
+    };
+    return kVariables;
+  }
+  void vary(std::size_t k, double value) override { (k == 0 ? gyro_ : accel_).noiseFactor(value); }
 
  private:
   const PhysicNode* node_ = nullptr;

@@ -31,6 +31,7 @@ WindParams windParams(const Descriptor& params, const WindSettings& scene) {
 
 void Wind::configure(const WindParams& params, double ground_z) {
   p_ = params;
+  configured_mean_ = params.mean;
   ground_z_ = ground_z;
   active_ = p_.active();
 }

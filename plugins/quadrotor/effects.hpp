@@ -48,6 +48,11 @@ class Wind {
   void configure(const WindParams& params, double ground_z);
   bool active() const { return active_; }
   const WindParams& params() const { return p_; }
+  /// Adds `offset` (m/s, world frame) to the configured mean wind from now on (zero: as configured).
+  void setOffset(const Vec3& offset) {
+    p_.mean = configured_mean_ + offset;
+    active_ = p_.active();
+  }
   /// The air's velocity (world frame) at a body at `position` moving at `velocity`, at time t; the
   /// turbulence advances by dt with draws from `random`.
   Vec3 air(double t, double dt, const Vec3& position, const Vec3& velocity, Random& random);
@@ -56,6 +61,7 @@ class Wind {
 
  private:
   WindParams p_;
+  Vec3 configured_mean_ = Vec3::Zero();
   double ground_z_ = 0;
   bool active_ = false;
   DrydenTurbulence turbulence_;

@@ -171,6 +171,9 @@ void QuadrotorDriver::configure(const Descriptor& params, PluginSetup& setup) {
 
   // the vehicle
   vehicle_.configure(frame->rotor_model, -a.root().poseInBody().position, c.vehicle.battery);
+  frame_ = frame;
+  rotor_factors_.fill(1.0);
+  wind_offset_.setZero();
   // the effects: ground effect over the highest horizontal ground plane, if there is one; the air
   ground_z_ = groundHeight(env);
   ground_effect_ = c.ground_effect;
@@ -297,6 +300,37 @@ void QuadrotorDriver::metrics(std::vector<Metric>& out) const {
 }
 
 // what changes while it flies: each part's state, what the driver last commanded and received
+namespace {
+
+constexpr Variable kVariables[] = {
+    {"thrust_coefficient", 1.0, 0.2, 5.0, "factor on the rotors' thrust coefficient"},
+    {"moment_constant", 1.0, 0.2, 5.0, "factor on the rotors' drag torque per thrust"},
+    {"time_constant_up", 1.0, 0.1, 10.0, "factor on the motors' time constant speeding up"},
+    {"time_constant_down", 1.0, 0.1, 10.0, "factor on the motors' time constant slowing down"},
+    {"wind_x", 0.0, -50.0, 50.0, "m/s added to the mean wind along x (world frame)"},
+    {"wind_y", 0.0, -50.0, 50.0, "m/s added to the mean wind along y (world frame)"},
+    {"wind_z", 0.0, -50.0, 50.0, "m/s added to the mean wind along z (world frame)"},
+};
+
+}  // namespace
+
+std::span<const Variable> QuadrotorDriver::variables() const { return kVariables; }
+
+void QuadrotorDriver::vary(std::size_t k, double value) {
+  if (k >= 4) {
+    wind_offset_[static_cast<Eigen::Index>(k - 4)] = value;
+    wind_.setOffset(wind_offset_);
+    return;
+  }
+  rotor_factors_[k] = value;
+  RotorParams p = frame_->rotor_model.params();
+  p.thrust_coefficient *= rotor_factors_[0];
+  p.moment_constant *= rotor_factors_[1];
+  p.time_constant_up *= rotor_factors_[2];
+  p.time_constant_down *= rotor_factors_[3];
+  vehicle_.setRotorParams(p, frame_->rotor_model);
+}
+
 void QuadrotorDriver::saveState(StateWriter& out) const {
   vehicle_.saveState(out);
   out.write(std::vector<double>(commanded_speeds_.begin(),

@@ -33,7 +33,11 @@
 
 namespace ssx::quadrotor {
 
-class QuadrotorDriver final : public Driver, public CommandInterface, public MetricSource, private FlightInputs {
+class QuadrotorDriver final : public Driver,
+                              public CommandInterface,
+                              public MetricSource,
+                              public VariationInterface,
+                              private FlightInputs {
  public:
   static constexpr const char* kDoc =
       "vehicle (rotors, motors, battery), environment effects, TeleKyb controller (integer attitude loop on IMU "
@@ -64,6 +68,10 @@ class QuadrotorDriver final : public Driver, public CommandInterface, public Met
   /// 1 once it came down on it and stopped its motors, else 0.
   std::vector<std::string> metricNames() const override;
   void metrics(std::vector<Metric>& out) const override;
+  /// The rotors' and motors' constants (factors: the flight controller keeps the configured ones)
+  /// and the mean wind (an offset, m/s), for domain randomisation (ssx/variation.hpp).
+  std::span<const Variable> variables() const override;
+  void vary(std::size_t k, double value) override;
 
   /// For tests: the parts.
   const RotorModel& rotors() const { return vehicle_.rotors(); }
@@ -106,6 +114,11 @@ class QuadrotorDriver final : public Driver, public CommandInterface, public Met
   Wind wind_;
   std::optional<Downwash> downwash_;
   double ground_z_ = 0;  // the ground plane's height (-inf: none)
+  // varied constants (vary): the rotor constants' factors, the mean wind's offset; the airframe
+  // holds the configured rotor model they scale
+  std::shared_ptr<const Airframe> frame_;
+  std::array<double, 4> rotor_factors_{1.0, 1.0, 1.0, 1.0};
+  Vec3 wind_offset_ = Vec3::Zero();
 };
 
 }  // namespace ssx::quadrotor

@@ -79,6 +79,18 @@ RotorModel::RotorModel(const std::vector<Rotor>& rotors, const RotorParams& para
   gains_.fill(1.0);
 }
 
+void RotorModel::setParams(const RotorParams& params, const RotorModel& nominal) {
+  if (params == constants_->params) return;
+  if (params == nominal.params()) {
+    constants_ = nominal.constants_;
+  } else {
+    auto constants = std::make_shared<Constants>(*constants_);
+    constants->params = params;
+    constants_ = std::move(constants);
+  }
+  alpha_dt_ = -1;  // the motors' filter factors follow the time constants
+}
+
 void RotorModel::setSpeeds(std::span<const double> w) {
   if (w.size() != count_)
     throw std::invalid_argument("rotor model: " + std::to_string(w.size()) + " speeds for " + std::to_string(count_) +

@@ -37,6 +37,7 @@ struct RotorParams {
   double rolling_moment_coefficient = 1e-6;    ///< mu1, N m/(m/s)/(rad/s)
   double rotor_inertia = 0.0;                  ///< kg m^2; > 0 adds the rotors' gyroscopic torque
   double rotor_radius = 0.127;                 ///< m, for ground effect (10-inch propellers; EST)
+  bool operator==(const RotorParams&) const = default;
 };
 
 /// Ground effect on one rotor (Cheeseman and Bennett 1955, the form gym-pybullet-drones uses):
@@ -183,6 +184,9 @@ class RotorModel {
   std::span<const Rotor> rotors() const { return {constants_->rotors.data(), count_}; }
   std::size_t size() const { return count_; }
   const RotorParams& params() const { return constants_->params; }
+  /// From now on its constants are `params`, the rotors' places kept: shared again with
+  /// `nominal` (the model it was copied from) when they are nominal's, else its own copy.
+  void setParams(const RotorParams& params, const RotorModel& nominal);
 
  private:
   struct Constants {

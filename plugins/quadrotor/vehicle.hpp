@@ -64,6 +64,8 @@ class Vehicle {
   void configure(const RotorModel& at_rest, const Vec3& com_in_root, const std::optional<BatteryParams>& battery);
   const RotorModel& rotors() const { return *rotors_; }
   std::size_t rotorCount() const { return rotors_->size(); }
+  /// Its rotors' constants from now on (RotorModel::setParams).
+  void setRotorParams(const RotorParams& params, const RotorModel& nominal) { rotors_->setParams(params, nominal); }
   /// Sets every rotor spinning at `speed` (a vehicle placed in the air starts at its hover speed).
   void spinAt(std::span<const double> speeds) { rotors_->setSpeeds(speeds); }
   /// Advances the motors by dt towards the commanded speeds (one per rotor).

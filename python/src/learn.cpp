@@ -188,6 +188,29 @@ class PyVectorEnvironment {
     }
   }
 
+  py::list variables(std::size_t robot) {
+    py::list out;
+    for (const ssx::Variable& v : envs().variables(robot)) out.append(variableDict(v));
+    return out;
+  }
+
+  void vary(const py::handle& which, const std::string& name, const py::handle& values) {
+    InUse use(busy_);
+    const std::vector<std::size_t> chosen = indices(which);
+    const Doubles a = Doubles::ensure(values);
+    if (!a || a.ndim() != 2 || a.shape(0) != static_cast<py::ssize_t>(chosen.size()) ||
+        a.shape(1) != static_cast<py::ssize_t>(robots()))
+      throw py::value_error("ssx: vary values must have shape (" + std::to_string(chosen.size()) + ", " +
+                            std::to_string(robots()) + "): one per robot of each environment named");
+    ssx::VectorEnvironment& v = envs();
+    try {
+      py::gil_scoped_release release;
+      v.vary(chosen, name, std::span<const double>(a.data(), static_cast<std::size_t>(a.size())));
+    } catch (const ssx::ConfigError& e) {
+      throw py::value_error(std::string("ssx: ") + e.what());
+    }
+  }
+
   py::array_t<std::uint64_t> stateHashes() {
     InUse use(busy_);
     py::array_t<std::uint64_t> out(static_cast<py::ssize_t>(size()));
@@ -215,6 +238,16 @@ class PyVectorEnvironment {
 };
 
 }  // namespace
+
+py::dict variableDict(const ssx::Variable& v) {
+  py::dict d;
+  d["name"] = v.name;
+  d["neutral"] = v.neutral;
+  d["min"] = v.min;
+  d["max"] = v.max;
+  d["doc"] = v.doc;
+  return d;
+}
 
 void bindVectorEnvironment(py::module_& m) {
   py::class_<PyVectorEnvironment>(m, "VectorEnvironment",
@@ -244,6 +277,11 @@ void bindVectorEnvironment(py::module_& m) {
       .def("move_robots", &PyVectorEnvironment::moveRobots, py::arg("indices"), py::arg("offsets"),
            py::arg("velocities") = py::none(),
            "Moves every robot of the copies named by offsets (len(indices), robots, 3), at velocities (or at rest).")
+      .def("variables", &PyVectorEnvironment::variables, py::arg("robot") = 0,
+           "What vary takes for robot index robot: dicts of name, neutral, min, max, doc.")
+      .def("vary", &PyVectorEnvironment::vary, py::arg("indices"), py::arg("name"), py::arg("values"),
+           "Sets constant name ('mass', 'inertia' or a plugin's variable) of every robot of the copies named to "
+           "values (len(indices), robots), checked whole first (GIL released).")
       .def("state_hashes", &PyVectorEnvironment::stateHashes, "Each copy's state hash (uint64).")
       .def("times", &PyVectorEnvironment::times, "Each copy's simulated time, s.")
       .def("close", &PyVectorEnvironment::close, "Stops and frees every copy.");

@@ -7,17 +7,54 @@
 #include <pybind11/pybind11.h>
 
 #include <cstdint>
+#include <string>
+#include <utility>
 
 namespace ssx_python {
 
 /// Adds the class VectorEnvironment to the module.
 void bindVectorEnvironment(pybind11::module_& m);
 
+/// A variable (ssx/variation.hpp) as a dict: name, neutral, min, max, doc.
+pybind11::dict variableDict(const ssx::Variable& v);
+
 /// The class VectorEnvironment, and on the Environment class (`E` has env() and guarded()) what a
-/// learning loop on one environment needs besides save and restore: reseed.
+/// learning loop on one environment needs besides save and restore: reseed, and the constants
+/// varied between episodes (variables, vary, variation).
 template <class E>
 void bindLearn(pybind11::module_& m, pybind11::class_<E>& environment) {
   bindVectorEnvironment(m);
+  auto artifact = [](E& e, const std::string& name) -> const ssx::Artifact& {
+    const ssx::Artifact* a = std::as_const(e.env()).findArtifact(name);
+    if (a == nullptr) throw pybind11::key_error("ssx: no artifact named '" + name + "'");
+    return *a;
+  };
+  environment.def(
+      "variables",
+      [artifact](E& e, const std::string& robot) {
+        pybind11::list out;
+        for (const ssx::Variable& v : e.env().variables(artifact(e, robot))) out.append(variableDict(v));
+        return out;
+      },
+      pybind11::arg("robot"),
+      "The constants of a robot that vary() takes: dicts of name, neutral (the value as configured), min, max, doc.");
+  environment.def(
+      "vary",
+      [artifact](E& e, const std::string& robot, const std::string& name, double value) {
+        e.guarded([&] {
+          if (e.env().state() == ssx::Environment::State::Setup) e.env().start();
+          e.env().vary(artifact(e, robot), name, value);
+        });
+      },
+      pybind11::arg("robot"), pybind11::arg("name"), pybind11::arg("value"),
+      "Sets a constant of the robot from the next step on (domain randomisation): 'mass' and 'inertia' (factors on "
+      "its bodies'), or a variable of its plugins (variables()). Part of the saved state.");
+  environment.def(
+      "variation",
+      [artifact](E& e, const std::string& robot, const std::string& name) {
+        return e.env().variation(artifact(e, robot), name);
+      },
+      pybind11::arg("robot"), pybind11::arg("name"), "The value vary() set (the neutral one when never varied).");
   environment.def(
       "reseed",
       [](E& e, std::uint64_t seed) {

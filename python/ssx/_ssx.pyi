@@ -118,6 +118,12 @@ class Environment:
         """The switches of physics engine so far: (time s, from, to) each, in order."""
     def reseed(self, seed: int) -> None:
         """Restarts every random stream (sensor noise, wind gusts) as a scene loaded with this seed would start it."""
+    def variables(self, robot: str) -> List[Dict[str, Any]]:
+        """The constants of a robot that vary() takes: dicts of name, neutral, min, max, doc."""
+    def vary(self, robot: str, name: str, value: float) -> None:
+        """Sets a constant of the robot from the next step on (domain randomisation); part of the saved state."""
+    def variation(self, robot: str, name: str) -> float:
+        """The value vary() set (the neutral one when never varied)."""
     def save_state(self) -> bytes:
         """Everything that determines the future."""
     def restore_state(self, state: bytes) -> None:
@@ -226,6 +232,10 @@ class VectorEnvironment:
         """Restores the copies named to state and reseeds their random streams, one seed each."""
     def move_robots(self, indices: Sequence[int], offsets: npt.ArrayLike, velocities: Optional[npt.ArrayLike] = None) -> None:
         """Moves every robot of the copies named by offsets (len(indices), robots, 3), at velocities (or at rest)."""
+    def variables(self, robot: int = 0) -> List[Dict[str, Any]]:
+        """What vary takes for robot index robot: dicts of name, neutral, min, max, doc."""
+    def vary(self, indices: Sequence[int], name: str, values: npt.ArrayLike) -> None:
+        """Sets constant name of every robot of the copies named to values (len(indices), robots), checked whole first."""
     def state_hashes(self) -> npt.NDArray[np.uint64]:
         """Each copy's state hash."""
     def times(self) -> npt.NDArray[np.float64]:

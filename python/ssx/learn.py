@@ -58,11 +58,36 @@ def _sim_seed(rng):
     return int(rng.integers(0, 2**63, dtype=np.int64))
 
 
+def _ranges(randomize, sim):
+    """The domain randomisation asked for, checked against what every robot can vary: {name: (low, high)}."""
+    if not randomize:
+        return {}
+    if not isinstance(randomize, dict):
+        raise TypeError("ssx.learn: randomize must be a dict {name: (low, high)}")
+    out = {}
+    for name, bounds in randomize.items():
+        try:
+            low, high = (float(x) for x in bounds)
+        except (TypeError, ValueError):
+            raise ValueError(f"ssx.learn: randomize[{name!r}] must be a pair (low, high), got {bounds!r}") from None
+        for r, robot in enumerate(sim.robot_names):
+            known = {v["name"]: v for v in sim.variables(r)}
+            if name not in known:
+                raise ValueError(f"ssx.learn: randomize[{name!r}]: robot {robot!r} has no such constant; it has "
+                                 f"{', '.join(known) or 'none'}")
+            v = known[name]
+            if not (v["min"] <= low <= high <= v["max"]):
+                raise ValueError(f"ssx.learn: randomize[{name!r}] = ({low:g}, {high:g}) must have low <= high within "
+                                 f"[{v['min']:g}, {v['max']:g}] ({v['doc']})")
+        out[name] = (low, high)
+    return out
+
+
 class _Batch:
     """What VectorEnv and ParallelEnv share: the copies, the task, the episodes' generators, the
     buffers every step reuses (no array is made per step on the C++ side)."""
 
-    def __init__(self, task, num_envs, action_period, threads, physics):
+    def __init__(self, task, num_envs, action_period, threads, physics, randomize=None):
         self.task = task
         self.num_envs = int(num_envs)
         if self.num_envs < 1:
@@ -86,8 +111,16 @@ class _Batch:
         self.imu = np.empty((self.num_envs, self.robots, 6)) if task.reads_imu else None
         self.rngs = [np.random.default_rng() for _ in range(self.num_envs)]
         self.steps = np.zeros(self.num_envs, dtype=np.int64)
+        self.randomize = _ranges(randomize, self.sim)
+        # each copy's draws now, per constant: (E, R); neutral until the first reset
+        neutral = {v["name"]: v["neutral"] for v in self.sim.variables(0)}
+        self.variations = {name: np.full((self.num_envs, self.robots), neutral[name]) for name in self.randomize}
         self.read()
         task.bind(self.num_envs, self.action_period, self.states)
+
+    def variation_infos(self):
+        """The constants drawn for each copy's episode, {name: (E, R) array}, for infos."""
+        return {name: values.copy() for name, values in self.variations.items()}
 
     def read(self):
         self.sim.robot_states(out=self.states)
@@ -120,6 +153,11 @@ class _Batch:
         self.sim.reset(ids, self.start_state, [_sim_seed(rng) for rng in rngs])
         offsets, velocities = self.task.draw(ids, rngs)
         self.sim.move_robots(ids, offsets, velocities)
+        # domain randomisation: each robot's constants drawn from its copy's episode generator
+        for name, (low, high) in self.randomize.items():
+            draws = np.stack([rng.uniform(low, high, size=self.robots) for rng in rngs])
+            self.sim.vary(ids, name, draws)
+            self.variations[name][ids] = draws
         self.steps[ids] = 0
 
 
@@ -131,14 +169,18 @@ class VectorEnv(_VectorBase):
     autoreset_mode: "next_step" (Gymnasium's default: the step after an episode ended resets that
     copy and returns its first observation, reward 0) or "same_step" (reset at once; the last
     observation in infos["final_obs"]). threads: threads stepping the copies (None: one per core).
+    randomize: domain randomisation, {name: (low, high)}: each robot's constant drawn uniformly at
+    every reset from its copy's episode generator ("mass", "inertia", "thrust_coefficient",
+    "time_constant_up", "wind_x", "gyro_noise", ...: sim.variables(0) lists them); the draws are
+    in infos["variations"] at reset and whenever a copy resets in step (infos["_variations"] says which).
     """
 
     def __init__(self, task="goto", num_envs=16, action_period=0.02, autoreset_mode="next_step", threads=None,
-                 physics=None, **task_options):
+                 physics=None, randomize=None, **task_options):
         if autoreset_mode not in _MODES:
             raise ValueError(f"ssx.learn: autoreset_mode must be 'next_step' or 'same_step', got {autoreset_mode!r}")
         self.task = make_task(task, **task_options)
-        self._b = _Batch(self.task, num_envs, action_period, threads, physics)
+        self._b = _Batch(self.task, num_envs, action_period, threads, physics, randomize)
         self.num_envs = self._b.num_envs
         self.action_period = self._b.action_period
         self.metadata = {"autoreset_mode": _MODES[autoreset_mode], "render_modes": []}
@@ -181,7 +223,12 @@ class VectorEnv(_VectorBase):
         self._started = True
         b.read()
         self.task.observe(b.states, b.imu, self._obs)
-        return self._obs.copy(), {}
+        return self._obs.copy(), ({"variations": b.variation_infos()} if b.randomize else {})
+
+    @property
+    def sim(self):
+        """The copies (ssx._ssx.VectorEnvironment): their robots, variables and state hashes."""
+        return self._b.sim
 
     def step(self, actions):
         """Holds the actions for action_period: (observations, rewards, terminations, truncations, infos)."""
@@ -221,6 +268,13 @@ class VectorEnv(_VectorBase):
                 obs[ended] = self._obs[ended]
         else:
             self._autoreset = done
+        if b.randomize and (len(resetting) or (self._same_step and done.any())):
+            reset_now = np.zeros(self.num_envs, dtype=bool)
+            reset_now[resetting] = True
+            if self._same_step:
+                reset_now |= done
+            infos["variations"] = b.variation_infos()
+            infos["_variations"] = reset_now
         return obs, rewards.astype(np.float64), terminated, truncated, infos
 
     def close(self, **kwargs):
@@ -242,9 +296,10 @@ class ParallelEnv:
 
     metadata = {"name": "ssx_parallel_v0", "render_modes": []}
 
-    def __init__(self, task="formation", action_period=0.02, threads=1, physics=None, **task_options):
+    def __init__(self, task="formation", action_period=0.02, threads=1, physics=None, randomize=None,
+                 **task_options):
         self.task = make_task(task, **task_options)
-        self._b = _Batch(self.task, 1, action_period, threads, physics)
+        self._b = _Batch(self.task, 1, action_period, threads, physics, randomize)
         self.possible_agents = list(self._b.sim.robot_names)
         self.agents = []
         self.render_mode = None
@@ -275,7 +330,9 @@ class ParallelEnv:
         self.agents = list(self.possible_agents)
         b.read()
         self.task.observe(b.states, b.imu, self._obs)
-        return {a: self._obs[0, k].copy() for k, a in enumerate(self.possible_agents)}, {a: {} for a in self.agents}
+        drawn = b.variation_infos()
+        infos = {a: {name: float(values[0, k]) for name, values in drawn.items()} for k, a in enumerate(self.agents)}
+        return {a: self._obs[0, k].copy() for k, a in enumerate(self.possible_agents)}, infos
 
     def step(self, actions):
         b, task = self._b, self.task
@@ -342,3 +399,99 @@ class TorchVectorEnv:
             actions = actions.detach().cpu().numpy()
         obs, rew, term, trunc, infos = self.env.step(actions)
         return (torch.from_numpy(obs), torch.from_numpy(rew), torch.from_numpy(term), torch.from_numpy(trunc), infos)
+
+
+try:  # Stable-Baselines3 when it is there: the adapter is then one of its VecEnvs
+    from stable_baselines3.common.vec_env import VecEnv as _SB3Base
+except ImportError:
+    _SB3Base = object
+
+
+class SB3VecEnv(_SB3Base):
+    """A VectorEnv behind Stable-Baselines3's VecEnv interface (reset() -> obs, step_async /
+    step_wait -> obs, rewards, dones, infos as a list of dicts, with "terminal_observation" and
+    "TimeLimit.truncated" where an episode ended). SB3 resets a finished environment in the step
+    that ends it: the VectorEnv must be made with autoreset_mode="same_step"."""
+
+    def __init__(self, env):
+        if env.metadata["autoreset_mode"] != _MODES["same_step"]:
+            raise ValueError("ssx.learn: SB3VecEnv needs a VectorEnv made with autoreset_mode='same_step' "
+                             "(Stable-Baselines3 resets an environment in the step that ends its episode)")
+        self.env = env
+        if _SB3Base is not object:
+            super().__init__(env.num_envs, env.single_observation_space, env.single_action_space)
+        else:
+            self.num_envs = env.num_envs
+            self.observation_space = env.single_observation_space
+            self.action_space = env.single_action_space
+        self.reset_infos = [{} for _ in range(env.num_envs)]
+        self._actions = None
+        self._seed = None
+
+    def _per_env(self, infos):
+        out = [{} for _ in range(self.num_envs)]
+        for key, value in infos.items():
+            if key.startswith("_") or key == "final_obs":
+                continue
+            if isinstance(value, dict):  # variations: {name: (E, R)}
+                for name, values in value.items():
+                    for i in range(self.num_envs):
+                        out[i].setdefault(key, {})[name] = values[i]
+            elif isinstance(value, np.ndarray) and value.shape[:1] == (self.num_envs,):
+                for i in range(self.num_envs):
+                    out[i][key] = value[i]
+        return out
+
+    def seed(self, seed=None):
+        """Seeds the next reset: environment i with seed + i (SB3's convention)."""
+        self._seed = seed
+        return [None if seed is None else seed + i for i in range(self.num_envs)]
+
+    def reset(self):
+        obs, infos = self.env.reset(seed=self._seed)
+        self._seed = None
+        self.reset_infos = self._per_env(infos)
+        return obs
+
+    def step_async(self, actions):
+        self._actions = np.asarray(actions)
+
+    def step_wait(self):
+        if self._actions is None:
+            raise RuntimeError("ssx.learn: step_wait() without step_async()")
+        obs, rewards, terminated, truncated, infos = self.env.step(self._actions)
+        self._actions = None
+        dones = terminated | truncated
+        out = self._per_env(infos)
+        for i in np.flatnonzero(dones):
+            out[i]["terminal_observation"] = infos["final_obs"][i]
+            out[i]["TimeLimit.truncated"] = bool(truncated[i] and not terminated[i])
+        return obs, rewards.astype(np.float32), dones, out
+
+    def step(self, actions):
+        self.step_async(actions)
+        return self.step_wait()
+
+    def close(self):
+        self.env.close()
+
+    def _indices(self, indices):
+        if indices is None:
+            return range(self.num_envs)
+        return [indices] if isinstance(indices, int) else indices
+
+    # the copies share one VectorEnv: an attribute or method is the VectorEnv's, once per index
+    def get_attr(self, attr_name, indices=None):
+        return [getattr(self.env, attr_name) for _ in self._indices(indices)]
+
+    def set_attr(self, attr_name, value, indices=None):
+        setattr(self.env, attr_name, value)
+
+    def env_method(self, method_name, *method_args, indices=None, **method_kwargs):
+        return [getattr(self.env, method_name)(*method_args, **method_kwargs) for _ in self._indices(indices)]
+
+    def env_is_wrapped(self, wrapper_class, indices=None):
+        return [False for _ in self._indices(indices)]
+
+    def get_images(self):
+        return [None for _ in range(self.num_envs)]

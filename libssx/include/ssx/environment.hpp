@@ -35,6 +35,7 @@
 #include <ssx/spatial_index.hpp>
 #include <ssx/timing.hpp>
 #include <ssx/types.hpp>
+#include <ssx/variation.hpp>
 
 #include <atomic>
 #include <condition_variable>
@@ -337,6 +338,21 @@ class SSX_EXPORT Environment {
   void setBodyState(int i, const BodyState& state);
   /// A 64-bit hash (FNV-1a) of every body's pose and velocities, bit for bit, and the time.
   std::uint64_t stateHash() const;
+
+  // --- variations: constants that change between episodes (ssx/variation.hpp) --------------
+
+  /// What `vary` takes for `artifact`: `mass` and `inertia` (when it has a moving body), then its
+  /// plugins' variables (driver first, then sensors; a name two plugins give goes to the first).
+  std::vector<Variable> variables(const Artifact& artifact) const;
+  /// Sets constant `name` of `artifact` to `value` from the next step on (a learning
+  /// environment's domain randomisation): `mass` and `inertia` are factors on each of its bodies'
+  /// mass and inertia as the scene gave them; any other name is a variable of one of its plugins
+  /// (VariationInterface). Part of the saved state; restoring a state sets every varied constant to
+  /// the state's value. Between steps only. ConfigError for an unknown name (listing the known
+  /// ones) or a value outside the variable's range, before anything changes.
+  void vary(const Artifact& artifact, std::string_view name, double value);
+  /// The value `name` has now for `artifact` (its neutral value when never varied).
+  double variation(const Artifact& artifact, std::string_view name) const;
 
   // --- ghosts: real robots inside the simulation --------------------------------------------
 

@@ -140,6 +140,10 @@ class SSX_EXPORT PhysicEngine {
   virtual void setKinematic(int body) = 0;
   /// Whether setKinematic made `body` kinematic.
   virtual bool isKinematic(int body) const = 0;
+  /// Scales a dynamic body's mass and its inertia (about its centre of mass) by these factors,
+  /// relative to what addBody gave it ((1, 1): as added), from the next step on; its state stays.
+  /// Between steps; a kinematic body ignores it (it has no mass to move).
+  virtual void setMassScale(int body, double mass_factor, double inertia_factor) = 0;
   /// Joins two bodies (or a body and the world) where they are now and returns the joint's index.
   /// Bodies joined, directly or through others, do not collide with each other and are always
   /// solved together. A scene joint is made before the first step (or restoreState); a run-time

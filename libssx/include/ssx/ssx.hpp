@@ -31,4 +31,5 @@
 #include <ssx/state.hpp>
 #include <ssx/timing.hpp>
 #include <ssx/types.hpp>
+#include <ssx/variation.hpp>
 #include <ssx/version.hpp>

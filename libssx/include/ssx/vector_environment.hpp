@@ -19,6 +19,7 @@
 #include <memory>
 #include <span>
 #include <string>
+#include <string_view>
 #include <vector>
 
 namespace ssx {
@@ -82,19 +83,30 @@ class SSX_EXPORT VectorEnvironment {
   /// `columns` numbers (the order of ssx/command.hpp). Every row is checked (its size, finite, what
   /// its robot takes) before any robot gets one; ConfigError "copy i, robot 'name': ..." otherwise.
   void setCommands(CommandLevel level, std::span<const double> values, std::size_t columns);
+  /// What vary takes for robot `robot` (Environment::variables of its artifact in copy 0; every
+  /// copy is the same scene). std::out_of_range past robotNames().
+  std::vector<Variable> variables(std::size_t robot) const;
+  /// Sets constant `name` of every robot of copy `which[k]` to `values[k * robots + r]`
+  /// (Environment::vary: `mass`, `inertia`, or a variable of its plugins), in parallel: a learning
+  /// environment's domain randomisation, drawn at reset. Every value is checked (the robot has
+  /// the constant, the value is within its range) before any copy changes; ConfigError "copy i,
+  /// robot 'name': ..." otherwise.
+  void vary(std::span<const std::size_t> which, std::string_view name, std::span<const double> values);
 
  private:
   struct Pool;
+  // per copy: where it is in `which` (or -1); ConfigError for a copy past size() or named twice
+  std::vector<std::ptrdiff_t> positions(std::span<const std::size_t> which, const char* what) const;
   std::vector<Scene> scenes_;
   std::vector<Environment*> envs_;
   std::vector<std::string> robot_names_;
+  std::vector<const Artifact*> artifacts_;  // per copy, per robot
   // per copy, per robot: the root node read by robotStates and the driver commanded
   std::vector<const PhysicNode*> roots_;
   std::vector<SetpointInterface*> setpoints_;
   std::vector<CommandInterface*> commands_;
-  std::vector<std::vector<int>> bodies_;
-  std::vector<const Sensor*>
-      imus_;  // per copy, per robot: its first IMU sensor, or nullptr  // per copy, per robot: its moving bodies
+  std::vector<std::vector<int>> bodies_;  // per copy, per robot: its moving bodies
+  std::vector<const Sensor*> imus_;       // per copy, per robot: its first IMU sensor, or nullptr
   std::unique_ptr<Pool> pool_;
 };
 

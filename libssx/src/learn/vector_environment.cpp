@@ -10,6 +10,7 @@
 #include <algorithm>
 #include <cmath>
 #include <exception>
+#include <sstream>
 #include <stdexcept>
 #include <string>
 #include <thread>
@@ -39,7 +40,6 @@ VectorEnvironment::VectorEnvironment(const std::function<Scene(std::size_t)>& lo
   const unsigned pool_threads = poolSize(threads, count);
   scenes_.reserve(count);
   envs_.reserve(count);
-  std::vector<const Artifact*> robot_artifacts;  // per copy, per robot
   for (std::size_t i = 0; i < count; ++i) {
     scenes_.push_back(load(i));
     Environment& env = *scenes_.back().environment;
@@ -57,7 +57,7 @@ VectorEnvironment::VectorEnvironment(const std::function<Scene(std::size_t)>& lo
       roots_.push_back(&std::as_const(artifact).root());
       setpoints_.push_back(setpoint);
       commands_.push_back(dynamic_cast<CommandInterface*>(setpoint));
-      robot_artifacts.push_back(&artifact);
+      artifacts_.push_back(&artifact);
       const Sensor* imu = nullptr;
       for (std::size_t k = 0; k < artifact.sensorCount() && imu == nullptr; ++k)
         if (dynamic_cast<const ImuMeasurement*>(&std::as_const(artifact).sensor(k).latest()) != nullptr)
@@ -80,7 +80,7 @@ VectorEnvironment::VectorEnvironment(const std::function<Scene(std::size_t)>& lo
   pool_ = std::make_unique<Pool>(pool_threads, count);
   forEach([&](std::size_t i) { envs_[i]->start(); });
   // bodies are numbered at start
-  for (const Artifact* artifact : robot_artifacts) {
+  for (const Artifact* artifact : artifacts_) {
     std::vector<int> bodies;
     for (std::size_t k = 0; k < artifact->nodeCount(); ++k) {
       const int b = artifact->nodeAt(k).bodyIndex();
@@ -159,21 +159,68 @@ void VectorEnvironment::reset(std::span<const std::size_t> which, std::span<cons
   if (seeds.size() != which.size())
     throw ConfigError({}, "a reset names " + std::to_string(which.size()) + " copies and gives " +
                               std::to_string(seeds.size()) + " seeds; one seed per copy");
-  std::vector<bool> chosen(envs_.size(), false);
-  for (const std::size_t i : which) {
-    if (i >= envs_.size())
-      throw ConfigError({}, "a reset names copy " + std::to_string(i) + " of " + std::to_string(envs_.size()));
-    if (chosen[i]) throw ConfigError({}, "a reset names copy " + std::to_string(i) + " twice");
-    chosen[i] = true;
-  }
+  const std::vector<std::ptrdiff_t> at = positions(which, "a reset");
   if (which.empty()) return;
   envs_[which[0]]->checkState(state);  // the copies are one scene: a state fits all or none
-  std::vector<const std::uint64_t*> seed_of(envs_.size(), nullptr);  // per copy: its seed, if reset
-  for (std::size_t k = 0; k < which.size(); ++k) seed_of[which[k]] = &seeds[k];
   forEach([&](std::size_t i) {
-    if (seed_of[i] == nullptr) return;
+    if (at[i] < 0) return;
     envs_[i]->restoreState(state);
-    envs_[i]->reseed(*seed_of[i]);
+    envs_[i]->reseed(seeds[static_cast<std::size_t>(at[i])]);
+  });
+}
+
+std::vector<std::ptrdiff_t> VectorEnvironment::positions(std::span<const std::size_t> which, const char* what) const {
+  std::vector<std::ptrdiff_t> at(envs_.size(), -1);
+  for (std::size_t k = 0; k < which.size(); ++k) {
+    const std::size_t i = which[k];
+    if (i >= envs_.size())
+      throw ConfigError({}, std::string(what) + " names copy " + std::to_string(i) + " of " +
+                                std::to_string(envs_.size()));
+    if (at[i] >= 0) throw ConfigError({}, std::string(what) + " names copy " + std::to_string(i) + " twice");
+    at[i] = static_cast<std::ptrdiff_t>(k);
+  }
+  return at;
+}
+
+std::vector<Variable> VectorEnvironment::variables(std::size_t robot) const {
+  if (robot >= robot_names_.size())
+    throw std::out_of_range("ssx: robot " + std::to_string(robot) + " of a vector environment's " +
+                            std::to_string(robot_names_.size()));
+  return envs_[0]->variables(*artifacts_[robot]);
+}
+
+void VectorEnvironment::vary(std::span<const std::size_t> which, std::string_view name,
+                             std::span<const double> values) {
+  const std::size_t robots = robot_names_.size();
+  if (values.size() != which.size() * robots)
+    throw ConfigError({}, "varying '" + std::string(name) + "' in " + std::to_string(which.size()) + " copies needs " +
+                              std::to_string(which.size()) + " x " + std::to_string(robots) + " values, got " +
+                              std::to_string(values.size()));
+  const std::vector<std::ptrdiff_t> at = positions(which, "varying constants");
+  // every value checked before any copy changes (each robot's variable from copy 0: one scene)
+  for (std::size_t r = 0; r < robots; ++r) {
+    const std::vector<Variable> known = variables(r);
+    const auto v = std::find_if(known.begin(), known.end(), [&](const Variable& x) { return name == x.name; });
+    if (v == known.end()) {
+      std::string list;
+      for (const Variable& x : known) list += (list.empty() ? "" : ", ") + std::string(x.name);
+      throw ConfigError({}, "robot '" + robot_names_[r] + "' has no constant '" + std::string(name) +
+                                "' that can vary (it has: " + (list.empty() ? "none" : list) + ")");
+    }
+    for (std::size_t k = 0; k < which.size(); ++k) {
+      const double x = values[k * robots + r];
+      if (!std::isfinite(x) || x < v->min || x > v->max) {
+        std::ostringstream m;
+        m << "copy " << which[k] << ", robot '" << robot_names_[r] << "': " << name << " must be within [" << v->min
+          << ", " << v->max << "] (" << v->doc << "), got " << x;
+        throw ConfigError({}, m.str());
+      }
+    }
+  }
+  forEach([&](std::size_t i) {
+    if (at[i] < 0) return;
+    const auto k = static_cast<std::size_t>(at[i]);
+    for (std::size_t r = 0; r < robots; ++r) envs_[i]->vary(*artifacts_[i * robots + r], name, values[k * robots + r]);
   });
 }
 
@@ -227,9 +274,7 @@ void VectorEnvironment::moveRobots(std::span<const std::size_t> which, std::span
   for (const double x : velocities)
     if (!std::isfinite(x) || std::abs(x) > kMaxCommandValue)
       throw ConfigError({}, "a robot's start velocity is not finite or beyond 1e6 m/s");
-  for (const std::size_t i : which)
-    if (i >= envs_.size())
-      throw ConfigError({}, "moving robots of copy " + std::to_string(i) + " of " + std::to_string(envs_.size()));
+  positions(which, "moving robots");
   for (std::size_t k = 0; k < which.size(); ++k) {
     Environment& env = *envs_[which[k]];
     for (std::size_t r = 0; r < robots; ++r) {

@@ -29,6 +29,13 @@ void applyAttachRequests(World& world, PhysicEngine& engine);
 void loadAttachments(World& world, StateReader& in);
 /// Makes the run-time joints again in another engine (switching engines), where the bodies are now.
 void reattach(World& world, PhysicEngine& engine);
+/// Writes the varied constants (World::varied) into a saved state; variations.cpp.
+void saveVariations(const World& world, StateWriter& out);
+/// Reads them back and sets every constant to the state's value (the others to their neutral
+/// ones); throws StateError for an entry that fits no variable of the world.
+void loadVariations(World& world, StateReader& in);
+/// Sets the bodies' mass scales World::varied holds on `engine` (one just made: switching engines).
+void applyMassScales(const World& world, PhysicEngine& engine);
 /// A hinge's angle or slider's displacement from the snapshot (0 before start).
 double jointPosition(const World& world, const JointData& joint);
 /// A hinge's or slider's rate from the snapshot (0 before start).

@@ -75,6 +75,7 @@ void Environment::exchangePhysics(const std::string& engine) {
     ghosts_->adopt(*next);
     for (std::size_t i = 0; i < w.states.size(); ++i) next->setState(static_cast<int>(i), w.states[i]);
     detail::reattach(w, *next);
+    detail::applyMassScales(w, *next);
   } catch (...) {
     w.attachments = attachments;
     w.attached = attached;

@@ -136,6 +136,14 @@ struct ArtifactData {
   std::uint32_t slot_end = 0;
 };
 
+/// A constant varied (Environment::vary): `plugin` -1 is the artifact's bodies (k 0: mass, 1:
+/// inertia), else its plugin as PluginSlot::index numbers them; `k` indexes its variables.
+struct Varied {
+  std::int32_t plugin = 0;
+  std::uint32_t k = 0;
+  double value = 0;
+};
+
 struct PendingError {
   std::string plugin;
   std::string message;
@@ -157,6 +165,9 @@ struct World {
   std::vector<ArtifactModel> models;
   std::unordered_map<std::string, Artifact*> names;
   std::vector<PendingError> errors;  // filled by the parallel phases
+  // the constants varied (Environment::vary), per artifact, sorted by (plugin, k); empty until
+  // the first variation. Only values other than the neutral one are kept.
+  std::vector<std::vector<Varied>> varied;
   std::weak_ptr<const PhysicNodeSpec> last_validated_spec;  // a tree shared by a swarm: checked once
   std::uint64_t subscription_sequence = 0;
 

@@ -4,7 +4,7 @@
 // Layout: "SSXSTATE", format version (u32), reserved (u32), scene fingerprint (u64), payload size
 // (u64), FNV-1a of the payload (u64); then the payload: step count, the engine's name and its block, the
 // snapshot (body states with accelerations, the velocities before the last step), the command
-// buffers, the joints' motor commands, the run-time joints, every plugin's random stream (the
+// buffers, the joints' motor commands, the run-time joints, the varied constants, every plugin's random stream (the
 // world's plugin table, in order), then one block per plugin (driver first, then sensors, artifact by artifact: what it saved) and one per extension.
 #include "world/ghosts.hpp"
 #include "world/phases.hpp"
@@ -26,8 +26,8 @@ namespace {
 
 constexpr char kMagic[8] = {'S', 'S', 'X', 'S', 'T', 'A', 'T', 'E'};
 // 4: run-time joints (PhysicNode::attach); 5: the engine's name (states restore on the engine that
-// saved them), the run-time joints' kinds
-constexpr std::uint32_t kFormatVersion = 5;
+// saved them), the run-time joints' kinds; 6: the varied constants (Environment::vary)
+constexpr std::uint32_t kFormatVersion = 6;
 constexpr std::size_t kHeaderSize = 8 + 4 + 4 + 8 + 8 + 8;
 
 void writeBody(StateWriter& out, const BodyState& s) {
@@ -119,6 +119,7 @@ std::vector<std::byte> Environment::saveState() const {
     out.write(static_cast<std::int32_t>(x.engine));
     out.write(static_cast<std::uint8_t>(x.kind));
   }
+  detail::saveVariations(w, out);
   // the random streams, then each plugin's own state (driver first, then sensors, by artifact)
   for (const Random& r : w.randoms) r.save(out);
   for (const auto& a : w.artifact_data) {
@@ -229,6 +230,7 @@ void Environment::applyState(std::span<const std::byte> payload) {
     j.mode = static_cast<detail::JointData::Mode>(mode);
   }
   detail::loadAttachments(w, in);
+  detail::loadVariations(w, in);
   for (Random& r : w.randoms) r.load(in);
   for (std::size_t i = 0; i < w.artifacts.size(); ++i) {
     const std::string of = " of artifact '" + w.artifacts[i]->name() + "'";

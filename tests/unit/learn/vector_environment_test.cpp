@@ -11,6 +11,7 @@
 
 #include <catch2/catch.hpp>
 
+#include <algorithm>
 #include <array>
 #include <cstdint>
 #include <string>
@@ -159,4 +160,46 @@ TEST_CASE("vector environment: copies must be one scene, each on one thread", "[
                         1),
                     Contains("load each copy with one"));
   CHECK_THROWS_AS(VectorEnvironment([](std::size_t) { return crazyflies(); }, 0), ConfigError);
+}
+
+TEST_CASE("vector environment: constants varied per copy and robot, checked whole, the others untouched", "[learn]") {
+  VectorEnvironment v([](std::size_t) { return crazyflies(2); }, 3, 2);
+  v.step(500);
+  const std::vector<std::byte> hovering = v[0].saveState();
+  // the same variation made on one environment alone: the copy varied ends as it does
+  Scene alone = crazyflies(2);
+  alone.environment->restoreState(hovering);
+  alone.environment->vary(*alone.environment->findArtifact("cf1"), "mass", 1.3);
+  alone.environment->step(200);
+  const auto untouched = hashes(v);
+
+  const std::array<std::size_t, 1> which{1};
+  const std::array<double, 2> values{1.0, 1.3};  // cf0 as it is, cf1 heavier
+  v.vary(which, "mass", values);
+  CHECK(v[1].variation(*v[1].findArtifact("cf1"), "mass") == 1.3);
+  CHECK(v[0].variation(*v[0].findArtifact("cf1"), "mass") == 1.0);
+  std::vector<std::string> names;
+  for (const Variable& x : v.variables(0)) names.emplace_back(x.name);
+  CHECK(std::find(names.begin(), names.end(), "thrust_coefficient") != names.end());
+  v.step(200);
+  CHECK(hashes(v)[1] == alone.environment->stateHash());
+  Scene plain = crazyflies(2);
+  plain.environment->restoreState(hovering);
+  plain.environment->step(200);
+  CHECK(hashes(v)[0] == plain.environment->stateHash());
+  CHECK(hashes(v)[2] == plain.environment->stateHash());
+  CHECK(untouched[0] != hashes(v)[0]);
+
+  // refused whole: a bad value in the last row changes nothing in the first
+  const auto now = hashes(v);
+  const std::array<std::size_t, 2> both{0, 2};
+  const std::array<double, 4> bad{1.1, 1.1, 1.1, 40.0};
+  CHECK_THROWS_WITH(v.vary(both, "mass", bad), Contains("copy 2, robot 'cf1': mass must be within"));
+  CHECK(v[0].variation(*v[0].findArtifact("cf0"), "mass") == 1.0);
+  CHECK_THROWS_WITH(v.vary(both, "thrust", std::array<double, 4>{1, 1, 1, 1}),
+                    Contains("robot 'cf0' has no constant 'thrust'"));
+  CHECK_THROWS_WITH(v.vary(std::array<std::size_t, 2>{0, 0}, "mass", std::array<double, 4>{1, 1, 1, 1}),
+                    Contains("names copy 0 twice"));
+  CHECK_THROWS_WITH(v.vary(both, "mass", std::array<double, 2>{1, 1}), Contains("needs 2 x 2 values"));
+  CHECK(hashes(v) == now);
 }

@@ -105,6 +105,8 @@ int BulletEngine::addBody(const MassProperties& mass, const std::vector<Shape>& 
   info.m_friction = settings_.friction;
   info.m_restitution = settings_.restitution;
   body->rb = std::make_unique<btRigidBody>(info);
+  body->mass = mass.mass;
+  body->inertia = toBt(diagonal);
   body->rb->setFlags(BT_ENABLE_GYROSCOPIC_FORCE_IMPLICIT_BODY);
   body->rb->setActivationState(DISABLE_DEACTIVATION);
   body->rb->setGravity(toBt(settings_.gravity));
@@ -128,6 +130,13 @@ void BulletEngine::setKinematic(int index) {
 }
 
 bool BulletEngine::isKinematic(int index) const { return bodies_.at(static_cast<std::size_t>(index))->kinematic; }
+
+void BulletEngine::setMassScale(int index, double mass_factor, double inertia_factor) {
+  Body& body = *bodies_.at(static_cast<std::size_t>(index));
+  if (body.kinematic) return;
+  body.rb->setMassProps(body.mass * mass_factor, body.inertia * inertia_factor);
+  body.rb->updateInertiaTensor();
+}
 
 int BulletEngine::addStatic(const std::vector<Shape>& shapes, const Pose& pose) {
   const int group = static_groups_++;

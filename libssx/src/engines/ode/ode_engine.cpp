@@ -217,6 +217,7 @@ int OdeEngine::addBody(const MassProperties& mass, const std::vector<Shape>& sha
   // the body frame is the centre-of-mass frame: ODE requires the centre at the origin
   dMassSetParameters(&body.mass, mass.mass, 0, 0, 0, j(0, 0), j(1, 1), j(2, 2), j(0, 1), j(0, 2), j(1, 2));
   dBodySetMass(body.id, &body.mass);
+  body.added = body.mass;
   dBodySetData(body.id, reinterpret_cast<void*>(static_cast<std::intptr_t>(index)));
   for (const auto& s : shapes) {
     if (s.kind == Shape::Kind::Plane) {
@@ -260,6 +261,15 @@ void OdeEngine::setKinematic(int index) {
 }
 
 bool OdeEngine::isKinematic(int index) const { return bodies_.at(static_cast<std::size_t>(index)).kinematic; }
+
+void OdeEngine::setMassScale(int index, double mass_factor, double inertia_factor) {
+  Body& body = bodies_.at(static_cast<std::size_t>(index));
+  if (body.kinematic) return;
+  body.mass = body.added;  // the factors never compound
+  body.mass.mass *= mass_factor;
+  for (dReal& i : body.mass.I) i *= inertia_factor;
+  dBodySetMass(body.id, &body.mass);
+}
 
 int OdeEngine::addStatic(const std::vector<Shape>& shapes, const Pose& pose) {
   ensureThreadData();

@@ -48,6 +48,7 @@ class OdeEngine final : public PhysicEngine {
   int addBody(const MassProperties& mass, const std::vector<Shape>& shapes, const BodyState& state) override;
   void setKinematic(int body) override;
   bool isKinematic(int body) const override;
+  void setMassScale(int body, double mass_factor, double inertia_factor) override;
   int addStatic(const std::vector<Shape>& shapes, const Pose& pose) override;
   void setTaskRunner(TaskRunner* runner) override { runner_ = runner; }
   void step(Nanoseconds dt, std::span<const Wrench> wrenches) override;
@@ -87,7 +88,8 @@ class OdeEngine final : public PhysicEngine {
     int home = 0;
     bool kinematic = false;  // moved only by setState (dBodySetKinematic)
     bool pinned = false;     // joined to another body or the world: always in world 0
-    dMass mass;
+    dMass mass;   // now (setMassScale)
+    dMass added;  // as addBody gave it
     std::vector<Geom> geoms;
   };
 
