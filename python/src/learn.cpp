@@ -107,6 +107,18 @@ class PyVectorEnvironment {
     return a;
   }
 
+  py::array_t<double> read(const std::string& kind, const py::object& out, std::size_t slots) {
+    InUse use(busy_);
+    try {
+      const std::size_t width = envs().sensorWidth(kind, slots);
+      py::array_t<double> a = output(out, width, "read");
+      envs().readSensors(kind, std::span<double>(a.mutable_data(), static_cast<std::size_t>(a.size())), slots);
+      return a;
+    } catch (const ssx::ConfigError& e) {
+      throw py::value_error(std::string("ssx: ") + e.what());
+    }
+  }
+
   void setCommands(const std::string& level_name, const py::handle& values) {
     InUse use(busy_);
     const auto level = ssx::commandLevelFromName(level_name);
@@ -269,6 +281,10 @@ void bindVectorEnvironment(py::module_& m) {
            "(num_envs, robots, 13): x y z, qw qx qy qz, vx vy vz, wx wy wz (world frame); into out= when given.")
       .def("imu", &PyVectorEnvironment::imu, py::arg("out") = py::none(),
            "(num_envs, robots, 6): each robot's first IMU, accelerometer (m/s^2) then gyroscope (rad/s).")
+      .def("read", &PyVectorEnvironment::read, py::arg("kind"), py::arg("out") = py::none(), py::arg("slots") = 0,
+           "(num_envs, robots, width): one kind of sensor of every robot: pose (13), proximity (per ray), ground (per "
+           "point), range (5 per slot: present, x, y, z, distance), range_and_bearing (4 per slot: present, range, "
+           "bearing, elevation), odometry (9); slots: how many detections or messages; into out= when given.")
       .def("set_commands", &PyVectorEnvironment::setCommands, py::arg("level"), py::arg("values"),
            "One command level for every robot: values (num_envs, robots, columns), checked whole first.")
       .def("save_state", &PyVectorEnvironment::saveState, py::arg("index") = 0, "Copy index's state, as bytes.")

@@ -232,6 +232,8 @@ class VectorEnvironment:
         """Restores the copies named to state and reseeds their random streams, one seed each."""
     def move_robots(self, indices: Sequence[int], offsets: npt.ArrayLike, velocities: Optional[npt.ArrayLike] = None) -> None:
         """Moves every robot of the copies named by offsets (len(indices), robots, 3), at velocities (or at rest)."""
+    def read(self, kind: str, out: Optional[npt.NDArray[np.float64]] = None, slots: int = 0) -> npt.NDArray[np.float64]:
+        """(num_envs, robots, width): one kind of sensor of every robot (pose, proximity, ground, range, range_and_bearing, odometry)."""
     def variables(self, robot: int = 0) -> List[Dict[str, Any]]:
         """What vary takes for robot index robot: dicts of name, neutral, min, max, doc."""
     def vary(self, indices: Sequence[int], name: str, values: npt.ArrayLike) -> None:

@@ -112,15 +112,17 @@ class _Batch:
         self.rngs = [np.random.default_rng() for _ in range(self.num_envs)]
         self.steps = np.zeros(self.num_envs, dtype=np.int64)
         self.randomize = _ranges(randomize, self.sim)
-        # each copy's draws now, per constant: (E, R); neutral until the first reset
+        low = np.array([r[0] for r in self.randomize.values()]).reshape(-1, 1, 1)
+        self._bounds = (low, np.array([r[1] for r in self.randomize.values()]).reshape(-1, 1, 1) - low)
+        # each copy's draws now, (constants, E, R) in the order of randomize; neutral until the first reset
         neutral = {v["name"]: v["neutral"] for v in self.sim.variables(0)}
-        self.variations = {name: np.full((self.num_envs, self.robots), neutral[name]) for name in self.randomize}
+        self.drawn = np.array([np.full((self.num_envs, self.robots), neutral[name]) for name in self.randomize])
         self.read()
         task.bind(self.num_envs, self.action_period, self.states)
 
     def variation_infos(self):
         """The constants drawn for each copy's episode, {name: (E, R) array}, for infos."""
-        return {name: values.copy() for name, values in self.variations.items()}
+        return {name: self.drawn[j].copy() for j, name in enumerate(self.randomize)}
 
     def read(self):
         self.sim.robot_states(out=self.states)
@@ -154,10 +156,12 @@ class _Batch:
         offsets, velocities = self.task.draw(ids, rngs)
         self.sim.move_robots(ids, offsets, velocities)
         # domain randomisation: each robot's constants drawn from its copy's episode generator
-        for name, (low, high) in self.randomize.items():
-            draws = np.stack([rng.uniform(low, high, size=self.robots) for rng in rngs])
-            self.sim.vary(ids, name, draws)
-            self.variations[name][ids] = draws
+        if self.randomize:
+            low, span = self._bounds
+            draws = low + span * np.stack([rng.random((len(self.randomize), self.robots)) for rng in rngs], axis=1)
+            for j, name in enumerate(self.randomize):
+                self.sim.vary(ids, name, draws[j])
+            self.drawn[:, ids] = draws
         self.steps[ids] = 0
 
 

@@ -486,6 +486,9 @@ class SSX_EXPORT Environment {
   void requireOutsidePhases(const char* what) const;
   std::uint64_t sceneFingerprint() const;
   void applyState(std::span<const std::byte> payload);
+  // restoreState after checkState passed (VectorEnvironment checks a state once for all its copies)
+  void restoreChecked(std::span<const std::byte> state);
+  friend class VectorEnvironment;
   void raiseFirstError(const char* phase);
   void fail();
   void warnUnusedParameters() const;

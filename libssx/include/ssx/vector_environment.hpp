@@ -72,6 +72,23 @@ class SSX_EXPORT VectorEnvironment {
   /// m/s^2, gyroscope in rad/s, body frame, noise and all), from its first IMU sensor. ConfigError
   /// naming the first robot that has none.
   void imuReadings(std::span<double> out) const;
+  /// How many numbers readSensors(kind, out, slots) writes per robot. The kinds, each from a
+  /// robot's first sensor (or driver) of that kind:
+  /// - `pose`: 13, its motion capture (PoseMeasurement, noise and all): position, orientation
+  ///   w x y z, linear and angular velocity, world frame;
+  /// - `proximity`: one per ray, its reading 0..1 (0: nothing within range);
+  /// - `ground`: one per point, its grey level 0..1;
+  /// - `range`: 5 per slot, the `slots` nearest robots or obstacles seen: 1 (0: an empty slot,
+  ///   all zeros), relative x y z (m; world or body frame as the sensor is set), distance (m);
+  /// - `range_and_bearing`: 4 per slot, the first `slots` messages received (in sender order):
+  ///   1 (0: empty), range (m), bearing, elevation (rad);
+  /// - `odometry`: 9, its driver's dead reckoning (ssx/odometry.hpp, in the order of Odometry's fields).
+  /// ConfigError for another kind, a robot without such a sensor, robots whose rays or points
+  /// differ in number, or a proximity or ground sensor that has not measured yet (step first).
+  std::size_t sensorWidth(std::string_view kind, std::size_t slots = 0) const;
+  /// Every robot's latest reading of one kind into `out` (size() x robots x sensorWidth(kind,
+  /// slots) doubles, in that order). Read between steps.
+  void readSensors(std::string_view kind, std::span<double> out, std::size_t slots = 0) const;
   /// Moves every robot of copy `which[k]` by `offsets` (which.size() x robots x 3, m, world frame)
   /// and sets its linear velocity to `velocities` (the same shape, m/s; empty: at rest), its
   /// angular velocity to zero; its orientation stays. Every body of a robot moves together. For
@@ -95,8 +112,11 @@ class SSX_EXPORT VectorEnvironment {
 
  private:
   struct Pool;
-  // per copy: where it is in `which` (or -1); ConfigError for a copy past size() or named twice
-  std::vector<std::ptrdiff_t> positions(std::span<const std::size_t> which, const char* what) const;
+  // ConfigError for a copy in `which` past size() or named twice
+  void checkWhich(std::span<const std::size_t> which, const char* what) const;
+  // fn(which[k], k) for every k in parallel (every copy, fn(i, i), for `which` empty), the first
+  // failure by copy index rethrown as that copy's
+  void forEachOf(std::span<const std::size_t> which, const std::function<void(std::size_t, std::size_t)>& fn);
   std::vector<Scene> scenes_;
   std::vector<Environment*> envs_;
   std::vector<std::string> robot_names_;

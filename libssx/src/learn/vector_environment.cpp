@@ -74,6 +74,11 @@ VectorEnvironment::VectorEnvironment(const std::function<Scene(std::size_t)>& lo
                                 " is '" + (k < names.size() ? names[k] : std::string("(none)")) + "' there and '" +
                                 (k < robot_names_.size() ? robot_names_[k] : std::string("(none)")) +
                                 "' in copy 0; every copy must be the same scene");
+    } else if (env.sceneFingerprint() != envs_[0]->sceneFingerprint()) {
+      // (a state saved from one copy must fit every other: reset checks it once for all)
+      throw ConfigError({}, "copy " + std::to_string(i) +
+                                " of a vector environment is not the same scene as copy 0 "
+                                "(its timestep, bodies or plugins differ); every copy must be the same scene");
     }
     envs_.push_back(&env);
   }
@@ -103,19 +108,29 @@ Environment& VectorEnvironment::operator[](std::size_t i) {
 unsigned VectorEnvironment::threadCount() const noexcept { return pool_->workers.size(); }
 
 void VectorEnvironment::forEach(const std::function<void(std::size_t)>& fn) {
+  forEachOf({}, [&](std::size_t i, std::size_t) { fn(i); });
+}
+
+void VectorEnvironment::forEachOf(std::span<const std::size_t> which,
+                                  const std::function<void(std::size_t, std::size_t)>& fn) {
   // every copy is attempted; the first failure by index is rethrown after the barrier, so which
   // error a caller sees does not depend on the threads' timing
   std::vector<std::exception_ptr>& errors = pool_->errors;  // kept: no allocation per step
   auto body = [&](std::size_t begin, std::size_t end) {
-    for (std::size_t i = begin; i < end; ++i) {
+    for (std::size_t k = begin; k < end; ++k) {
+      const std::size_t i = which.empty() ? k : which[k];
       try {
-        fn(i);
+        fn(i, k);
       } catch (...) {
         errors[i] = std::current_exception();
       }
     }
   };
-  pool_->workers.parallelFor(envs_.size(), 1, body);
+  const std::size_t n = which.empty() ? envs_.size() : which.size();
+  if (n == 1)
+    body(0, 1);  // one copy (a reset in the middle of a batch): waking the pool would cost more
+  else
+    pool_->workers.parallelFor(n, 1, body);
   const auto first = std::find_if(errors.begin(), errors.end(), [](const auto& e) { return static_cast<bool>(e); });
   if (first == errors.end()) return;
   std::vector<std::exception_ptr> failed;
@@ -159,27 +174,25 @@ void VectorEnvironment::reset(std::span<const std::size_t> which, std::span<cons
   if (seeds.size() != which.size())
     throw ConfigError({}, "a reset names " + std::to_string(which.size()) + " copies and gives " +
                               std::to_string(seeds.size()) + " seeds; one seed per copy");
-  const std::vector<std::ptrdiff_t> at = positions(which, "a reset");
+  checkWhich(which, "a reset");
   if (which.empty()) return;
-  envs_[which[0]]->checkState(state);  // the copies are one scene: a state fits all or none
-  forEach([&](std::size_t i) {
-    if (at[i] < 0) return;
-    envs_[i]->restoreState(state);
-    envs_[i]->reseed(seeds[static_cast<std::size_t>(at[i])]);
+  // the copies are one scene (checked when made): a state fits all or none
+  envs_[which[0]]->checkState(state);
+  forEachOf(which, [&](std::size_t i, std::size_t k) {
+    envs_[i]->restoreChecked(state);
+    envs_[i]->reseed(seeds[k]);
   });
 }
 
-std::vector<std::ptrdiff_t> VectorEnvironment::positions(std::span<const std::size_t> which, const char* what) const {
-  std::vector<std::ptrdiff_t> at(envs_.size(), -1);
-  for (std::size_t k = 0; k < which.size(); ++k) {
-    const std::size_t i = which[k];
+void VectorEnvironment::checkWhich(std::span<const std::size_t> which, const char* what) const {
+  std::vector<bool> named(envs_.size(), false);
+  for (const std::size_t i : which) {
     if (i >= envs_.size())
-      throw ConfigError({}, std::string(what) + " names copy " + std::to_string(i) + " of " +
-                                std::to_string(envs_.size()));
-    if (at[i] >= 0) throw ConfigError({}, std::string(what) + " names copy " + std::to_string(i) + " twice");
-    at[i] = static_cast<std::ptrdiff_t>(k);
+      throw ConfigError({},
+                        std::string(what) + " names copy " + std::to_string(i) + " of " + std::to_string(envs_.size()));
+    if (named[i]) throw ConfigError({}, std::string(what) + " names copy " + std::to_string(i) + " twice");
+    named[i] = true;
   }
-  return at;
 }
 
 std::vector<Variable> VectorEnvironment::variables(std::size_t robot) const {
@@ -196,7 +209,7 @@ void VectorEnvironment::vary(std::span<const std::size_t> which, std::string_vie
     throw ConfigError({}, "varying '" + std::string(name) + "' in " + std::to_string(which.size()) + " copies needs " +
                               std::to_string(which.size()) + " x " + std::to_string(robots) + " values, got " +
                               std::to_string(values.size()));
-  const std::vector<std::ptrdiff_t> at = positions(which, "varying constants");
+  checkWhich(which, "varying constants");
   // every value checked before any copy changes (each robot's variable from copy 0: one scene)
   for (std::size_t r = 0; r < robots; ++r) {
     const std::vector<Variable> known = variables(r);
@@ -217,9 +230,8 @@ void VectorEnvironment::vary(std::span<const std::size_t> which, std::string_vie
       }
     }
   }
-  forEach([&](std::size_t i) {
-    if (at[i] < 0) return;
-    const auto k = static_cast<std::size_t>(at[i]);
+  if (which.empty()) return;
+  forEachOf(which, [&](std::size_t i, std::size_t k) {
     for (std::size_t r = 0; r < robots; ++r) envs_[i]->vary(*artifacts_[i * robots + r], name, values[k * robots + r]);
   });
 }
@@ -274,7 +286,7 @@ void VectorEnvironment::moveRobots(std::span<const std::size_t> which, std::span
   for (const double x : velocities)
     if (!std::isfinite(x) || std::abs(x) > kMaxCommandValue)
       throw ConfigError({}, "a robot's start velocity is not finite or beyond 1e6 m/s");
-  positions(which, "moving robots");
+  checkWhich(which, "moving robots");
   for (std::size_t k = 0; k < which.size(); ++k) {
     Environment& env = *envs_[which[k]];
     for (std::size_t r = 0; r < robots; ++r) {

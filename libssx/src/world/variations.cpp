@@ -80,9 +80,10 @@ void applyMass(const detail::World& w, std::size_t artifact, PhysicEngine& engin
 void record(detail::World& w, std::size_t artifact, const detail::Varied& entry, double neutral) {
   if (w.varied.empty()) w.varied.resize(w.artifacts.size());
   auto& list = w.varied[artifact];
-  const auto at = std::lower_bound(list.begin(), list.end(), entry, [](const detail::Varied& a, const detail::Varied& b) {
-    return a.plugin != b.plugin ? a.plugin < b.plugin : a.k < b.k;
-  });
+  const auto at =
+      std::lower_bound(list.begin(), list.end(), entry, [](const detail::Varied& a, const detail::Varied& b) {
+        return a.plugin != b.plugin ? a.plugin < b.plugin : a.k < b.k;
+      });
   const bool present = at != list.end() && at->plugin == entry.plugin && at->k == entry.k;
   if (entry.value == neutral) {
     if (present) list.erase(at);
@@ -141,8 +142,8 @@ void Environment::vary(const Artifact& artifact, std::string_view name, double v
 double Environment::variation(const Artifact& artifact, std::string_view name) const {
   const Found f = find(*world_, artifact.index(), name);
   if (f.variable == nullptr)
-    throw ConfigError({}, "variation: artifact '" + artifact.name() + "' has no constant '" + std::string(name) +
-                              "' that can vary");
+    throw ConfigError(
+        {}, "variation: artifact '" + artifact.name() + "' has no constant '" + std::string(name) + "' that can vary");
   return valueOf(*world_, artifact.index(), f.plugin, f.k, f.variable->neutral);
 }
 
@@ -171,15 +172,16 @@ void loadVariations(World& w, StateReader& in) {
   for (std::size_t i = 0; i < artifacts; ++i) {
     const auto a = in.get<std::uint32_t>();
     if (a >= w.artifacts.size() || !next[a].empty())
-      throw StateError("saved state: varied constants of artifact " + std::to_string(a) + " that does not fit (corrupted)");
+      throw StateError("saved state: varied constants of artifact " + std::to_string(a) +
+                       " that does not fit (corrupted)");
     const std::size_t n = in.count(4 + 4 + 8);
     for (std::size_t j = 0; j < n; ++j) {
       Varied v;
       in.read(v.plugin);
       in.read(v.k);
       in.read(v.value);
-      const auto vars = v.plugin >= -1 && v.plugin < pluginCount(w, a) ? variablesOf(w, a, v.plugin)
-                                                                          : std::span<const Variable>();
+      const auto vars =
+          v.plugin >= -1 && v.plugin < pluginCount(w, a) ? variablesOf(w, a, v.plugin) : std::span<const Variable>();
       const bool sorted = next[a].empty() || next[a].back().plugin < v.plugin ||
                           (next[a].back().plugin == v.plugin && next[a].back().k < v.k);
       if (v.k >= vars.size() || !sorted || !std::isfinite(v.value) || v.value < vars[v.k].min ||

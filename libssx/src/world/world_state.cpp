@@ -174,6 +174,10 @@ void Environment::reseed(std::uint64_t seed) {
 
 void Environment::restoreState(std::span<const std::byte> state) {
   checkState(state);  // before anything starts
+  restoreChecked(state);
+}
+
+void Environment::restoreChecked(std::span<const std::byte> state) {
   if (world_->state == State::Setup) start();
   if (world_->state != State::Running) throw Error("restoreState: the environment failed or was stopped");
 

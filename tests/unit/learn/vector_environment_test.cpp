@@ -160,6 +160,19 @@ TEST_CASE("vector environment: copies must be one scene, each on one thread", "[
                         1),
                     Contains("load each copy with one"));
   CHECK_THROWS_AS(VectorEnvironment([](std::size_t) { return crazyflies(); }, 0), ConfigError);
+  // the same robots, but copy 1 has a ground too: not one scene (a state of one would not fit the other)
+  CHECK_THROWS_WITH(VectorEnvironment(
+                        [](std::size_t i) {
+                          SceneOptions options;
+                          options.threads = 1;
+                          return loadSceneFromString(
+                              "<scene><environment timestep=\"0.002\"/><type name=\"cf\" file=\"" +
+                                  (kArtifacts / "crazyflie.xml").string() + "\"/>" + (i == 1 ? "<ground/>" : "") +
+                                  "<artifact type=\"cf\" name=\"cf0\" xyz=\"0 0 1\"/></scene>",
+                              "cf.xml", kArtifacts, options);
+                        },
+                        2),
+                    Contains("copy 1 of a vector environment is not the same scene as copy 0"));
 }
 
 TEST_CASE("vector environment: constants varied per copy and robot, checked whole, the others untouched", "[learn]") {

@@ -1,0 +1,189 @@
+// VectorEnvironment::readSensors: one kind of sensor of every robot of every copy into one array
+// (ssx/vector_environment.hpp lists the kinds and their layouts).
+#include <ssx/error.hpp>
+#include <ssx/measurements.hpp>
+#include <ssx/odometry.hpp>
+#include <ssx/vector_environment.hpp>
+
+#include <algorithm>
+#include <array>
+#include <optional>
+#include <string>
+
+namespace ssx {
+
+namespace {
+
+enum class Kind { Pose, Proximity, Ground, Range, RangeBearing, Odometry };
+
+constexpr std::array<std::pair<std::string_view, Kind>, 6> kKinds{{{"pose", Kind::Pose},
+                                                                   {"proximity", Kind::Proximity},
+                                                                   {"ground", Kind::Ground},
+                                                                   {"range", Kind::Range},
+                                                                   {"range_and_bearing", Kind::RangeBearing},
+                                                                   {"odometry", Kind::Odometry}}};
+
+Kind kindOf(std::string_view name) {
+  for (const auto& [n, k] : kKinds)
+    if (n == name) return k;
+  throw ConfigError({}, "no sensor kind '" + std::string(name) +
+                            "' to read (pose, proximity, ground, range, range_and_bearing or odometry)");
+}
+
+template <class M>
+const M* firstOf(const Artifact& a) {
+  for (std::size_t k = 0; k < a.sensorCount(); ++k)
+    if (const auto* m = dynamic_cast<const M*>(&a.sensor(k).latest())) return m;
+  return nullptr;
+}
+
+// the reading of `kind` of robot `a`, or nullptr when it has no such sensor (odometry: the driver)
+const void* source(const Artifact& a, Kind kind) {
+  switch (kind) {
+    case Kind::Pose:
+      return firstOf<PoseMeasurement>(a);
+    case Kind::Proximity:
+      return firstOf<ProximityMeasurement>(a);
+    case Kind::Ground:
+      return firstOf<GroundMeasurement>(a);
+    case Kind::Range:
+      return firstOf<RangeMeasurement>(a);
+    case Kind::RangeBearing:
+      return firstOf<RangeBearingMeasurement>(a);
+    case Kind::Odometry:
+      return dynamic_cast<const OdometryInterface*>(a.driver());
+  }
+  return nullptr;
+}
+
+const char* toAdd(Kind kind) {
+  switch (kind) {
+    case Kind::Pose:
+      return "add <sensor plugin=\"pose\"/> to its type";
+    case Kind::Proximity:
+      return "add <sensor plugin=\"proximity\"/> to its type";
+    case Kind::Ground:
+      return "add <sensor plugin=\"ground\"/> to its type";
+    case Kind::Range:
+      return "add <sensor plugin=\"range\"/> to its type";
+    case Kind::RangeBearing:
+      return "add <sensor plugin=\"range_and_bearing\"/> to its type";
+    case Kind::Odometry:
+      return "its driver keeps no odometry (diff_drive does)";
+  }
+  return "";
+}
+
+std::size_t countOf(const void* reading, Kind kind) {
+  return kind == Kind::Proximity ? static_cast<const ProximityMeasurement*>(reading)->readings.size()
+                                 : static_cast<const GroundMeasurement*>(reading)->readings.size();
+}
+
+}  // namespace
+
+std::size_t VectorEnvironment::sensorWidth(std::string_view name, std::size_t slots) const {
+  const Kind kind = kindOf(name);
+  // copy 0's robots say it for all (every copy is the same scene)
+  std::optional<std::size_t> count;
+  for (std::size_t r = 0; r < robot_names_.size(); ++r) {
+    const void* reading = source(*artifacts_[r], kind);
+    if (reading == nullptr)
+      throw ConfigError({}, "robot '" + robot_names_[r] + "' has no " + std::string(name) + " to read: " + toAdd(kind));
+    if (kind != Kind::Proximity && kind != Kind::Ground) continue;
+    const std::size_t n = countOf(reading, kind);
+    if (n == 0)
+      throw ConfigError({}, "robot '" + robot_names_[r] + "''s " + std::string(name) +
+                                " sensor has not measured yet: step the environments first");
+    if (count && *count != n)
+      throw ConfigError({}, "robot '" + robot_names_[r] + "''s " + std::string(name) + " sensor has " +
+                                std::to_string(n) + " values, robot '" + robot_names_[0] + "''s " +
+                                std::to_string(*count) + ": one array needs the same number for every robot");
+    count = n;
+  }
+  switch (kind) {
+    case Kind::Pose:
+      return 13;
+    case Kind::Odometry:
+      return 9;
+    case Kind::Range:
+      return 5 * slots;
+    case Kind::RangeBearing:
+      return 4 * slots;
+    case Kind::Proximity:
+    case Kind::Ground:
+      return count.value_or(0);
+  }
+  return 0;
+}
+
+void VectorEnvironment::readSensors(std::string_view name, std::span<double> out, std::size_t slots) const {
+  const Kind kind = kindOf(name);
+  const std::size_t width = sensorWidth(name, slots), robots = robot_names_.size();
+  if (out.size() != envs_.size() * robots * width)
+    throw ConfigError({}, "reading " + std::string(name) + " needs " + std::to_string(envs_.size()) + " x " +
+                              std::to_string(robots) + " x " + std::to_string(width) + " numbers, got " +
+                              std::to_string(out.size()));
+  for (std::size_t row = 0; row < artifacts_.size(); ++row) {
+    double* p = out.data() + row * width;
+    const void* reading = source(*artifacts_[row], kind);
+    switch (kind) {
+      case Kind::Pose: {
+        const auto& m = *static_cast<const PoseMeasurement*>(reading);
+        const Quat& q = m.pose.orientation;
+        const double v[13] = {m.pose.position.x(),
+                              m.pose.position.y(),
+                              m.pose.position.z(),
+                              q.w(),
+                              q.x(),
+                              q.y(),
+                              q.z(),
+                              m.linear_velocity.x(),
+                              m.linear_velocity.y(),
+                              m.linear_velocity.z(),
+                              m.angular_velocity.x(),
+                              m.angular_velocity.y(),
+                              m.angular_velocity.z()};
+        std::copy(v, v + 13, p);
+        break;
+      }
+      case Kind::Proximity:
+      case Kind::Ground: {
+        const auto& values = kind == Kind::Proximity ? static_cast<const ProximityMeasurement*>(reading)->readings
+                                                     : static_cast<const GroundMeasurement*>(reading)->readings;
+        if (values.size() != width)
+          throw ConfigError({}, "copy " + std::to_string(row / robots) + ", robot '" + robot_names_[row % robots] +
+                                    "': " + std::to_string(values.size()) + " " + std::string(name) + " values, not " +
+                                    std::to_string(width));
+        std::copy(values.begin(), values.end(), p);
+        break;
+      }
+      case Kind::Range: {
+        const auto& d = static_cast<const RangeMeasurement*>(reading)->detections;
+        std::fill(p, p + width, 0.0);
+        for (std::size_t k = 0; k < std::min(slots, d.size()); ++k) {
+          const double v[5] = {1.0, d[k].relative.x(), d[k].relative.y(), d[k].relative.z(), d[k].distance};
+          std::copy(v, v + 5, p + 5 * k);
+        }
+        break;
+      }
+      case Kind::RangeBearing: {
+        const auto& msgs = static_cast<const RangeBearingMeasurement*>(reading)->messages;
+        std::fill(p, p + width, 0.0);
+        for (std::size_t k = 0; k < std::min(slots, msgs.size()); ++k) {
+          const double v[4] = {1.0, msgs[k].range, msgs[k].bearing, msgs[k].elevation};
+          std::copy(v, v + 4, p + 4 * k);
+        }
+        break;
+      }
+      case Kind::Odometry: {
+        const Odometry o = static_cast<const OdometryInterface*>(reading)->odometry();
+        const double v[9] = {o.x,          o.y,           o.yaw,        o.forward,    o.yaw_rate,
+                             o.left_speed, o.right_speed, o.left_angle, o.right_angle};
+        std::copy(v, v + 9, p);
+        break;
+      }
+    }
+  }
+}
+
+}  // namespace ssx

@@ -1,0 +1,36 @@
+"""Batched sensor reads from Python (ssx._ssx.VectorEnvironment.read): one kind of sensor of every
+robot of every environment in one (E, R, width) array, into an array the caller keeps, equal to
+what one environment reads; what a robot lacks is refused naming what to add."""
+import numpy as np
+import pytest
+
+import ssx
+
+EPUCKS = """<scene><environment timestep="0.002" seed="3"/><type name="e" file="artifacts/epuck_full.xml"/><ground/>
+<swarm type="e" count="3" name="e{i}" spacing="0.1" xyz="0 0 0"/></scene>"""
+
+
+def test_read_every_robots_sensor_into_one_array():
+    sim = ssx._ssx.VectorEnvironment(EPUCKS, 2, base_dir=ssx.data_directory(), threads=2)
+    sim.set_commands("wheels", np.tile([1.0, 2.0], (2, 3, 1)))
+    sim.step(100)
+    proximity = sim.read("proximity")
+    assert proximity.shape == (2, 3, 8) and proximity.dtype == np.float64
+    assert proximity.max() > 0 and np.all((proximity >= 0) & (proximity <= 1))
+    out = np.empty((2, 3, 12))
+    assert sim.read("range_and_bearing", out=out, slots=3) is out
+    assert np.all(out[:, :, [0, 4]] == 1.0) and np.all(out[:, :, 8:] == 0.0)  # two neighbours heard, slot 3 empty
+    odometry = sim.read("odometry")
+    assert odometry.shape == (2, 3, 9) and np.all(odometry[:, :, 2] > 0)  # turned left: right wheel faster
+    # the copies are the simulation one environment of the same scene and seed runs
+    alone = ssx.load_scene_string(EPUCKS, base_dir=ssx.data_directory(), seed=3, threads=1)
+    alone.set_commands("wheels", np.tile([1.0, 2.0], (3, 1)))
+    alone.step(100)
+    assert np.array_equal(sim.state_hashes()[0], alone.state_hash())
+    with pytest.raises(ValueError, match='add <sensor plugin="pose"/>'):
+        sim.read("pose")
+    with pytest.raises(ValueError, match="no sensor kind 'sonar'"):
+        sim.read("sonar")
+    with pytest.raises(ValueError, match="shape"):
+        sim.read("proximity", out=np.empty((2, 3, 7)))
+    sim.close()
