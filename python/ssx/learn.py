@@ -22,7 +22,7 @@ import numpy as np
 
 from . import _ssx
 from .spaces import Box, Dict, box  # noqa: F401  (re-exported)
-from .tasks import Formation, GoTo, Hover, Task  # noqa: F401  (re-exported)
+from .tasks import Coverage, Formation, GoTo, Hover, Task  # noqa: F401  (re-exported)
 
 try:  # Gymnasium when it is there (Debian 12 does not package it): the class is then one of its
     import gymnasium as _gymnasium
@@ -39,7 +39,7 @@ except ImportError:
     _VectorBase = object
     _MODES = {"next_step": "next_step", "same_step": "same_step"}
 
-TASKS = {"hover": Hover, "goto": GoTo, "formation": Formation}
+TASKS = {"hover": Hover, "goto": GoTo, "formation": Formation, "coverage": Coverage}
 
 
 def make_task(task, **options):
@@ -104,11 +104,15 @@ class _Batch:
                              f"timesteps ({self.sim.timestep} s)")
         self.action_period = self.steps_per_action * self.sim.timestep
         # the start state: every copy's robots taken off and hovering where the task puts them
-        self.sim.set_commands("position", task.takeoff_commands(self.sim.robot_states(), self.num_envs))
-        self.sim.step(int(round(task.takeoff_seconds / self.sim.timestep)))
+        takeoff = task.takeoff_commands(self.sim.robot_states(), self.num_envs)
+        if takeoff is not None:
+            self.sim.set_commands("position", takeoff)
+        self.sim.step(max(1, int(round(task.takeoff_seconds / self.sim.timestep))))
         self.start_state = self.sim.save_state(0)
         self.states = np.empty((self.num_envs, self.robots, 13))
         self.imu = np.empty((self.num_envs, self.robots, 6)) if task.reads_imu else None
+        self.sensors = [(kind, slots, self.sim.read(kind, slots=slots)) for kind, slots in task.sensors]
+        task.readings = {kind: out for kind, _, out in self.sensors}
         self.rngs = [np.random.default_rng() for _ in range(self.num_envs)]
         self.steps = np.zeros(self.num_envs, dtype=np.int64)
         self.randomize = _ranges(randomize, self.sim)
@@ -128,6 +132,8 @@ class _Batch:
         self.sim.robot_states(out=self.states)
         if self.imu is not None:
             self.sim.imu(out=self.imu)
+        for kind, slots, out in self.sensors:
+            self.sim.read(kind, out=out, slots=slots)
 
     def seed_all(self, seed):
         """Gymnasium's convention: an int seeds copy i with seed + i, a list one seed per copy,

@@ -38,6 +38,9 @@ class Task:
     robots = 1
     level = "attitude"  # the command level actions become (ssx/command.hpp)
     reads_imu = True
+    # batched sensor reads (VectorEnvironment.read): (kind, slots) pairs, read after every step
+    # into self.readings[kind], (E, R, width) arrays the environment fills before bind
+    sensors = ()
     takeoff_seconds = 3.0
     horizon = 250  # actions per episode (set by bind from horizon_seconds)
 
@@ -46,7 +49,8 @@ class Task:
         raise NotImplementedError
 
     def takeoff_commands(self, states, num_envs):
-        """(E, R, 4) position commands flown for takeoff_seconds before the start state is saved."""
+        """(E, R, 4) position commands flown for takeoff_seconds before the start state is saved
+        (None: no commands, the robots stand or hover as the scene has them)."""
         raise NotImplementedError
 
     def bind(self, num_envs, action_period, states):
@@ -312,3 +316,122 @@ class Formation(_Flight):
         reward, distance, close, crashed = self._agent_rewards(states)
         infos = {"distance": distance.mean(axis=1), "collisions": close.sum(axis=(1, 2)) // 2, "agent_rewards": reward}
         return reward.mean(axis=1), crashed.any(axis=1), infos
+
+
+class Coverage(Task):
+    """Ground robots (`robots` e-pucks) cover a walled square arena of `arena` m together: the
+    floor is cut into cells of `cell` m, and a cell counts once any robot's centre has been in it.
+
+    Observation per robot (21, float32): its position (/ half the arena), heading (cos, sin), its 8
+    proximity readings (0..1, batched from its own sensors), and the 3 x 3 cells around its own
+    (1: covered or beyond the walls, 0: still to cover). Action per robot (2, in [-1, 1]): left and
+    right wheel speeds (times max_wheel_speed rad/s; the `wheels` command level). Reward per robot:
+    `cell_reward` for each cell it is the first to reach, minus `bump_penalty` while a proximity
+    reading is above `bump_reading` (a wall or a robot within about a centimetre); the environment's
+    reward is the robots' sum. Nothing terminates an episode (a ground robot cannot crash); it is
+    truncated after horizon_seconds. Start: the robots on a grid in the arena, each moved by up to
+    `start_jitter` m. infos: "coverage" (the fraction of cells covered) and "bumps" (robots bumping)."""
+
+    name = "coverage"
+    level = "wheels"
+    reads_imu = False
+    sensors = (("proximity", 0),)
+    takeoff_seconds = 0.2  # standing still: the proximity sensors' first readings
+
+    def __init__(self, robots=4, arena=1.0, cell=0.1, horizon_seconds=30.0, max_wheel_speed=6.2832,
+                 start_jitter=0.03, cell_reward=1.0, bump_penalty=0.05, bump_reading=0.8, timestep=0.002):
+        self.robots, self.arena, self.cell = int(robots), float(arena), float(cell)
+        self.cells = int(math.ceil(self.arena / self.cell - 1e-9))
+        side = int(math.ceil(math.sqrt(self.robots)))
+        self.spacing = self.arena / (side + 1)
+        if self.spacing < 0.1:
+            raise ValueError(f"ssx.learn: {self.robots} e-pucks do not fit a {self.arena} m arena 10 cm apart")
+        self.horizon_seconds, self.max_wheel_speed, self.start_jitter = horizon_seconds, max_wheel_speed, start_jitter
+        self.cell_reward, self.bump_penalty, self.bump_reading = cell_reward, bump_penalty, bump_reading
+        self.timestep = timestep
+        self.readings = {}
+
+    def scene(self):
+        h, t = self.arena / 2, 0.02  # half the arena; the walls' thickness
+        walls = "".join(
+            f'<obstacle name="wall{k}" xyz="{x} {y} 0.05"><box size="{sx} {sy} 0.1"/></obstacle>'
+            for k, (x, y, sx, sy) in enumerate([(h + t / 2, 0, t, self.arena + 2 * t), (-h - t / 2, 0, t, self.arena + 2 * t),
+                                                (0, h + t / 2, self.arena, t), (0, -h - t / 2, self.arena, t)]))
+        start = -h + self.spacing
+        return f"""<scene>
+  <environment timestep="{self.timestep}" seed="1"/>
+  <type name="epuck" file="artifacts/epuck.xml"/>
+  <ground/>
+  {walls}
+  <swarm type="epuck" count="{self.robots}" name="r{{i}}" layout="grid" spacing="{self.spacing}" xyz="{start} {start} 0"/>
+</scene>"""
+
+    def takeoff_commands(self, states, num_envs):
+        return None  # nothing to take off: the robots stand where the scene puts them
+
+    def bind(self, num_envs, action_period, states):
+        self.num_envs = num_envs
+        self.horizon = max(1, int(round(self.horizon_seconds / action_period)))
+        self.covered = np.zeros((num_envs, self.cells + 2, self.cells + 2), dtype=bool)  # a border of walls
+        self._border = np.ones_like(self.covered[0])
+        self._border[1:-1, 1:-1] = False
+        self.covered[:] = self._border
+        self._commands = np.zeros((num_envs, self.robots, 2))
+        self._offsets = np.array([(dx, dy) for dx in (-1, 0, 1) for dy in (-1, 0, 1)])
+
+    def _cells(self, states):
+        """(E, R, 2) each robot's cell, 1-based (0 and cells + 1 are the walls)."""
+        ij = np.floor((states[..., 0:2] + self.arena / 2) / self.cell).astype(np.int64)
+        return np.clip(ij, 0, self.cells - 1) + 1
+
+    def draw(self, ids, rngs):
+        u = np.array([rng.random((self.robots, 2)) for rng in rngs]) * 2.0 - 1.0
+        offsets = np.zeros((len(ids), self.robots, 3))
+        offsets[..., :2] = u * self.start_jitter
+        self.covered[ids] = self._border
+        return offsets, np.zeros_like(offsets)
+
+    def observation_space(self, per_agent=False):
+        return make_box(-1.5, 1.5, (21,) if per_agent else (self.robots, 21), np.float32)
+
+    def action_space(self, per_agent=False):
+        return make_box(-1.0, 1.0, (2,) if per_agent else (self.robots, 2), np.float32)
+
+    def observe(self, states, imu, out):
+        o = out.reshape(len(states), self.robots, 21)
+        o[..., 0:2] = states[..., 0:2] / (self.arena / 2)
+        w, x, y, z = (states[..., k] for k in range(3, 7))
+        yaw = np.arctan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z))
+        o[..., 2], o[..., 3] = np.cos(yaw), np.sin(yaw)
+        o[..., 4:12] = self.readings["proximity"]
+        ij = self._cells(states)
+        e = np.arange(len(states))[:, None, None]
+        around = ij[:, :, None, :] + self._offsets  # (E, R, 9, 2)
+        o[..., 12:21] = self.covered[e, around[..., 0], around[..., 1]]
+
+    def commands(self, actions):
+        a = np.clip(np.asarray(actions, dtype=np.float64).reshape(self.num_envs, self.robots, 2), -1.0, 1.0)
+        c = self._commands[: a.shape[0]]
+        np.multiply(a, self.max_wheel_speed, out=c)
+        return c
+
+    def evaluate(self, states, imu, actions):
+        ij = self._cells(states)
+        e = np.repeat(np.arange(len(states)), self.robots)
+        flat_i, flat_j = ij[..., 0].ravel(), ij[..., 1].ravel()
+        new = ~self.covered[e, flat_i, flat_j]
+        # a cell two robots reach in one step goes to the first of them (robot order)
+        key = (e * (self.cells + 2) + flat_i) * (self.cells + 2) + flat_j
+        _, first = np.unique(key, return_index=True)
+        firsts = np.zeros_like(new)
+        firsts[first] = True
+        new &= firsts
+        self.covered[e, flat_i, flat_j] = True
+        bumps = self.readings["proximity"].max(axis=-1) > self.bump_reading  # (E, R)
+        reward = self.cell_reward * new.reshape(len(states), self.robots) - self.bump_penalty * bumps
+        inside = self.covered[:, 1:-1, 1:-1]
+        infos = {"coverage": inside.mean(axis=(1, 2)), "bumps": bumps.sum(axis=1), "agent_rewards": reward}
+        return reward.sum(axis=1), np.zeros(len(states), dtype=bool), infos
+
+    def agent_terminations(self, states):
+        return np.zeros(states.shape[:2], dtype=bool)
