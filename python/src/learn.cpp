@@ -223,6 +223,22 @@ class PyVectorEnvironment {
     }
   }
 
+  void recordContacts(bool on) {
+    InUse use(busy_);
+    envs().recordContacts(on);
+  }
+  py::list contacts(std::size_t i) {
+    InUse use(busy_);
+    if (i >= size()) throw py::index_error("ssx: no environment " + std::to_string(i));
+    return contactList(envs()[i]);
+  }
+  py::array_t<double> contactImpulses(const py::object& out) {
+    InUse use(busy_);
+    py::array_t<double> a = output(out, 2, "contact_impulses");
+    envs().contactImpulses(std::span<double>(a.mutable_data(), static_cast<std::size_t>(a.size())));
+    return a;
+  }
+
   py::array_t<std::uint64_t> stateHashes() {
     InUse use(busy_);
     py::array_t<std::uint64_t> out(static_cast<py::ssize_t>(size()));
@@ -250,6 +266,17 @@ class PyVectorEnvironment {
 };
 
 }  // namespace
+
+py::list contactList(const ssx::Environment& env) {
+  py::list out;
+  for (const ssx::EngineContact& c : env.contacts()) {
+    const py::object other = c.body_b >= 0 ? py::object(py::str(env.bodyOwner(c.body_b).name())) : py::none();
+    out.append(py::make_tuple(env.bodyOwner(c.body_a).name(), other, c.impulse,
+                              py::make_tuple(c.position.x(), c.position.y(), c.position.z()),
+                              py::make_tuple(c.normal.x(), c.normal.y(), c.normal.z())));
+  }
+  return out;
+}
 
 py::dict variableDict(const ssx::Variable& v) {
   py::dict d;
@@ -298,6 +325,14 @@ void bindVectorEnvironment(py::module_& m) {
       .def("vary", &PyVectorEnvironment::vary, py::arg("indices"), py::arg("name"), py::arg("values"),
            "Sets constant name ('mass', 'inertia' or a plugin's variable) of every robot of the copies named to "
            "values (len(indices), robots), checked whole first (GIL released).")
+      .def("record_contacts", &PyVectorEnvironment::recordContacts, py::arg("on") = true,
+           "Every copy keeps the contacts of its steps from now on (off by default).")
+      .def("contact_list", &PyVectorEnvironment::contacts, py::arg("index"),
+           "Copy index's last-step contacts: (artifact, other or None for the static world, impulse N s, position, "
+           "normal).")
+      .def("contact_impulses", &PyVectorEnvironment::contactImpulses, py::arg("out") = py::none(),
+           "(num_envs, robots, 2): each robot's normal impulse (N s) in the last step from the static world and from "
+           "other bodies.")
       .def("state_hashes", &PyVectorEnvironment::stateHashes, "Each copy's state hash (uint64).")
       .def("times", &PyVectorEnvironment::times, "Each copy's simulated time, s.")
       .def("close", &PyVectorEnvironment::close, "Stops and frees every copy.");

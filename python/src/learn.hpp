@@ -17,6 +17,9 @@ void bindVectorEnvironment(pybind11::module_& m);
 
 /// A variable (ssx/variation.hpp) as a dict: name, neutral, min, max, doc.
 pybind11::dict variableDict(const ssx::Variable& v);
+/// The contacts of an environment's last step as a list of (artifact a, artifact b or None for
+/// the static world, impulse N s, position (x, y, z), normal (x, y, z) from b towards a).
+pybind11::list contactList(const ssx::Environment& env);
 
 /// The class VectorEnvironment, and on the Environment class (`E` has env() and guarded()) what a
 /// learning loop on one environment needs besides save and restore: reseed, and the constants
@@ -49,6 +52,14 @@ void bindLearn(pybind11::module_& m, pybind11::class_<E>& environment) {
       pybind11::arg("robot"), pybind11::arg("name"), pybind11::arg("value"),
       "Sets a constant of the robot from the next step on (domain randomisation): 'mass' and 'inertia' (factors on "
       "its bodies'), or a variable of its plugins (variables()). Part of the saved state.");
+  environment.def(
+      "record_contacts",
+      [](E& e, bool on) { e.guarded([&] { e.env().recordContacts(on); }); }, pybind11::arg("on") = true,
+      "Keeps the contacts of every step from now on (off by default); contact_list() lists the last step's.");
+  environment.def(
+      "contact_list", [](E& e) { return e.guarded([&] { return contactList(e.env()); }); },
+      "The last step's contacts, one per pair of bodies touching: (artifact, other artifact or None for the static "
+      "world, normal impulse N s, position, normal from the other towards the first). record_contacts() first.");
   environment.def(
       "variation",
       [artifact](E& e, const std::string& robot, const std::string& name) {

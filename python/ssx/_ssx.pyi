@@ -118,6 +118,10 @@ class Environment:
         """The switches of physics engine so far: (time s, from, to) each, in order."""
     def reseed(self, seed: int) -> None:
         """Restarts every random stream (sensor noise, wind gusts) as a scene loaded with this seed would start it."""
+    def record_contacts(self, on: bool = True) -> None:
+        """Keeps the contacts of every step from now on (off by default); contact_list() lists the last step's."""
+    def contact_list(self) -> List[Tuple[str, Optional[str], float, Tuple[float, float, float], Tuple[float, float, float]]]:
+        """The last step's contacts: (artifact, other or None for the static world, impulse N s, position, normal)."""
     def variables(self, robot: str) -> List[Dict[str, Any]]:
         """The constants of a robot that vary() takes: dicts of name, neutral, min, max, doc."""
     def vary(self, robot: str, name: str, value: float) -> None:
@@ -234,6 +238,12 @@ class VectorEnvironment:
         """Moves every robot of the copies named by offsets (len(indices), robots, 3), at velocities (or at rest)."""
     def read(self, kind: str, out: Optional[npt.NDArray[np.float64]] = None, slots: int = 0) -> npt.NDArray[np.float64]:
         """(num_envs, robots, width): one kind of sensor of every robot (pose, proximity, ground, range, range_and_bearing, odometry)."""
+    def record_contacts(self, on: bool = True) -> None:
+        """Every copy keeps the contacts of its steps from now on (off by default)."""
+    def contact_list(self, index: int) -> List[Tuple[str, Optional[str], float, Tuple[float, float, float], Tuple[float, float, float]]]:
+        """Copy index's last-step contacts: (artifact, other or None for the static world, impulse N s, position, normal)."""
+    def contact_impulses(self, out: Optional[npt.NDArray[np.float64]] = None) -> npt.NDArray[np.float64]:
+        """(num_envs, robots, 2): each robot's normal impulse (N s) in the last step from the static world and from other bodies."""
     def variables(self, robot: int = 0) -> List[Dict[str, Any]]:
         """What vary takes for robot index robot: dicts of name, neutral, min, max, doc."""
     def vary(self, indices: Sequence[int], name: str, values: npt.ArrayLike) -> None:

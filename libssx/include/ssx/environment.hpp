@@ -338,6 +338,16 @@ class SSX_EXPORT Environment {
   void setBodyState(int i, const BodyState& state);
   /// A 64-bit hash (FNV-1a) of every body's pose and velocities, bit for bit, and the time.
   std::uint64_t stateHash() const;
+  /// The artifact body `i` belongs to (std::out_of_range for another index).
+  const Artifact& bodyOwner(int i) const;
+  /// Keeps the contacts of every step from now on (on), or stops (off: the default, since a swarm
+  /// resting on the ground makes thousands a step); kept across engine switches, not part of the
+  /// saved state. Between steps.
+  void recordContacts(bool on = true);
+  /// The contacts of the last step taken while recording (PhysicEngine::contacts: one per pair of
+  /// bodies, or a body and the static world, with the normal impulse); empty after restoreState
+  /// until the next step. Throws Error when not recording.
+  const std::vector<EngineContact>& contacts() const;
 
   // --- variations: constants that change between episodes (ssx/variation.hpp) --------------
 

@@ -104,6 +104,18 @@ struct RayHit {
   int body = -1;                                             ///< the body met; -1: a static shape
 };
 
+/// A pair of bodies, or a body and the static world, that touched in the last step
+/// (PhysicEngine::contacts).
+struct EngineContact {
+  int body_a = 0;                ///< a dynamic body
+  int body_b = -1;               ///< the other, with a larger index; -1: a static shape
+  Vec3 position = Vec3::Zero();  ///< m, world frame: the pair's deepest contact point
+  Vec3 normal = Vec3::Zero();    ///< unit, world frame, at that point: from body_b towards body_a
+  /// N s: the normal impulse the solver applied over the step (every substep), summed over the
+  /// pair's contact points
+  double impulse = 0.0;
+};
+
 /// Runs independent tasks on the environment's worker pool, for an engine that can step parts
 /// of its world in parallel.
 class SSX_EXPORT TaskRunner {
@@ -181,6 +193,12 @@ class SSX_EXPORT PhysicEngine {
   virtual std::size_t bodyCount() const = 0;
   /// Contacts generated in the last step.
   virtual std::size_t contactCount() const = 0;
+  /// Whether contacts() lists the contacts of each step from now on (off: nothing is kept, and
+  /// nothing is spent on it); either way the list is emptied.
+  virtual void recordContacts(bool on) = 0;
+  /// The contacts of the last step while recordContacts is on, one per pair: ascending body_a,
+  /// then body_b (the static world first). The same on any thread count.
+  virtual const std::vector<EngineContact>& contacts() const = 0;
   /// Writes everything that determines the engine's next steps (body states bit for bit, its
   /// random seed), for Environment::saveState.
   virtual void saveState(StateWriter& out) const = 0;

@@ -89,6 +89,14 @@ class SSX_EXPORT VectorEnvironment {
   /// Every robot's latest reading of one kind into `out` (size() x robots x sensorWidth(kind,
   /// slots) doubles, in that order). Read between steps.
   void readSensors(std::string_view kind, std::span<double> out, std::size_t slots = 0) const;
+  /// Every copy keeps the contacts of its steps from now on (Environment::recordContacts).
+  void recordContacts(bool on = true);
+  /// Every robot's contacts in the last step into `out` (size() x robots x 2 doubles): the normal
+  /// impulse (N s) it took from the static world (the ground, obstacles), and from other bodies
+  /// (robots, items). Error when the copies do not record contacts.
+  void contactImpulses(std::span<double> out) const;
+  /// Per body of a copy (the same in every copy): the robot it belongs to, or -1.
+  const std::vector<int>& robotOfBody() const noexcept { return robot_of_body_; }
   /// Moves every robot of copy `which[k]` by `offsets` (which.size() x robots x 3, m, world frame)
   /// and sets its linear velocity to `velocities` (the same shape, m/s; empty: at rest), its
   /// angular velocity to zero; its orientation stays. Every body of a robot moves together. For
@@ -127,6 +135,7 @@ class SSX_EXPORT VectorEnvironment {
   std::vector<CommandInterface*> commands_;
   std::vector<std::vector<int>> bodies_;  // per copy, per robot: its moving bodies
   std::vector<const Sensor*> imus_;       // per copy, per robot: its first IMU sensor, or nullptr
+  std::vector<int> robot_of_body_;        // per body of a copy: its robot, or -1
   std::unique_ptr<Pool> pool_;
 };
 

@@ -1,5 +1,5 @@
 // VectorEnvironment::readSensors: one kind of sensor of every robot of every copy into one array
-// (ssx/vector_environment.hpp lists the kinds and their layouts).
+// (ssx/vector_environment.hpp lists the kinds and their layouts), and every robot's contacts.
 #include <ssx/error.hpp>
 #include <ssx/measurements.hpp>
 #include <ssx/odometry.hpp>
@@ -182,6 +182,35 @@ void VectorEnvironment::readSensors(std::string_view name, std::span<double> out
         std::copy(v, v + 9, p);
         break;
       }
+    }
+  }
+}
+
+}  // namespace ssx
+
+namespace ssx {
+
+void VectorEnvironment::recordContacts(bool on) {
+  forEach([&](std::size_t i) { envs_[i]->recordContacts(on); });
+}
+
+void VectorEnvironment::contactImpulses(std::span<double> out) const {
+  const std::size_t robots = robot_names_.size();
+  if (out.size() != envs_.size() * robots * 2)
+    throw ConfigError({}, "contactImpulses needs " + std::to_string(envs_.size()) + " x " + std::to_string(robots) +
+                              " x 2 numbers, got " + std::to_string(out.size()));
+  std::fill(out.begin(), out.end(), 0.0);
+  for (std::size_t i = 0; i < envs_.size(); ++i) {
+    double* copy = out.data() + i * robots * 2;
+    for (const EngineContact& c : envs_[i]->contacts()) {
+      const int a = robot_of_body_[static_cast<std::size_t>(c.body_a)];
+      const int b = c.body_b >= 0 ? robot_of_body_[static_cast<std::size_t>(c.body_b)] : -1;
+      if (c.body_b < 0) {
+        if (a >= 0) copy[2 * a] += c.impulse;
+        continue;
+      }
+      if (a >= 0) copy[2 * a + 1] += c.impulse;
+      if (b >= 0) copy[2 * b + 1] += c.impulse;
     }
   }
 }

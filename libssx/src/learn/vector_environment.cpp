@@ -94,6 +94,9 @@ VectorEnvironment::VectorEnvironment(const std::function<Scene(std::size_t)>& lo
     }
     bodies_.push_back(std::move(bodies));
   }
+  robot_of_body_.assign(envs_[0]->bodyCount(), -1);
+  for (std::size_t r = 0; r < robot_names_.size(); ++r)
+    for (const int b : bodies_[r]) robot_of_body_[static_cast<std::size_t>(b)] = static_cast<int>(r);
 }
 
 VectorEnvironment::~VectorEnvironment() = default;

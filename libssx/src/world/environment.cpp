@@ -82,6 +82,22 @@ const Artifact& Environment::artifact(std::size_t index) const { return *world_-
 const BodyState& Environment::bodyState(int i) const { return world_->states.at(static_cast<std::size_t>(i)); }
 std::size_t Environment::bodyCount() const noexcept { return world_->states.size(); }
 
+const Artifact& Environment::bodyOwner(int i) const {
+  return *world_->artifacts[world_->body_owner.at(static_cast<std::size_t>(i))];
+}
+
+void Environment::recordContacts(bool on) {
+  requireOutsidePhases("recordContacts");
+  world_->record_contacts = on;
+  if (physics_) physics_->recordContacts(on);
+}
+
+const std::vector<EngineContact>& Environment::contacts() const {
+  if (!world_->record_contacts || !physics_)
+    throw Error("contacts: they are not recorded: call recordContacts(true) before the steps whose contacts you want");
+  return physics_->contacts();
+}
+
 void Environment::setBodyState(int i, const BodyState& state) {
   requireOutsidePhases("setBodyState");
   if (world_->state != State::Running) throw Error("setBodyState: the environment is not running");
@@ -321,6 +337,7 @@ void Environment::start() {
       e.initialised = true;
     }
     physics_ = createPhysicEngine(settings_.physics);
+    physics_->recordContacts(w.record_contacts);  // (asked for before start)
     w.engine = physics_.get();
     renderer_ = createRenderEngine(settings_.render);
     detail::buildBodies(w, *physics_, &static_shapes_);

@@ -82,6 +82,7 @@ void Environment::exchangePhysics(const std::string& engine) {
     throw;
   }
   next->setTaskRunner(pool_.get());
+  next->recordContacts(w.record_contacts);
   physics_->setTaskRunner(nullptr);
   physics_ = std::move(next);
   w.engine = physics_.get();

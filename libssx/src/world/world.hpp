@@ -185,6 +185,7 @@ struct World {
   std::vector<std::uint16_t> attached;  // per body: run-time joints on it
   std::atomic<bool> attach_pending{false};  // some artifact has attach_requests
   PhysicEngine* engine = nullptr;           // from start
+  bool record_contacts = false;             // Environment::recordContacts
   std::vector<PluginSlot> plugins;
   std::vector<Random> randoms;
   // per plugin slot, written by the sensors phase: 1 when that sensor measured in this step (one

@@ -250,6 +250,7 @@ void Environment::applyState(std::span<const std::byte> payload) {
   if (!in.done()) throw StateError("saved state: " + std::to_string(in.remaining()) + " bytes left over (corrupted)");
   w.steps = steps;
   w.current_step = steps;
+  physics_->recordContacts(w.record_contacts);  // (the last step's contacts are another run's)
   cameras_->invalidate();
   if (neighbors_->enabled()) neighbors_->markStale(w.artifacts);
   rays_stale_ = true;

@@ -34,3 +34,29 @@ def test_read_every_robots_sensor_into_one_array():
     with pytest.raises(ValueError, match="shape"):
         sim.read("proximity", out=np.empty((2, 3, 7)))
     sim.close()
+
+
+BOXES = """<scene><environment timestep="0.002"/><type name="box" file="artifacts/box.xml"/><ground/>
+<artifact type="box" name="low" xyz="0 0 0.1"/><artifact type="box" name="high" xyz="0 0 0.3"/></scene>"""
+
+
+def test_contacts_say_who_touched_whom_and_how_hard():
+    env = ssx.load_scene_string(BOXES, base_dir=ssx.data_directory())
+    with pytest.raises(ssx.Error, match="record_contacts|recordContacts"):
+        env.contact_list()
+    env.record_contacts()
+    env.step(500)
+    contacts = env.contact_list()
+    assert [(a, b) for a, b, *_ in contacts] == [("low", None), ("low", "high")]
+    (_, _, ground, _, up), (_, _, stacked, _, down) = contacts
+    assert ground == pytest.approx(2 * 9.81 * 0.002, rel=0.05) and up[2] > 0.99
+    assert stacked == pytest.approx(9.81 * 0.002, rel=0.05) and down[2] < -0.99
+
+    sim = ssx._ssx.VectorEnvironment(EPUCKS, 2, base_dir=ssx.data_directory(), threads=2)
+    sim.record_contacts()
+    sim.step(10)
+    impulses = sim.contact_impulses()
+    assert impulses.shape == (2, 3, 2)
+    assert np.all(impulses[:, :, 0] > 0) and np.all(impulses[:, :, 1] == 0)  # on the ground, apart
+    assert all(b is None for _, b, *_ in sim.contact_list(1))
+    sim.close()

@@ -133,3 +133,30 @@ TEST_CASE("batched sensors: motion capture and the range sensor of flying robots
   CHECK_THROWS_WITH(v.sensorWidth("range", 2), Contains("add <sensor plugin=\"range\"/>"));
   CHECK_THROWS_WITH(v.sensorWidth("odometry"), Contains("its driver keeps no odometry"));
 }
+
+TEST_CASE("batched contacts: each robot's impulse from the ground and from other bodies", "[learn]") {
+  VectorEnvironment v(epucks, 2, 2);
+  std::vector<double> impulses(2 * 3 * 2);
+  CHECK_THROWS_WITH(v.contactImpulses(impulses), Contains("call recordContacts(true)"));
+  v.recordContacts();
+  // in copy 1, e0 drives into e1 backing into it; e2 and copy 0 stand still
+  std::vector<double> wheels(2 * 3 * 2, 0.0);
+  wheels[6] = wheels[7] = 6.0;
+  wheels[8] = wheels[9] = -6.0;
+  v.setCommands(CommandLevel::Wheels, wheels, 2);
+  v.step(250);
+  v.contactImpulses(impulses);
+  for (std::size_t row = 0; row < 6; ++row) CHECK(impulses[2 * row] > 0.0);  // all stand on the ground
+  CHECK(impulses[2 * 3 + 1] > 0.0);                                          // copy 1: e0 and e1 pushed into each other
+  CHECK(impulses[2 * 4 + 1] > 0.0);
+  CHECK(impulses[2 * 4 + 1] == impulses[2 * 3 + 1]);
+  CHECK(impulses[2 * 5 + 1] == 0.0);                                              // e2 touches nobody
+  for (std::size_t row = 0; row < 3; ++row) CHECK(impulses[2 * row + 1] == 0.0);  // copy 0 stood still
+  // the pair is in copy 1's list, the robots named through their bodies
+  bool pair = false;
+  for (const EngineContact& c : v[1].contacts())
+    pair |= c.body_b >= 0 && v.robotOfBody()[static_cast<std::size_t>(c.body_a)] == 0 &&
+            v.robotOfBody()[static_cast<std::size_t>(c.body_b)] == 1;
+  CHECK(pair);
+  CHECK_THROWS_WITH(v.contactImpulses(std::span<double>(impulses).first(3)), Contains("x 2 numbers"));
+}

@@ -1,4 +1,5 @@
 // The environment: its extensions, shared values, measurement callbacks, setup rules, settings and time.
+#include "scene_util.hpp"
 #include "test_util.hpp"
 
 #include <catch2/catch.hpp>
@@ -291,4 +292,49 @@ TEST_CASE("plugins find the node a parameter names, or the first root", "[enviro
                     "robot.xml:5: error: <sensor>: no physic node 'imu_mnt' in artifact 'robot'");
   Artifact& empty = env.addArtifact("logic");
   CHECK_THROWS_WITH(empty.nodeFromParameter(none), Catch::Contains("has no physic node"));
+}
+
+TEST_CASE("contacts: two boxes stacked on the ground, each pair once with the impulse that holds the weight",
+          "[environment]") {
+  for (const std::string engine : {"ode", "bullet"}) {
+    CAPTURE(engine);
+    auto boxes = [&] {
+      return loadSceneFromString("<scene><environment timestep=\"0.002\" threads=\"2\"/><physics engine=\"" + engine +
+                                     "\"/><type name=\"box\" file=\"" + (ssx::test::kArtifacts / "box.xml").string() +
+                                     "\"/><ground/><artifact type=\"box\" name=\"low\" xyz=\"0 0 0.1\"/>"
+                                     "<artifact type=\"box\" name=\"high\" xyz=\"0 0 0.3\"/></scene>",
+                                 "boxes.xml", ssx::test::kArtifacts);
+    };
+    Scene s = boxes(), unrecorded = boxes();
+    Environment& env = *s.environment;
+    CHECK_THROWS_WITH(env.contacts(), Catch::Contains("call recordContacts(true)"));
+    env.recordContacts();
+    env.step(500);  // 1 s: settled
+    unrecorded.environment->step(500);
+    CHECK(env.stateHash() == unrecorded.environment->stateHash());  // recording changes no bit
+    const std::vector<EngineContact> contacts = env.contacts();
+    REQUIRE(contacts.size() == 2);
+    const int low = env.findArtifact("low")->root().bodyIndex(), high = env.findArtifact("high")->root().bodyIndex();
+    CHECK(&env.bodyOwner(low) == env.findArtifact("low"));
+    const double step_weight = 9.81 * 0.002;  // N s per kg over one step
+    // low on the ground (the static world first), then high on low
+    CHECK(contacts[0].body_a == low);
+    CHECK(contacts[0].body_b == -1);
+    CHECK(contacts[0].normal.z() > 0.99);  // from the ground up into the low box
+    CHECK(contacts[0].impulse == Approx(2 * step_weight).epsilon(0.05));
+    CHECK(contacts[0].position.z() == Approx(0.0).margin(0.01));
+    CHECK(contacts[1].body_a == low);
+    CHECK(contacts[1].body_b == high);
+    CHECK(contacts[1].normal.z() < -0.99);  // from the high box down into the low one
+    CHECK(contacts[1].impulse == Approx(step_weight).epsilon(0.05));
+    // kept across an engine switch; emptied by a restore; gone when recording stops
+    const std::vector<std::byte> state = env.saveState();
+    env.switchPhysics(engine == "ode" ? "bullet" : "ode");
+    env.step(1);
+    CHECK(env.contacts().size() == 2);
+    env.restoreState(state);
+    CHECK(env.contacts().empty());
+    env.recordContacts(false);
+    CHECK_THROWS_AS(env.contacts(), Error);
+  }
 }

@@ -184,6 +184,7 @@ void BulletEngine::solve(double h) {
   forEach(islands_.size() + batches, [&](std::size_t t) {
     const Lease lease(*this);
     Context& context = lease.context();
+    context.solver.write_back = contact_log_.on();
     if (t < islands_.size()) {
       const Island& island = islands_[t];
       context.solver.solveGroup(&island_bodies_[island.first_body], static_cast<int>(island.bodies),
@@ -204,6 +205,8 @@ void BulletEngine::step(Nanoseconds dt, std::span<const Wrench> wrenches) {
   const int substeps = std::max(1, settings_.substeps);
   const double h = toSeconds(dt) / substeps;
   contact_count_ = 0;
+  const bool log = contact_log_.on();
+  if (log) contact_log_.begin();
   seal();
   if (labels_stale_ || articulation_.size() != bodies_.size()) {
     labelArticulations(articulation_, bodies_.size(), joints_);
@@ -224,6 +227,7 @@ void BulletEngine::step(Nanoseconds dt, std::span<const Wrench> wrenches) {
     for (const btPersistentManifold* m : manifolds_) contact_count_ += static_cast<std::size_t>(m->getNumContacts());
     buildIslands();
     solve(h);
+    if (log) logContacts();
     releaseContacts();
     forEach((bodies_.size() + kBodiesPerChunk - 1) / kBodiesPerChunk, [&](std::size_t c) {
       const std::size_t end = std::min(bodies_.size(), (c + 1) * kBodiesPerChunk);
@@ -235,6 +239,21 @@ void BulletEngine::step(Nanoseconds dt, std::span<const Wrench> wrenches) {
         rb.clearForces();
       }
     });
+  }
+  if (log) contact_log_.finish();
+}
+
+void BulletEngine::logContacts() {
+  // Bullet's normal on B points towards A; the applied impulse is the substep's, along it
+  for (const btPersistentManifold* m : manifolds_) {
+    const int a = m->getBody0()->getUserIndex(), b = m->getBody1()->getUserIndex();
+    for (int k = 0; k < m->getNumContacts(); ++k) {
+      const btManifoldPoint& p = m->getContactPoint(k);
+      const btVector3& x = p.getPositionWorldOnB();
+      const btVector3& n = p.m_normalWorldOnB;
+      contact_log_.add(a, b, Vec3(x.x(), x.y(), x.z()), Vec3(n.x(), n.y(), n.z()), -p.getDistance(),
+                       p.getAppliedImpulse());
+    }
   }
 }
 

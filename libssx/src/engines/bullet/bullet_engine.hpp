@@ -26,6 +26,7 @@
 // joint made between steps is saved with its frames and made again from them on restore.
 
 #include "engines/contact_groups.hpp"
+#include "engines/contact_log.hpp"
 #include "engines/grid_broadphase.hpp"
 
 #include <ssx/physic_engine.hpp>
@@ -63,6 +64,8 @@ class BulletEngine final : public PhysicEngine {
   void setState(int body, const BodyState& state) override;
   std::size_t bodyCount() const override { return bodies_.size(); }
   std::size_t contactCount() const override { return contact_count_; }
+  void recordContacts(bool on) override { contact_log_.setOn(on); }
+  const std::vector<EngineContact>& contacts() const override { return contact_log_.pairs(); }
   void saveState(StateWriter& out) const override;
   void restoreState(StateReader& in) override;
   int addJoint(const EngineJoint& joint) override;
@@ -110,6 +113,8 @@ class BulletEngine final : public PhysicEngine {
   void collide(double h);
   void narrowphase(Context& context, Chunk& chunk, int a, int b, double h);
   void releaseContacts();
+  // adds this substep's contact points, with the impulses the solver applied, to contact_log_
+  void logContacts();
   void buildIslands();
   void solve(double h);
   void setMotors(double h);
@@ -168,6 +173,7 @@ class BulletEngine final : public PhysicEngine {
   std::vector<Island> islands_;
   std::vector<btCollisionObject*> free_bodies_;
   std::size_t contact_count_ = 0;
+  detail::ContactLog contact_log_;  // recordContacts
 };
 
 }  // namespace ssx::detail

@@ -42,10 +42,26 @@ struct BulletEngine::StaticObject {
   int group = 0;        // addStatic's
 };
 
+// Bullet's solver, which also hands each contact point the impulse it applied when asked (Bullet
+// writes them back only when warm starting, which would change nothing here: every substep's
+// contacts are new)
+class ImpulseSolver final : public btSequentialImpulseConstraintSolver {
+ public:
+  bool write_back = false;  // while the engine records contacts
+
+ protected:
+  btScalar solveGroupCacheFriendlyFinish(btCollisionObject** bodies, int count,
+                                         const btContactSolverInfo& info) override {
+    if (write_back && (info.m_solverMode & SOLVER_USE_WARMSTARTING) == 0)
+      writeBackContacts(0, m_tmpSolverContactConstraintPool.size(), info);
+    return btSequentialImpulseConstraintSolver::solveGroupCacheFriendlyFinish(bodies, count, info);
+  }
+};
+
 struct BulletEngine::Context {
   btDefaultCollisionConfiguration configuration;
   btCollisionDispatcher dispatcher;
-  btSequentialImpulseConstraintSolver solver;
+  ImpulseSolver solver;
   Context() : dispatcher(&configuration) {
     // several contact points from one pass (the manifolds do not persist between substeps)
     configuration.setConvexConvexMultipointIterations();

@@ -387,6 +387,8 @@ void OdeEngine::step(Nanoseconds dt, std::span<const Wrench> wrenches) {
   const int substeps = std::max(1, settings_.substeps);
   const double h = toSeconds(dt) / substeps;
   contact_count_ = 0;
+  const bool log = contact_log_.on();
+  if (log) contact_log_.begin();
   seal();
   if (groups_.size() != bodies_.size()) groups_.resize(bodies_.size());
   if (labels_stale_ || articulation_.size() != bodies_.size()) {
@@ -400,7 +402,9 @@ void OdeEngine::step(Nanoseconds dt, std::span<const Wrench> wrenches) {
     groupContacts();
     for (Partition& p : partitions_) p.has_joints = false;
     partitions_[0].has_joints = live_joints_ > 0;  // (the joined bodies' world: see ode_engine.hpp)
-    for (const dContact& c : contacts_) {
+    if (log) feedback_.assign(contacts_.size(), dJointFeedback{});
+    for (std::size_t k = 0; k < contacts_.size(); ++k) {
+      const dContact& c = contacts_[k];
       const auto owner_a = reinterpret_cast<std::intptr_t>(dGeomGetData(c.geom.g1));
       const auto owner_b = reinterpret_cast<std::intptr_t>(dGeomGetData(c.geom.g2));
       const dBodyID a = owner_a > 0 ? bodies_[static_cast<std::size_t>(owner_a - 1)].id : nullptr;
@@ -409,11 +413,28 @@ void OdeEngine::step(Nanoseconds dt, std::span<const Wrench> wrenches) {
       Partition& p = partitions_[static_cast<std::size_t>(bodies_[static_cast<std::size_t>(owner)].partition)];
       dJointID j = dJointCreateContact(p.world, p.contacts, &c);
       dJointAttach(j, a, b);
+      if (log) dJointSetFeedback(j, &feedback_[k]);
       p.has_joints = true;
     }
     contact_count_ += contacts_.size();
     // the worlds, in parallel (serially for small worlds: the same results either way)
     forEach(partitions_.size(), [&](std::size_t i) { stepPartition(partitions_[i], h, wrenches); });
+    if (log) logContacts(h);
+  }
+  if (log) contact_log_.finish();
+}
+
+void OdeEngine::logContacts(double h) {
+  for (std::size_t k = 0; k < contacts_.size(); ++k) {
+    const dContactGeom& g = contacts_[k].geom;
+    const auto owner_a = reinterpret_cast<std::intptr_t>(dGeomGetData(g.g1));
+    const auto owner_b = reinterpret_cast<std::intptr_t>(dGeomGetData(g.g2));
+    // ODE's normal points into g1; the feedback's f1 is the force on the joint's first body (the
+    // one that is not the static world): its part along the normal, over the substep
+    const Vec3 normal(g.normal[0], g.normal[1], g.normal[2]);
+    const Vec3 force(feedback_[k].f1[0], feedback_[k].f1[1], feedback_[k].f1[2]);
+    contact_log_.add(owner_a > 0 ? static_cast<int>(owner_a - 1) : -1, owner_b > 0 ? static_cast<int>(owner_b - 1) : -1,
+                     Vec3(g.pos[0], g.pos[1], g.pos[2]), normal, g.depth, std::abs(force.dot(normal)) * h);
   }
 }
 

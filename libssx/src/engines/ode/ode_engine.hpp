@@ -28,6 +28,7 @@
 // joints, with their bodies' states when made, are part of the saved state.
 
 #include "engines/contact_groups.hpp"
+#include "engines/contact_log.hpp"
 #include "engines/grid_broadphase.hpp"
 
 #include <ssx/physic_engine.hpp>
@@ -58,6 +59,8 @@ class OdeEngine final : public PhysicEngine {
   void saveState(StateWriter& out) const override;
   void restoreState(StateReader& in) override;
   std::size_t contactCount() const override { return contact_count_; }
+  void recordContacts(bool on) override { contact_log_.setOn(on); }
+  const std::vector<EngineContact>& contacts() const override { return contact_log_.pairs(); }
   int addJoint(const EngineJoint& joint) override;
   void setJointMotor(int joint, double velocity, double max_effort) override;
   void removeJoint(int joint) override;
@@ -132,6 +135,8 @@ class OdeEngine final : public PhysicEngine {
   // recreates body i in partition p, bit for bit, last in its creation order
   void moveBody(int body, int partition);
   void groupContacts();
+  // adds this substep's contacts, with the impulses the feedback measured, to contact_log_
+  void logContacts(double h);
   void placeGeoms(std::size_t begin, std::size_t end);
   void stepPartition(Partition& p, double h, std::span<const Wrench> wrenches);
 
@@ -148,6 +153,7 @@ class OdeEngine final : public PhysicEngine {
   std::size_t live_joints_ = 0;
   std::size_t contacts_per_pair_ = 8;
   std::vector<dContact> contacts_;  // found in this substep, in a fixed order
+  std::vector<dJointFeedback> feedback_;  // per contact of this substep, while recording contacts
   // the grid broadphase: one box per geom (the bodies' geoms in body order, then static ones),
   // the planes apart; contacts found per chunk, joined in chunk order
   std::vector<dGeomID> static_geoms_;
@@ -169,6 +175,7 @@ class OdeEngine final : public PhysicEngine {
   ContactGroups groups_;            // bodies in body-body contact this substep, grouped
   std::vector<int> away_;           // bodies not in their home world
   std::size_t contact_count_ = 0;
+  detail::ContactLog contact_log_;  // recordContacts
   // ray geoms for castRays, one per query running at once
   mutable std::mutex rays_mutex_;
   mutable std::vector<dGeomID> free_rays_;
