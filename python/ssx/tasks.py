@@ -16,7 +16,7 @@ from . import _ssx
 from .spaces import make_box
 
 VEHICLES = ("crazyflie", "mk_quad", "hummingbird")
-LEVELS = ("attitude", "rates", "velocity")
+LEVELS = ("position", "velocity", "attitude", "rates")
 GRAVITY = 9.81
 
 
@@ -92,6 +92,7 @@ class _Flight(Task):
 
     def __init__(self, vehicle="crazyflie", level="attitude", robots=1, hover_height=1.0, spacing=1.0,
                  horizon_seconds=5.0, max_tilt=0.5, max_rate=4.0, max_yaw_rate=1.0, thrust_range=0.6, max_speed=1.0,
+                 max_offset=0.5,
                  bounds=3.0, max_tilt_crash=70.0, timestep=0.002):
         if vehicle not in VEHICLES:
             raise ValueError(f"ssx.learn: vehicle must be one of {', '.join(VEHICLES)}, got {vehicle!r}")
@@ -102,6 +103,7 @@ class _Flight(Task):
         self.horizon_seconds = horizon_seconds
         self.max_tilt, self.max_rate, self.max_yaw_rate = max_tilt, max_rate, max_yaw_rate
         self.thrust_range, self.max_speed, self.bounds = thrust_range, max_speed, bounds
+        self.max_offset = max_offset
         self.cos_crash = math.cos(math.radians(max_tilt_crash))
         self.weight = vehicle_mass(vehicle) * GRAVITY
         self._commands = None
@@ -127,6 +129,7 @@ class _Flight(Task):
         self.horizon = max(1, int(round(self.horizon_seconds / action_period)))
         self.home = states[0, :, :3].copy()  # every copy hovers at the same place in the start state
         self._commands = np.zeros((num_envs, self.robots, 4))
+        self._states = states  # the environment's, read in place after every step (position commands)
 
     def action_space(self, per_agent=False):
         shape = (4,) if per_agent or self.robots == 1 else (self.robots, 4)
@@ -135,7 +138,10 @@ class _Flight(Task):
     def commands(self, actions):
         a = np.clip(np.asarray(actions, dtype=np.float64).reshape(self.num_envs, self.robots, 4), -1.0, 1.0)
         c = self._commands[: a.shape[0]]
-        if self.level == "velocity":
+        if self.level == "position":  # a set-point up to max_offset m from where each robot is, and a heading
+            c[..., :3] = self._states[: a.shape[0], :, 0:3] + a[..., :3] * self.max_offset
+            c[..., 3] = a[..., 3] * np.pi
+        elif self.level == "velocity":
             c[..., :3] = a[..., :3] * self.max_speed
             c[..., 3] = a[..., 3] * self.max_yaw_rate
         else:
@@ -162,7 +168,8 @@ class GoTo(_Flight):
     to `start_speed` m/s along each axis.
     Goal: within `goal_range` m of home (half that vertically). Observation (16, float32): the goal
     relative to the robot (m), its velocity (m/s, / 2), its orientation (qw >= 0), the IMU's gyro
-    (rad/s, / 10) and accelerometer (m/s^2, / 10). Action (4, in [-1, 1]): at `level` "attitude"
+    (rad/s, / 10) and accelerometer (m/s^2, / 10). Action (4, in [-1, 1]): at `level` "position" a
+    set-point (times max_offset m from where the robot is) and a heading (times pi rad); "attitude"
     roll and pitch (times max_tilt rad), yaw rate (times max_yaw_rate) and thrust (the weight times
     1 + thrust_range a); "rates": body rates (times max_rate rad/s, yaw max_yaw_rate) and thrust;
     "velocity": m/s (times max_speed) and yaw rate. Reward: exp(-distance / 0.5) per action, minus
@@ -325,9 +332,10 @@ class Coverage(Task):
     Observation per robot (21, float32): its position (/ half the arena), heading (cos, sin), its 8
     proximity readings (0..1, batched from its own sensors), and the 3 x 3 cells around its own
     (1: covered or beyond the walls, 0: still to cover). Action per robot (2, in [-1, 1]): left and
-    right wheel speeds (times max_wheel_speed rad/s; the `wheels` command level). Reward per robot:
-    `cell_reward` for each cell it is the first to reach, minus `bump_penalty` while a proximity
-    reading is above `bump_reading` (a wall or a robot within about a centimetre); the environment's
+    right wheel speeds (times max_wheel_speed rad/s; the `wheels` command level), or with
+    level="velocity" a forward speed (times max_speed m/s) and a yaw rate (times max_yaw_rate rad/s).
+    Reward per robot: `cell_reward` for each cell it is the first to reach, minus `bump_penalty`
+    while a proximity reading is above `bump_reading` (a wall or a robot within about a centimetre); the environment's
     reward is the robots' sum. Nothing terminates an episode (a ground robot cannot crash); it is
     truncated after horizon_seconds. Start: the robots on a grid in the arena, each moved by up to
     `start_jitter` m. infos: "coverage" (the fraction of cells covered) and "bumps" (robots bumping)."""
@@ -339,7 +347,11 @@ class Coverage(Task):
     takeoff_seconds = 0.2  # standing still: the proximity sensors' first readings
 
     def __init__(self, robots=4, arena=1.0, cell=0.1, horizon_seconds=30.0, max_wheel_speed=6.2832,
-                 start_jitter=0.03, cell_reward=1.0, bump_penalty=0.05, bump_reading=0.8, timestep=0.002):
+                 start_jitter=0.03, cell_reward=1.0, bump_penalty=0.05, bump_reading=0.8, timestep=0.002,
+                 level="wheels", max_speed=0.128, max_yaw_rate=4.0):
+        if level not in ("wheels", "velocity"):
+            raise ValueError(f"ssx.learn: coverage's level must be 'wheels' or 'velocity', got {level!r}")
+        self.level, self.max_speed, self.max_yaw_rate = level, max_speed, max_yaw_rate
         self.robots, self.arena, self.cell = int(robots), float(arena), float(cell)
         self.cells = int(math.ceil(self.arena / self.cell - 1e-9))
         side = int(math.ceil(math.sqrt(self.robots)))
@@ -376,7 +388,8 @@ class Coverage(Task):
         self._border = np.ones_like(self.covered[0])
         self._border[1:-1, 1:-1] = False
         self.covered[:] = self._border
-        self._commands = np.zeros((num_envs, self.robots, 2))
+        self._commands = np.zeros((num_envs, self.robots, 2 if self.level == "wheels" else 4))
+        self._states = states  # the environment's, read in place after every step (headings)
         self._offsets = np.array([(dx, dy) for dx in (-1, 0, 1) for dy in (-1, 0, 1)])
 
     def _cells(self, states):
@@ -412,7 +425,15 @@ class Coverage(Task):
     def commands(self, actions):
         a = np.clip(np.asarray(actions, dtype=np.float64).reshape(self.num_envs, self.robots, 2), -1.0, 1.0)
         c = self._commands[: a.shape[0]]
-        np.multiply(a, self.max_wheel_speed, out=c)
+        if self.level == "wheels":
+            np.multiply(a, self.max_wheel_speed, out=c)
+            return c
+        # velocity: a forward speed along each robot's heading now, and a yaw rate
+        w, x, y, z = (self._states[: a.shape[0], :, k] for k in range(3, 7))
+        yaw = np.arctan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z))
+        speed = a[..., 0] * self.max_speed
+        c[..., 0], c[..., 1] = speed * np.cos(yaw), speed * np.sin(yaw)
+        c[..., 3] = a[..., 1] * self.max_yaw_rate
         return c
 
     def evaluate(self, states, imu, actions):

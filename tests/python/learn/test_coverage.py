@@ -54,3 +54,17 @@ def test_coverage_is_repeatable_and_a_parallel_env_keeps_its_agents():
     assert swarm.agents == swarm.possible_agents and not any(terminations.values())
     for env in (a, b, swarm):
         env.close()
+
+
+def test_velocity_actions_drive_along_each_robots_heading():
+    env = learn.VectorEnv("coverage", num_envs=2, robots=4, action_period=0.1, level="velocity", threads=1)
+    assert env.single_action_space.shape == (4, 2)
+    env.reset(seed=1)
+    start = env.sim.robot_states()[:, :, :2].copy()
+    forward = np.zeros(env.action_space.shape, np.float32)
+    forward[..., 0] = 1.0  # full speed ahead, no turn: 1 s at 0.128 m/s
+    for _ in range(10):
+        env.step(forward)
+    moved = np.linalg.norm(env.sim.robot_states()[:, :, :2] - start, axis=-1)
+    assert np.allclose(moved, 0.128, atol=0.01)
+    env.close()

@@ -311,3 +311,15 @@ def test_spaces_without_gymnasium_sample_contain_and_seed():
     again = both.sample()
     both.seed(5)
     assert all(np.array_equal(again[k], v) for k, v in both.sample().items())
+
+
+def test_position_actions_fly_to_set_points_near_the_robot():
+    env = learn.VectorEnv("goto", num_envs=4, level="position", threads=2)
+    obs, _ = env.reset(seed=3)
+    for _ in range(150):  # 3 s, each action a set-point towards the goal (at most 0.5 m away)
+        a = np.zeros((4, 4), dtype=np.float32)
+        a[:, :3] = np.clip(obs[:, 0:3] / env.task.max_offset, -1, 1)
+        obs, rewards, terminations, truncations, infos = env.step(a)
+        assert not terminations.any()
+    assert np.all(infos["distance"] < 0.2)
+    env.close()
