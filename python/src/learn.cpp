@@ -271,9 +271,8 @@ py::list contactList(const ssx::Environment& env) {
   py::list out;
   for (const ssx::EngineContact& c : env.contacts()) {
     const py::object other = c.body_b >= 0 ? py::object(py::str(env.bodyOwner(c.body_b).name())) : py::none();
-    out.append(py::make_tuple(env.bodyOwner(c.body_a).name(), other, c.impulse,
-                              py::make_tuple(c.position.x(), c.position.y(), c.position.z()),
-                              py::make_tuple(c.normal.x(), c.normal.y(), c.normal.z())));
+    out.append(
+        py::make_tuple(env.bodyOwner(c.body_a).name(), other, c.impulse, vector3(c.position), vector3(c.normal)));
   }
   return out;
 }

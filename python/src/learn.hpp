@@ -18,7 +18,8 @@ void bindVectorEnvironment(pybind11::module_& m);
 /// A variable (ssx/variation.hpp) as a dict: name, neutral, min, max, doc.
 pybind11::dict variableDict(const ssx::Variable& v);
 /// The contacts of an environment's last step as a list of (artifact a, artifact b or None for
-/// the static world, impulse N s, position (x, y, z), normal (x, y, z) from b towards a).
+/// the static world, impulse N s, position and normal (from b towards a) as
+/// numpy arrays of 3, as the module gives vectors).
 pybind11::list contactList(const ssx::Environment& env);
 
 /// The class VectorEnvironment, and on the Environment class (`E` has env() and guarded()) what a

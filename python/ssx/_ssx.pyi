@@ -120,7 +120,7 @@ class Environment:
         """Restarts every random stream (sensor noise, wind gusts) as a scene loaded with this seed would start it."""
     def record_contacts(self, on: bool = True) -> None:
         """Keeps the contacts of every step from now on (off by default); contact_list() lists the last step's."""
-    def contact_list(self) -> List[Tuple[str, Optional[str], float, Tuple[float, float, float], Tuple[float, float, float]]]:
+    def contact_list(self) -> List[Tuple[str, Optional[str], float, npt.NDArray[np.float64], npt.NDArray[np.float64]]]:
         """The last step's contacts: (artifact, other or None for the static world, impulse N s, position, normal)."""
     def variables(self, robot: str) -> List[Dict[str, Any]]:
         """The constants of a robot that vary() takes: dicts of name, neutral, min, max, doc."""
@@ -240,7 +240,7 @@ class VectorEnvironment:
         """(num_envs, robots, width): one kind of sensor of every robot (pose, proximity, ground, range, range_and_bearing, odometry)."""
     def record_contacts(self, on: bool = True) -> None:
         """Every copy keeps the contacts of its steps from now on (off by default)."""
-    def contact_list(self, index: int) -> List[Tuple[str, Optional[str], float, Tuple[float, float, float], Tuple[float, float, float]]]:
+    def contact_list(self, index: int) -> List[Tuple[str, Optional[str], float, npt.NDArray[np.float64], npt.NDArray[np.float64]]]:
         """Copy index's last-step contacts: (artifact, other or None for the static world, impulse N s, position, normal)."""
     def contact_impulses(self, out: Optional[npt.NDArray[np.float64]] = None) -> npt.NDArray[np.float64]:
         """(num_envs, robots, 2): each robot's normal impulse (N s) in the last step from the static world and from other bodies."""
