@@ -29,7 +29,7 @@ double medianUs(const ssx::TimingRecorder& t, ssx::Nanoseconds ssx::StepTiming::
 // ns per InnerLoopFixed::evaluate: mk_quad's mixer, inputs about hover with noise-sized rates
 double innerLoopNs() {
   using namespace ssx::quadrotor;
-  const RotorParams rp = *preset("mk_quad");
+  const RotorParams rp = RotorParams{};
   const std::vector<Rotor> rotors = {{ssx::Vec3(0.225, 0, 0), 1}, {ssx::Vec3(0, 0.225, 0), -1},
                                      {ssx::Vec3(-0.225, 0, 0), 1}, {ssx::Vec3(0, -0.225, 0), -1}};
   const Allocation allocation(rotors, rp);

@@ -2,8 +2,8 @@
 // A rotorcraft's flight controller, behind one interface: it takes commands at the command levels
 // it accepts (ssx/command.hpp) and turns them, with what it senses, into a speed for each rotor.
 // The vehicle (vehicle.hpp) spins the rotors; the references (references.hpp) give position-level
-// set-points. The quadrotor driver holds one controller; another fits beside TeleKybController
-// without touching the vehicle.
+// set-points. The quadrotor driver holds one controller, chosen at load (`controller`): another
+// fits beside TeleKybController and CrazyfliePidController without touching the vehicle.
 #include <ssx/ssx.hpp>
 
 #include <cstdint>
@@ -47,6 +47,13 @@ class FlightController {
     if (c.level == CommandLevel::Position) c.setpoint = currentSetpoint();
     return c;
   }
+  /// Before the first step: the vehicle starts in the air carrying `weight` N (0: on the ground);
+  /// a controller with integrators may start them there.
+  virtual void startInAir(double /*weight*/) {}
+  /// The battery's terminal voltage, when the vehicle has a battery: at load (`initial`: the
+  /// voltage since it was switched on) and before each run. A controller that compensates the
+  /// battery (the Crazyflie's firmware) reads it; the others need not.
+  virtual void batteryVoltage(double /*volts*/, bool /*initial*/) {}
   /// One run of the driver (`run` counts them from 0, at simulated time `t`): writes the commanded
   /// speed of each rotor (rad/s) into `speeds`, or leaves them as they were.
   virtual void step(std::int64_t run, double t, FlightInputs& in, std::span<double> speeds) = 0;

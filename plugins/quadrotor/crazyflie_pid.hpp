@@ -26,10 +26,10 @@ namespace ssx::quadrotor {
 
 /// The quadrotor driver's choice of controller, and this one's settings (part "controller").
 inline constexpr ssx_plugin_param kControllerChoiceParameters[] = {
-    param::choice("controller", "auto", "auto telekyb crazyflie_pid",
-                  "the flight controller: TeleKyb's cascade (the mk_quad's; every command level), the Crazyflie "
-                  "firmware's PID cascade (four rotors in an X; position and velocity commands), or auto: the "
-                  "preset's (crazyflie_pid for the crazyflie, telekyb for the others)"),
+    param::choice("controller", "telekyb", "telekyb crazyflie_pid",
+                  "the flight controller: TeleKyb's cascade (the mk_quad's; every command level) or the Crazyflie "
+                  "firmware's PID cascade (four rotors in an X; position and velocity commands; the crazyflie "
+                  "preset's)"),
     param::real("crazyflie_position_rate_hz", "100", "Hz", param::positive(),
                 "crazyflie_pid: position and velocity loops (its period a whole multiple of the driver's)"),
     param::real("crazyflie_attitude_rate_hz", "500", "Hz", param::positive(),
@@ -122,7 +122,13 @@ class CrazyfliePidController final : public FlightController {
   void setRuns(std::int64_t attitude_runs, std::int64_t position_runs, double run_seconds);
   /// A vehicle placed in the air: the vertical velocity loop's integral holds `weight` (N) from the
   /// first step, as it would after hovering a while.
-  void startInAir(double weight);
+  void startInAir(double weight) override;
+  void batteryVoltage(double volts, bool initial) override {
+    if (initial)
+      setBatteryVoltage(volts);
+    else
+      measureBattery(volts);
+  }
 
   /// Position and velocity (the commander's high-level modes), attitude (cmd_rpyt: roll and pitch
   /// absolute, a yaw rate, a thrust) and body rates (the rate mode of the firmware's controller:

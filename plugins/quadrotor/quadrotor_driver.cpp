@@ -30,9 +30,7 @@ struct QuadrotorDriver::Config {
         downwash_params(DownwashParams::of(params)),
         controller(params),
         reference(params),
-        crazyflie_pid(params.get<std::string>("controller") == "crazyflie_pid" ||
-                      (params.get<std::string>("controller") == "auto" &&
-                       params.get<std::string>("preset") == "crazyflie")),
+        crazyflie_pid(params.get<std::string>("controller") == "crazyflie_pid"),
         crazyflie_battery(params.get<double>("crazyflie_battery_volts")) {
     crazyflie_gains.position_rate_hz = params.get<double>("crazyflie_position_rate_hz");
     crazyflie_gains.attitude_rate_hz = params.get<double>("crazyflie_attitude_rate_hz");
@@ -123,8 +121,9 @@ void QuadrotorDriver::validate(const Descriptor& params, const PluginContext& co
   const auto frame =
       context.shared<Airframe>(frameKey(shared_config.get(), a), [&] { return Airframe(config, params, a); });
   if (config.vehicle.battery && config.vehicle.battery->compensated && !config.crazyflie_pid)
-    throw params.errorAt("battery", "the crazyflie's battery is compensated by its firmware's controller: fly "
-                                    "controller=\"crazyflie_pid\" (or \"auto\") with battery=\"true\"");
+    throw params.errorAt("battery", "this battery is compensated by the flight controller (battery_compensated, the "
+                                    "crazyflie's firmware): fly "
+                                    "controller=\"crazyflie_pid\" with battery=\"true\"");
   if (config.crazyflie_pid) {
     // (checked only for this controller: the rates mean nothing to TeleKyb's)
     const double period = toSeconds(context.period());
@@ -188,11 +187,17 @@ void QuadrotorDriver::configure(const Descriptor& params, PluginSetup& setup) {
   const Sensor* imu = firstSensorOf<ImuMeasurement>(a);
   if (imu == nullptr) throw params.error("a quadrotor needs an IMU: add <sensor plugin=\"imu\"/> to the artifact");
   const PluginContext context{&env, &a, periodSteps(), env.timestep(), {}};
-  controller_.configure(c.controller, frame->controller, c.vehicle.rotor, params, context, *imu, setup, frame_key);
-  crazyflie_.reset();
-  if (c.crazyflie_pid) crazyflie_ = c.crazyflie(frame->rotors, context);
-  // the firmware has measured the battery since it was switched on
-  if (crazyflie_ && vehicle_.hasBattery()) crazyflie_->setBatteryVoltage(vehicle_.batteryVoltage());
+  if (c.crazyflie_pid) {
+    flight_ = c.crazyflie(frame->rotors, context);
+  } else {
+    // (the one asked before the start, holding any command given then)
+    auto* telekyb = dynamic_cast<TeleKybController*>(flight_.get());
+    if (telekyb == nullptr) flight_ = std::make_unique<TeleKybController>();
+    telekyb = static_cast<TeleKybController*>(flight_.get());
+    telekyb->configure(c.controller, frame->controller, c.vehicle.rotor, params, context, *imu, setup, frame_key);
+  }
+  // (a firmware has measured the battery since it was switched on)
+  if (vehicle_.hasBattery()) flight_->batteryVoltage(vehicle_.batteryVoltage(), true);
   if (const Sensor* pose = firstSensorOf<PoseMeasurement>(a)) {
     have_pose_ = true;
     setup.subscribe<PoseMeasurement>(*pose, [this](const PoseMeasurement& m) { pose_ = m; });
@@ -212,20 +217,16 @@ void QuadrotorDriver::configure(const Descriptor& params, PluginSetup& setup) {
     const double hover = std::sqrt(frame->controller.mass * g / (static_cast<double>(n) * c.vehicle.rotor.thrust_coefficient));
     commanded_speeds_.fill(hover);
     vehicle_.spinAt(std::span(commanded_speeds_).first(n));
-    controller_.startInAir(frame->controller.mass * g);
-    if (crazyflie_) crazyflie_->startInAir(frame->controller.mass * g);
+    flight_->startInAir(frame->controller.mass * g);
   } else {
-    controller_.startInAir(0);
+    flight_->startInAir(0);
   }
 }
 
 void QuadrotorDriver::setCommand(const Command& command) {
   if (const std::string why = refusal(command); !why.empty()) throw std::invalid_argument("quadrotor: " + why);
   if (command.level == CommandLevel::Position) references_.setExternal(command.setpoint);
-  if (crazyflie_)
-    crazyflie_->setCommand(command, artifact().state().pose.position);
-  else
-    controller_.setCommand(command, artifact().state().pose.position);
+  flight_->setCommand(command, artifact().state().pose.position);
 }
 
 Command QuadrotorDriver::currentCommand() const {
@@ -251,12 +252,8 @@ void QuadrotorDriver::step(const StepInfo& info) {
   const double t = toSeconds(info.time);
   const std::size_t n = vehicle_.rotorCount();
   // the controller chooses the rotor speeds, the vehicle spins up to them
-  if (crazyflie_) {
-    if (vehicle_.hasBattery()) crazyflie_->measureBattery(vehicle_.batteryVoltage());
-    crazyflie_->step(info.step / periodSteps(), t, *this, std::span(commanded_speeds_).first(n));
-  }
-  else
-    controller_.step(info.step / periodSteps(), t, *this, std::span(commanded_speeds_).first(n));
+  if (vehicle_.hasBattery()) flight_->batteryVoltage(vehicle_.batteryVoltage(), false);
+  flight_->step(info.step / periodSteps(), t, *this, std::span(commanded_speeds_).first(n));
   if (references_.source() == References::Source::Follow) {
     // down on the robot it follows: the motors stop for good (it rides on the deck)
     Pose at;
@@ -335,8 +332,7 @@ void QuadrotorDriver::saveState(StateWriter& out) const {
   vehicle_.saveState(out);
   out.write(std::vector<double>(commanded_speeds_.begin(),
                                 commanded_speeds_.begin() + static_cast<std::ptrdiff_t>(vehicle_.rotorCount())));
-  controller_.saveState(out);
-  if (crazyflie_) crazyflie_->saveState(out);
+  flight_->saveState(out);
   references_.saveState(out);
   wind_.saveState(out);
   ssx::save(out, pose_);
@@ -350,8 +346,7 @@ void QuadrotorDriver::loadState(StateReader& in) {
   if (commanded.size() != vehicle_.rotorCount())
     throw StateError("quadrotor: the saved commanded speeds do not fit this driver");
   std::copy(commanded.begin(), commanded.end(), commanded_speeds_.begin());
-  controller_.loadState(in);
-  if (crazyflie_) crazyflie_->loadState(in);
+  flight_->loadState(in);
   references_.loadState(in);
   wind_.loadState(in);
   ssx::load(in, pose_);

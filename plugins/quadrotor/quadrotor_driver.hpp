@@ -2,13 +2,13 @@
 // quadrotor: the driver of a quadrotor, assembled from parts that change for different reasons:
 //   vehicle.hpp             the rigid body, rotors and motors, battery
 //   effects.hpp             wind (the scene's <wind> and the artifact's own), ground effect, downwash
-//   telekyb_controller.hpp  the flight controller (controller.hpp: the interface), taking commands
-//                           at the five command levels (ssx/command.hpp)
-//   crazyflie_pid.hpp       the Crazyflie firmware's controller instead (controller="crazyflie_pid")
+//   controller.hpp          the flight controller's interface; the driver holds one, chosen at load:
+//   telekyb_controller.hpp    TeleKyb's, taking commands at the five command levels (ssx/command.hpp)
+//   crazyflie_pid.hpp         the Crazyflie firmware's (controller="crazyflie_pid")
 //   references.hpp          hover, figure eights, formation, trajectory file, external set-points
 //
 // Parameters: each part's table, joined in kParameters (`ssx plugins --params quadrotor` prints
-// them by part). Every RotorParams field by its name overrides the preset.
+// them by part). The preset (presets/quadrotor/NAME.xml) gives every value the element does not.
 //
 // Timing: the driver runs every `period` steps and integrates its motors over that period; the
 // controller's loops run every k of its runs (checked while loading).
@@ -75,18 +75,15 @@ class QuadrotorDriver final : public Driver,
 
   /// For tests: the parts.
   const RotorModel& rotors() const { return vehicle_.rotors(); }
-  const TeleKybController& controller() const { return controller_; }
-  /// The Crazyflie firmware's controller, when it flies this one (controller="crazyflie_pid").
-  const CrazyfliePidController* crazyflie() const { return crazyflie_.get(); }
+  /// The flight controller, chosen at load: TeleKybController, or CrazyfliePidController
+  /// (controller="crazyflie_pid").
+  const FlightController& controller() const { return *flight_; }
 
  private:
   struct Config;    // the parameters, parsed: one per parameter set (PluginSetup::shared)
   struct Airframe;  // what the rotors' places make of them: one per parameter set and artifact type
 
-  // the controller flying it: TeleKyb's (held inline: every step reads it), or the Crazyflie's
-  const FlightController& flight() const {
-    return crazyflie_ ? static_cast<const FlightController&>(*crazyflie_) : controller_;
-  }
+  const FlightController& flight() const { return *flight_; }
 
   // FlightInputs, for the controller
   Setpoint reference(double t, double dt) override { return references_.at(t, dt); }
@@ -103,8 +100,9 @@ class QuadrotorDriver final : public Driver,
   // they all point to, which stays in the cache; what only some features read comes last.
   bool have_pose_ = false;
   bool ground_effect_ = false;
-  std::unique_ptr<CrazyfliePidController> crazyflie_;  // controller="crazyflie_pid" (every step asks)
-  TeleKybController controller_;
+  // the controller flying it, chosen at load; before, TeleKyb's, which answers what a program asks
+  // before the start (the command levels it takes) and keeps a command given then
+  std::unique_ptr<FlightController> flight_ = std::make_unique<TeleKybController>();
   std::array<double, kMaxRotors> commanded_speeds_{};  // the first rotorCount() in use
   bool landed_ = false;  // reference="follow": it came down on the robot it follows, motors stopped
   Vehicle vehicle_;

@@ -15,45 +15,6 @@ namespace ssx::quadrotor {
 
 namespace fx = fixed;
 
-std::optional<RotorParams> preset(const std::string& name) {
-  RotorParams p;  // the defaults are mk_quad
-  if (name == "mk_quad") return p;
-  if (name == "hummingbird") {
-    p.rotor_radius = 0.1;  // 8-inch propellers (RotorS's hummingbird)
-    p.thrust_coefficient = 8.54858e-6;
-    p.moment_constant = 0.016;
-    p.max_rotor_speed = 838.0;
-    return p;
-  }
-  if (name == "crazyflie") {
-    // published values, each with its source in docs/quadrotor-reference.md (section 1, "crazyflie")
-    p.thrust_coefficient = 2.27e-8;       // Bitcraze's 2015 thrust stand: 57.9 g at 23,882 rpm
-    p.moment_constant = 6.9929e-3;        // the firmware's 2.1+ thrust-to-torque (platform_defaults_cf2.h)
-    p.time_constant_up = 0.065;           // Förster 2015: a first-order pole at -15.47 1/s
-    p.time_constant_down = 0.065;
-    p.max_rotor_speed = 2501.0;           // Bitcraze's 2015 table: 2,501 rad/s (0.142 N) at 93.75 % PWM
-    p.rotor_drag_coefficient = 9.1785e-7; // Förster 2015: K_aero,xy, force = -K (sum of rotor speeds) v
-    p.rolling_moment_coefficient = 0.0;   // none published
-    p.rotor_radius = 0.0231;              // as gym-pybullet-drones' cf2x
-    return p;
-  }
-  return std::nullopt;
-}
-
-BatteryParams batteryPreset(const std::string& name) {
-  BatteryParams b;  // the defaults are the mk_quad's
-  if (name != "crazyflie") return b;
-  b.full_voltage = 4.2;         // one LiPo cell, full
-  b.empty_voltage = 3.2;        // EST: the firmware's low-battery threshold (pm_stm32f4.c)
-  b.capacity = 0.25;            // Bitcraze: the Crazyflie 2.1's 250 mAh pack
-  b.resistance = 0.15;          // EST: a small 1S pack
-  b.efficiency = 0.45;          // EST: 250 mAh lasts about 7 min of hover at 29 g, Bitcraze's flight time
-  b.nominal_voltage = 3.7;      // (unused: compensated)
-  b.zero_thrust_voltage = 0.0;  // (unused: compensated)
-  b.compensated = true;
-  return b;
-}
-
 // --- allocation and rotors -------------------------------------------------------------------------
 
 Allocation::Allocation(const std::vector<Rotor>& rotors, const RotorParams& p) {

@@ -52,7 +52,7 @@ double groundEffectGain(double height, double radius);
 /// or, `compensated`, not at all: the flight controller reads the voltage and compensates (the
 /// Crazyflie's firmware; its controller then gives the thrust the voltage allows).
 /// The defaults are the mk_quad's: EST marks guesses for a 4S 2200 mAh pack (no published figure
-/// for the MK's). batteryPreset() has each preset's.
+/// for the MK's). The presets (examples/presets/quadrotor) give each vehicle's.
 struct BatteryParams {
   double full_voltage = 16.8;          ///< V, open circuit when full (4S LiPo, 4.2 V a cell)
   double empty_voltage = 14.0;         ///< V, open circuit when the capacity is drawn (EST, 3.5 V a cell)
@@ -64,10 +64,6 @@ struct BatteryParams {
   double initial_charge = 1.0;         ///< fraction of the capacity at the start
   bool compensated = false;            ///< the controller compensates: no thrust law here
 };
-
-/// The battery of a preset: the MikroKopter's 4S law for "mk_quad" and "hummingbird"; for
-/// "crazyflie" its 1S 250 mAh pack, compensated by its firmware (docs/quadrotor-reference.md).
-BatteryParams batteryPreset(const std::string& name);
 
 class Battery {
  public:
@@ -136,9 +132,6 @@ class DrydenTurbulence {
   };
   std::array<Discrete, 2> discrete_{};
 };
-
-/// The named presets: "mk_quad" (default), "hummingbird", "crazyflie". Empty if unknown.
-std::optional<RotorParams> preset(const std::string& name);
 
 /// The most rotors the inner loop's mixer drives.
 inline constexpr std::size_t kMaxRotors = 8;

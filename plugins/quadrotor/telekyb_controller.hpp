@@ -82,7 +82,7 @@ class TeleKybController final : public FlightController {
   void configure(const TeleKybParams& c, const TeleKybAirframe& frame, const RotorParams& rotor, const Descriptor& params,
                  const PluginContext& context, const Sensor& imu, PluginSetup& setup, const std::string& inner_key);
   /// A vehicle placed in the air holds its weight from the first step.
-  void startInAir(double weight);
+  void startInAir(double weight) override;
 
   bool accepts(CommandLevel level) const override { return level != CommandLevel::Wheels; }
   CommandLevel level() const override { return level_; }

@@ -13,12 +13,12 @@ std::vector<std::string> words(const std::string& text) {
   return out;
 }
 
-// a value the parameters give, else the preset's
+// a value the parameters give (the element's, else its preset's), else the model's default
 void presetOr(const Descriptor& params, const char* key, double& value) { value = params.get<double>(key, value); }
 
-// the rotor and motor constants: the preset, then any override (values checked while loading)
+// the rotor and motor constants (values checked while loading)
 RotorParams rotorParams(const Descriptor& params) {
-  RotorParams rp = *preset(params.get<std::string>("preset"));
+  RotorParams rp;
   presetOr(params, "thrust_coefficient", rp.thrust_coefficient);
   presetOr(params, "moment_constant", rp.moment_constant);
   presetOr(params, "time_constant_up", rp.time_constant_up);
@@ -38,9 +38,9 @@ RotorParams rotorParams(const Descriptor& params) {
   return rp;
 }
 
-// the battery: the preset's, then any override; its voltages checked against each other
+// the battery; its voltages checked against each other
 BatteryParams batteryParams(const Descriptor& params) {
-  BatteryParams bp = batteryPreset(params.get<std::string>("preset"));
+  BatteryParams bp;
   presetOr(params, "battery_full_voltage", bp.full_voltage);
   presetOr(params, "battery_empty_voltage", bp.empty_voltage);
   presetOr(params, "battery_capacity", bp.capacity);
@@ -49,6 +49,7 @@ BatteryParams batteryParams(const Descriptor& params) {
   presetOr(params, "battery_initial_charge", bp.initial_charge);
   presetOr(params, "battery_nominal_voltage", bp.nominal_voltage);
   presetOr(params, "battery_zero_thrust_voltage", bp.zero_thrust_voltage);
+  bp.compensated = params.get<bool>("battery_compensated");
   if (!(bp.empty_voltage < bp.full_voltage) || !(bp.nominal_voltage > bp.zero_thrust_voltage) ||
       !(bp.empty_voltage > bp.zero_thrust_voltage))
     throw params.error("battery: needs battery_zero_thrust_voltage < battery_empty_voltage < battery_full_voltage "

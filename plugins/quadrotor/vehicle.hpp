@@ -16,34 +16,59 @@
 
 namespace ssx::quadrotor {
 
+// `preset`: the quadrotor's presets (libssx's presets: a text parameter named `preset` whose
+// `choices` name the family, here for every class that flies this vehicle)
+inline constexpr ssx_plugin_param kPresetParameter = [] {
+  ssx_plugin_param p = param::text("preset", "mk_quad",
+                                   "the values to start from, for every parameter not given: a preset's name "
+                                   "(presets/quadrotor/NAME.xml in the artifact path or installed: mk_quad, "
+                                   "hummingbird, crazyflie) or a preset file's path");
+  p.choices = "quadrotor";
+  return p;
+}();
+
 inline constexpr ssx_plugin_param kVehicleParameters[] = {
-    param::choice("preset", "mk_quad", "mk_quad hummingbird crazyflie", "rotor and motor constants to start from"),
-    param::real("thrust_coefficient", "", "N s^2", param::positive(), "thrust per squared rotor speed (default: the preset's)"),
+    kPresetParameter,
+    param::real("thrust_coefficient", "", "N s^2", param::positive(),
+                "thrust per squared rotor speed (default: the preset's)"),
     param::real("moment_constant", "", "m", param::positive(), "drag torque per thrust (default: the preset's)"),
-    param::real("time_constant_up", "", "s", param::positive(), "motor time constant, speeding up (default: the preset's)"),
-    param::real("time_constant_down", "", "s", param::positive(), "motor time constant, slowing down (default: the preset's)"),
+    param::real("time_constant_up", "", "s", param::positive(),
+                "motor time constant, speeding up (default: the preset's)"),
+    param::real("time_constant_down", "", "s", param::positive(),
+                "motor time constant, slowing down (default: the preset's)"),
     param::real("max_rotor_speed", "", "rad/s", param::positive(), "(default: the preset's)"),
     param::real("min_rotor_speed", "", "rad/s", param::nonNegative(), "below max_rotor_speed (default: the preset's)"),
     param::real("rotor_drag_coefficient", "", "N s/m", param::nonNegative(), "rotor drag (default: the preset's)"),
-    param::real("rolling_moment_coefficient", "", "N m s/m", param::nonNegative(), "rolling moment (default: the preset's)"),
-    param::real("rotor_radius", "", "m", param::positive(), "propeller radius, for ground effect (default: the preset's)"),
+    param::real("rolling_moment_coefficient", "", "N m s/m", param::nonNegative(),
+                "rolling moment (default: the preset's)"),
+    param::real("rotor_radius", "", "m", param::positive(),
+                "propeller radius, for ground effect (default: the preset's)"),
     param::real("rotor_inertia", "", "kg m^2", param::nonNegative(), "(default: the preset's)"),
     param::text("rotors", "rotor0 rotor1 rotor2 rotor3", "physic node names of the rotors (4 to 8)"),
     param::text("directions", "1 -1 1 -1", "spin of each rotor: 1 counter-clockwise seen from above, -1 clockwise"),
-    param::flag("battery", "false", "a battery whose voltage sags with current and charge drawn; thrust at a fixed command follows it "
+    param::flag("battery", "false",
+                "a battery whose voltage sags with current and charge drawn; thrust at a fixed command follows it "
                 "(the crazyflie's firmware compensates: its thrust holds until the voltage cannot give it)"),
-    param::real("battery_full_voltage", "", "V", param::positive(), "open circuit when full (default: the preset's; mk_quad 16.8)"),
+    param::real("battery_full_voltage", "", "V", param::positive(),
+                "open circuit when full (default: the preset's; mk_quad 16.8)"),
     param::real("battery_empty_voltage", "", "V", param::positive(),
                 "open circuit when the capacity is drawn (default: the preset's; mk_quad 14, EST)"),
     param::real("battery_capacity", "", "Ah", param::positive(), "capacity (default: the preset's; mk_quad 2.2, EST)"),
-    param::real("battery_resistance", "", "ohm", param::nonNegative(), "internal resistance (default: the preset's; mk_quad 0.04, EST)"),
+    param::real("battery_resistance", "", "ohm", param::nonNegative(),
+                "internal resistance (default: the preset's; mk_quad 0.04, EST)"),
     param::real("battery_efficiency", "", "", param::positive() & param::atMost(1),
                 "mechanical / electrical power (default: the preset's; mk_quad 0.6, EST)"),
-    param::real("battery_initial_charge", "1", "", param::nonNegative() & param::atMost(1), "fraction of the capacity at the start"),
+    param::flag(
+        "battery_compensated", "false",
+        "the flight controller reads the voltage and compensates: no thrust law here (the crazyflie's firmware; "
+        "needs controller=\"crazyflie_pid\")"),
+    param::real("battery_initial_charge", "1", "", param::nonNegative() & param::atMost(1),
+                "fraction of the capacity at the start"),
     param::real("battery_nominal_voltage", "", "V", param::positive(),
                 "voltage at which the rotor model's thrust holds (MK law; default: the preset's; mk_quad 15.5)"),
     param::real("battery_zero_thrust_voltage", "", "V", param::nonNegative(),
-                "the MK law's offset: thrust at a fixed command is proportional to U minus this (default: the preset's; mk_quad 7.575)"),
+                "the MK law's offset: thrust at a fixed command is proportional to U minus this (default: the "
+                "preset's; mk_quad 7.575)"),
 };
 
 /// The vehicle's constants from its parameters, checked against each other.
@@ -90,7 +115,9 @@ class Vehicle {
     body.addTorque(torque, Frame::Local);
   }
   /// Adds a world-frame force at the centre of mass.
-  void push(PhysicNode& body, const Vec3& force) const { body.addForce(force, Frame::World, com_in_root_, Frame::Local); }
+  void push(PhysicNode& body, const Vec3& force) const {
+    body.addForce(force, Frame::World, com_in_root_, Frame::Local);
+  }
 
   void saveState(StateWriter& out) const;
   void loadState(StateReader& in);

@@ -5,6 +5,7 @@
 #include "render/scene_cameras.hpp"
 #include "engines/state_checks.hpp"
 #include "world/world.hpp"
+#include "plugin/presets.hpp"
 #include "base/worker_pool.hpp"
 
 #include <ssx/environment.hpp>
@@ -289,13 +290,22 @@ void Environment::checkDeclaredParameters() {
   // instances made by the class loader get their declared defaults and checks here too when a
   // program attached them itself (the scene loader has done it already: then nothing changes)
   std::string errors;
+  // presets by name from the installed directory (the scene loader also searches its artifact path)
+  std::optional<detail::Presets> presets;
   // `what` names the plugin, made only when its parameters are checked here
   auto check = [&](const void* instance, Descriptor& params, const Artifact* a, std::int64_t period, auto what) {
     if (!params.declarations().empty()) return;  // checked already (by the scene loader)
     const ssx_plugin_class* type = loader_->classOf(instance);
     if (type == nullptr) return;
     const PluginContext context{this, a, period, settings_.timestep, {}};
-    std::vector<Diagnostic> found = checkParameters({type->params, type->param_count}, params, context, what());
+    const std::span<const ssx_plugin_param> declarations{type->params, type->param_count};
+    if (!presets) {
+      std::vector<std::filesystem::path> dirs;
+      if (auto installed = detail::Presets::installedDirectory(); !installed.empty()) dirs.push_back(installed);
+      presets.emplace(std::move(dirs), kDefaultMaxInputBytes);
+    }
+    std::vector<Diagnostic> found = presets->apply(params, type->name, declarations, what());
+    if (found.empty()) found = checkParameters(declarations, params, context, what());
     // and the class's own checks (what a scene's plugins get from the loader), before anything is
     // initialised: a plugin added by a program is refused with the environment still in setup
     const bool declared_ok = std::none_of(found.begin(), found.end(), [](const Diagnostic& d) {

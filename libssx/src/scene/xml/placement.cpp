@@ -36,6 +36,24 @@ void SceneLoader::checkPlugin(Environment& env, const void* instance, Descriptor
   const ssx_plugin_class* type = env.classLoader().classOf(instance);
   if (type == nullptr) return;
   const std::span<const ssx_plugin_param> declarations{type->params, type->param_count};
+  // a preset's values first: then they are checked as the element's own (the preset file is an input)
+  if (!presets_) {
+    std::vector<fs::path> dirs;
+    for (const fs::path& d : options_.artifact_path) dirs.push_back(d / "presets");
+    if (options_.search_installed_artifacts)
+      if (fs::path installed = Presets::installedDirectory(); !installed.empty()) dirs.push_back(installed);
+    presets_.emplace(std::move(dirs), options_.max_input_bytes);
+  }
+  fs::path preset_file;
+  if (auto problems = presets_->apply(params, type->name, declarations, what, &preset_file); !problems.empty()) {
+    // (once: a swarm's members share the preset, and its problem)
+    for (auto& d : problems)
+      if (reported_presets_.insert(d.str()).second) add(std::move(d));
+    for (const auto& a : params.attributes()) a.used = true;
+    params.setDeclarations(declarations);
+    return;
+  }
+  if (!preset_file.empty()) files_.addInput(preset_file);
   // the declared checks read only the values, the period and the time step: once the parameters
   // of a declaration and a placing element passed, the next member of that swarm differs only in
   // the values where its index was put ({i}), and only those need checking
@@ -49,7 +67,9 @@ void SceneLoader::checkPlugin(Environment& env, const void* instance, Descriptor
     if (overrides != nullptr)
       for (const auto& a : overrides->attributes())
         if (a.value.find("{i}") != std::string::npos) per_member.push_back(a.key);
-    clean_checks_.emplace(key, std::move(per_member));
+    // (a preset that differs between members brings values that differ: each member checked whole)
+    if (std::find(per_member.begin(), per_member.end(), "preset") == per_member.end())
+      clean_checks_.emplace(key, std::move(per_member));
   }
   // the files it writes, with the run's others (only when its values are of the declared types)
   if (found.empty())

@@ -11,6 +11,8 @@
 #include <ssx/scene.hpp>
 #include <ssx/scene_model.hpp>
 
+#include "plugin/presets.hpp"
+
 #include <array>
 #include <deque>
 #include <filesystem>
@@ -276,7 +278,9 @@ class SceneLoader {
   std::vector<std::int64_t> stamps_;  // per diagnostic: its stage
   std::int64_t stage_ = 0;
   bool parsed_ = false;
-  RunFiles files_;  // the inputs, and the outputs claimed so far (build)  // this loader parsed the model it builds (its problems were reported then)
+  RunFiles files_;  // the inputs, and the outputs claimed so far (build)
+  std::optional<Presets> presets_;  // made at the first plugin checked (build)
+  std::set<std::string> reported_presets_;  // the presets' problems reported (each once)
   std::vector<std::int64_t> placement_stage_;  // per placement of the model parsed: its entity's parse stage
   // (class, declaration, placing element, period) whose check found nothing -> the parameters
   // whose values differ between the members (they hold {i}), for checkPlugin

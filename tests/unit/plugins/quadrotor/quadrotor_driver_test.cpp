@@ -4,7 +4,10 @@
 #include <catch2/catch.hpp>
 
 #include <cmath>
+#include <stdlib.h>
+
 #include <filesystem>
+#include <fstream>
 #include <vector>
 
 using namespace ssx;
@@ -186,7 +189,7 @@ TEST_CASE("the crazyflie's 1S battery: its firmware holds the thrust while the v
   CHECK(heightAfter("battery_initial_charge=\"0\" battery_resistance=\"1\"", 3) < 0.5);
   // the compensation is the firmware's: TeleKyb's controller would fly the pack uncompensated
   CHECK_THROWS_WITH(quadScene("<driver battery=\"true\" controller=\"telekyb\"/>", 1.0, 1, "crazyflie"),
-                    Catch::Contains("error: <driver>") && Catch::Contains("compensated by its firmware"));
+                    Catch::Contains("error: <driver>") && Catch::Contains("compensated by the flight controller"));
 }
 
 TEST_CASE("a crazyflie with its battery, saved mid-flight and restored, continues bitwise", "[quadrotor][crazyflie][determinism]") {
@@ -202,4 +205,39 @@ TEST_CASE("a crazyflie with its battery, saved mid-flight and restored, continue
   b.environment->step(800);
   CHECK(c.environment->stateHash() == a.environment->stateHash());
   CHECK(b.environment->stateHash() == a.environment->stateHash());
+}
+
+TEST_CASE("a vehicle from a preset file: by name from the artifact path, or by path, and the element's values win",
+          "[quadrotor][presets]") {
+  std::string pattern = (std::filesystem::temp_directory_path() / "ssx_quad_presets_XXXXXX").string();
+  REQUIRE(mkdtemp(pattern.data()) != nullptr);
+  const std::filesystem::path dir = pattern;
+  std::filesystem::create_directories(dir / "presets" / "quadrotor");
+  // motors too weak to carry the mk_quad's 0.82 kg (hover needs 448 rad/s)
+  std::ofstream(dir / "presets" / "quadrotor" / "weak.xml")
+      << "<preset class=\"quadrotor\">\n  <param name=\"max_rotor_speed\" value=\"300\"/>\n</preset>\n";
+  SceneOptions options;
+  options.artifact_path = {dir};
+  auto heightAfter = [&](const std::string& driver, std::uint64_t* hash = nullptr) {
+    const std::string xml = "<scene><environment timestep=\"0.002\" seed=\"3\"/><type name=\"q\" file=\"mk_quad.xml\"/>"
+                            "<ground/><artifact name=\"quad\" type=\"q\" xyz=\"0 0 2\">" +
+                            driver + "</artifact></scene>";
+    Scene s = loadSceneFromString(xml, "quad.xml", kArtifacts, options);
+    s.environment->step(500);  // 1 s
+    if (hash != nullptr) *hash = s.environment->stateHash();
+    return s.environment->findArtifact("quad")->pose().position.z();
+  };
+  std::uint64_t plain = 0, named = 0, by_path = 0;
+  CHECK(std::abs(heightAfter("", &plain) - 2) < 0.02);
+  // the installed mk_quad preset is the default written out: the same bits
+  (void)heightAfter("<driver preset=\"mk_quad\"/>", &named);
+  CHECK(named == plain);
+  (void)heightAfter("<driver preset=\"" + (kArtifacts.parent_path() / "presets/quadrotor/mk_quad.xml").string() + "\"/>",
+                    &by_path);
+  CHECK(by_path == plain);
+  // the user's weak motors: it falls (1 s of free fall is 4.9 m; it is on the ground)
+  CHECK(heightAfter("<driver preset=\"weak\"/>") < 0.5);
+  // unless the element gives its own
+  CHECK(std::abs(heightAfter("<driver preset=\"weak\" max_rotor_speed=\"940\"/>") - 2) < 0.02);
+  std::filesystem::remove_all(dir);
 }

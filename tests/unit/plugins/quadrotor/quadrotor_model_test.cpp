@@ -29,7 +29,7 @@ std::vector<Rotor> plusRotors(double arm) {
 
 TEST_CASE("rotor speeds for hover balance the weight within 1 %", "[quadrotor]") {
   // the mk_quad preset with its model mass; the rotors held at w_h = sqrt(m g / (4 kF))
-  const RotorParams p = *preset("mk_quad");
+  const RotorParams p = RotorParams{};
   const double m = 0.82, g = 9.81;
   const double w_h = std::sqrt(m * g / (4 * p.thrust_coefficient));
   EnvironmentSettings s;
@@ -58,7 +58,7 @@ TEST_CASE("rotor speeds for hover balance the weight within 1 %", "[quadrotor]")
 }
 
 TEST_CASE("a motor step reaches 63.2 % at the up time constant", "[quadrotor]") {
-  const RotorParams p = *preset("mk_quad");
+  const RotorParams p = RotorParams{};
   RotorModel model(plusRotors(0.225), p);
   const double dt = 1e-5;
   const auto steps = static_cast<int>(std::llround(p.time_constant_up / dt));
@@ -79,7 +79,7 @@ TEST_CASE("a single counter-clockwise rotor yaws the body clockwise", "[quadroto
   Artifact& a = env.addArtifact("quad", test::at(0, 0, 5));
   a.addPhysicRoot(test::boxBody(Vec3(0.2, 0.2, 0.05), 0.82, &j));
   // one CCW rotor at the centre: its reaction torque alone
-  auto model = std::make_shared<RotorModel>(std::vector<Rotor>{{Vec3::Zero(), 1}}, *preset("mk_quad"));
+  auto model = std::make_shared<RotorModel>(std::vector<Rotor>{{Vec3::Zero(), 1}}, RotorParams{});
   a.setDriver(std::make_unique<test::LambdaDriver>([model](Driver& d, const StepInfo&) {
     model->step(0.001, std::vector<double>{500.0});
     Vec3 f, t;
@@ -92,8 +92,11 @@ TEST_CASE("a single counter-clockwise rotor yaws the body clockwise", "[quadroto
 }
 
 TEST_CASE("the allocation times its inverse is the identity", "[quadrotor]") {
-  for (const char* name : {"mk_quad", "hummingbird", "crazyflie"}) {
-    const RotorParams p = *preset(name);
+  // the mk_quad's constants, and a crazyflie's (kF three orders of magnitude smaller)
+  RotorParams small;
+  small.thrust_coefficient = 2.27e-8;
+  small.moment_constant = 6.9929e-3;
+  for (const RotorParams& p : {RotorParams{}, small}) {
     const Allocation al(plusRotors(0.17), p);
     CHECK((al.matrix() * al.inverse() - Eigen::Matrix4d::Identity()).cwiseAbs().maxCoeff() < 1e-9);
     // and the columns follow the spec: rotor on +y gives +tau_x, a CCW rotor gives -tau_z
@@ -106,7 +109,7 @@ TEST_CASE("the allocation times its inverse is the identity", "[quadrotor]") {
     const double ang = i * std::numbers::pi / 3;
     hexa.push_back({Vec3(0.3 * std::cos(ang), 0.3 * std::sin(ang), 0), i % 2 == 0 ? 1 : -1});
   }
-  const Allocation al(hexa, *preset("mk_quad"));
+  const Allocation al(hexa, RotorParams{});
   CHECK((al.matrix() * al.inverse() - Eigen::Matrix4d::Identity()).cwiseAbs().maxCoeff() < 1e-9);
 }
 
@@ -171,7 +174,7 @@ TEST_CASE("fixed-point helpers: the fast square root is the bitwise one's intege
 namespace {
 
 InnerLoopParams mkInnerParams(double kp, double kd, double kyaw) {
-  const RotorParams rp = *preset("mk_quad");
+  const RotorParams rp = RotorParams{};
   const Allocation al(plusRotors(0.225), rp);
   InnerLoopParams p;
   p.attitude_kp = kp;
@@ -297,7 +300,7 @@ TEST_CASE("the integer inner loop does not overflow at the largest gains", "[qua
 }
 
 TEST_CASE("ground effect: the thrust gain at three heights is Cheeseman-Bennett's", "[quadrotor][fidelity]") {
-  const RotorParams p = *preset("mk_quad");
+  const RotorParams p = RotorParams{};
   const double R = p.rotor_radius;
   RotorModel model(plusRotors(0.225), p);
   model.setSpeeds(std::vector<double>{400, 410, 420, 430});
@@ -321,7 +324,7 @@ TEST_CASE("ground effect in flight: a quadrotor low over the ground gets the gai
           "[quadrotor][fidelity]") {
   // from hover speed; the difference in vertical acceleration with and without the effect
   // is (gain - 1) times the thrust, about m g
-  const double R = preset("mk_quad")->rotor_radius;
+  const double R = RotorParams{}.rotor_radius;
   for (double h : {0.15, 0.25, 0.5}) {  // rotor height; the rotors sit 2 cm above the body's origin
     double accel[2];
     for (int on = 0; on < 2; ++on) {
@@ -341,7 +344,7 @@ TEST_CASE("ground effect in flight: a quadrotor low over the ground gets the gai
 TEST_CASE("battery: thrust at a fixed command follows (U - 7.575 V), the voltage sags with current", "[quadrotor][fidelity]") {
   BatteryParams bp;
   Battery battery(bp);
-  RotorModel model(plusRotors(0.225), *preset("mk_quad"));
+  RotorModel model(plusRotors(0.225), RotorParams{});
   model.setSpeeds(std::vector<double>{500, 500, 500, 500});
   auto thrustAt = [&](double volts) {
     model.setThrustGains(std::vector<double>(4, battery.thrustGain(volts)));
@@ -539,7 +542,7 @@ TEST_CASE("wind: a hovering quadrotor in a 3 m/s wind is pushed by its rotors' d
   const double windy =
       accelerationAfterTwoSteps("<artifact name=\"q\" type=\"q\" xyz=\"0 0 1\"><driver wind=\"3 0 0\"/></artifact>", "q").x();
   // four rotors near hover speed: F = 4 w_h lambda1 V
-  const RotorParams p = *preset("mk_quad");
+  const RotorParams p = RotorParams{};
   const double w_h = std::sqrt(0.82 * 9.81 / (4 * p.thrust_coefficient));
   CHECK((windy - still) * 0.82 == Approx(4 * w_h * p.rotor_drag_coefficient * 3.0).epsilon(0.02));
 }

@@ -62,7 +62,7 @@ TEST_CASE("attitude level: level attitude at thrust m g holds the vehicle level,
   // commandable speed: the vehicle climbs or sinks at the constant acceleration that rounding makes
   // (0.06 m/s^2 up for the mk_quad: 0.7 m in 5 s). Its attitude is held level throughout.
   Flight f;
-  const quadrotor::RotorParams rp = *quadrotor::preset("mk_quad");
+  const quadrotor::RotorParams rp = quadrotor::RotorParams{};
   const double step = rp.max_rotor_speed / 255.0;
   const double exact = std::sqrt(f.mass * f.g / (4 * rp.thrust_coefficient));
   const double commanded = std::round(exact / step) * step;

@@ -18,7 +18,7 @@ TEST_CASE("a vehicle alone: its rotors at the hover speed carry a body of its we
   Environment& env = *s.environment;
   env.start();
   Artifact& box = *env.findArtifact("b");
-  const RotorParams rp = *preset("mk_quad");
+  const RotorParams rp = RotorParams{};
   const double g = -env.settings().physics.gravity.z();
   for (double factor : {1.0, 1.05}) {
     Vehicle vehicle;
@@ -42,4 +42,40 @@ TEST_CASE("a vehicle alone: its rotors at the hover speed carry a body of its we
       CHECK(climbed == Approx(0.5 * 0.1025 * g).epsilon(0.1));
     CHECK(box.pose().position.head<2>().norm() < 1e-6);  // a symmetric vehicle in still air stays put
   }
+}
+
+TEST_CASE("the installed presets: mk_quad writes out the model's defaults, and each gives a whole vehicle",
+          "[quadrotor][parts]") {
+  const fs::path dir = fs::path(SSX_EXAMPLES_DIR) / "presets" / "quadrotor";
+  auto vehicleOf = [&](const std::string& name) {
+    const Descriptor preset = readXmlFile(dir / (name + ".xml"));
+    Descriptor params("driver");
+    params.setDeclarations(kVehicleParameters);
+    for (const Descriptor& p : preset.children())
+      if (p.find("name")->value != "controller") params.set(p.find("name")->value, p.find("value")->value);
+    params.set("battery", true);
+    return VehicleParams(params);
+  };
+  const VehicleParams mk = vehicleOf("mk_quad");
+  CHECK(mk.rotor == RotorParams{});
+  const BatteryParams b{};
+  REQUIRE(mk.battery);
+  CHECK(mk.battery->full_voltage == b.full_voltage);
+  CHECK(mk.battery->empty_voltage == b.empty_voltage);
+  CHECK(mk.battery->capacity == b.capacity);
+  CHECK(mk.battery->resistance == b.resistance);
+  CHECK(mk.battery->efficiency == b.efficiency);
+  CHECK(mk.battery->nominal_voltage == b.nominal_voltage);
+  CHECK(mk.battery->zero_thrust_voltage == b.zero_thrust_voltage);
+  CHECK(mk.battery->compensated == b.compensated);
+  // the others differ where their sources say (docs/quadrotor-reference.md, section 1)
+  const VehicleParams cf = vehicleOf("crazyflie");
+  CHECK(cf.rotor.thrust_coefficient == 2.27e-8);
+  CHECK(cf.rotor.max_rotor_speed == 2501);
+  CHECK(cf.battery->compensated);
+  CHECK(cf.battery->capacity == 0.25);
+  const VehicleParams hb = vehicleOf("hummingbird");
+  CHECK(hb.rotor.thrust_coefficient == 8.54858e-6);
+  CHECK(hb.rotor.rotor_radius == 0.1);
+  CHECK_FALSE(hb.battery->compensated);
 }
