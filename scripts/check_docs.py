@@ -85,7 +85,9 @@ class Checker:
     def cpp(self, text, where, link):
         src = self.work / "doc_block.cpp"
         src.write_text(text)
+        # (and the robots' parts, as installed: <ssx/quadrotor/...>, <ssx/diff_drive/...>)
         includes = ["-I", str(self.source / "libssx/include"), "-I", str(self.build / "libssx/include"),
+                    "-I", str(self.build / "plugins/quadrotor/include"), "-I", str(self.build / "plugins/diff_drive/include"),
                     "-isystem", "/usr/include/eigen3"]
         if not link:
             self.run(["c++", "-std=c++20", "-fsyntax-only", *includes, str(src)], where)
