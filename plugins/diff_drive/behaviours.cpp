@@ -59,18 +59,41 @@ class Diffusion : public GroundController {
     return std::abs(angle) * drive.axleLength() / (2 * drive.wheelRadius() * cruise_);
   }
 
-  enum class Phase : std::uint8_t { Walk, Wait, Turn };
   int proximity_;
   double cruise_, delta_, straight_;
 };
 
-// BEECLUST: wander; on meeting a robot, wait as long as the floor is dark; then turn away
-class BeeClust final : public Diffusion {
+// a wanderer that hears robots and items (range and bearing) and reads the floor, and between its
+// walks waits or turns on the spot until a time: what BEECLUST and foraging share, state included
+class Roaming : public Diffusion {
  public:
-  BeeClust(const Descriptor& params, const Artifact& a, const DriveModel& drive)
+  Roaming(const Descriptor& params, const Artifact& a, const DriveModel& drive)
       : Diffusion(params, a, drive),
         board_(sensorOf<RangeBearingMeasurement>(a)),
-        ground_(sensorOf<GroundMeasurement>(a)),
+        ground_(sensorOf<GroundMeasurement>(a)) {}
+  void saveState(StateWriter& out) const override {
+    out.write(static_cast<std::uint8_t>(phase_));
+    out.write(until_);
+    out.write(turn_);
+  }
+  void loadState(StateReader& in) override {
+    phase_ = static_cast<Phase>(in.get<std::uint8_t>() % 3);
+    in.read(until_);
+    in.read(turn_);
+  }
+
+ protected:
+  enum class Phase : std::uint8_t { Walk, Wait, Turn };
+  int board_, ground_;
+  Phase phase_ = Phase::Walk;
+  double until_ = 0, turn_ = 1;  // the phase lasts until then; the turn's way (1: left)
+};
+
+// BEECLUST: wander; on meeting a robot, wait as long as the floor is dark; then turn away
+class BeeClust final : public Roaming {
+ public:
+  BeeClust(const Descriptor& params, const Artifact& a, const DriveModel& drive)
+      : Roaming(params, a, drive),
         meet_range_(params.get<double>("meet_range")),
         wait_max_(params.get<double>("wait_max")),
         theta_(params.get<double>("cue_theta")) {}
@@ -109,31 +132,16 @@ class BeeClust final : public Diffusion {
     until_ = t + wait_max_ * cue * cue / (cue * cue + theta_);
     in.drive.setWheels(0, 0);
   }
-  void saveState(StateWriter& out) const override {
-    out.write(static_cast<std::uint8_t>(phase_));
-    out.write(until_);
-    out.write(turn_);
-  }
-  void loadState(StateReader& in) override {
-    phase_ = static_cast<Phase>(in.get<std::uint8_t>() % 3);
-    in.read(until_);
-    in.read(turn_);
-  }
 
  private:
-  int board_, ground_;
   double meet_range_, wait_max_, theta_;
-  Phase phase_ = Phase::Walk;
-  double until_ = 0, turn_ = 1;
 };
 
 // foraging: search (wander, steer to an item heard), carry it home, let go in the nest
-class Foraging final : public Diffusion {
+class Foraging final : public Roaming {
  public:
   Foraging(const Descriptor& params, const Artifact& a, const DriveModel& drive)
-      : Diffusion(params, a, drive),
-        board_(sensorOf<RangeBearingMeasurement>(a)),
-        ground_(sensorOf<GroundMeasurement>(a)),
+      : Roaming(params, a, drive),
         item_code_(static_cast<std::uint8_t>(params.get<std::int64_t>("item_code"))),
         grab_range_(params.get<double>("grab_range")),
         nest_level_(params.get<double>("nest_level")) {}
@@ -212,9 +220,7 @@ class Foraging final : public Diffusion {
     if (!turnFromObstacle(in)) steer(in, nearest->bearing);
   }
   void saveState(StateWriter& out) const override {
-    out.write(static_cast<std::uint8_t>(phase_));
-    out.write(until_);
-    out.write(turn_);
+    Roaming::saveState(out);
     out.write(carrying_);
     out.write(home_x_);
     out.write(home_y_);
@@ -225,9 +231,7 @@ class Foraging final : public Diffusion {
     out.write(lost_until_);
   }
   void loadState(StateReader& in) override {
-    phase_ = static_cast<Phase>(in.get<std::uint8_t>() % 3);
-    in.read(until_);
-    in.read(turn_);
+    Roaming::loadState(in);
     carrying_ = in.get<std::int64_t>();
     in.read(home_x_);
     in.read(home_y_);
@@ -239,11 +243,8 @@ class Foraging final : public Diffusion {
   }
 
  private:
-  int board_, ground_;
   std::uint8_t item_code_;
   double grab_range_, nest_level_;
-  Phase phase_ = Phase::Walk;
-  double until_ = 0, turn_ = 1;
   std::int64_t carrying_ = -1;      // the item's artifact index, or -1
   double home_x_ = 0, home_y_ = 0;  // where odometry last had it in the nest
   bool has_home_ = false;

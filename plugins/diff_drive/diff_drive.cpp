@@ -6,10 +6,8 @@
 namespace ssx::ground {
 
 void DiffDrive::validate(const Descriptor& params, const PluginContext& context) {
-  const Artifact& a = *context.artifact;
-  if (a.rootCount() == 0 || a.root().isStatic()) throw params.error("diff_drive needs a dynamic physic root");
-  validateBehaviour(params, a);
-  DriveModel::validate(params, a);
+  DriveModel::validate(params, *context.artifact);
+  validateBehaviour(params, *context.artifact);
 }
 
 void DiffDrive::configure(const Descriptor& params, PluginSetup&) {

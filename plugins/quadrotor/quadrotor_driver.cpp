@@ -191,10 +191,9 @@ void QuadrotorDriver::configure(const Descriptor& params, PluginSetup& setup) {
     flight_ = c.crazyflie(frame->rotors, context);
   } else {
     // (the one asked before the start, holding any command given then)
-    auto* telekyb = dynamic_cast<TeleKybController*>(flight_.get());
-    if (telekyb == nullptr) flight_ = std::make_unique<TeleKybController>();
-    telekyb = static_cast<TeleKybController*>(flight_.get());
-    telekyb->configure(c.controller, frame->controller, c.vehicle.rotor, params, context, *imu, setup, frame_key);
+    if (dynamic_cast<TeleKybController*>(flight_.get()) == nullptr) flight_ = std::make_unique<TeleKybController>();
+    static_cast<TeleKybController&>(*flight_).configure(c.controller, frame->controller, c.vehicle.rotor, params,
+                                                        context, *imu, setup, frame_key);
   }
   // (a firmware has measured the battery since it was switched on)
   if (vehicle_.hasBattery()) flight_->batteryVoltage(vehicle_.batteryVoltage(), true);
