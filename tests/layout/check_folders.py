@@ -49,6 +49,14 @@ for path in sorted(src.rglob("*")):
             continue
         if first not in BELOW:
             continue  # not one of libssx's private folders
+        # the builder makes the world from the model alone: of scene/, only scene.cpp (which
+        # reads and builds) includes the XML reader
+        if (folder == "scene" and target.startswith("scene/xml/") and relative.parts[1] != "xml"
+                and relative.name != "scene.cpp"):
+            problems.append(f"libssx/src/{relative}:{number}: error: includes the XML reader \"{target}\": "
+                            f"the builder works from the scene model alone")
+        if folder == "scene" and relative.parts[1] == "xml" and target.startswith("scene/builder"):
+            problems.append(f"libssx/src/{relative}:{number}: error: the XML reader includes the builder \"{target}\"")
         if first != folder and first not in BELOW[folder]:
             problems.append(f"libssx/src/{relative}:{number}: error: {folder}/ includes \"{target}\" from {first}/, "
                             f"which is not below it")

@@ -53,6 +53,15 @@ struct ArtifactTypeModel {
   std::vector<PluginDeclaration> sensors;   ///< its sensors, by index
 };
 
+/// A shape of an `<obstacle>` as written: `<box size>`, `<sphere radius>`, `<cylinder radius length>`
+/// or `<capsule radius length>`, with its `xyz`, `rpy` and `density`.
+struct ShapeModel {
+  Shape shape;  ///< the geometry; its pose is poseFromXyzRpy(xyz, rpy)
+  Vec3 xyz = Vec3::Zero();  ///< as written: position in the obstacle's frame, m
+  Vec3 rpy = Vec3::Zero();  ///< as written: fixed-axis roll, pitch, yaw, rad
+  SourceLocation where;     ///< of its element
+};
+
 /// One element of the scene that makes artifacts, in document order: an `<artifact>`, a `<swarm>`
 /// (its members' places worked out), the `<ground>` or an `<obstacle>`.
 struct SSX_EXPORT PlacementModel {
@@ -93,8 +102,10 @@ struct SSX_EXPORT PlacementModel {
   bool random_yaw = false;      ///< each member turned about z by its own uniform angle
   std::vector<double> yaws;     ///< with random_yaw: each member's turn, rad, from a stream of the scene seed
   std::string memberName(std::int64_t k) const;  ///< member k's name (the pattern with {i} = first_index + k)
-  /// An obstacle: its element as written (shapes and colour). (The ground's height is xyz.z().)
-  std::shared_ptr<const Descriptor> obstacle;
+  /// An obstacle's shapes, in the obstacle's frame, in the order written (the ground has none: its
+  /// height is xyz.z()).
+  std::vector<ShapeModel> shapes;
+  Color color{0.55f, 0.55f, 0.6f, 1.0f};  ///< an obstacle's colour, rgba in 0..1
 };
 
 /// An `<extension>`: its name and its plugin.

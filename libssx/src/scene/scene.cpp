@@ -1,5 +1,6 @@
 // Loading scenes (ssx/scene.hpp): the entry points of the scene loader (xml/scene_loader.hpp), its
 // error, and where the installed data is.
+#include "scene/builder.hpp"
 #include "scene/xml/scene_loader.hpp"
 
 #include <ssx/scene.hpp>
@@ -68,19 +69,23 @@ fs::path directoryOf(const fs::path& file) {
 SceneModel parseWith(detail::SceneLoader& loader, Descriptor root, const fs::path& file, const fs::path& dir) {
   SceneModel model = loader.parse(std::move(root), file, dir);
   const bool failed = loader.hasErrors();
-  std::vector<Diagnostic> found = loader.takeDiagnostics();
+  std::vector<Diagnostic> found = loader.log().take();
   if (failed) throw SceneError(std::move(found));
   model.warnings = std::move(found);
   return model;
 }
 
-// parsed and built in one go: the problems of both together, even when parsing found errors
+// read and built in one go: the problems of both together in document order, even when reading
+// found errors
 Scene load(const SceneOptions& options, Descriptor root, const fs::path& file, const fs::path& dir) {
   detail::SceneLoader loader(options);
   SceneModel model = loader.parse(std::move(root), file, dir);
-  Scene scene = loader.build(model, false);
-  const bool failed = loader.hasErrors();
-  std::vector<Diagnostic> found = loader.takeDiagnostics();
+  detail::SceneBuilder builder(options, loader.buildOrder());
+  Scene scene = builder.build(model, false);
+  detail::DiagnosticLog& log = loader.log();
+  log.append(std::move(builder.log()));
+  const bool failed = log.errorCount() > 0;
+  std::vector<Diagnostic> found = log.take();
   if (failed) throw SceneError(std::move(found));
   scene.warnings = std::move(found);
   scene.model = std::make_shared<const SceneModel>(std::move(model));
@@ -101,11 +106,11 @@ SceneModel parseSceneString(std::string_view xml, const std::string& label, cons
 }
 
 Scene buildScene(const SceneModel& model, const SceneOptions& options) {
-  detail::SceneLoader loader(options);
-  Scene scene = loader.build(model, true);
-  const bool failed = loader.hasErrors();
+  detail::SceneBuilder builder(options);
+  Scene scene = builder.build(model, true);
+  const bool failed = builder.log().errorCount() > 0;
   std::vector<Diagnostic> found = model.warnings;
-  for (auto& d : loader.takeDiagnostics()) found.push_back(std::move(d));
+  for (auto& d : builder.log().take()) found.push_back(std::move(d));
   if (failed) throw SceneError(std::move(found));
   scene.warnings = std::move(found);
   scene.model = std::make_shared<const SceneModel>(model);

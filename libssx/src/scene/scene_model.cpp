@@ -196,6 +196,18 @@ void wind(std::ostringstream& out, const WindSettings& w) {
   e.end();
 }
 
+void obstacleShape(std::ostringstream& out, const ShapeModel& m) {
+  const Shape& s = m.shape;
+  static constexpr const char* kNames[] = {"box", "sphere", "cylinder", "capsule", "plane"};
+  Element e(out, kNames[static_cast<int>(s.kind)], 2);
+  if (s.kind == Shape::Kind::Box) e("size", vec(s.size));
+  if (s.kind == Shape::Kind::Sphere || s.kind == Shape::Kind::Cylinder || s.kind == Shape::Kind::Capsule)
+    e("radius", num(s.radius));
+  if (s.kind == Shape::Kind::Cylinder || s.kind == Shape::Kind::Capsule) e("length", num(s.length));
+  e("xyz", vec(m.xyz))("rpy", vec(m.rpy))("density", num(s.density));
+  e.end();
+}
+
 void placement(std::ostringstream& out, const PlacementModel& p) {
   switch (p.kind) {
     case PlacementModel::Kind::Artifact: {
@@ -220,9 +232,15 @@ void placement(std::ostringstream& out, const PlacementModel& p) {
     case PlacementModel::Kind::Ground:
       Element(out, "ground", 1)("z", num(p.xyz.z())).end();
       break;
-    case PlacementModel::Kind::Obstacle:
-      if (p.obstacle != nullptr) verbatim(out, *p.obstacle, 1);
+    case PlacementModel::Kind::Obstacle: {
+      Element e(out, "obstacle", 1);
+      e("name", p.name)("xyz", vec(p.xyz))("rpy", vec(p.rpy))("color", color(p.color));
+      if (p.allow_overlap) e("allow_overlap", "true");
+      e.open();
+      for (const ShapeModel& m : p.shapes) obstacleShape(out, m);
+      e.close();
       break;
+    }
   }
 }
 

@@ -4,7 +4,7 @@
 
 namespace ssx::detail {
 
-Shape SceneLoader::readShape(const Descriptor& d) {
+Shape SceneLoader::readShape(const Descriptor& d, Vec3* xyz_out, Vec3* rpy_out) {
   Shape s;
   const std::string& n = d.name();
   if (n == "box") {
@@ -19,7 +19,10 @@ Shape SceneLoader::readShape(const Descriptor& d) {
     if (n == "capsule" && l < 0) error(d.where(), "<capsule>: length must not be negative");
   }
   if (n == "box" && !(s.size.array() > 0).all()) error(d.where(), "<box>: every size must be positive");
-  s.pose = readPose(d);
+  const Vec3 xyz = read<Vec3>(d, "xyz", Vec3::Zero()), rpy = read<Vec3>(d, "rpy", Vec3::Zero());
+  s.pose = poseFromXyzRpy(xyz, rpy);
+  if (xyz_out != nullptr) *xyz_out = xyz;
+  if (rpy_out != nullptr) *rpy_out = rpy;
   s.density = readPositive(d, "density", s.density);
   checkUnknown(d);
   return s;
@@ -142,7 +145,7 @@ ArtifactType SceneLoader::parseArtifact(const Descriptor& root) {
     t.ok = false;
     return t;
   }
-  const std::size_t errors_before = diagnostics_.size();
+  const std::size_t errors_before = log_.size();
   for (const Descriptor& c : root.children()) {
     if (c.name() == "physic") {
       PhysicNodeSpec spec = readPhysicNode(c);
@@ -193,8 +196,8 @@ ArtifactType SceneLoader::parseArtifact(const Descriptor& root) {
     }
   }
   checkUnknown(root, {"physic", "render", "driver", "sensor"});
-  for (std::size_t i = errors_before; i < diagnostics_.size(); ++i)
-    if (diagnostics_[i].severity == Diagnostic::Severity::Error) t.ok = false;
+  for (std::size_t i = errors_before; i < log_.size(); ++i)
+    if (log_[i].severity == Diagnostic::Severity::Error) t.ok = false;
   return t;
 }
 

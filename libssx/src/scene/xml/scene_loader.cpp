@@ -388,22 +388,22 @@ void SceneLoader::applyOptions() {
 
 void SceneLoader::readExtensions() {
   for (std::size_t j = 0; j < extensions_.size(); ++j) {
-    stage_ = stage(1, 2 * static_cast<std::int64_t>(j));
+    log_.stage = stage(1, 2 * static_cast<std::int64_t>(j));
     const Descriptor& d = *extensions_[j].element;
     const std::string name = require(d, "name");
     std::optional<PluginDecl> decl = readPluginDecl(d);
     if (name.empty() || !decl) continue;
     decl->params.erase("name");  // the extension's name, read here
     model_.extensions.push_back({name, std::move(*decl)});
+    extension_stage_.push_back(log_.stage);
   }
 }
 
 SceneModel SceneLoader::parse(Descriptor root, const fs::path& file, const fs::path& dir) {
   model_.file = file;
-  parsed_ = true;
   std::error_code file_ec;
   if (fs::is_regular_file(file, file_ec)) model_.files.push_back(file);  // (a scene in memory is no file)
-  stage_ = stage(0);
+  log_.stage = stage(0);
   // an override that does not fit is reported with the rest (the scene is read without it)
   // two overrides of one attribute, however spelled, would apply one and report both: refused
   std::map<std::string, const AttributeOverride*> applied;
@@ -426,121 +426,6 @@ SceneModel SceneLoader::parse(Descriptor root, const fs::path& file, const fs::p
   for (const auto& [name, type] : types_)
     if (type.ok) model_.types.emplace(name, static_cast<const ArtifactTypeModel&>(type));
   return std::move(model_);
-}
-
-void SceneLoader::buildExtensions(Environment& env, const SceneModel& model) {
-  for (std::size_t j = 0; j < model.extensions.size(); ++j) {
-    stage_ = stage(1, 2 * static_cast<std::int64_t>(j) + 1);
-    const ExtensionModel& e = model.extensions[j];
-    Descriptor params = e.plugin.params;
-    try {
-      SimulationExtension& ext = env.classLoader().createExtension(e.plugin.plugin, e.plugin.class_name);
-      const std::size_t errors_before = errorCount();
-      checkPlugin(env, &ext, params, nullptr, 1, "extension '" + e.plugin.class_name + "'");
-      env.addExtension(e.name, ext, params);
-      // its own checks run once every artifact exists, if its parameters are of the declared types
-      if (errorCount() == errors_before)
-        extension_checks_.push_back({&ext, params, "extension '" + e.plugin.class_name + "'"});
-    } catch (const PluginError& err) {
-      error(params.where(), "<extension>: " + std::string(err.what()));
-    } catch (const ConfigError& err) {
-      error(params.where(), "<extension>: " + err.detail());
-    }
-  }
-}
-
-Scene SceneLoader::build(const SceneModel& model, bool report_missing_types) {
-  Scene scene;
-  scene.file = model.file;
-  files_.allowSpecialOutputs(options_.allow_special_outputs);
-  for (const fs::path& f : model.files) files_.addInput(f);
-  scene.run.realtime_factor = model.run.realtime_factor;
-  scene.run.overrun = model.run.overrun;
-  scene.duration = model.duration;
-  try {
-    scene.environment = std::make_unique<Environment>(model.settings);
-  } catch (const ConfigError& e) {
-    error(environment_element_ != nullptr ? environment_element_->where() : SourceLocation{model.file.string(), 0},
-          e.detail());
-    // go on with defaults, so that the artifacts are checked too
-    scene.environment = std::make_unique<Environment>(EnvironmentSettings{});
-  }
-  Environment& env = *scene.environment;
-  // search order: the scene's directories, the caller's, then the installation's
-  for (const auto& dir : model.plugin_dirs) env.classLoader().addSearchDirectory(dir);
-  for (const auto& dir : options_.plugin_path) env.classLoader().addSearchDirectory(dir);
-  if (options_.search_installed_plugins) env.classLoader().addSearchDirectory(ClassLoader::installedPluginDirectory());
-  buildExtensions(env, model);
-
-  std::vector<std::size_t> placement_of;  // per artifact: the placement that made it
-  for (std::size_t k = 0; k < model.placements.size(); ++k) {
-    const PlacementModel& p = model.placements[k];
-    stage_ = placementStage(k);
-    switch (p.kind) {
-      case PlacementModel::Kind::Artifact:
-      case PlacementModel::Kind::Swarm: {
-        const auto type = model.types.find(p.type);
-        if (type == model.types.end()) {
-          if (report_missing_types) error(p.where, "unknown artifact type '" + p.type + "' (the model has none of that name)");
-          if (p.kind == PlacementModel::Kind::Artifact && env.findArtifact(p.name) != nullptr)
-            error(p.where, "duplicate artifact name '" + p.name + "'");
-          break;
-        }
-        if (p.kind == PlacementModel::Kind::Artifact)
-          place(env, p.name, p, type->second, p.pose());
-        else
-          buildSwarm(env, p, type->second);
-        break;
-      }
-      case PlacementModel::Kind::Ground:
-        if (env.findArtifact("ground") != nullptr)
-          error(p.where, "<ground>: an artifact named 'ground' exists already");
-        else
-          env.addGround(p.xyz.z());
-        break;
-      case PlacementModel::Kind::Obstacle:
-        buildObstacle(env, p);
-        break;
-    }
-    placement_of.resize(env.artifactCount(), k);
-  }
-  // robots inside one another or an obstacle (checked once every artifact is built as asked)
-  if (errorCount() == 0) checkStartOverlaps(env, model, placement_of);
-  stage_ = stage(3);
-  // what the cameras write, with the plugins' outputs
-  for (const CameraSpec& cam : model.settings.render.cameras) {
-    const SourceLocation where = cam.where.file.empty() ? SourceLocation{model.file.string(), 0} : cam.where;
-    const std::string who = "camera '" + cam.name + "': ";
-    if (!cam.snapshot.empty())
-      if (auto problem = files_.claimOutput(cam.snapshot, who + "snapshot", false, true); !problem.empty()) error(where, problem);
-    if (!cam.video.empty())
-      if (auto problem = files_.claimOutput(cam.video, who + "video", false, true); !problem.empty()) error(where, problem);
-    if (!cam.frames_dir.empty())
-      if (auto problem = files_.claimOutputDirectory(cam.frames_dir, who + "frames"); !problem.empty())
-        error(where, problem);
-  }
-  // extensions check what they refer to (artifacts by name) once every artifact exists
-  for (const auto& c : extension_checks_) validatePlugin(env, c.extension, c.params, nullptr, 1, c.what);
-  for (const CameraSpec& cam : model.settings.render.cameras) {
-    if (cam.follow.empty()) continue;
-    const Artifact* a = env.findArtifact(cam.follow);
-    if (a == nullptr || a->rootCount() == 0)
-      error(cam.follow_from, "<camera>: follows '" + cam.follow + "', which is no artifact with a physic root in this scene");
-  }
-  scene.files = files_;
-  return scene;
-}
-
-std::vector<Diagnostic> SceneLoader::takeDiagnostics() {
-  std::vector<std::size_t> order(diagnostics_.size());
-  for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
-  std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return stamps_[a] < stamps_[b]; });
-  std::vector<Diagnostic> sorted;
-  sorted.reserve(order.size());
-  for (std::size_t i : order) sorted.push_back(std::move(diagnostics_[i]));
-  diagnostics_.clear();
-  stamps_.clear();
-  return sorted;
 }
 
 }  // namespace detail

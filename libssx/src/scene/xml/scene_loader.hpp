@@ -1,17 +1,15 @@
 #pragma once
-// The scene loader: scene and artifact files into a SceneModel (parse), and a SceneModel into an
-// Environment (build). Parsing collects every element of the scene and its includes and reads the
-// settings (scene_loader.cpp), reads artifact files when a type is first used (artifact_reader.cpp)
-// and reads every placement (placement.cpp); building places artifacts, creates their plugins and
-// checks every parameter against its class's declarations (placement.cpp). Every problem is
-// collected, and reported in document order (each element's parse problems, then its build
-// problems); any error stops the load before anything starts.
+// The scene reader: scene and artifact files into a SceneModel. Pass 1 collects every element of
+// the scene and its includes and reads the settings (scene_loader.cpp); artifact files are read
+// when a type is first used (artifact_reader.cpp); then every placement (placement.cpp). Every
+// problem is collected, stamped with its element's stage, so that scene/builder.hpp's (which
+// builds the model) come after each element's own: any error stops the load before anything starts.
 
 #include <cstdio>
 #include <ssx/scene.hpp>
 #include <ssx/scene_model.hpp>
 
-#include "plugin/presets.hpp"
+#include "scene/diagnostic_log.hpp"
 
 #include <array>
 #include <deque>
@@ -59,34 +57,20 @@ class SceneLoader {
 
   // the files into a model (what could not be read is left out of it and reported)
   SceneModel parse(Descriptor root, const fs::path& file, const fs::path& dir);
-  // a model into an environment (placements of types the model lacks are reported when
-  // `report_missing_types`; a model this loader parsed has reported them already)
-  Scene build(const SceneModel& model, bool report_missing_types);
+  // where each extension and placement of the model parsed was read: what a builder stamps its
+  // problems after
+  BuildOrder buildOrder() const { return {extension_stage_, placement_stage_}; }
   bool hasErrors() const { return errorCount() > 0; }
-  // every problem found so far, in document order
-  std::vector<Diagnostic> takeDiagnostics();
+  DiagnosticLog& log() { return log_; }
 
  private:
-  // --- diagnostics, each stamped with where in the document it belongs (see takeDiagnostics) ---
-  void add(Diagnostic d) {
-    diagnostics_.push_back(std::move(d));
-    stamps_.push_back(stage_);
-  }
-  void error(const SourceLocation& where, std::string message) {
-    add({Diagnostic::Severity::Error, where, std::move(message)});
-  }
-  void warning(const SourceLocation& where, std::string message) {
-    add({Diagnostic::Severity::Warning, where, std::move(message)});
-  }
-  // stages, in document order: pass 1; extension j (parse, then build); entity k (parse, then
-  // build); the checks at the end
-  static std::int64_t stage(std::int64_t major, std::int64_t minor = 0) { return (major << 40) + minor; }
+  // --- diagnostics, each stamped with where in the document it belongs (see DiagnosticLog) ---
+  void add(Diagnostic d) { log_.add(std::move(d)); }
+  void error(const SourceLocation& where, std::string message) { log_.error(where, std::move(message)); }
+  void warning(const SourceLocation& where, std::string message) { log_.warning(where, std::move(message)); }
+  static std::int64_t stage(std::int64_t major, std::int64_t minor = 0) { return documentStage(major, minor); }
   void record(const ConfigError& e) { error(e.where(), e.detail()); }
-  std::size_t errorCount() const {
-    std::size_t n = 0;
-    for (const auto& d : diagnostics_) n += d.severity == Diagnostic::Severity::Error ? 1 : 0;
-    return n;
-  }
+  std::size_t errorCount() const { return log_.errorCount(); }
 
   // --- typed reads that record errors and fall back ---
   // every attribute a read asked for, per element: what an unknown attribute may have meant
@@ -227,7 +211,8 @@ class SceneLoader {
   // --- artifact files ---
   const ArtifactType* artifactType(const std::string& name, const SourceLocation& where);
   ArtifactType parseArtifact(const Descriptor& root);
-  Shape readShape(const Descriptor& d);
+  // (xyz, rpy: set to the shape's position and angles as written)
+  Shape readShape(const Descriptor& d, Vec3* xyz = nullptr, Vec3* rpy = nullptr);
   void readJoint(const Descriptor& d, JointSpec& joint);
   PhysicNodeSpec readPhysicNode(const Descriptor& d);
   RenderNodeSpec readRenderNode(const Descriptor& d, bool is_root);
@@ -243,51 +228,10 @@ class SceneLoader {
   void checkMemory(const Descriptor& d, const PlacementModel& p);
   bool readObstacle(const Descriptor& d, PlacementModel& p);
 
-  // --- build ---
-  void buildExtensions(Environment& env, const SceneModel& model);
-  void buildObstacle(Environment& env, const PlacementModel& p);
-  void buildSwarm(Environment& env, const PlacementModel& p, const ArtifactTypeModel& type);
-  // the diagnostics stage of building placement k: after its parse, so in document order
-  std::int64_t placementStage(std::size_t k) const {
-    return (k < placement_stage_.size() ? placement_stage_[k] : stage(2, 2 * static_cast<std::int64_t>(k))) + 1;
-  }
-  // reports every robot that starts inside another artifact (xml/start_overlaps.cpp);
-  // placement_of[a]: the placement that made artifact a
-  void checkStartOverlaps(const Environment& env, const SceneModel& model, const std::vector<std::size_t>& placement_of);
-  // returns false when it reported an error
-  bool place(Environment& env, const std::string& name, const PlacementModel& p, const ArtifactTypeModel& type,
-             const Pose& pose, const std::string& index = {});
-  Descriptor withOverrides(const PluginDecl& decl, const Descriptor* overrides, const std::string& index);
-  std::int64_t periodOf(const PluginDecl& decl, const Descriptor* overrides);
-  static SourceLocation periodFrom(const PluginDecl& decl, const Descriptor* overrides);
-  template <class T, class Create>
-  T* createPlugin(const PluginDecl& decl, Create create);
-  // checks a plugin's parameters against its class's declarations (defaults added). `decl` and
-  // `overrides`: the parameters are that declaration's with that placing element's on top (its {i}
-  // replaced), so after a check of the same class, declaration, element and period that found
-  // nothing, only the values holding {i} are checked again (a swarm's members)
-  void checkPlugin(Environment& env, const void* instance, Descriptor& params, const Artifact* artifact,
-                   std::int64_t period_steps, const std::string& what, const SourceLocation& period_from = {},
-                   const PluginDecl* decl = nullptr, const Descriptor* overrides = nullptr);
-  // runs a class's own validate on a parameter set that passed checkPlugin
-  void validatePlugin(Environment& env, const void* instance, const Descriptor& params, const Artifact* artifact,
-                      std::int64_t period_steps, const std::string& what);
-
   const SceneOptions& options_;
-  std::vector<Diagnostic> diagnostics_;
-  std::vector<std::int64_t> stamps_;  // per diagnostic: its stage
-  std::int64_t stage_ = 0;
-  bool parsed_ = false;
-  RunFiles files_;  // the inputs, and the outputs claimed so far (build)
-  std::optional<Presets> presets_;  // made at the first plugin checked (build)
-  std::set<std::string> reported_presets_;  // the presets' problems reported (each once)
-  std::vector<std::int64_t> placement_stage_;  // per placement of the model parsed: its entity's parse stage
-  // (class, declaration, placing element, period) whose check found nothing -> the parameters
-  // whose values differ between the members (they hold {i}), for checkPlugin
-  std::map<std::tuple<const void*, const PluginDecl*, const Descriptor*, std::int64_t>, std::vector<std::string>>
-      clean_checks_;
-  // what each class's validate shares between its instances (PluginContext::shared)
-  std::map<const void*, PluginContext::SharedValues> validate_shared_;
+  DiagnosticLog log_;
+  std::vector<std::int64_t> extension_stage_;  // per extension of the model: its entity's stage
+  std::vector<std::int64_t> placement_stage_;  // per placement of the model: its entity's stage
   std::deque<Descriptor> documents_;  // every file read, kept alive for the pointers below
   SceneModel model_;  // what parse fills in
   EnvironmentSettings& settings_ = model_.settings;
@@ -309,13 +253,6 @@ class SceneLoader {
   std::map<std::string, ArtifactType> types_;          // by type name, parsed on first use
   double placed_bytes_ = 0;
   std::map<const Descriptor*, std::vector<std::string>> asked_;  // see asked()                            // estimated memory of the artifacts so far
-  std::map<std::string, std::string> failed_plugins_;  // "plugin/class" -> already reported
-  struct ExtensionCheck {
-    const SimulationExtension* extension;
-    Descriptor params;
-    std::string what;
-  };
-  std::vector<ExtensionCheck> extension_checks_;
 };
 
 }  // namespace ssx::detail

@@ -1,4 +1,4 @@
-// Placing elements: what a <swarm> or <artifact> changes of its type's plugins.
+// Placing elements read into the model: a swarm's size against the memory.
 #include <ssx/ssx.hpp>
 
 #include "scene_util.hpp"
@@ -12,25 +12,6 @@ using ssx::test::kData;
 using ssx::test::testOptions;
 using Catch::Contains;
 namespace fs = std::filesystem;
-
-TEST_CASE("a placing element's period overrides the type's plugin period and is no parameter", "[scene]") {
-  const std::string xml = R"(<scene>
-    <type name="q" file="mk_quad_formation.xml"/>
-    <swarm type="q" count="2" name="q{i}" spacing="2"><sensor index="2" period="3"/><driver period="2"/></swarm>
-    <artifact name="plain" type="q" xyz="0 5 0"/>
-  </scene>)";
-  Scene scene = loadSceneFromString(xml, "memory.xml", fs::path(SSX_EXAMPLES_DIR) / "artifacts");
-  const Artifact& q = *scene.environment->findArtifact("q1");
-  CHECK(q.sensor(2).periodSteps() == 3);  // the type says 10
-  CHECK(q.sensor(0).periodSteps() == 1);
-  CHECK(q.driver()->periodSteps() == 2);
-  CHECK(scene.environment->findArtifact("plain")->sensor(2).periodSteps() == 10);
-  for (const auto& w : scene.warnings) CHECK_THAT(w.message, !Catch::Contains("period"));
-  std::vector<std::string> log;  // unread plugin parameters are reported at start
-  scene.environment->setLogSink([&](LogLevel, std::string_view m) { log.emplace_back(m); });
-  scene.environment->start();
-  for (const auto& m : log) CHECK_THAT(m, !Catch::Contains("period"));
-}
 
 TEST_CASE("a swarm that cannot fit in memory is an error at its line, before anything is made", "[scene]") {
   const std::string xml = R"(<scene>

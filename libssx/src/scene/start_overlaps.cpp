@@ -3,7 +3,7 @@
 // allows it. Without it the engine would push the two apart at the first step, meters per second
 // from nowhere, and the run would report a crash with no cause.
 
-#include "scene/xml/scene_loader.hpp"
+#include "scene/builder.hpp"
 
 #include "engines/shape_overlaps.hpp"
 
@@ -35,7 +35,7 @@ std::string point(const Vec3& p) {
 
 }  // namespace
 
-void SceneLoader::checkStartOverlaps(const Environment& env, const SceneModel& model,
+void SceneBuilder::checkStartOverlaps(const Environment& env, const SceneModel& model,
                                      const std::vector<std::size_t>& placement_of) {
   std::vector<PosedShape> shapes;
   bool any_dynamic = false;
@@ -72,7 +72,7 @@ void SceneLoader::checkStartOverlaps(const Environment& env, const SceneModel& m
     const std::size_t ok = at_b ? placement_of[ia] : placement_of[ib];
     int& count = reported[{rk, ok}];
     if (++count > kReportsPerPair) continue;
-    stage_ = placementStage(rk);
+    log_.stage = placementStage(rk);
     const std::string& other_name = env.artifact(other).name();
     const bool ground = op.kind == PlacementModel::Kind::Ground;
     std::string message = "'" + env.artifact(robot).name() + "' starts " + millimetres(o.depth) + " inside '" +
@@ -86,7 +86,7 @@ void SceneLoader::checkStartOverlaps(const Environment& env, const SceneModel& m
   for (const auto& [pair, count] : reported) {
     if (count <= kReportsPerPair) continue;
     const PlacementModel& rp = model.placements.at(pair.first);
-    stage_ = placementStage(pair.first);
+    log_.stage = placementStage(pair.first);
     const PlacementModel& op = model.placements.at(pair.second);
     const std::string kind = rp.kind == PlacementModel::Kind::Swarm ? "<swarm>" : "<artifact>";
     const std::string more = "... and " + std::to_string(count - kReportsPerPair) + " more overlaps ";
