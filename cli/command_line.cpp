@@ -142,7 +142,7 @@ CommandLine parseCommandLine(int argc, const char* const* argv, std::ostream& ou
 
   CLI::App* plugins_cmd = app.add_subcommand("plugins", "list plugin libraries, their classes, and ABI checks");
   plugins_cmd->add_option("--plugin-path", c.plugins.plugin_path, "plugin directory (repeatable)")->check(path());
-  plugins_cmd->add_option("--params", c.plugins.params_of, "print the declared parameters of class NAME (a Markdown table)");
+  plugins_cmd->add_option("--params", c.plugins.params_of, "print the declared parameters of plugin class NAME, or the settings of physics engine NAME (a Markdown table)");
   plugins_cmd->add_option("--inspect", c.plugins.inspect_file, "(internal) report one library from a child process")
       ->group("");
 

@@ -132,6 +132,12 @@ int commandPlugins(const std::vector<std::string>& plugin_path, const std::strin
     files.insert(files.end(), here.begin(), here.end());
   }
   constexpr double kTimeout = 10.0;
+  // a physics engine's settings: the attributes of <physics engine="NAME"> besides the common ones
+  if (const ssx::PhysicEngineClass* engine = ssx::findPhysicEngine(params_of); engine != nullptr) {
+    std::cout << "physics engine '" << engine->name << "': " << engine->doc << "\n\n"
+              << ssx::parameterTable(engine->settings);
+    return 0;
+  }
   if (!params_of.empty()) {
     // one class's declared parameters, as the Markdown table the docs hold
     for (const auto& f : files) {

@@ -68,7 +68,7 @@ def test_scene_errors_carry_file_and_line_and_start_nothing(tmp_path):
         ssx.load_scene(scene)
     text = str(info.value)
     assert f"{scene}:4: error:" in text
-    assert f"{scene}:5: error: <physics>: attribute 'partitions'" in text
+    assert f"{scene}:5: error: <physics>: ode engine: parameter 'partitions'" in text
     assert "nothing was run" in text
     assert isinstance(info.value, ssx.Error)
     assert not log.exists()  # the logger's file was never opened

@@ -3,15 +3,19 @@
 /// The abstract physics engine. Nothing of a backend's library appears here, so another backend
 /// can be added without touching clients.
 
+#include <ssx/descriptor.hpp>
 #include <ssx/export.hpp>
 #include <ssx/physic_node.hpp>
+#include <ssx/parameters.hpp>
 #include <ssx/state.hpp>
 #include <ssx/types.hpp>
 
+#include <functional>
 #include <limits>
 #include <memory>
 #include <span>
 #include <string>
+#include <string_view>
 #include <vector>
 
 namespace ssx {
@@ -63,6 +67,13 @@ struct PhysicsSettings {
   double max_angular_speed = 1e6;  ///< rad/s
   OdeSettings ode;        ///< used when engine == "ode"
   BulletSettings bullet;  ///< used when engine == "bullet"
+  /// The engine's own settings, as its class declares them (PhysicEngineClass::settings), named
+  /// for the engine they belong to (`Descriptor("mine").set("time_scale", 0.5)`; an empty name:
+  /// whichever engine is chosen). The scene reader fills them in from `<physics>`;
+  /// createPhysicEngine checks them and fills in the defaults (options named for another engine,
+  /// after a switch, are not that engine's: it starts from its defaults). ODE and Bullet read
+  /// theirs typed, from `ode` and `bullet`.
+  Descriptor options;
 };
 
 /// Force and torque on a body, world frame, torque about the centre of mass.
@@ -214,9 +225,38 @@ struct PhysicsSwitch {
   std::string to;        ///< the engine that steps from then on
 };
 
-/// The physics engines in this build of ssx ("ode", "bullet").
+/// A physics engine as a scene chooses it (`<physics engine="NAME">`): what registerPhysicEngine
+/// takes. An engine is a PhysicEngine implementation and one of these; ODE and Bullet are
+/// registered so (`libssx/src/engines/{ode,bullet}/*_class.cpp`), and a program registers its own
+/// before it loads a scene.
+struct PhysicEngineClass {
+  std::string name;  ///< what `engine="..."` says: lower-case letters, digits and '_'
+  std::string doc;   ///< one line on what it is
+  /// Its own settings: the attributes of `<physics>` besides the common ones (gravity, substeps,
+  /// friction, restitution, max_linear_speed, max_angular_speed), declared as a plugin declares
+  /// its parameters (ssx/parameters.hpp's param::). The scene reader checks them against these
+  /// (and `ssx validate` with it); `ssx plugins --params NAME` prints them.
+  std::vector<ssx_plugin_param> settings;
+  /// Makes an engine of these settings (`settings.options` holds its own, checked, defaults filled in).
+  std::function<std::unique_ptr<PhysicEngine>(const PhysicsSettings& settings)> create;
+  /// Optional, for an engine that keeps its settings typed (as ODE and Bullet do): sets them from
+  /// the checked values the scene gives (`values`: every declared setting).
+  std::function<void(const Descriptor& values, PhysicsSettings& settings)> configure;
+  /// Optional, the other way: the typed settings as values (what a scene model prints).
+  std::function<void(const PhysicsSettings& settings, Descriptor& values)> describe;
+};
+
+/// Adds a physics engine: scenes may name it from then on, and an environment may switch to it.
+/// Throws ConfigError when the name is taken or not a word, `create` is missing, or a setting's
+/// declaration or default is wrong. Registering is for the start of a program, before scenes load.
+SSX_EXPORT void registerPhysicEngine(PhysicEngineClass engine);
+/// The engine of that name, or nullptr.
+SSX_EXPORT const PhysicEngineClass* findPhysicEngine(std::string_view name);
+/// The physics engines this program has: the built-in ones ("ode", "bullet"), then those
+/// registered, in order.
 SSX_EXPORT std::vector<std::string> physicEngineNames();
-/// Creates the engine `settings.engine` names; throws ConfigError for an unknown name.
+/// Creates the engine `settings.engine` names; throws ConfigError for an unknown name or a setting
+/// of its own that its declarations refuse.
 SSX_EXPORT std::unique_ptr<PhysicEngine> createPhysicEngine(const PhysicsSettings& settings);
 
 }  // namespace ssx

@@ -148,18 +148,12 @@ void physics(std::ostringstream& out, const PhysicsSettings& p) {
   e("engine", p.engine)("gravity", vec(p.gravity))("substeps", num(std::int64_t{p.substeps}))(
       "friction", num(p.friction))("restitution", num(p.restitution))("max_linear_speed", num(p.max_linear_speed))(
       "max_angular_speed", num(p.max_angular_speed));
-  if (p.engine == "ode") {
-    const OdeSettings& o = p.ode;
-    e("solver", o.solver == OdeSettings::Solver::Exact ? "exact" : "quickstep")(
-        "iterations", num(std::int64_t{o.iterations}))("sor", num(o.sor))("erp", num(o.erp))("cfm", num(o.cfm))(
-        "contact_soft_erp", num(o.contact_soft_erp))("contact_soft_cfm", num(o.contact_soft_cfm))(
-        "max_contacts", num(std::int64_t{o.max_contacts}))("partitions", num(std::int64_t{o.partitions}))(
-        "contact_surface_layer", num(o.contact_surface_layer));
-  } else if (p.engine == "bullet") {
-    const BulletSettings& b = p.bullet;
-    e("iterations", num(std::int64_t{b.iterations}))("erp", num(b.erp))("cfm", num(b.cfm))(
-        "split_impulse", b.split_impulse ? "true" : "false")("split_impulse_threshold", num(b.split_impulse_threshold))(
-        "linear_slop", num(b.linear_slop));
+  // the engine's own settings, in its declarations' order
+  if (const PhysicEngineClass* c = findPhysicEngine(p.engine)) {
+    Descriptor values = p.options;
+    if (c->describe) c->describe(p, values);
+    for (const ssx_plugin_param& s : c->settings)
+      if (const auto* a = values.find(s.name)) e(s.name, a->value);
   }
   e.end();
 }

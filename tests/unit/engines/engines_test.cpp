@@ -2,8 +2,11 @@
 // the null renderer draws nothing and says how to get images. What every engine must do alike:
 // kinematic bodies (moved only by setState, infinitely heavy to what touches them).
 #include "engine_util.hpp"
+#include "scene_util.hpp"
+#include "test_util.hpp"
 
 #include <ssx/physic_engine.hpp>
+#include <ssx/scene.hpp>
 #include <ssx/render.hpp>
 
 #include <catch2/catch.hpp>
@@ -17,7 +20,9 @@ using namespace ssx::test;
 
 TEST_CASE("engines: every physics engine offered by name is made under that name", "[engines]") {
   const auto names = physicEngineNames();
-  CHECK(names == std::vector<std::string>{"ode", "bullet"});
+  // the built-in ones first (a test below registers one of its own)
+  REQUIRE(names.size() >= 2);
+  CHECK(std::vector<std::string>(names.begin(), names.begin() + 2) == std::vector<std::string>{"ode", "bullet"});
   for (const auto& name : names) {
     PhysicsSettings settings;
     settings.engine = name;
@@ -134,4 +139,141 @@ TEST_CASE("engines: an engine with kinematic bodies in contact restores and cont
   const auto s = states(*first);
   CHECK(s[0].angular_velocity == Vec3(0, 0, 1));
   CHECK(s[1].angular_velocity.z() == Approx(1).margin(0.1));
+}
+
+namespace {
+
+// An engine of a program's own, registered from outside libssx: ODE with its clock scaled by the
+// setting `time_scale` (what a slow-motion or a model-in-the-loop engine might do). Everything
+// else is ODE's.
+class TimeScaledEngine final : public PhysicEngine {
+ public:
+  explicit TimeScaledEngine(const PhysicsSettings& settings) : scale_(settings.options.get<double>("time_scale")) {
+    PhysicsSettings ode = settings;
+    ode.engine = "ode";
+    ode.options = Descriptor();
+    inner_ = createPhysicEngine(ode);
+  }
+  double scale() const { return scale_; }
+  std::string name() const override { return "time_scaled"; }
+  void setTaskRunner(TaskRunner* runner) override { inner_->setTaskRunner(runner); }
+  int addBody(const MassProperties& m, const std::vector<Shape>& s, const BodyState& b) override { return inner_->addBody(m, s, b); }
+  void setKinematic(int body) override { inner_->setKinematic(body); }
+  bool isKinematic(int body) const override { return inner_->isKinematic(body); }
+  void setMassScale(int body, double m, double i) override { inner_->setMassScale(body, m, i); }
+  int addJoint(const EngineJoint& joint) override { return inner_->addJoint(joint); }
+  void removeJoint(int joint) override { inner_->removeJoint(joint); }
+  void setJointMotor(int joint, double v, double e) override { inner_->setJointMotor(joint, v, e); }
+  std::size_t jointCount() const override { return inner_->jointCount(); }
+  void prepareRayQueries() override { inner_->prepareRayQueries(); }
+  void castRays(std::span<const Ray> r, std::span<RayHit> h, int b, int e) const override { inner_->castRays(r, h, b, e); }
+  int addStatic(const std::vector<Shape>& shapes, const Pose& pose) override { return inner_->addStatic(shapes, pose); }
+  void step(Nanoseconds dt, std::span<const Wrench> w) override {
+    inner_->step(static_cast<Nanoseconds>(static_cast<double>(dt) * scale_), w);
+  }
+  void readStates(std::span<BodyState> out) const override { inner_->readStates(out); }
+  void setState(int body, const BodyState& state) override { inner_->setState(body, state); }
+  std::size_t bodyCount() const override { return inner_->bodyCount(); }
+  std::size_t contactCount() const override { return inner_->contactCount(); }
+  void recordContacts(bool on) override { inner_->recordContacts(on); }
+  const std::vector<EngineContact>& contacts() const override { return inner_->contacts(); }
+  void saveState(StateWriter& out) const override { inner_->saveState(out); }
+  void restoreState(StateReader& in) override { inner_->restoreState(in); }
+
+ private:
+  double scale_;
+  std::unique_ptr<PhysicEngine> inner_;
+};
+
+constexpr ssx_plugin_param kTimeScaled[] = {
+    param::real("time_scale", "1", "", param::positive() & param::atMost(10), "simulated seconds per second of the world's clock"),
+};
+
+// registered once per process, as a program would at its start
+void registerTimeScaled() {
+  static const bool registered = [] {
+    PhysicEngineClass c;
+    c.name = "time_scaled";
+    c.doc = "ODE with its clock scaled (a test)";
+    c.settings.assign(std::begin(kTimeScaled), std::end(kTimeScaled));
+    c.create = [](const PhysicsSettings& s) -> std::unique_ptr<PhysicEngine> { return std::make_unique<TimeScaledEngine>(s); };
+    registerPhysicEngine(std::move(c));
+    return true;
+  }();
+  (void)registered;
+}
+
+// how far a ball dropped at 1 m has fallen after `seconds`, in a scene on `physics`
+double fallen(const std::string& physics, double seconds) {
+  const std::string xml = "<scene><environment timestep=\"0.001\"/>" + physics +
+                          "<type name=\"ball\" file=\"box.xml\"/><artifact name=\"b\" type=\"ball\" xyz=\"0 0 10\"/></scene>";
+  Scene scene = loadSceneFromString(xml, "engine.xml", test::kArtifacts, testOptions());
+  scene.environment->step(static_cast<std::int64_t>(seconds * 1000));
+  return 10 - scene.environment->findArtifact("b")->pose().position.z();
+}
+
+}  // namespace
+
+TEST_CASE("engines: a program's own engine, registered from outside libssx, is chosen and checked as the built-in ones",
+          "[engines][registry]") {
+  registerTimeScaled();
+  const auto names = physicEngineNames();
+  CHECK(std::find(names.begin(), names.end(), "time_scaled") != names.end());
+  REQUIRE(findPhysicEngine("time_scaled") != nullptr);
+  CHECK(findPhysicEngine("time_scaled")->settings.size() == 1);
+  // a scene names it; its setting reaches it: half the clock, a quarter of the fall
+  const double ode = fallen("", 1.0);
+  const double slow = fallen(R"(<physics engine="time_scaled" time_scale="0.5"/>)", 1.0);
+  CHECK(ode == Approx(0.5 * 9.81).epsilon(0.01));
+  CHECK(slow == Approx(ode / 4).epsilon(0.02));
+  CHECK(fallen(R"(<physics engine="time_scaled"/>)", 1.0) == ode);  // the default: 1, ODE's own bits
+  // its setting is checked before anything runs, at the attribute's line, like a plugin's
+  CHECK_THROWS_WITH(fallen(R"(<physics engine="time_scaled"
+      time_scale="20"/>)", 1.0),
+                    Contains("engine.xml:2: error: <physics>: time_scaled engine: parameter 'time_scale' must be"));
+  // ODE's settings are not its own
+  CHECK_THROWS_WITH(fallen(R"(<physics engine="time_scaled" partitions="4"/>)", 1.0),
+                    Contains("attribute 'partitions' is an option of the ode engine, and the engine is 'time_scaled'"));
+  // and its own are not ODE's
+  CHECK_THROWS_WITH(fallen(R"(<physics time_scale="0.5"/>)", 1.0),
+                    Contains("attribute 'time_scale' is an option of the time_scaled engine, and the engine is 'ode'"));
+  // a model prints its settings, defaults filled in
+  const SceneModel model = parseSceneString(R"(<scene><physics engine="time_scaled"/></scene>)", "m.xml", ".", {});
+  CHECK_THAT(model.toXml(), Contains(R"(engine="time_scaled")") && Contains(R"(time_scale="1")"));
+}
+
+TEST_CASE("engines: a running environment switches to a registered engine, which starts from its own defaults",
+          "[engines][registry]") {
+  registerTimeScaled();
+  Environment env(EnvironmentSettings{});
+  addBall(env, "b");
+  env.start();
+  env.step(10);
+  env.switchPhysics("time_scaled");
+  env.step(10);
+  CHECK(env.physics().name() == "time_scaled");
+  CHECK(dynamic_cast<const TimeScaledEngine&>(env.physics()).scale() == 1.0);
+  env.switchPhysics("ode");
+  env.step(10);
+  CHECK(env.physics().name() == "ode");
+}
+
+TEST_CASE("engines: registering refuses a taken name, a name that is no word, a missing create, a bad default",
+          "[engines][registry]") {
+  registerTimeScaled();
+  PhysicEngineClass c;
+  c.name = "time_scaled";
+  c.create = [](const PhysicsSettings& s) -> std::unique_ptr<PhysicEngine> { return std::make_unique<TimeScaledEngine>(s); };
+  CHECK_THROWS_WITH(registerPhysicEngine(c), Contains("'time_scaled' is registered already"));
+  c.name = "Time Scaled";
+  CHECK_THROWS_WITH(registerPhysicEngine(c), Contains("lower-case letters, digits and '_'"));
+  c.name = "no_create";
+  c.create = nullptr;
+  CHECK_THROWS_WITH(registerPhysicEngine(c), Contains("no create function"));
+  static constexpr ssx_plugin_param kBad[] = {param::real("k", "-1", "", param::positive(), "a gain")};
+  c.name = "bad_default";
+  c.create = [](const PhysicsSettings& s) -> std::unique_ptr<PhysicEngine> { return std::make_unique<TimeScaledEngine>(s); };
+  c.settings.assign(std::begin(kBad), std::end(kBad));
+  CHECK_THROWS_WITH(registerPhysicEngine(c), Contains("physics engine 'bad_default': ") && Contains("'k' must be > 0"));
+  CHECK(findPhysicEngine("bad_default") == nullptr);
 }

@@ -3,6 +3,8 @@
 #include "scene/xml/scene_loader.hpp"
 #include "scene/xml/xml_reader.hpp"
 
+#include "engines/engine_options.hpp"
+
 #include <ssx/scene.hpp>
 
 #include <algorithm>
@@ -191,39 +193,34 @@ void SceneLoader::readEnvironment(const Descriptor& d) {
   checkUnknown(d);
 }
 
-namespace {
-// each engine's own attributes of <physics>; the common ones are read for every engine
-const std::vector<std::pair<std::string, std::set<std::string>>>& engineAttributes() {
-  static const std::vector<std::pair<std::string, std::set<std::string>>> table = {
-      {"ode",
-       {"solver", "iterations", "sor", "erp", "cfm", "contact_soft_erp", "contact_soft_cfm", "contact_surface_layer",
-        "max_contacts", "partitions"}},
-      {"bullet",
-       {"iterations", "erp", "cfm", "split_impulse", "split_impulse_threshold", "linear_slop"}},
-  };
-  return table;
-}
-}  // namespace
-
 void SceneLoader::readPhysics(const Descriptor& d) {
   PhysicsSettings& p = settings_.physics;
-  p.engine = readChoice(d, "engine", p.engine, {"ode", "bullet"});
+  const std::vector<std::string> engines = physicEngineNames();
+  p.engine = read<std::string>(d, "engine", p.engine);
+  if (std::find(engines.begin(), engines.end(), p.engine) == engines.end()) {
+    std::string list;
+    for (const auto& n : engines) list += (list.empty() ? "" : ", ") + n;
+    record(d.error(*d.find("engine"), "attribute 'engine' must be one of " + list + ", got '" + p.engine + "'"));
+    p.engine = "ode";
+  }
   const bool overridden = options_.physics_engine.has_value();
   if (overridden) p.engine = *options_.physics_engine;
+  const PhysicEngineClass* own = findPhysicEngine(p.engine);
+  const auto declares = [](const PhysicEngineClass* c, std::string_view key) {
+    return c != nullptr && std::any_of(c->settings.begin(), c->settings.end(),
+                                       [&](const ssx_plugin_param& s) { return key == s.name; });
+  };
   // an attribute that only another engine takes is an error: it would silently do nothing
-  const auto& table = engineAttributes();
-  const auto own = std::find_if(table.begin(), table.end(), [&](const auto& e) { return e.first == p.engine; });
-  if (own != table.end()) {
-    for (const auto& [engine, attributes] : table) {
-      if (engine == p.engine) continue;
-      for (const auto& a : attributes) {
-        const auto* attr = d.find(a);
-        if (attr == nullptr || own->second.contains(a)) continue;
-        attr->used = true;
-        error(attr->where, "<physics>: attribute '" + a + "' is an option of the " + engine + " engine, and the engine is '" +
-                               p.engine + "'" + (overridden ? " (chosen with --physics)" : "") +
-                               ": remove it, or choose engine=\"" + engine + "\"");
-      }
+  std::set<std::string_view> reported;  // (two other engines may declare one name)
+  for (const auto& engine : engines) {
+    const PhysicEngineClass* other = findPhysicEngine(engine);
+    if (other == own || other == nullptr) continue;
+    for (const ssx_plugin_param& s : other->settings) {
+      if (declares(own, s.name) || !d.has(s.name) || !reported.insert(s.name).second) continue;
+      const auto* attr = d.find(s.name);
+      error(attr->where, "<physics>: attribute '" + std::string(s.name) + "' is an option of the " + engine +
+                             " engine, and the engine is '" + p.engine + "'" + (overridden ? " (chosen with --physics)" : "") +
+                             ": remove it, or choose engine=\"" + engine + "\"");
     }
   }
   p.substeps = static_cast<int>(readCount(d, "substeps", p.substeps, 1, 10'000));
@@ -240,35 +237,16 @@ void SceneLoader::readPhysics(const Descriptor& d) {
   if (p.restitution < 0 || p.restitution > 1) error(d.where(), "<physics>: restitution must be in 0..1");
   p.max_linear_speed = readPositive(d, "max_linear_speed", p.max_linear_speed);
   p.max_angular_speed = readPositive(d, "max_angular_speed", p.max_angular_speed);
-  if (p.engine == "ode") {
-    OdeSettings& o = p.ode;
-    o.solver = readChoice(d, "solver", "quickstep", {"quickstep", "exact"}) == "exact" ? OdeSettings::Solver::Exact
-                                                                                       : OdeSettings::Solver::QuickStep;
-    o.iterations = static_cast<int>(readCount(d, "iterations", o.iterations, 1, 100'000));
-    o.sor = readPositive(d, "sor", o.sor);
-    o.erp = readPositive(d, "erp", o.erp);
-    o.cfm = readPositive(d, "cfm", o.cfm);
-    o.contact_soft_erp = readPositive(d, "contact_soft_erp", o.contact_soft_erp);
-    o.contact_soft_cfm = readPositive(d, "contact_soft_cfm", o.contact_soft_cfm);
-    o.max_contacts = static_cast<int>(readCount(d, "max_contacts", o.max_contacts, 1, 1024));
-    o.partitions = static_cast<int>(readCount(d, "partitions", o.partitions, 1, 1024));
-    o.contact_surface_layer = read<double>(d, "contact_surface_layer", o.contact_surface_layer);
-    if (!(o.contact_surface_layer >= 0 && o.contact_surface_layer < 1))
-      error(d.find("contact_surface_layer")->where, "<physics>: contact_surface_layer must be in [0, 1) m");
-  } else if (p.engine == "bullet") {
-    BulletSettings& b = p.bullet;
-    b.iterations = static_cast<int>(readCount(d, "iterations", b.iterations, 1, 100'000));
-    b.erp = read<double>(d, "erp", b.erp);
-    if (!(b.erp >= 0 && b.erp <= 1)) error(d.find("erp")->where, "<physics>: erp must be in 0..1");
-    b.cfm = read<double>(d, "cfm", b.cfm);
-    if (!(b.cfm >= 0 && b.cfm <= 1)) error(d.find("cfm")->where, "<physics>: cfm must be in 0..1");
-    b.split_impulse = read<bool>(d, "split_impulse", b.split_impulse);
-    b.split_impulse_threshold = read<double>(d, "split_impulse_threshold", b.split_impulse_threshold);
-    if (!(b.split_impulse_threshold <= 0 && b.split_impulse_threshold > -1))
-      error(d.find("split_impulse_threshold")->where,
-            "<physics>: split_impulse_threshold is a penetration depth, in (-1, 0] m");
-    b.linear_slop = read<double>(d, "linear_slop", b.linear_slop);
-    if (!(b.linear_slop >= 0 && b.linear_slop < 1)) error(d.find("linear_slop")->where, "<physics>: linear_slop must be in [0, 1) m");
+  // the engine's own settings, checked against its declarations as a plugin's parameters are
+  if (own != nullptr) {
+    for (const ssx_plugin_param& s : own->settings) {
+      asked(d, s.name);
+      if (const auto* a = d.find(s.name)) a->used = true;
+    }
+    std::vector<Diagnostic> found;
+    p.options = engineOptions(*own, d, found);
+    if (found.empty() && own->configure) own->configure(p.options, p);
+    for (auto& problem : found) add(std::move(problem));
   }
   checkUnknown(d);
 }

@@ -123,10 +123,10 @@ TEST_CASE("counts have upper bounds", "[scene]") {
     FAIL("loaded");
   } catch (const SceneError& e) {
     CHECK_THAT(e.what(),
-               Catch::Contains("m.xml:2: error: <physics>: attribute 'partitions' must be at most 1024, got 4000"));
+               Catch::Contains("m.xml:2: error: <physics>: ode engine: parameter 'partitions' must be >= 1 and <= 1024, got '4000'"));
     // ODE's broadphases are gone: a scene that names one is told so
     CHECK_THAT(e.what(), Catch::Contains("m.xml:2: error: <physics>: attribute 'broadphase' is no longer offered"));
-    CHECK_THAT(e.what(), Catch::Contains("attribute 'max_contacts' must be at most 1024"));
+    CHECK_THAT(e.what(), Catch::Contains("parameter 'max_contacts' must be >= 1 and <= 1024"));
     CHECK_THAT(e.what(), Catch::Contains("m.xml:4: error: <swarm>: attribute 'count' must be at most 10000000"));
   }
 }
