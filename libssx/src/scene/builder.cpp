@@ -49,7 +49,7 @@ void SceneBuilder::buildExtensions(Environment& env, const SceneModel& model) {
   }
 }
 
-void SceneBuilder::checkCameras(const Environment& env, const SceneModel& model) {
+void SceneBuilder::checkCameras(const SceneModel& model) {
   // what the cameras write, with the plugins' outputs
   for (const CameraSpec& cam : model.settings.render.cameras) {
     const SourceLocation where = cam.where.file.empty() ? SourceLocation{model.file.string(), 0} : cam.where;
@@ -62,6 +62,9 @@ void SceneBuilder::checkCameras(const Environment& env, const SceneModel& model)
       if (auto problem = files_.claimOutputDirectory(cam.frames_dir, who + "frames"); !problem.empty())
         error(where, problem);
   }
+}
+
+void SceneBuilder::checkFollowedNodes(const Environment& env, const SceneModel& model) {
   for (const CameraSpec& cam : model.settings.render.cameras) {
     if (cam.follow.empty()) continue;
     const Artifact* a = env.findArtifact(cam.follow);
@@ -129,11 +132,13 @@ Scene SceneBuilder::build(const SceneModel& model, bool report_missing_types) {
     placement_of.resize(env.artifactCount(), k);
   }
   // robots inside one another or an obstacle (checked once every artifact is built as asked)
-  if (errorCount() == 0) checkStartOverlaps(env, model, placement_of);
+  // (not after the reader's errors: what it left out of the model would be missing here)
+  if (errorCount() == 0 && !order_.after_errors) checkStartOverlaps(env, model, placement_of);
   log_.stage = documentStage(3);
-  checkCameras(env, model);
+  checkCameras(model);
   // extensions check what they refer to (artifacts by name) once every artifact exists
   for (const auto& c : extension_checks_) validatePlugin(env, c.extension, c.params, nullptr, 1, c.what);
+  checkFollowedNodes(env, model);
   scene.files = files_;
   return scene;
 }

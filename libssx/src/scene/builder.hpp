@@ -48,8 +48,10 @@ class SceneBuilder {
   // returns false when it reported an error
   bool place(Environment& env, const std::string& name, const PlacementModel& p, const ArtifactTypeModel& type,
              const Pose& pose, const std::string& index = {});
-  // the camera outputs claimed with the plugins'; cameras that follow what exists
-  void checkCameras(const Environment& env, const SceneModel& model);
+  // the camera outputs claimed with the plugins'
+  void checkCameras(const SceneModel& model);
+  // cameras follow artifacts that exist
+  void checkFollowedNodes(const Environment& env, const SceneModel& model);
   // reports every robot that starts inside another artifact (scene/start_overlaps.cpp);
   // placement_of[a]: the placement that made artifact a
   void checkStartOverlaps(const Environment& env, const SceneModel& model, const std::vector<std::size_t>& placement_of);

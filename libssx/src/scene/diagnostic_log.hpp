@@ -21,6 +21,7 @@ constexpr std::int64_t documentStage(std::int64_t major, std::int64_t minor = 0)
 struct BuildOrder {
   std::vector<std::int64_t> extensions;  // per extension of the model
   std::vector<std::int64_t> placements;  // per placement of the model
+  bool after_errors = false;  // the reader found errors (what needs the whole scene is not checked)
 };
 
 class DiagnosticLog {

@@ -118,3 +118,21 @@ TEST_CASE("a model made in code with a bad value is reported by the builder, at 
     CHECK_THAT(e.what(), Contains("code.xml:40: error: duplicate artifact name 'post'"));
   }
 }
+
+TEST_CASE("robots that start inside one another are checked only when the reader found no errors", "[scene][builder]") {
+  const std::string overlapping = R"(<scene>
+    <type name="box" file="box.xml"/>
+    <artifact name="a" type="box" xyz="0 0 1"/>
+    <artifact name="b" type="box" xyz="0 0 1"/>
+  )";
+  CHECK_THROWS_WITH(loadSceneFromString(overlapping + "</scene>", "m.xml", test::kArtifacts, testOptions()),
+                    Contains("'b' starts"));
+  // an obstacle the reader refused is not in the model: what overlaps it could not be told
+  try {
+    (void)loadSceneFromString(overlapping + R"(<obstacle name="o"/></scene>)", "m.xml", test::kArtifacts, testOptions());
+    FAIL("loaded");
+  } catch (const SceneError& e) {
+    CHECK_THAT(e.what(), Contains("m.xml:5: error: <obstacle>: needs at least one shape"));
+    CHECK_THAT(e.what(), !Contains("starts"));
+  }
+}

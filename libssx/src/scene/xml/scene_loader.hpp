@@ -59,7 +59,7 @@ class SceneLoader {
   SceneModel parse(Descriptor root, const fs::path& file, const fs::path& dir);
   // where each extension and placement of the model parsed was read: what a builder stamps its
   // problems after
-  BuildOrder buildOrder() const { return {extension_stage_, placement_stage_}; }
+  BuildOrder buildOrder() const { return {extension_stage_, placement_stage_, hasErrors()}; }
   bool hasErrors() const { return errorCount() > 0; }
   DiagnosticLog& log() { return log_; }
 
