@@ -39,4 +39,24 @@ inline std::vector<std::byte> saved(const PhysicEngine& engine) {
   return bytes;
 }
 
+/// For an engine that keeps its settings typed: its declared defaults, configured into `start`
+/// (typed settings set away from the defaults), and described back, give the values the typed
+/// defaults describe to. Returns the declarations whose values differ (none: configure sets every
+/// field from its declaration, describe reads every one back).
+inline std::vector<std::string> typedDefaultsMismatch(const PhysicEngineClass& engine, PhysicsSettings start) {
+  Descriptor defaults("physics");
+  for (const ssx_plugin_param& p : engine.settings) defaults.set(p.name, p.default_value);
+  engine.configure(defaults, start);
+  Descriptor described("physics"), typed("physics");
+  engine.describe(start, described);
+  engine.describe(PhysicsSettings{}, typed);
+  std::vector<std::string> differ;
+  for (const ssx_plugin_param& p : engine.settings) {
+    const auto* a = described.find(p.name);
+    const auto* b = typed.find(p.name);
+    if (a == nullptr || b == nullptr || a->value != b->value) differ.emplace_back(p.name);
+  }
+  return differ;
+}
+
 }  // namespace ssx::test

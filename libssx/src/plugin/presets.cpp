@@ -1,4 +1,5 @@
 #include "plugin/presets.hpp"
+#include "plugin/parameter_checks.hpp"
 
 #include <ssx/parameters.hpp>
 #include <ssx/scene.hpp>
@@ -11,11 +12,6 @@ namespace ssx::detail {
 namespace fs = std::filesystem;
 
 namespace {
-
-bool declares(std::span<const ssx_plugin_param> declarations, std::string_view name) {
-  return std::any_of(declarations.begin(), declarations.end(),
-                     [&](const ssx_plugin_param& d) { return name == d.name; });
-}
 
 // a value naming a file rather than a preset by name
 bool isPath(const std::string& value) {
@@ -68,7 +64,6 @@ const Presets::File& Presets::read(const fs::path& file, const std::string& fami
     return fail(of != nullptr ? of->where : root.where(), "this preset is for '" +
                                                               (of != nullptr ? of->value : std::string()) + "', not '" +
                                                               family + "': say <preset class=\"" + family + "\">");
-    return f;
   }
   for (const auto& a : root.attributes())
     if (a.key != "class") return fail(a.where, "<preset>: unknown attribute '" + a.key + "' (it has only 'class')");

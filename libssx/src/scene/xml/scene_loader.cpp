@@ -4,6 +4,7 @@
 #include "scene/xml/xml_reader.hpp"
 
 #include "engines/engine_options.hpp"
+#include "plugin/parameter_checks.hpp"
 
 #include <ssx/scene.hpp>
 
@@ -206,17 +207,13 @@ void SceneLoader::readPhysics(const Descriptor& d) {
   const bool overridden = options_.physics_engine.has_value();
   if (overridden) p.engine = *options_.physics_engine;
   const PhysicEngineClass* own = findPhysicEngine(p.engine);
-  const auto declares = [](const PhysicEngineClass* c, std::string_view key) {
-    return c != nullptr && std::any_of(c->settings.begin(), c->settings.end(),
-                                       [&](const ssx_plugin_param& s) { return key == s.name; });
-  };
   // an attribute that only another engine takes is an error: it would silently do nothing
   std::set<std::string_view> reported;  // (two other engines may declare one name)
   for (const auto& engine : engines) {
     const PhysicEngineClass* other = findPhysicEngine(engine);
     if (other == own || other == nullptr) continue;
     for (const ssx_plugin_param& s : other->settings) {
-      if (declares(own, s.name) || !d.has(s.name) || !reported.insert(s.name).second) continue;
+      if ((own != nullptr && declares(own->settings, s.name)) || !d.has(s.name) || !reported.insert(s.name).second) continue;
       const auto* attr = d.find(s.name);
       error(attr->where, "<physics>: attribute '" + std::string(s.name) + "' is an option of the " + engine +
                              " engine, and the engine is '" + p.engine + "'" + (overridden ? " (chosen with --physics)" : "") +

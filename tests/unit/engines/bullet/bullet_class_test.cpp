@@ -3,6 +3,7 @@
 #include <ssx/physic_engine.hpp>
 #include <ssx/scene.hpp>
 
+#include "engine_util.hpp"
 #include "scene_util.hpp"
 
 #include <catch2/catch.hpp>
@@ -17,17 +18,7 @@ TEST_CASE("bullet's settings: declared defaults are BulletSettings', a scene's v
   PhysicsSettings from_defaults;
   from_defaults.bullet.iterations = 1;
   from_defaults.bullet.split_impulse = false;
-  Descriptor defaults("physics");
-  for (const ssx_plugin_param& p : bullet->settings) defaults.set(p.name, p.default_value);
-  bullet->configure(defaults, from_defaults);
-  Descriptor described("physics"), typed("physics");
-  bullet->describe(from_defaults, described);
-  bullet->describe(PhysicsSettings{}, typed);
-  for (const ssx_plugin_param& p : bullet->settings) {
-    INFO(p.name);
-    REQUIRE(typed.find(p.name) != nullptr);
-    CHECK(described.find(p.name)->value == typed.find(p.name)->value);
-  }
+  CHECK(test::typedDefaultsMismatch(*bullet, from_defaults) == std::vector<std::string>{});
   const SceneModel model = parseSceneString(
       R"(<scene><physics engine="bullet" iterations="25" split_impulse="false" linear_slop="0.001"/></scene>)", "m.xml",
       ".", {});

@@ -3,6 +3,7 @@
 #include <ssx/physic_engine.hpp>
 #include <ssx/scene.hpp>
 
+#include "engine_util.hpp"
 #include "scene_util.hpp"
 
 #include <catch2/catch.hpp>
@@ -19,17 +20,7 @@ TEST_CASE("ode's settings: declared defaults are OdeSettings', a scene's values 
   PhysicsSettings from_defaults;
   from_defaults.ode.iterations = 1;  // (configure must set every field)
   from_defaults.ode.partitions = 1;
-  Descriptor defaults("physics");
-  for (const ssx_plugin_param& p : ode->settings) defaults.set(p.name, p.default_value);
-  ode->configure(defaults, from_defaults);
-  Descriptor described("physics"), typed("physics");
-  ode->describe(from_defaults, described);
-  ode->describe(PhysicsSettings{}, typed);
-  for (const ssx_plugin_param& p : ode->settings) {
-    INFO(p.name);
-    REQUIRE(typed.find(p.name) != nullptr);
-    CHECK(described.find(p.name)->value == typed.find(p.name)->value);
-  }
+  CHECK(test::typedDefaultsMismatch(*ode, from_defaults) == std::vector<std::string>{});
   // a scene's values
   const SceneModel model = parseSceneString(
       R"(<scene><physics solver="exact" iterations="35" contact_surface_layer="0.002" partitions="4"/></scene>)", "m.xml",
