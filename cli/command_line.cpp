@@ -103,6 +103,12 @@ CommandLine parseCommandLine(int argc, const char* const* argv, std::ostream& ou
   run_cmd->add_option("--snapshot", c.run.snapshot, "write the first camera's last frame as PNG to FILE")->check(path());
   run_cmd->add_option("--video", c.run.video, "write the first camera's frames as MP4 to FILE (needs ffmpeg)")->check(path());
   run_cmd->add_option("--frames", c.run.frames, "write the first camera's frames as PNG files into DIR")->check(path());
+  run_cmd->add_option("--frames-from", c.run.frames_from,
+                      "start the cameras' frames (video, PNG frames, snapshot) at this simulated second")
+      ->check(realNumber(0.0, ssx::kMaxDurationSeconds));
+  auto* frames_until = run_cmd->add_option("--frames-until", c.run.frames_until,
+                                           "end the cameras' frames after this simulated second (outputs finished then)")
+                           ->check(realNumber(0.0, ssx::kMaxDurationSeconds));
   run_cmd->add_option("--save-state", c.run.save_state, "write the world's state to FILE at the end (ssx run --load-state)")->check(path());
   auto* record = run_cmd->add_option("--record", c.run.record,
                       "record the run into FILE (MCAP: the scene, every body's pose, saved states; ssx inspect, "
@@ -209,6 +215,11 @@ CommandLine parseCommandLine(int argc, const char* const* argv, std::ostream& ou
     viewPort(view, c.run.view);
     c.run.duration_given = duration->count() > 0;
     if (c.realtime_given && (realtime->results().empty() || realtime->results().front().empty())) c.run.realtime = 1.0;
+    if (frames_until->count() > 0 && c.run.frames_until < c.run.frames_from) {
+      err << "ssx run: --frames-from " << c.run.frames_from << " --frames-until " << c.run.frames_until
+          << ": an empty window (--frames-until comes before --frames-from)\n";
+      c.exit_status = kExitBadInput;
+    }
     const auto& channels = c.run.record_channels;
     if (channels.size() > 1 && std::find(channels.begin(), channels.end(), "none") != channels.end()) {
       err << "ssx run: --record-channels: 'none' cannot go with other channels\n";

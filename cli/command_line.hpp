@@ -39,6 +39,8 @@ struct RunArgs {
   bool duration_given = false;
   int rt_priority = 0;
   std::vector<std::string> switch_physics;  // --switch-physics SECONDS:ENGINE, each
+  double frames_from = 0;    // --frames-from: the scene cameras' frames start at this simulated second
+  double frames_until = -1;  // --frames-until: ... and end after this one (< 0: at the end)
 };
 
 struct ValidateArgs {

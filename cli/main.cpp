@@ -207,6 +207,18 @@ int commandRun(const RunArgs& args, bool realtime_given) {
       return kExitBadInput;
     }
   }
+  if (args.frames_from > 0 || args.frames_until >= 0) {
+    // the scene cameras' frames in a window of simulated time: opened at its start, finished at its end
+    ssx::RenderSettings render = env.settings().render;
+    if (render.cameras.empty()) {
+      std::cerr << "ssx: error: --frames-from/--frames-until: the scene draws no frames: give --video, --frames or "
+                   "--snapshot, or a <camera> in the scene's <render>\n";
+      return kExitBadInput;
+    }
+    render.from = ssx::toNanoseconds(args.frames_from);
+    render.until = args.frames_until < 0 ? -1 : ssx::toNanoseconds(args.frames_until);
+    env.attachRenderer(std::move(render));  // (before start: what the run starts with)
+  }
   // this command's own files, with the scene's: nothing is written over what the run reads or
   // writes already, before anything starts
   {

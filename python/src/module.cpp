@@ -52,6 +52,7 @@ class PyEnvironment {
   }
 
   ssx::Environment& env() { return env_; }
+  const ssx::RunFiles& files() const { return scene_.files; }
   // `read()` while no other thread steps this environment (RuntimeError otherwise)
   template <class Read>
   auto guarded(Read read) {
@@ -400,13 +401,6 @@ class PyEnvironment {
   }
   bool recording() const { return recorder_ != nullptr; }
 
-  std::string view(int port, const std::string& bind, double rate_hz, int max_clients) {
-    InUse use(busy_);
-    if (env_.state() != ssx::Environment::State::Setup)
-      throw py::value_error("ssx: view() comes before the first step, run or command: the viewer starts with the environment");
-    return ssx_python::startViewer(env_, port, bind, rate_hz, max_clients);
-  }
-
   void close() {
     InUse use(busy_);
     py::gil_scoped_release release;
@@ -546,10 +540,6 @@ PYBIND11_MODULE(_ssx, m) {
       .def("stop_recording", &PyEnvironment::stopRecording,
            "Ends the recording (the file complete) and returns what it wrote: samples, dropped, states, bytes.")
       .def_property_readonly("recording", &PyEnvironment::recording, "Whether a recording is running.")
-      .def("view", &PyEnvironment::view, py::arg("port") = 8765, py::arg("bind") = "127.0.0.1", py::arg("rate_hz") = 30.0,
-           py::arg("max_clients") = 4,
-           "Serves a live 3D view of this environment to web browsers (as ssx run --view) and returns its URL; "
-           "port 0 takes a free one. Starts the environment, so it comes before the first step or run.")
       .def("close", &PyEnvironment::close,
            "Stops the environment: a recording finished, plugins destroyed, files and videos finished.")
       .def("__enter__", [](py::object self) { return self; })
@@ -559,6 +549,7 @@ PYBIND11_MODULE(_ssx, m) {
   ssx_python::bindGhostsAndOperators(environment);
   ssx_python::bindJoints(environment);
   ssx_python::bindPhysics(environment);
+  ssx_python::bindView(environment);
   ssx_python::bindRecording(m);
   ssx_python::bindLearn(m, environment);
 

@@ -147,7 +147,20 @@ class Environment:
     def recording(self) -> bool:
         """Whether a recording is running."""
     def view(self, port: int = 8765, bind: str = "127.0.0.1", rate_hz: float = 30.0, max_clients: int = 4) -> str:
-        """Serves a live 3D view to web browsers (as ssx run --view); returns its URL. Before the first step or run."""
+        """Serves a live 3D view to web browsers (as ssx run --view); returns its URL. Attaches to the run as it is
+        (before the first step: starts the environment); changes nothing in the run."""
+    def stop_view(self) -> None:
+        """Takes the live view off the run; view() can attach one again."""
+    def attach_renderer(self, *, snapshot: Optional[_Path] = None, video: Optional[_Path] = None,
+                        frames: Optional[_Path] = None, rate_hz: Optional[float] = None, width: Optional[int] = None,
+                        height: Optional[int] = None, engine: Optional[str] = None) -> None:
+        """Draws the scene cameras' frames from the next step on (a camera framing the scene when it has none) into
+        a PNG snapshot, an MP4 video and/or a directory of PNG frames; changes nothing in the run."""
+    def detach_renderer(self) -> None:
+        """Stops drawing frames: the outputs finished (a video closed, the snapshot written)."""
+    @property
+    def frame_count(self) -> int:
+        """Frames drawn for the scene's cameras so far."""
     def close(self) -> None:
         """Stops the environment: a recording finished, plugins destroyed, files and videos finished."""
     def __enter__(self) -> "Environment": ...

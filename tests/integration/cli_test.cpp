@@ -659,3 +659,50 @@ TEST_CASE("ssx replay and inspect: a hard link to the recording is the recording
     CHECK_THAT(r.err, Contains("not a regular file"));
   }
 }
+
+TEST_CASE("ssx run --frames-from/--frames-until: frames only in that window, the run bitwise the same", "[cli][render]") {
+  const fs::path dir = fs::current_path() / "cli_frames_window";
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  const std::string scene = (kExamples / "scenes" / "quad_hover.xml").string();
+  const std::string out = (dir / "out").string();
+  REQUIRE(run({"run", scene, "--steps", "750", "--fast", "--quiet", "--out", out, "--save-state",
+               (dir / "plain.state").string()})
+              .status == 0);
+  const Result windowed = run({"run", scene, "--steps", "750", "--fast", "--quiet", "--out", out, "--frames",
+                               (dir / "frames").string(), "--frames-from", "0.5", "--frames-until", "1", "--save-state",
+                               (dir / "windowed.state").string()});
+  REQUIRE(windowed.status == 0);
+  // 25 frames per simulated second from 0.5 s to 1 s: 0.5, 0.54, ..., 0.98 s
+  int files = 0;
+  for (const auto& e : fs::directory_iterator(dir / "frames")) files += e.path().extension() == ".png" ? 1 : 0;
+  CHECK(files == 13);
+  auto bytes = [](const fs::path& file) {
+    std::ifstream in(file, std::ios::binary);
+    return std::string(std::istreambuf_iterator<char>(in), {});
+  };
+  CHECK(bytes(dir / "plain.state") == bytes(dir / "windowed.state"));
+  CHECK_FALSE(bytes(dir / "plain.state").empty());
+  const Result backwards = run({"run", scene, "--steps", "1", "--fast", "--quiet", "--snapshot", (dir / "s.png").string(),
+                                "--frames-from", "1", "--frames-until", "0.5"});
+  CHECK(backwards.status == 2);
+  CHECK_THAT(backwards.err, Contains("an empty window"));
+  const Result nothing = run({"run", scene, "--steps", "1", "--fast", "--quiet", "--frames-from", "1"});
+  CHECK(nothing.status == 2);
+  CHECK_THAT(nothing.err, Contains("the scene draws no frames"));
+}
+
+TEST_CASE("ssx run --view: the view is no part of the run's state, so its recording re-simulates without it",
+          "[cli][record]") {
+  const fs::path dir = fs::current_path() / "cli_view_record";
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  const std::string scene = (kExamples / "scenes" / "quad_hover.xml").string();
+  const std::string rec = (dir / "viewed.mcap").string();
+  REQUIRE(run({"run", scene, "--steps", "600", "--fast", "--quiet", "--view", "0", "--record", rec, "--record-states",
+               "0.5", "--out", (dir / "out").string()})
+              .status == 0);
+  const Result again = run({"replay", rec, "--resimulate-from", "0.6"});
+  CHECK(again.status == 0);
+  CHECK_THAT(again.out, Contains("every one equal to the recording bit for bit"));
+}

@@ -59,6 +59,10 @@ CALLS = [
     ("stop_recording", "env.stop_recording()"),
     ("recording", "env.recording"),
     ("view_bad_rate", "env.view(port=0, rate_hz=-1)"),
+    ("view_stop_view", "env.view(port=0); env.step(2); env.stop_view(); env.view(port=0); env.stop_view()"),
+    ("stop_view", "env.stop_view()"),
+    ("attach_renderer", "env.attach_renderer(snapshot=RECORDING + '.png'); env.step(3); env.detach_renderer()"),
+    ("detach_renderer", "env.detach_renderer(); env.frame_count"),
     ("close", "env.close(); env.close()"),
 ]
 

@@ -194,14 +194,26 @@ class SSX_EXPORT Environment {
   Artifact& addArtifact(std::string name, const Pose& placement = {});
   /// Adds a static ground plane at height `z` (an artifact named "ground").
   Artifact& addGround(double z = 0.0);
-  /// Adds an extension under a unique name.
+  /// Adds an extension under a unique name, before start: it is part of the scene, its saveState
+  /// in every saved state (a state restores only into an environment with the same extensions).
+  /// While running it attaches an observer (attachExtension).
   SimulationExtension& addExtension(std::string name, std::unique_ptr<SimulationExtension> extension,
                                     Descriptor params = {});
   /// Same, for an extension owned elsewhere (by classLoader()).
   SimulationExtension& addExtension(std::string name, SimulationExtension& extension, Descriptor params);
-  /// Takes the extension added under `name` out again, before the environment starts (a start that
-  /// failed leaves it in setup): the environment is as it was before it was added. False when there
-  /// is none by that name.
+  /// Adds an observer: an extension that looks at or steers the run from outside (a viewer, a
+  /// bridge), before start (initialised with the others) or while running, between steps (its
+  /// parameters checked as at start, then its init at once, its hooks from the next step on; an
+  /// init that throws attaches nothing). It is not part of saved states (its saveState and
+  /// loadState are not called) nor of what a state must match, so a state saved with it restores
+  /// without it and the other way round; removeExtension takes it off again between steps.
+  /// Error from inside a step (an extension's hook, a listener), or once stopped or failed.
+  SimulationExtension& attachExtension(std::string name, SimulationExtension& extension, Descriptor params);
+  /// Takes the extension named `name` out again: before the environment starts (a start that
+  /// failed leaves it in setup), the environment is as it was before it was added; while running,
+  /// between steps, an observer (attachExtension) is shut down at once (Error with what its
+  /// shutdown threw, the extension taken off all the same). False when there is none by that
+  /// name; Error for one that is part of the scene (addExtension before start) while running.
   bool removeExtension(std::string_view name);
   /// The loader for plugin libraries; it owns what it creates, and the environment destroys
   /// those instances right after its plugins' destroy() and before anything else.
@@ -460,8 +472,24 @@ class SSX_EXPORT Environment {
   void drawFrame(Nanoseconds time, std::span<const RenderNode> overlay = {});
   /// Frames drawn for the scene's cameras so far.
   std::int64_t frameCount() const noexcept;
-  /// The scene cameras' specs as used (frame_scene cameras placed), from start() on.
+  /// The scene cameras' specs as used (frame_scene cameras placed), while their frames are drawn.
   std::vector<CameraSpec> cameras() const;
+  /// Draws the scene cameras' frames with `render` (its engine, cameras, rate, size, outputs and
+  /// its window in time, RenderSettings::from and until). Before start it sets what the run starts
+  /// with. While running, between steps, it attaches a renderer to the run: the frames being drawn
+  /// are finished first (as detachRenderer does), then the new ones are drawn from the next step
+  /// (or `render.from`, if later) on, every `period_steps` from there; their outputs are opened
+  /// and the framing cameras placed now (at `from` when that is later). Pictures change nothing
+  /// in the world: the same run gives the same bits with or without them, attached and detached at
+  /// any steps. Camera sensors keep drawing as they started (engine and background), so while one
+  /// does the engine may not change. ConfigError for settings out of range or a camera following
+  /// no robot, before anything changes; Error from a step's hooks or listeners, or once stopped.
+  void attachRenderer(RenderSettings render);
+  /// Stops drawing the scene cameras' frames, between steps: the frames queued are drawn, the
+  /// outputs finished (a video closed, a snapshot of the last frame written), the cameras
+  /// forgotten; camera sensors go on. Throws Error naming an output that could not be finished
+  /// (the run goes on, without frames). Nothing to stop: nothing happens.
+  void detachRenderer();
 
   /// The physics engine, read-only (bodies are added by the environment, at start); throws when
   /// the environment is not running.
@@ -505,6 +533,8 @@ class SSX_EXPORT Environment {
   void runExtensionHook(void (SimulationExtension::*hook)(Environment&), const char* what);
   void exchangePhysics(const std::string& engine);
   void runScheduledSwitches();
+  void requireBetweenSteps(const char* what) const;
+  void checkObserver(const SimulationExtension& extension, Descriptor& params, const std::string& name) const;
 
   struct ExtensionSlot {
     std::string name;
@@ -512,6 +542,7 @@ class SSX_EXPORT Environment {
     std::unique_ptr<SimulationExtension> owned;  // null when the ClassLoader owns it
     Descriptor params;
     bool initialised = false;
+    bool observer = false;  // added while running: not part of saved states nor the fingerprint
   };
 
   EnvironmentSettings settings_;

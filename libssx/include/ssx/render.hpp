@@ -108,6 +108,12 @@ struct RenderSettings {
   bool shadows = true;     ///< the scene cameras draw each robot's shadow on the ground
   bool time_stamp = true;  ///< the scene cameras' frames show the simulated time, top left
   std::vector<CameraSpec> cameras;  ///< frames are drawn only when there is a camera
+  /// The frames start with the first step that ends at or after this simulated time, ns (0: the
+  /// first step): the cameras' outputs are opened and the cameras framing the scene placed then.
+  Nanoseconds from = 0;
+  /// The frames end with the last step that ends at or before this simulated time, ns, and the
+  /// outputs are finished then (a video closed, a snapshot written); < 0: when the run stops.
+  Nanoseconds until = -1;
 };
 
 /// A live render node: one node of an artifact's render tree, posed in the world from the

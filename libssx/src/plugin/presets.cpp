@@ -2,6 +2,7 @@
 #include "plugin/parameter_checks.hpp"
 
 #include <ssx/parameters.hpp>
+#include <ssx/run_files.hpp>
 #include <ssx/scene.hpp>
 
 #include <algorithm>
@@ -153,6 +154,30 @@ std::vector<Diagnostic> Presets::apply(Descriptor& params, const char* class_nam
     if (!params.has(v.key) && declares(declarations, v.key)) params.set(v.key, v.value, v.where);
   if (used != nullptr) *used = file;
   return {};
+}
+
+std::vector<Diagnostic> Presets::checkInstance(Descriptor& params, const ssx_plugin_class& type,
+                                               const PluginContext& context, const std::string& what) {
+  const std::span<const ssx_plugin_param> declarations{type.params, type.param_count};
+  std::vector<Diagnostic> found = apply(params, type.name, declarations, what);
+  if (found.empty()) found = checkParameters(declarations, params, context, what);
+  // the class's own checks only for parameters that passed the declared ones
+  const bool declared_ok = std::none_of(found.begin(), found.end(), [](const Diagnostic& d) {
+    return d.severity == Diagnostic::Severity::Error;
+  });
+  if (declared_ok && type.validate != nullptr) {
+    std::vector<Diagnostic> own;
+    type.validate(&params, &context, &own);
+    for (auto& d : own) d.message = what + ": " + d.message;
+    found.insert(found.end(), own.begin(), own.end());
+  }
+  return found;
+}
+
+Presets Presets::installed() {
+  std::vector<fs::path> dirs;
+  if (fs::path dir = installedDirectory(); !dir.empty()) dirs.push_back(std::move(dir));
+  return Presets(std::move(dirs), kDefaultMaxInputBytes);
 }
 
 }  // namespace ssx::detail

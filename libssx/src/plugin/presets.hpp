@@ -43,9 +43,17 @@ class Presets {
                                 std::span<const ssx_plugin_param> declarations, const std::string& what,
                                 std::filesystem::path* used = nullptr);
 
+  /// What a plugin instance made by a program (not by the scene loader) is checked with before it
+  /// runs: the preset it names applied, its parameters against the class's declarations, then the
+  /// class's own validate. Errors and warnings, their messages starting with `what`.
+  std::vector<Diagnostic> checkInstance(Descriptor& params, const ssx_plugin_class& type, const PluginContext& context,
+                                        const std::string& what);
+
   /// The presets of a class found in the directories, by name, sorted (for messages and listings).
   std::vector<std::string> available(const std::string& class_name) const;
 
+  /// The presets installed with libssx (installedDirectory(), when there is one).
+  static Presets installed();
   /// The installed preset directory (installedDataDirectory()/presets), or empty.
   static std::filesystem::path installedDirectory();
 

@@ -3,10 +3,12 @@
 #include "render/frame_output.hpp"
 #include "render/frame_worker.hpp"
 
+#include <ssx/environment.hpp>
 #include <ssx/error.hpp>
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numbers>
 
 namespace ssx::detail {
@@ -73,58 +75,117 @@ void frameBox(CameraSpec& spec, Eigen::AlignedBox3d box, double aspect) {
 
 }  // namespace
 
+void checkRenderSettings(const RenderSettings& r) {
+  auto bad = [](const std::string& what) { throw ConfigError({}, what); };
+  if (r.period_steps < 0) bad("render period must be 0 (never) or positive");
+  if (!(r.rate_hz == 0 || (r.rate_hz >= kMinRateHz && std::isfinite(r.rate_hz))))
+    bad("render rate_hz must be 0 (none) or at least 1e-6");
+  if (r.width < 1 || r.height < 1 || r.width > kMaxImageSide || r.height > kMaxImageSide)
+    bad("render width and height must be in 1.." + std::to_string(kMaxImageSide));
+  for (const auto& c : r.cameras)
+    if (!validFieldOfView(c.fov_deg)) bad("camera '" + c.name + "': fov_deg must be in (0, 180)");
+  if (r.from < 0 || r.from > toNanoseconds(kMaxDurationSeconds))
+    bad("render from must be a simulated time in 0.." + std::to_string(static_cast<long long>(kMaxDurationSeconds)) + " s");
+  if (r.until >= 0 && r.until < r.from) bad("render until must not come before from (or be negative: until the end)");
+}
+
+void resolveRenderPeriod(RenderSettings& r, Nanoseconds timestep) {
+  if (r.rate_hz > 0) r.period_steps = std::max<std::int64_t>(1, std::llround(1.0 / (r.rate_hz * toSeconds(timestep))));
+  // a camera with somewhere to put its frames and no rate given: 25 frames per simulated second
+  if (r.period_steps == 0 && !r.cameras.empty())
+    r.period_steps = std::max<std::int64_t>(1, std::llround(1.0 / (25.0 * toSeconds(timestep))));
+}
+
 SceneCameras::SceneCameras() = default;
 SceneCameras::~SceneCameras() = default;
 
-void SceneCameras::start(const RenderSettings& r, Nanoseconds timestep, const RenderEngine& renderer,
-                         const Artifacts& artifacts, const Log& warn) {
+void SceneCameras::bind(const Artifacts& artifacts, Nanoseconds timestep, const Color& sensor_background, Log warn) {
   timestep_ = timestep;
+  sensor_background_ = sensor_background;
+  warn_ = std::move(warn);
   // render roots follow their physic nodes, looked up once
   follow_.clear();
   for (const auto& a : artifacts) {
     auto& follow = follow_.emplace_back();
     for (const auto& root : a->renderRoots()) follow.push_back(root->follow.empty() ? nullptr : a->node(root->follow));
   }
+}
+
+void SceneCameras::schedule(const RenderSettings& r, std::int64_t now, const RenderEngine& renderer,
+                            const Artifacts& artifacts) {
+  checkCameras(r, artifacts);
+  settings_ = r;
+  draws_pixels_ = renderer.drawsPixels();
+  engine_ = renderer.name();
+  period_ = r.period_steps;
+  // step s ends at (s + 1) timesteps: the first ending at or after `from`, the last by `until`
+  first_ = std::max(now, (r.from + timestep_ - 1) / timestep_ - 1);
+  last_ = r.until < 0 ? std::numeric_limits<std::int64_t>::max() : r.until / timestep_ - 1;
+  if (period_ > 0 && first_ == now && first_ <= last_) {
+    try {
+      open(artifacts);
+    } catch (...) {
+      period_ = 0;  // nothing scheduled
+      throw;
+    }
+  }
+}
+
+void SceneCameras::checkCameras(const RenderSettings& r, const Artifacts& artifacts) {
+  for (const CameraSpec& spec : r.cameras) {
+    if (spec.follow.empty()) continue;
+    const auto it = std::find_if(artifacts.begin(), artifacts.end(), [&](const auto& a) { return a->name() == spec.follow; });
+    if (it == artifacts.end() || (*it)->rootCount() == 0)
+      throw ConfigError({}, "camera '" + spec.name + "' follows '" + spec.follow +
+                                "', which is no artifact with a physic root");
+  }
+}
+
+void SceneCameras::open(const Artifacts& artifacts) {
+  const RenderSettings& r = settings_;
+  open_ = true;
   if (r.cameras.empty()) return;
-  if (!renderer.drawsPixels()) {
+  if (!draws_pixels_) {
     std::string names;
     for (const auto& c : r.cameras) names += (names.empty() ? "'" : ", '") + c.name + "'";
-    warn("render engine '" + renderer.name() + "' draws no pixels: camera " + names +
-         " gets no frames (choose engine=\"osmesa\" in <render> or --render osmesa)");
+    warn_("render engine '" + engine_ + "' draws no pixels: camera " + names +
+          " gets no frames (choose engine=\"osmesa\" in <render> or --render osmesa)");
     return;
   }
   for (const CameraSpec& spec : r.cameras) {
     Camera c;
     c.spec = spec;
-    if (!spec.follow.empty()) {
-      for (const auto& a : artifacts)
-        if (a->name() == spec.follow) c.follow = a.get();
-      if (c.follow == nullptr || c.follow->rootCount() == 0)
-        throw ConfigError({}, "camera '" + spec.name + "' follows '" + spec.follow +
-                                  "', which is no artifact with a physic root");
-    }
+    for (const auto& a : artifacts)
+      if (!spec.follow.empty() && a->name() == spec.follow) c.follow = a.get();  // (checked by schedule)
     if (spec.frame_scene) {
       c.seen = robotsBox(artifacts);
       frameBox(c.spec, c.seen, static_cast<double>(r.width) / r.height);
     }
     cameras_.push_back(std::move(c));
   }
-  const double fps = 1.0 / (static_cast<double>(r.period_steps) * toSeconds(timestep));
-  std::vector<std::unique_ptr<FrameOutput>> outputs;
-  for (const auto& c : cameras_) outputs.push_back(std::make_unique<FrameOutput>(c.spec, fps, warn));
-  worker_ = std::make_unique<FrameWorker>(r, std::move(outputs));
+  const double fps = 1.0 / (static_cast<double>(r.period_steps) * toSeconds(timestep_));
+  try {
+    std::vector<std::unique_ptr<FrameOutput>> outputs;
+    for (const auto& c : cameras_) outputs.push_back(std::make_unique<FrameOutput>(c.spec, fps, warn_));
+    worker_ = std::make_unique<FrameWorker>(r, std::move(outputs));
+  } catch (...) {
+    cameras_.clear();
+    open_ = false;
+    throw;
+  }
 }
 
-void SceneCameras::finish(const Log& error) {
-  if (worker_) {
-    try {
-      worker_->finish();
-    } catch (const std::exception& e) {
-      error(std::string("frames: ") + e.what());
-    }
-    worker_.reset();
-  }
+void SceneCameras::close() {
+  period_ = 0;
+  open_ = false;
   cameras_.clear();
+  if (!worker_) return;
+  const std::unique_ptr<FrameWorker> worker = std::move(worker_);
+  try {
+    worker->finish();
+  } catch (const std::exception& e) {
+    throw Error(std::string("frames: ") + e.what());
+  }
 }
 
 std::vector<CameraSpec> SceneCameras::specs() const {
@@ -157,25 +218,43 @@ void SceneCameras::sync(std::int64_t step, const Artifacts& artifacts) {
   }
 }
 
-void SceneCameras::renderRequests(std::int64_t step, RenderEngine& renderer, const Color& background,
-                                  const Artifacts& artifacts) {
+void SceneCameras::renderRequests(std::int64_t step, RenderEngine& renderer, const Artifacts& artifacts) {
   CameraView view;
   for (auto& r : requests_) {
     try {
       view = CameraView{};
       if (!r.due(step, view)) continue;
       sync(step + 1, artifacts);
-      renderer.renderView(view, items_, background, *r.target);
+      renderer.renderView(view, items_, sensor_background_, *r.target);
     } catch (const std::exception& e) {
       throw StepError("", r.owner, step, std::string("camera image: ") + e.what());
     }
   }
 }
 
-void SceneCameras::drawFrame(std::int64_t step, const RenderSettings& settings, const Artifacts& artifacts,
-                             Nanoseconds time, std::span<const RenderNode> overlay) {
+void SceneCameras::drawFrame(std::int64_t step, const Artifacts& artifacts, Nanoseconds time,
+                             std::span<const RenderNode> overlay, bool close_after) {
   sync(step + 1, artifacts);  // also without cameras: renderNodes() serves viewers outside ssx
-  if (!worker_) return;
+  if (period_ > 0 && !open_) {
+    try {
+      open(artifacts);
+    } catch (const std::exception& e) {
+      throw StepError("", "render", step, std::string("starting the frames: ") + e.what());
+    }
+  }
+  if (worker_) submit(step, artifacts, time, overlay);
+  if (close_after && ended(step)) {
+    try {
+      close();
+    } catch (const std::exception& e) {
+      throw StepError("", "render", step, std::string("finishing the frames: ") + e.what());
+    }
+  }
+}
+
+void SceneCameras::submit(std::int64_t step, const Artifacts& artifacts, Nanoseconds time,
+                          std::span<const RenderNode> overlay) {
+  const RenderSettings& settings = settings_;
   std::vector<CameraView> views;
   for (auto& c : cameras_) {
     CameraView view;

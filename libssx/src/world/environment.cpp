@@ -38,13 +38,7 @@ void checkSettings(const EnvironmentSettings& s) {
   if (s.physics.ode.max_contacts < 1) bad("physics max_contacts must be at least 1");
   if (s.physics.ode.partitions < 1) bad("physics partitions must be at least 1");
   if (!s.physics.gravity.allFinite()) bad("gravity must be finite");
-  if (s.render.period_steps < 0) bad("render period must be 0 (never) or positive");
-  if (!(s.render.rate_hz == 0 || (s.render.rate_hz >= kMinRateHz && std::isfinite(s.render.rate_hz))))
-    bad("render rate_hz must be 0 (none) or at least 1e-6");
-  if (s.render.width < 1 || s.render.height < 1 || s.render.width > kMaxImageSide || s.render.height > kMaxImageSide)
-    bad("render width and height must be in 1.." + std::to_string(kMaxImageSide));
-  for (const auto& c : s.render.cameras)
-    if (!validFieldOfView(c.fov_deg)) bad("camera '" + c.name + "': fov_deg must be in (0, 180)");
+  detail::checkRenderSettings(s.render);
 }
 
 }  // namespace
@@ -57,12 +51,7 @@ Environment::Environment(EnvironmentSettings settings)
       neighbors_(std::make_unique<detail::NeighborIndex>()),
       ghosts_(std::make_unique<detail::Ghosts>()) {
   checkSettings(settings_);
-  RenderSettings& r = settings_.render;
-  if (r.rate_hz > 0)
-    r.period_steps = std::max<std::int64_t>(1, std::llround(1.0 / (r.rate_hz * toSeconds(settings_.timestep))));
-  // a camera with somewhere to put its frames and no rate given: 25 frames per simulated second
-  if (r.period_steps == 0 && !r.cameras.empty())
-    r.period_steps = std::max<std::int64_t>(1, std::llround(1.0 / (25.0 * toSeconds(settings_.timestep))));
+  detail::resolveRenderPeriod(settings_.render, settings_.timestep);
 }
 
 Environment::~Environment() {
@@ -158,22 +147,6 @@ SimulationExtension& Environment::addExtension(std::string name, std::unique_ptr
   SimulationExtension& e = addExtension(std::move(name), *extension, std::move(params));
   extensions_.back().owned = std::move(extension);
   return e;
-}
-
-SimulationExtension& Environment::addExtension(std::string name, SimulationExtension& extension, Descriptor params) {
-  requireSetup("extensions can be added");
-  if (name.empty()) throw ConfigError(params.where(), "an extension needs a name");
-  if (this->extension(name) != nullptr) throw ConfigError(params.where(), "duplicate extension name '" + name + "'");
-  extensions_.push_back({std::move(name), &extension, nullptr, std::move(params), false});
-  return extension;
-}
-
-bool Environment::removeExtension(std::string_view name) {
-  requireSetup("extensions can be removed");
-  const auto it = std::find_if(extensions_.begin(), extensions_.end(), [&](const ExtensionSlot& e) { return e.name == name; });
-  if (it == extensions_.end()) return false;
-  extensions_.erase(it);
-  return true;
 }
 
 void Environment::subscribe(const Sensor& sensor, Artifact& subscriber,
@@ -298,25 +271,10 @@ void Environment::checkDeclaredParameters() {
     const ssx_plugin_class* type = loader_->classOf(instance);
     if (type == nullptr) return;
     const PluginContext context{this, a, period, settings_.timestep, {}};
-    const std::span<const ssx_plugin_param> declarations{type->params, type->param_count};
-    if (!presets) {
-      std::vector<std::filesystem::path> dirs;
-      if (auto installed = detail::Presets::installedDirectory(); !installed.empty()) dirs.push_back(installed);
-      presets.emplace(std::move(dirs), kDefaultMaxInputBytes);
-    }
-    std::vector<Diagnostic> found = presets->apply(params, type->name, declarations, what());
-    if (found.empty()) found = checkParameters(declarations, params, context, what());
+    if (!presets) presets.emplace(detail::Presets::installed());
     // and the class's own checks (what a scene's plugins get from the loader), before anything is
     // initialised: a plugin added by a program is refused with the environment still in setup
-    const bool declared_ok = std::none_of(found.begin(), found.end(), [](const Diagnostic& d) {
-      return d.severity == Diagnostic::Severity::Error;
-    });
-    if (declared_ok && type->validate != nullptr) {
-      std::vector<Diagnostic> own;
-      type->validate(&params, &context, &own);
-      for (auto& d : own) d.message = what() + ": " + d.message;
-      found.insert(found.end(), own.begin(), own.end());
-    }
+    const std::vector<Diagnostic> found = presets->checkInstance(params, *type, context, what());
     for (const auto& d : found)
       if (d.severity == Diagnostic::Severity::Error) errors += (errors.empty() ? "" : "\n") + d.str();
   };
@@ -355,8 +313,9 @@ void Environment::start() {
     detail::publishSnapshot(w, *physics_, true);
     // (queries enabled before start, by an extension's init, see the first snapshot too)
     if (neighbors_->enabled()) neighbors_->markStale(w.artifacts);
-    cameras_->start(settings_.render, settings_.timestep, *renderer_, w.artifacts,
-                    [this](std::string_view m) { log(LogLevel::Warning, m); });
+    cameras_->bind(w.artifacts, settings_.timestep, settings_.render.background,
+                   [this](std::string_view m) { log(LogLevel::Warning, m); });
+    cameras_->schedule(settings_.render, 0, *renderer_, w.artifacts);
     const unsigned threads = settings_.threads > 0 ? static_cast<unsigned>(settings_.threads)
                                                    : std::max(1u, std::thread::hardware_concurrency());
     pool_ = std::make_unique<detail::WorkerPool>(threads);
@@ -435,7 +394,11 @@ void Environment::stop() {
     }
     if (physics_) physics_->setTaskRunner(nullptr);
     pool_.reset();
-    cameras_->finish([&](std::string_view m) { failed(std::string(m)); });
+    try {
+      cameras_->close();
+    } catch (const std::exception& e) {
+      failed(e.what());
+    }
     renderer_.reset();
     physics_.reset();
   }
@@ -506,7 +469,7 @@ void Environment::drawFrame(Nanoseconds time, std::span<const RenderNode> overla
   requireOutsidePhases("drawFrame");
   if (world_->state != State::Running) throw Error("drawFrame: the environment is not running");
   cameras_->invalidate();  // the bodies may have moved without a step: pose the items again
-  cameras_->drawFrame(world_->steps, settings_.render, world_->artifacts, time, overlay);
+  cameras_->drawFrame(world_->steps, world_->artifacts, time, overlay);
 }
 
 void Environment::addCameraRequest(std::string owner, std::function<bool(std::int64_t, CameraView&)> due,

@@ -186,6 +186,12 @@ void Environment::step() {
     throw Error(w.state == State::Failed ? "the environment failed in an earlier step; it cannot step again"
                                         : "the environment is stopped");
   if (!scheduled_.empty() && scheduled_.front().time <= time()) runScheduledSwitches();
+  // (extensions, renderers and engines are exchanged between steps, not from the step's own hooks)
+  struct Stepping {
+    bool& flag;
+    explicit Stepping(bool& f) : flag(f) { flag = true; }
+    ~Stepping() { flag = false; }
+  } stepping(w.stepping);
   // one clock reading ends a phase and starts the next (a lap timer): half the readings of a
   // start and an end per phase, which cost a twentieth of a small world's step
   const auto t_step = Clock::now();
@@ -229,7 +235,7 @@ void Environment::step() {
   timing.snapshot = lap(t);
   if (cameras_->hasRequests()) {
     try {
-      cameras_->renderRequests(w.current_step, *renderer_, settings_.render.background, w.artifacts);
+      cameras_->renderRequests(w.current_step, *renderer_, w.artifacts);
     } catch (...) {
       fail();
       throw;
@@ -253,11 +259,11 @@ void Environment::step() {
   // the joints the drivers asked for, at the poses they saw (before anything else moves a body)
   if (w.attach_pending.load(std::memory_order_relaxed)) detail::applyAttachRequests(w, *physics_);
 
-  // render, when due
-  if (settings_.render.period_steps > 0 && w.current_step % settings_.render.period_steps == 0) {
+  // render, when due (the outputs opened at the first frame, finished after the last)
+  if (cameras_->due(w.current_step)) {
     lap(t);  // (the attach requests before it count in the total only)
     try {
-      cameras_->drawFrame(w.current_step, settings_.render, w.artifacts);
+      cameras_->drawFrame(w.current_step, w.artifacts, -1, {}, true);
     } catch (...) {
       fail();
       throw;

@@ -156,6 +156,7 @@ struct World {
   const EnvironmentSettings& settings;
   Environment::State state = Environment::State::Setup;
   bool configuring = false;      // plugins' configure is running
+  bool stepping = false;         // inside step(): its hooks, phases and listeners
   std::int64_t steps = 0;        // steps taken
   std::int64_t current_step = 0;  // the step being taken
 

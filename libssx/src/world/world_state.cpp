@@ -84,7 +84,8 @@ std::uint64_t Environment::sceneFingerprint() const {
   for (const auto& p : world_->plugins)
     mix((p.index == 0 ? "driver " : "sensor ") + p.class_name + " " + std::to_string(p.period_steps) + " of " +
         std::to_string(p.artifact));
-  for (const auto& e : extensions_) mix("extension " + e.name);
+  for (const auto& e : extensions_)
+    if (!e.observer) mix("extension " + e.name);  // (those attached while running are not in a state)
   for (const auto& g : ghosts_->list()) mix("ghost " + std::to_string(g.artifact));
   return h;
 }
@@ -126,7 +127,8 @@ std::vector<std::byte> Environment::saveState() const {
     if (a.driver != nullptr) writeBlock(out, [&] { a.driver->saveState(out); });
     for (const auto& s : a.sensors) writeBlock(out, [&] { s.sensor->saveState(out); });
   }
-  for (const auto& e : extensions_) writeBlock(out, [&] { e.extension->saveState(out); });
+  for (const auto& e : extensions_)
+    if (!e.observer) writeBlock(out, [&] { e.extension->saveState(out); });
   if (!ghosts_->empty()) writeBlock(out, [&] { ghosts_->save(out); });
 
   // the header, now that the payload is known
@@ -245,7 +247,8 @@ void Environment::applyState(std::span<const std::byte> payload) {
       readBlock(in, "sensor '" + s.sensor->className() + "'" + of, [&](StateReader& b) { s.sensor->loadState(b); });
   }
   for (auto& e : extensions_)
-    readBlock(in, "extension '" + e.name + "'", [&](StateReader& block) { e.extension->loadState(block); });
+    if (!e.observer)
+      readBlock(in, "extension '" + e.name + "'", [&](StateReader& block) { e.extension->loadState(block); });
   if (!ghosts_->empty()) readBlock(in, "the ghosts' poses", [&](StateReader& block) { ghosts_->load(block, w); });
   if (!in.done()) throw StateError("saved state: " + std::to_string(in.remaining()) + " bytes left over (corrupted)");
   w.steps = steps;
