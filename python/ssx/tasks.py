@@ -190,21 +190,24 @@ class GoTo(_Flight):
         self.goals = np.repeat(self.home[None], num_envs, axis=0)
         self._start_scale = np.array([self.start_range, self.start_range, 0.5 * self.start_range])
         self._goal_scale = np.array([self.goal_range, self.goal_range, 0.5 * self.goal_range])
+        self._draw_scale = np.concatenate([self._start_scale, np.full(3, self.start_speed), self._goal_scale])
 
-    def _goals(self, starts, u):
-        """Goals for episodes starting at `starts` (k, R, 3) from uniform numbers u in [-1, 1) (k, R, 3)."""
-        goals = self.home + u * self._goal_scale
+    def _goals(self, starts, u, scaled=False):
+        """Goals for episodes starting at `starts` (k, R, 3) from uniform numbers u in [-1, 1) (k, R, 3)
+        (`scaled`: u already times the goal range)."""
+        goals = self.home + (u if scaled else u * self._goal_scale)
         np.maximum(goals[..., 2], 0.3, out=goals[..., 2])
         return goals
 
     def draw(self, ids, rngs):
         # one call per environment to its own generator (9 numbers a robot), the rest for all at once
+        # (few numpy calls: a reset of one environment is a handful of small arrays)
         u = np.array([rng.random((self.robots, 9)) for rng in rngs])
         u *= 2.0
         u -= 1.0  # (k, R, 9) in [-1, 1)
-        offsets = u[..., 0:3] * self._start_scale
-        self.goals[ids] = self._goals(self.home + offsets, u[..., 6:9])
-        return offsets, u[..., 3:6] * self.start_speed
+        u *= self._draw_scale  # start offsets (m), start velocities (m/s), goals from home (m)
+        self.goals[ids] = self._goals(self.home + u[..., 0:3], u[..., 6:9], scaled=True)
+        return u[..., 0:3], u[..., 3:6]
 
     def observation_space(self, per_agent=False):
         shape = (16,) if per_agent or self.robots == 1 else (self.robots, 16)
@@ -240,7 +243,7 @@ class Hover(GoTo):
         options.pop("goal_range", None)
         super().__init__(vehicle=vehicle, level=level, goal_range=0.0, start_speed=start_speed, **options)
 
-    def _goals(self, starts, u):
+    def _goals(self, starts, u, scaled=False):
         return starts
 
 

@@ -157,6 +157,14 @@ struct World {
   Environment::State state = Environment::State::Setup;
   bool configuring = false;      // plugins' configure is running
   bool stepping = false;         // inside step(): its hooks, phases and listeners
+  // what a saved state must match, computed once the world is built (nothing changes it then)
+  std::uint64_t fingerprint = 0;
+  bool fingerprint_known = false;
+  // the checksum and size of the last state restored here without error: restoring the same
+  // bytes again needs no copy of the state before it to fall back on (a learning environment's
+  // reset, from one start state, episode after episode)
+  std::uint64_t restored_checksum = 0;
+  std::size_t restored_size = 0;
   std::int64_t steps = 0;        // steps taken
   std::int64_t current_step = 0;  // the step being taken
 

@@ -99,3 +99,46 @@ TEST_CASE("a plugin that reads back less than it saved fails the restore, which 
   CHECK(env.stateHash() == hash);
   CHECK(driver.runs_ == 15);
 }
+
+namespace {
+
+// a driver whose loadState takes the count it saved, then refuses 13 (after taking it)
+class PickyDriver final : public Driver {
+ public:
+  void step(const StepInfo&) override { ++runs_; }
+  void saveState(StateWriter& out) const override { out.write(runs_); }
+  void loadState(StateReader& in) override {
+    in.read(runs_);
+    if (runs_ == 13) throw StateError("13 refused");
+  }
+  std::int64_t runs_ = 0;
+};
+
+}  // namespace
+
+TEST_CASE("a state restored again continues the same, and another that fails still changes nothing", "[state]") {
+  Environment env;
+  Artifact& a = env.addArtifact("body", test::at(0, 0, 1));
+  a.addPhysicRoot(test::boxBody(Vec3(0.1, 0.1, 0.1), 1.0));
+  auto& driver = static_cast<PickyDriver&>(a.setDriver(std::make_unique<PickyDriver>()));
+  env.step(10);
+  const auto at10 = env.saveState();
+  env.step(3);
+  const auto at13 = env.saveState();
+  env.step(2);
+  // the first restore of these bytes keeps a copy to fall back on; the next ones need none
+  env.restoreState(at10);
+  env.step(5);
+  const auto hash = env.stateHash();
+  for (int k = 0; k < 2; ++k) {
+    env.restoreState(at10);
+    CHECK(driver.runs_ == 10);
+    env.step(5);
+    CHECK(env.stateHash() == hash);
+  }
+  // other bytes, refused half way: put back as they were
+  CHECK_THROWS_WITH(env.restoreState(at13), Catch::Contains("13 refused"));
+  CHECK(driver.runs_ == 15);
+  CHECK(env.stepCount() == 15);
+  CHECK(env.stateHash() == hash);
+}
