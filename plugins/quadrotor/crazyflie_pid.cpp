@@ -149,6 +149,9 @@ void CrazyfliePidController::setCommand(const Command& command, const Vec3&) {
     } else {
       command_rates_ = command.body_rates;
     }
+  } else if (command.level == CommandLevel::Rotors) {
+    for (std::size_t i = 0; i < rotor_command_.size(); ++i)
+      rotor_command_[i] = i < command.rotor_speeds.size() ? command.rotor_speeds[i] : 0.0;
   }
 }
 
@@ -158,6 +161,7 @@ Command CrazyfliePidController::command() const {
   if (level_ == CommandLevel::Attitude)
     return Command::attitude(roll_deg_ / kDeg, pitch_deg_ / kDeg, command_yaw_rate_, thrust);
   if (level_ == CommandLevel::Rates) return Command::rates(command_rates_, thrust);
+  if (level_ == CommandLevel::Rotors) return Command::rotors({rotor_command_.begin(), rotor_command_.end()});
   return FlightController::command();
 }
 
@@ -244,6 +248,10 @@ void CrazyfliePidController::step(std::int64_t run, double t, FlightInputs& in, 
   const Vec3 rates = in.bodyRates() * kDeg;
   for (int k = 0; k < 3; ++k) gyro_deg_[k] = gyro_filter_[k].apply(rates[k]);
   const bool high_level = level_ == CommandLevel::Position || level_ == CommandLevel::Velocity;
+  if (level_ == CommandLevel::Rotors) {  // the loops rest, the motors take the speeds asked for
+    for (std::size_t i = 0; i < 4 && i < speeds.size(); ++i) speeds[i] = rotor_command_[i];
+    return;
+  }
   if (high_level && run % position_every_ == 0) positionLoop(t, in);
   if (run % attitude_every_ == 0) attitudeLoop(in);
   for (std::size_t i = 0; i < 4 && i < speeds.size(); ++i) speeds[i] = std::sqrt(motorThrust(motors_[i]) / thrust_coefficient_);
@@ -261,13 +269,15 @@ void CrazyfliePidController::saveState(StateWriter& out) const {
   out.write(yaw_target_set_);
   for (const double m : motors_) out.write(m);
   for (int k = 0; k < 3; ++k) out.write(gyro_filter_[k].state(0)), out.write(gyro_filter_[k].state(1)), out.write(gyro_deg_[k]);
+  if (level_ == CommandLevel::Rotors)  // (only then: states saved at the other levels read as before)
+    for (const double w : rotor_command_) out.write(w);
 }
 
 void CrazyfliePidController::loadState(StateReader& in) {
   for (int k = 0; k < 3; ++k) pos_[k].load(in), vel_[k].load(in), att_[k].load(in), rate_[k].load(in);
   std::uint8_t level = 0;
   in.read(level);
-  if (level > static_cast<std::uint8_t>(CommandLevel::Rates) || !accepts(static_cast<CommandLevel>(level)))
+  if (level > static_cast<std::uint8_t>(CommandLevel::Rotors) || !accepts(static_cast<CommandLevel>(level)))
     throw StateError("crazyflie_pid: a saved command level this controller does not take (" +
                      std::to_string(level) + ")");
   level_ = static_cast<CommandLevel>(level);
@@ -286,6 +296,8 @@ void CrazyfliePidController::loadState(StateReader& in) {
     gyro_filter_[k].setState(d1, d2);
     in.read(gyro_deg_[k]);
   }
+  if (level_ == CommandLevel::Rotors)
+    for (double& w : rotor_command_) in.read(w);
 }
 
 }  // namespace ssx::quadrotor

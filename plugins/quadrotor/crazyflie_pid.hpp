@@ -134,10 +134,12 @@ class CrazyfliePidController final : public FlightController {
   /// absolute, a yaw rate, a thrust) and body rates (the rate mode of the firmware's controller:
   /// the attitude loop bypassed). An attitude or rates command's collective thrust in N becomes
   /// the motor command that asks for a quarter of it per motor (the battery compensation's
-  /// meaning of a command), at most 65535.
+  /// meaning of a command), at most 65535. Rotor speeds (rad/s) go to the motors as they are, the
+  /// firmware's loops resting (as the firmware's motor power override, for learning at the lowest
+  /// level).
   bool accepts(CommandLevel level) const override {
     return level == CommandLevel::Position || level == CommandLevel::Velocity || level == CommandLevel::Attitude ||
-           level == CommandLevel::Rates;
+           level == CommandLevel::Rates || level == CommandLevel::Rotors;
   }
   CommandLevel level() const override { return level_; }
   void setCommand(const Command& command, const Vec3& position) override;
@@ -173,6 +175,7 @@ class CrazyfliePidController final : public FlightController {
   double motor_volts_ = 4.2;
   int filter_ticks_ = 2;  // the firmware's 1 ms ticks per run of the driver
   CommandLevel level_ = CommandLevel::Position;
+  std::array<double, 4> rotor_command_{};  // rad/s, at the rotors level
   Setpoint current_;
   Vec3 command_velocity_ = Vec3::Zero();
   double command_yaw_rate_ = 0;  // rad/s

@@ -16,7 +16,7 @@ from . import _ssx
 from .spaces import make_box
 
 VEHICLES = ("crazyflie", "mk_quad", "hummingbird")
-LEVELS = ("position", "velocity", "attitude", "rates")
+LEVELS = ("position", "velocity", "attitude", "rates", "rotors")
 GRAVITY = 9.81
 
 
@@ -25,6 +25,18 @@ def vehicle_mass(vehicle):
     path = _ssx.data_directory() / "artifacts" / f"{vehicle}.xml"
     root = ElementTree.parse(path).getroot()
     return sum(float(p.get("mass", "0")) for p in root.iter("physic"))
+
+
+def vehicle_rotors(vehicle):
+    """(thrust coefficient N s^2, top rotor speed rad/s, rotor count) of an installed vehicle type: its
+    artifact's quadrotor driver, each value from the driver's attributes or else from its preset."""
+    data = _ssx.data_directory()
+    driver = ElementTree.parse(data / "artifacts" / f"{vehicle}.xml").getroot().find(".//driver")
+    preset = ElementTree.parse(data / "presets" / "quadrotor" / f"{driver.get('preset', 'mk_quad')}.xml").getroot()
+    values = {p.get("name"): p.get("value") for p in preset.iter("param")}
+    values.update(driver.attrib)
+    rotors = len(values["rotors"].split()) if "rotors" in values else 4
+    return float(values["thrust_coefficient"]), float(values["max_rotor_speed"]), rotors
 
 
 class Task:
@@ -106,6 +118,11 @@ class _Flight(Task):
         self.max_offset = max_offset
         self.cos_crash = math.cos(math.radians(max_tilt_crash))
         self.weight = vehicle_mass(vehicle) * GRAVITY
+        self.rotor_count = 4
+        if level == "rotors":
+            # each rotor's speed: a = 0 holds the weight (thrust grows with the speed squared)
+            coefficient, self.max_rotor_speed, self.rotor_count = vehicle_rotors(vehicle)
+            self.hover_rotor_speed = math.sqrt(self.weight / (self.rotor_count * coefficient))
         self._commands = None
 
     def scene(self):
@@ -128,17 +145,23 @@ class _Flight(Task):
         self.num_envs = num_envs
         self.horizon = max(1, int(round(self.horizon_seconds / action_period)))
         self.home = states[0, :, :3].copy()  # every copy hovers at the same place in the start state
-        self._commands = np.zeros((num_envs, self.robots, 4))
+        self._commands = np.zeros((num_envs, self.robots, self.rotor_count if self.level == "rotors" else 4))
         self._states = states  # the environment's, read in place after every step (position commands)
 
     def action_space(self, per_agent=False):
-        shape = (4,) if per_agent or self.robots == 1 else (self.robots, 4)
+        n = self.rotor_count if self.level == "rotors" else 4
+        shape = (n,) if per_agent or self.robots == 1 else (self.robots, n)
         return make_box(-1.0, 1.0, shape, np.float32)
 
     def commands(self, actions):
-        a = np.clip(np.asarray(actions, dtype=np.float64).reshape(self.num_envs, self.robots, 4), -1.0, 1.0)
-        c = self._commands[: a.shape[0]]
-        if self.level == "position":  # a set-point up to max_offset m from where each robot is, and a heading
+        c = self._commands
+        a = np.clip(np.asarray(actions, dtype=np.float64).reshape(self.num_envs, self.robots, c.shape[-1]), -1.0, 1.0)
+        c = c[: a.shape[0]]
+        if self.level == "rotors":  # each rotor's thrust the weight's share times 1 + thrust_range a
+            np.sqrt(np.maximum(1.0 + self.thrust_range * a, 0.0), out=c)
+            c *= self.hover_rotor_speed
+            np.minimum(c, self.max_rotor_speed, out=c)
+        elif self.level == "position":  # a set-point up to max_offset m from where each robot is, and a heading
             c[..., :3] = self._states[: a.shape[0], :, 0:3] + a[..., :3] * self.max_offset
             c[..., 3] = a[..., 3] * np.pi
         elif self.level == "velocity":

@@ -261,7 +261,7 @@ def test_vector_environment_core_reads_into_given_arrays():
     with pytest.raises(ValueError, match=r"\(3, 1, 13\)"):
         sim.robot_states(out=np.empty((3, 13)))
     with pytest.raises(ValueError, match="copy 0, robot 'r0'"):
-        sim.set_commands("rotors", np.zeros((3, 1, 4)))  # the Crazyflie's PID takes no rotor speeds
+        sim.set_commands("wheels", np.zeros((3, 1, 2)))  # a quadrotor has no wheels
     sim.close()
     with pytest.raises(RuntimeError, match="closed"):
         sim.step()
@@ -322,4 +322,24 @@ def test_position_actions_fly_to_set_points_near_the_robot():
         obs, rewards, terminations, truncations, infos = env.step(a)
         assert not terminations.any()
     assert np.all(infos["distance"] < 0.2)
+    env.close()
+
+
+@pytest.mark.parametrize("vehicle", ["crazyflie", "mk_quad"])
+def test_rotor_speed_actions_hold_the_weight_climb_and_turn(vehicle):
+    env = learn.VectorEnv("goto", num_envs=3, level="rotors", vehicle=vehicle, start_speed=0.0, threads=1)
+    assert env.single_action_space.shape == (4,)
+    env.reset(seed=2)
+    states = env._b.states
+    z0 = states[:, 0, 2].copy()
+    a = np.zeros((3, 4), dtype=np.float32)
+    a[1] = 0.5  # every rotor's thrust x 1.5: climbs
+    a[2] = [0.3, -0.3, 0.3, -0.3]  # one diagonal faster, the other slower: turns about z, the same thrust
+    for _ in range(25):  # 0.5 s
+        env.step(a)
+    dz = states[:, 0, 2] - z0
+    yaw_rate = np.abs(states[:, 0, 12])
+    assert abs(dz[0]) < 0.02  # a = 0: each rotor at the speed that holds its share of the weight
+    assert dz[1] > dz[0] + 0.2
+    assert yaw_rate[2] > 0.3 and yaw_rate[2] > 50 * yaw_rate[0]
     env.close()

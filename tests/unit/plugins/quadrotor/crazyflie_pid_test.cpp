@@ -160,7 +160,8 @@ TEST_CASE("crazyflie_pid: a saved state continues identically, velocity commands
   CHECK(a.accepts(CommandLevel::Velocity));
   CHECK(a.accepts(CommandLevel::Attitude));
   CHECK(a.accepts(CommandLevel::Rates));
-  CHECK_FALSE(a.accepts(CommandLevel::Rotors));
+  CHECK(a.accepts(CommandLevel::Rotors));
+  CHECK_FALSE(a.accepts(CommandLevel::Wheels));
   a.setCommand(Command::velocityYawRate(Vec3(0.5, 0, 0), 0), in.pose.position);
   a.step(20, 0.04, in, sa);
   CHECK(a.desiredVelocity().x() == Approx(0.5));
@@ -304,4 +305,31 @@ TEST_CASE("crazyflie_pid: attitude and body-rate commands fly the rigid Crazyfli
   f.controller.step(run, t, f, a);
   copy.step(run, t, f, b);
   CHECK(a == b);
+}
+
+TEST_CASE("crazyflie_pid: rotor speeds go to the motors as asked, the loops resting, and survive a saved state",
+          "[quadrotor][crazyflie]") {
+  const CrazyfliePidGains gains;
+  Standing in;
+  in.pose.position = Vec3(0, 0, 1);
+  in.rates = Vec3(0.3, -0.2, 0.1);  // turning: the rate loop would answer it
+  CrazyfliePidController a(gains, xFrame(), crazyflieRotors()), b(gains, xFrame(), crazyflieRotors());
+  std::array<double, 4> sa{}, sb{};
+  a.setCommand(Command::rotors({1500, 1600, 1700, 1800}), in.pose.position);
+  for (int i = 0; i < 5; ++i) a.step(i, i * 0.002, in, sa);
+  CHECK(sa == std::array<double, 4>{1500, 1600, 1700, 1800});
+  CHECK(a.command().level == CommandLevel::Rotors);
+  CHECK(a.command().rotor_speeds == std::vector<double>{1500, 1600, 1700, 1800});
+  std::vector<std::byte> saved;
+  StateWriter out(saved);
+  a.saveState(out);
+  StateReader back(saved);
+  b.loadState(back);
+  CHECK(back.done());
+  b.step(5, 0.01, in, sb);
+  CHECK(sb == sa);
+  // back to attitude: the loops take over again
+  a.setCommand(Command::attitude(0, 0, 0, 0.029 * 9.81), in.pose.position);
+  a.step(6, 0.012, in, sa);
+  CHECK(sa != std::array<double, 4>{1500, 1600, 1700, 1800});
 }

@@ -117,7 +117,8 @@ TEST_CASE("the crazyflie flies its firmware's controller: hover, the 1.1 m/s cla
   auto* input = dynamic_cast<CommandInterface*>(cf.driver());
   REQUIRE(input != nullptr);
   CHECK(input->acceptsCommand(CommandLevel::Velocity));
-  CHECK_FALSE(input->acceptsCommand(CommandLevel::Rotors));
+  CHECK(input->acceptsCommand(CommandLevel::Rotors));  // (the firmware's loops resting)
+  CHECK_FALSE(input->acceptsCommand(CommandLevel::Wheels));
   Setpoint sp;
   sp.position = Vec3(0, 0, 1);
   input->setSetpoint(sp);
