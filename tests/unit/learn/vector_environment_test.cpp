@@ -128,7 +128,8 @@ TEST_CASE("vector environment: states and IMU readings in one array, commands ch
   commands.back() = std::nan("");
   CHECK_THROWS_WITH(v.setCommands(CommandLevel::Velocity, commands, 4), Contains("copy 2, robot 'cf1'"));
   commands.back() = 0;
-  CHECK_THROWS_WITH(v.setCommands(CommandLevel::Rotors, commands, 4), Contains("copy 0, robot 'cf0'"));
+  const std::vector<double> wheels(3 * 2 * 2, 0.0);  // a quadrotor has none
+  CHECK_THROWS_WITH(v.setCommands(CommandLevel::Wheels, wheels, 2), Contains("copy 0, robot 'cf0'"));
   CHECK_THROWS_WITH(v.setCommands(CommandLevel::Velocity, commands, 3), Contains("rows of 3"));
   v.setCommands(CommandLevel::Velocity, commands, 4);
   v.step(500);
