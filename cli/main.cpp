@@ -368,7 +368,8 @@ int commandRun(const RunArgs& args, bool realtime_given) {
       status = kExitRunFailure;
     }
   }
-  const std::vector<ssx::CameraSpec> cameras = env.cameras();
+  // (the settings' cameras: those whose frames had a window are closed by now)
+  const std::vector<ssx::CameraSpec> cameras = env.settings().render.cameras;
   if (env.state() == ssx::Environment::State::Running) flights.observe(env);  // the end states
   // stop cleanly: plugins destroyed, engines stopped, extensions shut down (files closed)
   try {

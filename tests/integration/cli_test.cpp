@@ -669,7 +669,7 @@ TEST_CASE("ssx run --frames-from/--frames-until: frames only in that window, the
   REQUIRE(run({"run", scene, "--steps", "750", "--fast", "--quiet", "--out", out, "--save-state",
                (dir / "plain.state").string()})
               .status == 0);
-  const Result windowed = run({"run", scene, "--steps", "750", "--fast", "--quiet", "--out", out, "--frames",
+  const Result windowed = run({"run", scene, "--steps", "750", "--fast", "--out", out, "--frames",
                                (dir / "frames").string(), "--frames-from", "0.5", "--frames-until", "1", "--save-state",
                                (dir / "windowed.state").string()});
   REQUIRE(windowed.status == 0);
@@ -677,6 +677,7 @@ TEST_CASE("ssx run --frames-from/--frames-until: frames only in that window, the
   int files = 0;
   for (const auto& e : fs::directory_iterator(dir / "frames")) files += e.path().extension() == ".png" ? 1 : 0;
   CHECK(files == 13);
+  CHECK_THAT(windowed.out, Contains(": 13 frames in " + (dir / "frames").string()));
   auto bytes = [](const fs::path& file) {
     std::ifstream in(file, std::ios::binary);
     return std::string(std::istreambuf_iterator<char>(in), {});
