@@ -186,13 +186,13 @@ TEST_CASE("render attach: camera sensors keep the engine they started with", "[o
 
 TEST_CASE("observers: an extension attached while running observes from the next step, outside saved states",
           "[observers]") {
+  Watcher watcher;  // (outliving the environment that calls it)
   Scene watched = hoverSwarm(1);
   Scene plain = hoverSwarm(1);
   Environment& env = *watched.environment;
   Environment& ref = *plain.environment;
   env.step(100);
   ref.step(100);
-  Watcher watcher;
   env.addExtension("watcher", watcher, Descriptor("watcher", {}));  // while running: attached as an observer
   CHECK(watcher.inits == 1);
   env.step(10);
@@ -213,9 +213,9 @@ TEST_CASE("observers: an extension attached while running observes from the next
 }
 
 TEST_CASE("observers: attached before start they start with the run and come off while it goes on", "[observers]") {
+  Watcher scene_part, observer, other_part;  // (outliving the environments that call them)
   Scene s = hoverSwarm(1);
   Environment& env = *s.environment;
-  Watcher scene_part, observer;
   env.addExtension("part", scene_part, Descriptor("part", {}));
   env.attachExtension("observer", observer, Descriptor("observer", {}));
   CHECK(observer.inits == 0);
@@ -230,7 +230,6 @@ TEST_CASE("observers: attached before start they start with the run and come off
   CHECK(scene_part.steps == 4);
   // a state saved with the scene's extension in it holds its block; one without the observer restores
   Scene other = hoverSwarm(1);
-  Watcher other_part;
   other.environment->addExtension("part", other_part, Descriptor("part", {}));
   other.environment->restoreState(env.saveState());
   CHECK(other.environment->stateHash() == env.stateHash());
@@ -238,18 +237,16 @@ TEST_CASE("observers: attached before start they start with the run and come off
 
 TEST_CASE("observers: attaching is refused inside a step, for a duplicate name or a failing init, changing nothing",
           "[observers]") {
+  Watcher refusing, first, second, late;  // (outliving the environment that calls them)
   Scene s = hoverSwarm(1);
   Environment& env = *s.environment;
   env.step(1);
-  Watcher refusing;
   refusing.throw_at_init = true;
   CHECK_THROWS_WITH(env.attachExtension("refusing", refusing, Descriptor("refusing", {})), Contains("watcher: refused"));
   CHECK(env.extension("refusing") == nullptr);
-  Watcher first, second;
   env.attachExtension("w", first, Descriptor("w", {}));
   CHECK_THROWS_AS(env.attachExtension("w", second, Descriptor("w", {})), ConfigError);
   // from its own hook: an exchange in the middle of a step is refused (the step fails with it)
-  Watcher late;
   first.at_step = [&](Environment& e) { e.attachExtension("late", late, Descriptor("late", {})); };
   CHECK_THROWS_WITH(env.step(), Contains("between steps"));
   CHECK(late.inits == 0);
