@@ -197,6 +197,8 @@ void QuadrotorDriver::configure(const Descriptor& params, PluginSetup& setup) {
   }
   // (a firmware has measured the battery since it was switched on)
   if (vehicle_.hasBattery()) flight_->batteryVoltage(vehicle_.batteryVoltage(), true);
+  battery_varies_ = vehicle_.hasBattery() || c.crazyflie_pid;
+  crazyflie_battery_ = c.crazyflie_battery;
   if (const Sensor* pose = firstSensorOf<PoseMeasurement>(a)) {
     have_pose_ = true;
     setup.subscribe<PoseMeasurement>(*pose, [this](const PoseMeasurement& m) { pose_ = m; });
@@ -306,13 +308,29 @@ constexpr Variable kVariables[] = {
     {"wind_x", 0.0, -50.0, 50.0, "m/s added to the mean wind along x (world frame)"},
     {"wind_y", 0.0, -50.0, 50.0, "m/s added to the mean wind along y (world frame)"},
     {"wind_z", 0.0, -50.0, 50.0, "m/s added to the mean wind along z (world frame)"},
+    // (listed only for a vehicle with a battery: a battery model, or the Crazyflie's controller)
+    {"battery_volts", 0.0, -2.0, 0.5,
+     "V added to the battery's voltage (the Crazyflie's crazyflie_battery_volts, or a battery model's open circuit)"},
 };
+constexpr std::size_t kBatteryVariable = 7;
 
 }  // namespace
 
-std::span<const Variable> QuadrotorDriver::variables() const { return kVariables; }
+std::span<const Variable> QuadrotorDriver::variables() const {
+  return std::span(kVariables).first(battery_varies_ ? kBatteryVariable + 1 : kBatteryVariable);
+}
 
 void QuadrotorDriver::vary(std::size_t k, double value) {
+  if (k == kBatteryVariable) {
+    // a battery model's open circuit moves; the Crazyflie's held battery is measured anew (its
+    // firmware has measured it since it was switched on)
+    if (vehicle_.hasBattery()) {
+      vehicle_.setBatteryOffset(value);
+    } else if (auto* cf = dynamic_cast<CrazyfliePidController*>(flight_.get())) {
+      cf->setBatteryVoltage(crazyflie_battery_ + value);
+    }
+    return;
+  }
   if (k >= 4) {
     wind_offset_[static_cast<Eigen::Index>(k - 4)] = value;
     wind_.setOffset(wind_offset_);

@@ -117,6 +117,9 @@ class QuadrotorDriver final : public Driver,
   std::shared_ptr<const Airframe> frame_;
   std::array<double, 4> rotor_factors_{1.0, 1.0, 1.0, 1.0};
   Vec3 wind_offset_ = Vec3::Zero();
+  // the battery varies (battery_volts) with a battery model, or the Crazyflie's held battery
+  bool battery_varies_ = false;
+  double crazyflie_battery_ = 4.2;  // V, crazyflie_battery_volts
 };
 
 }  // namespace ssx::quadrotor

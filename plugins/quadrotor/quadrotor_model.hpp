@@ -74,8 +74,12 @@ class Battery {
     return (voltage - p_.zero_thrust_voltage) / (p_.nominal_voltage - p_.zero_thrust_voltage);
   }
   double thrustGain() const { return thrustGain(voltage_); }
-  /// The open-circuit voltage at the charge left.
-  double openCircuit() const { return p_.empty_voltage + (p_.full_voltage - p_.empty_voltage) * charge_; }
+  /// The open-circuit voltage at the charge left (plus the offset a learning environment drew).
+  double openCircuit() const {
+    return p_.empty_voltage + (p_.full_voltage - p_.empty_voltage) * charge_ + offset_;
+  }
+  /// Volts added to the open-circuit voltage from the next step on (0: the pack as configured).
+  void setOffset(double volts) { offset_ = volts; }
   /// Delivers `mechanical_power` W for dt s: the terminal voltage U solves U = U_oc - R P / (eta U);
   /// the charge drops by the current times dt.
   void step(double dt, double mechanical_power);
@@ -89,6 +93,7 @@ class Battery {
 
  private:
   BatteryParams p_;
+  double offset_ = 0;  // (before voltage_, which the constructor sets from openCircuit())
   double charge_, voltage_;
 };
 

@@ -97,6 +97,10 @@ class Vehicle {
   void stepMotors(double dt, std::span<const double> commanded) { rotors_->step(dt, commanded); }
   /// Whether thrust gains change from step to step (a battery; or ground effect, told by the caller).
   bool hasBattery() const { return battery_.has_value(); }
+  /// Volts added to the battery's open-circuit voltage from the next step on (Battery::setOffset).
+  void setBatteryOffset(double volts) {
+    if (battery_) battery_->setOffset(volts);
+  }
   /// The battery's terminal voltage (V) after the last step; call only with a battery.
   double batteryVoltage() const { return battery_->voltage(); }
   /// Updates each rotor's thrust gain: the battery's (after drawing the rotors' power for dt) times

@@ -223,6 +223,22 @@ class PyVectorEnvironment {
     }
   }
 
+  void setCommandDelays(const py::handle& which, const py::handle& steps) {
+    InUse use(busy_);
+    const std::vector<std::size_t> chosen = indices(which);
+    using Steps = py::array_t<std::int64_t, py::array::c_style | py::array::forcecast>;
+    const Steps a = Steps::ensure(steps);
+    if (!a || a.ndim() != 2 || a.shape(0) != static_cast<py::ssize_t>(chosen.size()) ||
+        a.shape(1) != static_cast<py::ssize_t>(robots()))
+      throw py::value_error("ssx: command delays must have shape (" + std::to_string(chosen.size()) + ", " +
+                            std::to_string(robots()) + "): steps per robot of each environment named");
+    try {
+      envs().setCommandDelays(chosen, std::span<const std::int64_t>(a.data(), static_cast<std::size_t>(a.size())));
+    } catch (const ssx::ConfigError& e) {
+      throw py::value_error(std::string("ssx: ") + e.what());
+    }
+  }
+
   void recordContacts(bool on) {
     InUse use(busy_);
     envs().recordContacts(on);
@@ -268,12 +284,12 @@ class PyVectorEnvironment {
 }  // namespace
 
 py::list contactList(const ssx::Environment& env) {
+  // ssx.Contact, made when the module was imported (bindVectorEnvironment)
+  const py::object contact = py::module_::import("ssx._ssx").attr("Contact");
   py::list out;
-  for (const ssx::EngineContact& c : env.contacts()) {
-    const py::object other = c.body_b >= 0 ? py::object(py::str(env.bodyOwner(c.body_b).name())) : py::none();
-    out.append(
-        py::make_tuple(env.bodyOwner(c.body_a).name(), other, c.impulse, vector3(c.position), vector3(c.normal)));
-  }
+  for (const ssx::EngineContact& c : env.contacts())
+    out.append(contact(env.bodyOwner(c.body_a).name(), env.contactOther(c).name(), c.impulse, vector3(c.position),
+                       vector3(c.normal), c.body_b < 0));
   return out;
 }
 
@@ -288,6 +304,14 @@ py::dict variableDict(const ssx::Variable& v) {
 }
 
 void bindVectorEnvironment(py::module_& m) {
+  py::object contact = py::module_::import("collections")
+                           .attr("namedtuple")("Contact", "artifact other impulse position normal static",
+                                               py::arg("module") = "ssx");
+  contact.attr("__doc__") =
+      "One pair touching in the last step: artifact (a robot or item), other (what it touched: another robot or item, "
+      "or the static artifact, the ground or a wall), impulse (N s, normal, summed over the step), position (m) and "
+      "normal (from other towards artifact) of the deepest point, static (other is static).";
+  m.attr("Contact") = contact;
   py::class_<PyVectorEnvironment>(m, "VectorEnvironment",
                                   "num_envs copies of one scene, each a world of its own, stepped together on a pool "
                                   "of threads (the GIL released): the core of ssx.learn.VectorEnv.")
@@ -324,11 +348,14 @@ void bindVectorEnvironment(py::module_& m) {
       .def("vary", &PyVectorEnvironment::vary, py::arg("indices"), py::arg("name"), py::arg("values"),
            "Sets constant name ('mass', 'inertia' or a plugin's variable) of every robot of the copies named to "
            "values (len(indices), robots), checked whole first (GIL released).")
+      .def("set_command_delays", &PyVectorEnvironment::setCommandDelays, py::arg("indices"), py::arg("steps"),
+           "Actuation latency: robot r of environment indices[k] takes each later set_commands steps[k, r] physics "
+           "steps into the steps that follow (0: at once), holding the one before until then. Not in saved states; "
+           "reset drops the commands waiting.")
       .def("record_contacts", &PyVectorEnvironment::recordContacts, py::arg("on") = true,
            "Every copy keeps the contacts of its steps from now on (off by default).")
       .def("contact_list", &PyVectorEnvironment::contacts, py::arg("index"),
-           "Copy index's last-step contacts: (artifact, other or None for the static world, impulse N s, position, "
-           "normal).")
+           "Copy index's last-step contacts: ssx.Contact(artifact, other, impulse N s, position, normal, static).")
       .def("contact_impulses", &PyVectorEnvironment::contactImpulses, py::arg("out") = py::none(),
            "(num_envs, robots, 2): each robot's normal impulse (N s) in the last step from the static world and from "
            "other bodies.")

@@ -59,8 +59,9 @@ void bindLearn(pybind11::module_& m, pybind11::class_<E>& environment) {
       "Keeps the contacts of every step from now on (off by default); contact_list() lists the last step's.");
   environment.def(
       "contact_list", [](E& e) { return e.guarded([&] { return contactList(e.env()); }); },
-      "The last step's contacts, one per pair of bodies touching: (artifact, other artifact or None for the static "
-      "world, normal impulse N s, position, normal from the other towards the first). record_contacts() first.");
+      "The last step's contacts, one per pair touching: ssx.Contact(artifact, other, impulse N s, position, normal "
+      "from other towards artifact, static), other the artifact touched (the ground or a wall when static). "
+      "record_contacts() first.");
   environment.def(
       "variation",
       [artifact](E& e, const std::string& robot, const std::string& name) {

@@ -9,6 +9,7 @@ The simulation runs in libssx (C++); stepping releases the GIL. See docs/python.
 """
 from ._ssx import (
     ConfigError,
+    Contact,
     Environment,
     Error,
     Recording,
@@ -24,6 +25,7 @@ from ._ssx import (
 
 __all__ = [
     "ConfigError",
+    "Contact",
     "Environment",
     "Error",
     "Recording",

@@ -1,5 +1,6 @@
 from ._ssx import (
     ConfigError as ConfigError,
+    Contact as Contact,
     Environment as Environment,
     Error as Error,
     SceneError as SceneError,

@@ -2,7 +2,7 @@
 
 tests/python/test_stubs.py checks that these name exactly what the module has."""
 import os
-from typing import Any, Dict, List, Optional, Sequence, Tuple, Union
+from typing import Any, Dict, List, NamedTuple, Optional, Sequence, Tuple, Union
 
 import numpy as np
 import numpy.typing as npt
@@ -18,6 +18,21 @@ class ConfigError(Error): ...
 class SceneError(Error): ...
 class StepError(Error): ...
 class StateError(Error): ...
+
+class Contact(NamedTuple):
+    """One pair touching in the last step (Environment.contact_list)."""
+    artifact: str
+    """A robot or item (a dynamic body's artifact)."""
+    other: str
+    """What it touched: another robot or item, or the static artifact (the ground, a wall)."""
+    impulse: float
+    """N s: the normal impulse over the step, summed over the pair's contact points."""
+    position: npt.NDArray[np.float64]
+    """m, world frame: the pair's deepest point."""
+    normal: npt.NDArray[np.float64]
+    """Unit, world frame: from other towards artifact."""
+    static: bool
+    """Whether other is static (the ground, walls, obstacles)."""
 
 class Environment:
     """A loaded scene: step it, read its state as numpy arrays, command it (load_scene, load_scene_string)."""
@@ -120,8 +135,8 @@ class Environment:
         """Restarts every random stream (sensor noise, wind gusts) as a scene loaded with this seed would start it."""
     def record_contacts(self, on: bool = True) -> None:
         """Keeps the contacts of every step from now on (off by default); contact_list() lists the last step's."""
-    def contact_list(self) -> List[Tuple[str, Optional[str], float, npt.NDArray[np.float64], npt.NDArray[np.float64]]]:
-        """The last step's contacts: (artifact, other or None for the static world, impulse N s, position, normal)."""
+    def contact_list(self) -> List[Contact]:
+        """The last step's contacts, one per pair touching: Contact(artifact, other, impulse N s, position, normal, static); other names the static artifact (the ground, a wall) when static."""
     def variables(self, robot: str) -> List[Dict[str, Any]]:
         """The constants of a robot that vary() takes: dicts of name, neutral, min, max, doc."""
     def vary(self, robot: str, name: str, value: float) -> None:
@@ -253,8 +268,10 @@ class VectorEnvironment:
         """(num_envs, robots, width): one kind of sensor of every robot (pose, proximity, ground, range, range_and_bearing, odometry)."""
     def record_contacts(self, on: bool = True) -> None:
         """Every copy keeps the contacts of its steps from now on (off by default)."""
-    def contact_list(self, index: int) -> List[Tuple[str, Optional[str], float, npt.NDArray[np.float64], npt.NDArray[np.float64]]]:
-        """Copy index's last-step contacts: (artifact, other or None for the static world, impulse N s, position, normal)."""
+    def set_command_delays(self, indices: Sequence[int], steps: npt.ArrayLike) -> None:
+        """Actuation latency: robot r of environment indices[k] takes each later set_commands steps[k, r] physics steps into the steps that follow (0: at once), holding the one before until then. Not in saved states; reset drops the commands waiting."""
+    def contact_list(self, index: int) -> List[Contact]:
+        """Copy index's last-step contacts: Contact(artifact, other, impulse N s, position, normal, static)."""
     def contact_impulses(self, out: Optional[npt.NDArray[np.float64]] = None) -> npt.NDArray[np.float64]:
         """(num_envs, robots, 2): each robot's normal impulse (N s) in the last step from the static world and from other bodies."""
     def variables(self, robot: int = 0) -> List[Dict[str, Any]]:

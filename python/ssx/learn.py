@@ -58,7 +58,13 @@ def _sim_seed(rng):
     return int(rng.integers(0, 2**63, dtype=np.int64))
 
 
-def _ranges(randomize, sim):
+def _latency(action_period):
+    """The actuation latency as learn's randomize takes it, beside what the robots' plugins vary."""
+    return {"name": "latency", "neutral": 0.0, "min": 0.0, "max": action_period,
+            "doc": "s from an action to the motors (whole physics steps, at most action_period)"}
+
+
+def _ranges(randomize, sim, action_period):
     """The domain randomisation asked for, checked against what every robot can vary: {name: (low, high)}."""
     if not randomize:
         return {}
@@ -71,7 +77,7 @@ def _ranges(randomize, sim):
         except (TypeError, ValueError):
             raise ValueError(f"ssx.learn: randomize[{name!r}] must be a pair (low, high), got {bounds!r}") from None
         for r, robot in enumerate(sim.robot_names):
-            known = {v["name"]: v for v in sim.variables(r)}
+            known = {v["name"]: v for v in sim.variables(r) + [_latency(action_period)]}
             if name not in known:
                 raise ValueError(f"ssx.learn: randomize[{name!r}]: robot {robot!r} has no such constant; it has "
                                  f"{', '.join(known) or 'none'}")
@@ -115,11 +121,11 @@ class _Batch:
         task.readings = {kind: out for kind, _, out in self.sensors}
         self.rngs = [np.random.default_rng() for _ in range(self.num_envs)]
         self.steps = np.zeros(self.num_envs, dtype=np.int64)
-        self.randomize = _ranges(randomize, self.sim)
+        self.randomize = _ranges(randomize, self.sim, self.action_period)
         low = np.array([r[0] for r in self.randomize.values()]).reshape(-1, 1, 1)
         self._bounds = (low, np.array([r[1] for r in self.randomize.values()]).reshape(-1, 1, 1) - low)
         # each copy's draws now, (constants, E, R) in the order of randomize; neutral until the first reset
-        neutral = {v["name"]: v["neutral"] for v in self.sim.variables(0)}
+        neutral = {v["name"]: v["neutral"] for v in self.sim.variables(0) + [_latency(self.action_period)]}
         self.drawn = np.array([np.full((self.num_envs, self.robots), neutral[name]) for name in self.randomize])
         self.read()
         task.bind(self.num_envs, self.action_period, self.states)
@@ -166,7 +172,12 @@ class _Batch:
             low, span = self._bounds
             draws = low + span * np.stack([rng.random((len(self.randomize), self.robots)) for rng in rngs], axis=1)
             for j, name in enumerate(self.randomize):
-                self.sim.vary(ids, name, draws[j])
+                if name == "latency":  # in whole physics steps: what the copies take
+                    steps = np.rint(draws[j] / self.sim.timestep).astype(np.int64)
+                    self.sim.set_command_delays(ids, steps)
+                    draws[j] = steps * self.sim.timestep
+                else:
+                    self.sim.vary(ids, name, draws[j])
             self.drawn[:, ids] = draws
         self.steps[ids] = 0
 
@@ -181,7 +192,8 @@ class VectorEnv(_VectorBase):
     observation in infos["final_obs"]). threads: threads stepping the copies (None: one per core).
     randomize: domain randomisation, {name: (low, high)}: each robot's constant drawn uniformly at
     every reset from its copy's episode generator ("mass", "inertia", "thrust_coefficient",
-    "time_constant_up", "wind_x", "gyro_noise", ...: sim.variables(0) lists them); the draws are
+    "time_constant_up", "wind_x", "gyro_noise", "battery_volts", ...: sim.variables(0) lists them; and
+    "latency", s from an action to the motors, whole physics steps up to action_period); the draws are
     in infos["variations"] at reset and whenever a copy resets in step (infos["_variations"] says which).
     """
 

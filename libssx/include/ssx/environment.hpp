@@ -360,6 +360,10 @@ class SSX_EXPORT Environment {
   /// bodies, or a body and the static world, with the normal impulse); empty after restoreState
   /// until the next step. Throws Error when not recording.
   const std::vector<EngineContact>& contacts() const;
+  /// What body_a of `contact` touched: the artifact of body_b, or for a static shape (body_b -1)
+  /// the static artifact it belongs to (the ground, a wall). std::out_of_range for a contact of
+  /// another environment.
+  const Artifact& contactOther(const EngineContact& contact) const;
 
   // --- variations: constants that change between episodes (ssx/variation.hpp) --------------
 

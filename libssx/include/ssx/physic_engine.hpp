@@ -125,6 +125,9 @@ struct EngineContact {
   /// N s: the normal impulse the solver applied over the step (every substep), summed over the
   /// pair's contact points
   double impulse = 0.0;
+  /// With body_b -1: the static shapes touched, as the group addStatic returned for them (a
+  /// body touching two static roots makes two contacts); -1 otherwise
+  int static_group = -1;
 };
 
 /// Runs independent tasks on the environment's worker pool, for an engine that can step parts

@@ -108,6 +108,13 @@ class SSX_EXPORT VectorEnvironment {
   /// `columns` numbers (the order of ssx/command.hpp). Every row is checked (its size, finite, what
   /// its robot takes) before any robot gets one; ConfigError "copy i, robot 'name': ..." otherwise.
   void setCommands(CommandLevel level, std::span<const double> values, std::size_t columns);
+  /// Actuation latency: robot r of copy `which[k]` takes each command setCommands gives it
+  /// `steps[k * robots + r]` physics steps into the steps that follow (0, the default: at once),
+  /// holding the one before until then; a learning environment's latency, drawn at reset. A
+  /// delay longer than the steps between two commands: the earlier takes effect when the later
+  /// is given. ConfigError for a wrong size or a negative delay, before any copy changes. The
+  /// commands waiting are not in a copy's saved state: reset() drops them (the delays stay).
+  void setCommandDelays(std::span<const std::size_t> which, std::span<const std::int64_t> steps);
   /// What vary takes for robot `robot` (Environment::variables of its artifact in copy 0; every
   /// copy is the same scene). std::out_of_range past robotNames().
   std::vector<Variable> variables(std::size_t robot) const;
@@ -125,6 +132,10 @@ class SSX_EXPORT VectorEnvironment {
   // fn(which[k], k) for every k in parallel (every copy, fn(i, i), for `which` empty), the first
   // failure by copy index rethrown as that copy's
   void forEachOf(std::span<const std::size_t> which, const std::function<void(std::size_t, std::size_t)>& fn);
+  // the command row r (copy r / robots, robot r % robots) sends now
+  void send(std::size_t r, const Command& command);
+  // copy i's n steps, with the commands waiting (setCommandDelays) sent when they are due
+  void stepCopy(std::size_t i, std::int64_t n);
   std::vector<Scene> scenes_;
   std::vector<Environment*> envs_;
   std::vector<std::string> robot_names_;
@@ -136,6 +147,11 @@ class SSX_EXPORT VectorEnvironment {
   std::vector<std::vector<int>> bodies_;  // per copy, per robot: its moving bodies
   std::vector<const Sensor*> imus_;       // per copy, per robot: its first IMU sensor, or nullptr
   std::vector<int> robot_of_body_;        // per body of a copy: its robot, or -1
+  // actuation latency (setCommandDelays; all empty until it is first called), per copy per robot:
+  // the delay in steps, the steps until the waiting command is sent (-1: none waits), the command
+  std::vector<std::int64_t> delays_, remaining_;
+  std::vector<Command> waiting_;
+  std::vector<std::uint8_t> copy_waits_;  // per copy: a command of one of its robots waits
   std::unique_ptr<Pool> pool_;
 };
 

@@ -23,25 +23,29 @@ class ContactLog {
     points_.clear();
     pairs_.clear();
   }
-  /// A contact point between bodies `a` and `b` (-1: a static shape), `normal` from b towards a.
-  void add(int a, int b, const Vec3& position, Vec3 normal, double depth, double impulse) {
+  /// A contact point between bodies `a` and `b` (-1: a static shape of addStatic's group
+  /// `static_group`), `normal` from b towards a.
+  void add(int a, int b, int static_group, const Vec3& position, Vec3 normal, double depth, double impulse) {
     if (a < 0 || (b >= 0 && b < a)) {
       std::swap(a, b);
       normal = -normal;
     }
-    points_.push_back({{a, b, position, normal, impulse}, depth});
+    points_.push_back({{a, b, position, normal, impulse, b < 0 ? static_group : -1}, depth});
   }
-  /// Merges the points into pairs: ascending body_a, then body_b (-1 first); the deepest point
-  /// (the first of equals, in the engine's order) stands for the pair; impulses add up.
+  /// Merges the points into pairs: ascending body_a, then body_b (-1 first), then the static
+  /// group; the deepest point (the first of equals, in the engine's order) stands for the pair;
+  /// impulses add up.
   void finish() {
     std::stable_sort(points_.begin(), points_.end(), [](const Point& x, const Point& y) {
-      return x.contact.body_a != y.contact.body_a ? x.contact.body_a < y.contact.body_a
-                                                  : x.contact.body_b < y.contact.body_b;
+      const EngineContact &p = x.contact, &q = y.contact;
+      if (p.body_a != q.body_a) return p.body_a < q.body_a;
+      return p.body_b != q.body_b ? p.body_b < q.body_b : p.static_group < q.static_group;
     });
     pairs_.clear();
     double deepest = 0;
     for (const Point& p : points_) {
-      if (pairs_.empty() || pairs_.back().body_a != p.contact.body_a || pairs_.back().body_b != p.contact.body_b) {
+      if (pairs_.empty() || pairs_.back().body_a != p.contact.body_a || pairs_.back().body_b != p.contact.body_b ||
+          pairs_.back().static_group != p.contact.static_group) {
         pairs_.push_back(p.contact);
         deepest = p.depth;
         continue;

@@ -168,8 +168,61 @@ void VectorEnvironment::step(std::int64_t n, std::span<const std::uint8_t> activ
                               std::to_string(active.size()) + " flags of which copies step");
   if (n == 0) return;
   forEach([&](std::size_t i) {
-    if (active.empty() || active[i] != 0) envs_[i]->step(n);
+    if (active.empty() || active[i] != 0) stepCopy(i, n);
   });
+}
+
+void VectorEnvironment::stepCopy(std::size_t i, std::int64_t n) {
+  if (copy_waits_.empty() || copy_waits_[i] == 0) {
+    envs_[i]->step(n);
+    return;
+  }
+  const std::size_t robots = robot_names_.size(), first = i * robots;
+  std::int64_t left = n;
+  bool waits = true;
+  while (left > 0 && waits) {
+    std::int64_t next = left;  // steps until the next command waiting is due (or the end)
+    for (std::size_t r = first; r < first + robots; ++r)
+      if (remaining_[r] >= 0) next = std::min(next, remaining_[r]);
+    envs_[i]->step(next);
+    left -= next;
+    waits = false;
+    for (std::size_t r = first; r < first + robots; ++r) {
+      if (remaining_[r] < 0) continue;
+      remaining_[r] -= next;
+      if (remaining_[r] == 0) {
+        send(r, waiting_[r]);
+        remaining_[r] = -1;
+      } else {
+        waits = true;
+      }
+    }
+  }
+  copy_waits_[i] = waits ? 1 : 0;
+  envs_[i]->step(left);
+}
+
+void VectorEnvironment::setCommandDelays(std::span<const std::size_t> which, std::span<const std::int64_t> steps) {
+  const std::size_t robots = robot_names_.size();
+  if (steps.size() != which.size() * robots)
+    throw ConfigError({}, "command delays for " + std::to_string(which.size()) + " copies of " + std::to_string(robots) +
+                              " robots need " + std::to_string(which.size() * robots) + " numbers, got " +
+                              std::to_string(steps.size()));
+  checkWhich(which, "setting command delays");
+  for (std::size_t k = 0; k < steps.size(); ++k)
+    if (steps[k] < 0)
+      throw ConfigError({}, "copy " + std::to_string(which[k / robots]) + ", robot '" + robot_names_[k % robots] +
+                                "': a command delay is >= 0 steps, got " + std::to_string(steps[k]));
+  if (delays_.empty()) {
+    const std::size_t rows = envs_.size() * robots;
+    delays_.assign(rows, 0);
+    remaining_.assign(rows, -1);
+    waiting_.assign(rows, Command{});
+    copy_waits_.assign(envs_.size(), 0);
+  }
+  for (std::size_t k = 0; k < which.size(); ++k)
+    std::copy_n(steps.begin() + static_cast<std::ptrdiff_t>(k * robots), robots,
+                delays_.begin() + static_cast<std::ptrdiff_t>(which[k] * robots));
 }
 
 void VectorEnvironment::reset(std::span<const std::size_t> which, std::span<const std::byte> state,
@@ -185,6 +238,12 @@ void VectorEnvironment::reset(std::span<const std::size_t> which, std::span<cons
     envs_[i]->restoreChecked(state);
     envs_[i]->reseed(seeds[k]);
   });
+  if (copy_waits_.empty()) return;
+  const std::size_t robots = robot_names_.size();
+  for (const std::size_t i : which) {
+    std::fill_n(remaining_.begin() + static_cast<std::ptrdiff_t>(i * robots), robots, -1);
+    copy_waits_[i] = 0;
+  }
 }
 
 void VectorEnvironment::checkWhich(std::span<const std::size_t> which, const char* what) const {
@@ -336,11 +395,22 @@ void VectorEnvironment::setCommands(CommandLevel level, std::span<const double> 
     if (!why.empty()) throw ConfigError({}, who() + ": " + why);
   }
   for (std::size_t r = 0; r < rows; ++r) {
-    if (commands_[r] != nullptr)
-      commands_[r]->setCommand(commands[r]);
-    else
-      setpoints_[r]->setSetpoint(commands[r].setpoint);
+    if (delays_.empty() || delays_[r] == 0) {
+      send(r, commands[r]);
+      continue;
+    }
+    if (remaining_[r] >= 0) send(r, waiting_[r]);  // overtaken: it takes effect now
+    waiting_[r] = commands[r];
+    remaining_[r] = delays_[r];
+    copy_waits_[r / robots] = 1;
   }
+}
+
+void VectorEnvironment::send(std::size_t r, const Command& command) {
+  if (commands_[r] != nullptr)
+    commands_[r]->setCommand(command);
+  else
+    setpoints_[r]->setSetpoint(command.setpoint);
 }
 
 }  // namespace ssx

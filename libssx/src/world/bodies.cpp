@@ -51,6 +51,7 @@ void buildBodies(World& world, PhysicEngine& engine, std::vector<Environment::St
       }
       if (top.isStatic()) {
         const int group = engine.addStatic(shapes, top_data.pose);
+        if (static_shapes != nullptr) world.static_group_owner.push_back(static_cast<std::uint32_t>(artifact->index()));
         for (std::size_t k = h; k < count; ++k)
           if (head[k] == h) world.nodes[offset + k].static_group = group;
         continue;

@@ -76,6 +76,11 @@ const Artifact& Environment::bodyOwner(int i) const {
   return *world_->artifacts[world_->body_owner.at(static_cast<std::size_t>(i))];
 }
 
+const Artifact& Environment::contactOther(const EngineContact& contact) const {
+  if (contact.body_b >= 0) return bodyOwner(contact.body_b);
+  return *world_->artifacts[world_->static_group_owner.at(static_cast<std::size_t>(contact.static_group))];
+}
+
 void Environment::recordContacts(bool on) {
   requireOutsidePhases("recordContacts");
   world_->record_contacts = on;

@@ -209,6 +209,7 @@ struct World {
   std::vector<Vec3> previous_angular;
   std::vector<Wrench> wrenches;
   std::vector<std::uint32_t> body_owner;  // artifact index
+  std::vector<std::uint32_t> static_group_owner;  // per addStatic group: artifact index
   // per body: the largest force and torque that change its speeds by at most the speed guards in
   // one step (commands beyond them are refused before the engine sees them)
   std::vector<WrenchLimit> wrench_limits;

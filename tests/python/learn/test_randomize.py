@@ -72,6 +72,44 @@ def test_draws_are_part_of_a_saved_state_and_redrawn_at_autoreset():
     env.close()
 
 
+def test_latency_and_battery_are_drawn_like_the_other_constants():
+    # latency: the action reaches the motors that many whole physics steps later (the one before held);
+    # a tilt commanded 10 ms late has moved the robot less by the end of the action
+    late = learn.VectorEnv("hover", num_envs=2, threads=1, randomize={"latency": (0.0095, 0.0105)})
+    prompt = learn.VectorEnv("hover", num_envs=2, threads=1)
+    _, infos = late.reset(seed=3)
+    prompt.reset(seed=3)
+    assert np.allclose(infos["variations"]["latency"], 0.01)  # rounded to whole steps of 2 ms
+    tilt = np.tile(np.array([0.5, 0.0, 0.0, 0.0], dtype=np.float32), (2, 1))  # attitude: roll
+    late.step(tilt)
+    prompt.step(tilt)
+    roll = {name: abs(env.sim.robot_states()[:, 0, 4]) for name, env in (("late", late), ("prompt", prompt))}  # qx
+    assert np.all(roll["late"] < 0.9 * roll["prompt"])  # (0.54 and 0.80 of it: the motors lag either way)
+    # no latency drawn is the scene's run, bit for bit
+    none = learn.VectorEnv("hover", num_envs=2, threads=1, randomize={"latency": (0.0, 0.0009)})
+    again = learn.VectorEnv("hover", num_envs=2, threads=1)
+    for env in (none, again):
+        env.reset(seed=3)
+        env.step(tilt)
+    assert np.array_equal(none.state_hashes(), again.state_hashes())
+    with pytest.raises(ValueError, match=r"latency.*within \[0, 0.02\]"):
+        learn.VectorEnv("hover", num_envs=1, randomize={"latency": (0.0, 0.05)})
+    # the battery: the Crazyflie's firmware sees the voltage drawn; a drained one cannot lift as much
+    weak = learn.VectorEnv("hover", num_envs=2, threads=1, randomize={"battery_volts": (-1.8, -1.8)})
+    _, infos = weak.reset(seed=3)
+    assert np.all(infos["variations"]["battery_volts"] == -1.8)
+    full = np.tile(np.array([0.0, 0.0, 0.0, 1.0], dtype=np.float32), (2, 1))  # the most thrust
+    prompt.reset(seed=3)
+    start = prompt.sim.robot_states()[:, 0, 2]  # (the same start: the task draws it before the constants)
+    for _ in range(8):
+        weak.step(full)
+        prompt.step(full)
+    climbed = {name: env.sim.robot_states()[:, 0, 2] - start for name, env in (("weak", weak), ("full", prompt))}
+    assert np.all(climbed["weak"] < climbed["full"] - 0.02)
+    for env in (late, prompt, none, again, weak):
+        env.close()
+
+
 def test_bad_ranges_are_refused_before_anything_runs():
     with pytest.raises(ValueError, match="has no such constant"):
         learn.VectorEnv("hover", num_envs=1, randomize={"weight": (0.9, 1.1)})

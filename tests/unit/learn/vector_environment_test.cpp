@@ -217,3 +217,47 @@ TEST_CASE("vector environment: constants varied per copy and robot, checked whol
   CHECK_THROWS_WITH(v.vary(both, "mass", std::array<double, 2>{1, 1}), Contains("needs 2 x 2 values"));
   CHECK(hashes(v) == now);
 }
+
+TEST_CASE("vector environment: a command delayed by some steps takes effect then, as one copy alone would",
+          "[learn]") {
+  auto load = [](std::size_t) { return crazyflies(2); };
+  const std::vector<double> tilt = {0.2, 0, 0, 0.3, 0.1, 0, 0, 0.3};  // attitude rows: roll, pitch, yaw rate, thrust
+  // the same by hand, in one environment: 3 steps on the old commands, then robot 0's, 4 more, then robot 1's
+  Scene alone = crazyflies(2);
+  Environment& env = *alone.environment;
+  env.step(400);
+  auto commands = [&](std::size_t r) { return dynamic_cast<CommandInterface*>(env.findArtifact("cf" + std::to_string(r))->driver()); };
+  env.step(3);
+  commands(0)->setCommand(Command::fromRow(CommandLevel::Attitude, std::span(tilt).first(4)));
+  env.step(4);
+  commands(1)->setCommand(Command::fromRow(CommandLevel::Attitude, std::span(tilt).subspan(4)));
+  env.step(13);
+  for (const int threads : {1, 2}) {
+    VectorEnvironment v(load, 2, threads);
+    v.step(400);
+    const std::vector<std::byte> start = v[0].saveState();
+    const std::array<std::size_t, 1> second{1};
+    const std::array<std::int64_t, 2> delays{3, 7};
+    v.setCommandDelays(second, delays);
+    std::vector<double> rows(tilt);
+    rows.insert(rows.end(), tilt.begin(), tilt.end());
+    v.setCommands(CommandLevel::Attitude, rows, 4);
+    v.step(2);  // (robot 0's is due within the next call)
+    v.step(18);
+    CHECK(v[1].stateHash() == env.stateHash());
+    CHECK(v[0].stateHash() != env.stateHash());  // copy 0: no delay
+    // a reset drops the commands waiting: the copy goes on from the state restored as one that was never commanded
+    const std::array<std::size_t, 2> both{0, 1};
+    const std::array<std::uint64_t, 2> seeds{9, 9};
+    v.reset(both, start, seeds);
+    v.setCommands(CommandLevel::Attitude, rows, 4);
+    v.reset(both, start, seeds);
+    v.step(20);
+    CHECK(v[1].stateHash() != env.stateHash());
+    CHECK(v[0].stateHash() == v[1].stateHash());  // copy 0's commands were sent at once, then restored over too
+    // refused before anything changes
+    const std::array<std::int64_t, 2> negative{0, -1};
+    CHECK_THROWS_WITH(v.setCommandDelays(second, negative), Contains("copy 1, robot 'cf1'") && Contains(">= 0"));
+    CHECK_THROWS_WITH(v.setCommandDelays(second, std::span(delays).first(1)), Contains("need 2 numbers, got 1"));
+  }
+}

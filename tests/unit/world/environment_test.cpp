@@ -338,3 +338,39 @@ TEST_CASE("contacts: two boxes stacked on the ground, each pair once with the im
     CHECK_THROWS_AS(env.contacts(), Error);
   }
 }
+
+TEST_CASE("contacts: a box pushed into a wall on the ground says which static artifact each contact is with",
+          "[environment]") {
+  for (const std::string engine : {"ode", "bullet"}) {
+    CAPTURE(engine);
+    Scene s = loadSceneFromString("<scene><environment timestep=\"0.002\"/><physics engine=\"" + engine +
+                                      "\"/><type name=\"box\" file=\"" + (ssx::test::kArtifacts / "box.xml").string() +
+                                      "\"/><ground/><obstacle name=\"wall\" xyz=\"0.2 0 0.5\"><box size=\"0.1 1 1\"/>"
+                                      "</obstacle><artifact type=\"box\" name=\"b\" xyz=\"0 0 0.1\"/></scene>",
+                                  "wall.xml", ssx::test::kArtifacts);
+    Environment& env = *s.environment;
+    env.recordContacts();
+    env.step(50);  // settled on the ground
+    const int b = env.findArtifact("b")->root().bodyIndex();
+    BodyState pushed = env.bodyState(b);
+    pushed.linear_velocity = Vec3(2, 0, 0);  // towards the wall, 5 cm away (friction would stop it 20 cm on)
+    env.setBodyState(b, pushed);
+    std::vector<EngineContact> both;
+    for (int k = 0; k < 200 && both.size() != 2; ++k) {
+      env.step();
+      both = env.contacts();
+    }
+    REQUIRE(both.size() == 2);
+    // one record per static artifact touched, in the order they were added: the ground, the wall
+    CHECK(both[0].body_b == -1);
+    CHECK(both[1].body_b == -1);
+    CHECK(both[0].static_group != both[1].static_group);
+    CHECK(env.contactOther(both[0]).name() == "ground");
+    CHECK(env.contactOther(both[1]).name() == "wall");
+    CHECK(both[0].normal.z() > 0.99);   // up, from the ground into the box
+    CHECK(both[1].normal.x() < -0.99);  // back, from the wall into the box
+    CHECK(both[1].impulse > 0);
+    CHECK(&env.contactOther(EngineContact{b, -1, {}, {}, 0, both[0].static_group}) == env.findArtifact("ground"));
+    CHECK_THROWS_AS(env.contactOther(EngineContact{b, -1, {}, {}, 0, 7}), std::out_of_range);
+  }
+}

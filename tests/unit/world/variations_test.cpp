@@ -127,6 +127,65 @@ TEST_CASE("variations: the IMU's noise and the wind vary", "[variations]") {
   CHECK(robot(*windy.environment).pose().position.x() > robot(*calm.environment).pose().position.x() + 0.002);
 }
 
+TEST_CASE("variations: the battery's voltage varies for a vehicle that has one", "[variations]") {
+  // the Crazyflie on its firmware's controller: the compensation keeps a command's thrust until the
+  // battery cannot give the voltage; full thrust from a weaker battery climbs less
+  auto firmware = [] {
+    return loadSceneFromString("<scene><environment timestep=\"0.002\" seed=\"3\" threads=\"1\"/><type name=\"cf\" "
+                               "file=\"" + (kArtifacts / "crazyflie.xml").string() +
+                                   "\"/><ground/><artifact type=\"cf\" name=\"cf0\" xyz=\"0 0 1\">"
+                                   "<driver controller=\"crazyflie_pid\"/></artifact></scene>",
+                               "cf.xml", kArtifacts);
+  };
+  Scene full = firmware(), low = firmware();
+  const auto names = [](const Environment& env) {
+    std::vector<std::string> out;
+    for (const Variable& v : env.variables(robot(env))) out.emplace_back(v.name);
+    return out;
+  };
+  full.environment->step(100);
+  low.environment->step(100);
+  const std::vector<std::string> listed = names(*full.environment);
+  CHECK(std::find(listed.begin(), listed.end(), "battery_volts") != listed.end());
+  low.environment->vary(robot(*low.environment), "battery_volts", -1.7);  // 2.5 V: 0.31 N at most
+  for (Scene* s : {&full, &low}) {
+    auto* commands = dynamic_cast<CommandInterface*>(s->environment->findArtifact("cf0")->driver());
+    REQUIRE(commands != nullptr);
+    commands->setCommand(Command::attitude(0, 0, 0, 0.47));  // nearly every motor's 0.12 N
+    s->environment->step(150);
+  }
+  const double climbed_full = robot(*full.environment).pose().position.z() - 1;
+  const double climbed_low = robot(*low.environment).pose().position.z() - 1;
+  CHECK(climbed_full > 0.1);
+  CHECK(climbed_low < 0.5 * climbed_full);
+  // a state saved on the low battery keeps it: restored where it was never varied, the same bits
+  const std::vector<std::byte> saved = low.environment->saveState();
+  low.environment->step(50);
+  Scene again = firmware();
+  again.environment->step(1);
+  again.environment->restoreState(saved);
+  again.environment->step(50);
+  CHECK(again.environment->stateHash() == low.environment->stateHash());
+  CHECK(again.environment->variation(robot(*again.environment), "battery_volts") == -1.7);
+
+  // a battery model, not compensated (thrust follows the voltage): a lower open circuit sinks the hover
+  auto mk = [] {
+    return loadSceneFromString("<scene><environment timestep=\"0.002\" seed=\"3\" threads=\"1\"/><type name=\"mk\" "
+                               "file=\"" + (kArtifacts / "mk_quad.xml").string() +
+                                   "\"/><ground/><artifact type=\"mk\" name=\"mk0\" xyz=\"0 0 1\">"
+                                   "<driver battery=\"true\"/></artifact></scene>",
+                               "mk.xml", kArtifacts);
+  };
+  Scene charged = mk(), drained = mk();
+  charged.environment->step(500);
+  drained.environment->step(500);
+  drained.environment->vary(*drained.environment->findArtifact("mk0"), "battery_volts", -2.0);
+  charged.environment->step(150);
+  drained.environment->step(150);
+  CHECK(drained.environment->findArtifact("mk0")->pose().position.z() <
+        charged.environment->findArtifact("mk0")->pose().position.z() - 0.01);
+}
+
 TEST_CASE("variations: unknown names and values out of range are refused before anything changes", "[variations]") {
   Scene s = crazyflie();
   Environment& env = *s.environment;
@@ -136,7 +195,7 @@ TEST_CASE("variations: unknown names and values out of range are refused before 
   for (const Variable& v : env.variables(robot(env))) names.emplace_back(v.name);
   CHECK(names == std::vector<std::string>{"mass", "inertia", "thrust_coefficient", "moment_constant",
                                           "time_constant_up", "time_constant_down", "wind_x", "wind_y", "wind_z",
-                                          "gyro_noise", "accel_noise"});
+                                          "battery_volts", "gyro_noise", "accel_noise"});
   const std::vector<std::byte> before = env.saveState();
   CHECK_THROWS_WITH(env.vary(robot(env), "thrust", 0.9),
                     Contains("no constant 'thrust'") && Contains("thrust_coefficient") && Contains("gyro_noise"));

@@ -155,6 +155,7 @@ int BulletEngine::addStatic(const std::vector<Shape>& shapes, const Pose& pose) 
     object->object = std::make_unique<btCollisionObject>();
     object->object->setCollisionShape(object->shape.get());
     object->object->setUserIndex(-1);
+    object->object->setUserIndex2(group);
     object->object->setFriction(settings_.friction);
     object->object->setRestitution(settings_.restitution);
     if (!object->plane)
@@ -251,7 +252,9 @@ void BulletEngine::logContacts() {
       const btManifoldPoint& p = m->getContactPoint(k);
       const btVector3& x = p.getPositionWorldOnB();
       const btVector3& n = p.m_normalWorldOnB;
-      contact_log_.add(a, b, Vec3(x.x(), x.y(), x.z()), Vec3(n.x(), n.y(), n.z()), -p.getDistance(),
+      // (a static object's second user index is its group: addStatic)
+      const int group = a < 0 ? m->getBody0()->getUserIndex2() : b < 0 ? m->getBody1()->getUserIndex2() : -1;
+      contact_log_.add(a, b, group, Vec3(x.x(), x.y(), x.z()), Vec3(n.x(), n.y(), n.z()), -p.getDistance(),
                        p.getAppliedImpulse());
     }
   }

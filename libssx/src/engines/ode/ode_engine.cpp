@@ -433,8 +433,10 @@ void OdeEngine::logContacts(double h) {
     // one that is not the static world): its part along the normal, over the substep
     const Vec3 normal(g.normal[0], g.normal[1], g.normal[2]);
     const Vec3 force(feedback_[k].f1[0], feedback_[k].f1[1], feedback_[k].f1[2]);
+    // (a static geom's data is -1 - its group: addStatic)
+    const auto group = static_cast<int>(-1 - std::min(owner_a, owner_b));
     contact_log_.add(owner_a > 0 ? static_cast<int>(owner_a - 1) : -1, owner_b > 0 ? static_cast<int>(owner_b - 1) : -1,
-                     Vec3(g.pos[0], g.pos[1], g.pos[2]), normal, g.depth, std::abs(force.dot(normal)) * h);
+                     group, Vec3(g.pos[0], g.pos[1], g.pos[2]), normal, g.depth, std::abs(force.dot(normal)) * h);
   }
 }
 
