@@ -166,7 +166,11 @@ Command CrazyfliePidController::command() const {
 }
 
 double CrazyfliePidController::motorThrust(double command) const {
-  const double pwm = curve_.pwm(command, filter_.volts());
+  const double battery = filter_.volts();
+  // the compensation reads the voltage the motors get (a battery held, or settled): the same
+  // numbers as below without inverting the curve (a tenth of a Crazyflie's step)
+  if (motor_volts_ == battery) return curve_.delivered(command, battery);
+  const double pwm = curve_.pwm(command, battery);
   if (pwm <= 0) return 0;
   return std::max(0.0, curve_.thrust(pwm / 65535.0 * motor_volts_));
 }

@@ -35,6 +35,12 @@ double CrazyflieThrustCurve::pwm(double u, double battery_volts) const {
   return std::min(65535.0, 65535.0 * volts(newtons) / battery_volts);
 }
 
+double CrazyflieThrustCurve::delivered(double u, double battery_volts) const {
+  const double newtons = std::clamp(u, 0.0, 65535.0) / 65535.0 * thrust_max;
+  if (newtons < thrust_min || battery_volts < 2.0) return 0;
+  return std::max(0.0, std::min(newtons, thrust(battery_volts)));
+}
+
 double BatteryFilter::update(double measured, int ticks) {
   for (int i = 0; i < ticks; ++i) v_ += 0.01 * (measured - v_);
   return v_;

@@ -88,6 +88,8 @@ struct EnvironmentSettings {
   std::uint64_t seed = 0;            ///< root of every random stream
   int threads = 0;                   ///< worker threads for the parallel phases; 0: one per core; 1: inline
   /// Steps whose timing is kept (timing()), in a ring allocated when the environment is made.
+  /// 0: none, and no clock is read in a step (a learning environment's copies: a twentieth of a
+  /// small world's step); timing() then stays empty.
   std::size_t timing_samples = TimingRecorder::kDefaultCapacity;
   PhysicsSettings physics;  ///< the physics engine and its parameters
   RenderSettings render;    ///< the render engine, scene cameras and outputs

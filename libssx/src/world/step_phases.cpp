@@ -33,7 +33,7 @@ Nanoseconds since(Clock::time_point t0) {
 }
 
 // the time since `t`, and `t` moved to now
-Nanoseconds lap(Clock::time_point& t) {
+Nanoseconds lapTimer(Clock::time_point& t) {
   const auto now = Clock::now();
   const Nanoseconds elapsed = std::chrono::duration_cast<std::chrono::nanoseconds>(now - t).count();
   t = now;
@@ -193,9 +193,12 @@ void Environment::step() {
     ~Stepping() { flag = false; }
   } stepping(w.stepping);
   // one clock reading ends a phase and starts the next (a lap timer): half the readings of a
-  // start and an end per phase, which cost a twentieth of a small world's step
-  const auto t_step = Clock::now();
+  // start and an end per phase, which cost a twentieth of a small world's step; none at all
+  // when no timing is kept
+  const bool timed = settings_.timing_samples > 0;
+  const auto t_step = timed ? Clock::now() : Clock::time_point{};
   auto t = t_step;
+  auto lap = [timed](Clock::time_point& at) { return timed ? lapTimer(at) : Nanoseconds{0}; };
   StepTiming timing;
   w.current_step = w.steps;
   timing.step = w.current_step;
@@ -272,8 +275,10 @@ void Environment::step() {
   }
 
   runExtensionHook(&SimulationExtension::afterStep, "afterStep");
-  timing.total = since(t_step);
-  timing_.add(timing);
+  if (timed) {
+    timing.total = since(t_step);
+    timing_.add(timing);
+  }
   for (std::size_t i = 0; i < listeners_.size(); ++i) {
     try {
       listeners_[i].second(*this);

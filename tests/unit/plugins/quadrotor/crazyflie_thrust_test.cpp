@@ -101,3 +101,23 @@ TEST_CASE("crazyflie thrust: the voltage agrees with a sixty-step bisection to 1
     CHECK(worst < 1e-12);
   }
 }
+
+TEST_CASE("crazyflie thrust: at the voltage the compensation reads, a command delivers its thrust up to the battery's",
+          "[quadrotor][crazyflie]") {
+  // delivered() is the PWM path, thrust(pwm / 65535 V), without inverting the curve
+  const CrazyflieThrustCurve curve = CrazyflieThrustCurve::propellers21plus();
+  for (const double volts : {1.9, 2.5, 3.0, 3.7, 4.2}) {
+    CAPTURE(volts);
+    double worst = 0;
+    for (int k = 0; k <= 1000; ++k) {
+      const double u = 70000.0 * k / 1000.0 - 2000.0;  // below 0 and above 65535 too
+      const double pwm = curve.pwm(u, volts);
+      const double through_pwm = pwm <= 0 ? 0.0 : std::max(0.0, curve.thrust(pwm / 65535.0 * volts));
+      worst = std::max(worst, std::abs(curve.delivered(u, volts) - through_pwm));
+    }
+    CHECK(worst < 1e-12);
+  }
+  CHECK(curve.delivered(65535, 3.0) == Approx(curve.thrust(3.0)));  // a weak battery: less than thrust_max
+  CHECK(curve.delivered(65535, 4.2) == Approx(curve.thrust_max));
+  CHECK(curve.delivered(100, 4.2) == 0);  // below thrust_min: off
+}
