@@ -318,11 +318,15 @@ class Formation(_Flight):
     def action_space(self, per_agent=False):
         return make_box(-1.0, 1.0, (4,) if per_agent else (self.robots, 4), np.float32)
 
-    def _pairs(self, states):
-        """(E, R, R) relative positions (j - i) and distances, the diagonal at infinity."""
+    def _pairs(self, states, fresh=False):
+        """(E, R, R) relative positions (j - i) and distances, the diagonal at infinity. observe()
+        keeps them for the evaluate() that follows it on the same states (a step's two calls)."""
+        kept, self._kept_pairs = getattr(self, "_kept_pairs", None), None
+        if kept is not None and not fresh:
+            return kept
         p = states[..., 0:3]
         rel = p[:, None, :, :] - p[:, :, None, :]
-        dist = np.linalg.norm(rel, axis=-1)
+        dist = np.sqrt(np.einsum("...i,...i->...", rel, rel))
         idx = np.arange(self.robots)
         dist[:, idx, idx] = np.inf
         return rel, dist
@@ -331,7 +335,8 @@ class Formation(_Flight):
         o = out.reshape(len(states), self.robots, 15)
         o[..., 0:3] = self.slots[: len(states)] - states[..., 0:3]
         o[..., 3:6] = states[..., 7:10] * 0.5
-        rel, dist = self._pairs(states)
+        rel, dist = self._pairs(states, fresh=True)
+        self._kept_pairs = (rel, dist)  # for evaluate(), on these states
         nearest = np.argsort(dist, axis=-1, kind="stable")[..., : self.neighbours]  # (E, R, 3)
         picked = np.take_along_axis(rel, nearest[..., None], axis=2)  # (E, R, 3, 3)
         o[..., 6:15] = picked.reshape(len(states), self.robots, 3 * self.neighbours)

@@ -134,6 +134,8 @@ class SSX_EXPORT VectorEnvironment {
   void forEachOf(std::span<const std::size_t> which, const std::function<void(std::size_t, std::size_t)>& fn);
   // the command row r (copy r / robots, robot r % robots) sends now
   void send(std::size_t r, const Command& command);
+  // builds row r's command from `row` into staged_[r]: what is wrong with it ("" when nothing)
+  std::string stageCommand(std::size_t r, CommandLevel level, std::span<const double> row);
   // copy i's n steps, with the commands waiting (setCommandDelays) sent when they are due
   void stepCopy(std::size_t i, std::int64_t n);
   std::vector<Scene> scenes_;
@@ -152,6 +154,8 @@ class SSX_EXPORT VectorEnvironment {
   std::vector<std::int64_t> delays_, remaining_;
   std::vector<Command> waiting_;
   std::vector<std::uint8_t> copy_waits_;  // per copy: a command of one of its robots waits
+  std::vector<Command> staged_;           // setCommands's, per copy per robot (kept: no allocation per call)
+  std::vector<std::string> problems_;     // setCommands's, per copy
   std::unique_ptr<Pool> pool_;
 };
 

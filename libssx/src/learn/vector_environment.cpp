@@ -303,19 +303,22 @@ void VectorEnvironment::robotStates(std::span<double> out) const {
   if (out.size() != envs_.size() * robots * kRobotStateSize)
     throw ConfigError({}, "robotStates needs " + std::to_string(envs_.size()) + " x " + std::to_string(robots) + " x " +
                               std::to_string(kRobotStateSize) + " numbers, got " + std::to_string(out.size()));
-  double* p = out.data();
-  for (const PhysicNode* node : roots_) {
-    const BodyState& s = node->state();
-    const Vec3& x = s.pose.position;
-    const Quat& q = s.pose.orientation;
-    const Vec3& v = s.linear_velocity;
-    const Vec3& w = s.angular_velocity;
-    p[0] = x.x(), p[1] = x.y(), p[2] = x.z();
-    p[3] = q.w(), p[4] = q.x(), p[5] = q.y(), p[6] = q.z();
-    p[7] = v.x(), p[8] = v.y(), p[9] = v.z();
-    p[10] = w.x(), p[11] = w.y(), p[12] = w.z();
-    p += kRobotStateSize;
-  }
+  // the copies in parallel: each robot's state is a few dependent loads into its own world
+  auto read = [&](std::size_t begin, std::size_t end) {
+    for (std::size_t r = begin * robots; r < end * robots; ++r) {
+      const BodyState& s = roots_[r]->state();
+      const Vec3& x = s.pose.position;
+      const Quat& q = s.pose.orientation;
+      const Vec3& v = s.linear_velocity;
+      const Vec3& w = s.angular_velocity;
+      double* p = out.data() + r * kRobotStateSize;
+      p[0] = x.x(), p[1] = x.y(), p[2] = x.z();
+      p[3] = q.w(), p[4] = q.x(), p[5] = q.y(), p[6] = q.z();
+      p[7] = v.x(), p[8] = v.y(), p[9] = v.z();
+      p[10] = w.x(), p[11] = w.y(), p[12] = w.z();
+    }
+  };
+  pool_->workers.parallelFor(envs_.size(), std::max<std::size_t>(1, envs_.size() / (pool_->workers.size() * 8)), read);
 }
 
 void VectorEnvironment::imuReadings(std::span<double> out) const {
@@ -375,35 +378,52 @@ void VectorEnvironment::setCommands(CommandLevel level, std::span<const double> 
     throw ConfigError({}, "commands for a vector environment need " + std::to_string(envs_.size()) + " x " +
                               std::to_string(robots) + " rows of " + std::to_string(columns) + " numbers, got " +
                               std::to_string(values.size()) + " numbers");
-  // every row checked before any robot gets one; the commands built here are what is sent
-  thread_local std::vector<Command> commands;
-  commands.resize(rows);
-  for (std::size_t r = 0; r < rows; ++r) {
-    auto who = [&] { return "copy " + std::to_string(r / robots) + ", robot '" + robot_names_[r % robots] + "'"; };
-    CommandInterface* target = commands_[r];
-    if (target == nullptr && level != CommandLevel::Position)
-      throw ConfigError({}, who() + " takes set-points only, no commands at the " + commandLevelName(level) + " level");
-    const std::size_t rotors = target != nullptr ? target->rotorCount() : 0;
-    if (!Command::rowSizeFits(level, columns, rotors))
-      throw ConfigError({}, "a " + std::string(commandLevelName(level)) + " command for " + who() + " has " +
-                                Command::rowSizes(level, rotors) + " values, got " + std::to_string(columns));
-    const std::span<const double> row = values.subspan(r * columns, columns);
-    for (const double x : row)
-      if (!std::isfinite(x)) throw ConfigError({}, "the command for " + who() + " holds a NaN or an infinity");
-    commands[r] = Command::fromRow(level, row);
-    const std::string why = target != nullptr ? target->refusal(commands[r]) : commands[r].problem();
-    if (!why.empty()) throw ConfigError({}, who() + ": " + why);
-  }
-  for (std::size_t r = 0; r < rows; ++r) {
-    if (delays_.empty() || delays_[r] == 0) {
-      send(r, commands[r]);
-      continue;
+  // every row checked before any robot gets one (the copies in parallel: a robot's driver is
+  // far in memory from the next one's; each thread touches its own), the first problem by copy
+  // index reported; the commands built here are what is sent
+  staged_.resize(rows);
+  problems_.resize(envs_.size());
+  auto check = [&](std::size_t begin, std::size_t end) {
+    for (std::size_t i = begin; i < end; ++i) {
+      problems_[i].clear();
+      for (std::size_t r = i * robots; r < (i + 1) * robots && problems_[i].empty(); ++r)
+        problems_[i] = stageCommand(r, level, values.subspan(r * columns, columns));
     }
-    if (remaining_[r] >= 0) send(r, waiting_[r]);  // overtaken: it takes effect now
-    waiting_[r] = commands[r];
-    remaining_[r] = delays_[r];
-    copy_waits_[r / robots] = 1;
-  }
+  };
+  const std::size_t chunk = std::max<std::size_t>(1, envs_.size() / (pool_->workers.size() * 8));
+  pool_->workers.parallelFor(envs_.size(), chunk, check);
+  for (const std::string& problem : problems_)
+    if (!problem.empty()) throw ConfigError({}, problem);
+  auto deliver = [&](std::size_t begin, std::size_t end) {
+    for (std::size_t r = begin * robots; r < end * robots; ++r) {
+      if (delays_.empty() || delays_[r] == 0) {
+        send(r, staged_[r]);
+        continue;
+      }
+      if (remaining_[r] >= 0) send(r, waiting_[r]);  // overtaken: it takes effect now
+      waiting_[r] = staged_[r];
+      remaining_[r] = delays_[r];
+      copy_waits_[r / robots] = 1;
+    }
+  };
+  pool_->workers.parallelFor(envs_.size(), chunk, deliver);
+}
+
+std::string VectorEnvironment::stageCommand(std::size_t r, CommandLevel level, std::span<const double> row) {
+  const std::size_t robots = robot_names_.size();
+  auto who = [&] { return "copy " + std::to_string(r / robots) + ", robot '" + robot_names_[r % robots] + "'"; };
+  CommandInterface* target = commands_[r];
+  if (target == nullptr && level != CommandLevel::Position)
+    return who() + " takes set-points only, no commands at the " + commandLevelName(level) + " level";
+  const std::size_t rotors = target != nullptr ? target->rotorCount() : 0;
+  if (!Command::rowSizeFits(level, row.size(), rotors))
+    return "a " + std::string(commandLevelName(level)) + " command for " + who() + " has " +
+           Command::rowSizes(level, rotors) + " values, got " + std::to_string(row.size());
+  for (const double x : row)
+    if (!std::isfinite(x)) return "the command for " + who() + " holds a NaN or an infinity";
+  staged_[r] = Command::fromRow(level, row);
+  const std::string why = target != nullptr ? target->refusal(staged_[r]) : staged_[r].problem();
+  return why.empty() ? why : who() + ": " + why;
 }
 
 void VectorEnvironment::send(std::size_t r, const Command& command) {
