@@ -11,6 +11,7 @@
 #include <pybind11/stl.h>
 #include <pybind11/stl/filesystem.h>
 
+#include <array>
 #include <atomic>
 #include <memory>
 #include <optional>
@@ -105,6 +106,35 @@ class PyVectorEnvironment {
     py::array_t<double> a = output(out, 6, "imu");
     envs().imuReadings(std::span<double>(a.mutable_data(), static_cast<std::size_t>(a.size())));
     return a;
+  }
+
+  py::array_t<std::uint8_t> images(const py::object& out) {
+    InUse use(busy_);
+    try {
+      const std::array<std::size_t, 2> hw = envs().imageSize();
+      const std::vector<py::ssize_t> shape{static_cast<py::ssize_t>(size()), static_cast<py::ssize_t>(robots()),
+                                           static_cast<py::ssize_t>(hw[0]), static_cast<py::ssize_t>(hw[1]), 3};
+      py::array_t<std::uint8_t> a;
+      if (out.is_none()) {
+        a = py::array_t<std::uint8_t>(shape);
+      } else {
+        if (!py::isinstance<py::array_t<std::uint8_t>>(out))
+          throw py::type_error("ssx: images(out=) needs a uint8 numpy array");
+        a = py::reinterpret_borrow<py::array_t<std::uint8_t>>(out);
+        bool ok = a.ndim() == 5 && (a.flags() & py::array::c_style) != 0 && a.writeable();
+        for (int d = 0; ok && d < 5; ++d) ok = a.shape(d) == shape[static_cast<std::size_t>(d)];
+        if (!ok)
+          throw py::value_error("ssx: images(out=) needs a writable C-ordered uint8 array of shape (" +
+                                std::to_string(shape[0]) + ", " + std::to_string(shape[1]) + ", " +
+                                std::to_string(shape[2]) + ", " + std::to_string(shape[3]) + ", 3)");
+      }
+      std::span<std::uint8_t> bytes(a.mutable_data(), static_cast<std::size_t>(a.size()));
+      py::gil_scoped_release release;
+      envs().cameraImages(bytes);
+      return a;
+    } catch (const ssx::ConfigError& e) {
+      throw py::value_error(std::string("ssx: ") + e.what());
+    }
   }
 
   py::array_t<double> read(const std::string& kind, const py::object& out, std::size_t slots) {
@@ -335,6 +365,9 @@ void bindVectorEnvironment(py::module_& m) {
            "(num_envs, robots, width): one kind of sensor of every robot: pose (13), proximity (per ray), ground (per "
            "point), range (5 per slot: present, x, y, z, distance), range_and_bearing (4 per slot: present, range, "
            "bearing, elevation), odometry (9); slots: how many detections or messages; into out= when given.")
+      .def("images", &PyVectorEnvironment::images, py::arg("out") = py::none(),
+           "Every robot's latest camera image, (num_envs, robots, height, width, 3) uint8 RGB, rows from the top, "
+           "from its first camera sensor (into out when given).")
       .def("set_commands", &PyVectorEnvironment::setCommands, py::arg("level"), py::arg("values"),
            "One command level for every robot: values (num_envs, robots, columns), checked whole first.")
       .def("save_state", &PyVectorEnvironment::saveState, py::arg("index") = 0, "Copy index's state, as bytes.")

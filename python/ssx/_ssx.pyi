@@ -268,6 +268,8 @@ class VectorEnvironment:
         """(num_envs, robots, width): one kind of sensor of every robot (pose, proximity, ground, range, range_and_bearing, odometry)."""
     def record_contacts(self, on: bool = True) -> None:
         """Every copy keeps the contacts of its steps from now on (off by default)."""
+    def images(self, out: Optional[npt.NDArray[np.uint8]] = None) -> npt.NDArray[np.uint8]:
+        """Every robot's latest camera image, (num_envs, robots, height, width, 3) uint8 RGB, rows from the top, from its first camera sensor (into out when given)."""
     def set_command_delays(self, indices: Sequence[int], steps: npt.ArrayLike) -> None:
         """Actuation latency: robot r of environment indices[k] takes each later set_commands steps[k, r] physics steps into the steps that follow (0: at once), holding the one before until then. Not in saved states; reset drops the commands waiting."""
     def contact_list(self, index: int) -> List[Contact]:

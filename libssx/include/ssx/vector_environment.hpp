@@ -13,6 +13,7 @@
 #include <ssx/export.hpp>
 #include <ssx/scene.hpp>
 
+#include <array>
 #include <cstddef>
 #include <cstdint>
 #include <functional>
@@ -89,6 +90,15 @@ class SSX_EXPORT VectorEnvironment {
   /// Every robot's latest reading of one kind into `out` (size() x robots x sensorWidth(kind,
   /// slots) doubles, in that order). Read between steps.
   void readSensors(std::string_view kind, std::span<double> out, std::size_t slots = 0) const;
+  /// The size of every robot's camera image, {height, width} in pixels, from its first camera
+  /// sensor (CameraMeasurement). ConfigError naming the first robot that has none, whose camera
+  /// has not drawn yet (step first: a camera draws every `period` steps, with a render engine
+  /// that draws pixels), or whose image differs in size from robot 0's.
+  std::array<std::size_t, 2> imageSize() const;
+  /// Every robot's latest camera image into `out` (size() x robots x height x width x 3 bytes:
+  /// RGB, rows from the top), the copies in parallel. ConfigError as imageSize(), or for another
+  /// size of `out`.
+  void cameraImages(std::span<std::uint8_t> out) const;
   /// Every copy keeps the contacts of its steps from now on (Environment::recordContacts).
   void recordContacts(bool on = true);
   /// Every robot's contacts in the last step into `out` (size() x robots x 2 doubles): the normal
@@ -132,6 +142,8 @@ class SSX_EXPORT VectorEnvironment {
   // fn(which[k], k) for every k in parallel (every copy, fn(i, i), for `which` empty), the first
   // failure by copy index rethrown as that copy's
   void forEachOf(std::span<const std::size_t> which, const std::function<void(std::size_t, std::size_t)>& fn);
+  // fn(begin, end) over the copies [0, size()) in chunks, on the worker threads (fn must not throw)
+  void forChunks(const std::function<void(std::size_t, std::size_t)>& fn) const;
   // the command row r (copy r / robots, robot r % robots) sends now
   void send(std::size_t r, const Command& command);
   // builds row r's command from `row` into staged_[r]: what is wrong with it ("" when nothing)
@@ -155,7 +167,7 @@ class SSX_EXPORT VectorEnvironment {
   std::vector<Command> waiting_;
   std::vector<std::uint8_t> copy_waits_;  // per copy: a command of one of its robots waits
   std::vector<Command> staged_;           // setCommands's, per copy per robot (kept: no allocation per call)
-  std::vector<std::string> problems_;     // setCommands's, per copy
+  mutable std::vector<std::string> problems_;  // setCommands's and cameraImages's, per copy
   std::unique_ptr<Pool> pool_;
 };
 

@@ -186,6 +186,55 @@ void VectorEnvironment::readSensors(std::string_view name, std::span<double> out
   }
 }
 
+std::array<std::size_t, 2> VectorEnvironment::imageSize() const {
+  std::array<std::size_t, 2> size{0, 0};
+  for (std::size_t r = 0; r < robot_names_.size(); ++r) {
+    const CameraMeasurement* m = firstOf<CameraMeasurement>(*artifacts_[r]);
+    if (m == nullptr)
+      throw ConfigError({}, "robot '" + robot_names_[r] +
+                                "' has no camera to read: add <sensor plugin=\"camera\"/> to its type (and a render "
+                                "engine that draws pixels, <render engine=\"osmesa\"/>)");
+    const std::array<std::size_t, 2> own{static_cast<std::size_t>(m->image.height),
+                                         static_cast<std::size_t>(m->image.width)};
+    if (m->image.rgb.empty() || own[0] * own[1] * 3 != m->image.rgb.size())
+      throw ConfigError({}, "robot '" + robot_names_[r] + "''s camera has not drawn yet: step the environments first");
+    if (r > 0 && own != size)
+      throw ConfigError({}, "robot '" + robot_names_[r] + "''s camera draws " + std::to_string(own[1]) + " x " +
+                                std::to_string(own[0]) + " pixels, robot '" + robot_names_[0] + "''s " +
+                                std::to_string(size[1]) + " x " + std::to_string(size[0]) +
+                                ": one array needs the same size for every robot");
+    size = own;
+  }
+  return size;
+}
+
+void VectorEnvironment::cameraImages(std::span<std::uint8_t> out) const {
+  const std::array<std::size_t, 2> size = imageSize();
+  const std::size_t bytes = size[0] * size[1] * 3, robots = robot_names_.size();
+  if (out.size() != envs_.size() * robots * bytes)
+    throw ConfigError({}, "camera images need " + std::to_string(envs_.size()) + " x " + std::to_string(robots) +
+                              " x " + std::to_string(size[0]) + " x " + std::to_string(size[1]) + " x 3 bytes, got " +
+                              std::to_string(out.size()));
+  // every copy is the same scene: a camera of another copy has drawn the same size, or nothing
+  // yet (the copies left out of the steps since the start); the first such is reported
+  std::vector<std::string>& problems = problems_;
+  problems.assign(envs_.size(), {});
+  auto copy = [&](std::size_t begin, std::size_t end) {
+    for (std::size_t row = begin * robots; row < end * robots; ++row) {
+      const Image& image = firstOf<CameraMeasurement>(*artifacts_[row])->image;
+      if (image.rgb.size() != bytes) {
+        problems[row / robots] = "copy " + std::to_string(row / robots) + ", robot '" + robot_names_[row % robots] +
+                                 "': its camera has not drawn yet (step this copy first)";
+        continue;
+      }
+      std::copy(image.rgb.begin(), image.rgb.end(), out.begin() + static_cast<std::ptrdiff_t>(row * bytes));
+    }
+  };
+  forChunks(copy);
+  for (const std::string& problem : problems)
+    if (!problem.empty()) throw ConfigError({}, problem);
+}
+
 }  // namespace ssx
 
 namespace ssx {

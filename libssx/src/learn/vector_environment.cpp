@@ -318,7 +318,13 @@ void VectorEnvironment::robotStates(std::span<double> out) const {
       p[10] = w.x(), p[11] = w.y(), p[12] = w.z();
     }
   };
-  pool_->workers.parallelFor(envs_.size(), std::max<std::size_t>(1, envs_.size() / (pool_->workers.size() * 8)), read);
+  forChunks(read);
+}
+
+void VectorEnvironment::forChunks(const std::function<void(std::size_t, std::size_t)>& fn) const {
+  auto chunked = [&fn](std::size_t begin, std::size_t end) { fn(begin, end); };
+  pool_->workers.parallelFor(envs_.size(), std::max<std::size_t>(1, envs_.size() / (pool_->workers.size() * 8)),
+                             chunked);
 }
 
 void VectorEnvironment::imuReadings(std::span<double> out) const {

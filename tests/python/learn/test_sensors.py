@@ -60,3 +60,34 @@ def test_contacts_say_who_touched_whom_and_how_hard():
     assert np.all(impulses[:, :, 0] > 0) and np.all(impulses[:, :, 1] == 0)  # on the ground, apart
     assert {(c.other, c.static) for c in sim.contact_list(1)} == {("ground", True)}
     sim.close()
+
+
+def test_camera_images_of_every_robot_in_one_uint8_array(tmp_path):
+    # e-pucks with a camera looking along +x, a red wall ahead: e1 is nearer it than e0 (which sees e1 too)
+    epuck = (ssx.data_directory() / "artifacts" / "epuck.xml").read_text()
+    camera = '<sensor plugin="camera" xyz="0.04 0 0.03" width="32" height="24" fov_deg="60" period="5"/>'
+    (tmp_path / "eye.xml").write_text(epuck.replace("</artifact>", camera + "</artifact>"))
+    xml = """<scene><environment timestep="0.002" seed="3"/><render engine="osmesa"/><type name="e" file="eye.xml"/>
+    <ground/><swarm type="e" count="2" name="e{i}" spacing="0.3" xyz="0 0 0"/>
+    <obstacle name="wall" xyz="0.6 0 0.1" color="1 0 0"><box size="0.05 2 0.2"/></obstacle></scene>"""
+    sim = ssx._ssx.VectorEnvironment(xml, 3, base_dir=tmp_path, threads=2)
+    with pytest.raises(ValueError, match="camera has not drawn yet: step"):
+        sim.images()
+    sim.step(5)  # one image each
+    images = sim.images()
+    assert images.shape == (3, 2, 24, 32, 3) and images.dtype == np.uint8
+    red = (images[..., 0] > 150) & (images[..., 1] < 80) & (images[..., 2] < 80)
+    share = red.mean(axis=(2, 3))  # (3, 2): how much of each picture the wall fills
+    assert np.all(share[:, 1] > share[:, 0] + 0.03) and np.all(share[:, 0] > 0.02)
+    assert np.array_equal(images[0], images[2])  # the copies are one scene
+    out = np.zeros_like(images)
+    assert sim.images(out=out) is out and np.array_equal(out, images)
+    with pytest.raises(ValueError, match=r"shape \(3, 2, 24, 32, 3\)"):
+        sim.images(out=np.zeros((3, 2, 24, 32), dtype=np.uint8))
+    with pytest.raises(TypeError, match="uint8"):
+        sim.images(out=np.zeros((3, 2, 24, 32, 3)))
+    sim.close()
+    plain = ssx._ssx.VectorEnvironment(EPUCKS, 1, base_dir=ssx.data_directory(), threads=1)
+    with pytest.raises(ValueError, match='add <sensor plugin="camera"/>'):
+        plain.images()
+    plain.close()
