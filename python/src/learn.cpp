@@ -323,6 +323,67 @@ py::list contactList(const ssx::Environment& env) {
   return out;
 }
 
+namespace {
+
+std::vector<const ssx::Artifact*> robotsOf(const ssx::Environment& env) {
+  std::vector<const ssx::Artifact*> robots;
+  for (std::size_t a = 0; a < env.artifactCount(); ++a)
+    if (dynamic_cast<const ssx::SetpointInterface*>(env.artifact(a).driver()) != nullptr)
+      robots.push_back(&env.artifact(a));
+  return robots;
+}
+
+// `out` when it is a writable C-ordered array of T of `shape`, else a new one (None), else an error
+template <class T>
+py::array_t<T> outputOf(const py::object& out, const std::vector<py::ssize_t>& shape, const char* what,
+                        const char* dtype) {
+  if (out.is_none()) return py::array_t<T>(shape);
+  if (!py::isinstance<py::array_t<T>>(out))
+    throw py::type_error(std::string("ssx: ") + what + "(out=) needs a " + dtype + " numpy array");
+  auto a = py::reinterpret_borrow<py::array_t<T>>(out);
+  bool ok = a.ndim() == static_cast<py::ssize_t>(shape.size()) && (a.flags() & py::array::c_style) != 0 &&
+            a.writeable();
+  for (std::size_t d = 0; ok && d < shape.size(); ++d) ok = a.shape(static_cast<py::ssize_t>(d)) == shape[d];
+  if (!ok) {
+    std::string s;
+    for (const py::ssize_t n : shape) s += (s.empty() ? "" : ", ") + std::to_string(n);
+    throw py::value_error(std::string("ssx: ") + what + "(out=) needs a writable C-ordered " + dtype +
+                          " array of shape (" + s + ")");
+  }
+  return a;
+}
+
+}  // namespace
+
+py::object readRobots(const ssx::Environment& env, const std::string& kind, const py::object& out, std::size_t slots) {
+  const std::vector<const ssx::Artifact*> robots = robotsOf(env);
+  try {
+    const std::size_t width = ssx::sensorWidth(robots, kind, slots);
+    py::array_t<double> a = outputOf<double>(
+        out, {static_cast<py::ssize_t>(robots.size()), static_cast<py::ssize_t>(width)}, "read", "float64");
+    ssx::readSensors(robots, kind, std::span<double>(a.mutable_data(), static_cast<std::size_t>(a.size())), slots);
+    return a;
+  } catch (const ssx::ConfigError& e) {
+    throw py::value_error(std::string("ssx: ") + e.what());
+  }
+}
+
+py::object robotImages(const ssx::Environment& env, const py::object& out) {
+  const std::vector<const ssx::Artifact*> robots = robotsOf(env);
+  try {
+    const std::array<std::size_t, 2> hw = ssx::imageSize(robots);
+    py::array_t<std::uint8_t> a = outputOf<std::uint8_t>(out,
+                                                         {static_cast<py::ssize_t>(robots.size()),
+                                                          static_cast<py::ssize_t>(hw[0]),
+                                                          static_cast<py::ssize_t>(hw[1]), 3},
+                                                         "images", "uint8");
+    ssx::cameraImages(robots, std::span<std::uint8_t>(a.mutable_data(), static_cast<std::size_t>(a.size())));
+    return a;
+  } catch (const ssx::ConfigError& e) {
+    throw py::value_error(std::string("ssx: ") + e.what());
+  }
+}
+
 py::dict variableDict(const ssx::Variable& v) {
   py::dict d;
   d["name"] = v.name;

@@ -21,6 +21,12 @@ pybind11::dict variableDict(const ssx::Variable& v);
 /// the static world, impulse N s, position and normal (from b towards a) as
 /// numpy arrays of 3, as the module gives vectors).
 pybind11::list contactList(const ssx::Environment& env);
+/// One kind of sensor of every robot of `env` (the artifacts whose driver takes set-points, in
+/// artifact order), (robots, width) float64, into `out` when not None (ssx::readSensors).
+pybind11::object readRobots(const ssx::Environment& env, const std::string& kind, const pybind11::object& out,
+                            std::size_t slots);
+/// Every robot's latest camera image, (robots, height, width, 3) uint8, into `out` when not None.
+pybind11::object robotImages(const ssx::Environment& env, const pybind11::object& out);
 
 /// The class VectorEnvironment, and on the Environment class (`E` has env() and guarded()) what a
 /// learning loop on one environment needs besides save and restore: reseed, and the constants
@@ -53,6 +59,19 @@ void bindLearn(pybind11::module_& m, pybind11::class_<E>& environment) {
       pybind11::arg("robot"), pybind11::arg("name"), pybind11::arg("value"),
       "Sets a constant of the robot from the next step on (domain randomisation): 'mass' and 'inertia' (factors on "
       "its bodies'), or a variable of its plugins (variables()). Part of the saved state.");
+  environment.def(
+      "read",
+      [](E& e, const std::string& kind, const pybind11::object& out, std::size_t slots) {
+        return e.guarded([&] { return readRobots(e.env(), kind, out, slots); });
+      },
+      pybind11::arg("kind"), pybind11::arg("out") = pybind11::none(), pybind11::arg("slots") = 0,
+      "(robots, width): one kind of sensor of every robot (setpoint_names()), from its first sensor of the kind: "
+      "pose, imu, proximity, ground, range, range_and_bearing or odometry (VectorEnvironment.read's layouts).");
+  environment.def(
+      "images",
+      [](E& e, const pybind11::object& out) { return e.guarded([&] { return robotImages(e.env(), out); }); },
+      pybind11::arg("out") = pybind11::none(),
+      "(robots, height, width, 3) uint8: every robot's latest camera image (setpoint_names()), RGB, rows from the top.");
   environment.def(
       "record_contacts",
       [](E& e, bool on) { e.guarded([&] { e.env().recordContacts(on); }); }, pybind11::arg("on") = true,

@@ -135,6 +135,10 @@ class Environment:
         """Restarts every random stream (sensor noise, wind gusts) as a scene loaded with this seed would start it."""
     def record_contacts(self, on: bool = True) -> None:
         """Keeps the contacts of every step from now on (off by default); contact_list() lists the last step's."""
+    def read(self, kind: str, out: Optional[npt.NDArray[np.float64]] = None, slots: int = 0) -> npt.NDArray[np.float64]:
+        """(robots, width): one kind of sensor of every robot (setpoint_names()), from its first sensor of the kind: pose, imu, proximity, ground, range, range_and_bearing or odometry (VectorEnvironment.read's layouts)."""
+    def images(self, out: Optional[npt.NDArray[np.uint8]] = None) -> npt.NDArray[np.uint8]:
+        """(robots, height, width, 3) uint8: every robot's latest camera image (setpoint_names()), RGB, rows from the top."""
     def contact_list(self) -> List[Contact]:
         """The last step's contacts, one per pair touching: Contact(artifact, other, impulse N s, position, normal, static); other names the static artifact (the ground, a wall) when static."""
     def variables(self, robot: str) -> List[Dict[str, Any]]:
@@ -265,7 +269,7 @@ class VectorEnvironment:
     def move_robots(self, indices: Sequence[int], offsets: npt.ArrayLike, velocities: Optional[npt.ArrayLike] = None) -> None:
         """Moves every robot of the copies named by offsets (len(indices), robots, 3), at velocities (or at rest)."""
     def read(self, kind: str, out: Optional[npt.NDArray[np.float64]] = None, slots: int = 0) -> npt.NDArray[np.float64]:
-        """(num_envs, robots, width): one kind of sensor of every robot (pose, proximity, ground, range, range_and_bearing, odometry)."""
+        """(num_envs, robots, width): one kind of sensor of every robot (pose, imu, proximity, ground, range, range_and_bearing, odometry)."""
     def record_contacts(self, on: bool = True) -> None:
         """Every copy keeps the contacts of its steps from now on (off by default)."""
     def images(self, out: Optional[npt.NDArray[np.uint8]] = None) -> npt.NDArray[np.uint8]:

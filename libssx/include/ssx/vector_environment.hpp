@@ -25,6 +25,21 @@
 
 namespace ssx {
 
+/// One kind of sensor of `robots` (of one environment, or the copies' robots one copy after the
+/// other: `per_copy` robots each, named "copy i, robot 'name'" in messages; 0: one environment)
+/// into `out`, robots.size() x sensorWidth(...) numbers: the kinds and layouts of
+/// VectorEnvironment::sensorWidth. ConfigError as there.
+SSX_EXPORT void readSensors(std::span<const Artifact* const> robots, std::string_view kind, std::span<double> out,
+                            std::size_t slots = 0, std::size_t per_copy = 0);
+/// How many numbers readSensors writes per robot for these robots (VectorEnvironment::sensorWidth).
+SSX_EXPORT std::size_t sensorWidth(std::span<const Artifact* const> robots, std::string_view kind,
+                                   std::size_t slots = 0);
+/// The size of the robots' camera images, {height, width} (VectorEnvironment::imageSize).
+SSX_EXPORT std::array<std::size_t, 2> imageSize(std::span<const Artifact* const> robots);
+/// The robots' latest camera images into `out`, robots.size() x height x width x 3 bytes
+/// (VectorEnvironment::cameraImages).
+SSX_EXPORT void cameraImages(std::span<const Artifact* const> robots, std::span<std::uint8_t> out);
+
 /// The state of one robot as a learning environment reads it, in the order of its 13 numbers.
 inline constexpr std::size_t kRobotStateSize = 13;  ///< x y z, qw qx qy qz, vx vy vz, wx wy wz
 
@@ -77,6 +92,7 @@ class SSX_EXPORT VectorEnvironment {
   /// robot's first sensor (or driver) of that kind:
   /// - `pose`: 13, its motion capture (PoseMeasurement, noise and all): position, orientation
   ///   w x y z, linear and angular velocity, world frame;
+  /// - `imu`: 6, accelerometer (m/s^2) then gyroscope (rad/s), body frame (as imuReadings);
   /// - `proximity`: one per ray, its reading 0..1 (0: nothing within range);
   /// - `ground`: one per point, its grey level 0..1;
   /// - `range`: 5 per slot, the `slots` nearest robots or obstacles seen: 1 (0: an empty slot,

@@ -1,5 +1,6 @@
-// VectorEnvironment::readSensors: one kind of sensor of every robot of every copy into one array
-// (ssx/vector_environment.hpp lists the kinds and their layouts), and every robot's contacts.
+// readSensors: one kind of sensor of many robots (of one environment, or of every copy of a
+// VectorEnvironment) into one array (ssx/vector_environment.hpp lists the kinds and their
+// layouts), their camera images, and every robot's contacts.
 #include <ssx/error.hpp>
 #include <ssx/measurements.hpp>
 #include <ssx/odometry.hpp>
@@ -14,9 +15,10 @@ namespace ssx {
 
 namespace {
 
-enum class Kind { Pose, Proximity, Ground, Range, RangeBearing, Odometry };
+enum class Kind { Pose, Imu, Proximity, Ground, Range, RangeBearing, Odometry };
 
-constexpr std::array<std::pair<std::string_view, Kind>, 6> kKinds{{{"pose", Kind::Pose},
+constexpr std::array<std::pair<std::string_view, Kind>, 7> kKinds{{{"pose", Kind::Pose},
+                                                                   {"imu", Kind::Imu},
                                                                    {"proximity", Kind::Proximity},
                                                                    {"ground", Kind::Ground},
                                                                    {"range", Kind::Range},
@@ -27,7 +29,7 @@ Kind kindOf(std::string_view name) {
   for (const auto& [n, k] : kKinds)
     if (n == name) return k;
   throw ConfigError({}, "no sensor kind '" + std::string(name) +
-                            "' to read (pose, proximity, ground, range, range_and_bearing or odometry)");
+                            "' to read (pose, imu, proximity, ground, range, range_and_bearing or odometry)");
 }
 
 template <class M>
@@ -42,6 +44,8 @@ const void* source(const Artifact& a, Kind kind) {
   switch (kind) {
     case Kind::Pose:
       return firstOf<PoseMeasurement>(a);
+    case Kind::Imu:
+      return firstOf<ImuMeasurement>(a);
     case Kind::Proximity:
       return firstOf<ProximityMeasurement>(a);
     case Kind::Ground:
@@ -60,6 +64,8 @@ const char* toAdd(Kind kind) {
   switch (kind) {
     case Kind::Pose:
       return "add <sensor plugin=\"pose\"/> to its type";
+    case Kind::Imu:
+      return "add <sensor plugin=\"imu\"/> to its type";
     case Kind::Proximity:
       return "add <sensor plugin=\"proximity\"/> to its type";
     case Kind::Ground:
@@ -81,28 +87,29 @@ std::size_t countOf(const void* reading, Kind kind) {
 
 }  // namespace
 
-std::size_t VectorEnvironment::sensorWidth(std::string_view name, std::size_t slots) const {
+std::size_t sensorWidth(std::span<const Artifact* const> robots, std::string_view name, std::size_t slots) {
   const Kind kind = kindOf(name);
-  // copy 0's robots say it for all (every copy is the same scene)
   std::optional<std::size_t> count;
-  for (std::size_t r = 0; r < robot_names_.size(); ++r) {
-    const void* reading = source(*artifacts_[r], kind);
+  for (const Artifact* robot : robots) {
+    const void* reading = source(*robot, kind);
     if (reading == nullptr)
-      throw ConfigError({}, "robot '" + robot_names_[r] + "' has no " + std::string(name) + " to read: " + toAdd(kind));
+      throw ConfigError({}, "robot '" + robot->name() + "' has no " + std::string(name) + " to read: " + toAdd(kind));
     if (kind != Kind::Proximity && kind != Kind::Ground) continue;
     const std::size_t n = countOf(reading, kind);
     if (n == 0)
-      throw ConfigError({}, "robot '" + robot_names_[r] + "''s " + std::string(name) +
+      throw ConfigError({}, "robot '" + robot->name() + "''s " + std::string(name) +
                                 " sensor has not measured yet: step the environments first");
     if (count && *count != n)
-      throw ConfigError({}, "robot '" + robot_names_[r] + "''s " + std::string(name) + " sensor has " +
-                                std::to_string(n) + " values, robot '" + robot_names_[0] + "''s " +
+      throw ConfigError({}, "robot '" + robot->name() + "''s " + std::string(name) + " sensor has " +
+                                std::to_string(n) + " values, robot '" + robots[0]->name() + "''s " +
                                 std::to_string(*count) + ": one array needs the same number for every robot");
     count = n;
   }
   switch (kind) {
     case Kind::Pose:
       return 13;
+    case Kind::Imu:
+      return 6;
     case Kind::Odometry:
       return 9;
     case Kind::Range:
@@ -116,16 +123,38 @@ std::size_t VectorEnvironment::sensorWidth(std::string_view name, std::size_t sl
   return 0;
 }
 
+std::size_t VectorEnvironment::sensorWidth(std::string_view name, std::size_t slots) const {
+  // copy 0's robots say it for all (every copy is the same scene)
+  return ssx::sensorWidth(std::span(artifacts_).first(robot_names_.size()), name, slots);
+}
+
 void VectorEnvironment::readSensors(std::string_view name, std::span<double> out, std::size_t slots) const {
-  const Kind kind = kindOf(name);
   const std::size_t width = sensorWidth(name, slots), robots = robot_names_.size();
   if (out.size() != envs_.size() * robots * width)
     throw ConfigError({}, "reading " + std::string(name) + " needs " + std::to_string(envs_.size()) + " x " +
                               std::to_string(robots) + " x " + std::to_string(width) + " numbers, got " +
                               std::to_string(out.size()));
-  for (std::size_t row = 0; row < artifacts_.size(); ++row) {
+  ssx::readSensors(artifacts_, name, out, slots, robots);
+}
+
+void readSensors(std::span<const Artifact* const> robots, std::string_view name, std::span<double> out,
+                 std::size_t slots, std::size_t per_copy) {
+  const Kind kind = kindOf(name);
+  if (per_copy == 0) per_copy = robots.size();
+  const std::size_t width = sensorWidth(robots.first(std::min(per_copy, robots.size())), name, slots);
+  if (out.size() != robots.size() * width)
+    throw ConfigError({}, "reading " + std::string(name) + " of " + std::to_string(robots.size()) + " robots needs " +
+                              std::to_string(robots.size()) + " x " + std::to_string(width) + " numbers, got " +
+                              std::to_string(out.size()));
+  auto who = [&](std::size_t row) {
+    const std::string robot = "robot '" + robots[row]->name() + "'";
+    return per_copy == robots.size() ? robot : "copy " + std::to_string(row / per_copy) + ", " + robot;
+  };
+  for (std::size_t row = 0; row < robots.size(); ++row) {
     double* p = out.data() + row * width;
-    const void* reading = source(*artifacts_[row], kind);
+    const void* reading = source(*robots[row], kind);
+    if (reading == nullptr)  // (another copy's robot: the same scene, so the same sensors)
+      throw ConfigError({}, who(row) + " has no " + std::string(name) + " to read: " + toAdd(kind));
     switch (kind) {
       case Kind::Pose: {
         const auto& m = *static_cast<const PoseMeasurement*>(reading);
@@ -146,14 +175,18 @@ void VectorEnvironment::readSensors(std::string_view name, std::span<double> out
         std::copy(v, v + 13, p);
         break;
       }
+      case Kind::Imu: {
+        const auto& m = *static_cast<const ImuMeasurement*>(reading);
+        for (int k = 0; k < 3; ++k) p[k] = m.accelerometer[k], p[3 + k] = m.gyroscope[k];
+        break;
+      }
       case Kind::Proximity:
       case Kind::Ground: {
         const auto& values = kind == Kind::Proximity ? static_cast<const ProximityMeasurement*>(reading)->readings
                                                      : static_cast<const GroundMeasurement*>(reading)->readings;
         if (values.size() != width)
-          throw ConfigError({}, "copy " + std::to_string(row / robots) + ", robot '" + robot_names_[row % robots] +
-                                    "': " + std::to_string(values.size()) + " " + std::string(name) + " values, not " +
-                                    std::to_string(width));
+          throw ConfigError({}, who(row) + ": " + std::to_string(values.size()) + " " + std::string(name) +
+                                    " values, not " + std::to_string(width));
         std::copy(values.begin(), values.end(), p);
         break;
       }
@@ -187,20 +220,25 @@ void VectorEnvironment::readSensors(std::string_view name, std::span<double> out
 }
 
 std::array<std::size_t, 2> VectorEnvironment::imageSize() const {
+  return ssx::imageSize(std::span(artifacts_).first(robot_names_.size()));
+}
+
+std::array<std::size_t, 2> imageSize(std::span<const Artifact* const> robots) {
   std::array<std::size_t, 2> size{0, 0};
-  for (std::size_t r = 0; r < robot_names_.size(); ++r) {
-    const CameraMeasurement* m = firstOf<CameraMeasurement>(*artifacts_[r]);
+  for (std::size_t r = 0; r < robots.size(); ++r) {
+    const std::string& name = robots[r]->name();
+    const CameraMeasurement* m = firstOf<CameraMeasurement>(*robots[r]);
     if (m == nullptr)
-      throw ConfigError({}, "robot '" + robot_names_[r] +
+      throw ConfigError({}, "robot '" + name +
                                 "' has no camera to read: add <sensor plugin=\"camera\"/> to its type (and a render "
                                 "engine that draws pixels, <render engine=\"osmesa\"/>)");
     const std::array<std::size_t, 2> own{static_cast<std::size_t>(m->image.height),
                                          static_cast<std::size_t>(m->image.width)};
     if (m->image.rgb.empty() || own[0] * own[1] * 3 != m->image.rgb.size())
-      throw ConfigError({}, "robot '" + robot_names_[r] + "''s camera has not drawn yet: step the environments first");
+      throw ConfigError({}, "robot '" + name + "''s camera has not drawn yet: step the environments first");
     if (r > 0 && own != size)
-      throw ConfigError({}, "robot '" + robot_names_[r] + "''s camera draws " + std::to_string(own[1]) + " x " +
-                                std::to_string(own[0]) + " pixels, robot '" + robot_names_[0] + "''s " +
+      throw ConfigError({}, "robot '" + name + "''s camera draws " + std::to_string(own[1]) + " x " +
+                                std::to_string(own[0]) + " pixels, robot '" + robots[0]->name() + "''s " +
                                 std::to_string(size[1]) + " x " + std::to_string(size[0]) +
                                 ": one array needs the same size for every robot");
     size = own;
@@ -233,6 +271,19 @@ void VectorEnvironment::cameraImages(std::span<std::uint8_t> out) const {
   forChunks(copy);
   for (const std::string& problem : problems)
     if (!problem.empty()) throw ConfigError({}, problem);
+}
+
+void cameraImages(std::span<const Artifact* const> robots, std::span<std::uint8_t> out) {
+  const std::array<std::size_t, 2> size = imageSize(robots);
+  const std::size_t bytes = size[0] * size[1] * 3;
+  if (out.size() != robots.size() * bytes)
+    throw ConfigError({}, "camera images of " + std::to_string(robots.size()) + " robots need " +
+                              std::to_string(robots.size()) + " x " + std::to_string(size[0]) + " x " +
+                              std::to_string(size[1]) + " x 3 bytes, got " + std::to_string(out.size()));
+  for (std::size_t r = 0; r < robots.size(); ++r) {
+    const Image& image = firstOf<CameraMeasurement>(*robots[r])->image;
+    std::copy(image.rgb.begin(), image.rgb.end(), out.begin() + static_cast<std::ptrdiff_t>(r * bytes));
+  }
 }
 
 }  // namespace ssx

@@ -5,6 +5,7 @@ import numpy as np
 import pytest
 
 import ssx
+import ssx.learn
 
 EPUCKS = """<scene><environment timestep="0.002" seed="3"/><type name="e" file="artifacts/epuck_full.xml"/><ground/>
 <swarm type="e" count="3" name="e{i}" spacing="0.1" xyz="0 0 0"/></scene>"""
@@ -87,7 +88,38 @@ def test_camera_images_of_every_robot_in_one_uint8_array(tmp_path):
     with pytest.raises(TypeError, match="uint8"):
         sim.images(out=np.zeros((3, 2, 24, 32, 3)))
     sim.close()
+    # one environment reads the same pictures, (robots, height, width, 3)
+    alone = ssx.load_scene_string(xml, base_dir=tmp_path, seed=3, threads=1)
+    alone.step(5)
+    assert np.array_equal(alone.images(), images[0])
     plain = ssx._ssx.VectorEnvironment(EPUCKS, 1, base_dir=ssx.data_directory(), threads=1)
     with pytest.raises(ValueError, match='add <sensor plugin="camera"/>'):
         plain.images()
     plain.close()
+
+
+def test_one_environment_reads_every_robots_sensor_in_one_array():
+    env = ssx.load_scene_string(EPUCKS, base_dir=ssx.data_directory(), seed=3, threads=1)
+    env.set_commands("wheels", np.tile([1.0, 2.0], (3, 1)))
+    env.step(100)
+    sim = ssx._ssx.VectorEnvironment(EPUCKS, 2, base_dir=ssx.data_directory(), seed=3, threads=2)
+    sim.set_commands("wheels", np.tile([1.0, 2.0], (2, 3, 1)))
+    sim.step(100)
+    for kind, slots in (("proximity", 0), ("ground", 0), ("odometry", 0), ("range_and_bearing", 3)):
+        one = env.read(kind, slots=slots)
+        assert one.shape == sim.read(kind, slots=slots).shape[1:]
+        assert np.array_equal(one, sim.read(kind, slots=slots)[1])
+    out = np.empty((3, 8))
+    assert env.read("proximity", out=out) is out
+    with pytest.raises(ValueError, match=r"shape \(3, 8\)"):
+        env.read("proximity", out=np.empty((3, 7)))
+    with pytest.raises(ValueError, match='add <sensor plugin="imu"/>'):
+        env.read("imu")
+    with pytest.raises(ValueError, match='add <sensor plugin="camera"/>'):
+        env.images()
+    # the IMU as a kind: what imu() reads
+    goto = ssx._ssx.VectorEnvironment(ssx.learn.GoTo().scene(), 2, base_dir=ssx.data_directory(), threads=1)
+    goto.step(3)
+    assert np.array_equal(goto.read("imu"), goto.imu())
+    goto.close()
+    sim.close()
