@@ -162,8 +162,12 @@ class PyVectorEnvironment {
       throw py::value_error("ssx: values must have shape (num_envs, robots, columns) = (" + std::to_string(size()) +
                             ", " + std::to_string(robots()) + ", columns)");
     try {
-      envs().setCommands(*level, std::span<const double>(a.data(), static_cast<std::size_t>(a.size())),
-                         static_cast<std::size_t>(a.shape(2)));
+      // (the drivers take them on the worker threads, where a plugin's log line needs the GIL)
+      const std::span<const double> rows(a.data(), static_cast<std::size_t>(a.size()));
+      const auto columns = static_cast<std::size_t>(a.shape(2));
+      ssx::VectorEnvironment& v = envs();
+      py::gil_scoped_release release;
+      v.setCommands(*level, rows, columns);
     } catch (const ssx::ConfigError& e) {
       throw py::value_error(std::string("ssx: ") + e.what());
     }
