@@ -95,14 +95,23 @@ std::string TimingSummary::str() const {
   const std::string timed_note =
       timed_steps < steps ? " (of the newest " + std::to_string(timed_steps) + " steps)" : std::string();
   char buf[896];
-  int used = std::snprintf(buf, sizeof buf,
-                           "steps %lld, simulated %.3f s in %.3f s wall (real-time factor %.3f)\n"
-                           "step time ms%s: median %.4f  p95 %.4f  p99 %.4f  max %.4f  mean %.4f\n"
-                           "phase medians ms: physics %.4f  sensors %.4f  drivers %.4f  render %.4f\n"
-                           "overruns %lld (max lateness %.3f ms)",
-                           static_cast<long long>(steps), simulated_s, wall_s, realtime_factor, timed_note.c_str(), median_ms, p95_ms,
-                           p99_ms, max_ms, mean_ms, physics_median_ms, sensors_median_ms, drivers_median_ms,
-                           render_median_ms, static_cast<long long>(overruns), max_lateness_ms);
+  int used = 0;
+  if (timed_steps == 0 && steps > 0)  // an environment that keeps no timing (timing_samples = 0)
+    used = std::snprintf(buf, sizeof buf,
+                         "steps %lld, simulated %.3f s in %.3f s wall (real-time factor %.3f)\n"
+                         "step times not kept (EnvironmentSettings::timing_samples = 0)\n"
+                         "overruns %lld (max lateness %.3f ms)",
+                         static_cast<long long>(steps), simulated_s, wall_s, realtime_factor,
+                         static_cast<long long>(overruns), max_lateness_ms);
+  else
+    used = std::snprintf(buf, sizeof buf,
+                         "steps %lld, simulated %.3f s in %.3f s wall (real-time factor %.3f)\n"
+                         "step time ms%s: median %.4f  p95 %.4f  p99 %.4f  max %.4f  mean %.4f\n"
+                         "phase medians ms: physics %.4f  sensors %.4f  drivers %.4f  render %.4f\n"
+                         "overruns %lld (max lateness %.3f ms)",
+                         static_cast<long long>(steps), simulated_s, wall_s, realtime_factor, timed_note.c_str(),
+                         median_ms, p95_ms, p99_ms, max_ms, mean_ms, physics_median_ms, sensors_median_ms,
+                         drivers_median_ms, render_median_ms, static_cast<long long>(overruns), max_lateness_ms);
   // (known only for a run's summary: the first late step of a run took long or began late, so a
   // summary without either kind is one made from the samples alone)
   const bool told_apart = overruns_long + overruns_began_late > 0;

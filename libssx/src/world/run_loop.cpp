@@ -194,6 +194,7 @@ TimingSummary Environment::run(const RunOptions& options) {
   }
 
   const std::int64_t first_sample = timing_.recorded();
+  const std::int64_t first_step = stepCount();  // (steps are counted when no timing is kept too)
   const Nanoseconds sim_start = time();
   const Nanoseconds wall_start = monotonicNow();
   Nanoseconds grid_start = wall_start;  // deadlines are grid_start + k * period
@@ -278,6 +279,7 @@ TimingSummary Environment::run(const RunOptions& options) {
   }
   // (the timing ring holds the newest steps; the overruns are counted over the whole run)
   TimingSummary summary = timing_.summary(monotonicNow() - wall_start, time() - sim_start, first_sample);
+  summary.steps = stepCount() - first_step;
   summary.overruns = overruns;
   summary.max_lateness_ms = static_cast<double>(max_late) * 1e-6;
   summary.overruns_long = overruns_long;

@@ -2,6 +2,8 @@
 
 #include <catch2/catch.hpp>
 
+#include <memory>
+
 #include <pthread.h>
 #include <sched.h>
 #include <sys/prctl.h>
@@ -289,6 +291,32 @@ TEST_CASE("a run's summary counts every step even when the timing ring keeps onl
   CHECK(summary.timed_steps == 16);
   CHECK_THAT(summary.str(), Catch::Contains("steps 100,") && Catch::Contains("(of the newest 16 steps)"));
   CHECK(env.timing().samples().size() == 16);
+}
+
+TEST_CASE("timing_samples = 0 keeps no timing and reads no clock in a step; the run is the same bits", "[run]") {
+  auto run = [](std::size_t samples) {
+    EnvironmentSettings s;
+    s.timestep = toNanoseconds(0.001);
+    s.timing_samples = samples;
+    auto env = std::make_unique<Environment>(s);
+    withBall(*env);
+    env->step(50);
+    return env;
+  };
+  const auto untimed = run(0), timed = run(16);
+  CHECK(untimed->timing().size() == 0);
+  CHECK(untimed->timing().recorded() == 0);
+  CHECK(timed->timing().size() == 16);
+  CHECK(untimed->stateHash() == timed->stateHash());
+  RunOptions o;
+  o.mode = RunOptions::Mode::Fast;
+  o.steps = 10;
+  const TimingSummary summary = untimed->run(o);
+  CHECK(summary.steps == 10);
+  CHECK(summary.timed_steps == 0);
+  INFO(summary.str());
+  CHECK_THAT(summary.str(), Catch::Contains("steps 10,") && Catch::Contains("step times not kept") &&
+                                !Catch::Contains("median"));
 }
 
 TEST_CASE("a run paused from another thread holds between steps, takes single steps, and resumes without catching up",
