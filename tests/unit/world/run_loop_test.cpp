@@ -293,7 +293,7 @@ TEST_CASE("a run's summary counts every step even when the timing ring keeps onl
   CHECK(env.timing().samples().size() == 16);
 }
 
-TEST_CASE("timing_samples = 0 keeps no timing and reads no clock in a step; the run is the same bits", "[run]") {
+TEST_CASE("timing_samples = 0 keeps no timing and reads no clock in a step, and the run is the same bits", "[run]") {
   auto run = [](std::size_t samples) {
     EnvironmentSettings s;
     s.timestep = toNanoseconds(0.001);
