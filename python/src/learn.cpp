@@ -27,6 +27,12 @@ namespace fs = std::filesystem;
 using Doubles = py::array_t<double, py::array::c_style | py::array::forcecast>;
 constexpr std::size_t kTimingSamples = 0;  // none: no clock read in a copy's step
 
+// a ConfigError as Python's ValueError says it: "ssx: file:line: error: ..." for bad input of a
+// file, "ssx: ..." for arguments given in code (no "<code>: error:" before them)
+std::string configMessage(const ssx::ConfigError& e) {
+  return std::string("ssx: ") + (e.where().file.empty() ? e.detail() : std::string(e.what()));
+}
+
 class PyVectorEnvironment {
  public:
   PyVectorEnvironment(const std::string& xml, std::size_t count, const fs::path& base_dir,
@@ -133,7 +139,7 @@ class PyVectorEnvironment {
       envs().cameraImages(bytes);
       return a;
     } catch (const ssx::ConfigError& e) {
-      throw py::value_error(std::string("ssx: ") + e.what());
+      throw py::value_error(configMessage(e));
     }
   }
 
@@ -145,7 +151,7 @@ class PyVectorEnvironment {
       envs().readSensors(kind, std::span<double>(a.mutable_data(), static_cast<std::size_t>(a.size())), slots);
       return a;
     } catch (const ssx::ConfigError& e) {
-      throw py::value_error(std::string("ssx: ") + e.what());
+      throw py::value_error(configMessage(e));
     }
   }
 
@@ -169,7 +175,7 @@ class PyVectorEnvironment {
       py::gil_scoped_release release;
       v.setCommands(*level, rows, columns);
     } catch (const ssx::ConfigError& e) {
-      throw py::value_error(std::string("ssx: ") + e.what());
+      throw py::value_error(configMessage(e));
     }
   }
 
@@ -206,7 +212,7 @@ class PyVectorEnvironment {
       py::gil_scoped_release release;
       v.reset(chosen, bytes, seeds);
     } catch (const ssx::ConfigError& e) {
-      throw py::value_error(std::string("ssx: ") + e.what());
+      throw py::value_error(configMessage(e));
     }
   }
 
@@ -230,7 +236,7 @@ class PyVectorEnvironment {
                         vel ? std::span<const double>(vel->data(), static_cast<std::size_t>(vel->size()))
                             : std::span<const double>());
     } catch (const ssx::ConfigError& e) {
-      throw py::value_error(std::string("ssx: ") + e.what());
+      throw py::value_error(configMessage(e));
     }
   }
 
@@ -253,7 +259,7 @@ class PyVectorEnvironment {
       py::gil_scoped_release release;
       v.vary(chosen, name, std::span<const double>(a.data(), static_cast<std::size_t>(a.size())));
     } catch (const ssx::ConfigError& e) {
-      throw py::value_error(std::string("ssx: ") + e.what());
+      throw py::value_error(configMessage(e));
     }
   }
 
@@ -269,7 +275,7 @@ class PyVectorEnvironment {
     try {
       envs().setCommandDelays(chosen, std::span<const std::int64_t>(a.data(), static_cast<std::size_t>(a.size())));
     } catch (const ssx::ConfigError& e) {
-      throw py::value_error(std::string("ssx: ") + e.what());
+      throw py::value_error(configMessage(e));
     }
   }
 
@@ -368,7 +374,7 @@ py::object readRobots(const ssx::Environment& env, const std::string& kind, cons
     ssx::readSensors(robots, kind, std::span<double>(a.mutable_data(), static_cast<std::size_t>(a.size())), slots);
     return a;
   } catch (const ssx::ConfigError& e) {
-    throw py::value_error(std::string("ssx: ") + e.what());
+    throw py::value_error(configMessage(e));
   }
 }
 
@@ -384,7 +390,7 @@ py::object robotImages(const ssx::Environment& env, const py::object& out) {
     ssx::cameraImages(robots, std::span<std::uint8_t>(a.mutable_data(), static_cast<std::size_t>(a.size())));
     return a;
   } catch (const ssx::ConfigError& e) {
-    throw py::value_error(std::string("ssx: ") + e.what());
+    throw py::value_error(configMessage(e));
   }
 }
 

@@ -37,8 +37,8 @@ class SSX_EXPORT Error : public std::runtime_error {
 /// `file:line: error: ...` when the location is known.
 class SSX_EXPORT ConfigError : public Error {
  public:
-  /// An error at `where`; what() is "file:line: error: message" (just the message when `where`
-  /// is empty).
+  /// An error at `where`; what() is "file:line: error: message" ("<code>: error: message" when
+  /// `where` is empty: SourceLocation::str).
   ConfigError(SourceLocation where, const std::string& message);
   /// Where the bad input is (empty when not known).
   const SourceLocation& where() const noexcept { return where_; }

@@ -113,8 +113,9 @@ def test_one_environment_reads_every_robots_sensor_in_one_array():
     assert env.read("proximity", out=out) is out
     with pytest.raises(ValueError, match=r"shape \(3, 8\)"):
         env.read("proximity", out=np.empty((3, 7)))
-    with pytest.raises(ValueError, match='add <sensor plugin="imu"/>'):
+    with pytest.raises(ValueError, match='add <sensor plugin="imu"/>') as refused:
         env.read("imu")
+    assert str(refused.value).startswith("ssx: robot 'e0' has no imu")  # (no "<code>: error:" before it)
     with pytest.raises(ValueError, match='add <sensor plugin="camera"/>'):
         env.images()
     # the IMU as a kind: what imu() reads
