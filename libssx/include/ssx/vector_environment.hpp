@@ -158,7 +158,8 @@ class SSX_EXPORT VectorEnvironment {
   // fn(which[k], k) for every k in parallel (every copy, fn(i, i), for `which` empty), the first
   // failure by copy index rethrown as that copy's
   void forEachOf(std::span<const std::size_t> which, const std::function<void(std::size_t, std::size_t)>& fn);
-  // fn(begin, end) over the copies [0, size()) in chunks, on the worker threads (fn must not throw)
+  // fn(begin, end) over the copies [0, size()) in chunks, on the worker threads (the first
+  // exception fn throws is rethrown: not by copy index, as forEachOf does)
   void forChunks(const std::function<void(std::size_t, std::size_t)>& fn) const;
   // the command row r (copy r / robots, robot r % robots) sends now
   void send(std::size_t r, const Command& command);

@@ -396,8 +396,7 @@ void VectorEnvironment::setCommands(CommandLevel level, std::span<const double> 
         problems_[i] = stageCommand(r, level, values.subspan(r * columns, columns));
     }
   };
-  const std::size_t chunk = std::max<std::size_t>(1, envs_.size() / (pool_->workers.size() * 8));
-  pool_->workers.parallelFor(envs_.size(), chunk, check);
+  forChunks(check);
   for (const std::string& problem : problems_)
     if (!problem.empty()) throw ConfigError({}, problem);
   auto deliver = [&](std::size_t begin, std::size_t end) {
@@ -412,7 +411,7 @@ void VectorEnvironment::setCommands(CommandLevel level, std::span<const double> 
       copy_waits_[r / robots] = 1;
     }
   };
-  pool_->workers.parallelFor(envs_.size(), chunk, deliver);
+  forChunks(deliver);
 }
 
 std::string VectorEnvironment::stageCommand(std::size_t r, CommandLevel level, std::span<const double> row) {

@@ -32,6 +32,14 @@ Scene crazyflie(const std::string& engine = "ode") {
 
 const Artifact& robot(const Environment& env) { return *env.findArtifact("cf0"); }
 
+// one vehicle of artifact file `type` named `name`, 1 m up, its driver given `driver` attributes
+Scene hovering(const std::string& type, const std::string& name, const std::string& driver) {
+  return loadSceneFromString("<scene><environment timestep=\"0.002\" seed=\"3\" threads=\"1\"/><type name=\"t\" "
+                             "file=\"" + (kArtifacts / type).string() + "\"/><ground/><artifact type=\"t\" name=\"" +
+                                 name + "\" xyz=\"0 0 1\"><driver " + driver + "/></artifact></scene>",
+                             "one.xml", kArtifacts);
+}
+
 double gyroSpread(Environment& env, int steps) {
   // the spread of the gyroscope's x reading from one step to the next (motion is far slower)
   const Sensor* imu = nullptr;
@@ -130,13 +138,7 @@ TEST_CASE("variations: the IMU's noise and the wind vary", "[variations]") {
 TEST_CASE("variations: the battery's voltage varies for a vehicle that has one", "[variations]") {
   // the Crazyflie on its firmware's controller: the compensation keeps a command's thrust until the
   // battery cannot give the voltage; full thrust from a weaker battery climbs less
-  auto firmware = [] {
-    return loadSceneFromString("<scene><environment timestep=\"0.002\" seed=\"3\" threads=\"1\"/><type name=\"cf\" "
-                               "file=\"" + (kArtifacts / "crazyflie.xml").string() +
-                                   "\"/><ground/><artifact type=\"cf\" name=\"cf0\" xyz=\"0 0 1\">"
-                                   "<driver controller=\"crazyflie_pid\"/></artifact></scene>",
-                               "cf.xml", kArtifacts);
-  };
+  auto firmware = [] { return hovering("crazyflie.xml", "cf0", "controller=\"crazyflie_pid\""); };
   Scene full = firmware(), low = firmware();
   const auto names = [](const Environment& env) {
     std::vector<std::string> out;
@@ -169,13 +171,7 @@ TEST_CASE("variations: the battery's voltage varies for a vehicle that has one",
   CHECK(again.environment->variation(robot(*again.environment), "battery_volts") == -1.7);
 
   // a battery model, not compensated (thrust follows the voltage): a lower open circuit sinks the hover
-  auto mk = [] {
-    return loadSceneFromString("<scene><environment timestep=\"0.002\" seed=\"3\" threads=\"1\"/><type name=\"mk\" "
-                               "file=\"" + (kArtifacts / "mk_quad.xml").string() +
-                                   "\"/><ground/><artifact type=\"mk\" name=\"mk0\" xyz=\"0 0 1\">"
-                                   "<driver battery=\"true\"/></artifact></scene>",
-                               "mk.xml", kArtifacts);
-  };
+  auto mk = [] { return hovering("mk_quad.xml", "mk0", "battery=\"true\""); };
   Scene charged = mk(), drained = mk();
   charged.environment->step(500);
   drained.environment->step(500);
