@@ -3,15 +3,20 @@
 of other CPU learning environments.
 
     PYTHONPATH=build/python python3 examples/learn/bench_learn.py [--envs 1024] [--batches 100]
+    PYTHONPATH=build/python python3 examples/learn/bench_learn.py --against OTHER/build/python [--rounds 3]
 
 Prints, for the Crazyflie `goto` task (actions at 50 Hz over 500 Hz physics, observations of pose,
 velocity and IMU) and for `formation` (64 environments of 16 robots): agent steps per second,
 the part of a step spent in Python (everything but the C++ stepping), the time to reset one
 environment, whether the batch allocates per step (tracemalloc, Python side), and what a
-Crazyflie's step costs as a world of its own against one world of many.
+Crazyflie's step costs as a world of its own against one world of many. With --against, only the
+two throughputs, of this build and of another build's Python package, in separate processes taking
+turns (the machine's speed swings between minutes: builds are compared in the same minutes).
 """
 import argparse
 import os
+import subprocess
+import sys
 import time
 import tracemalloc
 
@@ -94,12 +99,43 @@ def per_world_cost(robots=256, steps=500):
     return separate / (4 * steps * robots) * 1e6, together / (4 * steps * robots) * 1e6
 
 
+def throughputs(args):
+    """The goto and formation throughputs alone, one line."""
+    env = learn.VectorEnv("goto", num_envs=args.envs, threads=args.threads)
+    goto, goto_batch, _ = measure(env, args.batches, 1)
+    env.close()
+    env = learn.VectorEnv("formation", num_envs=64, robots=16, threads=args.threads)
+    formation, formation_batch, _ = measure(env, max(10, args.batches // 2), 16)
+    env.close()
+    print(f"goto {goto:,.0f} agent steps/s ({goto_batch * 1e3:.2f} ms a batch step), formation {formation:,.0f} "
+          f"({formation_batch * 1e3:.2f} ms)", flush=True)
+
+
+def against(args):
+    """This build and another's, in turns, each in a process of its own."""
+    builds = [("this", os.path.dirname(os.path.dirname(learn.__file__))), ("other", args.against)]
+    for r in range(args.rounds):
+        for name, path in builds:
+            env = dict(os.environ, PYTHONPATH=path)
+            line = subprocess.run([sys.executable, __file__, "--throughput-only", "--envs", str(args.envs),
+                                   "--batches", str(args.batches)], env=env, check=True, capture_output=True,
+                                  text=True).stdout.strip().splitlines()[-1]
+            print(f"round {r + 1}, {name} build ({path}): {line}", flush=True)
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("--envs", type=int, default=1024)
     parser.add_argument("--batches", type=int, default=100)
     parser.add_argument("--threads", type=int, default=None)
+    parser.add_argument("--against", metavar="PYTHON_DIR", help="another build's python directory, in turns")
+    parser.add_argument("--rounds", type=int, default=3)
+    parser.add_argument("--throughput-only", action="store_true", help=argparse.SUPPRESS)
     args = parser.parse_args()
+    if args.throughput_only:
+        return throughputs(args)
+    if args.against:
+        return against(args)
     print(f"machine: {os.cpu_count()} cores")
     for name, figure in PEERS:
         print(f"  peer: {name}: {figure}")
