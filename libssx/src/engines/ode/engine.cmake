@@ -3,6 +3,7 @@ target_sources(ssx PRIVATE
   ${CMAKE_CURRENT_LIST_DIR}/ode_class.cpp
   ${CMAKE_CURRENT_LIST_DIR}/ode_contacts.cpp
   ${CMAKE_CURRENT_LIST_DIR}/ode_engine.cpp
+  ${CMAKE_CURRENT_LIST_DIR}/ode_free_bodies.cpp
   ${CMAKE_CURRENT_LIST_DIR}/ode_joints.cpp
   ${CMAKE_CURRENT_LIST_DIR}/ode_overlaps.cpp
   ${CMAKE_CURRENT_LIST_DIR}/ode_rays.cpp)

@@ -37,6 +37,14 @@ void OdeEngine::placeGeoms(std::size_t begin, std::size_t end) {
   }
 }
 
+bool OdeEngine::aboveOf(const GridBroadphase::Box& box, const std::array<double, 4>& plane) {
+  // the box's corner deepest along the plane's normal, still in front of it by more than rounding
+  // could move a shape (dCollide would find no contact: skipping it changes nothing)
+  double lowest = -plane[3];
+  for (int k = 0; k < 3; ++k) lowest += plane[static_cast<std::size_t>(k)] * (plane[static_cast<std::size_t>(k)] > 0 ? box.min[k] : box.max[k]);
+  return lowest > 1e-6 * (1.0 + std::abs(plane[3]));
+}
+
 void OdeEngine::indexGeoms() {
   // the grid's boxes: the bodies' geoms in body order, then the static ones but the planes
   proxies_stale_ = false;
@@ -125,11 +133,12 @@ void OdeEngine::collide() {
   forEach((bodies_.size() + kBodiesPerChunk - 1) / kBodiesPerChunk, [&](std::size_t c) {
     placeGeoms(c * kBodiesPerChunk, std::min(bodies_.size(), (c + 1) * kBodiesPerChunk));
   });
-  grid_.build(boxes_, cell_);
+  // (one box cannot overlap another: a world of one robot over the ground builds no grid)
+  if (boxes_.size() > 1) grid_.build(boxes_, cell_);
   // pairs and their contacts, in chunks: the dynamic geoms against each plane (their number
   // fixed by the scene: each chunk keeps the room it needs), then the grid's
   constexpr std::size_t kGeomsPerPlaneChunk = 512;
-  const std::size_t grid_chunks = grid_.chunkCount();
+  const std::size_t grid_chunks = boxes_.size() > 1 ? grid_.chunkCount() : 0;
   const std::size_t plane_chunks =
       planes_.empty() ? 0 : (dynamic_proxies_ + kGeomsPerPlaneChunk - 1) / kGeomsPerPlaneChunk;
   if (chunks_.size() < grid_chunks + plane_chunks) {
@@ -148,7 +157,9 @@ void OdeEngine::collide() {
       const std::size_t begin = c * kGeomsPerPlaneChunk;
       const std::size_t end = std::min(dynamic_proxies_, begin + kGeomsPerPlaneChunk);
       for (std::size_t k = begin; k < end; ++k)
-        for (dGeomID plane : planes_) collidePair(proxy_geoms_[k], plane, chunk.contacts, chunk.scratch);
+        for (std::size_t p = 0; p < planes_.size(); ++p)
+          if (!aboveOf(boxes_[k], planes_params_[p]))
+            collidePair(proxy_geoms_[k], planes_[p], chunk.contacts, chunk.scratch);
       return;
     }
     chunk.pairs.clear();

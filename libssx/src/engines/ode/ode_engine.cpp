@@ -14,6 +14,7 @@
 #include <algorithm>
 #include <cstdint>
 #include <cstring>
+#include <exception>
 #include <mutex>
 
 namespace ssx::detail {
@@ -140,6 +141,8 @@ OdeEngine::OdeEngine(const PhysicsSettings& settings) : settings_(settings) {
     ensureThreadData();
     (void)seedIsPerWorld();  // (checked here, on the caller's thread, once per process)
     partitions_.resize(static_cast<std::size_t>(std::max(1, settings_.ode.partitions)));
+    for (int k = 0; k < 3; ++k) gravity_[k] = settings_.gravity[k];
+    integrate_free_ = settings_.ode.integrate_free_bodies && settings_.ode.solver == OdeSettings::Solver::QuickStep;
     for (Partition& p : partitions_) {
       p.world = dWorldCreate();
       const Vec3& g = settings_.gravity;
@@ -247,6 +250,7 @@ int OdeEngine::addBody(const MassProperties& mass, const std::vector<Shape>& sha
   }
   p.order.push_back(index);
   bodies_.push_back(std::move(body));
+  cacheFreeStep(bodies_.back());
   proxies_stale_ = true;
   setState(index, state);
   return index;
@@ -257,7 +261,14 @@ void OdeEngine::setKinematic(int index) {
   ensureThreadData();
   dBodySetKinematic(body.id);
   body.kinematic = true;
+  cacheFreeStep(body);
   proxies_stale_ = true;
+}
+
+void OdeEngine::cacheFreeStep(Body& body) {
+  odeInverseInertia(body.mass, body.kinematic, body.inv_inertia, body.inv_mass);
+  body.gyroscopic = dBodyGetGyroscopicMode(body.id) != 0;
+  body.plain = odeBodyIsPlain(body.id);
 }
 
 bool OdeEngine::isKinematic(int index) const { return bodies_.at(static_cast<std::size_t>(index)).kinematic; }
@@ -269,6 +280,7 @@ void OdeEngine::setMassScale(int index, double mass_factor, double inertia_facto
   body.mass.mass *= mass_factor;
   for (dReal& i : body.mass.I) i *= inertia_factor;
   dBodySetMass(body.id, &body.mass);
+  cacheFreeStep(body);
 }
 
 int OdeEngine::addStatic(const std::vector<Shape>& shapes, const Pose& pose) {
@@ -283,6 +295,9 @@ int OdeEngine::addStatic(const std::vector<Shape>& shapes, const Pose& pose) {
       dGeomSetData(plane, data);
       static_geoms_.push_back(plane);
       planes_.push_back(plane);
+      dVector4 params;
+      dGeomPlaneGetParams(plane, params);  // (normalised as ODE keeps it)
+      planes_params_.push_back({params[0], params[1], params[2], params[3]});
       continue;
     }
     dGeomID g = createOdeGeom(s);
@@ -331,6 +346,7 @@ void OdeEngine::moveBody(int index, int to) {
   writeOdeBits(b, bits);
   dBodyDestroy(old);
   body.id = b;
+  cacheFreeStep(body);
   const auto it = std::find(from.order.begin(), from.order.end(), index);
   if (it != from.order.end()) from.order.erase(it);
   into.order.push_back(index);
@@ -346,6 +362,27 @@ void OdeEngine::stepPartition(Partition& p, double h, std::span<const Wrench> wr
     dBodyAddForce(b, w.force.x(), w.force.y(), w.force.z());
     dBodyAddTorque(b, w.torque.x(), w.torque.y(), w.torque.z());
   }
+  // the bodies no constraint holds are stepped here, not by ODE (see ode_engine.hpp)
+  std::size_t free = 0;
+  if (integrate_free_)
+    for (const int i : p.order) free += isFree(bodies_[static_cast<std::size_t>(i)]) ? 1 : 0;
+  if (free == p.order.size()) {
+    stepFree(p, h);
+    return;
+  }
+  auto each_free = [&](auto&& f) {
+    for (const int i : p.order)
+      if (isFree(bodies_[static_cast<std::size_t>(i)])) f(bodies_[static_cast<std::size_t>(i)].id);
+  };
+  if (free > 0) each_free([](dBodyID b) { dBodyDisable(b); });  // (an ODE error after this poisons the engine)
+  solveWithOde(p, h);
+  if (free > 0) {
+    each_free([](dBodyID b) { dBodyEnable(b); });
+    stepFree(p, h);
+  }
+}
+
+void OdeEngine::solveWithOde(Partition& p, double h) {
   auto solve = [&] {
     if (settings_.ode.solver == OdeSettings::Solver::Exact)
       dWorldStep(p.world, h);
@@ -382,6 +419,13 @@ void OdeEngine::stepPartition(Partition& p, double h, std::span<const Wrench> wr
   dJointGroupEmpty(p.contacts);
 }
 
+void OdeEngine::stepFree(Partition& p, double h) {
+  for (const int i : p.order) {
+    const Body& body = bodies_[static_cast<std::size_t>(i)];
+    if (isFree(body)) stepFreeOdeBody(body.id, body.mass, body.inv_inertia, body.inv_mass, body.gyroscopic, gravity_, h);
+  }
+}
+
 void OdeEngine::step(Nanoseconds dt, std::span<const Wrench> wrenches) {
   ensureThreadData();
   const int substeps = std::max(1, settings_.substeps);
@@ -402,6 +446,8 @@ void OdeEngine::step(Nanoseconds dt, std::span<const Wrench> wrenches) {
     groupContacts();
     for (Partition& p : partitions_) p.has_joints = false;
     partitions_[0].has_joints = live_joints_ > 0;  // (the joined bodies' world: see ode_engine.hpp)
+    if (integrate_free_)
+      for (Body& body : bodies_) body.constrained = body.pinned;
     if (log) feedback_.assign(contacts_.size(), dJointFeedback{});
     for (std::size_t k = 0; k < contacts_.size(); ++k) {
       const dContact& c = contacts_[k];
@@ -415,6 +461,8 @@ void OdeEngine::step(Nanoseconds dt, std::span<const Wrench> wrenches) {
       dJointAttach(j, a, b);
       if (log) dJointSetFeedback(j, &feedback_[k]);
       p.has_joints = true;
+      if (owner_a > 0) bodies_[static_cast<std::size_t>(owner_a - 1)].constrained = true;
+      if (owner_b > 0) bodies_[static_cast<std::size_t>(owner_b - 1)].constrained = true;
     }
     contact_count_ += contacts_.size();
     // the worlds, in parallel (serially for small worlds: the same results either way)

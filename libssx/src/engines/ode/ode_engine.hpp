@@ -17,6 +17,14 @@
 // bodies however they are laid out, where ODE's sweep-and-prune is quadratic in a grid) and the
 // contacts (dCollide) run in parallel chunks too.
 //
+// A body that no contact and no joint holds in a substep is not handed to ODE's world step at
+// all: ssx steps it with QuickStep's own arithmetic for such a body (ode_free_bodies.cpp), which
+// gives the same bits without the fixed cost of ODE's step per world (its memory arena, islands and
+// threading stages, more than the arithmetic for a world of a few bodies). A world whose bodies are
+// all free is not stepped by ODE; in one that has contacts or joints, the free bodies are disabled
+// around dWorldQuickStep, which leaves the other islands as they would be. OdeSettings::
+// integrate_free_bodies = false hands every body to ODE (the cross-check of the tests).
+//
 // Joined bodies (addJoint) are pinned to world 0: an ODE joint belongs to one world and cannot
 // follow its bodies into another, and keeps frames (anchors, axes, the hinge's reference rotation)
 // taken when it was set up. So a contact group with a pinned body in it is solved in world 0, and
@@ -35,6 +43,7 @@
 
 #include <ode/ode.h>
 
+#include <array>
 #include <mutex>
 #include <vector>
 
@@ -93,6 +102,13 @@ class OdeEngine final : public PhysicEngine {
     bool pinned = false;     // joined to another body or the world: always in world 0
     dMass mass;   // now (setMassScale)
     dMass added;  // as addBody gave it
+    // what stepping it free takes: its inverse inertia and mass as ODE computed them (kinematic:
+    // zero), ODE's gyroscopic flag, and whether it has none of the options dxStepBody would apply
+    dReal inv_inertia[12] = {};
+    dReal inv_mass = 0;
+    bool gyroscopic = true;
+    bool plain = false;
+    bool constrained = false;  // in a contact or held by a joint this substep
     std::vector<Geom> geoms;
   };
 
@@ -138,9 +154,21 @@ class OdeEngine final : public PhysicEngine {
   // adds this substep's contacts, with the impulses the feedback measured, to contact_log_
   void logContacts(double h);
   void placeGeoms(std::size_t begin, std::size_t end);
+  // whether a box lies wholly in front of a plane (n x = d: n, then d), clear of it
+  static bool aboveOf(const GridBroadphase::Box& box, const std::array<double, 4>& plane);
   void stepPartition(Partition& p, double h, std::span<const Wrench> wrenches);
+  // the constants stepping body i free needs, from its ODE body (after a change of its mass, its
+  // kinematic flag or its ODE body)
+  void cacheFreeStep(Body& body);
+  bool isFree(const Body& body) const { return integrate_free_ && body.plain && !body.constrained; }
+  // steps the free bodies of partition p (stepFreeOdeBody), in its order
+  void stepFree(Partition& p, double h);
+  // dWorldStep or dWorldQuickStep of partition p's world, with its own random seed when it has joints
+  void solveWithOde(Partition& p, double h);
 
   PhysicsSettings settings_;
+  dReal gravity_[3] = {0, 0, 0};  // as ODE's worlds hold it
+  bool integrate_free_ = true;    // QuickStep and settings_.ode.integrate_free_bodies
   TaskRunner* runner_ = nullptr;
   std::vector<Partition> partitions_;
   std::vector<Body> bodies_;
@@ -159,6 +187,7 @@ class OdeEngine final : public PhysicEngine {
   std::vector<dGeomID> static_geoms_;
   int static_groups_ = 0;  // addStatic's calls so far
   std::vector<dGeomID> planes_;
+  std::vector<std::array<double, 4>> planes_params_;  // each plane's n x = d: n, then d
   std::vector<dGeomID> proxy_geoms_;
   std::vector<GridBroadphase::Box> boxes_;
   std::vector<std::uint32_t> first_proxy_;  // per body
@@ -191,6 +220,17 @@ void releaseOde();
 
 // every thread that calls into ODE needs its own collision data (ode_engine.cpp)
 void ensureThreadData();
+
+// Free bodies (ode_free_bodies.cpp). Whether dxStepBody would do no more for body b than its
+// plain step (enabled, no damping, no finite rotation, no angular speed cap, gravity on):
+bool odeBodyIsPlain(dBodyID b);
+// a body's inverse inertia (12 values, ODE's 3x4 layout) and inverse mass as dBodySetMass and
+// dBodySetKinematic leave them
+void odeInverseInertia(const dMass& mass, bool kinematic, dReal* inv_inertia, dReal& inv_mass);
+// one QuickStep substep of h seconds of a body that no constraint holds, its accumulators holding
+// the applied force and torque: the same bits as dWorldQuickStep's, the accumulators cleared after
+void stepFreeOdeBody(dBodyID b, const dMass& mass, const dReal* inv_inertia, dReal inv_mass, bool gyroscopic,
+                     const dReal* gravity, dReal h);
 
 // a body's state bit for bit (ode_engine.cpp): kOdeBodyReals values
 inline constexpr std::size_t kOdeBodyReals = 3 + 4 + 12 + 3 + 3;

@@ -1,0 +1,103 @@
+// Free bodies stepped without ODE's world step (ode_engine.hpp): QuickStep's arithmetic for a body
+// that no constraint holds, to the bit.
+//
+// For an island of one body and no joint, dWorldQuickStep adds gravity to the force accumulator,
+// the implicit gyroscopic torque (Lacoursière 2006) to the torque accumulator (quickstep.cpp,
+// stage 0), updates the velocities from both (stage 6a), then moves the body with dxStepBody and
+// clears the accumulators (stage 6b). What it spends around that — a memory arena per world and
+// step, the islands built, the stages posted to its threading implementation — costs more than
+// the arithmetic for a world of one or a few bodies. The same arithmetic here, with ODE's own
+// inline matrix helpers (ode/odemath.h) and its exported rotation functions, gives the same bits;
+// ode_engine_test.cpp checks that against dWorldQuickStep over thousands of steps.
+#include "engines/ode/ode_engine.hpp"
+
+#include <ode/odemath.h>
+#include <ode/rotation.h>
+
+#include <cstring>
+
+namespace ssx::detail {
+
+namespace {
+
+// the accumulators and state ODE keeps for a body, writable (ODE hands them out read-only)
+dReal* writable(const dReal* p) { return const_cast<dReal*>(p); }
+
+}  // namespace
+
+bool odeBodyIsPlain(dBodyID b) {
+  // what dxStepBody would do more than the plain step: no damping, no finite rotation, no cap on
+  // the angular speed; gravity on; enabled (ssx sets none of these: checked so that it stays so)
+  return dBodyIsEnabled(b) != 0 && dBodyGetFiniteRotationMode(b) == 0 && dBodyGetLinearDamping(b) == 0 &&
+         dBodyGetAngularDamping(b) == 0 && dBodyGetMaxAngularSpeed(b) == dInfinity && dBodyGetGravityMode(b) != 0;
+}
+
+void odeInverseInertia(const dMass& mass, bool kinematic, dReal* inv_inertia, dReal& inv_mass) {
+  // as dBodySetMass computes them (dBodySetKinematic zeroes both)
+  std::memset(inv_inertia, 0, 12 * sizeof(dReal));
+  if (kinematic) {
+    inv_mass = 0;
+    return;
+  }
+  if (dInvertPDMatrix(mass.I, inv_inertia, 3) == 0) dRSetIdentity(inv_inertia);
+  inv_mass = dRecip(mass.mass);
+}
+
+void stepFreeOdeBody(dBodyID b, const dMass& mass, const dReal* inv_inertia, dReal inv_mass, bool gyroscopic,
+                     const dReal* gravity, dReal h) {
+  dReal* const facc = writable(dBodyGetForce(b));
+  dReal* const tacc = writable(dBodyGetTorque(b));
+  dReal* const pos = writable(dBodyGetPosition(b));
+  dReal* const q = writable(dBodyGetQuaternion(b));
+  dReal* const R = writable(dBodyGetRotation(b));
+  dReal* const lvel = writable(dBodyGetLinearVel(b));
+  dReal* const avel = writable(dBodyGetAngularVel(b));
+
+  // stage 0: gravity (each axis only when it is not zero, as ODE does)
+  for (int k = 0; k < 3; ++k)
+    if (gravity[k] != 0) facc[k] += mass.mass * gravity[k];
+  // the inverse inertia in the world frame
+  dMatrix3 tmp, inv_world;
+  dMultiply2_333(tmp, inv_inertia, R);
+  dMultiply0_333(inv_world, R, tmp);
+  // the implicit gyroscopic torque
+  if (gyroscopic && inv_mass > 0) {
+    dMatrix3 I;
+    dMultiply2_333(tmp, mass.I, R);
+    dMultiply0_333(I, R, tmp);
+    dVector3 L;
+    dMultiply0_331(L, I, avel);
+    dMatrix3 Itild = {0};
+    dSetCrossMatrixMinus(Itild, L, 4);
+    for (int ii = 0; ii < 12; ++ii) Itild[ii] = Itild[ii] * h + I[ii];
+    dScaleVector3(L, dRecip(h));
+    dMatrix3 itInv;
+    if (dInvertMatrix3(itInv, Itild) != 0) {
+      dMultiply0_333(Itild, I, itInv);
+      Itild[0] -= 1;
+      Itild[5] -= 1;
+      Itild[10] -= 1;
+      dVector3 tau0;
+      dMultiply0_331(tau0, Itild, L);
+      dAddVectors3(tacc, tacc, tau0);
+    }
+  }
+  // stage 6a: the velocities
+  const dReal invmass_h = h * inv_mass;
+  for (int j = 0; j < 3; ++j) {
+    lvel[j] += invmass_h * facc[j];
+    tacc[j] *= h;
+  }
+  dMultiplyAdd0_331(avel, inv_world, tacc);
+  // stage 6b: dxStepBody, the infinitesimal rotation, then the accumulators cleared
+  for (int j = 0; j < 3; ++j) pos[j] += h * lvel[j];
+  dReal dq[4];
+  dDQfromW(dq, avel, q);
+  for (int j = 0; j < 4; ++j) q[j] += h * dq[j];
+  dNormalize4(q);
+  dQtoR(q, R);
+  dZeroVector3(facc);
+  dZeroVector3(tacc);
+}
+
+}  // namespace ssx::detail
