@@ -143,23 +143,7 @@ OdeEngine::OdeEngine(const PhysicsSettings& settings) : settings_(settings) {
     partitions_.resize(static_cast<std::size_t>(std::max(1, settings_.ode.partitions)));
     for (int k = 0; k < 3; ++k) gravity_[k] = settings_.gravity[k];
     integrate_free_ = settings_.ode.integrate_free_bodies && settings_.ode.solver == OdeSettings::Solver::QuickStep;
-    for (Partition& p : partitions_) {
-      p.world = dWorldCreate();
-      const Vec3& g = settings_.gravity;
-      dWorldSetGravity(p.world, g.x(), g.y(), g.z());
-      dWorldSetERP(p.world, settings_.ode.erp);
-      dWorldSetCFM(p.world, settings_.ode.cfm);
-      dWorldSetQuickStepNumIterations(p.world, settings_.ode.iterations);
-      dWorldSetQuickStepW(p.world, settings_.ode.sor);
-      dWorldSetContactSurfaceLayer(p.world, settings_.ode.contact_surface_layer);
-      dWorldSetAutoDisableFlag(p.world, 0);
-      // each world its own (single-threaded) threading implementation: ODE's default one is
-      // shared by every world and not meant for worlds stepped at the same time
-      p.threading = dThreadingAllocateSelfThreadedImplementation();
-      if (p.threading == nullptr) throw Error("ode: could not allocate a threading implementation");
-      dWorldSetStepThreadingImplementation(p.world, dThreadingImplementationGetFunctions(p.threading), p.threading);
-      p.contacts = dJointGroupCreate(0);
-    }
+    openWorld(partitions_[0]);  // (the others when a body first goes there: see openWorld)
   } catch (...) {
     for (Partition& p : partitions_) {
       if (p.contacts != nullptr) dJointGroupDestroy(p.contacts);
@@ -173,6 +157,27 @@ OdeEngine::OdeEngine(const PhysicsSettings& settings) : settings_(settings) {
   contacts_per_pair_ = static_cast<std::size_t>(std::max(1, settings_.ode.max_contacts));
 }
 
+void OdeEngine::openWorld(Partition& p) {
+  // worlds are made when a body first goes there: a world of a few bodies uses one of its
+  // partitions, and a thousand copies of it would otherwise keep thousands of idle ODE worlds
+  if (p.world != nullptr) return;
+  p.world = dWorldCreate();
+  const Vec3& g = settings_.gravity;
+  dWorldSetGravity(p.world, g.x(), g.y(), g.z());
+  dWorldSetERP(p.world, settings_.ode.erp);
+  dWorldSetCFM(p.world, settings_.ode.cfm);
+  dWorldSetQuickStepNumIterations(p.world, settings_.ode.iterations);
+  dWorldSetQuickStepW(p.world, settings_.ode.sor);
+  dWorldSetContactSurfaceLayer(p.world, settings_.ode.contact_surface_layer);
+  dWorldSetAutoDisableFlag(p.world, 0);
+  // each world its own (single-threaded) threading implementation: ODE's default one is
+  // shared by every world and not meant for worlds stepped at the same time
+  p.threading = dThreadingAllocateSelfThreadedImplementation();
+  if (p.threading == nullptr) throw Error("ode: could not allocate a threading implementation");
+  dWorldSetStepThreadingImplementation(p.world, dThreadingImplementationGetFunctions(p.threading), p.threading);
+  p.contacts = dJointGroupCreate(0);
+}
+
 OdeEngine::~OdeEngine() {
   if (g_ode_poisoned) {
     releaseOde();  // the worlds are leaked on purpose: ODE cannot tear them down after an internal error
@@ -184,10 +189,11 @@ OdeEngine::~OdeEngine() {
   for (dGeomID g : static_geoms_) dGeomDestroy(g);
   for (dGeomID g : free_rays_) dGeomDestroy(g);
   for (Partition& p : partitions_) {
-    dJointGroupDestroy(p.contacts);
+    if (p.world == nullptr) continue;  // (never used)
+    if (p.contacts != nullptr) dJointGroupDestroy(p.contacts);
     dWorldSetStepThreadingImplementation(p.world, nullptr, nullptr);
     dWorldDestroy(p.world);  // destroys its bodies
-    dThreadingFreeImplementation(p.threading);
+    if (p.threading != nullptr) dThreadingFreeImplementation(p.threading);
   }
   releaseOde();
 }
@@ -215,6 +221,8 @@ int OdeEngine::addBody(const MassProperties& mass, const std::vector<Shape>& sha
   body.home = homeOf(index);
   body.partition = body.home;
   Partition& p = partitions_[static_cast<std::size_t>(body.home)];
+  openWorld(p);
+  used_partitions_ = std::max(used_partitions_, static_cast<std::size_t>(body.home) + 1);
   body.id = dBodyCreate(p.world);
   const Mat3& j = mass.inertia;
   // the body frame is the centre-of-mass frame: ODE requires the centre at the origin
@@ -336,6 +344,7 @@ void OdeEngine::moveBody(int index, int to) {
   Body& body = bodies_[static_cast<std::size_t>(index)];
   Partition& from = partitions_[static_cast<std::size_t>(body.partition)];
   Partition& into = partitions_[static_cast<std::size_t>(to)];
+  openWorld(into);
   const dBodyID old = body.id;
   const dBodyID b = dBodyCreate(into.world);
   dBodySetMass(b, &body.mass);
@@ -351,6 +360,7 @@ void OdeEngine::moveBody(int index, int to) {
   if (it != from.order.end()) from.order.erase(it);
   into.order.push_back(index);
   body.partition = to;
+  used_partitions_ = std::max(used_partitions_, static_cast<std::size_t>(to) + 1);
 }
 
 void OdeEngine::stepPartition(Partition& p, double h, std::span<const Wrench> wrenches) {
@@ -444,7 +454,7 @@ void OdeEngine::step(Nanoseconds dt, std::span<const Wrench> wrenches) {
     // contacts in one space over every world, then the groups they make into one world each
     collide();
     groupContacts();
-    for (Partition& p : partitions_) p.has_joints = false;
+    for (std::size_t i = 0; i < used_partitions_; ++i) partitions_[i].has_joints = false;
     partitions_[0].has_joints = live_joints_ > 0;  // (the joined bodies' world: see ode_engine.hpp)
     if (integrate_free_)
       for (Body& body : bodies_) body.constrained = body.pinned;
@@ -466,7 +476,7 @@ void OdeEngine::step(Nanoseconds dt, std::span<const Wrench> wrenches) {
     }
     contact_count_ += contacts_.size();
     // the worlds, in parallel (serially for small worlds: the same results either way)
-    forEach(partitions_.size(), [&](std::size_t i) { stepPartition(partitions_[i], h, wrenches); });
+    forEach(used_partitions_, [&](std::size_t i) { stepPartition(partitions_[i], h, wrenches); });
     if (log) logContacts(h);
   }
   if (log) contact_log_.finish();

@@ -120,6 +120,8 @@ class OdeEngine final : public PhysicEngine {
     bool removed = false;                        // a run-time joint let go of (its slot reusable)
   };
 
+  // makes partition p's ODE world, with the settings, unless it has one
+  void openWorld(Partition& p);
   // makes joint j's ODE joint in world 0 from the bodies' current states
   void createJoint(Joint& joint);
   // recreates every joint, its bodies put back where they were when it was first made (restore)
@@ -171,6 +173,9 @@ class OdeEngine final : public PhysicEngine {
   bool integrate_free_ = true;    // QuickStep and settings_.ode.integrate_free_bodies
   TaskRunner* runner_ = nullptr;
   std::vector<Partition> partitions_;
+  // the partitions any body has been in, [0, used_partitions_): the others are never stepped (a
+  // world of a few bodies touches one partition a step, not all of them)
+  std::size_t used_partitions_ = 1;
   std::vector<Body> bodies_;
   std::vector<Joint> joints_;
   std::vector<int> articulation_;  // per body: the lowest body it is joined to (itself when none)
