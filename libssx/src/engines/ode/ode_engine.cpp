@@ -273,12 +273,6 @@ void OdeEngine::setKinematic(int index) {
   proxies_stale_ = true;
 }
 
-void OdeEngine::cacheFreeStep(Body& body) {
-  odeInverseInertia(body.mass, body.kinematic, body.inv_inertia, body.inv_mass);
-  body.gyroscopic = dBodyGetGyroscopicMode(body.id) != 0;
-  body.plain = odeBodyIsPlain(body.id);
-}
-
 bool OdeEngine::isKinematic(int index) const { return bodies_.at(static_cast<std::size_t>(index)).kinematic; }
 
 void OdeEngine::setMassScale(int index, double mass_factor, double inertia_factor) {
@@ -363,35 +357,6 @@ void OdeEngine::moveBody(int index, int to) {
   used_partitions_ = std::max(used_partitions_, static_cast<std::size_t>(to) + 1);
 }
 
-void OdeEngine::stepPartition(Partition& p, double h, std::span<const Wrench> wrenches) {
-  if (p.order.empty()) return;
-  // ODE clears force accumulators after each step: apply the held wrenches every substep
-  for (const int i : p.order) {
-    const Wrench& w = wrenches[static_cast<std::size_t>(i)];
-    const dBodyID b = bodies_[static_cast<std::size_t>(i)].id;
-    dBodyAddForce(b, w.force.x(), w.force.y(), w.force.z());
-    dBodyAddTorque(b, w.torque.x(), w.torque.y(), w.torque.z());
-  }
-  // the bodies no constraint holds are stepped here, not by ODE (see ode_engine.hpp)
-  std::size_t free = 0;
-  if (integrate_free_)
-    for (const int i : p.order) free += isFree(bodies_[static_cast<std::size_t>(i)]) ? 1 : 0;
-  if (free == p.order.size()) {
-    stepFree(p, h);
-    return;
-  }
-  auto each_free = [&](auto&& f) {
-    for (const int i : p.order)
-      if (isFree(bodies_[static_cast<std::size_t>(i)])) f(bodies_[static_cast<std::size_t>(i)].id);
-  };
-  if (free > 0) each_free([](dBodyID b) { dBodyDisable(b); });  // (an ODE error after this poisons the engine)
-  solveWithOde(p, h);
-  if (free > 0) {
-    each_free([](dBodyID b) { dBodyEnable(b); });
-    stepFree(p, h);
-  }
-}
-
 void OdeEngine::solveWithOde(Partition& p, double h) {
   auto solve = [&] {
     if (settings_.ode.solver == OdeSettings::Solver::Exact)
@@ -427,13 +392,6 @@ void OdeEngine::solveWithOde(Partition& p, double h) {
   } restore{p.rand_seed, outer_seed};
   solve();
   dJointGroupEmpty(p.contacts);
-}
-
-void OdeEngine::stepFree(Partition& p, double h) {
-  for (const int i : p.order) {
-    const Body& body = bodies_[static_cast<std::size_t>(i)];
-    if (isFree(body)) stepFreeOdeBody(body.id, body.mass, body.inv_inertia, body.inv_mass, body.gyroscopic, gravity_, h);
-  }
 }
 
 void OdeEngine::step(Nanoseconds dt, std::span<const Wrench> wrenches) {

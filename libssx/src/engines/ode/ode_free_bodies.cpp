@@ -100,4 +100,48 @@ void stepFreeOdeBody(dBodyID b, const dMass& mass, const dReal* inv_inertia, dRe
   dZeroVector3(tacc);
 }
 
+// the engine's side of it: which bodies are free, and the partitions' step around ODE's
+
+void OdeEngine::cacheFreeStep(Body& body) {
+  odeInverseInertia(body.mass, body.kinematic, body.inv_inertia, body.inv_mass);
+  body.gyroscopic = dBodyGetGyroscopicMode(body.id) != 0;
+  body.plain = odeBodyIsPlain(body.id);
+}
+
+void OdeEngine::stepPartition(Partition& p, double h, std::span<const Wrench> wrenches) {
+  if (p.order.empty()) return;
+  // ODE clears force accumulators after each step: apply the held wrenches every substep
+  for (const int i : p.order) {
+    const Wrench& w = wrenches[static_cast<std::size_t>(i)];
+    const dBodyID b = bodies_[static_cast<std::size_t>(i)].id;
+    dBodyAddForce(b, w.force.x(), w.force.y(), w.force.z());
+    dBodyAddTorque(b, w.torque.x(), w.torque.y(), w.torque.z());
+  }
+  // the bodies no constraint holds are stepped here, not by ODE (see ode_engine.hpp)
+  std::size_t free = 0;
+  if (integrate_free_)
+    for (const int i : p.order) free += isFree(bodies_[static_cast<std::size_t>(i)]) ? 1 : 0;
+  if (free == p.order.size()) {
+    stepFree(p, h);
+    return;
+  }
+  auto each_free = [&](auto&& f) {
+    for (const int i : p.order)
+      if (isFree(bodies_[static_cast<std::size_t>(i)])) f(bodies_[static_cast<std::size_t>(i)].id);
+  };
+  if (free > 0) each_free([](dBodyID b) { dBodyDisable(b); });  // (an ODE error after this poisons the engine)
+  solveWithOde(p, h);
+  if (free > 0) {
+    each_free([](dBodyID b) { dBodyEnable(b); });
+    stepFree(p, h);
+  }
+}
+
+void OdeEngine::stepFree(Partition& p, double h) {
+  for (const int i : p.order) {
+    const Body& body = bodies_[static_cast<std::size_t>(i)];
+    if (isFree(body)) stepFreeOdeBody(body.id, body.mass, body.inv_inertia, body.inv_mass, body.gyroscopic, gravity_, h);
+  }
+}
+
 }  // namespace ssx::detail
