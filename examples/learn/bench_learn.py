@@ -4,6 +4,7 @@ of other CPU learning environments.
 
     PYTHONPATH=build/python python3 examples/learn/bench_learn.py [--envs 1024] [--batches 100]
     PYTHONPATH=build/python python3 examples/learn/bench_learn.py --against OTHER/build/python [--rounds 3]
+    PYTHONPATH=build/python python3 examples/learn/bench_learn.py --huge-pages [--rounds 3]
 
 Prints, for the Crazyflie `goto` task (actions at 50 Hz over 500 Hz physics, observations of pose,
 velocity and IMU) and for `formation` (64 environments of 16 robots): agent steps per second,
@@ -11,7 +12,8 @@ the part of a step spent in Python (everything but the C++ stepping), the time t
 environment, whether the batch allocates per step (tracemalloc, Python side), and what a
 Crazyflie's step costs as a world of its own against one world of many. With --against, only the
 two throughputs, of this build and of another build's Python package, in separate processes taking
-turns (the machine's speed swings between minutes: builds are compared in the same minutes).
+turns (the machine's speed swings between minutes: builds are compared in the same minutes); with
+--huge-pages, of this build with glibc's malloc on transparent huge pages and without.
 """
 import argparse
 import os
@@ -111,16 +113,30 @@ def throughputs(args):
           f"({formation_batch * 1e3:.2f} ms)", flush=True)
 
 
-def against(args):
-    """This build and another's, in turns, each in a process of its own."""
-    builds = [("this", os.path.dirname(os.path.dirname(learn.__file__))), ("other", args.against)]
+def in_processes(args, variants):
+    """The throughputs of each variant (a name and the environment of its process), in turns,
+    each in a process of its own."""
     for r in range(args.rounds):
-        for name, path in builds:
-            env = dict(os.environ, PYTHONPATH=path)
+        for name, env in variants:
             line = subprocess.run([sys.executable, __file__, "--throughput-only", "--envs", str(args.envs),
                                    "--batches", str(args.batches)], env=env, check=True, capture_output=True,
                                   text=True).stdout.strip().splitlines()[-1]
-            print(f"round {r + 1}, {name} build ({path}): {line}", flush=True)
+            print(f"round {r + 1}, {name}: {line}", flush=True)
+
+
+def against(args):
+    """This build and another's, in turns, each in a process of its own."""
+    here = os.path.dirname(os.path.dirname(learn.__file__))
+    in_processes(args, [(f"this build ({here})", dict(os.environ, PYTHONPATH=here)),
+                        (f"other build ({args.against})", dict(os.environ, PYTHONPATH=args.against))])
+
+
+def huge_pages(args):
+    """The same build with glibc's malloc on transparent huge pages and without, in turns (a
+    thousand copies' memory spans more pages than the processor's TLB holds)."""
+    plain = {k: v for k, v in os.environ.items() if k != "GLIBC_TUNABLES"}
+    in_processes(args, [("malloc on huge pages (GLIBC_TUNABLES=glibc.malloc.hugetlb=1)",
+                         dict(plain, GLIBC_TUNABLES="glibc.malloc.hugetlb=1")), ("malloc as it comes", plain)])
 
 
 def main():
@@ -130,12 +146,16 @@ def main():
     parser.add_argument("--threads", type=int, default=None)
     parser.add_argument("--against", metavar="PYTHON_DIR", help="another build's python directory, in turns")
     parser.add_argument("--rounds", type=int, default=3)
+    parser.add_argument("--huge-pages", action="store_true",
+                        help="throughputs with glibc's malloc on transparent huge pages and without, in turns")
     parser.add_argument("--throughput-only", action="store_true", help=argparse.SUPPRESS)
     args = parser.parse_args()
     if args.throughput_only:
         return throughputs(args)
     if args.against:
         return against(args)
+    if args.huge_pages:
+        return huge_pages(args)
     print(f"machine: {os.cpu_count()} cores")
     for name, figure in PEERS:
         print(f"  peer: {name}: {figure}")
