@@ -147,7 +147,10 @@ void OdeEngine::collide() {
     for (std::size_t c = had; c < chunks_.size(); ++c) {
       chunks_[c].scratch.resize(contacts_per_pair_);
       chunks_[c].pairs.reserve(c < plane_chunks ? 0 : 256);
-      chunks_[c].contacts.reserve(c < plane_chunks ? 4 * kGeomsPerPlaneChunk : 64);
+      // (a plane chunk: four contacts for each of its geoms, a box resting on a face)
+      const std::size_t plane_geoms =
+          c < plane_chunks ? std::min(kGeomsPerPlaneChunk, dynamic_proxies_ - c * kGeomsPerPlaneChunk) : 0;
+      chunks_[c].contacts.reserve(c < plane_chunks ? 4 * plane_geoms : 64);
     }
   }
   forEach(grid_chunks + plane_chunks, [&](std::size_t c) {
