@@ -144,7 +144,9 @@ ClassLoader::Pool& ClassLoader::poolOf(const ssx_plugin_class& type) {
 
 void* ClassLoader::Pool::next() {
   if (chunks.empty() || used == chunks.back().second) {
-    constexpr std::size_t kFirst = 16, kMaxBytes = std::size_t{8} << 20;
+    // (the first chunk holds one: a world of one robot, as each of a learning environment's
+    // thousand copies is, keeps no room for fifteen more; a swarm's chunks double from there)
+    constexpr std::size_t kFirst = 1, kMaxBytes = std::size_t{8} << 20;
     const std::size_t slots =
         chunks.empty() ? kFirst : std::max<std::size_t>(1, std::min(2 * chunks.back().second, kMaxBytes / slot));
     chunks.emplace_back(static_cast<std::byte*>(::operator new(slots * slot, std::align_val_t(align))), slots);
