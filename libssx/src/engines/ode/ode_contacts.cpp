@@ -41,7 +41,10 @@ bool OdeEngine::aboveOf(const GridBroadphase::Box& box, const std::array<double,
   // the box's corner deepest along the plane's normal, still in front of it by more than rounding
   // could move a shape (dCollide would find no contact: skipping it changes nothing)
   double lowest = -plane[3];
-  for (int k = 0; k < 3; ++k) lowest += plane[static_cast<std::size_t>(k)] * (plane[static_cast<std::size_t>(k)] > 0 ? box.min[k] : box.max[k]);
+  for (std::size_t k = 0; k < 3; ++k) {
+    const int axis = static_cast<int>(k);
+    lowest += plane[k] * (plane[k] > 0 ? box.min[axis] : box.max[axis]);
+  }
   return lowest > 1e-6 * (1.0 + std::abs(plane[3]));
 }
 

@@ -119,8 +119,7 @@ void OdeEngine::stepPartition(Partition& p, double h, std::span<const Wrench> wr
   }
   // the bodies no constraint holds are stepped here, not by ODE (see ode_engine.hpp)
   std::size_t free = 0;
-  if (integrate_free_)
-    for (const int i : p.order) free += isFree(bodies_[static_cast<std::size_t>(i)]) ? 1 : 0;
+  for (const int i : p.order) free += isFree(bodies_[static_cast<std::size_t>(i)]) ? 1 : 0;
   if (free == p.order.size()) {
     stepFree(p, h);
     return;
@@ -140,7 +139,8 @@ void OdeEngine::stepPartition(Partition& p, double h, std::span<const Wrench> wr
 void OdeEngine::stepFree(Partition& p, double h) {
   for (const int i : p.order) {
     const Body& body = bodies_[static_cast<std::size_t>(i)];
-    if (isFree(body)) stepFreeOdeBody(body.id, body.mass, body.inv_inertia, body.inv_mass, body.gyroscopic, gravity_, h);
+    if (isFree(body))
+      stepFreeOdeBody(body.id, body.mass, body.inv_inertia, body.inv_mass, body.gyroscopic, gravity_, h);
   }
 }
 

@@ -160,7 +160,8 @@ TEST_CASE("a swarm taking off from the ground and flying has the same bits with 
     SceneOptions options;
     options.threads = threads;
     return loadSceneFromString(
-        std::string("<scene><environment timestep=\"0.002\" seed=\"3\"/><physics engine=\"ode\" integrate_free_bodies=\"") +
+        std::string("<scene><environment timestep=\"0.002\" seed=\"3\"/>"
+                    "<physics engine=\"ode\" integrate_free_bodies=\"") +
             (integrate_free ? "true" : "false") + "\"/><type name=\"cf\" file=\"" +
             (ssx::test::kArtifacts / "crazyflie.xml").string() +
             "\"/><ground/><swarm type=\"cf\" count=\"9\" name=\"cf{i}\" spacing=\"0.3\" xyz=\"0 0 0.0105\">"
