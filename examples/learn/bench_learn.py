@@ -9,8 +9,9 @@ of other CPU learning environments.
 Prints, for the Crazyflie `goto` task (actions at 50 Hz over 500 Hz physics, observations of pose,
 velocity and IMU) and for `formation` (64 environments of 16 robots): agent steps per second,
 the part of a step spent in Python (everything but the C++ stepping), the time to reset one
-environment, whether the batch allocates per step (tracemalloc, Python side), and what a
-Crazyflie's step costs as a world of its own against one world of many. With --against, only the
+environment, whether the batch allocates per step (tracemalloc, Python side), what a
+Crazyflie's step costs as a world of its own against one world of many, with free bodies stepped
+by ssx against every body handed to ODE, stepped 10 against 100 steps a call, and a copy's memory. With --against, only the
 two throughputs, of this build and of another build's Python package, in separate processes taking
 turns (the machine's speed swings between minutes: builds are compared in the same minutes); with
 --huge-pages, of this build with glibc's malloc on transparent huge pages and without.
@@ -101,6 +102,61 @@ def per_world_cost(robots=256, steps=500):
     return separate / (4 * steps * robots) * 1e6, together / (4 * steps * robots) * 1e6
 
 
+def memory_per_copy(copies=200):
+    """KiB allocated (glibc's mallinfo2) and resident (the growth of the process's peak resident
+    set: call it before anything else) per goto copy, after 10 steps."""
+    import ctypes
+    import resource
+
+    import ssx
+
+    class MallInfo(ctypes.Structure):
+        _fields_ = [(n, ctypes.c_size_t) for n in
+                    "arena ordblks smblks hblks hblkhd usmblks fsmblks uordblks fordblks keepcost".split()]
+
+    libc = ctypes.CDLL("libc.so.6")
+    libc.mallinfo2.restype = MallInfo
+
+    def allocated():
+        m = libc.mallinfo2()
+        return m.uordblks + m.hblkhd
+
+    a0, r0 = allocated(), resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
+    sim = ssx._ssx.VectorEnvironment(learn.GoTo().scene(), copies, base_dir=ssx.data_directory(), threads=1)
+    sim.step(10)
+    a1, r1 = allocated(), resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
+    sim.close()
+    return (a1 - a0) / copies / 1024, (r1 - r0) / copies
+
+
+class _GoToAllByOde(learn.GoTo):
+    """goto with every body handed to ODE's world step (the same bits, for the comparison)."""
+    name = "goto_all_by_ode"
+
+    def scene(self):
+        return super().scene().replace("<ground/>", '<physics engine="ode" integrate_free_bodies="false"/>\n  <ground/>')
+
+
+def free_bodies_cost(copies=256, steps=200, rounds=4):
+    """us per copy step on one thread (C++ only): free bodies stepped by ssx, and every body by ODE."""
+    envs = [learn.VectorEnv(task, num_envs=copies, threads=1) for task in ("goto", _GoToAllByOde())]
+    for e in envs:
+        e.reset(seed=1)
+    free, ode = in_turns(lambda: envs[0].sim.step(steps), lambda: envs[1].sim.step(steps), rounds)
+    for e in envs:
+        e.close()
+    return free / (rounds * steps * copies) * 1e6, ode / (rounds * steps * copies) * 1e6
+
+
+def cold_copies(copies=1024, rounds=4):
+    """us per copy step on one thread (C++ only), the copies stepped 10 and 100 steps a call."""
+    env = learn.VectorEnv("goto", num_envs=copies, threads=1)
+    env.reset(seed=1)
+    ten, hundred = in_turns(lambda: [env.sim.step(10) for _ in range(10)], lambda: env.sim.step(100), rounds)
+    env.close()
+    return ten / (rounds * 100 * copies) * 1e6, hundred / (rounds * 100 * copies) * 1e6
+
+
 def throughputs(args):
     """The goto and formation throughputs alone, one line."""
     env = learn.VectorEnv("goto", num_envs=args.envs, threads=args.threads)
@@ -156,6 +212,7 @@ def main():
         return against(args)
     if args.huge_pages:
         return huge_pages(args)
+    kib, resident = memory_per_copy()  # first: the peak resident set has not grown yet
     print(f"machine: {os.cpu_count()} cores")
     for name, figure in PEERS:
         print(f"  peer: {name}: {figure}")
@@ -190,6 +247,12 @@ def main():
     separate, together = per_world_cost()
     print(f"a Crazyflie's step on one thread: {separate:.2f} us as a world of its own, {together:.2f} us as one "
           f"of 256 in one world")
+    free, ode = free_bodies_cost()
+    print(f"  with free bodies stepped by ssx {free:.2f} us, with every body handed to ODE {ode:.2f} us "
+          f"(256 copies, in turns)")
+    ten, hundred = cold_copies()
+    print(f"  1,024 copies stepped 10 steps a call: {ten:.2f} us per copy step, 100 a call: {hundred:.2f} us")
+    print(f"  memory per copy: {kib:.0f} KiB allocated, {resident:.0f} KiB resident (200 copies, after 10 steps)")
 
     env = learn.VectorEnv("formation", num_envs=64, robots=16, threads=args.threads)
     rate, batch, python = measure(env, max(10, args.batches // 2), 16)
