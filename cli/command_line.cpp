@@ -146,6 +146,16 @@ CommandLine parseCommandLine(int argc, const char* const* argv, std::ostream& ou
       ->check(CLI::IsMember(ssx::physicEngineNames()));
   addMaxInputOption(validate_cmd, c.validate.max_input_mb);
 
+  CLI::App* import_cmd =
+      app.add_subcommand("import", "read a robot description (URDF) and print it as an ssx artifact file (docs/robots.md)");
+  import_cmd->add_option("file", c.import.file, "robot description (.urdf)")->required()->check(CLI::ExistingFile);
+  import_cmd->add_option("--out", c.import.out, "write the artifact file here (a new file) instead of standard output")
+      ->check(path());
+  import_cmd->add_option("--resource-path", c.import.resource_path,
+                         "where package://NAME/ and model://NAME/ are looked for, before SSX_RESOURCE_PATH (repeatable)")
+      ->check(path());
+  addMaxInputOption(import_cmd, c.import.max_input_mb);
+
   CLI::App* plugins_cmd = app.add_subcommand("plugins", "list plugin libraries, their classes, and ABI checks");
   plugins_cmd->add_option("--plugin-path", c.plugins.plugin_path, "plugin directory (repeatable)")->check(path());
   plugins_cmd->add_option("--params", c.plugins.params_of, "print the declared parameters of plugin class NAME, or the settings of physics engine NAME (a Markdown table)");
@@ -227,6 +237,8 @@ CommandLine parseCommandLine(int argc, const char* const* argv, std::ostream& ou
     }
   } else if (*validate_cmd) {
     c.command = CommandLine::Command::Validate;
+  } else if (*import_cmd) {
+    c.command = CommandLine::Command::Import;
   } else if (*sweep_cmd) {
     c.command = CommandLine::Command::Sweep;
   } else if (*inspect_cmd) {

@@ -86,8 +86,15 @@ struct ReplayArgs {
   std::string view_bind = "127.0.0.1";
 };
 
+struct ImportArgs {
+  std::string file;  // URDF
+  std::string out;   // the artifact file to write (empty: standard output)
+  std::vector<std::string> resource_path;
+  double max_input_mb = kDefaultMaxInputMb;
+};
+
 struct CommandLine {
-  enum class Command { Run, Validate, Sweep, Plugins, Inspect, Replay };
+  enum class Command { Run, Validate, Sweep, Plugins, Inspect, Replay, Import };
   /// Set when parsing ended the command: --help or --version (0), bad arguments (kExitBadInput);
   /// what CLI11 had to say went to the streams given.
   std::optional<int> exit_status;
@@ -99,6 +106,7 @@ struct CommandLine {
   PluginsArgs plugins;
   InspectArgs inspect;
   ReplayArgs replay;
+  ImportArgs import;
 };
 
 /// Parses argv (argv[0] the program). Never throws for bad arguments.

@@ -440,6 +440,43 @@ int commandValidate(const std::string& file, const std::vector<std::string>& plu
   }
 }
 
+int commandImport(const ImportArgs& args) {
+  ssx::SceneOptions options;
+  for (const std::string& d : args.resource_path) options.resource_path.emplace_back(d);
+  options.max_input_bytes = maxInputBytes(args.max_input_mb);
+  const fs::path out = args.out;
+  std::error_code ec;
+  // a new file: never over one the user has (the description itself, say)
+  if (!out.empty() && fs::exists(out, ec)) {
+    std::cerr << "ssx import: error: " << out.string() << " exists; give --out a new file (nothing was written)\n";
+    return kExitBadInput;
+  }
+  try {
+    const auto t0 = std::chrono::steady_clock::now();
+    const ssx::ImportedRobot robot =
+        ssx::importRobotDescription(args.file, out.empty() ? fs::current_path(ec) : fs::absolute(out, ec).parent_path(), options);
+    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    for (const auto& w : robot.warnings) std::cerr << w.str() << '\n';
+    if (out.empty()) {
+      std::cout << robot.artifact_xml;
+    } else {
+      std::ofstream f(out, std::ios::binary);
+      f << robot.artifact_xml;
+      f.close();
+      if (!f) {
+        std::cerr << "ssx import: error: could not write " << out.string() << '\n';
+        fs::remove(out, ec);
+        return kExitRunFailure;
+      }
+    }
+    std::fprintf(stderr, "%s: %zu bodies, %zu joints, %.4g kg; read in %.3f s\n", args.file.c_str(), robot.bodies,
+                 robot.joints, robot.mass, seconds);
+    return 0;
+  } catch (const ssx::SceneError& e) {
+    printSorted(e);
+    return kExitBadInput;
+  }
+}
 
 int commandSweep(const SweepArgs& args) {
   namespace sw = ssx::sweep;
@@ -501,6 +538,7 @@ int main(int argc, char** argv) {
         return commandValidate(c.validate.scene, c.validate.plugin_path, c.validate.physics, c.validate.print,
                                c.validate.max_input_mb);
       case CommandLine::Command::Sweep: return commandSweep(c.sweep);
+      case CommandLine::Command::Import: return commandImport(c.import);
       case CommandLine::Command::Inspect: return ssx::cli::commandInspect(c.inspect);
       case CommandLine::Command::Replay: return ssx::cli::commandReplay(c.replay);
       case CommandLine::Command::Plugins:

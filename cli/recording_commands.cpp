@@ -191,7 +191,10 @@ int draw(const Recording& r, const ReplayArgs& args) {
         const Vec3 here = at + n.pose.position;
         if (n.primitive != RenderNodeSpec::Primitive::None) {
           if (!coloured) dots[i].color = n.color, coloured = true;
-          const double half = n.primitive == RenderNodeSpec::Primitive::Box ? 0.5 * n.size.maxCoeff() : n.radius;
+          const double half = n.primitive == RenderNodeSpec::Primitive::Box ? 0.5 * n.size.maxCoeff()
+                              : n.primitive == RenderNodeSpec::Primitive::Mesh && n.mesh != nullptr
+                                  ? n.mesh->min.cwiseAbs().cwiseMax(n.mesh->max.cwiseAbs()).norm()
+                                  : n.radius;
           reach = std::max(reach, here.norm() + half);
         }
         for (const auto& c : n.children) self(self, c, here);

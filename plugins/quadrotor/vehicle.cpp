@@ -86,7 +86,15 @@ std::vector<Rotor> VehicleParams::rotorsOf(const Descriptor& params, const Artif
     if (node == nullptr)
       throw params.errorAt("rotors",
                            "no physic node '" + rotor_names[i] + "' for a rotor in artifact '" + a.name() + "'");
-    rotors.push_back({node->poseInBody().position, directions[i]});
+    // a rotor on a joint of its own (a propeller link of a URDF or SDF robot) counts where it sits
+    // on the frame, its joints at 0: the thrust acts on the frame
+    Pose in_root;
+    bool joined = false;
+    for (const PhysicNode* n = node; n != nullptr && n != &a.root(); n = n->parent()) {
+      in_root = n->spec().pose * in_root;
+      joined = joined || n->spec().joint.isBody();
+    }
+    rotors.push_back({joined ? (a.root().poseInBody() * in_root).position : node->poseInBody().position, directions[i]});
   }
   return rotors;
 }

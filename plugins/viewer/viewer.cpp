@@ -79,6 +79,7 @@ const char* kindName(RenderNodeSpec::Primitive p) {
     case RenderNodeSpec::Primitive::Cylinder: return "cylinder";
     case RenderNodeSpec::Primitive::Capsule: return "capsule";
     case RenderNodeSpec::Primitive::Plane: return "plane";
+    case RenderNodeSpec::Primitive::Mesh: return "box";  // (its bounding box: the page draws no meshes yet)
     case RenderNodeSpec::Primitive::None: break;
   }
   return "";
@@ -90,12 +91,16 @@ using viewer::jsonNumber;
 void shapes(std::string& out, const RenderNodeSpec& n, const Pose& parent, bool& first) {
   const Pose pose = parent * n.pose;
   if (n.primitive != RenderNodeSpec::Primitive::None) {
+    const bool mesh = n.primitive == RenderNodeSpec::Primitive::Mesh && n.mesh != nullptr;
+    // a mesh as its bounding box
+    const Vec3 size = mesh ? Vec3(n.mesh->max - n.mesh->min) : n.size;
+    const Pose at = mesh ? pose * Pose{0.5 * (n.mesh->min + n.mesh->max), Quat::Identity()} : pose;
     out += first ? "" : ",";
     first = false;
     out += R"({"kind":")";
     out += kindName(n.primitive);
     out += R"(","size":[)";
-    appendNumber(out, n.size.x()), out += ',', appendNumber(out, n.size.y()), out += ',', appendNumber(out, n.size.z());
+    appendNumber(out, size.x()), out += ',', appendNumber(out, size.y()), out += ',', appendNumber(out, size.z());
     out += R"(],"radius":)";
     appendNumber(out, n.radius);
     out += R"(,"length":)";
@@ -105,8 +110,8 @@ void shapes(std::string& out, const RenderNodeSpec& n, const Pose& parent, bool&
     out += R"(,"color":[)";
     for (int k = 0; k < 4; ++k) appendNumber(out, n.color[static_cast<std::size_t>(k)]), out += k < 3 ? "," : "";
     out += R"(],"pose":[)";
-    const Quat& q = pose.orientation;
-    for (const double v : {pose.position.x(), pose.position.y(), pose.position.z(), q.x(), q.y(), q.z(), q.w()})
+    const Quat& q = at.orientation;
+    for (const double v : {at.position.x(), at.position.y(), at.position.z(), q.x(), q.y(), q.z(), q.w()})
       appendNumber(out, v), out += ',';
     out.back() = ']';
     out += '}';

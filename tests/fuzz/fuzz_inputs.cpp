@@ -117,6 +117,13 @@ void artifactInput(std::span<const std::uint8_t> data) {
               scratch(), 25);
 }
 
+void robotInput(std::span<const std::uint8_t> data) {
+  write(scratch() / "a.urdf", text(data));
+  loadAndStep(R"(<scene><environment timestep="0.002"/><ground/><type name="a" file="a.urdf"/>
+      <swarm type="a" count="2" name="a{i}" layout="grid" spacing="2" xyz="0 0 0.5" allow_overlap="true"/></scene>)",
+              scratch(), 25);
+}
+
 void parameterInput(std::span<const std::uint8_t> data) {
   // the plugins of an mk_quad, their declared parameters read from the classes themselves
   struct Target {

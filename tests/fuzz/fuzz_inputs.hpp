@@ -18,6 +18,10 @@ void sceneInput(std::span<const std::uint8_t> data);
 /// An artifact file, placed three times in a fixed scene with a ground, loaded and stepped.
 void artifactInput(std::span<const std::uint8_t> data);
 
+/// A URDF file, placed twice in a fixed scene with a ground, loaded and stepped (meshes it names
+/// are looked for beside it: the fuzzer reaches the mesh reader through names it finds).
+void robotInput(std::span<const std::uint8_t> data);
+
 /// Up to four parameter assignments to the plugins of an mk_quad (driver quadrotor, sensors imu
 /// and pose): lines of [plugin byte][parameter byte][value text]. Loaded, then flown 0.2 s.
 void parameterInput(std::span<const std::uint8_t> data);

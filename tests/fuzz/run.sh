@@ -14,13 +14,14 @@ mkdir -p "$work/findings"
 declare -A seeds=(
   [scene]="tests/data/valid tests/data/invalid tests/data/fuzz/scene"
   [artifact]="examples/artifacts tests/data/fuzz/artifact"
+  [robot]="examples/robots/simple tests/data/fuzz/robot"
   [parameter]="tests/data/fuzz/parameter"
   [state]="tests/data/fuzz/state"
   [command_line]="tests/data/fuzz/command_line"
   [recording]="tests/data/fuzz/recording"
 )
 status=0
-for target in scene artifact parameter state command_line recording; do
+for target in scene artifact robot parameter state command_line recording; do
   corpus=$work/corpus_$target
   mkdir -p "$corpus"
   # shellcheck disable=SC2086

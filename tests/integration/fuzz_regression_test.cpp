@@ -38,6 +38,10 @@ TEST_CASE("inputs the fuzzers found or started from are refused or run cleanly: 
   CHECK(replay("artifact", ssx::fuzz::artifactInput) >= 1);
 }
 
+TEST_CASE("inputs the fuzzers found or started from are refused or run cleanly: robots (URDF)", "[fuzz]") {
+  CHECK(replay("robot", ssx::fuzz::robotInput) >= 3);
+}
+
 TEST_CASE("inputs the fuzzers found or started from are refused or run cleanly: parameters", "[fuzz]") {
   CHECK(replay("parameter", ssx::fuzz::parameterInput) >= 1);
 }

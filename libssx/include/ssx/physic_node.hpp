@@ -7,7 +7,9 @@
 #include <ssx/export.hpp>
 #include <ssx/types.hpp>
 
+#include <cstdint>
 #include <limits>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -19,18 +21,41 @@ namespace detail {
 struct World;
 }
 
+/// A triangle mesh read from a file (STL, OBJ, COLLADA and whatever else assimp reads), scaled
+/// as its description asks, in the frame of the shape that holds it, with its convex hull (computed
+/// once when the mesh is read). A moving body collides and weighs as the hull; a static one
+/// collides with the triangles themselves.
+struct SSX_EXPORT TriangleMesh {
+  std::string file;                 ///< where it was read from (messages)
+  std::vector<Vec3> vertices;       ///< m
+  std::vector<std::uint32_t> triangles;  ///< three vertex indices per triangle, counter-clockwise seen from outside
+  std::vector<Vec3> hull_vertices;       ///< the convex hull's corners, m
+  std::vector<std::uint32_t> hull_triangles;  ///< its faces, three indices into hull_vertices each, outward
+  double hull_volume = 0.0;                   ///< m^3
+  Vec3 hull_centroid = Vec3::Zero();          ///< the hull's centre of volume
+  /// The hull's inertia per kilogram about its centroid, mesh axes (uniform density), m^2.
+  Mat3 hull_unit_inertia = Mat3::Zero();
+  Vec3 min = Vec3::Zero(), max = Vec3::Zero();  ///< the vertices' bounding box, m
+
+  /// Fills in the hull (and the bounding box) from the vertices: Bullet's btConvexHullComputer.
+  /// Throws Error when they span no volume (fewer than four points off one plane).
+  void computeHull();
+};
+
 /// A collision and mass shape, posed relative to the node that holds it. Cylinders and capsules
 /// lie along their local z axis. A plane is the half-space below its local xy-plane (normal +z)
 /// and is allowed only on static nodes.
 struct SSX_EXPORT Shape {
   /// The shape's geometry.
-  enum class Kind : std::uint8_t { Box, Sphere, Cylinder, Capsule, Plane };
+  enum class Kind : std::uint8_t { Box, Sphere, Cylinder, Capsule, Plane, Mesh };
   Kind kind = Kind::Box;     ///< which geometry; the fields below that it uses
   Vec3 size = Vec3::Ones();  ///< box: full edge lengths, m
   double radius = 0.5;       ///< sphere, cylinder, capsule: m
   double length = 1.0;       ///< cylinder: full height; capsule: length of the cylindrical part, m
   Pose pose;                 ///< relative to the node
   double density = 1000.0;   ///< kg/m^3; used when the node's mass comes from its shapes
+  /// mesh: its triangles and hull (shared by every shape and artifact that uses the same file)
+  std::shared_ptr<const TriangleMesh> mesh;
 
   /// A box with full edge lengths `size`, m.
   static Shape box(const Vec3& size, const Pose& pose = {});
@@ -42,11 +67,15 @@ struct SSX_EXPORT Shape {
   static Shape capsule(double radius, double length, const Pose& pose = {});
   /// A plane (static nodes only): the half-space below the posed xy-plane.
   static Shape plane(const Pose& pose = {});
+  /// A mesh: its convex hull on a moving body, its triangles on a static one.
+  static Shape fromMesh(std::shared_ptr<const TriangleMesh> mesh, const Pose& pose = {});
 
   /// Volume in m^3 (0 for a plane).
   double volume() const;
   /// Inertia about the shape's own centre, in its own axes, for a given mass.
   Mat3 unitInertia(double mass) const;
+  /// The shape's centre of volume in its own frame (the origin but for a mesh: its hull's centroid).
+  Vec3 centroid() const;
 };
 
 /// The point of a shape's surface nearest to `p` (world frame), the shape posed at `world`; `p`
@@ -75,6 +104,12 @@ struct SSX_EXPORT JointSpec {
   /// The motor's largest torque (hinge, N m) or force (slider, N); 0: no motor. A driver sets its
   /// target velocity or position (PhysicNode::setJointVelocity, setJointPosition).
   double max_effort = 0.0;
+  /// The fastest the motor turns or moves the joint (rad/s or m/s): commanded velocities, and the
+  /// position servo's, are held within it. Infinite: no bound.
+  double max_velocity = std::numeric_limits<double>::infinity();
+  /// Coulomb friction in the joint (N m or N): while no motor command holds it, the joint is
+  /// braked with at most this effort (0: none).
+  double friction = 0.0;
 
   /// Whether the child is a body of its own (any kind but Rigid).
   bool isBody() const noexcept { return kind != Kind::Rigid; }

@@ -15,6 +15,7 @@
 #include <ssx/export.hpp>
 #include <ssx/error.hpp>
 #include <ssx/types.hpp>
+#include <ssx/physic_node.hpp>
 
 #include <array>
 #include <cstdint>
@@ -34,12 +35,13 @@ using Color = std::array<float, 4>;  ///< RGBA, 0..1
 struct RenderNodeSpec {
   /// The shape drawn; None draws nothing (a frame for children). Cylinders and capsules lie
   /// along z; a plane is the z = 0 plane of the node.
-  enum class Primitive : std::uint8_t { None, Box, Sphere, Cylinder, Capsule, Plane };
+  enum class Primitive : std::uint8_t { None, Box, Sphere, Cylinder, Capsule, Plane, Mesh };
   std::string name;                       ///< for messages; may be empty
   Primitive primitive = Primitive::None;  ///< what is drawn
   Vec3 size = Vec3::Ones();  ///< box edge lengths; plane: x and y extent
   double radius = 0.5;       ///< sphere, cylinder, capsule: m
   double length = 1.0;       ///< cylinder, capsule: length of the straight part, m
+  std::shared_ptr<const TriangleMesh> mesh;  ///< the mesh drawn (Primitive::Mesh), in this node's frame
   Color color{0.7f, 0.7f, 0.7f, 1.0f};  ///< RGBA, 0..1
   bool grid = false;  ///< draw a 1 m grid on it (the ground)
   Pose pose;          ///< relative to the parent (a root: to the followed node, or the artifact)

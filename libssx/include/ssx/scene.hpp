@@ -65,6 +65,10 @@ struct SceneOptions {
   /// installed artifact directory (installedDataDirectory()/artifacts). A `file` always wins.
   std::vector<std::filesystem::path> artifact_path;
   bool search_installed_artifacts = true;    ///< append installedDataDirectory()/artifacts
+  /// Where a URDF's `package://NAME/...` and an SDF's `model://NAME/...` are looked for (a folder
+  /// NAME in one of them, or the directory NAME itself), before SSX_RESOURCE_PATH and then
+  /// ROS_PACKAGE_PATH or GZ_SIM_RESOURCE_PATH (docs/robots.md).
+  std::vector<std::filesystem::path> resource_path;
   /// Attributes set before the scene file is read (see AttributeOverride), in order.
   std::vector<AttributeOverride> overrides;
   /// false: the scene's `<extension>` elements are left out (headless batch runs: no logger writes,
@@ -114,5 +118,21 @@ SSX_EXPORT Scene loadScene(const std::filesystem::path& file, const SceneOptions
 /// Same, from text in memory; relative paths resolve against `base_dir`, messages say `label`.
 SSX_EXPORT Scene loadSceneFromString(std::string_view xml, const std::string& label,
                                      const std::filesystem::path& base_dir, const SceneOptions& options = {});
+
+/// A robot description from another simulator, as `ssx import` gives it.
+struct ImportedRobot {
+  std::string artifact_xml;        ///< the same robot as ssx's artifact file
+  std::vector<Diagnostic> warnings;  ///< what was not imported (Gazebo extensions, textures, mimic joints...)
+  std::size_t bodies = 0;          ///< rigid bodies (fixed joints merge links into one)
+  std::size_t joints = 0;          ///< joints between them
+  double mass = 0;                 ///< kg, of every link
+};
+
+/// Reads a URDF file (docs/robots.md) into ssx's artifact form, checks it as a scene would use it
+/// (read and built on the default engine), and prints it as an artifact file; mesh paths are
+/// written relative to `out_dir` (where the file will be) when they are below it. Throws
+/// SceneError with every problem, each with its file and line.
+SSX_EXPORT ImportedRobot importRobotDescription(const std::filesystem::path& file, const std::filesystem::path& out_dir = {},
+                                                const SceneOptions& options = {});
 
 }  // namespace ssx

@@ -73,8 +73,29 @@ void appendShape(std::string& out, const Pose& pose, const Vec3& size, const Col
   out += '}';
 }
 
+// a mesh as a foxglove.TriangleListPrimitive: its vertices once, and three indices per triangle
+void appendTriangles(std::string& out, const Pose& pose, const TriangleMesh& mesh, const Color& color) {
+  out += '{';
+  appendPose(out, pose);
+  out += R"j(,"points":[)j";
+  for (std::size_t i = 0; i < mesh.vertices.size(); ++i) {
+    if (i > 0) out += ',';
+    const Vec3& v = mesh.vertices[i];
+    out += R"j({"x":)j", appendNumber(out, v.x()), out += R"j(,"y":)j", appendNumber(out, v.y());
+    out += R"j(,"z":)j", appendNumber(out, v.z()), out += '}';
+  }
+  out += "],";
+  appendObject(out, "color", {{"r", color[0]}, {"g", color[1]}, {"b", color[2]}, {"a", color[3]}});
+  out += R"j(,"colors":[],"indices":[)j";
+  for (std::size_t i = 0; i < mesh.triangles.size(); ++i) {
+    if (i > 0) out += ',';
+    out += std::to_string(mesh.triangles[i]);
+  }
+  out += "]}";
+}
+
 struct Primitives {
-  std::string cubes, spheres, cylinders;
+  std::string cubes, spheres, cylinders, triangles;
   static void add(std::string& list, auto&& write) {
     if (!list.empty()) list += ',';
     write(list);
@@ -97,7 +118,10 @@ const char* const kSceneUpdateSchema =
     R"j("lifetime":{"type":"object","properties":{"sec":{"type":"integer"},"nsec":{"type":"integer"}}},"frame_locked":{"type":"boolean"},)j"
     R"j("cubes":{"type":"array","items":)j" SSX_JSON_SHAPE R"j(}}},"spheres":{"type":"array","items":)j" SSX_JSON_SHAPE
     R"j(}}},"cylinders":{"type":"array","items":)j" SSX_JSON_SHAPE
-    R"j(,"bottom_scale":{"type":"number"},"top_scale":{"type":"number"}}}}}}}}})j";
+    R"j(,"bottom_scale":{"type":"number"},"top_scale":{"type":"number"}}}},)j"
+    R"j("triangles":{"type":"array","items":{"type":"object","properties":{"pose":)j" SSX_JSON_POSE
+    R"j(,"points":{"type":"array","items":)j" SSX_JSON_VEC3 R"j(},"color":)j" SSX_JSON_COLOR
+    R"j(,"colors":{"type":"array"},"indices":{"type":"array","items":{"type":"integer","minimum":0}}}}}}}}}})j";
 
 std::string frameTransforms(Nanoseconds time, std::span<const std::string> names, std::span<const float> positions,
                             std::span<const float> orientations) {
@@ -160,6 +184,10 @@ std::string sceneUpdate(Nanoseconds time, std::span<const SceneShape> shapes) {
             Primitives::add(f.spheres, [&](std::string& o) { appendShape(o, cap, Vec3(d, d, d), n.color); });
           }
         break;
+      case P::Mesh:
+        if (n.mesh != nullptr)
+          Primitives::add(f.triangles, [&](std::string& o) { appendTriangles(o, s.pose, *n.mesh, n.color); });
+        break;
       case P::None:
         break;
     }
@@ -176,7 +204,7 @@ std::string sceneUpdate(Nanoseconds time, std::span<const SceneShape> shapes) {
     out += R"j(,"id":)j";
     appendString(out, frame);
     out += R"j(,"lifetime":{"sec":0,"nsec":0},"frame_locked":true,"cubes":[)j" + p.cubes + R"j(],"spheres":[)j" +
-           p.spheres + R"j(],"cylinders":[)j" + p.cylinders + "]}";
+           p.spheres + R"j(],"cylinders":[)j" + p.cylinders + R"j(],"triangles":[)j" + p.triangles + "]}";
   }
   out += "]}";
   return out;

@@ -13,6 +13,7 @@
 // per robot on the ground, straight below it, as wide as the robot and fading with its height,
 // blended over the ground last.
 #include "render/osmesa_engine.hpp"
+#include "render/gl_programs.hpp"
 #include "render/osmesa_shaders.hpp"
 #include "render/unit_meshes.hpp"
 
@@ -30,6 +31,8 @@
 #include <cmath>
 #include <cstdlib>
 #include <limits>
+#include <map>
+#include <memory>
 #include <numbers>
 #include <string>
 #include <vector>
@@ -64,37 +67,6 @@ struct BatchVertex {
 
 const Vec3 kSun = Vec3(0.35, 0.25, 0.9).normalized();  // towards the sun (unit)
 
-// a shader from the version line, a definition and the source
-GLuint compile(GLenum kind, const char* definition, const char* source) {
-  const GLuint shader = glCreateShader(kind);
-  const char* parts[] = {shaders::kVersion, definition, source};
-  glShaderSource(shader, 3, parts, nullptr);
-  glCompileShader(shader);
-  GLint ok = 0;
-  glGetShaderiv(shader, GL_COMPILE_STATUS, &ok);
-  if (!ok) {
-    char log[2048] = {};
-    glGetShaderInfoLog(shader, sizeof log, nullptr, log);
-    throw Error(std::string("osmesa renderer: shader does not compile: ") + log);
-  }
-  return shader;
-}
-
-GLuint link(const char* definition, const char* vertex_source, const char* fragment_source) {
-  const GLuint vs = compile(GL_VERTEX_SHADER, definition, vertex_source),
-               fs = compile(GL_FRAGMENT_SHADER, definition, fragment_source);
-  const GLuint program = glCreateProgram();
-  glAttachShader(program, vs);
-  glAttachShader(program, fs);
-  glLinkProgram(program);
-  GLint ok = 0;
-  glGetProgramiv(program, GL_LINK_STATUS, &ok);
-  glDeleteShader(vs);
-  glDeleteShader(fs);
-  if (!ok) throw Error("osmesa renderer: shaders do not link");
-  return program;
-}
-
 // column-major 4x4 product
 std::array<float, 16> multiply(const std::array<float, 16>& a, const std::array<float, 16>& b) {
   std::array<float, 16> r{};
@@ -126,6 +98,13 @@ struct OsmesaRenderEngine::Gl {
   // every mesh's vertices and triangles, for the batches
   std::vector<Vertex> mesh_vertices[kMeshCount];
   std::vector<unsigned> mesh_indices[kMeshCount];
+  // the scene's own meshes (RenderNodeSpec::Primitive::Mesh), flat-shaded: each triangle its
+  // three corners with the face's normal; made on first sight, kept (and the meshes with them)
+  struct UserMesh {
+    std::vector<Vertex> vertices;
+    std::vector<unsigned> indices;
+  };
+  std::map<std::shared_ptr<const TriangleMesh>, UserMesh> user_meshes;
   // the batches: [0] one-sided, [1] seen from both sides, [2] the shadows (blended, drawn last)
   static constexpr int kBatches = 3, kShadowBatch = 2;
   GLuint batch_vao[kBatches] = {}, batch_vertex_buffer[kBatches] = {}, batch_index_buffer[kBatches] = {};
@@ -318,11 +297,11 @@ void OsmesaRenderEngine::renderView(const CameraView& view, const std::vector<Re
   // per-pixel shader would light it, with the direction to the eye from the primitive's centre (a
   // face seen from behind is turned towards the eye)
   const Eigen::Vector3f eye_f = eye.cast<float>(), sun_f = kSun.cast<float>();
-  auto batch = [&](Mesh mesh, const Pose& pose, const Vec3& scale, const RenderNodeSpec& spec) {
+  auto batchArrays = [&](const std::vector<Vertex>& mesh_vertices, const std::vector<unsigned>& mesh_indices,
+                         bool two_sided, const Pose& pose, const Vec3& scale, const RenderNodeSpec& spec) {
     const Eigen::Matrix3f rot = pose.orientation.toRotationMatrix().cast<float>();
     const Eigen::Vector3f at = pose.position.cast<float>(), s = scale.cwiseMax(1e-6).cast<float>();
     const Eigen::Matrix3f place = rot * s.asDiagonal(), turn = rot * s.cwiseInverse().asDiagonal();
-    const bool two_sided = twoSided(mesh);
     const Eigen::Vector3f to_eye = (eye_f - at).normalized();
     // a flat mesh's faces all lie in the plane through `at` with normal rot z
     const float side = two_sided && rot.col(2).dot(to_eye) < 0 ? -1.0f : 1.0f;
@@ -330,7 +309,6 @@ void OsmesaRenderEngine::renderView(const CameraView& view, const std::vector<Re
     auto& vertices = g.batch_vertices[two_sided ? 1 : 0];
     auto& indices = g.batch_indices[two_sided ? 1 : 0];
     const auto base = static_cast<unsigned>(vertices.size());
-    const std::vector<Vertex>& mesh_vertices = g.mesh_vertices[mesh];
     vertices.resize(base + mesh_vertices.size());
     BatchVertex* out = vertices.data() + base;
     const float* lit_normal = nullptr;  // the mesh normal `color` was computed for (faces share one)
@@ -350,11 +328,22 @@ void OsmesaRenderEngine::renderView(const CameraView& view, const std::vector<Re
       std::copy(color, color + 4, out->color);
       ++out;
     }
-    const std::vector<unsigned>& mesh_indices = g.mesh_indices[mesh];
     const std::size_t first = indices.size();
     indices.resize(first + mesh_indices.size());
     std::transform(mesh_indices.begin(), mesh_indices.end(), indices.begin() + static_cast<std::ptrdiff_t>(first),
                    [base](unsigned k) { return base + k; });
+  };
+  auto batch = [&](Mesh mesh, const Pose& pose, const Vec3& scale, const RenderNodeSpec& spec) {
+    batchArrays(g.mesh_vertices[mesh], g.mesh_indices[mesh], twoSided(mesh), pose, scale, spec);
+  };
+  // a scene's mesh: always placed and lit here (its vertices are its own, not a unit mesh's)
+  auto userMesh = [&](const Pose& pose, const RenderNodeSpec& spec) {
+    auto [it, fresh] = g.user_meshes.try_emplace(spec.mesh);
+    Gl::UserMesh& m = it->second;
+    if (fresh) flatMesh(*spec.mesh, m.vertices, m.indices);
+    const Vec3 centre = 0.5 * (spec.mesh->min + spec.mesh->max);
+    if (detail(pose.transformPoint(centre), 0.5 * (spec.mesh->max - spec.mesh->min).norm()).level < 0) return;
+    batchArrays(m.vertices, m.indices, false, pose, Vec3::Ones(), spec);
   };
   // at full detail: one instance, lit per pixel
   auto add = [&](Mesh mesh, const Pose& pose, const Vec3& scale, const RenderNodeSpec& spec) {
@@ -420,6 +409,9 @@ void OsmesaRenderEngine::renderView(const CameraView& view, const std::vector<Re
         break;
       }
       case P::Plane: add(kPlane, node.world, Vec3(s.size.x(), s.size.y(), 1.0), s); break;
+      case P::Mesh:
+        if (s.mesh != nullptr) userMesh(node.world, s);
+        break;
     }
   }
   // shadows: the ground is the first plane facing up; a robot's nodes (they come artifact by
@@ -440,6 +432,7 @@ void OsmesaRenderEngine::renderView(const CameraView& view, const std::vector<Re
         case P::Sphere:
         case P::Cylinder:
         case P::Capsule: return s.radius;
+        case P::Mesh: return s.mesh != nullptr ? 0.5 * std::hypot(s.mesh->max.x() - s.mesh->min.x(), s.mesh->max.y() - s.mesh->min.y()) : -1.0;
         default: return -1.0;  // casts none
       }
     };

@@ -99,4 +99,19 @@ void planeMesh(std::vector<Vertex>& v, std::vector<unsigned>& idx) {
   addQuad(v, idx, {0, 0, 1}, {{{-0.5f, -0.5f, 0}, {0.5f, -0.5f, 0}, {0.5f, 0.5f, 0}, {-0.5f, 0.5f, 0}}});
 }
 
+void flatMesh(const TriangleMesh& mesh, std::vector<Vertex>& v, std::vector<unsigned>& idx) {
+  for (std::size_t i = 0; i + 2 < mesh.triangles.size(); i += 3) {
+    const Vec3 &a = mesh.vertices[mesh.triangles[i]], &b = mesh.vertices[mesh.triangles[i + 1]],
+               &c = mesh.vertices[mesh.triangles[i + 2]];
+    const Vec3 n = (b - a).cross(c - a);
+    if (!(n.squaredNorm() > 0)) continue;  // (a degenerate triangle has no face)
+    const Vec3 u = n.normalized();
+    for (const Vec3* p : {&a, &b, &c}) {
+      idx.push_back(static_cast<unsigned>(v.size()));
+      v.push_back({{static_cast<float>(p->x()), static_cast<float>(p->y()), static_cast<float>(p->z())},
+                   {static_cast<float>(u.x()), static_cast<float>(u.y()), static_cast<float>(u.z())}});
+    }
+  }
+}
+
 }  // namespace ssx::detail

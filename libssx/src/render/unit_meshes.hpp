@@ -1,6 +1,8 @@
 #pragma once
 // The unit meshes the osmesa engine draws every primitive from: a cube, spheres and cylinders of a
 // chosen detail, a disc and a plane, centred on the origin, with outward normals.
+#include <ssx/physic_node.hpp>
+
 #include <vector>
 
 namespace ssx::detail {
@@ -22,5 +24,8 @@ void cylinderMesh(std::vector<Vertex>& v, std::vector<unsigned>& idx, int slices
 void discMesh(std::vector<Vertex>& v, std::vector<unsigned>& idx, int slices);
 /// A unit square in the x-y plane, facing +z.
 void planeMesh(std::vector<Vertex>& v, std::vector<unsigned>& idx);
+/// A scene's mesh, flat-shaded: each triangle its three corners with the face's normal
+/// (degenerate triangles left out).
+void flatMesh(const TriangleMesh& mesh, std::vector<Vertex>& v, std::vector<unsigned>& idx);
 
 }  // namespace ssx::detail

@@ -22,6 +22,10 @@ RenderNodeSpec renderNodeOf(const Shape& s, const Color& color) {
     case Shape::Kind::Cylinder: r.primitive = RenderNodeSpec::Primitive::Cylinder; break;
     case Shape::Kind::Capsule: r.primitive = RenderNodeSpec::Primitive::Capsule; break;
     case Shape::Kind::Plane: r.primitive = RenderNodeSpec::Primitive::Plane; break;
+    case Shape::Kind::Mesh:
+      r.primitive = RenderNodeSpec::Primitive::Mesh;
+      r.mesh = s.mesh;
+      break;
   }
   return r;
 }

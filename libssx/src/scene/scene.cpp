@@ -1,6 +1,7 @@
 // Loading scenes (ssx/scene.hpp): the entry points of the scene loader (xml/scene_loader.hpp), its
 // error, and where the installed data is.
 #include "scene/builder.hpp"
+#include "scene/import/robot_import.hpp"
 #include "scene/xml/scene_loader.hpp"
 
 #include <ssx/scene.hpp>
@@ -115,6 +116,35 @@ Scene buildScene(const SceneModel& model, const SceneOptions& options) {
   scene.warnings = std::move(found);
   scene.model = std::make_shared<const SceneModel>(model);
   return scene;
+}
+
+ImportedRobot importRobotDescription(const fs::path& file, const fs::path& out_dir, const SceneOptions& options) {
+  ImportedRobot out;
+  detail::DiagnosticLog log;
+  const detail::ResourcePath resources{options.resource_path};
+  const Descriptor artifact = detail::importRobot(file, resources, options.max_input_bytes, log);
+  if (log.errorCount() > 0) throw SceneError(log.take());
+  // the artifact checked as a scene would use it: read as an artifact file and built on the engine
+  std::error_code ec;
+  const fs::path absolute = fs::absolute(file, ec);
+  const std::string name = "robot";
+  const std::string scene = "<scene><type name=\"" + name + "\" file=\"" + absolute.string() +
+                            "\"/><artifact name=\"" + name + "\" type=\"" + name + "\" allow_overlap=\"true\"/></scene>";
+  SceneOptions checking = options;
+  checking.extensions = false;
+  Scene loaded = loadSceneFromString(scene, file.string(), directoryOf(file), checking);
+  out.warnings = log.take();
+  out.artifact_xml = detail::artifactXml(artifact, out_dir,
+                                         "made by `ssx import` from " + file.filename().string() +
+                                             " (docs/robots.md): edit it, and give it as a <type file>");
+  const Artifact& a = *loaded.environment->findArtifact(name);
+  out.bodies = 0;
+  for (std::size_t i = 0; i < a.nodeCount(); ++i)
+    if (a.nodeAt(i).parent() == nullptr || a.nodeAt(i).spec().joint.isBody()) ++out.bodies;
+  for (std::size_t i = 0; i < a.nodeCount(); ++i)
+    if (a.nodeAt(i).spec().joint.isBody()) ++out.joints;
+  for (std::size_t i = 0; i < a.rootCount(); ++i) out.mass += combinedMass(a.root(i).spec()).mass;
+  return out;
 }
 
 Scene loadScene(const fs::path& file, const SceneOptions& options) {

@@ -192,7 +192,7 @@ void wind(std::ostringstream& out, const WindSettings& w) {
 
 void obstacleShape(std::ostringstream& out, const ShapeModel& m) {
   const Shape& s = m.shape;
-  static constexpr const char* kNames[] = {"box", "sphere", "cylinder", "capsule", "plane"};
+  static constexpr const char* kNames[] = {"box", "sphere", "cylinder", "capsule", "plane", "mesh"};
   Element e(out, kNames[static_cast<int>(s.kind)], 2);
   if (s.kind == Shape::Kind::Box) e("size", vec(s.size));
   if (s.kind == Shape::Kind::Sphere || s.kind == Shape::Kind::Cylinder || s.kind == Shape::Kind::Capsule)

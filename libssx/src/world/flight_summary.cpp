@@ -22,6 +22,7 @@ double reach(const PhysicNodeSpec& node, const Pose& pose) {
       case Shape::Kind::Sphere: own = s.radius; break;
       case Shape::Kind::Cylinder: own = std::hypot(s.radius, 0.5 * s.length); break;
       case Shape::Kind::Capsule: own = 0.5 * s.length + s.radius; break;
+      case Shape::Kind::Mesh: own = s.mesh->min.cwiseAbs().cwiseMax(s.mesh->max.cwiseAbs()).norm(); break;
       case Shape::Kind::Plane: continue;
     }
     r = std::max(r, (pose * s.pose).position.norm() + own);
@@ -44,6 +45,7 @@ double footprint(const PhysicNodeSpec& node, const Pose& pose) {
       case Shape::Kind::Sphere: own = s.radius; break;
       case Shape::Kind::Cylinder: own = upright ? s.radius : std::hypot(s.radius, 0.5 * s.length); break;
       case Shape::Kind::Capsule: own = upright ? s.radius : 0.5 * s.length + s.radius; break;
+      case Shape::Kind::Mesh: own = s.mesh->min.cwiseAbs().cwiseMax(s.mesh->max.cwiseAbs()).norm(); break;
       case Shape::Kind::Plane: continue;
     }
     r = std::max(r, at.position.head<2>().norm() + own);

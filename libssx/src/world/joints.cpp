@@ -7,6 +7,7 @@
 #include <ssx/environment.hpp>
 #include <ssx/physic_node.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 
@@ -125,9 +126,13 @@ const Wrench* applyJoints(World& world, PhysicEngine& engine) {
   bool damped = false;
   for (const JointData& j : world.joints) {
     if (j.damping > 0) damped = true;
-    if (j.mode == JointData::Mode::Off) continue;  // (the engine's motor is off until commanded)
-    double velocity = j.target;
     const JointSpec& spec = world.node_handles[j.node].spec().joint;
+    if (j.mode == JointData::Mode::Off) {
+      // (the engine's motor is off until commanded); friction brakes the joint with the motor
+      if (spec.friction > 0) engine.setJointMotor(j.engine, 0.0, spec.friction);
+      continue;
+    }
+    double velocity = j.target;
     if (j.mode == JointData::Mode::Position) {
       // the velocity that reaches the target at the step's end, but no faster than the motor can
       // still stop from at half its effort (the rest for what loads the joint): it arrives, not overshoots
@@ -136,6 +141,7 @@ const Wrench* applyJoints(World& world, PhysicEngine& engine) {
       const double braking = 0.5 * spec.max_effort / j.effective;
       velocity = std::copysign(std::min(std::abs(error) / dt, std::sqrt(2 * braking * std::abs(error))), error);
     }
+    velocity = std::clamp(velocity, -spec.max_velocity, spec.max_velocity);
     engine.setJointMotor(j.engine, velocity, spec.max_effort);
   }
   if (!damped) return world.wrenches.data();

@@ -17,6 +17,50 @@
 
 namespace ssx {
 
+namespace {
+
+// the point of triangle (a, b, c) nearest to p (Ericson, Real-Time Collision Detection, 5.1.5)
+Vec3 nearestOnTriangle(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c) {
+  const Vec3 ab = b - a, ac = c - a, ap = p - a;
+  const double d1 = ab.dot(ap), d2 = ac.dot(ap);
+  if (d1 <= 0 && d2 <= 0) return a;
+  const Vec3 bp = p - b;
+  const double d3 = ab.dot(bp), d4 = ac.dot(bp);
+  if (d3 >= 0 && d4 <= d3) return b;
+  const double vc = d1 * d4 - d3 * d2;
+  if (vc <= 0 && d1 >= 0 && d3 <= 0) return a + d1 / (d1 - d3) * ab;
+  const Vec3 cp = p - c;
+  const double d5 = ab.dot(cp), d6 = ac.dot(cp);
+  if (d6 >= 0 && d5 <= d6) return c;
+  const double vb = d5 * d2 - d1 * d6;
+  if (vb <= 0 && d2 >= 0 && d6 <= 0) return a + d2 / (d2 - d6) * ac;
+  const double va = d3 * d6 - d5 * d4;
+  if (va <= 0 && d4 - d3 >= 0 && d5 - d6 >= 0) return b + (d4 - d3) / ((d4 - d3) + (d5 - d6)) * (c - b);
+  const double denom = 1 / (va + vb + vc);
+  return a + ab * (vb * denom) + ac * (vc * denom);
+}
+
+// the hull's point nearest to q (q itself inside it)
+Vec3 nearestHullPoint(const TriangleMesh& m, const Vec3& q) {
+  const auto& v = m.hull_vertices;
+  const auto& t = m.hull_triangles;
+  bool inside = !t.empty();
+  Vec3 best = q;
+  double best_d = std::numeric_limits<double>::infinity();
+  for (std::size_t i = 0; i + 2 < t.size(); i += 3) {
+    const Vec3 &a = v[t[i]], &b = v[t[i + 1]], &c = v[t[i + 2]];
+    if ((b - a).cross(c - a).dot(q - a) > 0) inside = false;
+    const Vec3 n = nearestOnTriangle(q, a, b, c);
+    if (const double d = (n - q).squaredNorm(); d < best_d) {
+      best_d = d;
+      best = n;
+    }
+  }
+  return inside ? q : best;
+}
+
+}  // namespace
+
 Vec3 nearestSurfacePoint(const Shape& s, const Pose& world, const Vec3& p) {
   const Vec3 q = world.inverse().transformPoint(p);
   Vec3 n = q;
@@ -41,6 +85,9 @@ Vec3 nearestSurfacePoint(const Shape& s, const Pose& world, const Vec3& p) {
     }
     case Shape::Kind::Plane:
       n.z() = 0;
+      break;
+    case Shape::Kind::Mesh:
+      if (s.mesh != nullptr) n = nearestHullPoint(*s.mesh, q);
       break;
   }
   return world.transformPoint(n);
@@ -72,7 +119,7 @@ MassProperties nodeMass(const PhysicNodeSpec& node) {
     if (s.kind == Shape::Kind::Plane) continue;
     const double m = s.volume() * s.density;
     const Mat3 r = s.pose.orientation.toRotationMatrix();
-    addMass(shapes, m, s.pose.position, r * s.unitInertia(m) * r.transpose());
+    addMass(shapes, m, s.pose.transformPoint(s.centroid()), r * s.unitInertia(m) * r.transpose());
   }
   if (!node.mass) return shapes;
   if (node.inertia) return {*node.mass, node.center_of_mass, *node.inertia};
@@ -115,8 +162,11 @@ void validateJoint(const PhysicNodeSpec& node, bool is_root) {
     if (!(std::isfinite(j.max_effort) && j.max_effort >= 0))
       fail(std::string("the motor's ") + (j.kind == JointSpec::Kind::Hinge ? "max_torque" : "max_force") +
            " must be finite and >= 0");
-  } else if (std::isfinite(j.lower) || std::isfinite(j.upper) || j.damping != 0 || j.max_effort != 0) {
-    fail("a " + kind + " joint takes no limits, damping or motor (only hinges and sliders do)");
+    if (!(j.max_velocity > 0)) fail("max_velocity must be positive (leave it out for no bound)");
+    if (!(std::isfinite(j.friction) && j.friction >= 0)) fail("friction must be finite and >= 0");
+  } else if (std::isfinite(j.lower) || std::isfinite(j.upper) || j.damping != 0 || j.max_effort != 0 ||
+             j.friction != 0 || std::isfinite(j.max_velocity)) {
+    fail("a " + kind + " joint takes no limits, damping, friction or motor (only hinges and sliders do)");
   }
   validateBody(node);
 }
@@ -154,6 +204,9 @@ void validateNode(const PhysicNodeSpec& node, bool is_root, bool root_static, st
         break;
       case Shape::Kind::Plane:
         if (!(is_root && root_static)) fail("a plane shape is allowed only on a static root node");
+        break;
+      case Shape::Kind::Mesh:
+        ok = s.mesh != nullptr && !s.mesh->triangles.empty() && (root_static || s.mesh->hull_volume > 0);
         break;
     }
     if (!ok) fail("shape sizes must be positive and finite");
@@ -197,6 +250,17 @@ Shape Shape::plane(const Pose& pose) {
   s.pose = pose;
   return s;
 }
+Shape Shape::fromMesh(std::shared_ptr<const TriangleMesh> mesh, const Pose& pose) {
+  Shape s;
+  s.kind = Kind::Mesh;
+  s.mesh = std::move(mesh);
+  s.pose = pose;
+  return s;
+}
+
+Vec3 Shape::centroid() const {
+  return kind == Kind::Mesh && mesh != nullptr ? mesh->hull_centroid : Vec3::Zero();
+}
 
 double Shape::volume() const {
   switch (kind) {
@@ -210,6 +274,8 @@ double Shape::volume() const {
       return kPi * radius * radius * (length + 4.0 / 3.0 * radius);
     case Kind::Plane:
       return 0.0;
+    case Kind::Mesh:
+      return mesh != nullptr ? mesh->hull_volume : 0.0;
   }
   return 0.0;
 }
@@ -239,6 +305,8 @@ Mat3 Shape::unitInertia(double m) const {
     }
     case Kind::Plane:
       return Mat3::Zero();
+    case Kind::Mesh:
+      return mesh != nullptr ? Mat3(m * mesh->hull_unit_inertia) : Mat3::Zero();
   }
   return Mat3::Zero();
 }

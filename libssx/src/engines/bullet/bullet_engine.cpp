@@ -16,8 +16,36 @@ using namespace bullet;
 
 namespace {
 
-std::unique_ptr<btCollisionShape> createShape(const Shape& s) {
+// a static mesh's triangles as Bullet reads them, kept beside the shape that reads them
+struct MeshArrays {
+  std::shared_ptr<const TriangleMesh> mesh;
+  std::vector<int> indices;
+  btTriangleIndexVertexArray array;
+  explicit MeshArrays(std::shared_ptr<const TriangleMesh> m)
+      : mesh(std::move(m)),
+        indices(mesh->triangles.begin(), mesh->triangles.end()),
+        array(static_cast<int>(indices.size() / 3), indices.data(), 3 * sizeof(int), static_cast<int>(mesh->vertices.size()),
+              const_cast<btScalar*>(mesh->vertices.data()->data()), sizeof(Vec3)) {}
+};
+
+// (the arrays first: built before the shape, destroyed after it)
+struct StaticMeshShape final : private MeshArrays, public btBvhTriangleMeshShape {
+  explicit StaticMeshShape(std::shared_ptr<const TriangleMesh> m)
+      : MeshArrays(std::move(m)), btBvhTriangleMeshShape(&array, true) {}
+};
+
+// the margin Bullet keeps around a hull (its default, 4 cm, is larger than a Crazyflie's arm)
+constexpr double kHullMargin = 1e-3;
+
+std::unique_ptr<btCollisionShape> createShape(const Shape& s, bool is_static) {
   switch (s.kind) {
+    case Shape::Kind::Mesh: {
+      if (is_static) return std::make_unique<StaticMeshShape>(s.mesh);
+      const auto& v = s.mesh->hull_vertices;
+      auto hull = std::make_unique<btConvexHullShape>(v.data()->data(), static_cast<int>(v.size()), sizeof(Vec3));
+      hull->setMargin(kHullMargin);
+      return hull;
+    }
     case Shape::Kind::Box:
       return std::make_unique<btBoxShape>(toBt(s.size / 2));
     case Shape::Kind::Sphere:
@@ -38,6 +66,7 @@ double diameterOf(const Shape& s) {
     case Shape::Kind::Sphere: return 2 * s.radius;
     case Shape::Kind::Cylinder: return 2 * std::hypot(s.radius, s.length / 2);
     case Shape::Kind::Capsule: return 2 * s.radius + s.length;
+    case Shape::Kind::Mesh: return 2 * s.mesh->min.cwiseAbs().cwiseMax(s.mesh->max.cwiseAbs()).norm();
     case Shape::Kind::Plane: break;
   }
   return 0.0;
@@ -92,7 +121,7 @@ int BulletEngine::addBody(const MassProperties& mass, const std::vector<Shape>& 
   }
   body->compound = std::make_unique<btCompoundShape>(false, static_cast<int>(shapes.size()));
   for (const auto& s : shapes) {
-    Geom g{createShape(s), {}, diameterOf(s)};
+    Geom g{createShape(s, false), {}, diameterOf(s)};
     const Pose local{body->principal.conjugate() * s.pose.position, body->principal.conjugate() * s.pose.orientation};
     const Quat q = local.orientation.normalized();
     const double offset[7] = {local.position.x(), local.position.y(), local.position.z(), q.x(), q.y(), q.z(), q.w()};
@@ -150,7 +179,7 @@ int BulletEngine::addStatic(const std::vector<Shape>& shapes, const Pose& pose) 
       object->offset = object->normal.dot(world.position);
       object->shape = std::make_unique<btStaticPlaneShape>(toBt(object->normal), object->offset);
     } else {
-      object->shape = createShape(s);
+      object->shape = createShape(s, true);
     }
     object->object = std::make_unique<btCollisionObject>();
     object->object->setCollisionShape(object->shape.get());

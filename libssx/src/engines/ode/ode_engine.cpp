@@ -197,7 +197,7 @@ OdeEngine::~OdeEngine() {
   releaseOde();
 }
 
-dGeomID createOdeGeom(const Shape& s) {
+dGeomID createOdeGeom(const Shape& s, OdeMeshes& meshes, bool is_static) {
   switch (s.kind) {
     case Shape::Kind::Box:
       return dCreateBox(nullptr, s.size.x(), s.size.y(), s.size.z());
@@ -207,6 +207,8 @@ dGeomID createOdeGeom(const Shape& s) {
       return dCreateCylinder(nullptr, s.radius, s.length);
     case Shape::Kind::Capsule:
       return dCreateCapsule(nullptr, s.radius, s.length);
+    case Shape::Kind::Mesh:
+      return meshes.create(s, is_static);
     case Shape::Kind::Plane:
       break;
   }
@@ -235,12 +237,13 @@ int OdeEngine::addBody(const MassProperties& mass, const std::vector<Shape>& sha
       for (const Geom& g : body.geoms) dGeomDestroy(g.id);
       throw Error("ode: a plane cannot belong to a dynamic body");
     }
-    Geom g{createOdeGeom(s), {}, {}, 0.0};
+    Geom g{createOdeGeom(s, meshes_), {}, {}, 0.0};
     switch (s.kind) {
       case Shape::Kind::Box: g.diameter = s.size.norm(); break;
       case Shape::Kind::Sphere: g.diameter = 2 * s.radius; break;
       case Shape::Kind::Cylinder: g.diameter = 2 * std::hypot(s.radius, s.length / 2); break;
       case Shape::Kind::Capsule: g.diameter = 2 * s.radius + s.length; break;
+      case Shape::Kind::Mesh: g.diameter = 2 * s.mesh->min.cwiseAbs().cwiseMax(s.mesh->max.cwiseAbs()).norm(); break;
       case Shape::Kind::Plane: break;
     }
     // the offset as dGeomSetOffsetPosition and dGeomSetOffsetQuaternion would keep it
@@ -301,7 +304,7 @@ int OdeEngine::addStatic(const std::vector<Shape>& shapes, const Pose& pose) {
       planes_params_.push_back({params[0], params[1], params[2], params[3]});
       continue;
     }
-    dGeomID g = createOdeGeom(s);
+    dGeomID g = createOdeGeom(s, meshes_, true);
     dQuaternion q;
     toOde(world.orientation, q);
     dGeomSetPosition(g, world.position.x(), world.position.y(), world.position.z());

@@ -44,10 +44,38 @@
 #include <ode/ode.h>
 
 #include <array>
+#include <map>
+#include <memory>
 #include <mutex>
 #include <vector>
 
 namespace ssx::detail {
+
+// the arrays ODE's mesh geoms read while they live, one set per mesh (ode_meshes.cpp): outlives
+// the geoms made with it
+class OdeMeshes {
+ public:
+  OdeMeshes() = default;
+  OdeMeshes(const OdeMeshes&) = delete;
+  OdeMeshes& operator=(const OdeMeshes&) = delete;
+  ~OdeMeshes();
+  // a geom in no space for a mesh shape: its triangles when static, else its convex hull
+  dGeomID create(const Shape& shape, bool is_static);
+
+ private:
+  struct Hull {
+    std::shared_ptr<const TriangleMesh> mesh;
+    std::vector<dReal> planes;       // a, b, c, d per face: a x + b y + c z = d, normal outward
+    std::vector<unsigned> polygons;  // 3, i, j, k per face
+  };
+  struct Triangles {
+    std::shared_ptr<const TriangleMesh> mesh;
+    std::vector<dTriIndex> indices;
+    dTriMeshDataID data = nullptr;
+  };
+  std::map<const TriangleMesh*, Hull> hulls_;
+  std::map<const TriangleMesh*, Triangles> triangles_;
+};
 
 class OdeEngine final : public PhysicEngine {
  public:
@@ -191,6 +219,7 @@ class OdeEngine final : public PhysicEngine {
   // the planes apart; contacts found per chunk, joined in chunk order
   std::vector<dGeomID> static_geoms_;
   int static_groups_ = 0;  // addStatic's calls so far
+  OdeMeshes meshes_;       // the arrays the mesh geoms read (destroyed after them)
   std::vector<dGeomID> planes_;
   std::vector<std::array<double, 4>> planes_params_;  // each plane's n x = d: n, then d
   std::vector<dGeomID> proxy_geoms_;
@@ -215,8 +244,9 @@ class OdeEngine final : public PhysicEngine {
   mutable std::vector<dGeomID> free_rays_;
 };
 
-// an ODE geom in no space for a shape that is not a plane (ode_engine.cpp)
-dGeomID createOdeGeom(const Shape& shape);
+// an ODE geom in no space for a shape that is not a plane (ode_engine.cpp); a mesh's arrays are
+// kept in `meshes`
+dGeomID createOdeGeom(const Shape& shape, OdeMeshes& meshes, bool is_static = false);
 
 // ODE's process-wide initialisation, reference-counted (ode_engine.cpp): each acquireOde is
 // matched by one releaseOde

@@ -16,13 +16,14 @@ namespace ssx::detail {
 
 namespace {
 
-dGeomID makeGeom(const PosedShape& s) {
+dGeomID makeGeom(const PosedShape& s, OdeMeshes& meshes) {
   const Shape& shape = *s.shape;
   if (shape.kind == Shape::Kind::Plane) {
     const Vec3 n = s.world.orientation * Vec3::UnitZ();
     return dCreatePlane(nullptr, n.x(), n.y(), n.z(), n.dot(s.world.position));
   }
-  dGeomID g = createOdeGeom(shape);
+  // (a mesh: its hull on a moving body, its triangles on a static one, as the engine steps them)
+  dGeomID g = createOdeGeom(shape, meshes, s.is_static);
   const Quat& q = s.world.orientation;
   const dQuaternion oq = {q.w(), q.x(), q.y(), q.z()};
   dGeomSetPosition(g, s.world.position.x(), s.world.position.y(), s.world.position.z());
@@ -32,6 +33,7 @@ dGeomID makeGeom(const PosedShape& s) {
 
 // the geoms of the shapes, destroyed with it
 struct Geoms {
+  OdeMeshes meshes;  // (destroyed after the geoms)
   std::vector<dGeomID> ids;
   ~Geoms() {
     for (dGeomID g : ids) dGeomDestroy(g);
@@ -53,7 +55,7 @@ std::vector<ShapeOverlap> findShapeOverlaps(std::span<const PosedShape> shapes, 
     std::vector<GridBroadphase::Box> boxes(shapes.size());
     std::vector<double> sizes;
     for (std::size_t i = 0; i < shapes.size(); ++i) {
-      geoms.ids.push_back(makeGeom(shapes[i]));
+      geoms.ids.push_back(makeGeom(shapes[i], geoms.meshes));
       dReal aabb[6];
       dGeomGetAABB(geoms.ids.back(), aabb);
       boxes[i].min = Vec3(aabb[0], aabb[2], aabb[4]);

@@ -1,4 +1,5 @@
 // Artifact files: physic and render node trees, shapes, and the driver and sensors they declare.
+#include "scene/import/robot_import.hpp"
 #include "scene/xml/scene_loader.hpp"
 #include "scene/xml/xml_reader.hpp"
 
@@ -28,6 +29,39 @@ Shape SceneLoader::readShape(const Descriptor& d, Vec3* xyz_out, Vec3* rpy_out) 
   return s;
 }
 
+std::shared_ptr<const TriangleMesh> SceneLoader::readMesh(const Descriptor& d, bool collides) {
+  const std::string file = require(d, "file");
+  const Vec3 scale = read<Vec3>(d, "scale", Vec3::Ones());
+  if (file.empty()) return nullptr;
+  if (!scale.allFinite() || (scale.array() == 0).any()) {
+    error(d.where(), "<mesh>: every scale must be finite and non-zero");
+    return nullptr;
+  }
+  const fs::path path = resolve(artifact_dir_, file);
+  std::error_code ec;
+  if (!fs::is_regular_file(path, ec)) {
+    error(d.where(), "<mesh>: no file '" + path.string() + "' (a relative path is relative to the artifact file)");
+    return nullptr;
+  }
+  if (const auto bytes = fs::file_size(path, ec); !ec && bytes > options_.max_input_bytes) {
+    error(d.where(), "<mesh>: '" + path.string() + "' is " + std::to_string(bytes >> 20) + " MB, larger than the " +
+                         std::to_string(options_.max_input_bytes >> 20) + " MB a file read may be (--max-input-mb)");
+    return nullptr;
+  }
+  std::string problem;
+  auto mesh = meshes_.load(path, scale, problem);
+  if (mesh == nullptr) {
+    error(d.where(), "<mesh>: '" + path.string() + "': " + problem);
+  } else if (collides && mesh->hull_triangles.empty()) {
+    error(d.where(), "<mesh>: '" + path.string() + "' encloses no volume (its points lie in a plane or on a line): "
+                     "it cannot be a body's shape; give the node a box or another primitive");
+    return nullptr;
+  }
+  if (mesh != nullptr && std::find(model_.files.begin(), model_.files.end(), path) == model_.files.end())
+    model_.files.push_back(path);
+  return mesh;
+}
+
 void SceneLoader::readJoint(const Descriptor& d, JointSpec& j) {
   const std::string kind = read<std::string>(d, "joint", "");
   static const std::map<std::string, JointSpec::Kind> kinds = {{"hinge", JointSpec::Kind::Hinge},
@@ -41,7 +75,7 @@ void SceneLoader::readJoint(const Descriptor& d, JointSpec& j) {
     else
       j.kind = it->second;
   }
-  for (const char* key : {"axis", "lower", "upper", "damping", "max_torque", "max_force"})
+  for (const char* key : {"axis", "lower", "upper", "damping", "max_torque", "max_force", "max_velocity", "friction"})
     if (d.has(key) && !j.hasPosition()) {
       error(d.where(), std::string("<physic>: '") + key + "' belongs to a hinge or slider joint" +
                            (kind.empty() ? " (this node has no joint attribute)" : ", and this joint is a " + kind));
@@ -60,6 +94,8 @@ void SceneLoader::readJoint(const Descriptor& d, JointSpec& j) {
   if (d.has(other))
     error(d.where(), std::string("<physic>: a ") + kind + "'s motor takes " + motor + ", not " + other);
   j.max_effort = read<double>(d, motor, 0.0);
+  j.max_velocity = read<double>(d, "max_velocity", j.max_velocity);
+  j.friction = read<double>(d, "friction", 0.0);
 }
 
 PhysicNodeSpec SceneLoader::readPhysicNode(const Descriptor& d) {
@@ -80,13 +116,19 @@ PhysicNodeSpec SceneLoader::readPhysicNode(const Descriptor& d) {
   n.is_static = read<bool>(d, "static", false);  // validatePhysicTree refuses it below the root
   readJoint(d, n.joint);
   for (const Descriptor& c : d.children()) {
-    if (kShapeElements.contains(c.name()))
+    if (kShapeElements.contains(c.name())) {
       n.shapes.push_back(readShape(c));
-    else if (c.name() == "physic")
+    } else if (c.name() == "mesh") {
+      Shape s = Shape::fromMesh(readMesh(c, true), readPose(c));
+      s.density = readPositive(c, "density", s.density);
+      checkUnknown(c);
+      if (s.mesh != nullptr) n.shapes.push_back(std::move(s));
+    } else if (c.name() == "physic") {
       n.children.push_back(readPhysicNode(c));
+    }
   }
   std::set<std::string> allowed = kShapeElements;
-  allowed.insert("physic");
+  allowed.insert({"physic", "mesh"});
   checkUnknown(d, allowed);
   return n;
 }
@@ -111,12 +153,15 @@ RenderNodeSpec SceneLoader::readRenderNode(const Descriptor& d, bool is_root) {
   } else if (kind == "plane") {
     n.primitive = RenderNodeSpec::Primitive::Plane;
     n.size = read<Vec3>(d, "size", Vec3(10, 10, 0));
+  } else if (kind == "mesh") {
+    n.mesh = readMesh(d, false);
+    if (n.mesh != nullptr) n.primitive = RenderNodeSpec::Primitive::Mesh;
   }
   for (const Descriptor& c : d.children())
-    if (kShapeElements.contains(c.name()) || c.name() == "plane" || c.name() == "render")
+    if (kShapeElements.contains(c.name()) || c.name() == "plane" || c.name() == "render" || c.name() == "mesh")
       n.children.push_back(readRenderNode(c, false));
   std::set<std::string> allowed = kShapeElements;
-  allowed.insert({"plane", "render"});
+  allowed.insert({"plane", "render", "mesh"});
   checkUnknown(d, allowed);
   return n;
 }
@@ -213,9 +258,23 @@ const ArtifactType* SceneLoader::artifactType(const std::string& name, const Sou
     return nullptr;
   }
   ArtifactType& t = types_[name];
+  artifact_dir_ = decl->second.file.parent_path();
   try {
     model_.files.push_back(decl->second.file);
-    documents_.push_back(readXmlFile(decl->second.file, options_.max_input_bytes));
+    if (isRobotDescription(decl->second.file)) {
+      // a URDF or SDF robot, in ssx's artifact form; its problems carry its own lines
+      ResourcePath resources{options_.resource_path};
+      const std::size_t errors_before = errorCount();
+      documents_.push_back(importRobot(decl->second.file, resources, options_.max_input_bytes, log_));
+      if (errorCount() != errors_before) {
+        t.ok = false;
+        return nullptr;
+      }
+    } else {
+      documents_.push_back(readXmlFile(decl->second.file, options_.max_input_bytes));
+    }
+    // the driver and sensors the scene's <type> gives it, after the file's own
+    for (const Descriptor* p : decl->second.plugins) documents_.back().addChild(*p);
     t = parseArtifact(documents_.back());
     t.name = name;
     t.file = decl->second.file;

@@ -10,6 +10,7 @@
 #include <ssx/scene_model.hpp>
 
 #include "scene/diagnostic_log.hpp"
+#include "scene/import/mesh_loader.hpp"
 
 #include <array>
 #include <deque>
@@ -213,6 +214,9 @@ class SceneLoader {
   ArtifactType parseArtifact(const Descriptor& root);
   // (xyz, rpy: set to the shape's position and angles as written)
   Shape readShape(const Descriptor& d, Vec3* xyz = nullptr, Vec3* rpy = nullptr);
+  // a <mesh file scale>'s mesh (file relative to the artifact file), or nullptr when it cannot be read
+  // (`collides`: for a physic node, which needs its convex hull)
+  std::shared_ptr<const TriangleMesh> readMesh(const Descriptor& d, bool collides);
   void readJoint(const Descriptor& d, JointSpec& joint);
   PhysicNodeSpec readPhysicNode(const Descriptor& d);
   RenderNodeSpec readRenderNode(const Descriptor& d, bool is_root);
@@ -232,6 +236,8 @@ class SceneLoader {
   DiagnosticLog log_;
   std::vector<std::int64_t> extension_stage_;  // per extension of the model: its entity's stage
   std::vector<std::int64_t> placement_stage_;  // per placement of the model: its entity's stage
+  MeshCache meshes_;
+  fs::path artifact_dir_;  // of the artifact file being read (its meshes' paths are relative to it)
   std::deque<Descriptor> documents_;  // every file read, kept alive for the pointers below
   SceneModel model_;  // what parse fills in
   EnvironmentSettings& settings_ = model_.settings;
@@ -248,6 +254,7 @@ class SceneLoader {
   struct TypeDecl {
     fs::path file;
     SourceLocation where;
+    std::vector<const Descriptor*> plugins;  // <driver> and <sensor> children: added to the type's own
   };
   std::map<std::string, TypeDecl> type_decls_;
   std::map<std::string, ArtifactType> types_;          // by type name, parsed on first use

@@ -1,0 +1,89 @@
+// Mesh shapes on the engines (ode_meshes.cpp, and Bullet's alike): a moving body's mesh collides as
+// its convex hull (a tetrahedron-made cube rests on the ground at its half height, a cone of
+// vertices rests on its base), a static mesh as its triangles (a sphere rests on a triangle floor).
+#include "engine_util.hpp"
+
+#include <catch2/catch.hpp>
+
+#include <cmath>
+#include <memory>
+#include <vector>
+
+using namespace ssx;
+using namespace ssx::test;
+
+namespace {
+
+// a cube of edge `a` as twelve triangles (outward), its hull computed
+std::shared_ptr<TriangleMesh> cubeMesh(double a) {
+  auto m = std::make_shared<TriangleMesh>();
+  m->file = "cube";
+  for (int i = 0; i < 8; ++i) m->vertices.emplace_back((i & 1 ? 0.5 : -0.5) * a, (i & 2 ? 0.5 : -0.5) * a, (i & 4 ? 0.5 : -0.5) * a);
+  const std::uint32_t faces[12][3] = {{0, 2, 1}, {1, 2, 3}, {4, 5, 6}, {5, 7, 6}, {0, 1, 4}, {1, 5, 4},
+                                      {2, 6, 3}, {3, 6, 7}, {0, 4, 2}, {2, 4, 6}, {1, 3, 5}, {3, 7, 5}};
+  for (const auto& f : faces) m->triangles.insert(m->triangles.end(), {f[0], f[1], f[2]});
+  m->computeHull();
+  return m;
+}
+
+// a flat floor of two triangles, 10 m across, at z = 0
+std::shared_ptr<TriangleMesh> floorMesh() {
+  auto m = std::make_shared<TriangleMesh>();
+  m->file = "floor";
+  m->vertices = {Vec3(-5, -5, 0), Vec3(5, -5, 0), Vec3(5, 5, 0), Vec3(-5, 5, 0)};
+  m->triangles = {0, 1, 2, 0, 2, 3};
+  m->min = Vec3(-5, -5, 0);
+  m->max = Vec3(5, 5, 0);
+  return m;
+}
+
+double settledHeight(PhysicEngine& engine, int body) {
+  const std::vector<Wrench> none(engine.bodyCount());
+  for (int k = 0; k < 1000; ++k) engine.step(toNanoseconds(0.002), none);
+  return states(engine)[static_cast<std::size_t>(body)].pose.position.z();
+}
+
+}  // namespace
+
+TEST_CASE("mesh shapes: a moving mesh collides as its hull, a static one as its triangles", "[physics][ode][bullet][mesh]") {
+  for (const std::string name : {"ode", "bullet"}) {
+    CAPTURE(name);
+    SECTION("a cube mesh dropped on the ground rests on a face " + name) {
+      auto engine = makeEngine(name);
+      engine->addStatic({Shape::plane()}, Pose{});
+      PhysicNodeSpec spec;
+      spec.shapes.push_back(Shape::fromMesh(cubeMesh(0.2)));
+      spec.mass = 1.0;
+      BodyState s;
+      s.pose.position = Vec3(0, 0, 0.3);
+      const int body = engine->addBody(combinedMass(spec), spec.shapes, s);
+      // (the hull's margin and the contacts' softness: within 2 mm)
+      CHECK(settledHeight(*engine, body) == Approx(0.1).margin(0.002));
+    }
+    SECTION("a sphere on a static triangle floor rests on it " + name) {
+      auto engine = makeEngine(name);
+      engine->addStatic({Shape::fromMesh(floorMesh())}, Pose{});
+      const int ball = [&] {
+        PhysicNodeSpec spec;
+        spec.shapes.push_back(Shape::sphere(0.1));
+        spec.mass = 1.0;
+        BodyState s;
+        s.pose.position = Vec3(0.3, -0.2, 0.5);
+        return engine->addBody(combinedMass(spec), spec.shapes, s);
+      }();
+      CHECK(settledHeight(*engine, ball) == Approx(0.1).margin(0.002));
+    }
+  }
+}
+
+TEST_CASE("mesh shapes: a mesh body weighs as its hull at its density", "[physics][mesh]") {
+  PhysicNodeSpec spec;
+  Shape s = Shape::fromMesh(cubeMesh(0.2), Pose{Vec3(0, 0, 1), Quat::Identity()});
+  s.density = 500;
+  spec.shapes.push_back(s);
+  const MassProperties m = combinedMass(spec);
+  CHECK(m.mass == Approx(0.2 * 0.2 * 0.2 * 500));
+  CHECK(m.center_of_mass.isApprox(Vec3(0, 0, 1)));
+  CHECK(m.inertia(0, 0) == Approx(m.mass * (0.04 + 0.04) / 12));
+  CHECK(std::abs(m.inertia(0, 1)) < 1e-15);
+}
