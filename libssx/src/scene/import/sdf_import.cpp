@@ -85,7 +85,7 @@ struct SdfReader {
           log.error(where, "link '" + link + "': mesh '" + m.Uri() + "': " + problem);
           return std::nullopt;
         }
-        d.emplace("mesh", where).set("file", path.string());
+        d.emplace("mesh", where).set("file", fs::absolute(path).lexically_normal().string());
         if (toVec(m.Scale()) != Vec3::Ones()) d->set("scale", toVec(m.Scale()));
         break;
       }

@@ -184,7 +184,7 @@ struct UrdfReader {
           error(at, "link '" + link + "': mesh '" + m.filename + "': " + problem);
           return std::nullopt;
         }
-        d.emplace("mesh", at).set("file", path.string());
+        d.emplace("mesh", at).set("file", fs::absolute(path).lexically_normal().string());
         if (vec(m.scale) != Vec3::Ones()) d->set("scale", vec(m.scale));
         break;
       }
