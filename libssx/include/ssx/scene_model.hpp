@@ -51,6 +51,10 @@ struct ArtifactTypeModel {
   std::vector<std::shared_ptr<const RenderNodeSpec>> render;  ///< shared by every instance
   std::optional<PluginDeclaration> driver;  ///< its driver, if it declares one
   std::vector<PluginDeclaration> sensors;   ///< its sensors, by index
+  /// What the scene's `<type>` itself adds (a URDF or SDF robot's plugins): its `<driver>`, if
+  /// any, and its `<sensor>`s, also in `driver` and at the end of `sensors`
+  std::optional<PluginDeclaration> type_driver;
+  std::vector<PluginDeclaration> type_sensors;  ///< (see type_driver)
 };
 
 /// A shape of an `<obstacle>` as written: `<box size>`, `<sphere radius>`, `<cylinder radius length>`

@@ -254,7 +254,26 @@ std::string SceneModel::toXml() const {
     plugin(e, x.plugin);
     e.end();
   }
-  for (const auto& [name, type] : types) Element(out, "type", 1)("name", name)("file", path(type.file)).end();
+  for (const auto& [name, type] : types) {
+    Element e(out, "type", 1);
+    e("name", name)("file", path(type.file));
+    if (!type.type_driver && type.type_sensors.empty()) {
+      e.end();
+      continue;
+    }
+    e.open();
+    if (type.type_driver) {
+      Element d(out, "driver", 2);
+      plugin(d, *type.type_driver);
+      d.end();
+    }
+    for (const PluginDeclaration& p : type.type_sensors) {
+      Element d(out, "sensor", 2);
+      plugin(d, p);
+      d.end();
+    }
+    e.close();
+  }
   for (const PlacementModel& p : placements) placement(out, p);
   out << "</scene>\n";
   return out.str();

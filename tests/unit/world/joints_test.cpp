@@ -386,7 +386,7 @@ TEST_CASE("joints: what does not make sense is refused before anything runs, nam
   PhysicNodeSpec ball = arm;
   ball.joint.kind = JointSpec::Kind::Ball;
   ball.joint.max_effort = 1.0;
-  refuse(ball, "takes no limits, damping or motor");
+  refuse(ball, "takes no limits, damping, friction or motor");
   PhysicNodeSpec skewed = arm;
   skewed.joint.axis = Vec3(1, 1, 0);
   refuse(skewed, "unit vector");

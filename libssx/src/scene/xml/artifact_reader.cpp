@@ -274,8 +274,18 @@ const ArtifactType* SceneLoader::artifactType(const std::string& name, const Sou
       documents_.push_back(readXmlFile(decl->second.file, options_.max_input_bytes));
     }
     // the driver and sensors the scene's <type> gives it, after the file's own
-    for (const Descriptor* p : decl->second.plugins) documents_.back().addChild(*p);
+    for (const Descriptor* p : decl->second.plugins) {
+      documents_.back().addChild(*p);
+      if (auto d = readPluginDecl(*p)) {
+        if (p->name() == "driver") t.type_driver = *d;
+        else t.type_sensors.push_back(*d);
+      }
+    }
+    auto type_driver = std::move(t.type_driver);
+    auto type_sensors = std::move(t.type_sensors);
     t = parseArtifact(documents_.back());
+    t.type_driver = std::move(type_driver);
+    t.type_sensors = std::move(type_sensors);
     t.name = name;
     t.file = decl->second.file;
     t.where = decl->second.where;

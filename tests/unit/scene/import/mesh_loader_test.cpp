@@ -64,7 +64,7 @@ TEST_CASE("a mesh read from a file: its hull's volume, centroid and inertia, sca
   CHECK(mirrored->hull_volume == Approx(1.0));
 }
 
-TEST_CASE("a flat mesh has no hull; a file that is no mesh is said", "[import][mesh]") {
+TEST_CASE("a flat mesh has no hull, and a file that is no mesh is said", "[import][mesh]") {
   detail::MeshCache cache;
   std::string problem;
   const auto flat = cache.load(writeObj("flat.obj", "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3 4\n"), Vec3::Ones(), problem);

@@ -48,7 +48,7 @@ TEST_CASE("resources: relative, package://, model:// and file://, and where they
   CHECK_THAT(problem, Contains("no file") && Contains("relative to the description"));
 }
 
-TEST_CASE("an imported pose reads back as the same pose; the artifact prints meshes relative to it", "[import]") {
+TEST_CASE("an imported pose reads back as the same pose, and the artifact prints meshes relative to it", "[import]") {
   const Pose p{Vec3(0.1, -0.2, 0.3), Quat(Eigen::AngleAxisd(0.4, Vec3(1, 2, 3).normalized()))};
   Descriptor d("physic");
   detail::setPoseAttributes(d, p);

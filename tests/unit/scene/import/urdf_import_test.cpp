@@ -133,7 +133,7 @@ TEST_CASE("A URDF cart-pole's pole falls as the Lagrangian of the cart-pole says
   }
 }
 
-TEST_CASE("A URDF door with limits stops at them; without, it turns on", "[import][urdf]") {
+TEST_CASE("A URDF door with limits stops at them, and without them turns on", "[import][urdf]") {
   const fs::path limited = variant(kRobots / "simple/door.urdf", "limited_door.urdf",
                                    {{R"(type="continuous">)", R"(type="revolute">)"},
                                     {R"(<axis xyz="0 0 1"/>)", R"(<axis xyz="0 0 1"/><limit lower="-0.5" upper="0.5" effort="0" velocity="2"/>)"}});
