@@ -197,7 +197,8 @@ OdeEngine::~OdeEngine() {
   releaseOde();
 }
 
-dGeomID createOdeGeom(const Shape& s, OdeMeshes& meshes, bool is_static) {
+dGeomID createOdeGeom(const Shape& s, OdeMeshes& meshes, bool is_static, Vec3& centre) {
+  centre = Vec3::Zero();
   switch (s.kind) {
     case Shape::Kind::Box:
       return dCreateBox(nullptr, s.size.x(), s.size.y(), s.size.z());
@@ -208,7 +209,7 @@ dGeomID createOdeGeom(const Shape& s, OdeMeshes& meshes, bool is_static) {
     case Shape::Kind::Capsule:
       return dCreateCapsule(nullptr, s.radius, s.length);
     case Shape::Kind::Mesh:
-      return meshes.create(s, is_static);
+      return meshes.create(s, is_static, centre);
     case Shape::Kind::Plane:
       break;
   }
@@ -237,7 +238,8 @@ int OdeEngine::addBody(const MassProperties& mass, const std::vector<Shape>& sha
       for (const Geom& g : body.geoms) dGeomDestroy(g.id);
       throw Error("ode: a plane cannot belong to a dynamic body");
     }
-    Geom g{createOdeGeom(s, meshes_), {}, {}, 0.0};
+    Vec3 centre;
+    Geom g{createOdeGeom(s, meshes_, false, centre), {}, {}, 0.0};
     switch (s.kind) {
       case Shape::Kind::Box: g.diameter = s.size.norm(); break;
       case Shape::Kind::Sphere: g.diameter = 2 * s.radius; break;
@@ -247,9 +249,10 @@ int OdeEngine::addBody(const MassProperties& mass, const std::vector<Shape>& sha
       case Shape::Kind::Plane: break;
     }
     // the offset as dGeomSetOffsetPosition and dGeomSetOffsetQuaternion would keep it
-    g.offset_position[0] = s.pose.position.x();
-    g.offset_position[1] = s.pose.position.y();
-    g.offset_position[2] = s.pose.position.z();
+    const Vec3 at = s.pose.transformPoint(centre);
+    g.offset_position[0] = at.x();
+    g.offset_position[1] = at.y();
+    g.offset_position[2] = at.z();
     g.offset_position[3] = 0;
     dQuaternion q;
     toOde(s.pose.orientation, q);
@@ -304,10 +307,12 @@ int OdeEngine::addStatic(const std::vector<Shape>& shapes, const Pose& pose) {
       planes_params_.push_back({params[0], params[1], params[2], params[3]});
       continue;
     }
-    dGeomID g = createOdeGeom(s, meshes_, true);
+    Vec3 centre;
+    dGeomID g = createOdeGeom(s, meshes_, true, centre);
     dQuaternion q;
     toOde(world.orientation, q);
-    dGeomSetPosition(g, world.position.x(), world.position.y(), world.position.z());
+    const Vec3 at = world.transformPoint(centre);
+    dGeomSetPosition(g, at.x(), at.y(), at.z());
     dGeomSetQuaternion(g, q);
     dGeomSetData(g, data);
     static_geoms_.push_back(g);

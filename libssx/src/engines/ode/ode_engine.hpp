@@ -59,14 +59,18 @@ class OdeMeshes {
   OdeMeshes(const OdeMeshes&) = delete;
   OdeMeshes& operator=(const OdeMeshes&) = delete;
   ~OdeMeshes();
-  // a geom in no space for a mesh shape: its triangles when static, else its convex hull
-  dGeomID create(const Shape& shape, bool is_static);
+  // a geom in no space for a mesh shape: its triangles when static, else its convex hull, given
+  // about the hull's centre (ODE's convex collider wants the origin inside the hull; a link's mesh
+  // often lies beside its frame): `centre` is where the geom's origin sits in the shape's frame
+  dGeomID create(const Shape& shape, bool is_static, Vec3& centre);
 
  private:
   struct Hull {
     std::shared_ptr<const TriangleMesh> mesh;
     std::vector<dReal> planes;       // a, b, c, d per face: a x + b y + c z = d, normal outward
     std::vector<unsigned> polygons;  // 3, i, j, k per face
+    std::vector<dReal> points;       // the hull's corners about `centre`
+    Vec3 centre = Vec3::Zero();      // the mean of its corners, in the mesh's frame
   };
   struct Triangles {
     std::shared_ptr<const TriangleMesh> mesh;
@@ -246,7 +250,8 @@ class OdeEngine final : public PhysicEngine {
 
 // an ODE geom in no space for a shape that is not a plane (ode_engine.cpp); a mesh's arrays are
 // kept in `meshes`
-dGeomID createOdeGeom(const Shape& shape, OdeMeshes& meshes, bool is_static = false);
+// `centre`: where the geom's origin lies in the shape's frame (zero but for a hull, see OdeMeshes)
+dGeomID createOdeGeom(const Shape& shape, OdeMeshes& meshes, bool is_static, Vec3& centre);
 
 // ODE's process-wide initialisation, reference-counted (ode_engine.cpp): each acquireOde is
 // matched by one releaseOde

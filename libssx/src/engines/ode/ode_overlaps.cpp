@@ -23,10 +23,12 @@ dGeomID makeGeom(const PosedShape& s, OdeMeshes& meshes) {
     return dCreatePlane(nullptr, n.x(), n.y(), n.z(), n.dot(s.world.position));
   }
   // (a mesh: its hull on a moving body, its triangles on a static one, as the engine steps them)
-  dGeomID g = createOdeGeom(shape, meshes, s.is_static);
+  Vec3 centre;
+  dGeomID g = createOdeGeom(shape, meshes, s.is_static, centre);
   const Quat& q = s.world.orientation;
   const dQuaternion oq = {q.w(), q.x(), q.y(), q.z()};
-  dGeomSetPosition(g, s.world.position.x(), s.world.position.y(), s.world.position.z());
+  const Vec3 at = s.world.transformPoint(centre);
+  dGeomSetPosition(g, at.x(), at.y(), at.z());
   dGeomSetQuaternion(g, oq);
   return g;
 }

@@ -8,6 +8,7 @@
 
 #include <urdf_parser/urdf_parser.h>
 
+#include <algorithm>
 #include <charconv>
 #include <cmath>
 #include <cstdlib>
@@ -27,6 +28,73 @@ std::string colorText(float v) {
   return ec == std::errc() ? std::string(text, end) : std::string("1");
 }
 
+// roslaunch's substitution args that xacro passes on to the launch, as roslaunch resolves them:
+// `$(optenv NAME default words)` (the variable, else the default), `$(env NAME)` (the variable, an
+// error when unset) and `$(find PKG)` (the package, found as package://PKG is). Any other `$(...)`
+// and xacro's own `${...}` and `<xacro:...>` are errors at their line: the file needs xacro first.
+// Comments are left as they are.
+std::string substituteArgs(const std::string& text, const fs::path& file, DiagnosticLog& log) {
+  std::string out;
+  out.reserve(text.size());
+  auto lineAt = [&](std::size_t at) {
+    return SourceLocation{file.string(), static_cast<int>(std::count(text.begin(), text.begin() + static_cast<std::ptrdiff_t>(at), '\n')) + 1};
+  };
+  const std::string run_xacro = ": this is a xacro file, not a URDF: run `xacro " + file.filename().string() +
+                                " -o " + file.stem().string() + ".urdf` and import its output";
+  std::size_t i = 0;
+  while (i < text.size()) {
+    if (text.compare(i, 4, "<!--") == 0) {
+      const std::size_t end = text.find("-->", i);
+      const std::size_t stop = end == std::string::npos ? text.size() : end + 3;
+      out.append(text, i, stop - i);
+      i = stop;
+      continue;
+    }
+    if (text.compare(i, 7, "<xacro:") == 0) {
+      log.error(lineAt(i), "<" + text.substr(i + 1, text.find_first_of(" />", i) - i - 1) + ">" + run_xacro);
+      return text;
+    }
+    const bool dollar = text[i] == '$' && i + 1 < text.size();
+    if (dollar && text[i + 1] == '{') {
+      const std::size_t end = text.find('}', i);
+      log.error(lineAt(i), "'" + text.substr(i, end == std::string::npos ? 2 : end + 1 - i) + "'" + run_xacro);
+      return text;
+    }
+    if (!dollar || text[i + 1] != '(') {
+      out += text[i++];
+      continue;
+    }
+    const std::size_t end = text.find(')', i);
+    if (end == std::string::npos) {
+      log.error(lineAt(i), "'$(' without its ')'");
+      return text;
+    }
+    std::istringstream words(text.substr(i + 2, end - i - 2));
+    std::string command, name, rest, word;
+    words >> command >> name;
+    while (words >> word) rest += (rest.empty() ? "" : " ") + word;
+    const char* value = name.empty() ? nullptr : std::getenv(name.c_str());
+    if (command == "optenv" && !name.empty()) {
+      out += value != nullptr ? value : rest;
+    } else if (command == "env" && !name.empty() && rest.empty()) {
+      if (value == nullptr) {
+        log.error(lineAt(i), "'$(env " + name + ")': the environment variable " + name +
+                                 " is not set; set it, or write the value in the file");
+        return text;
+      }
+      out += value;
+    } else if (command == "find" && !name.empty() && rest.empty()) {
+      out += "package://" + name;
+    } else {
+      log.error(lineAt(i), "'" + text.substr(i, end + 1 - i) + "': only roslaunch's $(optenv), $(env) and $(find) are "
+                               "read in a URDF" + run_xacro);
+      return text;
+    }
+    i = end + 1;
+  }
+  return out;
+}
+
 // the elements URDF defines, by parent, as urdfdom reads them (what is not here is reported)
 const std::map<std::string, std::set<std::string>> kUrdfElements = {
     {"robot", {"link", "joint", "material", "transmission", "gazebo"}},
@@ -38,6 +106,16 @@ const std::map<std::string, std::set<std::string>> kUrdfElements = {
     {"material", {"color", "texture"}},
     {"joint", {"origin", "parent", "child", "axis", "limit", "dynamics", "mimic", "safety_controller", "calibration"}},
 };
+
+// the mass of a link and of every link fixed to it (the rigid body they make)
+double fixedBodyMass(const urdf::Link& l) {
+  double mass = l.inertial ? l.inertial->mass : 0.0;
+  for (const auto& j : l.child_joints)
+    if (j->type == urdf::Joint::FIXED)
+      for (const auto& c : l.child_links)
+        if (c->name == j->child_link_name) mass += fixedBodyMass(*c);
+  return mass;
+}
 
 struct UrdfReader {
   const fs::path& file;
@@ -207,9 +285,11 @@ struct UrdfReader {
       joint(n, j);
       moving = j.type != urdf::Joint::FIXED;
     }
-    // a root of mass 0 is fixed in the world (the convention PyBullet and Bullet's URDFs follow)
+    // a root whose rigid body (it and the links fixed to it) has mass 0 is fixed in the world (the
+    // convention PyBullet and Bullet's URDFs follow); a massless root link carrying a body by a
+    // fixed joint (a ground robot's base_footprint over its base_link) is that body's frame
     const bool massless = !l.inertial || !(l.inertial->mass > 0);
-    if (is_root && massless) {
+    if (is_root && !(fixedBodyMass(l) > 0)) {
       n.set("static", true);
     } else if (!massless) {
       const urdf::Inertial& in = *l.inertial;
@@ -381,6 +461,9 @@ Descriptor importUrdf(const fs::path& file, const ResourcePath& resources, std::
   std::string text;
   try {
     text = readInputFile(file, max_bytes);
+    const std::size_t errors = log.errorCount();
+    text = substituteArgs(text, file, log);
+    if (log.errorCount() != errors) return artifact;
     robot = parseXml(text, file.string());
   } catch (const ConfigError& e) {
     log.error(e.where(), e.detail());

@@ -1,9 +1,14 @@
 // Mesh shapes on the engines (ode_meshes.cpp, and Bullet's alike): a moving body's mesh collides as
 // its convex hull (a tetrahedron-made cube rests on the ground at its half height, a cone of
-// vertices rests on its base), a static mesh as its triangles (a sphere rests on a triangle floor).
+// vertices rests on its base), a static mesh as its triangles (a sphere rests on a triangle floor);
+// a hull lying beside its own frame (a robot link's mesh often does) collides where it is.
 #include "engine_util.hpp"
 
 #include <catch2/catch.hpp>
+#include <unistd.h>
+
+#include <cstdio>
+#include <string>
 
 #include <cmath>
 #include <memory>
@@ -25,6 +30,37 @@ std::shared_ptr<TriangleMesh> cubeMesh(double a) {
   m->computeHull();
   return m;
 }
+
+// what this process writes to standard output while alive (ODE's convex checks print there)
+class StdoutCapture {
+ public:
+  StdoutCapture() : file_(std::tmpfile()), saved_(dup(1)) {
+    std::fflush(stdout);
+    dup2(fileno(file_), 1);
+  }
+  ~StdoutCapture() {
+    restore();
+    std::fclose(file_);
+  }
+  std::string text() {
+    restore();
+    std::string out;
+    std::rewind(file_);
+    for (int c; (c = std::fgetc(file_)) != EOF;) out += static_cast<char>(c);
+    return out;
+  }
+
+ private:
+  void restore() {
+    if (saved_ < 0) return;
+    std::fflush(stdout);
+    dup2(saved_, 1);
+    close(saved_);
+    saved_ = -1;
+  }
+  std::FILE* file_;
+  int saved_;
+};
 
 // a flat floor of two triangles, 10 m across, at z = 0
 std::shared_ptr<TriangleMesh> floorMesh() {
@@ -73,6 +109,33 @@ TEST_CASE("mesh shapes: a moving mesh collides as its hull, a static one as its 
       }();
       CHECK(settledHeight(*engine, ball) == Approx(0.1).margin(0.002));
     }
+  }
+}
+
+TEST_CASE("mesh shapes: a hull whose vertices lie beside its frame collides where it is, ODE not warning of it", "[physics][ode][bullet][mesh]") {
+  // the cube's vertices 0.5 m along x of the mesh's frame, the shape put back by -0.5 m: the frame's
+  // origin is outside the hull, as for most links of the KUKA iiwa's meshes
+  auto beside = cubeMesh(0.2);
+  for (Vec3& v : beside->vertices) v.x() += 0.5;
+  beside->computeHull();
+  for (const std::string name : {"ode", "bullet"}) {
+    CAPTURE(name);
+    StdoutCapture out;
+    auto engine = makeEngine(name);
+    engine->addStatic({Shape::box(Vec3(2, 2, 0.4), Pose{Vec3(0, 0, -0.2), Quat::Identity()})}, Pose{});
+    PhysicNodeSpec spec;
+    spec.shapes.push_back(Shape::fromMesh(beside, Pose{Vec3(-0.5, 0, 0), Quat::Identity()}));
+    spec.mass = 1.0;
+    BodyState s;
+    s.pose.position = Vec3(0.1, 0, 0.3);
+    s.pose.orientation = Quat(Eigen::AngleAxisd(0.3, Vec3::UnitY()));
+    const int body = engine->addBody(combinedMass(spec), spec.shapes, s);
+    const double height = settledHeight(*engine, body);
+    const std::string printed = out.text();
+    // tipped onto a face of the box below, it rests at half its edge, near where it fell
+    CHECK(height == Approx(0.1).margin(0.002));
+    CHECK(std::abs(states(*engine)[0].pose.position.x() - 0.1) < 0.1);
+    CHECK(printed.find("WARNING") == std::string::npos);
   }
 }
 

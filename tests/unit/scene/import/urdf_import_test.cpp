@@ -196,6 +196,26 @@ TEST_CASE("The KUKA iiwa from URDF: meshes as hulls, joints that hold a commande
   CHECK(std::abs(j2.jointPosition()) > 0.3);
 }
 
+TEST_CASE("The Husky from URDF: roslaunch's $(optenv) read, a massless base_footprint carries its body, it rests on its wheels",
+          "[import][urdf]") {
+  for (const std::string engine : {"ode", "bullet"}) {
+    CAPTURE(engine);
+    Scene scene = robotScene(kRobots / "husky/husky.urdf", engine, "<ground/>", "xyz=\"0 0 0.1\"");
+    Environment& env = *scene.environment;
+    const Artifact& husky = *env.findArtifact("r");
+    CHECK_FALSE(husky.root().isStatic());
+    // the IMU's pose came from $(optenv HUSKY_IMU_XYZ 0.19 0 0.149)'s default
+    CHECK(husky.node("imu_link")->spec().pose.position.isApprox(Vec3(0.19, 0, 0.149), 1e-12));
+    env.start();
+    env.step(1500);
+    // on its four wheels (radius 0.17775 m, their axles 0.03282 m above base_link, base_link 0.14493 m above
+    // base_footprint): base_footprint at the ground, level
+    const Pose p = husky.root().pose();
+    CHECK(std::abs(p.position.z()) < 0.01);
+    CHECK((p.orientation * Vec3::UnitZ()).z() > 0.999);
+  }
+}
+
 TEST_CASE("A URDF's problems are said at their lines before anything runs", "[import][urdf]") {
   const fs::path cartpole = kRobots / "simple/cartpole.urdf";
   SECTION("a floating joint is refused with what to do") {
@@ -213,6 +233,16 @@ TEST_CASE("A URDF's problems are said at their lines before anything runs", "[im
       <material name="blue">)"}});
     const std::string e = errorsOf([&] { robotScene(f, "ode"); });
     CHECK_THAT(e, Contains("nomesh.urdf:21: error: link 'cart': mesh 'meshes/none.stl': no file"));
+  }
+  SECTION("xacro left in the file: said, with what to run") {
+    const fs::path f = variant(cartpole, "xacro.urdf", {{R"(<mass value="10"/>)", R"(<mass value="${cart_mass}"/>)"}});
+    CHECK_THAT(errorsOf([&] { robotScene(f, "ode"); }),
+               Contains("xacro.urdf:62: error: '${cart_mass}': this is a xacro file, not a URDF: run `xacro xacro.urdf"));
+    const fs::path g = variant(cartpole, "arg.urdf", {{R"(<mass value="10"/>)", R"x(<mass value="$(arg m)"/>)x"}});
+    CHECK_THAT(errorsOf([&] { robotScene(g, "ode"); }), Contains("arg.urdf:62: error: '$(arg m)': only roslaunch's"));
+    const fs::path h = variant(cartpole, "env.urdf", {{R"(<mass value="10"/>)", R"x(<mass value="$(env SSX_TEST_UNSET_MASS)"/>)x"}});
+    CHECK_THAT(errorsOf([&] { robotScene(h, "ode"); }),
+               Contains("env.urdf:62: error: '$(env SSX_TEST_UNSET_MASS)': the environment variable SSX_TEST_UNSET_MASS is not set"));
   }
   SECTION("a loop and an unknown link") {
     const fs::path f = variant(cartpole, "loop.urdf", {{R"(<parent link="slideBar"/>)", R"(<parent link="pole"/>)"}});

@@ -1,0 +1,188 @@
+// ssx_bench_import: what a robot from URDF or SDF costs (docs/robots.md).
+//
+// 1. For each robot of examples/robots: the time `ssx import` takes to read it (the description,
+//    its meshes through assimp, the convex hulls of the moving links' meshes, the check that it
+//    builds), cold, in a process of its own; then the time to load and start a scene holding one
+//    of it, and the memory that scene holds (glibc's mallinfo2, allocated bytes):
+//      robot=kuka_iiwa/model.urdf import_s=0.210 bodies=8 joints=7 scene_s=0.150 scene_kib=900
+// 2. An imported robot against the same robot in ssx's XML: 100 Crazyflies read from Bitcraze's
+//    Gazebo model (a box, four propeller links on joints, COLLADA meshes drawn only) and 100 of
+//    ssx's crazyflie.xml (a box, four rotor points), both flown to 1 m by the quadrotor driver's
+//    Crazyflie preset at 500 Hz, in turns (--rounds, default 3), one thread:
+//      step robot=imported n=100 us_per_robot_step=1.62 ... ratio_imported_to_xml=1.10
+// 3. Real time: the imported 100 on the default threads, every step timed against its 2 ms:
+//      realtime n=100 median_ms=0.21 p99_ms=0.30 max_ms=0.9 late=0 of 5000 mean_height_m=1.00
+// usage: ssx_bench_import [--rounds K] [--n N] [--steps S]
+#include <ssx/ssx.hpp>
+
+#include <malloc.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <vector>
+
+namespace fs = std::filesystem;
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double seconds(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
+
+double allocatedBytes() { return static_cast<double>(mallinfo2().uordblks); }
+
+const fs::path kRobots = fs::path(SSX_EXAMPLES_DIR) / "robots";
+const char* const kCrazyflieSdf = "crazyflie/simulator_files/gazebo/crazyflie/model.sdf";
+
+// a scene of one robot of this description at 1 m (a static-rooted arm stands where its file puts it)
+fs::path writeOne(const fs::path& dir, const std::string& robot) {
+  const fs::path scene = dir / "one.xml";
+  std::ofstream(scene) << "<scene>\n  <environment timestep=\"0.002\" seed=\"1\"/>\n"
+                       << "  <type name=\"r\" file=\"" << (kRobots / robot).string() << "\"/>\n  <ground/>\n"
+                       << "  <artifact name=\"r\" type=\"r\" xyz=\"0 0 1\"/>\n</scene>\n";
+  return scene;
+}
+
+// n Crazyflies in a grid 0.5 m apart taking off to 1 m: read from the SDF model, or ssx's own artifact
+fs::path writeSwarm(const fs::path& dir, bool imported, int n) {
+  const fs::path scene = dir / (imported ? "imported.xml" : "xml.xml");
+  std::ofstream out(scene);
+  out << "<scene>\n  <environment timestep=\"0.002\" seed=\"1\"/>\n";
+  if (imported) {
+    out << "  <type name=\"cf\" file=\"" << (kRobots / kCrazyflieSdf).string() << "\">\n"
+        << "    <driver plugin=\"quadrotor\" preset=\"crazyflie\" directions=\"-1 1 -1 1\"\n"
+        << "            rotors=\"crazyflie/m1_prop crazyflie/m2_prop crazyflie/m3_prop crazyflie/m4_prop\"/>\n"
+        << "    <sensor plugin=\"imu\"/>\n"
+        << "    <sensor plugin=\"pose\" position_noise=\"0.0005\" velocity_noise=\"0.005\"/>\n  </type>\n";
+  } else {
+    out << "  <type name=\"cf\" file=\"" << SSX_EXAMPLES_DIR << "/artifacts/crazyflie.xml\"/>\n";
+  }
+  out << "  <ground/>\n  <swarm type=\"cf\" count=\"" << n << "\" name=\"cf{i}\" layout=\"grid\" spacing=\"0.5\">\n"
+      << "    <driver offset=\"0 0 1\"/>\n  </swarm>\n</scene>\n";
+  return scene;
+}
+
+double meanHeight(const ssx::Environment& env) {
+  double sum = 0;
+  std::size_t n = 0;
+  for (std::size_t i = 0; i < env.artifactCount(); ++i) {
+    const ssx::Artifact& a = env.artifact(i);
+    if (a.rootCount() == 0 || a.root().isStatic()) continue;
+    sum += a.root().pose().position.z();
+    ++n;
+  }
+  return n ? sum / static_cast<double>(n) : 0;
+}
+
+// one description, in a child process so that its import is cold and its memory its own
+bool importOne(const fs::path& dir, const std::string& robot) {
+  std::fflush(stdout);
+  const pid_t child = fork();
+  if (child < 0) return false;
+  if (child == 0) {
+    const auto t0 = Clock::now();
+    const ssx::ImportedRobot r = ssx::importRobotDescription(kRobots / robot);
+    const double import_s = seconds(t0);
+    const fs::path scene = writeOne(dir, robot);
+    const double before = allocatedBytes();
+    const auto t1 = Clock::now();
+    double scene_kib = 0;
+    {
+      ssx::Scene s = ssx::loadScene(scene, ssx::SceneOptions{});
+      s.environment->start();
+      const double scene_s = seconds(t1);
+      s.environment->step(10);
+      scene_kib = (allocatedBytes() - before) / 1024;
+      std::printf("robot=%s import_s=%.3f bodies=%zu joints=%zu mass_kg=%.3f warnings=%zu scene_s=%.3f scene_kib=%.0f\n",
+                  robot.c_str(), import_s, r.bodies, r.joints, r.mass, r.warnings.size(), scene_s, scene_kib);
+    }
+    std::fflush(stdout);
+    _exit(0);
+  }
+  int status = 0;
+  return waitpid(child, &status, 0) == child && WIFEXITED(status) && WEXITSTATUS(status) == 0;
+}
+
+// us per robot step of `steps` steps after 250 to take off
+double stepCost(const fs::path& scene, int n, int steps, double& height) {
+  ssx::SceneOptions options;
+  options.threads = 1;
+  ssx::Scene s = ssx::loadScene(scene, options);
+  s.environment->start();
+  s.environment->step(250);
+  const auto t0 = Clock::now();
+  s.environment->step(steps);
+  const double us = seconds(t0) * 1e6 / (static_cast<double>(steps) * n);
+  height = meanHeight(*s.environment);
+  return us;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  int rounds = 3, n = 100, steps = 2500;
+  for (int i = 1; i < argc; ++i) {
+    if (std::strcmp(argv[i], "--rounds") == 0 && i + 1 < argc) {
+      rounds = std::atoi(argv[++i]);
+    } else if (std::strcmp(argv[i], "--n") == 0 && i + 1 < argc) {
+      n = std::atoi(argv[++i]);
+    } else if (std::strcmp(argv[i], "--steps") == 0 && i + 1 < argc) {
+      steps = std::atoi(argv[++i]);
+    } else {
+      std::fprintf(stderr, "usage: ssx_bench_import [--rounds K] [--n N] [--steps S]\n");
+      return 2;
+    }
+  }
+  if (rounds < 1 || n < 1 || steps < 1) {
+    std::fprintf(stderr, "ssx_bench_import: --rounds, --n and --steps must be positive\n");
+    return 2;
+  }
+  char pattern[] = "/tmp/ssx_bench_import_XXXXXX";
+  const fs::path dir = mkdtemp(pattern);
+  for (const char* robot : {"kuka_iiwa/model.urdf", "kuka_iiwa/model.sdf", "husky/husky.urdf", kCrazyflieSdf,
+                            "quadrotor/quadrotor.urdf", "simple/cartpole.urdf", "simple/door.urdf"}) {
+    if (!importOne(dir, robot)) {
+      std::fprintf(stderr, "ssx_bench_import: %s failed\n", robot);
+      return 1;
+    }
+  }
+
+  const fs::path imported = writeSwarm(dir, true, n), xml = writeSwarm(dir, false, n);
+  for (int round = 0; round < rounds; ++round) {
+    double h_imported = 0, h_xml = 0;
+    const double a = stepCost(imported, n, steps, h_imported);
+    const double b = stepCost(xml, n, steps, h_xml);
+    std::printf("step round=%d n=%d threads=1 imported_us_per_robot_step=%.3f xml_us_per_robot_step=%.3f "
+                "ratio_imported_to_xml=%.2f mean_height_m=%.3f/%.3f\n",
+                round, n, a, b, a / b, h_imported, h_xml);
+    std::fflush(stdout);
+  }
+
+  // real time: each step of the imported swarm, on the default threads, against its timestep
+  ssx::Scene s = ssx::loadScene(imported, ssx::SceneOptions{});
+  s.environment->start();
+  const double budget_ms = static_cast<double>(s.environment->timestep()) * 1e-6;
+  std::vector<double> ms;
+  ms.reserve(static_cast<std::size_t>(steps));
+  for (int i = 0; i < steps; ++i) {
+    const auto t0 = Clock::now();
+    s.environment->step();
+    ms.push_back(seconds(t0) * 1e3);
+  }
+  const long late = std::count_if(ms.begin(), ms.end(), [&](double t) { return t > budget_ms; });
+  std::sort(ms.begin(), ms.end());
+  std::printf("realtime n=%d threads=default budget_ms=%.1f median_ms=%.3f p99_ms=%.3f max_ms=%.3f late=%ld of %d "
+              "mean_height_m=%.3f\n",
+              n, budget_ms, ms[ms.size() / 2], ms[ms.size() * 99 / 100], ms.back(), late, steps,
+              meanHeight(*s.environment));
+  fs::remove_all(dir);
+  return 0;
+}
