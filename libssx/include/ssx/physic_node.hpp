@@ -35,7 +35,8 @@ struct SSX_EXPORT TriangleMesh {
   Vec3 hull_centroid = Vec3::Zero();          ///< the hull's centre of volume
   /// The hull's inertia per kilogram about its centroid, mesh axes (uniform density), m^2.
   Mat3 hull_unit_inertia = Mat3::Zero();
-  Vec3 min = Vec3::Zero(), max = Vec3::Zero();  ///< the vertices' bounding box, m
+  Vec3 min = Vec3::Zero();  ///< the vertices' bounding box: its lowest corner, m
+  Vec3 max = Vec3::Zero();  ///< the vertices' bounding box: its highest corner, m
 
   /// Fills in the hull (and the bounding box) from the vertices: Bullet's btConvexHullComputer.
   /// Throws Error when they span no volume (fewer than four points off one plane).
