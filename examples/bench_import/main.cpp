@@ -3,13 +3,15 @@
 // 1. For each robot of examples/robots: the time `ssx import` takes to read it (the description,
 //    its meshes through assimp, the convex hulls of the moving links' meshes, the check that it
 //    builds), cold, in a process of its own; then the time to load and start a scene holding one
-//    of it, and the memory that scene holds (glibc's mallinfo2, allocated bytes):
+//    of it, and the memory that scene holds beyond a scene of one box's (glibc's mallinfo2, allocated bytes,
+//    after such a scene was loaded and started once):
 //      robot=kuka_iiwa/model.urdf import_s=0.210 bodies=8 joints=7 scene_s=0.150 scene_kib=900
 // 2. An imported robot against the same robot in ssx's XML: 100 Crazyflies read from Bitcraze's
-//    Gazebo model (a box, four propeller links on joints, COLLADA meshes drawn only) and 100 of
-//    ssx's crazyflie.xml (a box, four rotor points), both flown to 1 m by the quadrotor driver's
-//    Crazyflie preset at 500 Hz, in turns (--rounds, default 3), one thread:
-//      step robot=imported n=100 us_per_robot_step=1.62 ... ratio_imported_to_xml=1.10
+//    Gazebo model (a box, four propeller links on hinges, COLLADA meshes drawn only), 100 of the
+//    artifact file `ssx import` prints for it, and 100 of ssx's own crazyflie.xml (a box, four
+//    rotor points: one body, not five), all flown to 1 m by the quadrotor driver's Crazyflie preset
+//    at 500 Hz, in turns (--rounds, default 3), one thread:
+//      step round=0 n=100 threads=1 sdf_us_per_robot_step=8.0 printed_xml_us=8.0 ratio_sdf_to_printed=1.00 ...
 // 3. Real time: the imported 100 on the default threads, every step timed against its 2 ms:
 //      realtime n=100 median_ms=0.21 p99_ms=0.30 max_ms=0.9 late=0 of 5000 mean_height_m=1.00
 // usage: ssx_bench_import [--rounds K] [--n N] [--steps S]
@@ -51,21 +53,32 @@ fs::path writeOne(const fs::path& dir, const std::string& robot) {
   return scene;
 }
 
-// n Crazyflies in a grid 0.5 m apart taking off to 1 m: read from the SDF model, or ssx's own artifact
-fs::path writeSwarm(const fs::path& dir, bool imported, int n) {
-  const fs::path scene = dir / (imported ? "imported.xml" : "xml.xml");
+// how a swarm's Crazyflie is described: read from the SDF model, from the artifact file `ssx import`
+// prints for it, or ssx's own crazyflie.xml
+enum class Source { Sdf, Printed, Own };
+
+// n Crazyflies in a grid 0.5 m apart taking off to 1 m
+fs::path writeSwarm(const fs::path& dir, Source source, int n) {
+  const char* names[] = {"sdf.xml", "printed.xml", "own.xml"};
+  const fs::path scene = dir / names[static_cast<int>(source)];
   std::ofstream out(scene);
   out << "<scene>\n  <environment timestep=\"0.002\" seed=\"1\"/>\n";
-  if (imported) {
-    out << "  <type name=\"cf\" file=\"" << (kRobots / kCrazyflieSdf).string() << "\">\n"
+  if (source == Source::Own) {
+    out << "  <type name=\"cf\" file=\"" << SSX_EXAMPLES_DIR << "/artifacts/crazyflie.xml\"/>\n";
+  } else {
+    fs::path file = kRobots / kCrazyflieSdf;
+    if (source == Source::Printed) {
+      file = dir / "crazyflie_printed.xml";
+      std::ofstream(file) << ssx::importRobotDescription(kRobots / kCrazyflieSdf, dir).artifact_xml;
+    }
+    out << "  <type name=\"cf\" file=\"" << file.string() << "\">\n"
         << "    <driver plugin=\"quadrotor\" preset=\"crazyflie\" directions=\"-1 1 -1 1\"\n"
         << "            rotors=\"crazyflie/m1_prop crazyflie/m2_prop crazyflie/m3_prop crazyflie/m4_prop\"/>\n"
         << "    <sensor plugin=\"imu\"/>\n"
         << "    <sensor plugin=\"pose\" position_noise=\"0.0005\" velocity_noise=\"0.005\"/>\n  </type>\n";
-  } else {
-    out << "  <type name=\"cf\" file=\"" << SSX_EXAMPLES_DIR << "/artifacts/crazyflie.xml\"/>\n";
   }
-  out << "  <ground/>\n  <swarm type=\"cf\" count=\"" << n << "\" name=\"cf{i}\" layout=\"grid\" spacing=\"0.5\">\n"
+  out << "  <ground/>\n  <swarm type=\"cf\" count=\"" << n
+      << "\" name=\"cf{i}\" layout=\"grid\" spacing=\"0.5\" xyz=\"0 0 0.05\">\n"
       << "    <driver offset=\"0 0 1\"/>\n  </swarm>\n</scene>\n";
   return scene;
 }
@@ -92,6 +105,16 @@ bool importOne(const fs::path& dir, const std::string& robot) {
     const ssx::ImportedRobot r = ssx::importRobotDescription(kRobots / robot);
     const double import_s = seconds(t0);
     const fs::path scene = writeOne(dir, robot);
+    // what any scene costs this process once (plugins, the engines' first world, the worker pool),
+    // taken first so that the robot's scene counts only what it holds
+    {
+      const fs::path empty = dir / "empty.xml";
+      std::ofstream(empty) << "<scene><environment timestep=\"0.002\" seed=\"1\"/><ground/><type name=\"b\" file=\""
+                           << SSX_EXAMPLES_DIR << "/artifacts/box.xml\"/><artifact name=\"b\" type=\"b\" xyz=\"3 3 0.5\"/></scene>\n";
+      ssx::Scene e = ssx::loadScene(empty);
+      e.environment->start();
+      e.environment->step(10);
+    }
     const double before = allocatedBytes();
     const auto t1 = Clock::now();
     double scene_kib = 0;
@@ -155,14 +178,16 @@ int main(int argc, char** argv) {
     }
   }
 
-  const fs::path imported = writeSwarm(dir, true, n), xml = writeSwarm(dir, false, n);
+  const fs::path imported = writeSwarm(dir, Source::Sdf, n), printed = writeSwarm(dir, Source::Printed, n),
+                 own = writeSwarm(dir, Source::Own, n);
   for (int round = 0; round < rounds; ++round) {
-    double h_imported = 0, h_xml = 0;
+    double h_imported = 0, h_printed = 0, h_own = 0;
     const double a = stepCost(imported, n, steps, h_imported);
-    const double b = stepCost(xml, n, steps, h_xml);
-    std::printf("step round=%d n=%d threads=1 imported_us_per_robot_step=%.3f xml_us_per_robot_step=%.3f "
-                "ratio_imported_to_xml=%.2f mean_height_m=%.3f/%.3f\n",
-                round, n, a, b, a / b, h_imported, h_xml);
+    const double b = stepCost(printed, n, steps, h_printed);
+    const double c = stepCost(own, n, steps, h_own);
+    std::printf("step round=%d n=%d threads=1 sdf_us_per_robot_step=%.3f printed_xml_us=%.3f ratio_sdf_to_printed=%.2f "
+                "own_crazyflie_xml_us=%.3f ratio_sdf_to_own=%.2f mean_height_m=%.3f/%.3f/%.3f\n",
+                round, n, a, b, a / b, c, a / c, h_imported, h_printed, h_own);
     std::fflush(stdout);
   }
 
