@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <numbers>
+#include <sstream>
 
 namespace ssx::ground {
 
@@ -16,16 +17,40 @@ double wrapAngle(double a) {
   return a <= -kPi ? a + 2 * kPi : a;
 }
 
+namespace {
+
+// a side's wheel nodes: names separated by spaces
+std::vector<std::string> wheelNames(const Descriptor& params, const char* key) {
+  std::vector<std::string> names;
+  std::istringstream in(params.get<std::string>(key, ""));
+  for (std::string name; in >> name;) names.push_back(name);
+  return names;
+}
+
+// the mean of a side's wheel speeds (one wheel's to the bit)
+double meanSpeed(const std::vector<PhysicNode*>& wheels) {
+  double sum = wheels.front()->jointVelocity();
+  for (std::size_t i = 1; i < wheels.size(); ++i) sum += wheels[i]->jointVelocity();
+  return wheels.size() == 1 ? sum : sum / static_cast<double>(wheels.size());
+}
+
+}  // namespace
+
 void DriveModel::validate(const Descriptor& params, const Artifact& a) {
   if (a.rootCount() == 0 || a.root().isStatic()) throw params.error("diff_drive needs a dynamic physic root");
   if (params.get<std::string>("model") != "full") return;
   for (const char* key : {"left_wheel", "right_wheel"}) {
-    const std::string name = params.get<std::string>(key, "");
-    if (name.empty()) throw params.error(std::string("the full model needs '") + key + "' (the wheel's node)");
-    const PhysicNode* n = a.node(name);
-    if (n == nullptr) throw params.errorAt(key, "no physic node '" + name + "' in this artifact");
-    if (n->joint().kind != JointSpec::Kind::Hinge || !(n->joint().max_effort > 0))
-      throw params.errorAt(key, "node '" + name + "' must be joined by a hinge with a motor (max_torque)");
+    const std::vector<std::string> names = wheelNames(params, key);
+    if (names.empty())
+      throw params.error(std::string("the full model needs '") + key + "' (the wheel's node, or the side's nodes)");
+    for (const std::string& name : names) {
+      const PhysicNode* n = a.node(name);
+      if (n == nullptr) throw params.errorAt(key, "no physic node '" + name + "' in this artifact");
+      if (n->joint().kind != JointSpec::Kind::Hinge || !(n->joint().max_effort > 0))
+        throw params.errorAt(key, "node '" + name +
+                                      "' must be joined by a hinge with a motor (max_torque; for a robot description "
+                                      "without one, <joint node=\"" + name + "\" max_torque=\"...\"/> in its <type>)");
+    }
   }
 }
 
@@ -46,8 +71,8 @@ void DriveModel::configure(const Descriptor& params, Artifact& a) {
   max_torque_ = params.get<double>("max_torque");
   if (max_torque_ == 0) max_torque_ = max_force_ * axle_ / 2;
   if (full_) {
-    left_ = a.node(params.get<std::string>("left_wheel"));
-    right_ = a.node(params.get<std::string>("right_wheel"));
+    for (const std::string& name : wheelNames(params, "left_wheel")) left_.push_back(a.node(name));
+    for (const std::string& name : wheelNames(params, "right_wheel")) right_.push_back(a.node(name));
   }
   height_ = a.root().state().pose.position.z();
 }
@@ -61,8 +86,8 @@ void DriveModel::setWheels(double left, double right) {
 
 void DriveModel::apply(double dt) {
   if (full_) {
-    left_->setJointVelocity(left_cmd_);
-    right_->setJointVelocity(right_cmd_);
+    for (PhysicNode* wheel : left_) wheel->setJointVelocity(left_cmd_);
+    for (PhysicNode* wheel : right_) wheel->setJointVelocity(right_cmd_);
   } else {
     drive(dt);
   }
@@ -102,8 +127,8 @@ void DriveModel::drive(double dt) {
 void DriveModel::measure(double dt, Random& random) {
   double left = 0, right = 0;
   if (full_) {
-    left = left_->jointVelocity();
-    right = right_->jointVelocity();
+    left = meanSpeed(left_);
+    right = meanSpeed(right_);
   } else {
     const BodyState s = artifact_->root().state();
     const double yaw = yawOf(s.pose.orientation);

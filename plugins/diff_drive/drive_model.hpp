@@ -2,8 +2,8 @@
 // The differential drive's dynamics: two driven wheels on one axle, in one of two models behind the
 // same wheel commands and odometry:
 //   full:  the wheels are bodies on hinge motors (the artifact's `left_wheel` and `right_wheel`
-//          nodes); they roll on the ground with its friction, so they can slip; the encoders read
-//          the hinges.
+//          nodes, or several a side for a skid-steered robot such as the Husky); they roll on the
+//          ground with its friction, so they can slip; the encoders read the hinges (a side's mean).
 //   swarm: the robot is one body, driven each step to the twist its wheels would give by a force
 //          and a torque of at most `max_force` and `max_torque` (as ARGoS's 2D dynamics drives a
 //          foot-bot), held on its plane (its height and upright) by the same means; it touches
@@ -12,6 +12,8 @@
 // It knows nothing of who chooses the wheel speeds (ground_controller.hpp). Parameters:
 // kDriveModelParameters.
 #include <ssx/ssx.hpp>
+
+#include <vector>
 
 namespace ssx::ground {
 
@@ -25,8 +27,10 @@ inline constexpr ssx_plugin_param kDriveModelParameters[] = {
     param::required(param::real("max_wheel_speed", "", "rad/s", param::positive() & param::atMost(1e4),
                                 "the fastest a wheel turns, either way")),
     param::text("left_wheel", "",
-                "full model: the left wheel's node (a hinge with a motor; positive turns it forward)"),
-    param::text("right_wheel", "", "full model: the right wheel's node"),
+                "full model: the left wheel's node (a hinge with a motor; positive turns it forward), or the "
+                "left side's wheel nodes separated by spaces (a skid-steered robot: all driven alike, the "
+                "encoder their mean)"),
+    param::text("right_wheel", "", "full model: the right wheel's node, or the right side's nodes"),
     param::real("max_force", "0", "N", param::nonNegative(),
                 "swarm model: the largest force driving the body to the wheels' velocity; 0: friction times weight"),
     param::real("max_torque", "0", "N m", param::nonNegative(),
@@ -76,8 +80,8 @@ class DriveModel {
   double radius_ = 0, axle_ = 0, max_wheel_ = 0, noise_ = 0, mass_ = 0, max_force_ = 0, max_torque_ = 0, height_ = 0;
   Mat3 inertia_ = Mat3::Identity();
   Vec3 gravity_ = Vec3::Zero();
-  PhysicNode* left_ = nullptr;
-  PhysicNode* right_ = nullptr;
+  std::vector<PhysicNode*> left_;  // the full model's wheels, each side's
+  std::vector<PhysicNode*> right_;
   double left_cmd_ = 0, right_cmd_ = 0;
   Odometry odometry_;
 };

@@ -55,6 +55,10 @@ struct ArtifactTypeModel {
   /// any, and its `<sensor>`s, also in `driver` and at the end of `sensors`
   std::optional<PluginDeclaration> type_driver;
   std::vector<PluginDeclaration> type_sensors;  ///< (see type_driver)
+  /// The scene's `<joint node="..." .../>` children of `<type>`, as written: joint settings
+  /// (max_torque, max_force, max_velocity, damping, friction, lower, upper) set on the file's
+  /// physic node `node` before the file is read (a URDF's wheels that have no `<limit effort>`)
+  std::vector<Descriptor> type_joints;
 };
 
 /// A shape of an `<obstacle>` as written: `<box size>`, `<sphere radius>`, `<cylinder radius length>`

@@ -257,11 +257,12 @@ std::string SceneModel::toXml() const {
   for (const auto& [name, type] : types) {
     Element e(out, "type", 1);
     e("name", name)("file", path(type.file));
-    if (!type.type_driver && type.type_sensors.empty()) {
+    if (!type.type_driver && type.type_sensors.empty() && type.type_joints.empty()) {
       e.end();
       continue;
     }
     e.open();
+    for (const Descriptor& j : type.type_joints) verbatim(out, j, 2);
     if (type.type_driver) {
       Element d(out, "driver", 2);
       plugin(d, *type.type_driver);

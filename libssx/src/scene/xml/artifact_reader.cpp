@@ -3,6 +3,8 @@
 #include "scene/xml/scene_loader.hpp"
 #include "scene/xml/xml_reader.hpp"
 
+#include <set>
+
 namespace ssx::detail {
 
 Shape SceneLoader::readShape(const Descriptor& d, Vec3* xyz_out, Vec3* rpy_out) {
@@ -96,6 +98,50 @@ void SceneLoader::readJoint(const Descriptor& d, JointSpec& j) {
   j.max_effort = read<double>(d, motor, 0.0);
   j.max_velocity = read<double>(d, "max_velocity", j.max_velocity);
   j.friction = read<double>(d, "friction", 0.0);
+}
+
+namespace {
+
+// the physic node named `name` anywhere in an artifact document; every node's name into `names`
+Descriptor* findPhysic(Descriptor& d, const std::string& name, std::vector<std::string>& names) {
+  Descriptor* found = nullptr;
+  for (Descriptor& c : d.children()) {
+    if (c.name() != "physic") continue;
+    if (const auto* a = c.find("name")) {
+      names.push_back(a->value);
+      if (a->value == name && found == nullptr) found = &c;
+    }
+    if (Descriptor* below = findPhysic(c, name, names); below != nullptr && found == nullptr) found = below;
+  }
+  return found;
+}
+
+}  // namespace
+
+void SceneLoader::setJoint(const Descriptor& setting, Descriptor& document) {
+  static const std::set<std::string> kSettings = {"max_torque", "max_force", "max_velocity", "damping",
+                                                  "friction",   "lower",     "upper"};
+  const std::string node = require(setting, "node");
+  if (node.empty()) return;
+  std::vector<std::string> names;
+  Descriptor* target = findPhysic(document, node, names);
+  if (target == nullptr) {
+    const std::string nearest = nearestName(node, names);
+    error(setting.where(), "<joint>: the type's file has no physic node '" + node + "'" +
+                               (nearest.empty() ? std::string() : " (did you mean '" + nearest + "'?)"));
+    return;
+  }
+  for (const auto& a : setting.attributes()) {
+    if (a.key == "node") continue;
+    a.used = true;
+    if (!kSettings.contains(a.key)) {
+      error(a.where, "<joint>: '" + a.key +
+                         "' is not a joint setting (give max_torque, max_force, max_velocity, damping, friction, "
+                         "lower or upper)");
+      continue;
+    }
+    target->set(a.key, a.value, a.where);
+  }
 }
 
 PhysicNodeSpec SceneLoader::readPhysicNode(const Descriptor& d) {
@@ -273,6 +319,8 @@ const ArtifactType* SceneLoader::artifactType(const std::string& name, const Sou
     } else {
       documents_.push_back(readXmlFile(decl->second.file, options_.max_input_bytes));
     }
+    // the joint settings the scene's <type> gives the file's nodes, as if the file said them
+    for (const Descriptor* j : decl->second.joints) setJoint(*j, documents_.back());
     // the driver and sensors the scene's <type> gives it, after the file's own
     for (const Descriptor* p : decl->second.plugins) {
       documents_.back().addChild(*p);
@@ -286,6 +334,7 @@ const ArtifactType* SceneLoader::artifactType(const std::string& name, const Sou
     t = parseArtifact(documents_.back());
     t.type_driver = std::move(type_driver);
     t.type_sensors = std::move(type_sensors);
+    for (const Descriptor* j : decl->second.joints) t.type_joints.push_back(*j);
     t.name = name;
     t.file = decl->second.file;
     t.where = decl->second.where;

@@ -72,7 +72,7 @@ void SceneLoader::collect(const Descriptor& scene, const fs::path& dir, std::vec
     } else if (n == "type") {
       const std::string name = require(d, "name");
       const std::string file = d.get<std::string>("file", "");
-      checkUnknown(d, {"driver", "sensor"});
+      checkUnknown(d, {"driver", "sensor", "joint"});
       if (name.empty()) continue;
       if (d.has("file") && file.empty()) {
         error(d.where(), "<type>: attribute 'file' is empty; give an artifact file, or leave 'file' out to use the "
@@ -81,9 +81,11 @@ void SceneLoader::collect(const Descriptor& scene, const fs::path& dir, std::vec
       }
       const fs::path path = file.empty() ? findArtifactType(d, name) : resolve(dir, file);
       if (path.empty()) continue;
-      TypeDecl decl{path, d.where(), {}};
-      for (const Descriptor& c : d.children())
+      TypeDecl decl{path, d.where(), {}, {}};
+      for (const Descriptor& c : d.children()) {
         if (c.name() == "driver" || c.name() == "sensor") decl.plugins.push_back(&c);
+        if (c.name() == "joint") decl.joints.push_back(&c);
+      }
       const auto [it, fresh] = type_decls_.try_emplace(name, std::move(decl));
       if (!fresh)
         error(d.where(),

@@ -218,6 +218,8 @@ class SceneLoader {
   // (`collides`: for a physic node, which needs its convex hull)
   std::shared_ptr<const TriangleMesh> readMesh(const Descriptor& d, bool collides);
   void readJoint(const Descriptor& d, JointSpec& joint);
+  // a <type>'s <joint node="..." .../>: its settings written onto the file's physic node `node`
+  void setJoint(const Descriptor& setting, Descriptor& document);
   PhysicNodeSpec readPhysicNode(const Descriptor& d);
   RenderNodeSpec readRenderNode(const Descriptor& d, bool is_root);
   std::optional<PluginDecl> readPluginDecl(const Descriptor& d);
@@ -255,6 +257,7 @@ class SceneLoader {
     fs::path file;
     SourceLocation where;
     std::vector<const Descriptor*> plugins;  // <driver> and <sensor> children: added to the type's own
+    std::vector<const Descriptor*> joints;   // <joint> children: set on the file's nodes (setJoint)
   };
   std::map<std::string, TypeDecl> type_decls_;
   std::map<std::string, ArtifactType> types_;          // by type name, parsed on first use

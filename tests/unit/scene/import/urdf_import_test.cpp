@@ -216,6 +216,93 @@ TEST_CASE("The Husky from URDF: roslaunch's $(optenv) read, a massless base_foot
   }
 }
 
+// the Husky with motors on its four wheels (its URDF gives them none: <joint> in the scene's <type>),
+// skid-steered by diff_drive's full model, both sides' wheels driven alike
+Scene drivenHusky(const std::string& engine, const std::string& joint_extra = "") {
+  std::string joints;
+  for (const char* wheel : {"front_left", "rear_left", "front_right", "rear_right"})
+    joints += std::string("<joint node=\"") + wheel + "_wheel_link\" max_torque=\"60\"" + joint_extra + "/>";
+  const std::string xml =
+      "<scene><environment timestep=\"0.001\" seed=\"1\"/><physics engine=\"" + engine +
+      "\"/><type name=\"husky\" file=\"" + fs::absolute(kRobots / "husky/husky.urdf").string() + "\">" + joints +
+      "<driver plugin=\"diff_drive\" model=\"full\" wheel_radius=\"0.17775\" axle_length=\"0.5708\" "
+      "max_wheel_speed=\"10\" left_wheel=\"front_left_wheel_link rear_left_wheel_link\" "
+      "right_wheel=\"front_right_wheel_link rear_right_wheel_link\"/></type>"
+      "<ground/><artifact name=\"r\" type=\"husky\" xyz=\"0 0 0.02\"/></scene>";
+  return loadSceneFromString(xml, "husky_test.xml", fs::current_path(), test::testOptions());
+}
+
+double yawOf(const Quat& q) {
+  return std::atan2(2 * (q.w() * q.z() + q.x() * q.y()), 1 - 2 * (q.y() * q.y() + q.z() * q.z()));
+}
+
+TEST_CASE("The Husky from URDF drives a commanded twist: its wheels given motors in the scene, skid-steered by "
+          "diff_drive",
+          "[import][urdf]") {
+  for (const std::string engine : {"ode", "bullet"}) {
+    CAPTURE(engine);
+    Scene scene = drivenHusky(engine);
+    Environment& env = *scene.environment;
+    Artifact& husky = *env.findArtifact("r");
+    auto* driver = dynamic_cast<CommandInterface*>(husky.driver());
+    REQUIRE(driver != nullptr);
+    // the settings reached the joints: the wheels have motors, the other joints none
+    CHECK(husky.node("rear_right_wheel_link")->joint().max_effort == 60.0);
+    env.start();
+    env.step(500);  // settled on its wheels
+    const Pose start = husky.root().pose();
+    // 0.5 m/s ahead for 4 s
+    driver->setCommand(Command::velocityYawRate(Vec3(0.5, 0, 0), 0));
+    env.step(4000);
+    const Pose ahead = husky.root().pose();
+    const Vec3 moved = ahead.position - start.position;
+    CAPTURE(moved.transpose());
+    CHECK(moved.x() > 0.5 * 4 * 0.9);
+    CHECK(moved.x() < 0.5 * 4 * 1.05);
+    CHECK(std::abs(moved.y()) < 0.05);
+    CHECK(std::abs(yawOf(ahead.orientation) - yawOf(start.orientation)) < 0.05);
+    // turning on the spot at 0.5 rad/s for 2 s: a skid-steered robot's wheels slip sideways, so it
+    // turns slower than wheels on an axle of 0.5708 m would, but it turns left and stays about where
+    // it was (it turns about a point near its centre of mass, 8.7 cm behind base_link, slipping)
+    // (the first half second stops it from 0.5 m/s)
+    driver->setCommand(Command::velocityYawRate(Vec3::Zero(), 0.5));
+    env.step(500);
+    const Pose stopped = husky.root().pose();
+    env.step(2000);
+    const Pose turned = husky.root().pose();
+    const double yaw = yawOf(turned.orientation) - yawOf(stopped.orientation);
+    const double drift = (turned.position - stopped.position).norm();
+    CAPTURE(yaw, drift);
+    CHECK(yaw > 0.3);
+    CHECK(yaw < 1.0 + 0.05);
+    CHECK(drift < 0.15);
+    CHECK((turned.orientation * Vec3::UnitZ()).z() > 0.99);
+    WARN(engine << ": ahead " << moved.x() << " m in 4 s, turned " << yaw << " rad in 2 s, drifting " << drift << " m");
+  }
+}
+
+TEST_CASE("A <type>'s <joint> settings: a node the file lacks, or a setting that is not a joint's, said at its line",
+          "[import][urdf]") {
+  const std::string base = "<scene><environment timestep=\"0.001\"/><type name=\"husky\" file=\"" +
+                           fs::absolute(kRobots / "husky/husky.urdf").string() + "\">\n";
+  const auto load = [&](const std::string& joint) {
+    return errorsOf([&] {
+      loadSceneFromString(base + joint + "\n</type><artifact name=\"r\" type=\"husky\"/></scene>", "joints.xml",
+                          fs::current_path(), test::testOptions());
+    });
+  };
+  CHECK_THAT(load(R"(<joint node="front_left_wheel" max_torque="5"/>)"),
+             Contains("joints.xml:2: error: <joint>: the type's file has no physic node 'front_left_wheel' (did you "
+                      "mean 'front_left_wheel_link'?)"));
+  CHECK_THAT(load(R"(<joint node="front_left_wheel_link" mass="5"/>)"),
+             Contains("joints.xml:2: error: <joint>: 'mass' is not a joint setting"));
+  CHECK_THAT(load(R"(<joint node="front_left_wheel_link" max_torque="lots"/>)"), Contains("joints.xml:2: error:"));
+  // a setting the joint does not take is the artifact reader's error, at the scene's line
+  CHECK_THAT(load(R"(<joint node="front_left_wheel_link" max_force="5"/>)"),
+             Contains("a hinge's motor takes max_torque, not max_force"));
+  CHECK(load(R"(<joint node="front_left_wheel_link" max_torque="5"/>)").empty());
+}
+
 TEST_CASE("A URDF's problems are said at their lines before anything runs", "[import][urdf]") {
   const fs::path cartpole = kRobots / "simple/cartpole.urdf";
   SECTION("a floating joint is refused with what to do") {
