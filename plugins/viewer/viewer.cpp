@@ -47,6 +47,7 @@
 #include <filesystem>
 #include <condition_variable>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <cstdlib>
 #include <map>
@@ -79,7 +80,7 @@ const char* kindName(RenderNodeSpec::Primitive p) {
     case RenderNodeSpec::Primitive::Cylinder: return "cylinder";
     case RenderNodeSpec::Primitive::Capsule: return "capsule";
     case RenderNodeSpec::Primitive::Plane: return "plane";
-    case RenderNodeSpec::Primitive::Mesh: return "box";  // (its bounding box: the page draws no meshes yet)
+    case RenderNodeSpec::Primitive::Mesh: return "mesh";
     case RenderNodeSpec::Primitive::None: break;
   }
   return "";
@@ -87,19 +88,60 @@ const char* kindName(RenderNodeSpec::Primitive p) {
 
 using viewer::jsonNumber;
 
-// the shapes of a render tree, each posed in `frame` (a body's root, or the world)
-void shapes(std::string& out, const RenderNodeSpec& n, const Pose& parent, bool& first) {
+// the meshes a scene draws, each file's once: the shapes name them by their index
+struct MeshTable {
+  std::map<const TriangleMesh*, std::size_t> index;
+  std::vector<const TriangleMesh*> meshes;
+
+  std::size_t of(const TriangleMesh* mesh) {
+    const auto [it, fresh] = index.try_emplace(mesh, meshes.size());
+    if (fresh) meshes.push_back(mesh);
+    return it->second;
+  }
+
+  // [{"vertices":[x,y,z,...],"triangles":[i,j,k,...]},...]: metres to a micrometre (floats on the page)
+  std::string json() const {
+    std::string out = "[";
+    char text[32];
+    for (const TriangleMesh* m : meshes) {
+      out += out.size() > 1 ? R"(,{"vertices":[)" : R"({"vertices":[)";
+      for (const Vec3& v : m->vertices) {
+        for (int k = 0; k < 3; ++k) {
+          const int n = std::snprintf(text, sizeof text, "%.6g,", v[k]);
+          out.append(text, static_cast<std::size_t>(n));
+        }
+      }
+      if (!m->vertices.empty()) out.pop_back();
+      out += R"(],"triangles":[)";
+      for (const std::uint32_t i : m->triangles) out += std::to_string(i), out += ',';
+      if (!m->triangles.empty()) out.pop_back();
+      out += "]}";
+    }
+    return out + "]";
+  }
+};
+
+// the shapes of a render tree, each posed in `frame` (a body's root, or the world); a mesh names
+// its entry of `meshes`, and gives its bounding box as its size
+void shapes(std::string& out, const RenderNodeSpec& n, const Pose& parent, bool& first, MeshTable& meshes) {
   const Pose pose = parent * n.pose;
-  if (n.primitive != RenderNodeSpec::Primitive::None) {
-    const bool mesh = n.primitive == RenderNodeSpec::Primitive::Mesh && n.mesh != nullptr;
-    // a mesh as its bounding box
+  if (n.primitive != RenderNodeSpec::Primitive::None &&
+      (n.primitive != RenderNodeSpec::Primitive::Mesh || n.mesh != nullptr)) {
+    const bool mesh = n.primitive == RenderNodeSpec::Primitive::Mesh;
     const Vec3 size = mesh ? Vec3(n.mesh->max - n.mesh->min) : n.size;
-    const Pose at = mesh ? pose * Pose{0.5 * (n.mesh->min + n.mesh->max), Quat::Identity()} : pose;
     out += first ? "" : ",";
     first = false;
     out += R"({"kind":")";
     out += kindName(n.primitive);
-    out += R"(","size":[)";
+    if (mesh) {
+      out += R"(","mesh":)" + std::to_string(meshes.of(n.mesh.get()));
+      // how far it reaches from its origin
+      out += R"(,"reach":)";
+      appendNumber(out, n.mesh->min.cwiseAbs().cwiseMax(n.mesh->max.cwiseAbs()).norm());
+      out += R"(,"size":[)";
+    } else {
+      out += R"(","size":[)";
+    }
     appendNumber(out, size.x()), out += ',', appendNumber(out, size.y()), out += ',', appendNumber(out, size.z());
     out += R"(],"radius":)";
     appendNumber(out, n.radius);
@@ -110,13 +152,13 @@ void shapes(std::string& out, const RenderNodeSpec& n, const Pose& parent, bool&
     out += R"(,"color":[)";
     for (int k = 0; k < 4; ++k) appendNumber(out, n.color[static_cast<std::size_t>(k)]), out += k < 3 ? "," : "";
     out += R"(],"pose":[)";
-    const Quat& q = at.orientation;
-    for (const double v : {at.position.x(), at.position.y(), at.position.z(), q.x(), q.y(), q.z(), q.w()})
+    const Quat& q = pose.orientation;
+    for (const double v : {pose.position.x(), pose.position.y(), pose.position.z(), q.x(), q.y(), q.z(), q.w()})
       appendNumber(out, v), out += ',';
     out.back() = ']';
     out += '}';
   }
-  for (const auto& c : n.children) shapes(out, c, pose, first);
+  for (const auto& c : n.children) shapes(out, c, pose, first, meshes);
 }
 
 }  // namespace
@@ -482,6 +524,7 @@ class Viewer final : public SimulationExtension {
     std::map<std::pair<const RenderNodeSpec*, const PhysicNodeSpec*>, std::size_t> model_of;
     std::string models, bodies, world;
     bool first_world = true;
+    MeshTable meshes;
     for (std::size_t b = 0; b < nodes_.size(); ++b) {
       const Artifact& a = nodes_[b]->artifact();
       std::size_t model = 0;
@@ -499,7 +542,7 @@ class Viewer final : public SimulationExtension {
           // the trees that move with this body, in its head's frame
           const RecordedBody* body = recordedBodyOf(recorded_, *follow);
           if (body == nullptr || body->node != nodes_[b]) continue;
-          shapes(list, *tree, nodes_[b]->poseInBody().inverse() * follow->poseInBody(), first);
+          shapes(list, *tree, nodes_[b]->poseInBody().inverse() * follow->poseInBody(), first, meshes);
         }
         models += (models.empty() ? "" : ",") + std::string("[") + list + "]";
       }
@@ -515,8 +558,10 @@ class Viewer final : public SimulationExtension {
                           }) != nodes_.end();
       for (const auto& tree : a.renderRoots()) {
         const PhysicNode* follow = tree->follow.empty() ? nullptr : a.node(tree->follow);
-        if (follow != nullptr && (moving || follow->bodyIndex() >= 0)) continue;
-        shapes(world, *tree, follow != nullptr ? follow->pose() : a.placement(), first_world);
+        // (a moving artifact's trees move with its bodies, but those following a static node: an
+        // arm's base bolted to the world)
+        if (follow != nullptr && (follow->bodyIndex() >= 0 || (moving && !follow->isStatic()))) continue;
+        shapes(world, *tree, follow != nullptr ? follow->pose() : a.placement(), first_world, meshes);
       }
     }
     std::string out = R"({"type":"scene","time":)";
@@ -528,7 +573,8 @@ class Viewer final : public SimulationExtension {
       appendNumber(out, toSeconds(playback_->end()));
       out += '}';
     }
-    out += R"(,"models":[)" + models + R"(],"bodies":[)" + bodies + R"(],"world":[)" + world + "]}";
+    out += R"(,"models":[)" + models + R"(],"bodies":[)" + bodies + R"(],"world":[)" + world + R"(],"meshes":)" +
+           meshes.json() + "}";
     return out;
   }
 

@@ -67,8 +67,24 @@ function extent(shape) {
     case "sphere": return shape.radius;
     case "cylinder": return Math.hypot(shape.radius, shape.length / 2);
     case "capsule": return shape.radius + shape.length / 2;
+    case "mesh": return shape.reach;
   }
   return 0;
+}
+
+// the scene's meshes, each made once (every shape and every swarm member drawing it shares it):
+// flat-shaded, each triangle its own corners with its face's normal
+let meshes = [];
+function meshGeometries(list) {
+  return list.map((m) => {
+    const v = m.vertices, t = m.triangles;
+    const corners = new Float32Array(3 * t.length);
+    for (let i = 0; i < t.length; i++) corners.set(v.slice(3 * t[i], 3 * t[i] + 3), 3 * i);
+    const geometry = new THREE.BufferGeometry();
+    geometry.setAttribute("position", new THREE.BufferAttribute(corners, 3));
+    geometry.computeVertexNormals();
+    return geometry;
+  });
 }
 
 // a shape of the scene as geometry, in its own frame (ssx: cylinders and capsules along z)
@@ -84,6 +100,7 @@ function geometries(shape) {
                             new THREE.SphereBufferGeometry(r, 16, 12).translate(0, 0, l / 2),
                             new THREE.SphereBufferGeometry(r, 16, 12).translate(0, 0, -l / 2)];
     case "plane": return [new THREE.PlaneBufferGeometry(sx, sy)];
+    case "mesh": return meshes[shape.mesh] ? [meshes[shape.mesh]] : [];
   }
   return [];
 }
@@ -91,7 +108,7 @@ function geometries(shape) {
 function material(shape) {
   const [r, g, b, a] = shape.color;
   return new THREE.MeshLambertMaterial({ color: new THREE.Color(r, g, b), transparent: a < 1, opacity: a,
-                                         side: shape.kind === "plane" ? THREE.DoubleSide : THREE.FrontSide });
+                                         side: shape.kind === "plane" || shape.kind === "mesh" ? THREE.DoubleSide : THREE.FrontSide });
 }
 
 function poseMatrix(p) {
@@ -103,6 +120,8 @@ const built = [];  // what the last scene message added
 function buildScene(msg) {
   for (const object of built) scene.remove(object);
   built.length = 0;
+  for (const g of meshes) g.dispose();
+  meshes = meshGeometries(msg.meshes || []);
   const add = (object) => { scene.add(object); built.push(object); };
   state.positions = null;
   for (const shape of msg.world) {
@@ -155,8 +174,9 @@ function buildScene(msg) {
     }
     return { parts, points, full: new Int32Array(members[m]), far: new Int32Array(members[m]) };
   });
-  // (a robot's joined parts, "robot/wheel", are bodies of their own but not robots)
-  document.getElementById("robots").textContent = msg.bodies.filter((b) => !b.name.includes("/")).length;
+  // (a robot's joined parts, "robot/wheel", are bodies of their own but not robots; an arm bolted to
+  // the world is one robot of moving parts only)
+  document.getElementById("robots").textContent = new Set(msg.bodies.map((b) => b.name.split("/")[0])).size;
   state.framed = false;
   state.dirty = true;
   // a recording played (ssx replay --view): a time slider, and nothing to steer
@@ -456,6 +476,7 @@ function animate() {
 window.ssxViewer = {
   state, camera, controls, select,
   get renderer() { return renderer; },
+  get meshes() { return meshes; },  // the scene's mesh geometries, as the scene message lists them
   // draws now (for a test: pixel() reads this picture in the same task)
   draw() {
     renderer.render(scene, camera);
