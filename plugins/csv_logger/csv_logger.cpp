@@ -6,7 +6,9 @@
 // Columns: time_s,artifact,x,y,z,qw,qx,qy,qz,vx,vy,vz,wx,wy,wz (world frame, SI units). With
 // bodies="all", one row per body of each artifact: its root's named as the artifact, each joined
 // child's as "artifact/node" (the pose of the node the body begins at); with artifacts="*", the
-// joined children of static-rooted articulations (a door, an arm on a table) too.
+// joined children of static-rooted articulations (a door, an arm on a table) too. With joints="true"
+// (bodies="all"), two more columns, joint_position,joint_velocity: the joint joining the row's body
+// to its parent, a hinge's (rad, rad/s) or a slider's (m, m/s); empty for a body joined otherwise.
 #include <ssx/environment.hpp>
 #include <ssx/plugin_abi.hpp>
 #include <ssx/run_files.hpp>
@@ -35,12 +37,17 @@ class CsvLogger final : public SimulationExtension {
                   "rows per artifact per simulated second; 0 writes one every step"),
       param::real("flush_s", "1", "s", param::positive() & param::atMost(1e9),
                   "simulated time between flushes to the file (and at the end of the run)"),
+      param::flag("joints", "false",
+                  "bodies=all: also each body's joint position and velocity (a hinge's rad and rad/s, a slider's m "
+                  "and m/s; empty for a body joined otherwise)"),
   };
 
   // what is logged exists before anything is opened
   static void validate(const Descriptor& params, const PluginContext& context) {
     // (the file itself is checked by the loader, with the run's other files: SSX_PARAM_OUTPUT)
     (void)context.environment->selectArtifacts(params, "artifacts", "log");
+    if (params.get<bool>("joints") && params.get<std::string>("bodies") != "all")
+      throw params.errorAt("joints", "joints=\"true\" logs the joints of an artifact's bodies: give bodies=\"all\" too");
   }
 
   ~CsvLogger() override { close(); }
@@ -53,13 +60,16 @@ class CsvLogger final : public SimulationExtension {
     next_ = period_;  // rows at period, 2 period, ... of simulated time
     flush_period_ = toNanoseconds(params.get<double>("flush_s"));
     next_flush_ = flush_period_;
+    joints_ = params.get<bool>("joints");
     resolve(env, params);
     try {
       file_ = openOutputFile(path_);  // (locked while written: a second run writing it is refused)
     } catch (const Error& e) {
       throw params.error(e.what());
     }
-    check(std::fputs("time_s,artifact,x,y,z,qw,qx,qy,qz,vx,vy,vz,wx,wy,wz\n", file_) >= 0);
+    check(std::fputs(joints_ ? "time_s,artifact,x,y,z,qw,qx,qy,qz,vx,vy,vz,wx,wy,wz,joint_position,joint_velocity\n"
+                             : "time_s,artifact,x,y,z,qw,qx,qy,qz,vx,vy,vz,wx,wy,wz\n",
+                     file_) >= 0);
   }
 
   void afterStep(Environment& env) override {
@@ -78,10 +88,17 @@ class CsvLogger final : public SimulationExtension {
       const Quat& q = s.pose.orientation;
       const Vec3& v = s.linear_velocity;
       const Vec3& w = s.angular_velocity;
-      const int written = std::fprintf(file_, "%.9g,%s,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g\n", t,
+      const int written = std::fprintf(file_, "%.9g,%s,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g", t,
                    row.label.c_str(), p.x(), p.y(), p.z(), q.w(), q.x(), q.y(), q.z(), v.x(), v.y(), v.z(), w.x(),
                    w.y(), w.z());
       check(written > 0);
+      if (!joints_) {
+        check(std::fputc('\n', file_) != EOF);
+      } else if (row.node != nullptr && row.node->joint().hasPosition()) {
+        check(std::fprintf(file_, ",%.9g,%.9g\n", row.node->jointPosition(), row.node->jointVelocity()) > 0);
+      } else {
+        check(std::fputs(",,\n", file_) >= 0);
+      }
     }
   }
 
@@ -155,6 +172,7 @@ class CsvLogger final : public SimulationExtension {
   }
 
   std::string path_, names_;
+  bool joints_ = false;
   Nanoseconds period_ = 0, next_ = 0, flush_period_ = 0, next_flush_ = 0;
   std::FILE* file_ = nullptr;
   struct Row {

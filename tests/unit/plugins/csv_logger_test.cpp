@@ -144,3 +144,42 @@ TEST_CASE("csv_logger, recorder: a static-rooted articulation's moving parts are
   const Quat& o = arm.pose().orientation;
   CHECK(std::abs(q[0] * o.w() + q[1] * o.x() + q[2] * o.y() + q[3] * o.z()) > 1 - 1e-6);
 }
+
+TEST_CASE("csv_logger: joints=\"true\" adds each body's joint position and velocity, empty for a body without one",
+          "[scene][csv][joints]") {
+  writePendulum("csv_joint_columns", R"(<box size="0.1 0.1 0.1"/>)");
+  const std::string scene_text = R"(<scene><environment timestep="0.01"/><type name="p" file="pendulum.xml"/>
+    <type name="ball" file=")" + (fs::path(kData) / "valid" / "ball.xml").string() + R"("/>
+    <artifact name="p" type="p" xyz="0 0 2"/><artifact name="b" type="ball" xyz="3 0 1"/>
+    <extension name="log" plugin="csv_logger" file="joints.csv" bodies="all" joints="true"/></scene>)";
+  Scene scene = loadSceneFromString(scene_text, "memory.xml", fs::current_path() / "csv_joint_columns");
+  Environment& env = *scene.environment;
+  env.step(50);
+  const PhysicNode& arm = *env.findArtifact("p")->node("arm");
+  const double position = arm.jointPosition(), velocity = arm.jointVelocity();
+  env.stop();
+  const auto rows = fileLines("joints.csv");
+  REQUIRE(rows[0] == "time_s,artifact,x,y,z,qw,qx,qy,qz,vx,vy,vz,wx,wy,wz,joint_position,joint_velocity");
+  REQUIRE(rows.size() == 1 + 2 * 50);  // the arm and the ball, each step
+  const std::string& last_arm = rows[rows.size() - 2];
+  REQUIRE(last_arm.rfind("0.5,p/arm,", 0) == 0);
+  const std::string joints = last_arm.substr(last_arm.find(',', last_arm.find(',') + 1));
+  double columns[15] = {};
+  REQUIRE(std::sscanf(joints.c_str(), ",%lf,%lf,%lf,%lf,%lf,%lf,%lf,%lf,%lf,%lf,%lf,%lf,%lf,%lf,%lf", &columns[0],
+                      &columns[1], &columns[2], &columns[3], &columns[4], &columns[5], &columns[6], &columns[7],
+                      &columns[8], &columns[9], &columns[10], &columns[11], &columns[12], &columns[13],
+                      &columns[14]) == 15);
+  CHECK(columns[13] == Approx(position).margin(1e-8));
+  CHECK(columns[14] == Approx(velocity).margin(1e-8));
+  CHECK(std::abs(position) > 0.1);  // it swung
+  // the ball is a body of its own, joined to nothing: its joint columns are empty
+  CHECK(rows.back().rfind("0.5,b,", 0) == 0);
+  CHECK(rows.back().substr(rows.back().size() - 2) == ",,");
+  // joints without bodies="all": refused at its attribute, before anything is written
+  const std::string root_only = R"(<scene><environment timestep="0.01"/><type name="p" file="pendulum.xml"/>
+    <artifact name="p" type="p" xyz="0 0 2"/>
+    <extension name="log" plugin="csv_logger" file="refused.csv" joints="true"/></scene>)";
+  CHECK_THROWS_WITH(loadSceneFromString(root_only, "memory.xml", fs::current_path() / "csv_joint_columns"),
+                    Contains("joints=\"true\" logs the joints of an artifact's bodies: give bodies=\"all\" too"));
+  CHECK_FALSE(fs::exists("refused.csv"));
+}
