@@ -87,10 +87,27 @@ class BridgeExtension : public SimulationExtension {
         if (r.range == nullptr) r.range = dynamic_cast<const RangeMeasurement*>(&a->sensor(k).latest());
         if (r.camera == nullptr) r.camera = dynamic_cast<const CameraMeasurement*>(&a->sensor(k).latest());
       }
-      RobotTopics t{a->name(), r.imu != nullptr && imu_rate_.period > 0, r.tracker != nullptr, r.commands != nullptr};
+      RobotTopics t;
+      t.name = a->name();
+      t.imu = r.imu != nullptr && imu_rate_.period > 0;
+      t.setpoint = r.tracker != nullptr;
+      t.velocity = r.commands != nullptr;
       t.ghost = env.isGhost(*a);
       t.range = r.range != nullptr && range_rate_.period > 0;
       t.image = r.camera != nullptr && image_rate_.period > 0;
+      // its other bodies on /tf, its hinges and sliders on joint_states, where the transport offers them
+      t.tf = offersTransforms();
+      for (std::size_t k = 0; t.tf && k < a->nodeCount(); ++k) {
+        const PhysicNode& n = a->nodeAt(k);
+        const bool another_root = n.parent() == nullptr && &n != &a->root() && !n.isStatic();
+        if (!another_root && !n.joint().isBody()) continue;
+        r.parts.push_back(&n);
+        t.parts.push_back(n.name());
+        if (n.joint().hasPosition()) {
+          r.joints.push_back(&n);
+          t.joints.push_back(n.name());
+        }
+      }
       topics.push_back(t);
       robots_.push_back(r);
     }
@@ -100,7 +117,9 @@ class BridgeExtension : public SimulationExtension {
       o.op = op;  // (its force rate is read at the first step: it may be initialised after this one)
       o.name = n;
       operators_.push_back(o);
-      RobotTopics t{n, false, false, true};
+      RobotTopics t;
+      t.name = n;
+      t.velocity = true;
       t.odom = false;
       t.joy = true;
       t.force = true;
@@ -229,6 +248,19 @@ class BridgeExtension : public SimulationExtension {
         m.velocity = array3(to_body * s.linear_velocity);
         m.angular_velocity = array3(to_body * s.angular_velocity);
         transport_->publishOdometry(i, m);
+        if (!transport_->robots()[i].tf) continue;
+        // its frames at the odometry's time: base_link (the odometry's pose) and each part
+        values_.clear();
+        appendPose(values_, s.pose);
+        for (const PhysicNode* part : robots_[i].parts) appendPose(values_, part->pose());
+        transport_->publishTransforms(i, t, values_);
+        if (robots_[i].joints.empty()) continue;
+        values_.clear();
+        for (const PhysicNode* joint : robots_[i].joints) {
+          values_.push_back(joint->jointPosition());
+          values_.push_back(joint->jointVelocity());
+        }
+        transport_->publishJointStates(i, t, values_);
       }
       if (lockstep_) waiting_for_ = t;
     }
@@ -283,6 +315,8 @@ class BridgeExtension : public SimulationExtension {
   virtual void close(Transport& transport) = 0;
   /// "ros1", "ros2": the log lines' prefix.
   virtual const char* name() const = 0;
+  /// Whether the transport publishes /tf and joint states (RobotTopics::tf).
+  virtual bool offersTransforms() const { return false; }
 
  private:
   // a rate in simulated time: due at 0, period, 2 period, ...
@@ -303,6 +337,8 @@ class BridgeExtension : public SimulationExtension {
     const ImuMeasurement* imu = nullptr;
     const RangeMeasurement* range = nullptr;
     const CameraMeasurement* camera = nullptr;
+    std::vector<const PhysicNode*> parts;   // its other bodies: frames on /tf (RobotTopics::parts)
+    std::vector<const PhysicNode*> joints;  // its hinges and sliders (RobotTopics::joints)
     Nanoseconds range_published = -1;             // the stamp of the range last published
     Nanoseconds image_published = -1;             // of the image last published
     std::uint64_t setpoints = 0, velocities = 0;  // applied so far
@@ -375,6 +411,10 @@ class BridgeExtension : public SimulationExtension {
   }
   static std::array<double, 3> array3(const Vec3& v) { return {v.x(), v.y(), v.z()}; }
   static std::array<double, 4> array4(const Quat& q) { return {q.w(), q.x(), q.y(), q.z()}; }
+  static void appendPose(std::vector<double>& out, const Pose& p) {
+    const Quat& q = p.orientation;
+    out.insert(out.end(), {p.position.x(), p.position.y(), p.position.z(), q.w(), q.x(), q.y(), q.z()});
+  }
 
   static void applySetpoint(Robot& r, const Setpoint& s) {
     ssx::Setpoint sp;
@@ -469,6 +509,7 @@ class BridgeExtension : public SimulationExtension {
   std::vector<PoseSample> arrived_, held_;
   std::uint64_t poses_applied_ = 0, held_dropped_ = 0;
   std::vector<std::array<double, 3>> points_;  // a range's, reused
+  std::vector<double> values_;                  // a robot's frames or joint states, reused
   bool lockstep_ = false;
   double lockstep_timeout_ = 2.0, connect_timeout_ = 10.0;
   bool answered_ = false;  // lock-step: every robot answered once

@@ -93,6 +93,36 @@ void Transport::publishImage(std::size_t robot, double time, int width, int heig
   staged_.push_back(m);
 }
 
+void Transport::publishTransforms(std::size_t robot, double time, const std::vector<double>& poses) {
+  if (!robots_.at(robot).tf) return;
+  Outgoing m;
+  m.kind = Outgoing::Kind::Transforms;
+  m.robot = robot;
+  m.time = time;
+  m.first = staged_values_.size();
+  m.count = poses.size();
+  staged_values_.insert(staged_values_.end(), poses.begin(), poses.end());
+  staged_.push_back(m);
+}
+
+void Transport::publishJointStates(std::size_t robot, double time, const std::vector<double>& values) {
+  if (!robots_.at(robot).tf || robots_[robot].joints.empty()) return;
+  Outgoing m;
+  m.kind = Outgoing::Kind::JointStates;
+  m.robot = robot;
+  m.time = time;
+  m.first = staged_values_.size();
+  m.count = values.size();
+  staged_values_.insert(staged_values_.end(), values.begin(), values.end());
+  staged_.push_back(m);
+}
+
+namespace {
+bool holdsValues(Outgoing::Kind kind) {
+  return kind == Outgoing::Kind::Transforms || kind == Outgoing::Kind::JointStates;
+}
+}  // namespace
+
 void Transport::commit() {
   if (staged_.empty()) return;  // (most steps publish nothing: no lock, no wake-up)
   {
@@ -102,17 +132,21 @@ void Transport::commit() {
       queue_.swap(staged_);
       queue_points_.swap(staged_points_);
       queue_bytes_.swap(staged_bytes_);
+      queue_values_.swap(staged_values_);
     } else {
-      const std::size_t points = queue_points_.size(), bytes = queue_bytes_.size();
-      for (Outgoing& m : staged_) m.first += m.kind == Outgoing::Kind::Image ? bytes : points;
+      const std::size_t points = queue_points_.size(), bytes = queue_bytes_.size(), values = queue_values_.size();
+      for (Outgoing& m : staged_)
+        m.first += m.kind == Outgoing::Kind::Image ? bytes : holdsValues(m.kind) ? values : points;
       queue_.insert(queue_.end(), staged_.begin(), staged_.end());
       queue_points_.insert(queue_points_.end(), staged_points_.begin(), staged_points_.end());
       queue_bytes_.insert(queue_bytes_.end(), staged_bytes_.begin(), staged_bytes_.end());
+      queue_values_.insert(queue_values_.end(), staged_values_.begin(), staged_values_.end());
     }
   }
   staged_.clear();
   staged_points_.clear();
   staged_bytes_.clear();
+  staged_values_.clear();
   queue_changed_.notify_all();
 }
 
@@ -124,11 +158,13 @@ void Transport::publishLoop() {
     sending_.swap(queue_);
     sending_points_.swap(queue_points_);
     sending_bytes_.swap(queue_bytes_);
+    sending_values_.swap(queue_values_);
     busy_ = true;
     lock.unlock();
     for (Outgoing& m : sending_) {
       if (m.kind == Outgoing::Kind::Range) m.points = sending_points_.data() + m.first;
       if (m.kind == Outgoing::Kind::Image) m.bytes = sending_bytes_.data() + m.first;
+      if (holdsValues(m.kind)) m.values = sending_values_.data() + m.first;
       if (m.kind == Outgoing::Kind::Odometry && m.robot == 0) {  // the round trip starts when it leaves
         std::lock_guard<std::mutex> guard(mutex_);
         sent_[nanos(m.odometry.time)] = std::chrono::steady_clock::now();
@@ -139,6 +175,7 @@ void Transport::publishLoop() {
     sending_.clear();
     sending_points_.clear();
     sending_bytes_.clear();
+    sending_values_.clear();
     lock.lock();
     busy_ = false;
     queue_changed_.notify_all();  // (flush waits for this)

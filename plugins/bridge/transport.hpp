@@ -77,11 +77,14 @@ struct RobotTopics {
   bool joy = false;       // takes /<name>/joy (an operator)
   bool force = false;     // publishes /<name>/force (an operator: a WrenchStamped)
   bool image = false;     // publishes /<name>/image (what its camera sees: rgb8)
+  bool tf = false;        // its frames on /tf: <name>/base_link and each of `parts` (where the transport offers it)
+  std::vector<std::string> parts;   // its other bodies (joined parts): frames <name>/<part> on /tf
+  std::vector<std::string> joints;  // its hinges and sliders, by the node each moves: /<name>/joint_states
 };
 
 /// One message to send: what the stepping thread stages.
 struct Outgoing {
-  enum class Kind : std::uint8_t { Clock, Odometry, Imu, Range, Force, Image } kind = Kind::Clock;
+  enum class Kind : std::uint8_t { Clock, Odometry, Imu, Range, Force, Image, Transforms, JointStates } kind = Kind::Clock;
   std::size_t robot = 0;
   double time = 0;  // the clock's, the range's, the force's
   std::array<double, 3> force{};  // N, world frame
@@ -95,6 +98,9 @@ struct Outgoing {
   // bytes staged with it
   int width = 0, height = 0;
   const std::uint8_t* bytes = nullptr;  // set for send(): the first of them
+  // transforms (7 values a frame: x y z qw qx qy qz in the world, base_link then each part) and
+  // joint states (2 a joint: position, velocity): [first, first + count) of the values staged with it
+  const double* values = nullptr;  // set for send(): the first of them
 };
 
 class Transport {
@@ -116,6 +122,10 @@ class Transport {
   void publishRange(std::size_t robot, double time, bool body_frame, const std::vector<std::array<double, 3>>& points);
   void publishForce(std::size_t robot, double time, const std::array<double, 3>& force);
   void publishImage(std::size_t robot, double time, int width, int height, const std::vector<std::uint8_t>& rgb);
+  // `poses`: 7 values a frame (x y z qw qx qy qz, world), the robot's base_link then each of its parts
+  void publishTransforms(std::size_t robot, double time, const std::vector<double>& poses);
+  // `values`: 2 a joint (position, velocity), in the order of the robot's `joints`
+  void publishJointStates(std::size_t robot, double time, const std::vector<double>& values);
   void commit();
   // Waits until everything staged so far has been sent.
   void flush();
@@ -189,6 +199,7 @@ class Transport {
   std::vector<Outgoing> queue_, sending_;  // queue_mutex_ guards queue_, busy_, stop_
   std::vector<std::array<double, 3>> staged_points_, queue_points_, sending_points_;  // ranges', likewise
   std::vector<std::uint8_t> staged_bytes_, queue_bytes_, sending_bytes_;               // images', likewise
+  std::vector<double> staged_values_, queue_values_, sending_values_;  // transforms' and joint states', likewise
   bool busy_ = false, stop_ = false;
   std::thread publisher_;
 };

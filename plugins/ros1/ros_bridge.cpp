@@ -216,6 +216,9 @@ void RosTransport::send(const bridge::Outgoing& out) {
       range_[out.robot].publish(m);
       break;
     }
+    case bridge::Outgoing::Kind::Transforms:
+    case bridge::Outgoing::Kind::JointStates:
+      break;  // (the ROS 2 bridge's: this one's robots never ask for /tf, RobotTopics::tf)
   }
 }
 

@@ -5,8 +5,11 @@
 
 #include <dds/dds.h>
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
+#include <string>
+#include <vector>
 
 namespace ssx::ros2 {
 
@@ -23,18 +26,19 @@ builtin_interfaces_msg_dds__Time_ stamp(double t) {
 
 double seconds(const builtin_interfaces_msg_dds__Time_& t) { return t.sec + t.nanosec * 1e-9; }
 
-// rclcpp's QoS profiles (rmw_qos_profile_default, rmw_qos_profile_sensor_data, rclcpp::ClockQoS), in
-// plain CDR as rmw_cyclonedds_cpp writes
-enum class Profile { Default, SensorData, Clock };
+// rclcpp's QoS profiles (rmw_qos_profile_default, rmw_qos_profile_sensor_data, rclcpp::ClockQoS,
+// tf2_ros::DynamicBroadcasterQoS), in plain CDR as rmw_cyclonedds_cpp writes
+enum class Profile { Default, SensorData, Clock, Tf };
 dds_qos_t* qosOf(Profile p) {
   dds_qos_t* q = dds_create_qos();
   // (a reliable write never waits for a reader that stopped acknowledging, one that vanished without
   // a goodbye included, until its lease ends: what it missed is dropped for it)
-  if (p == Profile::Default)
+  if (p == Profile::Default || p == Profile::Tf)
     dds_qset_reliability(q, DDS_RELIABILITY_RELIABLE, 0);
   else
     dds_qset_reliability(q, DDS_RELIABILITY_BEST_EFFORT, 0);
-  dds_qset_history(q, DDS_HISTORY_KEEP_LAST, p == Profile::Default ? 10 : p == Profile::SensorData ? 5 : 1);
+  const int depth = p == Profile::Tf ? 100 : p == Profile::Default ? 10 : p == Profile::SensorData ? 5 : 1;
+  dds_qset_history(q, DDS_HISTORY_KEEP_LAST, depth);
   dds_qset_durability(q, DDS_DURABILITY_VOLATILE);
   const dds_data_representation_id_t xcdr1[] = {DDS_DATA_REPRESENTATION_XCDR1};
   dds_qset_data_representation(q, 1, xcdr1);
@@ -63,8 +67,12 @@ class DdsTransport final : public bridge::Transport {
   static void onData(dds_entity_t reader, void* arg);
 
   dds_entity_t domain_ = 0, participant_ = 0;
-  dds_entity_t clock_ = 0;
-  std::vector<dds_entity_t> odom_, imu_, range_, force_, image_;
+  dds_entity_t clock_ = 0, tf_ = 0;
+  std::vector<dds_entity_t> odom_, imu_, range_, force_, image_, joint_states_;
+  std::vector<std::vector<std::string>> frames_;  // per robot: base_link's, then each part's
+  std::vector<std::vector<char*>> joint_names_;   // per robot: into robots()[i].joints
+  std::vector<geometry_msgs_msg_dds__TransformStamped_> transforms_;  // the publishing thread's, reused
+  std::vector<double> positions_, velocities_;                       // likewise
   std::vector<std::string> camera_frames_;
   std::vector<Reader> readers_;  // reserved up front: listeners hold pointers to them
   std::vector<std::string> odom_frames_, imu_frames_;
@@ -110,7 +118,16 @@ DdsTransport::DdsTransport(int domain, Network network, const std::vector<bridge
       range_.push_back(r.range ? writer(&geometry_msgs_msg_dds__PoseArray__desc, ns + "/range", Profile::Default) : 0);
       odom_frames_.push_back(r.name + "/base_link");
       imu_frames_.push_back(r.name + "/imu");
+      if (r.tf && tf_ == 0) tf_ = writer(&tf2_msgs_msg_dds__TFMessage__desc, "/tf", Profile::Tf);
+      frames_.push_back({r.name + "/base_link"});
+      for (const std::string& part : r.parts) frames_.back().push_back(r.name + "/" + part);
+      const bool joints = r.tf && !r.joints.empty();
+      joint_states_.push_back(joints ? writer(&sensor_msgs_msg_dds__JointState__desc, ns + "/joint_states", Profile::Default) : 0);
+      joint_names_.emplace_back();
     }
+    // (the names' own storage: robots() is this transport's and lives as long)
+    for (std::size_t i = 0; i < robots.size(); ++i)
+      for (const std::string& joint : this->robots()[i].joints) joint_names_[i].push_back(const_cast<char*>(joint.c_str()));
     using Kind = Reader::Kind;
     for (std::size_t i = 0; i < robots.size(); ++i) {
       const std::string ns = "/" + robots[i].name;
@@ -260,6 +277,45 @@ void DdsTransport::send(const bridge::Outgoing& out) {
       m.header.frame_id = const_cast<char*>("world");
       m.wrench.force = {out.force[0], out.force[1], out.force[2]};
       dds_write(force_[out.robot], &m);
+      break;
+    }
+    case bridge::Outgoing::Kind::Transforms: {
+      // 7 values a frame: x y z qw qx qy qz, each in the world
+      const std::vector<std::string>& frames = frames_[out.robot];
+      const std::size_t n = std::min(frames.size(), out.count / 7);
+      transforms_.resize(n);
+      for (std::size_t k = 0; k < n; ++k) {
+        const double* v = out.values + 7 * k;
+        auto& t = transforms_[k];
+        t.header.stamp = stamp(out.time);
+        t.header.frame_id = const_cast<char*>("world");
+        t.child_frame_id = const_cast<char*>(frames[k].c_str());
+        t.transform.translation = {v[0], v[1], v[2]};
+        t.transform.rotation = {v[4], v[5], v[6], v[3]};
+      }
+      tf2_msgs_msg_dds__TFMessage_ m{};
+      m.transforms._length = m.transforms._maximum = static_cast<uint32_t>(n);
+      m.transforms._buffer = transforms_.data();
+      m.transforms._release = false;
+      dds_write(tf_, &m);
+      break;
+    }
+    case bridge::Outgoing::Kind::JointStates: {
+      // 2 values a joint: position, velocity
+      std::vector<char*>& names = joint_names_[out.robot];
+      const std::size_t n = std::min(names.size(), out.count / 2);
+      positions_.resize(n);
+      velocities_.resize(n);
+      for (std::size_t k = 0; k < n; ++k) positions_[k] = out.values[2 * k], velocities_[k] = out.values[2 * k + 1];
+      sensor_msgs_msg_dds__JointState_ m{};
+      m.header.stamp = stamp(out.time);
+      m.name._length = m.name._maximum = static_cast<uint32_t>(n);
+      m.name._buffer = names.data();
+      m.position._length = m.position._maximum = static_cast<uint32_t>(n);
+      m.position._buffer = positions_.data();
+      m.velocity._length = m.velocity._maximum = static_cast<uint32_t>(n);
+      m.velocity._buffer = velocities_.data();
+      dds_write(joint_states_[out.robot], &m);
       break;
     }
     case bridge::Outgoing::Kind::Range: {

@@ -6,7 +6,10 @@
 // pose, body-frame twist; default QoS), /<name>/imu (sensor_msgs/msg/Imu, sensor-data QoS) when it
 // has an IMU sensor, /<name>/setpoint (geometry_msgs/msg/PoseStamped) in for drivers that follow
 // set-points, /<name>/cmd_vel (geometry_msgs/msg/Twist, the robot's frame) in for drivers that take
-// velocity commands; /clock (rosgraph_msgs/msg/Clock, clock QoS) carries simulated time. Stamps are
+// velocity commands; /clock (rosgraph_msgs/msg/Clock, clock QoS) carries simulated time. With the
+// odometry, /tf (tf2_msgs/msg/TFMessage, tf2's QoS): each robot's <name>/base_link and its other
+// bodies' frames <name>/<node> in the world frame, and /<name>/joint_states (sensor_msgs/msg/JointState)
+// for a robot with hinges or sliders, each named by the node it moves. Stamps are
 // simulated time. What is published when, lock-step and applying what arrived between steps are the
 // bridges' shared logic (plugins/bridge), as in the ros1 extension; this file is the DDS transport's
 // parameters.
@@ -48,6 +51,7 @@ class Ros2Bridge final : public bridge::BridgeExtension {
   }
   void close(bridge::Transport& transport) override { ros2::close(transport); }
   const char* name() const override { return "ros2"; }
+  bool offersTransforms() const override { return true; }
 
  private:
   // the parameter, else $ROS_DOMAIN_ID, else 0; a domain ROS 2 cannot use is an error where it was given

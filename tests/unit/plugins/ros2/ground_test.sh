@@ -3,7 +3,9 @@
 # over DDS by a peer that is not ssx (peer.c --drive): a Twist of 0.1 m/s forward and 1 rad/s about z
 # on /q<i>/cmd_vel for 2 s, then 0. Each robot's odometry must show 0.2 m driven (within 15 %), 2 rad
 # turned (within 10 %) and the robot standing 2 s later (the 2 s start from 1 s, once the peer's
-# writer matched ssx's reader).
+# writer matched ssx's reader). /tf carries each robot's base_link at every odometry stamp, equal to
+# its odometry, and the Burger's wheel and caster frames; /q3/joint_states its wheels, turning as
+# the Twist asks.
 #
 # usage: ground_test.sh SSX_BINARY PEER_BINARY
 set -u

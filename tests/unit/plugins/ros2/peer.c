@@ -18,7 +18,13 @@
  *                                        the writer matched ssx's reader), then 0; success once every
  *                                        robot's odometry went 2 V along its path (within 15 %), turned by
  *                                        2 W (within 10 %, unwrapped) and then stood (below 1 cm/s 4 s
- *                                        after the start); no IMU is asked for
+ *                                        after the start); no IMU is asked for. Also /tf and
+ *                                        joint states: each robot's q<i>/base_link on /tf at every
+ *                                        odometry stamp, equal to its odometry's pose (1e-9); the last
+ *                                        robot (a TurtleBot3 Burger) also its wheels' and caster's
+ *                                        frames, the wheels 0.16 m apart, and /q<last>/joint_states
+ *                                        naming both wheels, turning at the speeds the Twist asks
+ *                                        mid-drive ((V -+ W 0.08) / 0.033 rad/s, their mean within 10 %)
  *   peer COUNT TIMEOUT_S --lockstep      answers each odometry message after 0-30 ms with a set-point
  *                                        stamped like it; no odometry of a round may arrive before
  *                                        every robot's answer to the round before was sent; answers
@@ -42,6 +48,28 @@
 #include <unistd.h>
 
 #define MAX_ROBOTS 128
+#define SLOTS 256 /* odometry and /tf poses kept per robot, by stamp (every 0.02 s) */
+
+/* a pose at a stamp: x y z qx qy qz qw */
+typedef struct {
+  double t;
+  double v[7];
+} Stamped;
+static Stamped odom_at[MAX_ROBOTS][SLOTS], tf_at[MAX_ROBOTS][SLOTS];
+static long tf_matched[MAX_ROBOTS], tf_mismatched = 0;
+
+/* a pose arrived on one topic: compared with the other's at the same stamp, if it came first */
+static void pair(Stamped (*mine)[SLOTS], Stamped (*theirs)[SLOTS], int robot, double t, const double* v) {
+  const int slot = (int)(llround(t / 0.02) % SLOTS);
+  mine[robot][slot].t = t;
+  memcpy(mine[robot][slot].v, v, sizeof mine[robot][slot].v);
+  const Stamped* other = &theirs[robot][slot];
+  if (fabs(other->t - t) > 1e-9) return;
+  double worst = 0;
+  for (int k = 0; k < 7; ++k) worst = fmax(worst, fabs(other->v[k] - v[k]));
+  if (worst <= 1e-9) ++tf_matched[robot];
+  else if (tf_mismatched++ == 0) fprintf(stderr, "peer: q%d: /tf at %.3f s differs from its odometry by %g\n", robot, t, worst);
+}
 
 static double wall(void) {
   struct timespec ts;
@@ -139,6 +167,19 @@ int main(int argc, char** argv) {
   const dds_entity_t imu_reliable = dds_create_reader(participant, imu_topic, reliable, NULL);  /* must not match */
   const dds_entity_t clock_reader =
       dds_create_reader(participant, dds_create_topic(participant, &rosgraph_msgs_msg_dds__Clock__desc, "rt/clock", NULL, NULL), clockq, NULL);
+  /* /tf as tf2's listeners read it (reliable, 100 deep); the last robot's joint states */
+  const dds_entity_t tf_reader =
+      dds_create_reader(participant, dds_create_topic(participant, &tf2_msgs_msg_dds__TFMessage__desc, "rt/tf", NULL, NULL), deep, NULL);
+  snprintf(name, sizeof name, "rt/q%d/joint_states", count - 1);
+  const dds_entity_t joints_reader =
+      dds_create_reader(participant, dds_create_topic(participant, &sensor_msgs_msg_dds__JointState__desc, name, NULL, NULL), deep, NULL);
+  long tf_messages = 0, wheel_frames = 0, joint_messages = 0, wheels_checked = 0;
+  double left_sum = 0, right_sum = 0;
+  int outside_pi = 0;
+  for (int i = 0; i < count; ++i) {
+    tf_matched[i] = 0;
+    for (int k = 0; k < SLOTS; ++k) odom_at[i][k].t = tf_at[i][k].t = -1;
+  }
   dds_delete_qos(reliable);
   dds_delete_qos(deep);
   dds_delete_qos(sensor);
@@ -199,6 +240,11 @@ int main(int argc, char** argv) {
           last_odom_wall = wall();
           const double x = m->pose.pose.position.x, y = m->pose.pose.position.y, z = m->pose.pose.position.z;
           if (!have_start[i]) start_x[i] = x, start_y[i] = y, start_z[i] = z, have_start[i] = 1;
+          if (drive) {
+            const double v[7] = {x, y, z, m->pose.pose.orientation.x, m->pose.pose.orientation.y, m->pose.pose.orientation.z,
+                                 m->pose.pose.orientation.w};
+            pair(odom_at, tf_at, i, t, v);
+          }
           if (drive) {
             const double qw = m->pose.pose.orientation.w, qx = m->pose.pose.orientation.x, qy = m->pose.pose.orientation.y,
                          qz = m->pose.pose.orientation.z;
@@ -301,6 +347,57 @@ int main(int argc, char** argv) {
       }
       dds_return_loan(clock_reader, samples, 1);
     }
+    /* /tf: every robot's base_link, the last one's parts */
+    while (drive && dds_take(tf_reader, samples, info, 1, 1) > 0) {
+      if (info[0].valid_data) {
+        const tf2_msgs_msg_dds__TFMessage_* m = samples[0];
+        ++tf_messages;
+        double left[3] = {NAN, NAN, NAN}, right[3] = {NAN, NAN, NAN};
+        for (uint32_t k = 0; k < m->transforms._length; ++k) {
+          const geometry_msgs_msg_dds__TransformStamped_* ts = &m->transforms._buffer[k];
+          const geometry_msgs_msg_dds__Transform_* tr = &ts->transform;
+          int robot = -1;
+          char part[64] = "";
+          if (strcmp(ts->header.frame_id, "world") != 0 && failures < 5) fail("a /tf transform not in the world frame");
+          if (sscanf(ts->child_frame_id, "q%d/%63s", &robot, part) != 2 || robot < 0 || robot >= count) continue;
+          const double v[7] = {tr->translation.x, tr->translation.y, tr->translation.z, tr->rotation.x, tr->rotation.y,
+                               tr->rotation.z, tr->rotation.w};
+          if (strcmp(part, "base_link") == 0) pair(tf_at, odom_at, robot, seconds(ts->header.stamp), v);
+          if (robot == count - 1 && strcmp(part, "left_wheel") == 0) memcpy(left, v, sizeof left);
+          if (robot == count - 1 && strcmp(part, "right_wheel") == 0) memcpy(right, v, sizeof right);
+        }
+        if (!isnan(left[0]) && !isnan(right[0])) {
+          const double apart = sqrt(pow(left[0] - right[0], 2) + pow(left[1] - right[1], 2) + pow(left[2] - right[2], 2));
+          if (fabs(apart - 0.16) > 0.005 && failures < 5) {
+            char line[120];
+            snprintf(line, sizeof line, "q%d's wheels on /tf are %.4f m apart, not 0.16", count - 1, apart);
+            fail(line);
+          }
+          ++wheel_frames;
+        }
+      }
+      dds_return_loan(tf_reader, samples, 1);
+    }
+    /* the last robot's wheels mid-drive, as the Twist asks */
+    while (drive && dds_take(joints_reader, samples, info, 1, 1) > 0) {
+      if (info[0].valid_data) {
+        const sensor_msgs_msg_dds__JointState_* m = samples[0];
+        const double t = seconds(m->header.stamp);
+        ++joint_messages;
+        if (m->name._length != 2 || m->velocity._length != 2 || m->position._length != 2 ||
+            strcmp(m->name._buffer[0], "left_wheel") != 0 || strcmp(m->name._buffer[1], "right_wheel") != 0) {
+          if (failures < 5) fail("joint states: not left_wheel and right_wheel with a position and a velocity each");
+        } else if (!isnan(go[count - 1]) && t >= go[count - 1] + 0.5 && t <= go[count - 1] + 1.5) {
+          /* (each sample is the motor's speed at that step, which its torque limit and the caster's
+             drag make ripple: their mean is compared at the end) */
+          left_sum += m->velocity._buffer[0];
+          right_sum += m->velocity._buffer[1];
+          if (fabs(m->position._buffer[0]) > M_PI + 1e-9 || fabs(m->position._buffer[1]) > M_PI + 1e-9) outside_pi = 1;
+          ++wheels_checked;
+        }
+      }
+      dds_return_loan(joints_reader, samples, 1);
+    }
     while (dds_take(imu, samples, info, 1, 1) > 0) {
       if (info[0].valid_data) ++imu_seen;
       dds_return_loan(imu, samples, 1);
@@ -337,6 +434,31 @@ int main(int argc, char** argv) {
     fail(line);
   }
   if (lockstep && violations > 0) fail("lock-step violated: odometry of a round came before every answer to the last");
+  if (drive) {
+    checkPublisher(tf_reader, "tf2_msgs::msg::dds_::TFMessage_", 1);
+    checkPublisher(joints_reader, "sensor_msgs::msg::dds_::JointState_", 1);
+    for (int i = 0; i < count; ++i) {
+      if (tf_matched[i] < 100) {
+        char line[120];
+        snprintf(line, sizeof line, "q%d: /tf matched its odometry at only %ld stamps", i, tf_matched[i]);
+        fail(line);
+      }
+    }
+    if (tf_mismatched > 0) fail("/tf differed from the odometry");
+    if (wheel_frames < 100 || wheels_checked < 30) fail("too few wheel frames on /tf or joint states mid-drive");
+    const double want_left = (drive_v - drive_w * 0.08) / 0.033, want_right = (drive_v + drive_w * 0.08) / 0.033;
+    const double left = left_sum / (wheels_checked > 0 ? wheels_checked : 1), right = right_sum / (wheels_checked > 0 ? wheels_checked : 1);
+    char line[200];
+    snprintf(line, sizeof line, "joint states mid-drive: wheels at %.3f and %.3f rad/s on average, %.3f and %.3f asked", left,
+             right, want_left, want_right);
+    if (fabs(left - want_left) > 0.1 * fabs(want_left) + 0.02 || fabs(right - want_right) > 0.1 * fabs(want_right) + 0.02)
+      fail(line);
+    else
+      printf("peer: %s\n", line);
+    if (outside_pi) fail("a joint state's position outside (-pi, pi]");
+    printf("peer: %ld /tf messages (q0's base_link equal to its odometry at %ld stamps), %ld with both wheels, %ld joint "
+           "states (%ld mid-drive)\n", tf_messages, tf_matched[0], wheel_frames, joint_messages, wheels_checked);
+  }
   printf("peer: %ld odometry, %ld clock messages, %.0f IMU; %ld rounds, %ld violations; %d failure(s)\n", odom_messages,
          clock_messages, imu_seen, rounds, violations, failures);
   dds_delete(participant);
