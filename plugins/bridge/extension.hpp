@@ -3,6 +3,7 @@
 // when (rates in simulated time), applying what arrived between steps (set-points, velocity
 // commands), lock-step with the controllers outside, and the log lines at the end. A bridge is this
 // class with a transport (open()); ros1 and ros2 differ only there.
+#include "frames.hpp"
 #include "transport.hpp"
 
 #include <ssx/command.hpp>
@@ -95,18 +96,12 @@ class BridgeExtension : public SimulationExtension {
       t.ghost = env.isGhost(*a);
       t.range = r.range != nullptr && range_rate_.period > 0;
       t.image = r.camera != nullptr && image_rate_.period > 0;
-      // its other bodies on /tf, its hinges and sliders on joint_states, where the transport offers them
+      // its other bodies on /tf, its hinges and sliders on joint_states, its fixed frames on
+      // /tf_static and its description, where the transport offers them
       t.tf = offersTransforms();
-      for (std::size_t k = 0; t.tf && k < a->nodeCount(); ++k) {
-        const PhysicNode& n = a->nodeAt(k);
-        const bool another_root = n.parent() == nullptr && &n != &a->root() && !n.isStatic();
-        if (!another_root && !n.joint().isBody()) continue;
-        r.parts.push_back(&n);
-        t.parts.push_back(n.name());
-        if (n.joint().hasPosition()) {
-          r.joints.push_back(&n);
-          t.joints.push_back(n.name());
-        }
+      if (t.tf) {
+        frames(*a, r, t);
+        t.description = describe(*a);
       }
       topics.push_back(t);
       robots_.push_back(r);
@@ -315,8 +310,10 @@ class BridgeExtension : public SimulationExtension {
   virtual void close(Transport& transport) = 0;
   /// "ros1", "ros2": the log lines' prefix.
   virtual const char* name() const = 0;
-  /// Whether the transport publishes /tf and joint states (RobotTopics::tf).
+  /// Whether the transport publishes /tf, /tf_static, joint states and descriptions (RobotTopics::tf).
   virtual bool offersTransforms() const { return false; }
+  /// A robot's description for RobotTopics::description (empty: none).
+  virtual std::string describe(const Artifact&) const { return {}; }
 
  private:
   // a rate in simulated time: due at 0, period, 2 period, ...
@@ -411,6 +408,42 @@ class BridgeExtension : public SimulationExtension {
   }
   static std::array<double, 3> array3(const Vec3& v) { return {v.x(), v.y(), v.z()}; }
   static std::array<double, 4> array4(const Quat& q) { return {q.w(), q.x(), q.y(), q.z()}; }
+  // a robot's frames: its other bodies (a joined part, another root) on /tf, each hinge and slider
+  // among them on joint_states, every other node on /tf_static in its body's frame
+  static void frames(const Artifact& a, Robot& r, RobotTopics& t) {
+    const auto isPart = [&a](const PhysicNode& n) {
+      const bool another_root = n.parent() == nullptr && &n != &a.root() && !n.isStatic();
+      return another_root || n.joint().isBody();
+    };
+    const std::string prefix = a.name() + "/";
+    for (std::size_t k = 0; k < a.nodeCount(); ++k) {
+      const PhysicNode& n = a.nodeAt(k);
+      if (&n == &a.root() || n.isStatic()) continue;
+      if (isPart(n)) {
+        r.parts.push_back(&n);
+        t.parts.push_back(linkName(a, n));
+        if (n.joint().hasPosition()) {
+          r.joints.push_back(&n);
+          t.joints.push_back(linkName(a, n));
+        }
+        continue;
+      }
+      // fixed in its body: its pose in the frame of the node that body begins at
+      Pose in_head = n.spec().pose;
+      const PhysicNode* head = n.parent();
+      while (head != nullptr && head != &a.root() && !isPart(*head)) {
+        in_head = head->spec().pose * in_head;
+        head = head->parent();
+      }
+      if (head == nullptr) continue;
+      StaticFrame f;
+      f.parent = prefix + linkName(a, *head);
+      f.child = prefix + linkName(a, n);
+      const Quat& q = in_head.orientation;
+      f.pose = {in_head.position.x(), in_head.position.y(), in_head.position.z(), q.w(), q.x(), q.y(), q.z()};
+      t.statics.push_back(f);
+    }
+  }
   static void appendPose(std::vector<double>& out, const Pose& p) {
     const Quat& q = p.orientation;
     out.insert(out.end(), {p.position.x(), p.position.y(), p.position.z(), q.w(), q.x(), q.y(), q.z()});

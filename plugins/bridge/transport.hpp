@@ -66,6 +66,12 @@ struct Joy {
   std::uint64_t order = 0;  // when it arrived, among every message received
 };
 
+// A frame fixed in another, for /tf_static: `child` at `pose` (x y z qw qx qy qz) in `parent`
+struct StaticFrame {
+  std::string parent, child;
+  std::array<double, 7> pose{0, 0, 0, 1, 0, 0, 0};
+};
+
 struct RobotTopics {
   std::string name;       // the namespace: /<name>/odom, /<name>/imu, /<name>/setpoint, /<name>/cmd_vel
   bool imu = false;       // publishes /<name>/imu
@@ -80,6 +86,8 @@ struct RobotTopics {
   bool tf = false;        // its frames on /tf: <name>/base_link and each of `parts` (where the transport offers it)
   std::vector<std::string> parts;   // its other bodies (joined parts): frames <name>/<part> on /tf
   std::vector<std::string> joints;  // its hinges and sliders, by the node each moves: /<name>/joint_states
+  std::vector<StaticFrame> statics;  // its frames fixed in its bodies' (a sensor's mount): /tf_static
+  std::string description;           // its URDF: /<name>/robot_description (empty: none)
 };
 
 /// One message to send: what the stepping thread stages.

@@ -27,19 +27,21 @@ builtin_interfaces_msg_dds__Time_ stamp(double t) {
 double seconds(const builtin_interfaces_msg_dds__Time_& t) { return t.sec + t.nanosec * 1e-9; }
 
 // rclcpp's QoS profiles (rmw_qos_profile_default, rmw_qos_profile_sensor_data, rclcpp::ClockQoS,
-// tf2_ros::DynamicBroadcasterQoS), in plain CDR as rmw_cyclonedds_cpp writes
-enum class Profile { Default, SensorData, Clock, Tf };
+// tf2_ros::DynamicBroadcasterQoS; Latched: tf2_ros::StaticBroadcasterQoS and a robot description's,
+// reliable, transient local, the last one kept for readers that come later), in plain CDR as
+// rmw_cyclonedds_cpp writes
+enum class Profile { Default, SensorData, Clock, Tf, Latched };
 dds_qos_t* qosOf(Profile p) {
   dds_qos_t* q = dds_create_qos();
   // (a reliable write never waits for a reader that stopped acknowledging, one that vanished without
   // a goodbye included, until its lease ends: what it missed is dropped for it)
-  if (p == Profile::Default || p == Profile::Tf)
+  if (p == Profile::Default || p == Profile::Tf || p == Profile::Latched)
     dds_qset_reliability(q, DDS_RELIABILITY_RELIABLE, 0);
   else
     dds_qset_reliability(q, DDS_RELIABILITY_BEST_EFFORT, 0);
   const int depth = p == Profile::Tf ? 100 : p == Profile::Default ? 10 : p == Profile::SensorData ? 5 : 1;
   dds_qset_history(q, DDS_HISTORY_KEEP_LAST, depth);
-  dds_qset_durability(q, DDS_DURABILITY_VOLATILE);
+  dds_qset_durability(q, p == Profile::Latched ? DDS_DURABILITY_TRANSIENT_LOCAL : DDS_DURABILITY_VOLATILE);
   const dds_data_representation_id_t xcdr1[] = {DDS_DATA_REPRESENTATION_XCDR1};
   dds_qset_data_representation(q, 1, xcdr1);
   return q;
@@ -67,7 +69,10 @@ class DdsTransport final : public bridge::Transport {
   static void onData(dds_entity_t reader, void* arg);
 
   dds_entity_t domain_ = 0, participant_ = 0;
-  dds_entity_t clock_ = 0, tf_ = 0;
+  void publishLatched(const std::vector<bridge::RobotTopics>& robots);
+
+  dds_entity_t clock_ = 0, tf_ = 0, tf_static_ = 0;
+  std::vector<dds_entity_t> descriptions_;
   std::vector<dds_entity_t> odom_, imu_, range_, force_, image_, joint_states_;
   std::vector<std::vector<std::string>> frames_;  // per robot: base_link's, then each part's
   std::vector<std::vector<char*>> joint_names_;   // per robot: into robots()[i].joints
@@ -125,6 +130,7 @@ DdsTransport::DdsTransport(int domain, Network network, const std::vector<bridge
       joint_states_.push_back(joints ? writer(&sensor_msgs_msg_dds__JointState__desc, ns + "/joint_states", Profile::Default) : 0);
       joint_names_.emplace_back();
     }
+    publishLatched(robots);
     // (the names' own storage: robots() is this transport's and lives as long)
     for (std::size_t i = 0; i < robots.size(); ++i)
       for (const std::string& joint : this->robots()[i].joints) joint_names_[i].push_back(const_cast<char*>(joint.c_str()));
@@ -156,6 +162,35 @@ DdsTransport::DdsTransport(int domain, Network network, const std::vector<bridge
     throw;
   }
   startPublishing();
+}
+
+// what does not change, once, kept for readers that come later: every robot's fixed frames in one
+// /tf_static message (tf2 keeps the last one only), each robot's description
+void DdsTransport::publishLatched(const std::vector<bridge::RobotTopics>& robots) {
+  std::vector<geometry_msgs_msg_dds__TransformStamped_> statics;
+  for (const bridge::RobotTopics& r : robots) {
+    for (const bridge::StaticFrame& f : r.statics) {
+      geometry_msgs_msg_dds__TransformStamped_ t{};
+      t.header.stamp = stamp(0);
+      t.header.frame_id = const_cast<char*>(f.parent.c_str());
+      t.child_frame_id = const_cast<char*>(f.child.c_str());
+      t.transform.translation = {f.pose[0], f.pose[1], f.pose[2]};
+      t.transform.rotation = {f.pose[4], f.pose[5], f.pose[6], f.pose[3]};
+      statics.push_back(t);
+    }
+    if (r.description.empty()) continue;
+    descriptions_.push_back(writer(&std_msgs_msg_dds__String__desc, "/" + r.name + "/robot_description", Profile::Latched));
+    std_msgs_msg_dds__String_ m{const_cast<char*>(r.description.c_str())};
+    if (const dds_return_t rc = dds_write(descriptions_.back(), &m); rc < 0)
+      throw ddsError("writing /" + r.name + "/robot_description", rc);
+  }
+  if (statics.empty()) return;
+  tf_static_ = writer(&tf2_msgs_msg_dds__TFMessage__desc, "/tf_static", Profile::Latched);
+  tf2_msgs_msg_dds__TFMessage_ m{};
+  m.transforms._length = m.transforms._maximum = static_cast<uint32_t>(statics.size());
+  m.transforms._buffer = statics.data();
+  m.transforms._release = false;
+  if (const dds_return_t rc = dds_write(tf_static_, &m); rc < 0) throw ddsError("writing /tf_static", rc);
 }
 
 dds_entity_t DdsTransport::topic(const dds_topic_descriptor_t* type, const std::string& ros_name) {

@@ -9,13 +9,16 @@
 // velocity commands; /clock (rosgraph_msgs/msg/Clock, clock QoS) carries simulated time. With the
 // odometry, /tf (tf2_msgs/msg/TFMessage, tf2's QoS): each robot's <name>/base_link and its other
 // bodies' frames <name>/<node> in the world frame, and /<name>/joint_states (sensor_msgs/msg/JointState)
-// for a robot with hinges or sliders, each named by the node it moves. Stamps are
+// for a robot with hinges or sliders, each named by the node it moves; once, kept for later readers,
+// /tf_static (every frame fixed in a body) and /<name>/robot_description (std_msgs/msg/String: a
+// URDF written from the artifact, robot_description.hpp). Stamps are
 // simulated time. What is published when, lock-step and applying what arrived between steps are the
 // bridges' shared logic (plugins/bridge), as in the ros1 extension; this file is the DDS transport's
 // parameters.
 //
 // Parameters: kParameters below, or `ssx plugins --params ros2`.
 #include "dds_bridge.hpp"
+#include "robot_description.hpp"
 
 #include "../bridge/extension.hpp"
 
@@ -34,7 +37,8 @@ inline constexpr ssx_plugin_param kRos2Parameters[] = {
 class Ros2Bridge final : public bridge::BridgeExtension {
  public:
   static constexpr const char* kDoc =
-      "bridges robots to ROS 2 over DDS: odometry, IMU and /clock out, set-points and velocity commands in";
+      "bridges robots to ROS 2 over DDS: odometry, IMU, /tf, joint states, descriptions and /clock out, set-points "
+      "and velocity commands in";
   static constexpr auto kParameters =
       param::join(param::part("ROS 2", kRos2Parameters), param::part("bridge", bridge::kBridgeParameters));
 
@@ -52,6 +56,7 @@ class Ros2Bridge final : public bridge::BridgeExtension {
   void close(bridge::Transport& transport) override { ros2::close(transport); }
   const char* name() const override { return "ros2"; }
   bool offersTransforms() const override { return true; }
+  std::string describe(const Artifact& a) const override { return ros2::robotDescription(a); }
 
  private:
   // the parameter, else $ROS_DOMAIN_ID, else 0; a domain ROS 2 cannot use is an error where it was given

@@ -27,6 +27,7 @@ struct World;
 /// collides with the triangles themselves.
 struct SSX_EXPORT TriangleMesh {
   std::string file;                 ///< where it was read from (messages)
+  Vec3 scale = Vec3::Ones();        ///< the scale the file's coordinates were multiplied by
   std::vector<Vec3> vertices;       ///< m
   std::vector<std::uint32_t> triangles;  ///< three vertex indices per triangle, counter-clockwise seen from outside
   std::vector<Vec3> hull_vertices;       ///< the convex hull's corners, m

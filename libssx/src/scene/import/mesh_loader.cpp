@@ -95,6 +95,7 @@ std::shared_ptr<const TriangleMesh> MeshCache::load(const fs::path& file, const 
   }
   auto mesh = std::make_shared<TriangleMesh>();
   mesh->file = file.string();
+  mesh->scale = scale;
   for (unsigned m = 0; m < scene->mNumMeshes; ++m) {
     const aiMesh& in = *scene->mMeshes[m];
     if ((in.mPrimitiveTypes & aiPrimitiveType_TRIANGLE) == 0) continue;  // points and lines have no surface

@@ -36,6 +36,7 @@ class Recording final : public Transport {
   using Transport::receivedJoy;
   std::vector<std::vector<std::array<double, 3>>> points;  // each range's, copied as it is sent
   std::vector<std::vector<std::uint8_t>> images;            // each image's bytes, likewise
+  std::vector<std::vector<double>> values;                  // each transforms' or joint states' values
 
  private:
   void send(const Outgoing& m) override {
@@ -44,13 +45,24 @@ class Recording final : public Transport {
     messages.push_back(m);
     if (m.kind == Outgoing::Kind::Range) points.emplace_back(m.points, m.points + m.count);
     if (m.kind == Outgoing::Kind::Image) images.emplace_back(m.bytes, m.bytes + m.count);
+    if (m.kind == Outgoing::Kind::Transforms || m.kind == Outgoing::Kind::JointStates)
+      values.emplace_back(m.values, m.values + m.count);
   }
   bool connected(std::size_t) const override { return peer; }
   mutable std::mutex mutex;
   std::vector<Outgoing> messages;
 };
 
-std::vector<RobotTopics> twoRobots() { return {{"a", true, true, true}, {"b", false, true, false}}; }
+RobotTopics topics(const std::string& name, bool imu, bool setpoint, bool velocity) {
+  RobotTopics t;
+  t.name = name;
+  t.imu = imu;
+  t.setpoint = setpoint;
+  t.velocity = velocity;
+  return t;
+}
+
+std::vector<RobotTopics> twoRobots() { return {topics("a", true, true, true), topics("b", false, true, false)}; }
 
 }  // namespace
 
@@ -199,4 +211,30 @@ TEST_CASE("bridge transport: a range's points, an image's bytes and an operator'
   CHECK(j.stamp == 0.5);
   CHECK(j.axes.size() == 64);
   CHECK(j.buttons == std::vector<int>{1, 1, 1});
+}
+
+TEST_CASE("bridge transport: transforms and joint states go out with their values, only for robots that take /tf",
+          "[bridge]") {
+  std::vector<RobotTopics> robots = twoRobots();
+  robots[0].tf = true;
+  robots[0].joints = {"wheel"};
+  Recording t(robots);
+  // two commits (the second's values found after the first's whether the publishing thread took
+  // the first batch already or both queued together), and the robot without /tf staging nothing
+  t.publishTransforms(0, 0.02, {1, 2, 3, 1, 0, 0, 0, 4, 5, 6, 0, 1, 0, 0});
+  t.publishJointStates(0, 0.02, {0.5, -1.5});
+  t.publishTransforms(1, 0.02, {9, 9, 9, 1, 0, 0, 0});
+  t.commit();
+  t.publishJointStates(0, 0.04, {0.6, -1.4});
+  t.commit();
+  t.flush();
+  const std::vector<Outgoing> sent = t.sent();
+  REQUIRE(sent.size() == 3);
+  CHECK(sent[0].kind == Outgoing::Kind::Transforms);
+  CHECK(sent[1].kind == Outgoing::Kind::JointStates);
+  CHECK(sent[2].time == 0.04);
+  REQUIRE(t.values.size() == 3);
+  CHECK(t.values[0] == std::vector<double>{1, 2, 3, 1, 0, 0, 0, 4, 5, 6, 0, 1, 0, 0});
+  CHECK(t.values[1] == std::vector<double>{0.5, -1.5});
+  CHECK(t.values[2] == std::vector<double>{0.6, -1.4});
 }

@@ -24,7 +24,10 @@
  *                                        robot (a TurtleBot3 Burger) also its wheels' and caster's
  *                                        frames, the wheels 0.16 m apart, and /q<last>/joint_states
  *                                        naming both wheels, turning at the speeds the Twist asks
- *                                        mid-drive ((V -+ W 0.08) / 0.033 rad/s, their mean within 10 %)
+ *                                        mid-drive ((V -+ W 0.08) / 0.033 rad/s, their mean within 10 %);
+ *                                        /tf_static with its deck fixed at (-0.032, 0, 0.21) in its
+ *                                        base_link, and its /q<last>/robot_description a URDF naming
+ *                                        its wheels (both transient local: kept for this late reader)
  *   peer COUNT TIMEOUT_S --lockstep      answers each odometry message after 0-30 ms with a set-point
  *                                        stamped like it; no odometry of a round may arrive before
  *                                        every robot's answer to the round before was sent; answers
@@ -173,6 +176,16 @@ int main(int argc, char** argv) {
   snprintf(name, sizeof name, "rt/q%d/joint_states", count - 1);
   const dds_entity_t joints_reader =
       dds_create_reader(participant, dds_create_topic(participant, &sensor_msgs_msg_dds__JointState__desc, name, NULL, NULL), deep, NULL);
+  /* what is published once and kept (transient local), read as tf2's static listener reads it */
+  dds_qos_t* latched = qos(1, 1);
+  dds_qset_durability(latched, DDS_DURABILITY_TRANSIENT_LOCAL);
+  const dds_entity_t static_reader = dds_create_reader(
+      participant, dds_create_topic(participant, &tf2_msgs_msg_dds__TFMessage__desc, "rt/tf_static", NULL, NULL), latched, NULL);
+  snprintf(name, sizeof name, "rt/q%d/robot_description", count - 1);
+  const dds_entity_t description_reader =
+      dds_create_reader(participant, dds_create_topic(participant, &std_msgs_msg_dds__String__desc, name, NULL, NULL), latched, NULL);
+  dds_delete_qos(latched);
+  int deck_seen = 0, description_seen = 0;
   long tf_messages = 0, wheel_frames = 0, joint_messages = 0, wheels_checked = 0;
   double left_sum = 0, right_sum = 0;
   int outside_pi = 0;
@@ -378,6 +391,36 @@ int main(int argc, char** argv) {
       }
       dds_return_loan(tf_reader, samples, 1);
     }
+    /* once: the fixed frames and the description */
+    while (drive && dds_take(static_reader, samples, info, 1, 1) > 0) {
+      if (info[0].valid_data) {
+        const tf2_msgs_msg_dds__TFMessage_* m = samples[0];
+        char deck[64], base[64];
+        snprintf(deck, sizeof deck, "q%d/deck", count - 1);
+        snprintf(base, sizeof base, "q%d/base_link", count - 1);
+        for (uint32_t k = 0; k < m->transforms._length; ++k) {
+          const geometry_msgs_msg_dds__TransformStamped_* ts = &m->transforms._buffer[k];
+          if (strcmp(ts->child_frame_id, deck) != 0) continue;
+          const geometry_msgs_msg_dds__Vector3_* p = &ts->transform.translation;
+          if (strcmp(ts->header.frame_id, base) != 0 || fabs(p->x + 0.032) > 1e-9 || fabs(p->y) > 1e-9 || fabs(p->z - 0.21) > 1e-9)
+            fail("/tf_static: the Burger's deck is not at (-0.032, 0, 0.21) in its base_link");
+          deck_seen = 1;
+        }
+      }
+      dds_return_loan(static_reader, samples, 1);
+    }
+    while (drive && dds_take(description_reader, samples, info, 1, 1) > 0) {
+      if (info[0].valid_data) {
+        const char* text = ((const std_msgs_msg_dds__String_*)samples[0])->data;
+        char robot[64];
+        snprintf(robot, sizeof robot, "<robot name=\"q%d\">", count - 1);
+        if (strstr(text, robot) == NULL || strstr(text, "<link name=\"left_wheel\">") == NULL ||
+            strstr(text, "type=\"continuous\"") == NULL)
+          fail("the Burger's robot_description is not a URDF of it with its wheels");
+        description_seen = 1;
+      }
+      dds_return_loan(description_reader, samples, 1);
+    }
     /* the last robot's wheels mid-drive, as the Twist asks */
     while (drive && dds_take(joints_reader, samples, info, 1, 1) > 0) {
       if (info[0].valid_data) {
@@ -456,6 +499,10 @@ int main(int argc, char** argv) {
     else
       printf("peer: %s\n", line);
     if (outside_pi) fail("a joint state's position outside (-pi, pi]");
+    if (!deck_seen) fail("no /tf_static with the Burger's deck");
+    if (!description_seen) fail("no robot_description of the Burger");
+    checkPublisher(static_reader, "tf2_msgs::msg::dds_::TFMessage_", 1);
+    checkPublisher(description_reader, "std_msgs::msg::dds_::String_", 1);
     printf("peer: %ld /tf messages (q0's base_link equal to its odometry at %ld stamps), %ld with both wheels, %ld joint "
            "states (%ld mid-drive)\n", tf_messages, tf_matched[0], wheel_frames, joint_messages, wheels_checked);
   }
