@@ -15,15 +15,12 @@ import json
 import pathlib
 import shutil
 import sys
-import time
 
-from viewer_util import ViewedRun, chromium_available
+from viewer_util import ViewedRun, chromium_available, headless_chromium, wait_until
 
 try:
+    import selenium  # noqa: F401 - headless_chromium's
     import websockets
-    from selenium import webdriver
-    from selenium.webdriver.chrome.options import Options
-    from selenium.webdriver.chrome.service import Service
 except ImportError:
     print("python3-websockets or python3-selenium is not installed: skipped")
     sys.exit(77)
@@ -77,26 +74,6 @@ def check_meshes(scene, what):
     return used
 
 
-def browser():
-    options = Options()
-    for a in ("--headless=new", "--no-sandbox", "--use-angle=swiftshader", "--enable-unsafe-swiftshader",
-              "--window-size=900,700", f"--user-data-dir={work}/profile"):
-        options.add_argument(a)
-    return webdriver.Chrome(service=Service("/usr/bin/chromedriver"), options=options)
-
-
-def wait_for(page, what, condition, seconds=60):
-    deadline = time.monotonic() + seconds
-    value = None
-    while time.monotonic() < deadline:
-        value = page.execute_script(what)
-        if condition(value):
-            return value
-        time.sleep(0.2)
-    problems.append(f"waited {seconds} s for {what!r}: last {value!r}")
-    return value
-
-
 def stopped(run):
     status, err = run.stop()
     if status not in (0, 130):  # (130: stopped by Ctrl-C, as a person stops it)
@@ -131,16 +108,18 @@ try:
     # its base, bolted to the world, is drawn with the world; its seven moving links with their bodies
     if len(used.get("world", [])) != 1 or len(scene["bodies"]) != 7:
         problems.append(f"the iiwa's base is not drawn with the world, or its links are not 7 bodies: {used}")
-    page = browser()
+    page = headless_chromium(f"{work}/profile", 900, 700)
     page.get(run.url)
-    wait_for(page, "return window.ssxViewer.state.bodies ? window.ssxViewer.state.bodies.length : 0", lambda v: v > 0)
-    wait_for(page, "return document.getElementById('robots').textContent", lambda v: v == "1")  # one arm
-    drawn = wait_for(page, "return window.ssxViewer.meshes.map((g) => g.attributes.position.count)",
-                     lambda v: len(v) == len(triangles))
+    wait_until(page, "return window.ssxViewer.state.bodies ? window.ssxViewer.state.bodies.length : 0",
+               lambda v: v > 0, problems)
+    wait_until(page, "return document.getElementById('robots').textContent", lambda v: v == "1", problems)  # one arm
+    drawn = wait_until(page, "return window.ssxViewer.meshes.map((g) => g.attributes.position.count)",
+                       lambda v: len(v) == len(triangles), problems)
     if drawn != [3 * t for t in triangles]:
         problems.append(f"the page's mesh geometries have {drawn} corners, not three per triangle of {triangles}")
     # the arm is drawn where its links are: a link's projected origin is not the background's colour
-    wait_for(page, "return document.getElementById('time').textContent", lambda v: v not in ("-", "") and float(v) > 0.5)
+    wait_until(page, "return document.getElementById('time').textContent",
+               lambda v: v not in ("-", "") and float(v) > 0.5, problems)
     result = page.execute_script("""
         const v = window.ssxViewer, n = v.state.bodies.length;
         v.draw();

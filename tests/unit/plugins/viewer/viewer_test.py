@@ -21,13 +21,10 @@ import shutil
 import sys
 import time
 
-from viewer_util import ViewedRun, chromium_available
+from viewer_util import ViewedRun, chromium_available, headless_chromium, wait_until
 
 try:
-    from selenium import webdriver
     from selenium.webdriver.common.action_chains import ActionChains
-    from selenium.webdriver.chrome.options import Options
-    from selenium.webdriver.chrome.service import Service
 except ImportError:
     print("selenium is not installed (apt-get install python3-selenium): skipped")
     sys.exit(77)
@@ -43,22 +40,11 @@ problems = []
 
 
 def browser():
-    options = Options()
-    for a in ("--headless=new", "--no-sandbox", "--use-angle=swiftshader", "--enable-unsafe-swiftshader",
-              "--window-size=1024,700", f"--user-data-dir={work}/profile{len(pages)}"):
-        options.add_argument(a)
-    return webdriver.Chrome(service=Service("/usr/bin/chromedriver"), options=options)
+    return headless_chromium(f"{work}/profile{len(pages)}")
 
 
 def wait_for(page, what, condition, seconds=60):
-    deadline = time.monotonic() + seconds
-    while time.monotonic() < deadline:
-        value = page.execute_script(what)
-        if condition(value):
-            return value
-        time.sleep(0.2)
-    problems.append(f"waited {seconds} s for {what!r}: last {value!r}")
-    return value
+    return wait_until(page, what, condition, problems, seconds)
 
 
 pages = []

@@ -39,3 +39,31 @@ class ViewedRun:
 
 def chromium_available():
     return os.path.exists("/usr/bin/chromium") and os.path.exists("/usr/bin/chromedriver")
+
+
+def headless_chromium(profile, width=1024, height=700):
+    """Debian's Chromium, headless, WebGL through SwiftShader, driven by selenium (imported here: a
+    test that needs none of it runs without it); its profile in the directory `profile`."""
+    from selenium import webdriver
+    from selenium.webdriver.chrome.options import Options
+    from selenium.webdriver.chrome.service import Service
+
+    options = Options()
+    for a in ("--headless=new", "--no-sandbox", "--use-angle=swiftshader", "--enable-unsafe-swiftshader",
+              f"--window-size={width},{height}", f"--user-data-dir={profile}"):
+        options.add_argument(a)
+    return webdriver.Chrome(service=Service("/usr/bin/chromedriver"), options=options)
+
+
+def wait_until(page, script, condition, problems, seconds=60):
+    """Runs `script` in the page every 0.2 s until `condition` holds of what it returns, at most
+    `seconds`; then what it returned last (a problem added to `problems` when it never held)."""
+    deadline = time.monotonic() + seconds
+    value = None
+    while time.monotonic() < deadline:
+        value = page.execute_script(script)
+        if condition(value):
+            return value
+        time.sleep(0.2)
+    problems.append(f"waited {seconds} s for {script!r}: last {value!r}")
+    return value
