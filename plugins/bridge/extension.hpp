@@ -101,7 +101,9 @@ class BridgeExtension : public SimulationExtension {
       t.tf = offersTransforms();
       if (t.tf) {
         frames(*a, r, t);
+        t.root_frame = linkName(*a, a->root());
         t.description = describe(*a);
+        t.joint_commands = !t.joints.empty();
       }
       topics.push_back(t);
       robots_.push_back(r);
@@ -210,6 +212,12 @@ class BridgeExtension : public SimulationExtension {
       if (new_velocity && new_setpoint && v.order < s.order) velocity();
       if (new_setpoint) setpoint();
       if (new_velocity && !(new_setpoint && v.order < s.order)) velocity();
+      if (r.joints.empty()) continue;
+      // its newest joint command (the transport's only if it offers them)
+      const JointCommand j = transport_->latestJointCommand(i);
+      if (j.count == r.joint_commands) continue;
+      r.joint_commands = j.count;
+      guarded(env, who, "joint_command", [&] { applyJoints(r, j); });
     }
   }
 
@@ -339,6 +347,7 @@ class BridgeExtension : public SimulationExtension {
     Nanoseconds range_published = -1;             // the stamp of the range last published
     Nanoseconds image_published = -1;             // of the image last published
     std::uint64_t setpoints = 0, velocities = 0;  // applied so far
+    std::uint64_t joint_commands = 0;             // likewise
     std::uint64_t bad_poses = 0;                  // a ghost's poses refused (not finite, not a rotation)
   };
 
@@ -460,6 +469,32 @@ class BridgeExtension : public SimulationExtension {
     c.setpoint = sp;
     if (const std::string why = c.problem(); !why.empty()) throw Error(why);
     r.tracker->setSetpoint(sp);
+  }
+  // a joint command: every joint it names to its position (or, without positions, its velocity),
+  // all checked before any is set
+  static void applyJoints(Robot& r, const JointCommand& j) {
+    const bool by_position = !j.positions.empty();
+    const std::vector<double>& values = by_position ? j.positions : j.velocities;
+    if (values.size() != j.names.size())
+      throw Error(std::to_string(j.names.size()) + " names with " + std::to_string(j.positions.size()) +
+                  " positions and " + std::to_string(j.velocities.size()) +
+                  " velocities (give one position, or one velocity, per name)");
+    std::vector<PhysicNode*> nodes;
+    for (std::size_t k = 0; k < j.names.size(); ++k) {
+      PhysicNode* node = nullptr;
+      for (const PhysicNode* n : r.joints)
+        if (linkName(*r.artifact, *n) == j.names[k]) node = const_cast<PhysicNode*>(n);
+      if (node == nullptr) throw Error("no joint '" + j.names[k] + "' (its joints are named by the node each moves)");
+      const JointSpec& spec = node->joint();
+      if (!(spec.max_effort > 0)) throw Error("joint '" + j.names[k] + "' has no motor");
+      if (!std::isfinite(values[k]) || (by_position && (values[k] < spec.lower || values[k] > spec.upper)))
+        throw Error("joint '" + j.names[k] + "': " + std::to_string(values[k]) + " is not finite or outside its limits");
+      nodes.push_back(node);
+    }
+    for (std::size_t k = 0; k < nodes.size(); ++k) {
+      if (by_position) nodes[k]->setJointPosition(values[k]);
+      else nodes[k]->setJointVelocity(values[k]);
+    }
   }
   // a Twist in the robot's frame (x forward): turned by its heading into the world's
   static void applyVelocity(Robot& r, const Velocity& v) {

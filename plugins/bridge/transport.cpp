@@ -16,6 +16,7 @@ Transport::Transport(std::vector<RobotTopics> robots)
       setpoints_(robots_.size()),
       velocities_(robots_.size()),
       joys_(robots_.size()),
+      joint_commands_(robots_.size()),
       queued_(robots_.size(), 0),
       newest_pose_(robots_.size(), -1.0) {
   const std::size_t room = 4 * robots_.size() + 16;
@@ -263,6 +264,29 @@ void Transport::receivedJoy(std::size_t robot, double stamp, const float* axes, 
     received_count_.store(received_, std::memory_order_release);
   }
   arrived_.notify_all();
+}
+
+void Transport::receivedJointCommand(std::size_t robot, const char* const* names, std::size_t name_count,
+                                     const double* positions, std::size_t position_count, const double* velocities,
+                                     std::size_t velocity_count) {
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    JointCommand& j = joint_commands_.at(robot);
+    j.names.clear();
+    for (std::size_t k = 0; k < std::min(name_count, kMaxJoints); ++k)
+      j.names.emplace_back(names[k] != nullptr ? std::string(names[k]).substr(0, 256) : std::string());
+    j.positions.assign(positions, positions + std::min(position_count, kMaxJoints));
+    j.velocities.assign(velocities, velocities + std::min(velocity_count, kMaxJoints));
+    ++j.count;
+    j.order = ++received_;
+    received_count_.store(received_, std::memory_order_release);
+  }
+  arrived_.notify_all();
+}
+
+JointCommand Transport::latestJointCommand(std::size_t robot) const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return joint_commands_.at(robot);
 }
 
 Joy Transport::latestJoy(std::size_t robot) const {

@@ -66,6 +66,15 @@ struct Joy {
   std::uint64_t order = 0;  // when it arrived, among every message received
 };
 
+// A robot's joint command (a JointState in): each named joint driven to its position, or, when the
+// message has no positions, at its velocity
+struct JointCommand {
+  std::vector<std::string> names;
+  std::vector<double> positions, velocities;  // empty, or one per name (checked when applied)
+  std::uint64_t count = 0;  // received so far for this robot
+  std::uint64_t order = 0;  // when it arrived, among every message received
+};
+
 // A frame fixed in another, for /tf_static: `child` at `pose` (x y z qw qx qy qz) in `parent`
 struct StaticFrame {
   std::string parent, child;
@@ -83,11 +92,13 @@ struct RobotTopics {
   bool joy = false;       // takes /<name>/joy (an operator)
   bool force = false;     // publishes /<name>/force (an operator: a WrenchStamped)
   bool image = false;     // publishes /<name>/image (what its camera sees: rgb8)
-  bool tf = false;        // its frames on /tf: <name>/base_link and each of `parts` (where the transport offers it)
+  bool tf = false;        // its frames on /tf: <name>/<root_frame> and each of `parts` (where the transport offers it)
+  std::string root_frame = "base_link";  // its root's frame: odometry's child frame, the first on /tf
   std::vector<std::string> parts;   // its other bodies (joined parts): frames <name>/<part> on /tf
   std::vector<std::string> joints;  // its hinges and sliders, by the node each moves: /<name>/joint_states
   std::vector<StaticFrame> statics;  // its frames fixed in its bodies' (a sensor's mount): /tf_static
   std::string description;           // its URDF: /<name>/robot_description (empty: none)
+  bool joint_commands = false;       // takes /<name>/joint_command (its `joints`)
 };
 
 /// One message to send: what the stepping thread stages.
@@ -141,6 +152,7 @@ class Transport {
   Setpoint latestSetpoint(std::size_t robot) const;
   Velocity latestVelocity(std::size_t robot) const;
   Joy latestJoy(std::size_t robot) const;
+  JointCommand latestJointCommand(std::size_t robot) const;
   // How many set-points and velocity commands arrived so far, for all robots (without a lock: a
   // step that sees the same number as the last skips the look-ups).
   std::uint64_t received() const { return received_count_.load(std::memory_order_acquire); }
@@ -180,6 +192,10 @@ class Transport {
   // (at most 64 axes and 64 buttons are kept: a client cannot make it allocate more)
   void receivedJoy(std::size_t robot, double stamp, const float* axes, std::size_t axis_count, const int* buttons,
                    std::size_t button_count);
+  // (at most kMaxJoints joints, each name at most 256 characters, are kept)
+  void receivedJointCommand(std::size_t robot, const char* const* names, std::size_t name_count, const double* positions,
+                            std::size_t position_count, const double* velocities, std::size_t velocity_count);
+  static constexpr std::size_t kMaxJoints = 64;
 
  private:
   void publishLoop();
@@ -192,6 +208,7 @@ class Transport {
   std::vector<Setpoint> setpoints_;                                    // mutex_
   std::vector<Velocity> velocities_;                                   // mutex_
   std::vector<Joy> joys_;                                              // mutex_
+  std::vector<JointCommand> joint_commands_;                           // mutex_
   std::vector<PoseSample> poses_;                                      // mutex_: not yet taken
   std::vector<std::size_t> queued_;                                    // mutex_: poses_ per robot
   std::vector<double> newest_pose_;                                    // mutex_: per robot (-1: none)

@@ -55,7 +55,7 @@ class DdsTransport final : public bridge::Transport {
 
  private:
   struct Reader {
-    enum class Kind : std::uint8_t { Setpoint, Velocity, Pose, Joy };
+    enum class Kind : std::uint8_t { Setpoint, Velocity, Pose, Joy, Joints };
     DdsTransport* self;
     std::size_t robot;
     Kind kind;
@@ -112,7 +112,7 @@ DdsTransport::DdsTransport(int domain, Network network, const std::vector<bridge
   running_ = true;
   try {
     clock_ = writer(&rosgraph_msgs_msg_dds__Clock__desc, "/clock", Profile::Clock);
-    readers_.reserve(4 * robots.size());
+    readers_.reserve(5 * robots.size());  // (at most one of each kind a robot)
     for (const bridge::RobotTopics& r : robots) {
       const std::string ns = "/" + r.name;
       odom_.push_back(r.odom ? writer(&nav_msgs_msg_dds__Odometry__desc, ns + "/odom", Profile::Default) : 0);
@@ -121,10 +121,10 @@ DdsTransport::DdsTransport(int domain, Network network, const std::vector<bridge
       force_.push_back(r.force ? writer(&geometry_msgs_msg_dds__WrenchStamped__desc, ns + "/force", Profile::Default) : 0);
       imu_.push_back(r.imu ? writer(&sensor_msgs_msg_dds__Imu__desc, ns + "/imu", Profile::SensorData) : 0);
       range_.push_back(r.range ? writer(&geometry_msgs_msg_dds__PoseArray__desc, ns + "/range", Profile::Default) : 0);
-      odom_frames_.push_back(r.name + "/base_link");
+      odom_frames_.push_back(r.name + "/" + r.root_frame);
       imu_frames_.push_back(r.name + "/imu");
       if (r.tf && tf_ == 0) tf_ = writer(&tf2_msgs_msg_dds__TFMessage__desc, "/tf", Profile::Tf);
-      frames_.push_back({r.name + "/base_link"});
+      frames_.push_back({r.name + "/" + r.root_frame});
       for (const std::string& part : r.parts) frames_.back().push_back(r.name + "/" + part);
       const bool joints = r.tf && !r.joints.empty();
       joint_states_.push_back(joints ? writer(&sensor_msgs_msg_dds__JointState__desc, ns + "/joint_states", Profile::Default) : 0);
@@ -144,6 +144,10 @@ DdsTransport::DdsTransport(int domain, Network network, const std::vector<bridge
       if (robots[i].velocity) {
         readers_.push_back({this, i, Kind::Velocity});
         reader(readers_.back(), &geometry_msgs_msg_dds__Twist__desc, ns + "/cmd_vel", Profile::Default);
+      }
+      if (robots[i].joint_commands) {
+        readers_.push_back({this, i, Kind::Joints});
+        reader(readers_.back(), &sensor_msgs_msg_dds__JointState__desc, ns + "/joint_command", Profile::Default);
       }
       if (robots[i].joy) {
         // (best effort: it matches a joystick node's writer whatever its reliability)
@@ -228,7 +232,11 @@ void DdsTransport::onData(dds_entity_t reader, void* arg) {
     const dds_return_t n = dds_take(reader, samples, info, 1, 1);
     if (n <= 0) return;
     if (info[0].valid_data) {
-      if (r.kind == Reader::Kind::Joy) {
+      if (r.kind == Reader::Kind::Joints) {
+        const auto& m = *static_cast<const sensor_msgs_msg_dds__JointState_*>(samples[0]);
+        r.self->receivedJointCommand(r.robot, m.name._buffer, m.name._length, m.position._buffer, m.position._length,
+                                     m.velocity._buffer, m.velocity._length);
+      } else if (r.kind == Reader::Kind::Joy) {
         const auto& m = *static_cast<const sensor_msgs_msg_dds__Joy_*>(samples[0]);
         r.self->receivedJoy(r.robot, seconds(m.header.stamp), m.axes._buffer, m.axes._length, m.buttons._buffer,
                             m.buttons._length);
@@ -254,7 +262,7 @@ bool DdsTransport::connected(std::size_t robot) const {
   if (odom_[robot] != 0 && (dds_get_publication_matched_status(odom_[robot], &out) < 0 || out.current_count == 0))
     return false;
   for (const Reader& r : readers_) {
-    if (r.robot != robot || r.kind == Reader::Kind::Velocity) continue;
+    if (r.robot != robot || r.kind == Reader::Kind::Velocity || r.kind == Reader::Kind::Joints) continue;
     dds_subscription_matched_status_t in{};
     if (dds_get_subscription_matched_status(r.entity, &in) < 0 || in.current_count == 0) return false;
   }

@@ -101,7 +101,7 @@ std::string robotDescription(const Artifact& a) {
   Out written;
   std::ostringstream& out = written.text;
   out << "<?xml version=\"1.0\"?>\n<!-- written by ssx from artifact '" << escaped(a.name())
-      << "': links are its physic nodes, the root base_link -->\n<robot name=\"" << escaped(a.name()) << "\">\n";
+      << "': links are its physic nodes, named as /tf names them -->\n<robot name=\"" << escaped(a.name()) << "\">\n";
   // each node's link with the render trees that follow it
   std::map<std::string, std::vector<const RenderNodeSpec*>> followers;
   for (const auto& tree : a.renderRoots())
@@ -113,7 +113,7 @@ std::string robotDescription(const Artifact& a) {
       for (const RenderNodeSpec* tree : it->second) visuals(written, *tree, Pose{});
     out << "  </link>\n";
   }
-  // each node's joint to its parent (a second root of the artifact hangs from base_link, floating)
+  // each node's joint to its parent (a second root of the artifact hangs from the root, floating)
   for (std::size_t k = 0; k < a.nodeCount(); ++k) {
     const PhysicNode& n = a.nodeAt(k);
     if (&n == &a.root()) continue;
@@ -125,7 +125,7 @@ std::string robotDescription(const Artifact& a) {
     else if (j.kind == JointSpec::Kind::Hinge) type = std::isfinite(j.lower) && std::isfinite(j.upper) ? "revolute" : "continuous";
     const std::string name = linkName(a, n);
     out << "  <joint name=\"" << escaped(name) << "_joint\" type=\"" << type << "\">\n    <parent link=\""
-        << escaped(parent != nullptr ? linkName(a, *parent) : "base_link") << "\"/>\n    <child link=\"" << escaped(name)
+        << escaped(linkName(a, parent != nullptr ? *parent : a.root())) << "\"/>\n    <child link=\"" << escaped(name)
         << "\"/>\n    " << origin(parent != nullptr ? n.spec().pose : Pose{}) << "\n";
     if (j.hasPosition()) {
       out << "    <axis xyz=\"" << triple(j.axis) << "\"/>\n";

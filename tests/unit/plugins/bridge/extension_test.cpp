@@ -22,6 +22,7 @@ class FakeTransport final : public Transport {
  public:
   explicit FakeTransport(std::vector<RobotTopics> robots) : Transport(std::move(robots)) { startPublishing(); }
   ~FakeTransport() override { stopPublishing(); }
+  using Transport::receivedJointCommand;
   using Transport::receivedJoy;
   using Transport::receivedSetpoint;
   using Transport::receivedVelocity;
@@ -33,6 +34,7 @@ class FakeTransport final : public Transport {
 
 class TestBridge final : public BridgeExtension {
  public:
+  explicit TestBridge(bool transforms = false) : transforms_(transforms) {}
   FakeTransport* transport = nullptr;
 
  protected:
@@ -43,6 +45,10 @@ class TestBridge final : public BridgeExtension {
   }
   void close(Transport&) override {}
   const char* name() const override { return "test"; }
+  bool offersTransforms() const override { return transforms_; }
+
+ private:
+  bool transforms_;
 };
 
 const char* kScene = R"(<scene><environment timestep="0.002" seed="5"/><ground/>
@@ -131,4 +137,65 @@ TEST_CASE("bridges: a good message after bad ones is used", "[bridge]") {
   CHECK(tracker.currentSetpoint().position == Vec3(0.5, 0, 1));
   env.step(1500);
   CHECK(env.findArtifact("q0")->pose().position.x() > 0.4);  // on its way there
+}
+
+TEST_CASE("bridges: joint commands drive a robot's joints by name, a command naming a joint it lacks is dropped",
+          "[bridge][joints]") {
+  // the Husky from its URDF, no driver: its wheels (given motors here) take commands from outside
+  const std::string scene_text = R"(<scene><environment timestep="0.002" seed="5"/><ground/>
+    <type name="h" file=")" + std::string(SSX_EXAMPLES_DIR) + R"(/robots/husky/husky.urdf">
+      <joint node="front_left_wheel_link" max_torque="60"/><joint node="rear_left_wheel_link" max_torque="60"/>
+      <joint node="front_right_wheel_link" max_torque="60"/><joint node="rear_right_wheel_link" max_torque="60"/>
+    </type><artifact name="h0" type="h" xyz="0 0 0.02"/></scene>)";
+  Scene scene = loadSceneFromString(scene_text, "joints.xml", test::kArtifacts, test::testOptions());
+  Environment& env = *scene.environment;
+  std::vector<std::string> warnings;
+  env.setLogSink([&](LogLevel level, std::string_view text) {
+    if (level == LogLevel::Warning) warnings.emplace_back(text);
+  });
+  auto bridge = std::make_unique<TestBridge>(true);
+  TestBridge& b = *bridge;
+  env.addExtension("bridge", std::move(bridge), bridgeParams());
+  env.step(10);
+  REQUIRE(b.transport != nullptr);
+  const RobotTopics& topics = b.transport->robots()[0];
+  CHECK(topics.joints == std::vector<std::string>{"front_left_wheel_link", "front_right_wheel_link",
+                                                  "rear_left_wheel_link", "rear_right_wheel_link"});
+  CHECK(topics.joint_commands);
+  CHECK(topics.parts == topics.joints);
+  // its root is base_footprint, above a link named base_link: the root keeps its own name, and
+  // base_link and the IMU's link are fixed frames on /tf_static, where the file puts them
+  CHECK(topics.root_frame == "base_footprint");
+  int fixed = 0;
+  for (const StaticFrame& f : topics.statics) {
+    if (f.child == "h0/base_link" && f.parent == "h0/base_footprint" && std::abs(f.pose[2] - 0.14493) < 1e-9) ++fixed;
+    if (f.child == "h0/imu_link" && f.parent == "h0/base_footprint" && std::abs(f.pose[0] - 0.19) < 1e-9) ++fixed;
+  }
+  CHECK(fixed == 2);
+  const Artifact& robot = *env.findArtifact("h0");
+  const char* names[] = {"front_left_wheel_link", "rear_left_wheel_link", "front_right_wheel_link", "rear_right_wheel_link"};
+  const double speeds[] = {2.0, 2.0, 2.0, 2.0};
+  b.transport->receivedJointCommand(0, names, 4, nullptr, 0, speeds, 4);
+  env.step(500);
+  CHECK(robot.node("front_left_wheel_link")->jointVelocity() == Approx(2.0).margin(0.05));
+  CHECK(robot.node("rear_right_wheel_link")->jointVelocity() == Approx(2.0).margin(0.05));
+  CHECK(robot.root().pose().position.x() > 0.1);  // it drives ahead
+  CHECK(warnings.empty());
+  // a joint it lacks: the whole command dropped, the wheels keep what they had
+  const char* wrong[] = {"front_left_wheel_link", "no_such_wheel"};
+  const double stop[] = {0.0, 0.0, 0.0, 0.0};
+  b.transport->receivedJointCommand(0, wrong, 2, nullptr, 0, stop, 2);
+  env.step(100);
+  CHECK(robot.node("front_left_wheel_link")->jointVelocity() == Approx(2.0).margin(0.05));
+  REQUIRE(warnings.size() == 1);
+  CHECK_THAT(warnings[0], Catch::Contains("/h0/joint_command was dropped (no joint 'no_such_wheel'"));
+  // positions and names of other lengths: dropped too
+  b.transport->receivedJointCommand(0, names, 4, stop, 1, nullptr, 0);
+  env.step(1);
+  CHECK(robot.node("front_left_wheel_link")->jointVelocity() == Approx(2.0).margin(0.05));
+  // stopped by a good one
+  b.transport->receivedJointCommand(0, names, 4, nullptr, 0, stop, 4);
+  env.step(500);
+  CHECK(std::abs(robot.node("front_left_wheel_link")->jointVelocity()) < 0.05);
+  env.stop();  // (its summary logged while `warnings` is there)
 }

@@ -36,6 +36,13 @@
  *   peer COUNT SECONDS --bench           answers every odometry message at once with a set-point stamped
  *                                        like it for SECONDS, then prints how many messages came per
  *                                        robot (tests/unit/plugins/ros2/bench.sh)
+ *   peer 1 TIMEOUT_S --wheels W R        as a ROS user drives a robot's joints: a JointState on
+ *                                        /q0/joint_command naming the Husky's four wheels, first with a
+ *                                        joint it lacks (ssx must drop that one), then at W rad/s for
+ *                                        2 s of simulated time (from 1 s, once matched), then 0;
+ *                                        success once q0 went 2 W R m ahead (within 15 %) and stood,
+ *                                        its joint states showing the wheels at W mid-drive (mean
+ *                                        within 10 %)
  *   --vanish-after S                     (with any) ends the process abruptly after S wall seconds
  *
  * Exit 0 on success, 1 with a message otherwise. */
@@ -128,6 +135,89 @@ static int checkPublisher(dds_entity_t reader, const char* type, int reliable) {
   return n;
 }
 
+static const char* kWheels[4] = {"front_left_wheel_link", "rear_left_wheel_link", "front_right_wheel_link",
+                                 "rear_right_wheel_link"};
+
+/* --wheels: q0's four wheel joints driven by JointState commands */
+static int wheelsMode(dds_entity_t participant, double timeout, double w, double radius) {
+  dds_qos_t* q = qos(1, 100);
+  const dds_entity_t odom =
+      dds_create_reader(participant, dds_create_topic(participant, &nav_msgs_msg_dds__Odometry__desc, "rt/q0/odom", NULL, NULL), q, NULL);
+  const dds_entity_t states = dds_create_reader(
+      participant, dds_create_topic(participant, &sensor_msgs_msg_dds__JointState__desc, "rt/q0/joint_states", NULL, NULL), q, NULL);
+  const dds_entity_t command = dds_create_writer(
+      participant, dds_create_topic(participant, &sensor_msgs_msg_dds__JointState__desc, "rt/q0/joint_command", NULL, NULL), q, NULL);
+  dds_delete_qos(q);
+  double go = -1, x0 = 0, latest = -1, wheel_sum = 0;
+  long wheel_samples = 0;
+  int bad_sent = 0;
+  void* samples[1] = {NULL};
+  dds_sample_info_t info[1];
+  const double started = wall();
+  for (;;) {
+    if (wall() - started > timeout) {
+      fail("timed out");
+      return 1;
+    }
+    int busy = 0;
+    while (dds_take(odom, samples, info, 1, 1) > 0) {
+      busy = 1;
+      if (info[0].valid_data) {
+        const nav_msgs_msg_dds__Odometry_* m = samples[0];
+        const double t = seconds(m->header.stamp), x = m->pose.pose.position.x;
+        latest = t;
+        dds_publication_matched_status_t matched;
+        if (go < 0 && t >= 1.0 && dds_get_publication_matched_status(command, &matched) == 0 && matched.current_count > 0)
+          go = t, x0 = x;
+        if (go >= 0 && t >= go + 4.0) {
+          const double moved = x - x0, speed = hypot(m->twist.twist.linear.x, m->twist.twist.linear.y);
+          const double mean = wheel_sum / (wheel_samples > 0 ? wheel_samples : 1);
+          printf("peer: q0 went %.4f m (%.4f asked), %.4f m/s 4 s after the start; wheels at %.3f rad/s mid-drive (%.3f asked)\n",
+                 moved, 2 * w * radius, speed, mean, w);
+          if (fabs(moved - 2 * w * radius) > 0.15 * 2 * w * radius || speed > 0.01) fail("q0 did not drive as its wheels were told");
+          if (wheel_samples < 30 || fabs(mean - w) > 0.1 * w) fail("the joint states do not show the wheels at the speed commanded");
+          dds_return_loan(odom, samples, 1);
+          return failures == 0 ? 0 : 1;
+        }
+      }
+      dds_return_loan(odom, samples, 1);
+    }
+    while (dds_take(states, samples, info, 1, 1) > 0) {
+      if (info[0].valid_data) {
+        const sensor_msgs_msg_dds__JointState_* m = samples[0];
+        const double t = seconds(m->header.stamp);
+        if (go >= 0 && t >= go + 0.5 && t <= go + 1.5) {
+          /* each of the four wheels, found by name */
+          for (uint32_t k = 0; k < m->name._length && k < m->velocity._length; ++k)
+            for (int n = 0; n < 4; ++n)
+              if (strcmp(m->name._buffer[k], kWheels[n]) == 0) wheel_sum += m->velocity._buffer[k], ++wheel_samples;
+        }
+      }
+      dds_return_loan(states, samples, 1);
+    }
+    if (busy && latest >= 0) {
+      sensor_msgs_msg_dds__JointState_ cmd;
+      memset(&cmd, 0, sizeof cmd);
+      char* names[4] = {(char*)kWheels[0], (char*)kWheels[1], (char*)kWheels[2], (char*)kWheels[3]};
+      double velocity[4];
+      const int moving = go >= 0 && latest >= go && latest < go + 2.0;
+      for (int n = 0; n < 4; ++n) velocity[n] = moving ? w : 0.0;
+      if (!bad_sent) {
+        /* a joint the robot lacks: the whole command is dropped, with a warning */
+        names[3] = "no_such_joint";
+        bad_sent = 1;
+      }
+      cmd.name._length = cmd.name._maximum = 4;
+      cmd.name._buffer = names;
+      cmd.velocity._length = cmd.velocity._maximum = 4;
+      cmd.velocity._buffer = velocity;
+      dds_write(command, &cmd);
+    } else if (!busy) {
+      usleep(200);
+    }
+  }
+}
+
 int main(int argc, char** argv) {
   if (argc < 3) {
     fprintf(stderr, "usage: peer COUNT TIMEOUT_S [--lockstep|--cmd-vel|--drive V W] [--vanish-after S]\n");
@@ -135,13 +225,15 @@ int main(int argc, char** argv) {
   }
   const int count = atoi(argv[1]);
   const double timeout = atof(argv[2]);
-  int lockstep = 0, cmd_vel = 0, bench = 0, drive = 0;
+  int lockstep = 0, cmd_vel = 0, bench = 0, drive = 0, wheels = 0;
+  double wheel_speed = 0, wheel_radius = 0;
   double vanish = -1, drive_v = 0.5, drive_w = 0; /* the Twist sent from 1 s to 3 s */
   for (int i = 3; i < argc; ++i) {
     if (strcmp(argv[i], "--lockstep") == 0) lockstep = 1;
     else if (strcmp(argv[i], "--cmd-vel") == 0) cmd_vel = 1;
     else if (strcmp(argv[i], "--drive") == 0 && i + 2 < argc) cmd_vel = drive = 1, drive_v = atof(argv[i + 1]), drive_w = atof(argv[i + 2]), i += 2;
     else if (strcmp(argv[i], "--bench") == 0) bench = lockstep = 1;
+    else if (strcmp(argv[i], "--wheels") == 0 && i + 2 < argc) wheels = 1, wheel_speed = atof(argv[i + 1]), wheel_radius = atof(argv[i + 2]), i += 2;
     else if (strcmp(argv[i], "--vanish-after") == 0 && i + 1 < argc) vanish = atof(argv[++i]);
   }
   if (count < 1 || count > MAX_ROBOTS) return 2;
@@ -151,6 +243,11 @@ int main(int argc, char** argv) {
   if (participant < 0) {
     fprintf(stderr, "peer: no DDS participant: %s\n", dds_strretcode(participant));
     return 1;
+  }
+  if (wheels) {
+    const int status = wheelsMode(participant, timeout, wheel_speed, wheel_radius);
+    dds_delete(participant);
+    return status;
   }
   /* ROS 2's profiles; the odometry readers keep 100 (not 10), so that a peer slowed down by a loaded
      machine loses none and the stamps' spacing checks the writer's rate, not this reader's pace */
