@@ -301,6 +301,15 @@ class BridgeExtension : public SimulationExtension {
       publish_costs_.push_back(std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count());
   }
 
+  /// After the world was put back to its start (a reset): the rates and lock-step start again.
+  void restarted() {
+    for (Rate* r : {&odom_rate_, &imu_rate_, &clock_rate_, &range_rate_, &image_rate_}) r->next = 0;
+    for (Robot& r : robots_) r.range_published = r.image_published = -1;
+    for (Operator& o : operators_) o.force_rate.next = 0;
+    waiting_for_ = cutoff_ = -1;
+    held_.clear();
+  }
+
   void shutdown(Environment& env) override {
     if (transport_) {
       logSummary(env);

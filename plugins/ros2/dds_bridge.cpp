@@ -52,6 +52,7 @@ class DdsTransport final : public bridge::Transport {
   DdsTransport(int domain, Network network, const std::vector<bridge::RobotTopics>& robots, bool reliable_poses);
   ~DdsTransport() override { shutdown(); }
   void shutdown();
+  dds_entity_t participant() const { return participant_; }
 
  private:
   struct Reader {
@@ -404,5 +405,7 @@ std::unique_ptr<bridge::Transport> open(int domain, Network network, const std::
 }
 
 void close(bridge::Transport& transport) { static_cast<DdsTransport&>(transport).shutdown(); }
+
+int participant(const bridge::Transport& transport) { return static_cast<const DdsTransport&>(transport).participant(); }
 
 }  // namespace ssx::ros2

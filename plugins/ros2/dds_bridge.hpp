@@ -28,5 +28,7 @@ std::unique_ptr<bridge::Transport> open(int domain, Network network, const std::
                                         bool reliable_poses);
 /// Sends what is staged, then leaves the domain.
 void close(bridge::Transport& transport);
+/// The transport's DDS participant (for the services on the same node), 0 once closed.
+int participant(const bridge::Transport& transport);
 
 }  // namespace ssx::ros2

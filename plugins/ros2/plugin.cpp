@@ -11,7 +11,10 @@
 // bodies' frames <name>/<node> in the world frame, and /<name>/joint_states (sensor_msgs/msg/JointState)
 // for a robot with hinges or sliders, each named by the node it moves; once, kept for later readers,
 // /tf_static (every frame fixed in a body) and /<name>/robot_description (std_msgs/msg/String: a
-// URDF written from the artifact, robot_description.hpp). Stamps are
+// URDF written from the artifact, robot_description.hpp). With services="true" (the default), the
+// ROS 2 standard simulation services (simulation_interfaces: /get_entities, /get_entity_state,
+// /set_entity_state, /set_simulation_state, /step_simulation, /reset_simulation, ...;
+// sim_services.hpp), answered between steps. Stamps are
 // simulated time. What is published when, lock-step and applying what arrived between steps are the
 // bridges' shared logic (plugins/bridge), as in the ros1 extension; this file is the DDS transport's
 // parameters.
@@ -19,6 +22,7 @@
 // Parameters: kParameters below, or `ssx plugins --params ros2`.
 #include "dds_bridge.hpp"
 #include "robot_description.hpp"
+#include "sim_services.hpp"
 
 #include "../bridge/extension.hpp"
 
@@ -32,13 +36,16 @@ inline constexpr ssx_plugin_param kRos2Parameters[] = {
     param::choice("network", "loopback", "loopback system",
                   "loopback: this machine only (127.0.0.1; discovery by unicast there: a ROS 2 program uses the same "
                   "CYCLONEDDS_URI, see docs); system: Cyclone's choice of interfaces, or $CYCLONEDDS_URI's"),
+    param::flag("services", "true",
+                "serve ROS 2's simulation_interfaces services (/get_entities, /set_entity_state, /step_simulation, "
+                "/reset_simulation, ...), answered between steps"),
 };
 
 class Ros2Bridge final : public bridge::BridgeExtension {
  public:
   static constexpr const char* kDoc =
       "bridges robots to ROS 2 over DDS: odometry, IMU, /tf, joint states, descriptions and /clock out, set-points "
-      "and velocity commands in";
+      "and velocity commands in, the simulation_interfaces services";
   static constexpr auto kParameters =
       param::join(param::part("ROS 2", kRos2Parameters), param::part("bridge", bridge::kBridgeParameters));
 
@@ -47,11 +54,36 @@ class Ros2Bridge final : public bridge::BridgeExtension {
     (void)domainOf(params);
   }
 
+ void init(Environment& env, const Descriptor& params) override {
+    BridgeExtension::init(env, params);
+    if (!params.get<bool>("services")) return;
+    try {
+      services_ = std::make_unique<ros2::SimulationServices>(ros2::participant(*dds_), env, "",
+                                                             [this] { restarted(); });
+    } catch (const std::exception& e) {
+      BridgeExtension::shutdown(env);
+      throw params.error(e.what());
+    }
+  }
+  void afterStep(Environment& env) override {
+    BridgeExtension::afterStep(env);
+    if (services_) services_->afterStep();
+  }
+  void shutdown(Environment& env) override {
+    if (services_) {
+      if (const std::string line = services_->summary(); !line.empty()) env.log(LogLevel::Info, line);
+      services_.reset();  // (before the participant its endpoints belong to)
+    }
+    BridgeExtension::shutdown(env);
+  }
+
  protected:
   std::unique_ptr<bridge::Transport> open(Environment&, const Descriptor& params,
                                           const std::vector<bridge::RobotTopics>& robots) override {
     const auto network = params.get<std::string>("network") == "system" ? ros2::Network::System : ros2::Network::Loopback;
-    return ros2::open(domainOf(params), network, robots, params.get<bool>("lockstep"));
+    auto t = ros2::open(domainOf(params), network, robots, params.get<bool>("lockstep"));
+    dds_ = t.get();
+    return t;
   }
   void close(bridge::Transport& transport) override { ros2::close(transport); }
   const char* name() const override { return "ros2"; }
@@ -59,6 +91,8 @@ class Ros2Bridge final : public bridge::BridgeExtension {
   std::string describe(const Artifact& a) const override { return ros2::robotDescription(a); }
 
  private:
+  bridge::Transport* dds_ = nullptr;  // the transport open() made (the base owns it)
+  std::unique_ptr<ros2::SimulationServices> services_;
   // the parameter, else $ROS_DOMAIN_ID, else 0; a domain ROS 2 cannot use is an error where it was given
   static int domainOf(const Descriptor& params) {
     const char* from_env = std::getenv("ROS_DOMAIN_ID");

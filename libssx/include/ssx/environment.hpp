@@ -116,17 +116,31 @@ class SSX_EXPORT RunControl {
   bool paused() const;
   /// The factor set, or 0 when none was (the run's own applies).
   double realtimeFactor() const;
+  /// Ends run() between two steps (after the current one), as its stop flag would.
+  void stop();
+  /// Whether stop() was called (run() clears it when it returns).
+  bool stopped() const;
+  /// Work for the stepping thread between two steps (a ROS service call that reads or moves the
+  /// world), from any thread: run() runs the tasks posted, in order, before each step and at once
+  /// while paused; a program stepping with step() calls runPosted(). A task that throws ends run().
+  void post(std::function<void()> task);
+  /// Runs the tasks posted so far, on the calling thread; returns how many ran.
+  std::size_t runPosted();
 
   /// For Environment::run: waits while paused (returns at once otherwise) until resumed, a step is
-  /// asked for, or `stop` is set; returns true when a step may be taken.
+  /// asked for, `stop` is set or a task is posted (run it with runPosted() and wait again); returns
+  /// true when a step may be taken.
   bool waitWhilePaused(const std::atomic<bool>* stop);
 
  private:
+  friend class Environment;
   mutable std::mutex mutex_;
   std::condition_variable changed_;
   bool paused_ = false;
+  bool stop_ = false;
   std::int64_t steps_ = 0;
   double factor_ = 0;
+  std::vector<std::function<void()>> tasks_;
 };
 
 /// How a run is paced.

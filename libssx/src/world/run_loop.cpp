@@ -140,13 +140,59 @@ double RunControl::realtimeFactor() const {
   return factor_;
 }
 
+void RunControl::stop() {
+  std::lock_guard lock(mutex_);
+  stop_ = true;
+  changed_.notify_all();
+}
+
+bool RunControl::stopped() const {
+  std::lock_guard lock(mutex_);
+  return stop_;
+}
+
+void RunControl::post(std::function<void()> task) {
+  std::lock_guard lock(mutex_);
+  tasks_.push_back(std::move(task));
+  changed_.notify_all();
+}
+
+std::size_t RunControl::runPosted() {
+  std::vector<std::function<void()>> now;
+  {
+    std::lock_guard lock(mutex_);
+    if (tasks_.empty()) return 0;
+    now.swap(tasks_);
+  }
+  // (outside the lock: a task may post, pause or step)
+  for (std::size_t k = 0; k < now.size(); ++k) {
+    try {
+      now[k]();
+    } catch (...) {
+      // the ones after it stay posted, in order
+      std::lock_guard lock(mutex_);
+      tasks_.insert(tasks_.begin(), std::make_move_iterator(now.begin() + static_cast<std::ptrdiff_t>(k + 1)),
+                    std::make_move_iterator(now.end()));
+      throw;
+    }
+  }
+  return now.size();
+}
+
 bool RunControl::waitWhilePaused(const std::atomic<bool>* stop) {
   std::unique_lock lock(mutex_);
-  while (paused_ && steps_ == 0) {
+  while (paused_ && steps_ == 0 && !stop_) {
     if (stop != nullptr && stop->load()) return false;
+    if (!tasks_.empty()) {
+      lock.unlock();
+      runPosted();
+      lock.lock();
+      continue;
+    }
     // (the stop flag is a plain atomic that nobody notifies: looked at every 20 ms)
     changed_.wait_for(lock, std::chrono::milliseconds(20));
   }
+  if (stop_) return false;
   if (paused_) --steps_;
   return true;
 }
@@ -193,6 +239,16 @@ TimingSummary Environment::run(const RunOptions& options) {
     fifo.emplace(threads, options.realtime_priority);
   }
 
+  RunControl& control = *run_control_;
+  // (a stop() left from an earlier run is forgotten when this one ends)
+  struct ClearStop {
+    RunControl& c;
+    ~ClearStop() {
+      std::lock_guard lock(c.mutex_);
+      c.stop_ = false;
+    }
+  } clear_stop{control};
+  control.runPosted();  // (before the clock starts: what was asked before the first step)
   const std::int64_t first_sample = timing_.recorded();
   const std::int64_t first_step = stepCount();  // (steps are counted when no timing is kept too)
   const Nanoseconds sim_start = time();
@@ -210,12 +266,16 @@ TimingSummary Environment::run(const RunOptions& options) {
   double factor = realtime ? options.realtime_factor : 1.0;
   double period = static_cast<double>(settings_.timestep) / factor;
   while ((options.steps < 0 || done < options.steps) && !(options.stop != nullptr && options.stop->load())) {
-    // steered from elsewhere (RunControl): a pause holds the run here; real time starts afresh
-    // after it, and a new factor takes over from now
-    RunControl& control = *run_control_;
+    // steered from elsewhere (RunControl): posted tasks run here, a pause holds the run here (and
+    // runs what is posted meanwhile); real time starts afresh after it, and a new factor takes over
+    // from now
+    control.runPosted();
+    if (control.stopped()) break;
     const bool was_paused = control.paused();
+    bool asked_while_paused = false;  // a step asked for while paused: taken at once, not paced
     if (was_paused) {
       if (!control.waitWhilePaused(options.stop)) break;
+      asked_while_paused = control.paused();
     }
     const double asked = control.realtimeFactor();
     if (realtime && ((asked > 0 && asked != factor) || was_paused)) {
@@ -228,7 +288,7 @@ TimingSummary Environment::run(const RunOptions& options) {
     step();
     ++done;
     ++grid_k;
-    if (realtime) {
+    if (realtime && !asked_while_paused) {
       const Nanoseconds deadline =
           grid_start + static_cast<Nanoseconds>(std::llround(static_cast<double>(grid_k) * period));
       const Nanoseconds now = monotonicNow();

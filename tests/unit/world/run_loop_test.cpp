@@ -381,3 +381,72 @@ TEST_CASE("a real-time factor set from another thread paces the rest of the run"
   stopper.join();
   CHECK(env.stepCount() == 40);
 }
+
+TEST_CASE("tasks posted from another thread run on the stepping thread between steps, in order, also while paused, "
+          "stop() ends the run",
+          "[run]") {
+  EnvironmentSettings s;
+  s.timestep = toNanoseconds(0.002);
+  Environment env(s);
+  withBall(env);
+  RunControl& control = env.runControl();
+  std::atomic<std::int64_t> steps{0};
+  std::atomic<bool> stop{false};  // (the test's bound only: stop() ends the run)
+  RunOptions o;
+  o.steps = -1;
+  o.stop = &stop;
+  o.on_step = [&](const Environment& e) { steps = e.stepCount(); };
+  std::thread::id stepper;
+  std::vector<std::int64_t> seen;  // the step count each task saw, in the order they ran
+  std::mutex m;
+  auto record = [&] {
+    std::lock_guard lock(m);
+    seen.push_back(env.stepCount());
+    stepper = std::this_thread::get_id();
+  };
+  control.post(record);  // before the run: runs before its first step
+  std::thread runner([&] { env.run(o); });
+  auto waitFor = [](auto done) {
+    const auto until = std::chrono::steady_clock::now() + std::chrono::seconds(10);
+    while (!done() && std::chrono::steady_clock::now() < until) std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    return done();
+  };
+  auto count = [&] {
+    std::lock_guard lock(m);
+    return seen.size();
+  };
+  CHECK(waitFor([&] { return steps.load() >= 20; }));
+  // while it plays: between two steps, on the stepping thread
+  control.post(record);
+  CHECK(waitFor([&] { return count() == 2; }));
+  // while paused: at once, and the run stays where it was
+  control.pause();
+  CHECK(waitFor([&] { return steps.load() == env.stepCount(); }));
+  std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  const std::int64_t held = steps.load();
+  for (int k = 0; k < 3; ++k) control.post(record);
+  CHECK(waitFor([&] { return count() == 5; }));
+  control.post([&] { control.stop(); });
+  runner.join();
+  CHECK(stop.load() == false);
+  std::lock_guard lock(m);
+  REQUIRE(seen.size() == 5);
+  CHECK(seen[0] == 0);
+  CHECK(seen[1] >= 20);
+  CHECK((seen[2] == held && seen[3] == held && seen[4] == held));
+  CHECK(env.stepCount() == held);
+  CHECK(stepper != std::this_thread::get_id());
+  CHECK_FALSE(control.stopped());  // (forgotten when the run ended)
+
+  // a task that throws ends the run; the ones after it stay posted, in order
+  control.resume();
+  std::vector<int> order;
+  control.post([&] { throw std::runtime_error("task failed"); });
+  control.post([&] { order.push_back(1); });
+  control.post([&] { order.push_back(2); });
+  o.steps = 10;
+  CHECK_THROWS_WITH(env.run(o), "task failed");
+  CHECK(order.empty());
+  CHECK(control.runPosted() == 2);
+  CHECK(order == std::vector<int>{1, 2});
+}
