@@ -30,5 +30,8 @@ std::unique_ptr<bridge::Transport> open(int domain, Network network, const std::
 void close(bridge::Transport& transport);
 /// The transport's DDS participant (for the services on the same node), 0 once closed.
 int participant(const bridge::Transport& transport);
+/// Tells ROS 2's graph (ros_discovery_info) that the participant is the node /`node`, with every
+/// reader and writer it has now; kept for ROS tools that start later. Throws std::runtime_error.
+void announce(const bridge::Transport& transport, const std::string& node);
 
 }  // namespace ssx::ros2

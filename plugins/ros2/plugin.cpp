@@ -26,6 +26,8 @@
 
 #include "../bridge/extension.hpp"
 
+#include <algorithm>
+#include <cctype>
 #include <charconv>
 #include <cstdlib>
 
@@ -36,6 +38,7 @@ inline constexpr ssx_plugin_param kRos2Parameters[] = {
     param::choice("network", "loopback", "loopback system",
                   "loopback: this machine only (127.0.0.1; discovery by unicast there: a ROS 2 program uses the same "
                   "CYCLONEDDS_URI, see docs); system: Cyclone's choice of interfaces, or $CYCLONEDDS_URI's"),
+    param::text("node_name", "ssx", "the ROS 2 node the bridge is to ROS tools (ros2 node list): letters, digits, _"),
     param::flag("services", "true",
                 "serve ROS 2's simulation_interfaces services (/get_entities, /set_entity_state, /step_simulation, "
                 "/reset_simulation, ...), answered between steps"),
@@ -52,15 +55,24 @@ class Ros2Bridge final : public bridge::BridgeExtension {
   static void validate(const Descriptor& params, const PluginContext& context) {
     BridgeExtension::validate(params, context);
     (void)domainOf(params);
+    const std::string node = params.get<std::string>("node_name");
+    const bool valid = !node.empty() && node.size() <= 255 && !std::isdigit(static_cast<unsigned char>(node[0])) &&
+                       std::all_of(node.begin(), node.end(), [](char c) { return std::isalnum(static_cast<unsigned char>(c)) || c == '_'; });
+    if (!valid)
+      throw params.errorAt("node_name", "node_name '" + node + "' is not a ROS 2 node name: letters, digits and _, "
+                                        "not starting with a digit");
   }
 
- void init(Environment& env, const Descriptor& params) override {
+  void init(Environment& env, const Descriptor& params) override {
     BridgeExtension::init(env, params);
-    if (!params.get<bool>("services")) return;
     try {
-      services_ = std::make_unique<ros2::SimulationServices>(ros2::participant(*dds_), env, "",
-                                                             [this] { restarted(); });
+      if (params.get<bool>("services"))
+        services_ = std::make_unique<ros2::SimulationServices>(ros2::participant(*dds_), env, "",
+                                                               [this] { restarted(); });
+      // (last: it lists every reader and writer made)
+      ros2::announce(*dds_, params.get<std::string>("node_name"));
     } catch (const std::exception& e) {
+      services_.reset();
       BridgeExtension::shutdown(env);
       throw params.error(e.what());
     }

@@ -178,6 +178,54 @@ static void printTrips(int phase, const char* what) {
   printf("round trip %s: %d calls, median %.2f ms, p99 %.2f ms\n", what, n, 1e3 * t[n / 2], 1e3 * t[n * 99 / 100]);
 }
 
+static int contains(const dds_sequence_rmw_dds_common_msg_dds__Gid_* seq, const dds_guid_t* guid) {
+  for (uint32_t k = 0; k < seq->_length; ++k)
+    if (memcmp(seq->_buffer[k].data, guid->v, 16) == 0) return 1;
+  return 0;
+}
+
+/* ROS 2's graph: ssx's participant announces the node /ssx on ros_discovery_info (kept for late
+   readers), listing the reply writer and request reader this client matched */
+static void checkGraph(dds_entity_t participant) {
+  dds_instance_handle_t h;
+  if (dds_get_matched_publications(readers[ENTITIES], &h, 1) != 1) return check(0, "the reply writer's identity");
+  dds_builtintopic_endpoint_t* writer = dds_get_matched_publication_data(readers[ENTITIES], h);
+  if (dds_get_matched_subscriptions(writers[ENTITIES], &h, 1) != 1) return check(0, "the request reader's identity");
+  dds_builtintopic_endpoint_t* reader = dds_get_matched_subscription_data(writers[ENTITIES], h);
+  dds_qos_t* q = dds_create_qos();
+  dds_qset_reliability(q, DDS_RELIABILITY_RELIABLE, DDS_SECS(1));
+  dds_qset_durability(q, DDS_DURABILITY_TRANSIENT_LOCAL);
+  dds_qset_history(q, DDS_HISTORY_KEEP_LAST, 1);
+  const dds_entity_t graph = dds_create_reader(
+      participant, dds_create_topic(participant, &rmw_dds_common_msg_dds__ParticipantEntitiesInfo__desc, "ros_discovery_info", NULL, NULL),
+      q, NULL);
+  dds_delete_qos(q);
+  int found = 0;
+  const double t0 = now();
+  while (!found && now() - t0 < 5.0) {
+    void* samples[1] = {NULL};
+    dds_sample_info_t info;
+    if (dds_take(graph, samples, &info, 1, 1) == 1) {
+      const rmw_dds_common_msg_dds__ParticipantEntitiesInfo_* m = samples[0];
+      if (info.valid_data && memcmp(m->gid.data, writer->participant_key.v, 16) == 0 && m->node_entities_info_seq._length == 1) {
+        const rmw_dds_common_msg_dds__NodeEntitiesInfo_* n = &m->node_entities_info_seq._buffer[0];
+        found = 1;
+        printf("  ros_discovery_info: node %s%s with %u readers and %u writers\n", n->node_namespace, n->node_name,
+               n->reader_gid_seq._length, n->writer_gid_seq._length);
+        check(strcmp(n->node_namespace, "/") == 0 && strcmp(n->node_name, "ssx") == 0, "the node is /ssx");
+        check(contains(&n->writer_gid_seq, &writer->key) && contains(&n->reader_gid_seq, &reader->key),
+              "its endpoints include the services' reply writer and request reader");
+      }
+      dds_return_loan(graph, samples, 1);
+    } else {
+      dds_sleepfor(DDS_MSECS(5));
+    }
+  }
+  check(found, "ssx's participant is on ros_discovery_info");
+  dds_builtintopic_free_endpoint(writer);
+  dds_builtintopic_free_endpoint(reader);
+}
+
 int main(int argc, char** argv) {
   if (argc < 2) {
     fprintf(stderr, "usage: services_client TIMEOUT_S\n");
@@ -216,6 +264,7 @@ int main(int argc, char** argv) {
   }
   check(matched, "every service's request and reply topics matched ssx's");
   if (!matched) return 1;
+  checkGraph(participant);
   dds_sleepfor(DDS_MSECS(200)); /* (the run has started) */
 
   /* what the simulator offers */
