@@ -173,6 +173,7 @@ void Transport::publishLoop() {
       }
       send(m);
     }
+    sent();
     sending_.clear();
     sending_points_.clear();
     sending_bytes_.clear();

@@ -181,6 +181,9 @@ class Transport {
   void startPublishing();
   // Sends one message (on the publishing thread).
   virtual void send(const Outgoing& message) = 0;
+  // After send() was given every message of a batch (on the publishing thread): what a subclass
+  // gathers across robots goes out here (ROS 2's /tf: one message for all).
+  virtual void sent() {}
   // Whether robot `robot`'s controller is there: someone reads its odometry and writes its set-points.
   virtual bool connected(std::size_t robot) const = 0;
   // What a subclass received, from any thread.

@@ -64,6 +64,7 @@ class DdsTransport final : public bridge::Transport {
     dds_entity_t entity = 0;
   };
   void send(const bridge::Outgoing& out) override;
+  void sent() override;
   bool connected(std::size_t robot) const override;
   dds_entity_t topic(const dds_topic_descriptor_t* type, const std::string& ros_name);
   dds_entity_t writer(const dds_topic_descriptor_t* type, const std::string& ros_name, Profile profile);
@@ -78,7 +79,7 @@ class DdsTransport final : public bridge::Transport {
   std::vector<dds_entity_t> odom_, imu_, range_, force_, image_, joint_states_;
   std::vector<std::vector<std::string>> frames_;  // per robot: base_link's, then each part's
   std::vector<std::vector<char*>> joint_names_;   // per robot: into robots()[i].joints
-  std::vector<geometry_msgs_msg_dds__TransformStamped_> transforms_;  // the publishing thread's, reused
+  std::vector<geometry_msgs_msg_dds__TransformStamped_> transforms_;  // a batch's, every robot's: one /tf message
   std::vector<double> positions_, velocities_;                       // likewise
   std::vector<std::string> camera_frames_;
   std::vector<Reader> readers_;  // reserved up front: listeners hold pointers to them
@@ -326,23 +327,19 @@ void DdsTransport::send(const bridge::Outgoing& out) {
     }
     case bridge::Outgoing::Kind::Transforms: {
       // 7 values a frame: x y z qw qx qy qz, each in the world
+      // gathered: every robot's frames of the batch go out in one message (sent())
       const std::vector<std::string>& frames = frames_[out.robot];
       const std::size_t n = std::min(frames.size(), out.count / 7);
-      transforms_.resize(n);
       for (std::size_t k = 0; k < n; ++k) {
         const double* v = out.values + 7 * k;
-        auto& t = transforms_[k];
+        geometry_msgs_msg_dds__TransformStamped_ t{};
         t.header.stamp = stamp(out.time);
         t.header.frame_id = const_cast<char*>("world");
         t.child_frame_id = const_cast<char*>(frames[k].c_str());
         t.transform.translation = {v[0], v[1], v[2]};
         t.transform.rotation = {v[4], v[5], v[6], v[3]};
+        transforms_.push_back(t);
       }
-      tf2_msgs_msg_dds__TFMessage_ m{};
-      m.transforms._length = m.transforms._maximum = static_cast<uint32_t>(n);
-      m.transforms._buffer = transforms_.data();
-      m.transforms._release = false;
-      dds_write(tf_, &m);
       break;
     }
     case bridge::Outgoing::Kind::JointStates: {
@@ -380,6 +377,16 @@ void DdsTransport::send(const bridge::Outgoing& out) {
       break;
     }
   }
+}
+
+void DdsTransport::sent() {
+  if (transforms_.empty()) return;
+  tf2_msgs_msg_dds__TFMessage_ m{};
+  m.transforms._length = m.transforms._maximum = static_cast<uint32_t>(transforms_.size());
+  m.transforms._buffer = transforms_.data();
+  m.transforms._release = false;
+  dds_write(tf_, &m);
+  transforms_.clear();
 }
 
 void DdsTransport::shutdown() {
