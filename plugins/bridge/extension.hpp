@@ -44,6 +44,8 @@ inline constexpr ssx_plugin_param kBridgeParameters[] = {
                 "rate of /<robot>/range (what a range sensor sees, as a PoseArray) in simulated time; 0: none"),
     param::real("image_rate_hz", "10", "Hz", param::nonNegative() & param::atMost(kMaxRateHz),
                 "rate of /<robot>/image (what a camera sensor sees, rgb8) in simulated time; 0: none"),
+    param::real("scan_rate_hz", "10", "Hz", param::nonNegative() & param::atMost(kMaxRateHz),
+                "rate of /<robot>/scan (its proximity ring as a LaserScan; ROS 2) in simulated time; 0: none"),
     param::text("operators", "", "operator extensions bridged: names separated by spaces (/<name>/cmd_vel and "
                 "/<name>/joy in, /<name>/force out)"),
     param::choice("pose_stamps", "sim", "sim wall",
@@ -73,6 +75,8 @@ class BridgeExtension : public SimulationExtension {
     connect_timeout_ = params.get<double>("lockstep_connect_timeout_s");
     range_rate_ = rateOf(params, "range_rate_hz", env.timestep());
     if (params.get<double>("range_rate_hz") == 0) range_rate_.period = 0;
+    scan_rate_ = rateOf(params, "scan_rate_hz", env.timestep());
+    if (params.get<double>("scan_rate_hz") == 0) scan_rate_.period = 0;
     image_rate_ = rateOf(params, "image_rate_hz", env.timestep());
     if (params.get<double>("image_rate_hz") == 0) image_rate_.period = 0;
     wall_stamps_ = params.get<std::string>("pose_stamps") == "wall";  // (not with lockstep: validate)
@@ -87,6 +91,7 @@ class BridgeExtension : public SimulationExtension {
         if (r.imu == nullptr) r.imu = dynamic_cast<const ImuMeasurement*>(&a->sensor(k).latest());
         if (r.range == nullptr) r.range = dynamic_cast<const RangeMeasurement*>(&a->sensor(k).latest());
         if (r.camera == nullptr) r.camera = dynamic_cast<const CameraMeasurement*>(&a->sensor(k).latest());
+        if (r.proximity == nullptr) r.proximity = dynamic_cast<const ProximityMeasurement*>(&a->sensor(k).latest());
       }
       RobotTopics t;
       t.name = a->name();
@@ -100,10 +105,11 @@ class BridgeExtension : public SimulationExtension {
       // /tf_static and its description, where the transport offers them
       t.tf = offersTransforms();
       if (t.tf) {
-        frames(*a, r, t);
+        frames(*a, r.parts, r.joints, t);
         t.root_frame = linkName(*a, a->root());
         t.description = describe(*a);
         t.joint_commands = !t.joints.empty();
+        if (r.proximity != nullptr && scan_rate_.period > 0) scanOf(*a, t);
       }
       topics.push_back(t);
       robots_.push_back(r);
@@ -278,13 +284,22 @@ class BridgeExtension : public SimulationExtension {
         transport_->publishRange(i, toSeconds(r.range->stamp), r.range->body_frame, points_);
       }
     }
+    if (scan_rate_.due(now)) {
+      for (std::size_t i = 0; i < robots_.size(); ++i) {
+        Robot& r = robots_[i];
+        if (r.proximity == nullptr || r.proximity->stamp == r.scan_published || r.proximity->distances.empty()) continue;
+        r.scan_published = r.proximity->stamp;
+        const ProximityMeasurement& p = *r.proximity;
+        transport_->publishScan(i, toSeconds(p.stamp), p.range, p.radius, p.angles, p.distances, p.readings);
+      }
+    }
     if (image_rate_.due(now)) {
       for (std::size_t i = 0; i < robots_.size(); ++i) {
         Robot& r = robots_[i];
         if (r.camera == nullptr || r.camera->stamp == r.image_published || r.camera->image.rgb.empty()) continue;
         r.image_published = r.camera->stamp;
         transport_->publishImage(i, toSeconds(r.camera->stamp), r.camera->image.width, r.camera->image.height,
-                                 r.camera->image.rgb);
+                                 r.camera->view.fov_deg, r.camera->image.rgb);
       }
     }
     for (std::size_t k = 0; k < operators_.size(); ++k) {
@@ -303,8 +318,8 @@ class BridgeExtension : public SimulationExtension {
 
   /// After the world was put back to its start (a reset): the rates and lock-step start again.
   void restarted() {
-    for (Rate* r : {&odom_rate_, &imu_rate_, &clock_rate_, &range_rate_, &image_rate_}) r->next = 0;
-    for (Robot& r : robots_) r.range_published = r.image_published = -1;
+    for (Rate* r : {&odom_rate_, &imu_rate_, &clock_rate_, &range_rate_, &image_rate_, &scan_rate_}) r->next = 0;
+    for (Robot& r : robots_) r.range_published = r.image_published = r.scan_published = -1;
     for (Operator& o : operators_) o.force_rate.next = 0;
     waiting_for_ = cutoff_ = -1;
     held_.clear();
@@ -351,10 +366,12 @@ class BridgeExtension : public SimulationExtension {
     const ImuMeasurement* imu = nullptr;
     const RangeMeasurement* range = nullptr;
     const CameraMeasurement* camera = nullptr;
+    const ProximityMeasurement* proximity = nullptr;
     std::vector<const PhysicNode*> parts;   // its other bodies: frames on /tf (RobotTopics::parts)
     std::vector<const PhysicNode*> joints;  // its hinges and sliders (RobotTopics::joints)
     Nanoseconds range_published = -1;             // the stamp of the range last published
     Nanoseconds image_published = -1;             // of the image last published
+    Nanoseconds scan_published = -1;              // of the proximity readings last published
     std::uint64_t setpoints = 0, velocities = 0;  // applied so far
     std::uint64_t joint_commands = 0;             // likewise
     std::uint64_t bad_poses = 0;                  // a ghost's poses refused (not finite, not a rotation)
@@ -426,42 +443,6 @@ class BridgeExtension : public SimulationExtension {
   }
   static std::array<double, 3> array3(const Vec3& v) { return {v.x(), v.y(), v.z()}; }
   static std::array<double, 4> array4(const Quat& q) { return {q.w(), q.x(), q.y(), q.z()}; }
-  // a robot's frames: its other bodies (a joined part, another root) on /tf, each hinge and slider
-  // among them on joint_states, every other node on /tf_static in its body's frame
-  static void frames(const Artifact& a, Robot& r, RobotTopics& t) {
-    const auto isPart = [&a](const PhysicNode& n) {
-      const bool another_root = n.parent() == nullptr && &n != &a.root() && !n.isStatic();
-      return another_root || n.joint().isBody();
-    };
-    const std::string prefix = a.name() + "/";
-    for (std::size_t k = 0; k < a.nodeCount(); ++k) {
-      const PhysicNode& n = a.nodeAt(k);
-      if (&n == &a.root() || n.isStatic()) continue;
-      if (isPart(n)) {
-        r.parts.push_back(&n);
-        t.parts.push_back(linkName(a, n));
-        if (n.joint().hasPosition()) {
-          r.joints.push_back(&n);
-          t.joints.push_back(linkName(a, n));
-        }
-        continue;
-      }
-      // fixed in its body: its pose in the frame of the node that body begins at
-      Pose in_head = n.spec().pose;
-      const PhysicNode* head = n.parent();
-      while (head != nullptr && head != &a.root() && !isPart(*head)) {
-        in_head = head->spec().pose * in_head;
-        head = head->parent();
-      }
-      if (head == nullptr) continue;
-      StaticFrame f;
-      f.parent = prefix + linkName(a, *head);
-      f.child = prefix + linkName(a, n);
-      const Quat& q = in_head.orientation;
-      f.pose = {in_head.position.x(), in_head.position.y(), in_head.position.z(), q.w(), q.x(), q.y(), q.z()};
-      t.statics.push_back(f);
-    }
-  }
   static void appendPose(std::vector<double>& out, const Pose& p) {
     const Quat& q = p.orientation;
     out.insert(out.end(), {p.position.x(), p.position.y(), p.position.z(), q.w(), q.x(), q.y(), q.z()});
@@ -580,7 +561,7 @@ class BridgeExtension : public SimulationExtension {
   std::vector<Robot> robots_;
   std::vector<Operator> operators_;  // their topics follow the robots'
   std::map<std::string, std::uint64_t> dropped_;  // messages dropped, by topic
-  Rate odom_rate_, imu_rate_, clock_rate_, range_rate_, image_rate_;
+  Rate odom_rate_, imu_rate_, clock_rate_, range_rate_, image_rate_, scan_rate_;
   bool wall_stamps_ = false;
   double cutoff_ = -1;                 // lock-step: poses stamped later wait
   std::vector<PoseSample> arrived_, held_;

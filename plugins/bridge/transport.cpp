@@ -80,7 +80,8 @@ void Transport::publishForce(std::size_t robot, double time, const std::array<do
   staged_.push_back(m);
 }
 
-void Transport::publishImage(std::size_t robot, double time, int width, int height, const std::vector<std::uint8_t>& rgb) {
+void Transport::publishImage(std::size_t robot, double time, int width, int height, double fov_deg,
+                             const std::vector<std::uint8_t>& rgb) {
   if (!robots_.at(robot).image) return;
   Outgoing m;
   m.kind = Outgoing::Kind::Image;
@@ -88,6 +89,7 @@ void Transport::publishImage(std::size_t robot, double time, int width, int heig
   m.time = time;
   m.width = width;
   m.height = height;
+  m.fov_deg = fov_deg;
   m.first = staged_bytes_.size();
   m.count = rgb.size();
   staged_bytes_.insert(staged_bytes_.end(), rgb.begin(), rgb.end());
@@ -118,9 +120,24 @@ void Transport::publishJointStates(std::size_t robot, double time, const std::ve
   staged_.push_back(m);
 }
 
+void Transport::publishScan(std::size_t robot, double time, double reach, double radius, const std::vector<double>& angles,
+                            const std::vector<double>& distances, const std::vector<double>& readings) {
+  if (!robots_.at(robot).scan) return;
+  Outgoing m;
+  m.kind = Outgoing::Kind::Scan;
+  m.robot = robot;
+  m.time = time;
+  m.first = staged_values_.size();
+  const std::size_t n = std::min({angles.size(), distances.size(), readings.size()});
+  m.count = 2 + 3 * n;
+  staged_values_.insert(staged_values_.end(), {reach, radius});
+  for (std::size_t k = 0; k < n; ++k) staged_values_.insert(staged_values_.end(), {angles[k], distances[k], readings[k]});
+  staged_.push_back(m);
+}
+
 namespace {
 bool holdsValues(Outgoing::Kind kind) {
-  return kind == Outgoing::Kind::Transforms || kind == Outgoing::Kind::JointStates;
+  return kind == Outgoing::Kind::Transforms || kind == Outgoing::Kind::JointStates || kind == Outgoing::Kind::Scan;
 }
 }  // namespace
 
@@ -173,7 +190,7 @@ void Transport::publishLoop() {
       }
       send(m);
     }
-    sent();
+    batchSent();
     sending_.clear();
     sending_points_.clear();
     sending_bytes_.clear();

@@ -99,11 +99,13 @@ struct RobotTopics {
   std::vector<StaticFrame> statics;  // its frames fixed in its bodies' (a sensor's mount): /tf_static
   std::string description;           // its URDF: /<name>/robot_description (empty: none)
   bool joint_commands = false;       // takes /<name>/joint_command (its `joints`)
+  bool scan = false;                 // publishes /<name>/scan (its proximity ring, where the transport offers it)
+  std::string scan_frame;            // the ring's frame (without the robot's prefix)
 };
 
 /// One message to send: what the stepping thread stages.
 struct Outgoing {
-  enum class Kind : std::uint8_t { Clock, Odometry, Imu, Range, Force, Image, Transforms, JointStates } kind = Kind::Clock;
+  enum class Kind : std::uint8_t { Clock, Odometry, Imu, Range, Force, Image, Transforms, JointStates, Scan } kind = Kind::Clock;
   std::size_t robot = 0;
   double time = 0;  // the clock's, the range's, the force's
   std::array<double, 3> force{};  // N, world frame
@@ -116,9 +118,12 @@ struct Outgoing {
   // an image: width x height rgb8 pixels, row by row from the top, [first, first + count) of the
   // bytes staged with it
   int width = 0, height = 0;
+  double fov_deg = 0;  // the image's horizontal field of view
   const std::uint8_t* bytes = nullptr;  // set for send(): the first of them
-  // transforms (7 values a frame: x y z qw qx qy qz in the world, base_link then each part) and
-  // joint states (2 a joint: position, velocity): [first, first + count) of the values staged with it
+  // transforms (7 values a frame: x y z qw qx qy qz in the world, base_link then each part), joint
+  // states (2 a joint: position, velocity) and scans (the ring's reach from it and its radius in m,
+  // then 3 a ray: direction in rad, distance from the ring in m, +inf for none, and reading 0..1):
+  // [first, first + count) of the values staged with it
   const double* values = nullptr;  // set for send(): the first of them
 };
 
@@ -140,7 +145,11 @@ class Transport {
   // `points`: the detections' positions relative to the robot, nearest first
   void publishRange(std::size_t robot, double time, bool body_frame, const std::vector<std::array<double, 3>>& points);
   void publishForce(std::size_t robot, double time, const std::array<double, 3>& force);
-  void publishImage(std::size_t robot, double time, int width, int height, const std::vector<std::uint8_t>& rgb);
+  void publishImage(std::size_t robot, double time, int width, int height, double fov_deg, const std::vector<std::uint8_t>& rgb);
+  // a proximity ring: its reach from the ring and radius (m), each ray's direction (rad), distance (m)
+  // and reading
+  void publishScan(std::size_t robot, double time, double reach, double radius, const std::vector<double>& angles,
+                   const std::vector<double>& distances, const std::vector<double>& readings);
   // `poses`: 7 values a frame (x y z qw qx qy qz, world), the robot's base_link then each of its parts
   void publishTransforms(std::size_t robot, double time, const std::vector<double>& poses);
   // `values`: 2 a joint (position, velocity), in the order of the robot's `joints`
@@ -183,7 +192,7 @@ class Transport {
   virtual void send(const Outgoing& message) = 0;
   // After send() was given every message of a batch (on the publishing thread): what a subclass
   // gathers across robots goes out here (ROS 2's /tf: one message for all).
-  virtual void sent() {}
+  virtual void batchSent() {}
   // Whether robot `robot`'s controller is there: someone reads its odometry and writes its set-points.
   virtual bool connected(std::size_t robot) const = 0;
   // What a subclass received, from any thread.

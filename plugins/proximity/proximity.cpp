@@ -79,10 +79,12 @@ class ProximitySensor final : public SensorOf<ProximityMeasurement> {
     output().readings.assign(a.size(), 0.0);
     output().distances.assign(a.size(), std::numeric_limits<double>::infinity());
     output().angles = a;
+    output().range = range_;
+    output().radius = radius_;
     setup.enableRayQueries();
   }
 
-  void sense(const StepInfo&) override {
+  void sense(const StepInfo& info) override {
     const Pose pose = node_->pose();
     for (std::size_t k = 0; k < rays_.size(); ++k) {
       rays_[k].from = pose.transformPoint(starts_[k]);
@@ -90,6 +92,7 @@ class ProximitySensor final : public SensorOf<ProximityMeasurement> {
     }
     environment().castRays(rays_, hits_, &artifact());
     ProximityMeasurement& m = output();
+    m.stamp = info.time;
     for (std::size_t k = 0; k < rays_.size(); ++k) {
       const bool seen = hits_[k].hit && hits_[k].distance <= radius_ + range_;
       const double d = seen ? std::max(0.0, hits_[k].distance - radius_) : std::numeric_limits<double>::infinity();

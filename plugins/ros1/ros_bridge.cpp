@@ -218,6 +218,7 @@ void RosTransport::send(const bridge::Outgoing& out) {
     }
     case bridge::Outgoing::Kind::Transforms:
     case bridge::Outgoing::Kind::JointStates:
+    case bridge::Outgoing::Kind::Scan:
       break;  // (the ROS 2 bridge's: this one's robots never ask for /tf, RobotTopics::tf)
   }
 }

@@ -69,6 +69,8 @@ struct SSX_EXPORT ProximityMeasurement : Measurement {
   std::vector<double> readings;   ///< per ray, in the sensor's order: 0..1
   std::vector<double> distances;  ///< per ray: m to what it met, +inf when nothing within range
   std::vector<double> angles;     ///< per ray: its direction, rad from the node's x axis toward y
+  double range = 0.0;             ///< m: how far a ray reaches from the ring (the sensor's range)
+  double radius = 0.0;            ///< m: the ring's distance from the node's z axis, where distances start
   ~ProximityMeasurement() override;
   bool finite() const noexcept override;
 };

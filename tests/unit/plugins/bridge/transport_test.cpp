@@ -11,6 +11,7 @@
 #include <atomic>
 #include <chrono>
 #include <functional>
+#include <limits>
 #include <mutex>
 #include <thread>
 
@@ -45,7 +46,7 @@ class Recording final : public Transport {
     messages.push_back(m);
     if (m.kind == Outgoing::Kind::Range) points.emplace_back(m.points, m.points + m.count);
     if (m.kind == Outgoing::Kind::Image) images.emplace_back(m.bytes, m.bytes + m.count);
-    if (m.kind == Outgoing::Kind::Transforms || m.kind == Outgoing::Kind::JointStates)
+    if (m.kind == Outgoing::Kind::Transforms || m.kind == Outgoing::Kind::JointStates || m.kind == Outgoing::Kind::Scan)
       values.emplace_back(m.values, m.values + m.count);
   }
   bool connected(std::size_t) const override { return peer; }
@@ -185,8 +186,8 @@ TEST_CASE("bridge transport: a range's points, an image's bytes and an operator'
     t.publishRange(0, k, false, points);
     t.publishRange(1, k, false, points);  // b publishes no range: dropped
     t.publishForce(1, k, {0, double(k), 0});
-    t.publishImage(1, k, 2, 1, std::vector<std::uint8_t>(6, static_cast<std::uint8_t>(k)));
-    t.publishImage(0, k, 2, 1, std::vector<std::uint8_t>(6, 0));  // a has no image topic: dropped
+    t.publishImage(1, k, 2, 1, 60.0, std::vector<std::uint8_t>(6, static_cast<std::uint8_t>(k)));
+    t.publishImage(0, k, 2, 1, 60.0, std::vector<std::uint8_t>(6, 0));  // a has no image topic: dropped
     t.commit();
   }
   t.flush();
@@ -202,6 +203,18 @@ TEST_CASE("bridge transport: a range's points, an image's bytes and an operator'
     CHECK(sent[3 * k + 2].width == 2);
     CHECK(t.images[k] == std::vector<std::uint8_t>(6, static_cast<std::uint8_t>(k)));
   }
+  // a proximity ring's distances and readings, in pairs, for a robot that publishes a scan
+  robots[0].scan = true;
+  Recording s(robots);
+  const std::vector<double> angles{0.5, -0.5}, distances{0.01, std::numeric_limits<double>::infinity()}, readings{0.8, 0.0};
+  s.publishScan(0, 1.5, 0.05, 0.03, angles, distances, readings);
+  s.publishScan(1, 1.5, 0.05, 0.03, angles, distances, readings);  // b has no scan: dropped
+  s.flush();
+  REQUIRE(s.sent().size() == 1);
+  CHECK(s.sent()[0].kind == Outgoing::Kind::Scan);
+  CHECK(s.sent()[0].time == 1.5);
+  CHECK(s.values.at(0) == std::vector<double>{0.05, 0.03, 0.5, 0.01, 0.8, -0.5, std::numeric_limits<double>::infinity(), 0.0});
+  CHECK(sent[2].fov_deg == 60.0);
   // a joystick's state: the newest, at most 64 axes and buttons
   std::vector<float> axes(100, 0.5f);
   std::vector<int> buttons(3, 1);
