@@ -3,6 +3,7 @@
 // when (rates in simulated time), applying what arrived between steps (set-points, velocity
 // commands), lock-step with the controllers outside, and the log lines at the end. A bridge is this
 // class with a transport (open()); ros1 and ros2 differ only there.
+#include "commands.hpp"
 #include "frames.hpp"
 #include "transport.hpp"
 
@@ -46,6 +47,10 @@ inline constexpr ssx_plugin_param kBridgeParameters[] = {
                 "rate of /<robot>/image (what a camera sensor sees, rgb8) in simulated time; 0: none"),
     param::real("scan_rate_hz", "10", "Hz", param::nonNegative() & param::atMost(kMaxRateHz),
                 "rate of /<robot>/scan (its proximity ring as a LaserScan; ROS 2) in simulated time; 0: none"),
+    param::real("ground_rate_hz", "10", "Hz", param::nonNegative() & param::atMost(kMaxRateHz),
+                "rate of /<robot>/ground (ssx_msgs/Ground; ROS 2) in simulated time; 0: none"),
+    param::real("range_bearing_rate_hz", "10", "Hz", param::nonNegative() & param::atMost(kMaxRateHz),
+                "rate of /<robot>/range_bearing (ssx_msgs/RangeBearing: the messages received since; ROS 2) in simulated time; 0: none"),
     param::text("operators", "", "operator extensions bridged: names separated by spaces (/<name>/cmd_vel and "
                 "/<name>/joy in, /<name>/force out)"),
     param::choice("pose_stamps", "sim", "sim wall",
@@ -75,6 +80,10 @@ class BridgeExtension : public SimulationExtension {
     connect_timeout_ = params.get<double>("lockstep_connect_timeout_s");
     range_rate_ = rateOf(params, "range_rate_hz", env.timestep());
     if (params.get<double>("range_rate_hz") == 0) range_rate_.period = 0;
+    ground_rate_ = rateOf(params, "ground_rate_hz", env.timestep());
+    if (params.get<double>("ground_rate_hz") == 0) ground_rate_.period = 0;
+    rab_rate_ = rateOf(params, "range_bearing_rate_hz", env.timestep());
+    if (params.get<double>("range_bearing_rate_hz") == 0) rab_rate_.period = 0;
     scan_rate_ = rateOf(params, "scan_rate_hz", env.timestep());
     if (params.get<double>("scan_rate_hz") == 0) scan_rate_.period = 0;
     image_rate_ = rateOf(params, "image_rate_hz", env.timestep());
@@ -92,6 +101,8 @@ class BridgeExtension : public SimulationExtension {
         if (r.range == nullptr) r.range = dynamic_cast<const RangeMeasurement*>(&a->sensor(k).latest());
         if (r.camera == nullptr) r.camera = dynamic_cast<const CameraMeasurement*>(&a->sensor(k).latest());
         if (r.proximity == nullptr) r.proximity = dynamic_cast<const ProximityMeasurement*>(&a->sensor(k).latest());
+        if (r.ground == nullptr) r.ground = dynamic_cast<const GroundMeasurement*>(&a->sensor(k).latest());
+        if (r.rab == nullptr) r.rab = dynamic_cast<const RangeBearingMeasurement*>(&a->sensor(k).latest());
       }
       RobotTopics t;
       t.name = a->name();
@@ -110,6 +121,8 @@ class BridgeExtension : public SimulationExtension {
         t.description = describe(*a);
         t.joint_commands = !t.joints.empty();
         if (r.proximity != nullptr && scan_rate_.period > 0) scanOf(*a, t);
+        t.ground = r.ground != nullptr && ground_rate_.period > 0;
+        t.range_bearing = r.rab != nullptr && rab_rate_.period > 0;
       }
       topics.push_back(t);
       robots_.push_back(r);
@@ -213,8 +226,8 @@ class BridgeExtension : public SimulationExtension {
       r.setpoints = s.count;
       r.velocities = v.count;
       const std::string& who = r.artifact->name();
-      auto setpoint = [&] { guarded(env, who, "setpoint", [&] { applySetpoint(r, s); }); };
-      auto velocity = [&] { guarded(env, who, "cmd_vel", [&] { applyVelocity(r, v); }); };
+      auto setpoint = [&] { guarded(env, who, "setpoint", [&] { applySetpoint(*r.tracker, s); }); };
+      auto velocity = [&] { guarded(env, who, "cmd_vel", [&] { applyVelocity(*r.artifact, *r.commands, v); }); };
       if (new_velocity && new_setpoint && v.order < s.order) velocity();
       if (new_setpoint) setpoint();
       if (new_velocity && !(new_setpoint && v.order < s.order)) velocity();
@@ -223,7 +236,7 @@ class BridgeExtension : public SimulationExtension {
       const JointCommand j = transport_->latestJointCommand(i);
       if (j.count == r.joint_commands) continue;
       r.joint_commands = j.count;
-      guarded(env, who, "joint_command", [&] { applyJoints(r, j); });
+      guarded(env, who, "joint_command", [&] { applyJoints(*r.artifact, r.joints, j); });
     }
   }
 
@@ -284,6 +297,8 @@ class BridgeExtension : public SimulationExtension {
         transport_->publishRange(i, toSeconds(r.range->stamp), r.range->body_frame, points_);
       }
     }
+    const bool ground_due = ground_rate_.due(now), rab_due = rab_rate_.due(now);
+    if (ground_due || rab_due) publishBoards(env, ground_due, rab_due);
     if (scan_rate_.due(now)) {
       for (std::size_t i = 0; i < robots_.size(); ++i) {
         Robot& r = robots_[i];
@@ -318,8 +333,9 @@ class BridgeExtension : public SimulationExtension {
 
   /// After the world was put back to its start (a reset): the rates and lock-step start again.
   void restarted() {
-    for (Rate* r : {&odom_rate_, &imu_rate_, &clock_rate_, &range_rate_, &image_rate_, &scan_rate_}) r->next = 0;
-    for (Robot& r : robots_) r.range_published = r.image_published = r.scan_published = -1;
+    for (Rate* r : {&odom_rate_, &imu_rate_, &clock_rate_, &range_rate_, &image_rate_, &scan_rate_, &ground_rate_, &rab_rate_})
+      r->next = 0;
+    for (Robot& r : robots_) r.range_published = r.image_published = r.scan_published = r.ground_published = -1;
     for (Operator& o : operators_) o.force_rate.next = 0;
     waiting_for_ = cutoff_ = -1;
     held_.clear();
@@ -367,11 +383,14 @@ class BridgeExtension : public SimulationExtension {
     const RangeMeasurement* range = nullptr;
     const CameraMeasurement* camera = nullptr;
     const ProximityMeasurement* proximity = nullptr;
+    const GroundMeasurement* ground = nullptr;
+    const RangeBearingMeasurement* rab = nullptr;
     std::vector<const PhysicNode*> parts;   // its other bodies: frames on /tf (RobotTopics::parts)
     std::vector<const PhysicNode*> joints;  // its hinges and sliders (RobotTopics::joints)
     Nanoseconds range_published = -1;             // the stamp of the range last published
     Nanoseconds image_published = -1;             // of the image last published
     Nanoseconds scan_published = -1;              // of the proximity readings last published
+    Nanoseconds ground_published = -1;            // of the ground readings last published
     std::uint64_t setpoints = 0, velocities = 0;  // applied so far
     std::uint64_t joint_commands = 0;             // likewise
     std::uint64_t bad_poses = 0;                  // a ghost's poses refused (not finite, not a rotation)
@@ -448,58 +467,6 @@ class BridgeExtension : public SimulationExtension {
     out.insert(out.end(), {p.position.x(), p.position.y(), p.position.z(), q.w(), q.x(), q.y(), q.z()});
   }
 
-  static void applySetpoint(Robot& r, const Setpoint& s) {
-    ssx::Setpoint sp;
-    sp.position = Vec3(s.position[0], s.position[1], s.position[2]);
-    const Quat q(s.orientation[0], s.orientation[1], s.orientation[2], s.orientation[3]);
-    if (!q.coeffs().allFinite() || q.norm() < 1e-6) throw Error("its orientation is not a rotation (a zero or non-finite quaternion)");
-    sp.yaw = std::atan2(2 * (q.w() * q.z() + q.x() * q.y()), 1 - 2 * (q.y() * q.y() + q.z() * q.z()));
-    Command c;
-    c.level = CommandLevel::Position;
-    c.setpoint = sp;
-    if (const std::string why = c.problem(); !why.empty()) throw Error(why);
-    r.tracker->setSetpoint(sp);
-  }
-  // a joint command: every joint it names to its position (or, without positions, its velocity),
-  // all checked before any is set
-  static void applyJoints(Robot& r, const JointCommand& j) {
-    const bool by_position = !j.positions.empty();
-    const std::vector<double>& values = by_position ? j.positions : j.velocities;
-    if (values.size() != j.names.size())
-      throw Error(std::to_string(j.names.size()) + " names with " + std::to_string(j.positions.size()) +
-                  " positions and " + std::to_string(j.velocities.size()) +
-                  " velocities (give one position, or one velocity, per name)");
-    std::vector<PhysicNode*> nodes;
-    for (std::size_t k = 0; k < j.names.size(); ++k) {
-      PhysicNode* node = nullptr;
-      for (const PhysicNode* n : r.joints)
-        if (linkName(*r.artifact, *n) == j.names[k]) node = const_cast<PhysicNode*>(n);
-      if (node == nullptr) throw Error("no joint '" + j.names[k] + "' (its joints are named by the node each moves)");
-      const JointSpec& spec = node->joint();
-      if (!(spec.max_effort > 0)) throw Error("joint '" + j.names[k] + "' has no motor");
-      if (!std::isfinite(values[k]) || (by_position && (values[k] < spec.lower || values[k] > spec.upper)))
-        throw Error("joint '" + j.names[k] + "': " + std::to_string(values[k]) + " is not finite or outside its limits");
-      nodes.push_back(node);
-    }
-    for (std::size_t k = 0; k < nodes.size(); ++k) {
-      if (by_position) nodes[k]->setJointPosition(values[k]);
-      else nodes[k]->setJointVelocity(values[k]);
-    }
-  }
-  // a Twist in the robot's frame (x forward): turned by its heading into the world's
-  static void applyVelocity(Robot& r, const Velocity& v) {
-    const Quat q = r.artifact->root().pose().orientation;
-    const double yaw = std::atan2(2 * (q.w() * q.z() + q.x() * q.y()), 1 - 2 * (q.y() * q.y() + q.z() * q.z()));
-    const Vec3 world(std::cos(yaw) * v.linear[0] - std::sin(yaw) * v.linear[1],
-                     std::sin(yaw) * v.linear[0] + std::cos(yaw) * v.linear[1], v.linear[2]);
-    const Command c = Command::velocityYawRate(world, v.angular[2]);
-    // (checked before it is turned: an absurd speed overflows in the turn)
-    const Command raw = Command::velocityYawRate(Vec3(v.linear[0], v.linear[1], v.linear[2]), v.angular[2]);
-    if (const std::string why = raw.problem(); !why.empty()) throw Error(why);
-    if (const std::string why = r.commands->refusal(c); !why.empty()) throw Error(why);
-    r.commands->setCommand(c);
-  }
-
   // a message that cannot be used is dropped and counted, with a warning naming its topic the
   // first time (and a count per topic at the end): one bad message never stops the run
   void drop(Environment& env, const std::string& who, const char* topic, const std::string& why) {
@@ -561,7 +528,35 @@ class BridgeExtension : public SimulationExtension {
   std::vector<Robot> robots_;
   std::vector<Operator> operators_;  // their topics follow the robots'
   std::map<std::string, std::uint64_t> dropped_;  // messages dropped, by topic
-  Rate odom_rate_, imu_rate_, clock_rate_, range_rate_, image_rate_, scan_rate_;
+  Rate odom_rate_, imu_rate_, clock_rate_, range_rate_, image_rate_, scan_rate_, ground_rate_, rab_rate_;
+  std::vector<std::uint8_t> bytes_;  // range-and-bearing names and payloads, reused
+
+  // the ground sensors' readings, and the range-and-bearing messages received (each sensing step's,
+  // as the receiver holds them when due)
+  void publishBoards(const Environment& env, bool ground, bool rab) {
+    for (std::size_t i = 0; i < robots_.size(); ++i) {
+      Robot& r = robots_[i];
+      if (ground && r.ground != nullptr && r.ground->stamp != r.ground_published) {
+        r.ground_published = r.ground->stamp;
+        values_.clear();
+        for (std::size_t k = 0; k < r.ground->readings.size() && k < r.ground->colors.size(); ++k) {
+          const Vec3& c = r.ground->colors[k];
+          values_.insert(values_.end(), {r.ground->readings[k], c.x(), c.y(), c.z()});
+        }
+        transport_->publishGround(i, toSeconds(r.ground->stamp), values_);
+      }
+      if (!rab || r.rab == nullptr) continue;
+      values_.clear();
+      bytes_.clear();
+      for (const RangeBearingMeasurement::Message& m : r.rab->messages) {
+        const std::string& sender = env.artifact(m.sender).name();
+        values_.insert(values_.end(), {m.range, m.bearing, m.elevation, double(sender.size()), double(m.data.size())});
+        bytes_.insert(bytes_.end(), sender.begin(), sender.end());
+        bytes_.insert(bytes_.end(), m.data.begin(), m.data.end());
+      }
+      transport_->publishRangeBearing(i, toSeconds(r.rab->stamp), values_, bytes_);
+    }
+  }
   bool wall_stamps_ = false;
   double cutoff_ = -1;                 // lock-step: poses stamped later wait
   std::vector<PoseSample> arrived_, held_;

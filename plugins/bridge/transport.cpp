@@ -135,9 +135,37 @@ void Transport::publishScan(std::size_t robot, double time, double reach, double
   staged_.push_back(m);
 }
 
+void Transport::publishGround(std::size_t robot, double time, const std::vector<double>& values) {
+  if (!robots_.at(robot).ground) return;
+  Outgoing m;
+  m.kind = Outgoing::Kind::Ground;
+  m.robot = robot;
+  m.time = time;
+  m.first = staged_values_.size();
+  m.count = values.size();
+  staged_values_.insert(staged_values_.end(), values.begin(), values.end());
+  staged_.push_back(m);
+}
+
+void Transport::publishRangeBearing(std::size_t robot, double time, const std::vector<double>& values,
+                                    const std::vector<std::uint8_t>& bytes) {
+  if (!robots_.at(robot).range_bearing) return;
+  Outgoing m;
+  m.kind = Outgoing::Kind::RangeBearing;
+  m.robot = robot;
+  m.time = time;
+  m.first = staged_values_.size();
+  m.count = values.size();
+  m.first_byte = staged_bytes_.size();
+  staged_values_.insert(staged_values_.end(), values.begin(), values.end());
+  staged_bytes_.insert(staged_bytes_.end(), bytes.begin(), bytes.end());
+  staged_.push_back(m);
+}
+
 namespace {
 bool holdsValues(Outgoing::Kind kind) {
-  return kind == Outgoing::Kind::Transforms || kind == Outgoing::Kind::JointStates || kind == Outgoing::Kind::Scan;
+  return kind == Outgoing::Kind::Transforms || kind == Outgoing::Kind::JointStates || kind == Outgoing::Kind::Scan ||
+         kind == Outgoing::Kind::Ground || kind == Outgoing::Kind::RangeBearing;
 }
 }  // namespace
 
@@ -153,8 +181,10 @@ void Transport::commit() {
       queue_values_.swap(staged_values_);
     } else {
       const std::size_t points = queue_points_.size(), bytes = queue_bytes_.size(), values = queue_values_.size();
-      for (Outgoing& m : staged_)
+      for (Outgoing& m : staged_) {
         m.first += m.kind == Outgoing::Kind::Image ? bytes : holdsValues(m.kind) ? values : points;
+        m.first_byte += bytes;
+      }
       queue_.insert(queue_.end(), staged_.begin(), staged_.end());
       queue_points_.insert(queue_points_.end(), staged_points_.begin(), staged_points_.end());
       queue_bytes_.insert(queue_bytes_.end(), staged_bytes_.begin(), staged_bytes_.end());
@@ -182,6 +212,7 @@ void Transport::publishLoop() {
     for (Outgoing& m : sending_) {
       if (m.kind == Outgoing::Kind::Range) m.points = sending_points_.data() + m.first;
       if (m.kind == Outgoing::Kind::Image) m.bytes = sending_bytes_.data() + m.first;
+      if (m.kind == Outgoing::Kind::RangeBearing) m.bytes = sending_bytes_.data() + m.first_byte;
       if (holdsValues(m.kind)) m.values = sending_values_.data() + m.first;
       if (m.kind == Outgoing::Kind::Odometry && m.robot == 0) {  // the round trip starts when it leaves
         std::lock_guard<std::mutex> guard(mutex_);

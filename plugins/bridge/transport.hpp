@@ -101,11 +101,14 @@ struct RobotTopics {
   bool joint_commands = false;       // takes /<name>/joint_command (its `joints`)
   bool scan = false;                 // publishes /<name>/scan (its proximity ring, where the transport offers it)
   std::string scan_frame;            // the ring's frame (without the robot's prefix)
+  bool ground = false;               // publishes /<name>/ground (ssx_msgs/Ground; where the transport offers it)
+  bool range_bearing = false;        // publishes /<name>/range_bearing (ssx_msgs/RangeBearing; likewise)
 };
 
 /// One message to send: what the stepping thread stages.
 struct Outgoing {
-  enum class Kind : std::uint8_t { Clock, Odometry, Imu, Range, Force, Image, Transforms, JointStates, Scan } kind = Kind::Clock;
+  enum class Kind : std::uint8_t { Clock, Odometry, Imu, Range, Force, Image, Transforms, JointStates, Scan, Ground,
+                                  RangeBearing } kind = Kind::Clock;
   std::size_t robot = 0;
   double time = 0;  // the clock's, the range's, the force's
   std::array<double, 3> force{};  // N, world frame
@@ -123,7 +126,11 @@ struct Outgoing {
   // transforms (7 values a frame: x y z qw qx qy qz in the world, base_link then each part), joint
   // states (2 a joint: position, velocity) and scans (the ring's reach from it and its radius in m,
   // then 3 a ray: direction in rad, distance from the ring in m, +inf for none, and reading 0..1):
-  // [first, first + count) of the values staged with it
+  // [first, first + count) of the values staged with it. A ground reading: 4 values a point (grey,
+  // red, green, blue). Range-and-bearing: 5 values a message (range, bearing, elevation, the sender's
+  // name's length, the payload's length), the names and payloads one after the other in the bytes
+  // staged with it from first_byte
+  std::size_t first_byte = 0;
   const double* values = nullptr;  // set for send(): the first of them
 };
 
@@ -148,6 +155,10 @@ class Transport {
   void publishImage(std::size_t robot, double time, int width, int height, double fov_deg, const std::vector<std::uint8_t>& rgb);
   // a proximity ring: its reach from the ring and radius (m), each ray's direction (rad), distance (m)
   // and reading
+  void publishGround(std::size_t robot, double time, const std::vector<double>& values);
+  // values: 5 a message as in Outgoing; bytes: each message's sender name then payload
+  void publishRangeBearing(std::size_t robot, double time, const std::vector<double>& values,
+                           const std::vector<std::uint8_t>& bytes);
   void publishScan(std::size_t robot, double time, double reach, double radius, const std::vector<double>& angles,
                    const std::vector<double>& distances, const std::vector<double>& readings);
   // `poses`: 7 values a frame (x y z qw qx qy qz, world), the robot's base_link then each of its parts

@@ -222,9 +222,10 @@ class GroundSensor final : public SensorOf<GroundMeasurement> {
     output().readings.assign(points_.size(), 0.0);
   }
 
-  void sense(const StepInfo&) override {
+  void sense(const StepInfo& info) override {
     const Pose pose = node_->pose();
     GroundMeasurement& m = output();
+    m.stamp = info.time;
     for (std::size_t k = 0; k < points_.size(); ++k) {
       const Vec3 p = pose.transformPoint(points_[k]);
       Vec3 color = floor_;

@@ -96,13 +96,14 @@ class RangeAndBearing final : public SensorOf<RangeBearingMeasurement>, public R
   }
   std::span<const std::uint8_t> data() const override { return data_; }
 
-  void sense(const StepInfo&) override {
+  void sense(const StepInfo& info) override {
     const Environment& env = environment();
     const Pose me = artifact().root().pose();
     const Vec3 at = me.transformPoint(Vec3(0, 0, height_));
     hits_.clear();
     env.neighbors(at, range_, hits_);  // ascending artifact order
     RangeBearingMeasurement& m = output();
+    m.stamp = info.time;
     std::size_t kept = 0;
     for (const SpatialIndex::Hit& h : hits_) {
       const std::size_t j = h.id;

@@ -219,6 +219,8 @@ void RosTransport::send(const bridge::Outgoing& out) {
     case bridge::Outgoing::Kind::Transforms:
     case bridge::Outgoing::Kind::JointStates:
     case bridge::Outgoing::Kind::Scan:
+    case bridge::Outgoing::Kind::Ground:
+    case bridge::Outgoing::Kind::RangeBearing:
       break;  // (the ROS 2 bridge's: this one's robots never ask for /tf, RobotTopics::tf)
   }
 }

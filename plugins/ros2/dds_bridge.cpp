@@ -78,7 +78,10 @@ class DdsTransport final : public bridge::Transport {
 
   dds_entity_t clock_ = 0, tf_ = 0, tf_static_ = 0;
   std::vector<dds_entity_t> descriptions_;
-  std::vector<dds_entity_t> odom_, imu_, range_, force_, image_, joint_states_, scan_, camera_info_;
+  std::vector<dds_entity_t> odom_, imu_, range_, force_, image_, joint_states_, scan_, camera_info_, ground_, rab_;
+  std::vector<double> readings_, colors_;                              // the publishing thread's, reused
+  std::vector<ssx_msgs_msg_dds__RangeBearingMessage_> rab_messages_;   // likewise
+  std::vector<std::string> senders_;                                   // likewise
   std::vector<ScanLayout> scan_layouts_;          // per robot with a scan
   std::vector<std::string> scan_frames_;
   std::vector<float> ranges_, intensities_;  // the publishing thread's, reused
@@ -129,6 +132,8 @@ DdsTransport::DdsTransport(int domain, Network network, const std::vector<bridge
       // (sensor data: best effort, REP 2003)
       scan_.push_back(r.scan ? writer(&sensor_msgs_msg_dds__LaserScan__desc, ns + "/scan", Profile::SensorData) : 0);
       scan_layouts_.emplace_back();
+      ground_.push_back(r.ground ? writer(&ssx_msgs_msg_dds__Ground__desc, ns + "/ground", Profile::SensorData) : 0);
+      rab_.push_back(r.range_bearing ? writer(&ssx_msgs_msg_dds__RangeBearing__desc, ns + "/range_bearing", Profile::Default) : 0);
       scan_frames_.push_back(r.name + "/" + r.scan_frame);
       camera_frames_.push_back(r.name + "/camera");
       force_.push_back(r.force ? writer(&geometry_msgs_msg_dds__WrenchStamped__desc, ns + "/force", Profile::Default) : 0);
@@ -419,6 +424,54 @@ void DdsTransport::send(const bridge::Outgoing& out) {
       m.intensities._buffer = intensities_.data();
       m.intensities._length = m.intensities._maximum = static_cast<uint32_t>(intensities_.size());
       dds_write(scan_[out.robot], &m);
+      break;
+    }
+    case bridge::Outgoing::Kind::Ground: {
+      // 4 values a point: grey, red, green, blue
+      const std::size_t n = out.count / 4;
+      readings_.resize(n);
+      colors_.resize(3 * n);
+      for (std::size_t k = 0; k < n; ++k) {
+        readings_[k] = out.values[4 * k];
+        for (std::size_t c = 0; c < 3; ++c) colors_[3 * k + c] = out.values[4 * k + 1 + c];
+      }
+      ssx_msgs_msg_dds__Ground_ m{};
+      m.header.stamp = stamp(out.time);
+      m.header.frame_id = odom_frames_[out.robot].data();
+      m.readings._buffer = readings_.data();
+      m.readings._length = m.readings._maximum = static_cast<uint32_t>(n);
+      m.colors._buffer = colors_.data();
+      m.colors._length = m.colors._maximum = static_cast<uint32_t>(3 * n);
+      dds_write(ground_[out.robot], &m);
+      break;
+    }
+    case bridge::Outgoing::Kind::RangeBearing: {
+      // 5 values a message (range, bearing, elevation, name length, payload length); the names and
+      // payloads one after the other in the bytes
+      const std::size_t n = out.count / 5;
+      rab_messages_.resize(n);
+      senders_.resize(n);
+      const std::uint8_t* b = out.bytes;
+      for (std::size_t k = 0; k < n; ++k) {
+        const double* v = out.values + 5 * k;
+        const auto name = static_cast<std::size_t>(v[3]), data = static_cast<std::size_t>(v[4]);
+        senders_[k].assign(reinterpret_cast<const char*>(b), name);
+        auto& m = rab_messages_[k];
+        m.sender = senders_[k].data();
+        m.range = v[0];
+        m.bearing = v[1];
+        m.elevation = v[2];
+        m.data._buffer = const_cast<std::uint8_t*>(b + name);
+        m.data._length = m.data._maximum = static_cast<uint32_t>(data);
+        m.data._release = false;
+        b += name + data;
+      }
+      ssx_msgs_msg_dds__RangeBearing_ m{};
+      m.header.stamp = stamp(out.time);
+      m.header.frame_id = odom_frames_[out.robot].data();
+      m.messages._buffer = rab_messages_.data();
+      m.messages._length = m.messages._maximum = static_cast<uint32_t>(n);
+      dds_write(rab_[out.robot], &m);
       break;
     }
     case bridge::Outgoing::Kind::Range: {

@@ -2,7 +2,9 @@
  * against tests/unit/plugins/ros2/ros2_sensors.xml it reads /q0/scan (sensor_msgs/LaserScan: the
  * e-puck's eight rays on a grid of one degree, NaN between them, the two rays facing the wall 6.6 cm
  * from the robot's axis at 0.066 / cos(17 deg) m, the others +inf), and /q1/camera_info beside
- * /q1/image (a pinhole: fx = fy = 32 / tan(30 deg), centre 32, 24, for 64 x 48 and 60 degrees).
+ * /q1/image (a pinhole: fx = fy = 32 / tan(30 deg), centre 32, 24, for 64 x 48 and 60 degrees),
+ * /q0/range_bearing (ssx_msgs/RangeBearing: q2's 4-byte payload from 0.3 m to the left) and
+ * /q0/ground (ssx_msgs/Ground: one point, its grey and colour).
  *   sensors_peer TIMEOUT_S            exit 0 when all held */
 #include "ros2_messages.h"
 
@@ -48,6 +50,8 @@ int main(int argc, char** argv) {
   const dds_entity_t scan = subscribe(p, &sensor_msgs_msg_dds__LaserScan__desc, "rt/q0/scan", 0);
   const dds_entity_t info = subscribe(p, &sensor_msgs_msg_dds__CameraInfo__desc, "rt/q1/camera_info", 1);
   const dds_entity_t image = subscribe(p, &sensor_msgs_msg_dds__Image__desc, "rt/q1/image", 1);
+  const dds_entity_t rab = subscribe(p, &ssx_msgs_msg_dds__RangeBearing__desc, "rt/q0/range_bearing", 1);
+  const dds_entity_t ground = subscribe(p, &ssx_msgs_msg_dds__Ground__desc, "rt/q0/ground", 0);
 
   /* (the first scans come before the robot settles on the ground: the 8th is looked at) */
   void* loan[1] = {NULL};
@@ -112,6 +116,47 @@ int main(int argc, char** argv) {
     check(strcmp(c.header.frame_id, im.header.frame_id) == 0, "in the image's frame");
   }
   if (got_info) dds_sample_free(&c, &sensor_msgs_msg_dds__CameraInfo__desc, DDS_FREE_CONTENTS);
+
+  /* ssx_msgs: what q0's range-and-bearing board received from q2, and its ground sensor */
+  void* rl[1] = {NULL};
+  dds_sample_info_t ri;
+  int got_rab = 0;
+  for (double waited = 0; !got_rab && waited < timeout; waited += 0.005) {
+    if (dds_take(rab, rl, &ri, 1, 1) == 1) {
+      const ssx_msgs_msg_dds__RangeBearing_* m = rl[0];
+      if (ri.valid_data && m->messages._length == 1) {
+        const ssx_msgs_msg_dds__RangeBearingMessage_* x = &m->messages._buffer[0];
+        got_rab = 1;
+        printf("  range_bearing: from %s, %.4f m, bearing %.4f rad, elevation %.4f rad, %u bytes\n", x->sender, x->range,
+               x->bearing, x->elevation, x->data._length);
+        check(strcmp(x->sender, "q2") == 0 && fabs(x->range - 0.3) < 0.03 && fabs(x->bearing - M_PI / 2) < 0.1 &&
+                  x->data._length == 4,
+              "q0 hears q2's 4 bytes from 0.3 m to its left");
+      }
+      dds_return_loan(rab, rl, 1);
+    } else {
+      dds_sleepfor(DDS_MSECS(5));
+    }
+  }
+  check(got_rab, "/q0/range_bearing arrives");
+  int got_ground = 0;
+  for (double waited = 0; !got_ground && waited < timeout; waited += 0.005) {
+    if (dds_take(ground, rl, &ri, 1, 1) == 1) {
+      const ssx_msgs_msg_dds__Ground_* g = rl[0];
+      if (ri.valid_data) {
+        got_ground = 1;
+        printf("  ground: %u reading(s), first %.3f, colour %.3f %.3f %.3f\n", g->readings._length,
+               g->readings._length ? g->readings._buffer[0] : -1.0, g->colors._length > 2 ? g->colors._buffer[0] : -1.0,
+               g->colors._length > 2 ? g->colors._buffer[1] : -1.0, g->colors._length > 2 ? g->colors._buffer[2] : -1.0);
+        check(g->readings._length == 1 && g->colors._length == 3 && g->readings._buffer[0] >= 0 && g->readings._buffer[0] <= 1,
+              "one ground point: a grey level 0..1 and its colour");
+      }
+      dds_return_loan(ground, rl, 1);
+    } else {
+      dds_sleepfor(DDS_MSECS(5));
+    }
+  }
+  check(got_ground, "/q0/ground arrives");
   if (got_image) dds_sample_free(&im, &sensor_msgs_msg_dds__Image__desc, DDS_FREE_CONTENTS);
   dds_delete(p);
   printf("%d check(s) failed\n", failures);
