@@ -96,28 +96,24 @@ void Transport::publishImage(std::size_t robot, double time, int width, int heig
   staged_.push_back(m);
 }
 
-void Transport::publishTransforms(std::size_t robot, double time, const std::vector<double>& poses) {
-  if (!robots_.at(robot).tf) return;
+Outgoing& Transport::stageValues(Outgoing::Kind kind, std::size_t robot, double time, const std::vector<double>& values) {
   Outgoing m;
-  m.kind = Outgoing::Kind::Transforms;
-  m.robot = robot;
-  m.time = time;
-  m.first = staged_values_.size();
-  m.count = poses.size();
-  staged_values_.insert(staged_values_.end(), poses.begin(), poses.end());
-  staged_.push_back(m);
-}
-
-void Transport::publishJointStates(std::size_t robot, double time, const std::vector<double>& values) {
-  if (!robots_.at(robot).tf || robots_[robot].joints.empty()) return;
-  Outgoing m;
-  m.kind = Outgoing::Kind::JointStates;
+  m.kind = kind;
   m.robot = robot;
   m.time = time;
   m.first = staged_values_.size();
   m.count = values.size();
   staged_values_.insert(staged_values_.end(), values.begin(), values.end());
   staged_.push_back(m);
+  return staged_.back();
+}
+
+void Transport::publishTransforms(std::size_t robot, double time, const std::vector<double>& poses) {
+  if (robots_.at(robot).tf) stageValues(Outgoing::Kind::Transforms, robot, time, poses);
+}
+
+void Transport::publishJointStates(std::size_t robot, double time, const std::vector<double>& values) {
+  if (robots_.at(robot).tf && !robots_[robot].joints.empty()) stageValues(Outgoing::Kind::JointStates, robot, time, values);
 }
 
 void Transport::publishScan(std::size_t robot, double time, double reach, double radius, const std::vector<double>& angles,
@@ -136,30 +132,14 @@ void Transport::publishScan(std::size_t robot, double time, double reach, double
 }
 
 void Transport::publishGround(std::size_t robot, double time, const std::vector<double>& values) {
-  if (!robots_.at(robot).ground) return;
-  Outgoing m;
-  m.kind = Outgoing::Kind::Ground;
-  m.robot = robot;
-  m.time = time;
-  m.first = staged_values_.size();
-  m.count = values.size();
-  staged_values_.insert(staged_values_.end(), values.begin(), values.end());
-  staged_.push_back(m);
+  if (robots_.at(robot).ground) stageValues(Outgoing::Kind::Ground, robot, time, values);
 }
 
 void Transport::publishRangeBearing(std::size_t robot, double time, const std::vector<double>& values,
                                     const std::vector<std::uint8_t>& bytes) {
   if (!robots_.at(robot).range_bearing) return;
-  Outgoing m;
-  m.kind = Outgoing::Kind::RangeBearing;
-  m.robot = robot;
-  m.time = time;
-  m.first = staged_values_.size();
-  m.count = values.size();
-  m.first_byte = staged_bytes_.size();
-  staged_values_.insert(staged_values_.end(), values.begin(), values.end());
+  stageValues(Outgoing::Kind::RangeBearing, robot, time, values).first_byte = staged_bytes_.size();
   staged_bytes_.insert(staged_bytes_.end(), bytes.begin(), bytes.end());
-  staged_.push_back(m);
 }
 
 namespace {

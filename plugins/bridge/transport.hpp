@@ -221,6 +221,8 @@ class Transport {
   static constexpr std::size_t kMaxJoints = 64;
 
  private:
+  // a message of `kind` whose values are `values`, staged (returned to set what else it carries)
+  Outgoing& stageValues(Outgoing::Kind kind, std::size_t robot, double time, const std::vector<double>& values);
   void publishLoop();
   std::vector<std::string> missingSetpoints(double time) const;  // (mutex_ held)
 
