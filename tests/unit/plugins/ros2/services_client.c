@@ -190,8 +190,12 @@ static void checkGraph(dds_entity_t participant) {
   dds_instance_handle_t h;
   if (dds_get_matched_publications(readers[ENTITIES], &h, 1) != 1) return check(0, "the reply writer's identity");
   dds_builtintopic_endpoint_t* writer = dds_get_matched_publication_data(readers[ENTITIES], h);
-  if (dds_get_matched_subscriptions(writers[ENTITIES], &h, 1) != 1) return check(0, "the request reader's identity");
-  dds_builtintopic_endpoint_t* reader = dds_get_matched_subscription_data(writers[ENTITIES], h);
+  dds_instance_handle_t hr;
+  if (dds_get_matched_subscriptions(writers[ENTITIES], &hr, 1) != 1) {
+    dds_builtintopic_free_endpoint(writer);
+    return check(0, "the request reader's identity");
+  }
+  dds_builtintopic_endpoint_t* reader = dds_get_matched_subscription_data(writers[ENTITIES], hr);
   dds_qos_t* q = dds_create_qos();
   dds_qset_reliability(q, DDS_RELIABILITY_RELIABLE, DDS_SECS(1));
   dds_qset_durability(q, DDS_DURABILITY_TRANSIENT_LOCAL);
@@ -249,6 +253,7 @@ int main(int argc, char** argv) {
     snprintf(name, sizeof name, "rr/%sReply", kNames[k]);
     readers[k] = dds_create_reader(participant, dds_create_topic(participant, kTypes[k][1], name, NULL, NULL), q, NULL);
   }
+  dds_delete_qos(q);
   /* the service is up when every request writer and reply reader matched ssx's */
   const double t0 = now();
   int matched = 0;
