@@ -148,8 +148,14 @@ Call decode(Kind kind, const void* sample) {
   return c;
 }
 
+// (the message is pointed to, not copied: it must outlive the reply's write; a temporary string is
+// refused at compile time)
 simulation_interfaces_msg_dds__Result_ result(std::uint8_t code, const std::string& message) {
   return {code, const_cast<char*>(message.c_str())};
+}
+simulation_interfaces_msg_dds__Result_ result(std::uint8_t code, std::string&& message) = delete;
+simulation_interfaces_msg_dds__Result_ result(std::uint8_t code, const char* message) {
+  return {code, const_cast<char*>(message)};
 }
 
 builtin_interfaces_msg_dds__Time_ stamp(Nanoseconds t) {
