@@ -195,7 +195,9 @@ static int wheelsMode(dds_entity_t participant, double timeout, double w, double
       }
       dds_return_loan(states, samples, 1);
     }
-    if (busy && latest >= 0) {
+    dds_publication_matched_status_t heard;
+    if (busy && latest >= 0 && dds_get_publication_matched_status(command, &heard) == 0 && heard.current_count > 0) {
+      /* only once ssx's reader has matched: a command written before is lost, the bad one with it */
       sensor_msgs_msg_dds__JointState_ cmd;
       memset(&cmd, 0, sizeof cmd);
       char* names[4] = {(char*)kWheels[0], (char*)kWheels[1], (char*)kWheels[2], (char*)kWheels[3]};
