@@ -58,6 +58,9 @@ install_npm_tools() {
   npm ci --prefix "$1/npm" --no-audit --no-fund >/dev/null
 }
 
+# the tests' precompiled header can come from ccache too
+export CCACHE_SLOPPINESS=pch_defines,time_macros
+
 # build [TARGET]: configures and builds everything, or only TARGET
 build() {
   install_packages

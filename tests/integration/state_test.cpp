@@ -36,7 +36,11 @@ std::string slurp(const fs::path& file) {
 }
 
 int runCli(const std::string& args) {
-  const int status = std::system((std::string(SSX_CLI_PATH) + " " + args + " 2>/dev/null").c_str());
+  std::string command = SSX_CLI_PATH;
+  command += ' ';
+  command += args;
+  command += " 2>/dev/null";
+  const int status = std::system(command.c_str());
   return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
 }
 

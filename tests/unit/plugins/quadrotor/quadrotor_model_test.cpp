@@ -526,8 +526,11 @@ Vec3 accelerationAfterTwoSteps(const std::string& artifacts, const std::string& 
 
 TEST_CASE("downwash in flight: a Crazyflie 0.5 m below another drops by the model's force", "[quadrotor][fidelity]") {
   auto pair = [](const char* on) {
-    return std::string("<artifact name=\"up\" type=\"cf\" xyz=\"0 0 1.5\"/>") +
-           "<artifact name=\"low\" type=\"cf\" xyz=\"0.02 0 1.0\"><driver downwash=\"" + on + "\"/></artifact>";
+    std::string scene = "<artifact name=\"up\" type=\"cf\" xyz=\"0 0 1.5\"/>";
+    scene += "<artifact name=\"low\" type=\"cf\" xyz=\"0.02 0 1.0\"><driver downwash=\"";
+    scene += on;
+    scene += "\"/></artifact>";
+    return scene;
   };
   const double off = accelerationAfterTwoSteps(pair("false"), "low").z();
   const double on = accelerationAfterTwoSteps(pair("true"), "low").z();
