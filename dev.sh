@@ -17,7 +17,7 @@ cd "$(dirname "$0")"
 
 packages=(build-essential cmake ninja-build pkg-config ccache
           libode-dev libbullet-dev libeigen3-dev libpugixml-dev libcli11-dev catch2 libpng-dev libosmesa6-dev libzstd-dev
-          libcivetweb-dev libjs-three cyclonedds-dev cyclonedds-tools liburdfdom-dev libassimp-dev libsdformat-dev
+          libcivetweb-dev nlohmann-json3-dev libjs-three cyclonedds-dev cyclonedds-tools liburdfdom-dev libassimp-dev libsdformat-dev
           python3-dev python3-numpy pybind11-dev libopenmpi-dev openmpi-bin)
 # for `test` also pytest and matplotlib (the Python module's tests and examples), doxygen (the
 # API reference and its check), Chromium with selenium and websockets (the viewer's tests), and

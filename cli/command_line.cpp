@@ -82,6 +82,15 @@ CommandLine parseCommandLine(int argc, const char* const* argv, std::ostream& ou
   auto* fast = run_cmd->add_flag("--fast", c.run.fast, "run as fast as possible")->excludes(realtime);
   auto* view = addViewOptions(run_cmd, c.run.view, c.run.view_bind,
                               "serve a live 3D view of the run to web browsers at http://127.0.0.1:PORT/");
+  auto* foxglove = run_cmd->add_option("--foxglove", c.run.foxglove,
+                                       "serve the run live to Foxglove at ws://127.0.0.1:PORT (default 8765, "
+                                       "Foxglove's own; 0: a free port)")
+                       ->expected(0, 1)
+                       ->check(CLI::Range(0, 65535));
+  run_cmd->add_option("--foxglove-bind", c.run.foxglove_bind,
+                      "address the Foxglove server listens on (default 127.0.0.1; another prints a token the URL needs)")
+      ->check(listenAddress())
+      ->needs(foxglove);
   run_cmd
       ->add_option("--rt-priority", c.run.rt_priority,
                    "step at this SCHED_FIFO priority (1-99; needs root or CAP_SYS_NICE): steps are not woken late "
@@ -223,6 +232,12 @@ CommandLine parseCommandLine(int argc, const char* const* argv, std::ostream& ou
     // --realtime alone means factor 1
     c.realtime_given = realtime->count() > 0;
     viewPort(view, c.run.view);
+    viewPort(foxglove, c.run.foxglove);
+    if (c.run.view > 0 && c.run.view == c.run.foxglove) {
+      err << "ssx run: --view and --foxglove both on port " << c.run.view << ": give one of them another port "
+          << "(--foxglove 8766)\n";
+      c.exit_status = kExitBadInput;
+    }
     c.run.duration_given = duration->count() > 0;
     if (c.realtime_given && (realtime->results().empty() || realtime->results().front().empty())) c.run.realtime = 1.0;
     if (frames_until->count() > 0 && c.run.frames_until < c.run.frames_from) {

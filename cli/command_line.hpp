@@ -19,6 +19,8 @@ struct RunArgs {
   double realtime = 1.0;
   int view = -1;                       // --view: the viewer's port (8765 when given bare); -1: no viewer
   std::string view_bind = "127.0.0.1";  // --view-bind: the viewer's address (another needs the printed token)
+  int foxglove = -1;                        // --foxglove: the Foxglove server's port (8765 bare); -1: none
+  std::string foxglove_bind = "127.0.0.1";  // --foxglove-bind: its address (another needs the printed token)
   bool fast = false;
   int threads = -1;
   std::optional<std::uint64_t> seed;

@@ -53,4 +53,12 @@ inline void addViewer(ssx::Environment& env, int port, const std::string& bind, 
   env.attachExtension("viewer", env.classLoader().createExtension("viewer", "viewer"), params);
 }
 
+// --foxglove: the foxglove extension, as <extension plugin="foxglove"/> adds it (it listens when the
+// environment starts); an observer, as the viewer
+inline void addFoxglove(ssx::Environment& env, int port, const std::string& bind) {
+  ssx::Descriptor params("foxglove", {"--foxglove", 0});
+  params.set("port", static_cast<std::int64_t>(port)).set("bind", bind);
+  env.attachExtension("foxglove", env.classLoader().createExtension("foxglove", "foxglove"), params);
+}
+
 }  // namespace ssx::cli

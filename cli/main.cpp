@@ -207,6 +207,14 @@ int commandRun(const RunArgs& args, bool realtime_given) {
       return kExitBadInput;
     }
   }
+  if (args.foxglove >= 0) {
+    try {
+      addFoxglove(env, args.foxglove, args.foxglove_bind);
+    } catch (const std::exception& e) {
+      std::cerr << "ssx: error: --foxglove: " << e.what() << '\n';
+      return kExitBadInput;
+    }
+  }
   if (args.frames_from > 0 || args.frames_until >= 0) {
     // the scene cameras' frames in a window of simulated time: opened at its start, finished at its end
     ssx::RenderSettings render = env.settings().render;

@@ -3,6 +3,7 @@
 #include "record/foxglove.hpp"
 #include "record/mcap_writer.hpp"
 #include "record/pose_codec.hpp"
+#include "record/run_channels.hpp"
 
 #include <ssx/command.hpp>
 #include <ssx/environment.hpp>
@@ -29,20 +30,6 @@ namespace ssx {
 
 namespace {
 
-// the optional channels' JSON Schemas (only what is written)
-const char* const kTimingSchema =
-    R"j({"title":"ssx.StepTiming","description":"one step's wall-clock cost, ms, and how late it ended (real-time runs)","type":"object","properties":{)j"
-    R"j("step":{"type":"integer"},"contacts":{"type":"integer"},"total_ms":{"type":"number"},"physics_ms":{"type":"number"},"snapshot_ms":{"type":"number"},)j"
-    R"j("sensors_ms":{"type":"number"},"drivers_ms":{"type":"number"},"render_ms":{"type":"number"},"late_ms":{"type":"number"}}})j";
-const char* const kSensorsSchema =
-    R"j({"title":"ssx.Sensors","description":"each artifact's latest measurements by sensor index: imu (accelerometer m/s^2, gyroscope rad/s, sensor frame), )j"
-    R"j(pose (position m, orientation w x y z, velocities world frame), range (detections: seen, obstacle, relative m, distance m)","type":"object",)j"
-    R"j("additionalProperties":{"type":"object","additionalProperties":{"type":"object","properties":{"kind":{"type":"string"},"stamp":{"type":"number"}}}}})j";
-
-const char* const kCommandsSchema =
-    R"j({"title":"ssx.Commands","description":"each commandable robot's current command: its level (position, velocity, attitude, rates, rotors) and values in the column order of Python's set_commands","type":"object",)j"
-    R"j("additionalProperties":{"type":"object","properties":{"level":{"type":"string"},"values":{"type":"array","items":{"type":"number"}}}}})j";
-
 // a JSON message of an optional channel, made on the stepping thread
 struct Extra {
   std::uint16_t channel = 0;
@@ -59,62 +46,6 @@ struct Job {
   std::vector<std::byte> bytes;
   std::vector<Extra> extras;
 };
-
-double ms(Nanoseconds t) { return static_cast<double>(t) / 1e6; }
-
-// /ssx/timing: one step's cost
-std::string timingJson(const StepTiming& t, std::size_t contacts) {
-  std::string out = R"({"step":)" + std::to_string(t.step) + R"(,"contacts":)" + std::to_string(contacts);
-  const std::pair<const char*, Nanoseconds> fields[] = {{"total_ms", t.total},     {"physics_ms", t.physics},
-                                                        {"snapshot_ms", t.snapshot}, {"sensors_ms", t.sensors},
-                                                        {"drivers_ms", t.drivers}, {"render_ms", t.render},
-                                                        {"late_ms", t.lateness}};
-  for (const auto& [name, value] : fields) {
-    out += ",\"";
-    out += name;
-    out += "\":";
-    detail::appendNumber(out, ms(value));
-  }
-  return out + "}";
-}
-
-// /ssx/sensors: {"<artifact>": {"0": {measurement}, ...}, ...} for every artifact with a recorded kind
-std::string sensorsJson(const Environment& env) {
-  std::string out = "{";
-  bool first_artifact = true;
-  for (std::size_t i = 0; i < env.artifactCount(); ++i) {
-    const Artifact& a = env.artifact(i);
-    std::string body;
-    for (std::size_t k = 0; k < a.sensorCount(); ++k) {
-      const std::string m = measurementJson(a.sensor(k).latest(), env);
-      if (m.empty()) continue;
-      if (!body.empty()) body += ',';
-      body += '"' + std::to_string(k) + "\":" + m;
-    }
-    if (body.empty()) continue;
-    if (!first_artifact) out += ',';
-    first_artifact = false;
-    detail::appendString(out, a.name());
-    out += ":{" + body + "}";
-  }
-  return out + "}";
-}
-
-// /ssx/commands: {"<artifact>": {"level": "attitude", "values": [...]}, ...} in set_commands' column order
-std::string commandsJson(const Environment& env) {
-  std::string out = "{";
-  bool first = true;
-  for (std::size_t i = 0; i < env.artifactCount(); ++i) {
-    const Artifact& a = env.artifact(i);
-    const auto* commandable = dynamic_cast<const CommandInterface*>(a.driver());
-    if (commandable == nullptr) continue;
-    if (!first) out += ',';
-    first = false;
-    detail::appendString(out, a.name());
-    out += ':' + commandJson(commandable->currentCommand());
-  }
-  return out + "}";
-}
 
 }  // namespace
 
@@ -232,9 +163,9 @@ void Recorder::Impl::begin() {
     writer->addMessage(static_cast<std::uint16_t>(scene), env->time(),
                        std::as_bytes(std::span(update.data(), update.size())));
   }
-  if (options.timing) addJsonChannel(timing_channel, "/ssx/timing", "ssx.StepTiming", kTimingSchema);
-  if (options.sensors) addJsonChannel(sensors_channel, "/ssx/sensors", "ssx.Sensors", kSensorsSchema);
-  if (options.commands) addJsonChannel(commands_channel, "/ssx/commands", "ssx.Commands", kCommandsSchema);
+  if (options.timing) addJsonChannel(timing_channel, "/ssx/timing", "ssx.StepTiming", detail::kTimingSchema);
+  if (options.sensors) addJsonChannel(sensors_channel, "/ssx/sensors", "ssx.Sensors", detail::kSensorsSchema);
+  if (options.commands) addJsonChannel(commands_channel, "/ssx/commands", "ssx.Commands", detail::kCommandsSchema);
   next_state = env->time();
   thread = std::thread([this] { loop(); });
 }
@@ -246,33 +177,10 @@ void Recorder::Impl::addJsonChannel(int& channel, const char* topic, const char*
   summary.channels.push_back(topic);
 }
 
-std::string Recorder::Impl::sceneJson() const {
-  // each render tree in the frame of the recorded body it moves with, or of the world
-  std::vector<detail::SceneShape> shapes;
-  auto add = [&](auto& self, const RenderNodeSpec& spec, const std::string& frame, const Pose& parent) -> void {
-    const Pose pose = parent * spec.pose;
-    shapes.push_back({frame, &spec, pose});
-    for (const auto& c : spec.children) self(self, c, frame, pose);
-  };
-  for (std::size_t i = 0; i < env->artifactCount(); ++i) {
-    const Artifact& a = std::as_const(*env).artifact(i);
-    for (const auto& tree : a.renderRoots()) {
-      const PhysicNode* follow = tree->follow.empty() ? nullptr : a.node(tree->follow);
-      const RecordedBody* body = follow != nullptr ? recordedBodyOf(bodies, *follow) : nullptr;
-      if (follow == nullptr) {
-        add(add, *tree, detail::kWorldFrame, a.placement());
-      } else if (body == nullptr) {  // a static root: where it is now, for good
-        add(add, *tree, detail::kWorldFrame, follow->pose());
-      } else {  // the followed node in the frame of its body's head (both fixed in that body)
-        add(add, *tree, body->name, body->node->poseInBody().inverse() * follow->poseInBody());
-      }
-    }
-  }
-  return detail::sceneUpdate(env->time(), shapes);
-}
+std::string Recorder::Impl::sceneJson() const { return detail::runSceneUpdate(*env, bodies); }
 
 void Recorder::Impl::takeTiming(const StepTiming& t) {
-  const std::string json = timingJson(t, contacts);
+  const std::string json = detail::timingJson(t, contacts);
   extras.push_back({static_cast<std::uint16_t>(timing_channel), (t.step + 1) * env->timestep(), json});
 }
 
@@ -315,9 +223,9 @@ void Recorder::Impl::observe() {
   if (env->stepCount() % period_steps != 0) return;
   Job job;
   job.time = now;
-  if (sensors_channel >= 0) extras.push_back({static_cast<std::uint16_t>(sensors_channel), now, sensorsJson(*env)});
+  if (sensors_channel >= 0) extras.push_back({static_cast<std::uint16_t>(sensors_channel), now, detail::sensorsJson(*env)});
   if (commands_channel >= 0)
-    extras.push_back({static_cast<std::uint16_t>(commands_channel), now, commandsJson(*env)});
+    extras.push_back({static_cast<std::uint16_t>(commands_channel), now, detail::commandsJson(*env)});
   job.extras.swap(extras);
   {
     std::lock_guard lock(mutex);

@@ -1,0 +1,334 @@
+// foxglove: an extension that serves the run live to Foxglove (or Lichtblick, or any client of
+// Foxglove's WebSocket protocol: foxglove_server.hpp), on 127.0.0.1 unless told otherwise. In
+// Foxglove: Open connection, Foxglove WebSocket, ws://127.0.0.1:8765.
+//
+// Channels, JSON-encoded with JSON Schemas; the first five are a recording's (ssx record), so one
+// Foxglove layout serves a run live and its recording:
+// - /tf (foxglove.FrameTransforms): every body's pose, "world" -> the body's name;
+// - /scene (foxglove.SceneUpdate): every artifact's shapes, each in its body's frame (sent once);
+// - /ssx/timing (ssx.StepTiming): the last step's cost per phase, ms;
+// - /ssx/sensors (ssx.Sensors), /ssx/commands (ssx.Commands): every robot's latest measurements and
+//   current command;
+// - /ssx/run (ssx.RunStatus): simulated time, the real-time factor, late steps so far, paused;
+// - /ROBOT/odom (ssx.Odometry), one per robot (up to robot_channels): its pose and velocities in
+//   the world frame.
+// Messages are stamped with the simulated time, which the server also sends as its time.
+//
+// Never makes a step late: at rate_hz per wall-clock second, the stepping thread copies the poses
+// and velocities it needs (only of what a client subscribed to) and hands them to a thread of the
+// extension's own, which writes the JSON; the server's threads send it. The sensors and commands
+// are read on the stepping thread (they are the environment's), only while a client subscribes.
+//
+// Parameters: kParameters below, or `ssx plugins --params foxglove`.
+#include "foxglove_server.hpp"
+
+#include "base/json.hpp"
+#include "record/foxglove.hpp"
+#include "record/run_channels.hpp"
+
+#include <ssx/environment.hpp>
+#include <ssx/error.hpp>
+#include <ssx/plugin_abi.hpp>
+#include <ssx/recording.hpp>
+
+#include <arpa/inet.h>
+
+#include <algorithm>
+#include <chrono>
+#include <condition_variable>
+#include <cstdio>
+#include <memory>
+#include <mutex>
+#include <random>
+#include <string>
+#include <thread>
+#include <vector>
+
+namespace ssx::plugins {
+
+namespace {
+
+using detail::appendNumber;
+using detail::appendString;
+
+enum Fixed : std::size_t { kTf, kScene, kTiming, kSensors, kCommands, kRun, kFixedChannels };
+
+const char* const kRunSchema =
+    R"j({"title":"ssx.RunStatus","description":"the run: simulated time (s), real-time factor since the last message, steps late so far (real-time runs), paused","type":"object","properties":{)j"
+    R"j("time":{"type":"number"},"step":{"type":"integer"},"realtime_factor":{"type":"number"},"late_steps":{"type":"integer"},"paused":{"type":"boolean"}}})j";
+const char* const kOdometrySchema =
+    R"j({"title":"ssx.Odometry","description":"a robot's pose (m, quaternion) and velocities (m/s, rad/s) in the world frame","type":"object","properties":{)j"
+    R"j("timestamp":{"type":"object","properties":{"sec":{"type":"integer"},"nsec":{"type":"integer"}}},"frame_id":{"type":"string"},"child_frame_id":{"type":"string"},)j"
+    R"j("position":{"type":"object","properties":{"x":{"type":"number"},"y":{"type":"number"},"z":{"type":"number"}}},)j"
+    R"j("orientation":{"type":"object","properties":{"x":{"type":"number"},"y":{"type":"number"},"z":{"type":"number"},"w":{"type":"number"}}},)j"
+    R"j("linear_velocity":{"type":"object","properties":{"x":{"type":"number"},"y":{"type":"number"},"z":{"type":"number"}}},)j"
+    R"j("angular_velocity":{"type":"object","properties":{"x":{"type":"number"},"y":{"type":"number"},"z":{"type":"number"}}}}})j";
+
+// what the stepping thread hands to the extension's thread
+struct Snapshot {
+  Nanoseconds time = 0;
+  bool tf = false;
+  std::vector<float> positions, orientations;  // every body (N x 3, N x 4 w x y z), when /tf is wanted
+  std::vector<std::pair<std::size_t, BodyState>> odometry;  // (robot, its first body's state) of those wanted
+  std::vector<std::pair<std::size_t, std::string>> ready;  // (channel, JSON) made on the stepping thread
+};
+
+void appendXyz(std::string& out, const char* name, double x, double y, double z) {
+  out += '"';
+  out += name;
+  out += "\":{\"x\":";
+  appendNumber(out, x);
+  out += ",\"y\":";
+  appendNumber(out, y);
+  out += ",\"z\":";
+  appendNumber(out, z);
+  out += '}';
+}
+
+std::string odometryJson(Nanoseconds time, const std::string& name, const BodyState& s) {
+  std::string out = R"({"timestamp":{"sec":)" + std::to_string(time / 1'000'000'000) + R"(,"nsec":)" +
+                    std::to_string(time % 1'000'000'000) + R"(},"frame_id":"world","child_frame_id":)";
+  appendString(out, name);
+  out += ',';
+  appendXyz(out, "position", s.pose.position.x(), s.pose.position.y(), s.pose.position.z());
+  const Quat& q = s.pose.orientation;
+  out += R"(,"orientation":{"x":)";
+  appendNumber(out, q.x());
+  out += ",\"y\":";
+  appendNumber(out, q.y());
+  out += ",\"z\":";
+  appendNumber(out, q.z());
+  out += ",\"w\":";
+  appendNumber(out, q.w());
+  out += "},";
+  appendXyz(out, "linear_velocity", s.linear_velocity.x(), s.linear_velocity.y(), s.linear_velocity.z());
+  out += ',';
+  appendXyz(out, "angular_velocity", s.angular_velocity.x(), s.angular_velocity.y(), s.angular_velocity.z());
+  return out + "}";
+}
+
+}  // namespace
+
+class Foxglove final : public SimulationExtension {
+ public:
+  static constexpr const char* kDoc =
+      "the run live in Foxglove (its WebSocket protocol): transforms, the scene, timing, sensors, commands and each "
+      "robot's odometry, on 127.0.0.1 by default";
+  static constexpr ssx_plugin_param kParameters[] = {
+      param::integer("port", "8765", param::atLeast(0) & param::atMost(65535),
+                     "TCP port (ws://ADDR:PORT, Foxglove's default); 0: a free one, said when the run starts"),
+      param::text("bind", "127.0.0.1",
+                  "address listened on; another than 127.0.0.1 needs the token printed at start in the URL"),
+      param::real("rate_hz", "30", "Hz", param::positive() & param::atMost(240),
+                  "messages per channel per wall-clock second, at most"),
+      param::integer("max_clients", "4", param::atLeast(1) & param::atMost(64), "clients connected at once, at most"),
+      param::integer("robot_channels", "1000", param::atLeast(0) & param::atMost(100000),
+                     "robots that get an odometry channel of their own (the first ones), at most"),
+  };
+
+  // before anything is bound: the address is one address (civetweb would take "+" or a list)
+  static void validate(const Descriptor& params, const PluginContext&) {
+    const std::string bind = params.get<std::string>("bind");
+    in_addr address{};
+    if (bind != "localhost" && inet_pton(AF_INET, bind.c_str(), &address) != 1)
+      throw params.error("bind must be one IPv4 address (127.0.0.1, 0.0.0.0 for every interface, or an interface's "
+                         "address) or localhost, got '" + bind + "'");
+  }
+
+  void init(Environment& env, const Descriptor& params) override {
+    control_ = &env.runControl();
+    period_ = std::chrono::duration<double>(1.0 / params.get<double>("rate_hz"));
+    const std::string bind = params.get<std::string>("bind");
+    const bool loopback = bind == "127.0.0.1" || bind == "localhost";
+    std::string token;
+    if (!loopback) {
+      std::random_device random;
+      const char* digits = "0123456789abcdef";
+      for (int i = 0; i < 32; ++i) token += digits[random() % 16];
+    }
+    std::vector<foxglove::Channel> channels(kFixedChannels);
+    channels[kTf] = {"/tf", "json", "foxglove.FrameTransforms", detail::kFrameTransformsSchema, "jsonschema"};
+    channels[kScene] = {"/scene", "json", "foxglove.SceneUpdate", detail::kSceneUpdateSchema, "jsonschema"};
+    channels[kTiming] = {"/ssx/timing", "json", "ssx.StepTiming", detail::kTimingSchema, "jsonschema"};
+    channels[kSensors] = {"/ssx/sensors", "json", "ssx.Sensors", detail::kSensorsSchema, "jsonschema"};
+    channels[kCommands] = {"/ssx/commands", "json", "ssx.Commands", detail::kCommandsSchema, "jsonschema"};
+    channels[kRun] = {"/ssx/run", "json", "ssx.RunStatus", kRunSchema, "jsonschema"};
+    // a robot: an artifact that moves (the bodies are known from the first step; the channels now)
+    const auto most = static_cast<std::size_t>(params.get<std::int64_t>("robot_channels"));
+    for (std::size_t i = 0; i < env.artifactCount() && robots_.size() < most; ++i) {
+      const Artifact& a = std::as_const(env).artifact(i);
+      bool moves = false;
+      for (std::size_t r = 0; r < a.rootCount(); ++r) moves = moves || !a.root(r).isStatic();
+      if (!moves) continue;
+      robots_.push_back({i, a.name(), nullptr});
+      channels.push_back({"/" + a.name() + "/odom", "json", "ssx.Odometry", kOdometrySchema, "jsonschema"});
+    }
+    try {
+      server_ = std::make_unique<foxglove::Server>(bind, static_cast<int>(params.get<std::int64_t>("port")), token,
+                                                   static_cast<int>(params.get<std::int64_t>("max_clients")), "ssx",
+                                                   std::move(channels));
+    } catch (const std::exception& e) {
+      throw params.error(std::string("foxglove: ") + e.what());
+    }
+    url_ = "ws://" + (loopback ? std::string("127.0.0.1") : bind) + ":" + std::to_string(server_->port()) +
+           (token.empty() ? "" : "/?token=" + token);
+    env.log(LogLevel::Info, "foxglove: " + url_ + " (in Foxglove: Open connection, Foxglove WebSocket)");
+    last_wall_ = std::chrono::steady_clock::now() - std::chrono::hours(1);
+    builder_ = std::thread([this] { build(); });
+  }
+
+  void afterStep(Environment& env) override {
+    if (!begun_) {  // the bodies exist from the first step on
+      begun_ = true;
+      bodies_ = recordedBodies(env);
+      for (const RecordedBody& b : bodies_) names_.push_back(b.name);
+      for (Robot& r : robots_)
+        for (const RecordedBody& b : bodies_)
+          if (b.name == r.name && &b.node->artifact() == &std::as_const(env).artifact(r.artifact)) r.node = b.node;
+      server_->publish(kScene, static_cast<std::uint64_t>(std::max<Nanoseconds>(0, env.time())),
+                       detail::runSceneUpdate(env, bodies_));
+    }
+    const TimingRecorder& timing = env.timing();
+    if (timing.size() >= 2 && timing[timing.size() - 2].lateness > 0) ++late_;
+    const auto now = std::chrono::steady_clock::now();
+    if (now - last_wall_ < period_ && !control_->paused()) return;
+    const auto started = std::chrono::steady_clock::now();
+    const double wall = std::chrono::duration<double>(now - last_wall_).count();
+    const double rtf = last_sim_ >= 0 && wall < 60 ? (toSeconds(env.time()) - last_sim_) / wall : 0;
+    last_wall_ = now;
+    last_sim_ = toSeconds(env.time());
+    const auto time = static_cast<std::uint64_t>(std::max<Nanoseconds>(0, env.time()));
+    server_->publishTime(time);
+
+    std::unique_ptr<Snapshot> s = takeSpare();
+    s->time = env.time();
+    s->tf = server_->wanted(kTf);
+    s->positions.clear(), s->orientations.clear(), s->odometry.clear(), s->ready.clear();
+    if (s->tf)
+      for (const RecordedBody& b : bodies_) {
+        const Pose pose = env.bodyState(b.node->bodyIndex()).pose * b.node->poseInBody();
+        const Quat& q = pose.orientation;
+        for (const double v : {pose.position.x(), pose.position.y(), pose.position.z()})
+          s->positions.push_back(static_cast<float>(v));
+        for (const double v : {q.w(), q.x(), q.y(), q.z()}) s->orientations.push_back(static_cast<float>(v));
+      }
+    for (std::size_t r = 0; r < robots_.size(); ++r)
+      if (robots_[r].node != nullptr && server_->wanted(kFixedChannels + r))
+        s->odometry.emplace_back(r, env.bodyState(robots_[r].node->bodyIndex()).attached(robots_[r].node->poseInBody()));
+    if (server_->wanted(kTiming) && timing.size() > 0)
+      s->ready.emplace_back(kTiming, detail::timingJson(timing[timing.size() - 1], env.physics().contactCount()));
+    if (server_->wanted(kSensors)) s->ready.emplace_back(kSensors, detail::sensorsJson(env));
+    if (server_->wanted(kCommands)) s->ready.emplace_back(kCommands, detail::commandsJson(env));
+    if (server_->wanted(kRun)) {
+      std::string run = R"({"time":)";
+      appendNumber(run, toSeconds(env.time()));
+      run += R"(,"step":)" + std::to_string(env.stepCount()) + R"(,"realtime_factor":)";
+      appendNumber(run, rtf);
+      run += R"(,"late_steps":)" + std::to_string(late_) + R"(,"paused":)" + (control_->paused() ? "true" : "false") + "}";
+      s->ready.emplace_back(kRun, std::move(run));
+    }
+    {
+      std::lock_guard lock(mutex_);
+      if (pending_) ++replaced_;  // the thread is behind: the newer snapshot instead
+      std::swap(pending_, s);
+      changed_.notify_all();
+    }
+    if (s) giveSpare(std::move(s));
+    const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - started).count();
+    ++taken_, taken_ms_sum_ += ms, taken_ms_max_ = std::max(taken_ms_max_, ms);
+  }
+
+  void shutdown(Environment& env) override {
+    stopBuilding();
+    if (!server_) return;
+    const foxglove::ServerCounts c = server_->counts();
+    server_->stop();
+    env.log(LogLevel::Info, "foxglove: " + std::to_string(c.messages_published) + " messages published, " +
+                                std::to_string(c.messages_sent) + " sent, " + std::to_string(c.messages_skipped) +
+                                " skipped by slow clients, " + std::to_string(replaced_) + " snapshots replaced, " +
+                                std::to_string(c.requests_dropped) + " requests dropped, " +
+                                std::to_string(c.clients_refused) + " clients refused");
+    if (taken_ > 0) {
+      char text[160];
+      std::snprintf(text, sizeof text, "foxglove: a snapshot took %.3f ms on the stepping thread on average, %.3f ms at most",
+                    taken_ms_sum_ / static_cast<double>(taken_), taken_ms_max_);
+      env.log(LogLevel::Info, text);
+    }
+    server_.reset();
+  }
+
+  ~Foxglove() override {
+    stopBuilding();
+    if (server_) server_->stop();
+  }
+
+ private:
+  struct Robot {
+    std::size_t artifact;
+    std::string name;
+    const PhysicNode* node;  // its first body's head, from the first step on
+  };
+
+  std::unique_ptr<Snapshot> takeSpare() {
+    std::lock_guard lock(mutex_);
+    if (spare_) return std::move(spare_);
+    return std::make_unique<Snapshot>();
+  }
+  void giveSpare(std::unique_ptr<Snapshot> s) {
+    std::lock_guard lock(mutex_);
+    if (!spare_) spare_ = std::move(s);
+  }
+
+  // the extension's thread: each snapshot's JSON, published
+  void build() {
+    for (;;) {
+      std::unique_ptr<Snapshot> s;
+      {
+        std::unique_lock lock(mutex_);
+        changed_.wait(lock, [&] { return stopping_ || pending_ != nullptr; });
+        if (stopping_) return;
+        s = std::move(pending_);
+      }
+      const auto time = static_cast<std::uint64_t>(std::max<Nanoseconds>(0, s->time));
+      if (s->tf) server_->publish(kTf, time, detail::frameTransforms(s->time, names_, s->positions, s->orientations));
+      for (const auto& [r, state] : s->odometry)
+        server_->publish(kFixedChannels + r, time, odometryJson(s->time, robots_[r].name, state));
+      for (auto& [channel, json] : s->ready) server_->publish(channel, time, std::move(json));
+      giveSpare(std::move(s));
+    }
+  }
+
+  void stopBuilding() {
+    {
+      std::lock_guard lock(mutex_);
+      stopping_ = true;
+      changed_.notify_all();
+    }
+    if (builder_.joinable()) builder_.join();
+  }
+
+  RunControl* control_ = nullptr;
+  std::unique_ptr<foxglove::Server> server_;
+  std::string url_;
+  std::chrono::duration<double> period_{1.0 / 30};
+  std::chrono::steady_clock::time_point last_wall_;
+  double last_sim_ = -1;
+  bool begun_ = false;
+  std::vector<RecordedBody> bodies_;
+  std::vector<std::string> names_;
+  std::vector<Robot> robots_;
+  std::int64_t late_ = 0;
+  // the stepping thread and the extension's thread
+  std::mutex mutex_;
+  std::condition_variable changed_;
+  std::unique_ptr<Snapshot> pending_, spare_;
+  bool stopping_ = false;
+  std::uint64_t replaced_ = 0;  // (under mutex_)
+  std::thread builder_;
+  std::uint64_t taken_ = 0;
+  double taken_ms_sum_ = 0, taken_ms_max_ = 0;
+};
+
+}  // namespace ssx::plugins
+
+SSX_PLUGIN(SSX_EXTENSION(ssx::plugins::Foxglove, "foxglove"));

@@ -1,0 +1,60 @@
+// The JSON channels a run offers, recorded and live: the scene, a step's timing, the sensors, the commands.
+#include <ssx/ssx.hpp>
+
+#include "record/run_channels.hpp"
+#include "scene_util.hpp"
+
+#include <catch2/catch.hpp>
+
+#include <string>
+
+using namespace ssx;
+using namespace ssx::test;
+
+namespace {
+
+const char* kQuads = R"(<scene><environment timestep="0.002" seed="5" threads="1"/><type name="q" file="mk_quad.xml"/>
+  <ground/><swarm type="q" count="2" name="q{i}" spacing="1.5" xyz="0 0 0.05"><driver offset="0 0 1"/></swarm></scene>)";
+
+std::size_t count(const std::string& text, const std::string& what) {
+  std::size_t n = 0;
+  for (std::size_t at = text.find(what); at != std::string::npos; at = text.find(what, at + 1)) ++n;
+  return n;
+}
+
+}  // namespace
+
+TEST_CASE("run channels: the scene in each robot's frame, its sensors and its command, as JSON", "[record][foxglove]") {
+  Scene scene = loadSceneFromString(kQuads, "quads.xml", kArtifacts, testOptions());
+  Environment& env = *scene.environment;
+  env.step(10);
+  const std::vector<RecordedBody> bodies = recordedBodies(env);
+  REQUIRE(bodies.size() == 2);
+
+  const std::string update = detail::runSceneUpdate(env, bodies);
+  CHECK(count(update, R"("frame_id":"q0")") == 1);
+  CHECK(count(update, R"("frame_id":"q1")") == 1);
+  CHECK(count(update, R"("frame_locked":true)") >= 2);
+
+  // every robot's sensors by index, each measurement with its kind and stamp
+  const std::string sensors = detail::sensorsJson(env);
+  CHECK(sensors.front() == '{');
+  CHECK(sensors.back() == '}');
+  CHECK(count(sensors, R"("q0":{)") == 1);
+  CHECK(count(sensors, R"("q1":{)") == 1);
+  CHECK(count(sensors, R"("kind":)") >= 2);
+
+  // every commandable robot's command: the set-point 1 m up, at the position level
+  const std::string commands = detail::commandsJson(env);
+  CHECK(count(commands, R"("q0":{"level":"position")") == 1);
+  CHECK(count(commands, R"("q1":{"level":"position")") == 1);
+
+  // a step's cost, ms, with its step and the contacts
+  StepTiming t;
+  t.step = 41;
+  t.total = 2'500'000;
+  t.lateness = 0;
+  const std::string timing = detail::timingJson(t, 3);
+  CHECK(timing.rfind(R"({"step":41,"contacts":3,"total_ms":2.5,)", 0) == 0);
+  CHECK(count(timing, R"("late_ms":0})") == 1);
+}
