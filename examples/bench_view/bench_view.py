@@ -9,8 +9,11 @@ then, with Debian's chromium, chromium-driver and python3-selenium installed, th
 rate drawing N robots in headless Chromium (WebGL through SwiftShader, on the same two cores as the
 run):
     n=N page_fps_median=... page_fps_min=... (samples over S s)
+With --foxglove the watchers are Foxglove clients instead (`ssx run --foxglove`; python3-websockets
+clients of its protocol subscribed to /tf, /scene, /ssx/timing, /ssx/sensors, /ssx/commands and
+/ssx/run, reading every message): frames_per_page is then the /tf messages each got.
 
-    bench_view.py SSX [--n N]... [--seconds S] [--runs R] [--pages K] [--fps-seconds S]"""
+    bench_view.py SSX [--n N]... [--seconds S] [--runs R] [--pages K] [--fps-seconds S] [--foxglove]"""
 import argparse
 import asyncio
 import math
@@ -38,10 +41,10 @@ def scene_text(n):
             f'outer_rate_hz="50" offset="0 0 1.5" start_time="2"/></swarm></scene>')
 
 
-def start(ssx, scene, out, seconds, view):
+def start(ssx, scene, out, seconds, view, foxglove=False):
     args = [ssx, "run", str(scene), "--realtime", "--duration", str(seconds), "--out", str(out)]
     if view:
-        args += ["--view", "0"]
+        args += ["--foxglove", "0"] if foxglove else ["--view", "0"]
     process = subprocess.Popen(args, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     url, lines = None, []
     while view and url is None:
@@ -49,7 +52,7 @@ def start(ssx, scene, out, seconds, view):
         if not line:
             sys.exit("ssx ended before the viewer listened:\n" + "".join(lines))
         lines.append(line)
-        found = re.search(r"viewer: (http://\S+)", line)
+        found = re.search(r"(?:viewer|foxglove): ((?:http|ws)://\S+)", line)
         url = found.group(1) if found else None
     return process, url, lines
 
@@ -78,6 +81,34 @@ async def pages(url, count, process):
         except (websockets.exceptions.ConnectionClosed, OSError):
             pass
     tasks = [asyncio.create_task(page(k)) for k in range(count)]
+    while process.poll() is None:
+        await asyncio.sleep(0.2)
+    for t in tasks:
+        t.cancel()
+    await asyncio.gather(*tasks, return_exceptions=True)
+    return got
+
+
+async def foxglove_clients(url, count, process):
+    """`count` Foxglove clients subscribed to the run's fixed channels, reading every message until the
+    run ends; /tf messages each got."""
+    import json
+    import websockets
+    got = [0] * count
+
+    async def client(k):
+        try:
+            async with websockets.connect(url, subprotocols=["foxglove.websocket.v1"], max_size=None) as ws:
+                async for message in ws:
+                    if isinstance(message, str) and json.loads(message).get("op") == "advertise":
+                        wanted = [c for c in json.loads(message)["channels"] if not c["topic"].endswith("/odom")]
+                        await ws.send(json.dumps({"op": "subscribe", "subscriptions": [
+                            {"id": c["id"], "channelId": c["id"]} for c in wanted]}))
+                    elif isinstance(message, bytes) and message[0] == 1 and int.from_bytes(message[1:5], "little") == 1:
+                        got[k] += 1
+        except (websockets.exceptions.ConnectionClosed, OSError):
+            pass
+    tasks = [asyncio.create_task(client(k)) for k in range(count)]
     while process.poll() is None:
         await asyncio.sleep(0.2)
     for t in tasks:
@@ -127,6 +158,7 @@ def main():
     parser.add_argument("--runs", type=int, default=2)
     parser.add_argument("--pages", type=int, default=2)
     parser.add_argument("--fps-seconds", type=float, default=10)
+    parser.add_argument("--foxglove", action="store_true", help="Foxglove clients instead of the viewer's pages")
     a = parser.parse_args()
     with tempfile.TemporaryDirectory() as work:
         work = pathlib.Path(work)
@@ -136,8 +168,9 @@ def main():
             medians = {0: [], 1: []}
             for run in range(2 * a.runs):
                 view = run % 2
-                process, url, lines = start(a.ssx, scene, work / f"out{n}_{run}", a.seconds, view)
-                got = asyncio.run(pages(url, a.pages, process)) if view else []
+                process, url, lines = start(a.ssx, scene, work / f"out{n}_{run}", a.seconds, view, a.foxglove)
+                watch = foxglove_clients if a.foxglove else pages
+                got = asyncio.run(watch(url, a.pages, process)) if view else []
                 out, err = process.communicate()
                 median, p99, late = summary(out + "".join(lines) + err)
                 medians[view].append(median)
@@ -145,7 +178,7 @@ def main():
                       f"frames_per_page={'/'.join(map(str, got)) if got else '-'}", flush=True)
             print(f"n={n} median_ms without {statistics.median(medians[0]):.3f} with {statistics.median(medians[1]):.3f} "
                   f"({100 * (statistics.median(medians[1]) / statistics.median(medians[0]) - 1):+.1f} %)", flush=True)
-            samples = page_fps(a.ssx, scene, work / f"fps{n}", a.fps_seconds) if a.fps_seconds > 0 else None
+            samples = page_fps(a.ssx, scene, work / f"fps{n}", a.fps_seconds) if a.fps_seconds > 0 and not a.foxglove else None
             if samples:
                 print(f"n={n} page_fps_median={statistics.median(samples):.0f} page_fps_min={min(samples):.0f} "
                       f"(samples over {a.fps_seconds:.0f} s)", flush=True)

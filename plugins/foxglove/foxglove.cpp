@@ -16,8 +16,8 @@
 //
 // Never makes a step late: at rate_hz per wall-clock second, the stepping thread copies the poses
 // and velocities it needs (only of what a client subscribed to) and hands them to a thread of the
-// extension's own, which writes the JSON; the server's threads send it. The sensors and commands
-// are read on the stepping thread (they are the environment's), only while a client subscribes.
+// extension's own, which writes the JSON; the server's threads send it. The sensors' latest
+// measurements and the commands are copied likewise (detail::RunSample), only while a client subscribes.
 //
 // Parameters: kParameters below, or `ssx plugins --params foxglove`.
 #include "foxglove_server.hpp"
@@ -32,6 +32,9 @@
 #include <ssx/recording.hpp>
 
 #include <arpa/inet.h>
+#include <sys/resource.h>
+#include <sys/syscall.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <chrono>
@@ -71,6 +74,8 @@ struct Snapshot {
   std::vector<float> positions, orientations;  // every body (N x 3, N x 4 w x y z), when /tf is wanted
   std::vector<std::pair<std::size_t, BodyState>> odometry;  // (robot, its first body's state) of those wanted
   std::vector<std::pair<std::size_t, std::string>> ready;  // (channel, JSON) made on the stepping thread
+  bool sensors = false, commands = false;
+  detail::RunSample sample;  // the sensors and commands, when wanted
 };
 
 void appendXyz(std::string& out, const char* name, double x, double y, double z) {
@@ -136,6 +141,7 @@ class Foxglove final : public SimulationExtension {
   }
 
   void init(Environment& env, const Descriptor& params) override {
+    env_ = &env;
     control_ = &env.runControl();
     period_ = std::chrono::duration<double>(1.0 / params.get<double>("rate_hz"));
     const std::string bind = params.get<std::string>("bind");
@@ -217,8 +223,10 @@ class Foxglove final : public SimulationExtension {
         s->odometry.emplace_back(r, env.bodyState(robots_[r].node->bodyIndex()).attached(robots_[r].node->poseInBody()));
     if (server_->wanted(kTiming) && timing.size() > 0)
       s->ready.emplace_back(kTiming, detail::timingJson(timing[timing.size() - 1], env.physics().contactCount()));
-    if (server_->wanted(kSensors)) s->ready.emplace_back(kSensors, detail::sensorsJson(env));
-    if (server_->wanted(kCommands)) s->ready.emplace_back(kCommands, detail::commandsJson(env));
+    s->sensors = server_->wanted(kSensors);
+    s->commands = server_->wanted(kCommands);
+    if (s->sensors) s->sample.takeSensors(env);
+    if (s->commands) s->sample.takeCommands(env);
     if (server_->wanted(kRun)) {
       std::string run = R"({"time":)";
       appendNumber(run, toSeconds(env.time()));
@@ -269,6 +277,10 @@ class Foxglove final : public SimulationExtension {
     const PhysicNode* node;  // its first body's head, from the first step on
   };
 
+  // this thread only (Linux's nice value is per thread): the stepping threads take a core first, and
+  // when this thread falls behind the newest snapshot replaces the one waiting (counted)
+  static void lowerPriority() { (void)setpriority(PRIO_PROCESS, static_cast<id_t>(::syscall(SYS_gettid)), 19); }
+
   std::unique_ptr<Snapshot> takeSpare() {
     std::lock_guard lock(mutex_);
     if (spare_) return std::move(spare_);
@@ -281,6 +293,7 @@ class Foxglove final : public SimulationExtension {
 
   // the extension's thread: each snapshot's JSON, published
   void build() {
+    lowerPriority();
     for (;;) {
       std::unique_ptr<Snapshot> s;
       {
@@ -293,6 +306,8 @@ class Foxglove final : public SimulationExtension {
       if (s->tf) server_->publish(kTf, time, detail::frameTransforms(s->time, names_, s->positions, s->orientations));
       for (const auto& [r, state] : s->odometry)
         server_->publish(kFixedChannels + r, time, odometryJson(s->time, robots_[r].name, state));
+      if (s->sensors) server_->publish(kSensors, time, s->sample.sensorsJson(*env_));
+      if (s->commands) server_->publish(kCommands, time, s->sample.commandsJson(*env_));
       for (auto& [channel, json] : s->ready) server_->publish(channel, time, std::move(json));
       giveSpare(std::move(s));
     }
@@ -307,6 +322,7 @@ class Foxglove final : public SimulationExtension {
     if (builder_.joinable()) builder_.join();
   }
 
+  const Environment* env_ = nullptr;  // (the extension's thread reads only its artifacts' names)
   RunControl* control_ = nullptr;
   std::unique_ptr<foxglove::Server> server_;
   std::string url_;

@@ -3,6 +3,9 @@
 #include "foxglove_server.hpp"
 
 #include <civetweb.h>
+#include <sys/resource.h>
+#include <sys/syscall.h>
+#include <unistd.h>
 #include <nlohmann/json.hpp>
 
 #include <chrono>
@@ -185,6 +188,8 @@ void Server::onReady(mg_connection* conn, void* self) {
 }
 
 void Server::sendLoop(const std::shared_ptr<Client>& client) {
+  // this thread only (Linux's nice value is per thread): the stepping threads take a core first
+  (void)setpriority(PRIO_PROCESS, static_cast<id_t>(::syscall(SYS_gettid)), 19);
   std::vector<char> frame;
   for (;;) {
     std::vector<std::string> texts;

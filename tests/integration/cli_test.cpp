@@ -625,7 +625,15 @@ TEST_CASE("ssx: empty output names, options without the one they need, and empty
     const Result r = run({"run", scene, "--steps", "1", "--fast", "--quiet", "--view", "0", "--view-bind", bind});
     CHECK(r.status == 2);
     CHECK_THAT(r.err, Contains("must be one IPv4 address"));
+    const Result f = run({"run", scene, "--steps", "1", "--fast", "--quiet", "--foxglove", "0", "--foxglove-bind", bind});
+    CHECK(f.status == 2);
+    CHECK_THAT(f.err, Contains("must be one IPv4 address"));
   }
+  // the viewer and the Foxglove server both on Foxglove's default port: said before anything listens
+  const Result both = run({"run", scene, "--steps", "1", "--fast", "--quiet", "--view", "--foxglove"});
+  CHECK(both.status == 2);
+  CHECK_THAT(both.err, Contains("--view and --foxglove both on port 8765: give one of them another port"));
+  CHECK(run({"run", scene, "--steps", "1", "--fast", "--quiet", "--foxglove-bind", "127.0.0.1"}).status == 2);
 }
 
 TEST_CASE("ssx replay and inspect: a hard link to the recording is the recording, a FIFO is refused, not waited on",

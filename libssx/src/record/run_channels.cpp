@@ -64,40 +64,75 @@ std::string timingJson(const StepTiming& t, std::size_t contacts) {
   return out + "}";
 }
 
-std::string sensorsJson(const Environment& env) {
-  std::string out = "{";
-  bool first_artifact = true;
+void RunSample::takeSensors(const Environment& env) {
+  sensor_count_ = 0;
   for (std::size_t i = 0; i < env.artifactCount(); ++i) {
     const Artifact& a = env.artifact(i);
-    std::string body;
     for (std::size_t k = 0; k < a.sensorCount(); ++k) {
-      const std::string m = measurementJson(a.sensor(k).latest(), env);
-      if (m.empty()) continue;
-      if (!body.empty()) body += ',';
-      body += '"' + std::to_string(k) + "\":" + m;
+      const Measurement& m = a.sensor(k).latest();
+      if (sensor_count_ == sensors_.size()) sensors_.emplace_back();
+      Sensor& s = sensors_[sensor_count_];
+      s.artifact = i, s.index = k;
+      if (const auto* imu = dynamic_cast<const ImuMeasurement*>(&m))
+        s.kind = 0, s.imu = *imu;
+      else if (const auto* pose = dynamic_cast<const PoseMeasurement*>(&m))
+        s.kind = 1, s.pose = *pose;
+      else if (const auto* range = dynamic_cast<const RangeMeasurement*>(&m))
+        s.kind = 2, s.range = *range;  // (the detections into the vector's room: no allocation once grown)
+      else
+        continue;
+      ++sensor_count_;
     }
-    if (body.empty()) continue;
-    if (!first_artifact) out += ',';
-    first_artifact = false;
-    appendString(out, a.name());
-    out += ":{" + body + "}";
+  }
+}
+
+void RunSample::takeCommands(const Environment& env) {
+  commands_.clear();
+  for (std::size_t i = 0; i < env.artifactCount(); ++i)
+    if (const auto* commandable = dynamic_cast<const CommandInterface*>(env.artifact(i).driver()))
+      commands_.emplace_back(i, commandable->currentCommand());
+}
+
+std::string RunSample::sensorsJson(const Environment& env) const {
+  std::string out = "{";
+  for (std::size_t k = 0; k < sensor_count_;) {
+    const std::size_t artifact = sensors_[k].artifact;
+    if (out.size() > 1) out += ',';
+    appendString(out, env.artifact(artifact).name());
+    out += ":{";
+    for (bool first = true; k < sensor_count_ && sensors_[k].artifact == artifact; ++k, first = false) {
+      const Sensor& s = sensors_[k];
+      const Measurement& m = s.kind == 0 ? static_cast<const Measurement&>(s.imu)
+                             : s.kind == 1 ? static_cast<const Measurement&>(s.pose)
+                                           : static_cast<const Measurement&>(s.range);
+      if (!first) out += ',';
+      out += '"' + std::to_string(s.index) + "\":" + measurementJson(m, env);
+    }
+    out += '}';
   }
   return out + "}";
 }
 
-std::string commandsJson(const Environment& env) {
+std::string RunSample::commandsJson(const Environment& env) const {
   std::string out = "{";
-  bool first = true;
-  for (std::size_t i = 0; i < env.artifactCount(); ++i) {
-    const Artifact& a = env.artifact(i);
-    const auto* commandable = dynamic_cast<const CommandInterface*>(a.driver());
-    if (commandable == nullptr) continue;
-    if (!first) out += ',';
-    first = false;
-    appendString(out, a.name());
-    out += ':' + commandJson(commandable->currentCommand());
+  for (const auto& [artifact, command] : commands_) {
+    if (out.size() > 1) out += ',';
+    appendString(out, env.artifact(artifact).name());
+    out += ':' + commandJson(command);
   }
   return out + "}";
+}
+
+std::string sensorsJson(const Environment& env) {
+  RunSample sample;
+  sample.takeSensors(env);
+  return sample.sensorsJson(env);
+}
+
+std::string commandsJson(const Environment& env) {
+  RunSample sample;
+  sample.takeCommands(env);
+  return sample.commandsJson(env);
 }
 
 }  // namespace ssx::detail
