@@ -65,6 +65,16 @@ def summary(text):
     return float(median.group(1)), float(median.group(2)), int(late.group(1))
 
 
+async def until_the_end(process, watchers):
+    """Runs the watchers (coroutines) until the run ends, then stops them."""
+    tasks = [asyncio.create_task(w) for w in watchers]
+    while process.poll() is None:
+        await asyncio.sleep(0.2)
+    for t in tasks:
+        t.cancel()
+    await asyncio.gather(*tasks, return_exceptions=True)
+
+
 async def pages(url, count, process):
     """`count` pages at 30 frames a second, reading every frame until the run ends; frames each got."""
     import websockets
@@ -80,12 +90,7 @@ async def pages(url, count, process):
                         got[k] += 1
         except (websockets.exceptions.ConnectionClosed, OSError):
             pass
-    tasks = [asyncio.create_task(page(k)) for k in range(count)]
-    while process.poll() is None:
-        await asyncio.sleep(0.2)
-    for t in tasks:
-        t.cancel()
-    await asyncio.gather(*tasks, return_exceptions=True)
+    await until_the_end(process, [page(k) for k in range(count)])
     return got
 
 
@@ -108,12 +113,7 @@ async def foxglove_clients(url, count, process):
                         got[k] += 1
         except (websockets.exceptions.ConnectionClosed, OSError):
             pass
-    tasks = [asyncio.create_task(client(k)) for k in range(count)]
-    while process.poll() is None:
-        await asyncio.sleep(0.2)
-    for t in tasks:
-        t.cancel()
-    await asyncio.gather(*tasks, return_exceptions=True)
+    await until_the_end(process, [client(k) for k in range(count)])
     return got
 
 

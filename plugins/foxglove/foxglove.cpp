@@ -22,6 +22,7 @@
 // Parameters: kParameters below, or `ssx plugins --params foxglove`.
 #include "foxglove_server.hpp"
 
+#include "../common/web_access.hpp"
 #include "base/json.hpp"
 #include "record/foxglove.hpp"
 #include "record/run_channels.hpp"
@@ -31,10 +32,6 @@
 #include <ssx/plugin_abi.hpp>
 #include <ssx/recording.hpp>
 
-#include <arpa/inet.h>
-#include <sys/resource.h>
-#include <sys/syscall.h>
-#include <unistd.h>
 
 #include <algorithm>
 #include <chrono>
@@ -42,7 +39,6 @@
 #include <cstdio>
 #include <memory>
 #include <mutex>
-#include <random>
 #include <string>
 #include <thread>
 #include <vector>
@@ -131,27 +127,16 @@ class Foxglove final : public SimulationExtension {
                      "robots that get an odometry channel of their own (the first ones), at most"),
   };
 
-  // before anything is bound: the address is one address (civetweb would take "+" or a list)
-  static void validate(const Descriptor& params, const PluginContext&) {
-    const std::string bind = params.get<std::string>("bind");
-    in_addr address{};
-    if (bind != "localhost" && inet_pton(AF_INET, bind.c_str(), &address) != 1)
-      throw params.error("bind must be one IPv4 address (127.0.0.1, 0.0.0.0 for every interface, or an interface's "
-                         "address) or localhost, got '" + bind + "'");
-  }
+  // before anything is bound: the address is one address
+  static void validate(const Descriptor& params, const PluginContext&) { web::checkBindAddress(params); }
 
   void init(Environment& env, const Descriptor& params) override {
     env_ = &env;
     control_ = &env.runControl();
     period_ = std::chrono::duration<double>(1.0 / params.get<double>("rate_hz"));
     const std::string bind = params.get<std::string>("bind");
-    const bool loopback = bind == "127.0.0.1" || bind == "localhost";
-    std::string token;
-    if (!loopback) {
-      std::random_device random;
-      const char* digits = "0123456789abcdef";
-      for (int i = 0; i < 32; ++i) token += digits[random() % 16];
-    }
+    const bool loopback = web::isLoopback(bind);
+    const std::string token = web::accessToken(bind);
     std::vector<foxglove::Channel> channels(kFixedChannels);
     channels[kTf] = {"/tf", "json", "foxglove.FrameTransforms", detail::kFrameTransformsSchema, "jsonschema"};
     channels[kScene] = {"/scene", "json", "foxglove.SceneUpdate", detail::kSceneUpdateSchema, "jsonschema"};
@@ -277,10 +262,6 @@ class Foxglove final : public SimulationExtension {
     const PhysicNode* node;  // its first body's head, from the first step on
   };
 
-  // this thread only (Linux's nice value is per thread): the stepping threads take a core first, and
-  // when this thread falls behind the newest snapshot replaces the one waiting (counted)
-  static void lowerPriority() { (void)setpriority(PRIO_PROCESS, static_cast<id_t>(::syscall(SYS_gettid)), 19); }
-
   std::unique_ptr<Snapshot> takeSpare() {
     std::lock_guard lock(mutex_);
     if (spare_) return std::move(spare_);
@@ -293,7 +274,7 @@ class Foxglove final : public SimulationExtension {
 
   // the extension's thread: each snapshot's JSON, published
   void build() {
-    lowerPriority();
+    web::lowerThisThreadsPriority();  // (behind, the newest snapshot replaces the one waiting: counted)
     for (;;) {
       std::unique_ptr<Snapshot> s;
       {

@@ -2,10 +2,9 @@
 // nlohmann/json (Debian's nlohmann-json3-dev).
 #include "foxglove_server.hpp"
 
+#include "../common/web_access.hpp"
+
 #include <civetweb.h>
-#include <sys/resource.h>
-#include <sys/syscall.h>
-#include <unistd.h>
 #include <nlohmann/json.hpp>
 
 #include <chrono>
@@ -26,9 +25,7 @@ struct Server::Client {
   std::map<std::uint32_t, std::size_t> subscriptions;  // the client's id -> channel index
   std::vector<std::uint64_t> sent;  // per channel: the sequence number of the message sent last
   std::uint64_t time_seq = 0;
-  // the client's message rate: messages in the current second
-  std::chrono::steady_clock::time_point window;
-  int messages = 0;
+  web::MessageRate rate;
 };
 
 namespace {
@@ -36,13 +33,6 @@ namespace {
 using nlohmann::json;
 
 constexpr std::size_t kMaxQueuedTexts = 64;
-
-std::string queryValue(const char* query, const char* key) {
-  if (query == nullptr) return {};
-  char value[256];
-  const int n = mg_get_var(query, std::strlen(query), key, value, sizeof value);
-  return n < 0 ? std::string() : std::string(value, static_cast<std::size_t>(n));
-}
 
 std::string status(int level, const std::string& message) {
   return json{{"op", "status"}, {"level", level}, {"message", message}}.dump();
@@ -160,7 +150,7 @@ int Server::onConnect(const mg_connection* conn, void* self) {
       info->acceptedWebSocketSubprotocol != nullptr && std::strcmp(info->acceptedWebSocketSubprotocol, kSubprotocol) == 0;
   std::lock_guard lock(s.mutex_);
   if (s.stopping_ || !foxglove || static_cast<int>(s.clients_.size()) >= s.max_clients_ ||
-      (!s.token_.empty() && queryValue(info->query_string, "token") != s.token_)) {
+      (!s.token_.empty() && web::queryValue(info->query_string, "token") != s.token_)) {
     ++s.counts_.clients_refused;
     return 1;  // refused
   }
@@ -168,7 +158,6 @@ int Server::onConnect(const mg_connection* conn, void* self) {
   client->conn = const_cast<mg_connection*>(conn);
   client->sent.assign(s.channels_.size(), 0);
   client->time_seq = s.time_seq_ > 0 ? s.time_seq_ - 1 : 0;  // (the time now, first)
-  client->window = std::chrono::steady_clock::now();
   client->texts = {s.info_, s.advertise_};
   s.clients_.push_back(client);
   mg_set_user_connection_data(conn, client.get());
@@ -188,8 +177,7 @@ void Server::onReady(mg_connection* conn, void* self) {
 }
 
 void Server::sendLoop(const std::shared_ptr<Client>& client) {
-  // this thread only (Linux's nice value is per thread): the stepping threads take a core first
-  (void)setpriority(PRIO_PROCESS, static_cast<id_t>(::syscall(SYS_gettid)), 19);
+  web::lowerThisThreadsPriority();
   std::vector<char> frame;
   for (;;) {
     std::vector<std::string> texts;
@@ -244,21 +232,10 @@ int Server::onData(mg_connection* conn, int opcode, char* data, std::size_t size
   auto* client = static_cast<Client*>(mg_get_user_connection_data(conn));
   const int kind = opcode & 0xf;
   if (kind == MG_WEBSOCKET_OPCODE_CONNECTION_CLOSE) return 0;
-  if (kind == MG_WEBSOCKET_OPCODE_PING && size <= 125) {  // answered, as the protocol asks (clients' keep-alive)
-    mg_lock_connection(conn);
-    mg_websocket_write(conn, MG_WEBSOCKET_OPCODE_PONG, data, size);
-    mg_unlock_connection(conn);
-    return 1;
-  }
-  if (kind == MG_WEBSOCKET_OPCODE_PING || kind == MG_WEBSOCKET_OPCODE_PONG || client == nullptr) return 1;
+  if (web::answerPing(conn, opcode, data, size) || client == nullptr) return 1;
   std::lock_guard lock(s.mutex_);
-  const auto now = std::chrono::steady_clock::now();
-  if (now - client->window > std::chrono::seconds(1)) {
-    client->window = now;
-    client->messages = 0;
-  }
   std::string refused;
-  if (++client->messages > kMaxMessagesPerSecond)
+  if (!client->rate.allow(kMaxMessagesPerSecond))
     refused = "more than " + std::to_string(kMaxMessagesPerSecond) + " messages a second: dropped";
   else if (kind != MG_WEBSOCKET_OPCODE_TEXT)
     refused = "binary messages (publishing, service calls) are not offered: dropped";

@@ -34,6 +34,7 @@
 #include "scene_shapes.hpp"
 #include "viewer_server.hpp"
 
+#include "../common/web_access.hpp"
 #include <ssx/command.hpp>
 #include <ssx/environment.hpp>
 #include <ssx/error.hpp>
@@ -41,7 +42,6 @@
 #include <ssx/plugin_abi.hpp>
 #include <ssx/recording.hpp>
 
-#include <arpa/inet.h>
 
 #include <algorithm>
 #include <chrono>
@@ -55,7 +55,6 @@
 #include <memory>
 #include <mutex>
 #include <optional>
-#include <random>
 #include <string>
 #include <thread>
 #include <vector>
@@ -98,11 +97,7 @@ class Viewer final : public SimulationExtension {
   // before anything is opened or bound: the address is one address (civetweb would take "+" or a
   // list of ports in it and listen wider than asked), the recording a regular file
   static void validate(const Descriptor& params, const PluginContext&) {
-    const std::string bind = params.get<std::string>("bind");
-    in_addr address{};
-    if (bind != "localhost" && inet_pton(AF_INET, bind.c_str(), &address) != 1)
-      throw params.error("bind must be one IPv4 address (127.0.0.1, 0.0.0.0 for every interface, or an interface's "
-                         "address) or localhost, got '" + bind + "'");
+    web::checkBindAddress(params);
     if (const std::string file = params.has("recording") ? params.get<std::string>("recording") : ""; !file.empty()) {
       std::error_code ec;
       const auto status = std::filesystem::status(file, ec);
@@ -127,13 +122,8 @@ class Viewer final : public SimulationExtension {
       if (recording_->times().empty()) throw params.error("viewer: " + file + " holds no pose sample to play");
       playback_ = std::make_unique<viewer::Playback>(recording_->times());
     }
-    const bool loopback = bind == "127.0.0.1" || bind == "localhost";
-    std::string token;
-    if (!loopback) {
-      std::random_device random;
-      const char* digits = "0123456789abcdef";
-      for (int i = 0; i < 32; ++i) token += digits[random() % 16];
-    }
+    const bool loopback = web::isLoopback(bind);
+    const std::string token = web::accessToken(bind);
     const std::vector<viewer::Asset> assets{
         {"/", "text/html; charset=utf-8", ssx_viewer_index_html,
          static_cast<std::size_t>(ssx_viewer_index_html_end - ssx_viewer_index_html)},

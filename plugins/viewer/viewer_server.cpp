@@ -1,6 +1,8 @@
 // The viewer's server (viewer_server.hpp), on civetweb.
 #include "viewer_server.hpp"
 
+#include "../common/web_access.hpp"
+
 #include <civetweb.h>
 
 #include <chrono>
@@ -21,21 +23,8 @@ struct Server::Client {
   std::uint64_t sent = 0;       // frames sent to it
   std::chrono::duration<double> period{0};  // the least time between two frames the page asked for
   std::chrono::steady_clock::time_point next_send;
-  // the page's message rate: messages in the current second
-  std::chrono::steady_clock::time_point window;
-  int messages = 0;
+  web::MessageRate rate;  // the page's messages in the current second
 };
-
-namespace {
-
-std::string queryValue(const char* query, const char* key) {
-  if (query == nullptr) return {};
-  char value[256];
-  const int n = mg_get_var(query, std::strlen(query), key, value, sizeof value);
-  return n < 0 ? std::string() : std::string(value, static_cast<std::size_t>(n));
-}
-
-}  // namespace
 
 std::optional<double> jsonNumber(const std::string& text, const char* key, int index) {
   const std::string quoted = std::string("\"") + key + "\":";
@@ -129,7 +118,7 @@ int Server::onRequest(mg_connection* conn, void* self) {
   const std::string uri = info->local_uri != nullptr ? info->local_uri : "";
   for (const Asset& a : s.assets_) {
     if (uri != a.path) continue;
-    if (!s.token_.empty() && std::strcmp(a.path, "/") == 0 && queryValue(info->query_string, "token") != s.token_) {
+    if (!s.token_.empty() && std::strcmp(a.path, "/") == 0 && web::queryValue(info->query_string, "token") != s.token_) {
       mg_send_http_error(conn, 403, "%s", "this viewer needs the token printed when the run started (?token=...)");
       return 403;
     }
@@ -149,14 +138,13 @@ int Server::onConnect(const mg_connection* conn, void* self) {
   const mg_request_info* info = mg_get_request_info(conn);
   std::lock_guard lock(s.mutex_);
   if (s.stopping_ || static_cast<int>(s.clients_.size()) >= s.max_clients_ ||
-      (!s.token_.empty() && queryValue(info->query_string, "token") != s.token_)) {
+      (!s.token_.empty() && web::queryValue(info->query_string, "token") != s.token_)) {
     ++s.counts_.clients_refused;
     return 1;  // refused
   }
   auto client = std::make_shared<Client>();
   client->conn = const_cast<mg_connection*>(conn);
   client->first_seq = client->sent_seq = s.newest_seq_;
-  client->window = std::chrono::steady_clock::now();
   s.clients_.push_back(client);
   mg_set_user_connection_data(conn, client.get());
   return 0;
@@ -222,22 +210,9 @@ int Server::onData(mg_connection* conn, int opcode, char* data, std::size_t size
   auto* client = static_cast<Client*>(mg_get_user_connection_data(conn));
   const int kind = opcode & 0xf;
   if (kind == MG_WEBSOCKET_OPCODE_CONNECTION_CLOSE) return 0;
-  if (kind == MG_WEBSOCKET_OPCODE_PING && size <= 125) {  // answered, as the protocol asks (clients' keep-alive)
-    mg_lock_connection(conn);
-    mg_websocket_write(conn, MG_WEBSOCKET_OPCODE_PONG, data, size);
-    mg_unlock_connection(conn);
-    return 1;
-  }
-  if (kind == MG_WEBSOCKET_OPCODE_PING || kind == MG_WEBSOCKET_OPCODE_PONG) return 1;
+  if (web::answerPing(conn, opcode, data, size)) return 1;
   bool take = client != nullptr && kind == MG_WEBSOCKET_OPCODE_TEXT && size <= kMaxMessage;
-  if (take) {
-    const auto now = std::chrono::steady_clock::now();
-    if (now - client->window > std::chrono::seconds(1)) {
-      client->window = now;
-      client->messages = 0;
-    }
-    take = ++client->messages <= kMaxMessagesPerSecond;
-  }
+  if (take) take = client->rate.allow(kMaxMessagesPerSecond);
   std::string text(take ? data : "", take ? size : 0);
   if (take && text.find(R"("type":"hello")") != std::string::npos) {
     if (const auto rate = jsonNumber(text, "rate_hz")) {

@@ -165,6 +165,7 @@ struct World {
   // reset, from one start state, episode after episode)
   std::uint64_t restored_checksum = 0;
   std::size_t restored_size = 0;
+  mutable std::size_t state_size_hint = 0;  // the last saved state's size (saveState reserves it)
   std::int64_t steps = 0;        // steps taken
   std::int64_t current_step = 0;  // the step being taken
 

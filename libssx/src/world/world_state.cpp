@@ -26,8 +26,9 @@ namespace {
 
 constexpr char kMagic[8] = {'S', 'S', 'X', 'S', 'T', 'A', 'T', 'E'};
 // 4: run-time joints (PhysicNode::attach); 5: the engine's name (states restore on the engine that
-// saved them), the run-time joints' kinds; 6: the varied constants (Environment::vary)
-constexpr std::uint32_t kFormatVersion = 6;
+// saved them), the run-time joints' kinds; 6: the varied constants (Environment::vary); 7: the
+// same payload under a faster checksum (stateChecksum; format 6's states are still read)
+constexpr std::uint32_t kFormatVersion = 7;
 constexpr std::size_t kHeaderSize = 8 + 4 + 4 + 8 + 8 + 8;
 
 void writeBody(StateWriter& out, const BodyState& s) {
@@ -54,6 +55,26 @@ void writeBlock(StateWriter& out, Fill fill) {
   fill();
   const std::uint64_t size = out.size() - at - sizeof(std::uint64_t);
   std::memcpy(out.buffer().data() + at, &size, sizeof size);
+}
+
+// Format 7's checksum: FNV-1a's step (xor, multiply by its prime) on 8-byte words in four
+// independent lanes, the bytes left over by FNV-1a itself, then the lanes and the size folded in.
+// Each step is a bijection of its lane, so any one changed word changes the sum. Byte-wise FNV-1a
+// (format 6) took about 50 ms for the 21 MB state of 10,000 quadrotors, on the stepping thread
+// whenever a recording saved a state; this takes a few.
+std::uint64_t stateChecksum(const std::byte* data, std::size_t size) {
+  constexpr std::uint64_t kPrime = 1099511628211ull;
+  std::uint64_t lane[4] = {kFnv1aBasis, kFnv1aBasis ^ 1, kFnv1aBasis ^ 2, kFnv1aBasis ^ 3};
+  std::size_t i = 0;
+  for (; i + 32 <= size; i += 32)
+    for (int k = 0; k < 4; ++k) {
+      std::uint64_t word = 0;
+      std::memcpy(&word, data + i + 8 * k, 8);
+      lane[k] = (lane[k] ^ word) * kPrime;
+    }
+  std::uint64_t h = fnv1a(data + i, size - i);
+  for (const std::uint64_t l : lane) h = (h ^ l) * kPrime;
+  return (h ^ size) * kPrime;
 }
 
 template <class Load>
@@ -102,6 +123,7 @@ std::vector<std::byte> Environment::saveState() const {
   if (w.state != State::Running)
     throw Error("saveState: the environment is not running (start it, or it failed or stopped)");
   std::vector<std::byte> buffer(kHeaderSize);
+  buffer.reserve(w.state_size_hint);  // (the last state's size: no copy as it grows, 21 MB at 10,000 quadrotors)
   StateWriter out(buffer);
   out.write(w.steps);
   out.write(physics_->name());
@@ -140,7 +162,8 @@ std::vector<std::byte> Environment::saveState() const {
 
   // the header, now that the payload is known
   const std::uint64_t payload = buffer.size() - kHeaderSize;
-  const std::uint64_t checksum = fnv1a(buffer.data() + kHeaderSize, payload);
+  const std::uint64_t checksum = stateChecksum(buffer.data() + kHeaderSize, payload);
+  w.state_size_hint = buffer.size();
   const std::uint64_t fingerprint = sceneFingerprint();
   std::byte* h = buffer.data();
   std::memcpy(h, kMagic, 8);
@@ -163,13 +186,14 @@ void Environment::checkState(std::span<const std::byte> state) const {
   std::memcpy(&fingerprint, state.data() + 16, 8);
   std::memcpy(&payload, state.data() + 24, 8);
   std::memcpy(&checksum, state.data() + 32, 8);
-  if (version != kFormatVersion)
-    throw StateError("restoreState: saved state format " + std::to_string(version) + ", this ssx reads format " +
+  if (version != kFormatVersion && version != 6)
+    throw StateError("restoreState: saved state format " + std::to_string(version) + ", this ssx reads formats 6 and " +
                      std::to_string(kFormatVersion));
   if (payload != state.size() - kHeaderSize)
     throw StateError("restoreState: the saved state is " + std::to_string(state.size()) + " bytes, its header says " +
                      std::to_string(payload + kHeaderSize) + " (truncated?)");
-  if (fnv1a(state.data() + kHeaderSize, payload) != checksum)
+  const std::byte* body = state.data() + kHeaderSize;
+  if ((version == 6 ? fnv1a(body, payload) : stateChecksum(body, payload)) != checksum)
     throw StateError("restoreState: the saved state is corrupted (checksum mismatch)");
   if (fingerprint != sceneFingerprint())
     throw StateError("restoreState: the state was saved from a different scene (timestep, bodies, artifacts or "

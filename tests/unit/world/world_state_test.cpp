@@ -7,6 +7,7 @@
 
 #include <catch2/catch.hpp>
 
+#include <cstring>
 #include <string>
 #include <vector>
 
@@ -141,4 +142,38 @@ TEST_CASE("a state restored again continues the same, and another that fails sti
   CHECK(driver.runs_ == 15);
   CHECK(env.stepCount() == 15);
   CHECK(env.stateHash() == hash);
+}
+
+TEST_CASE("format 7's checksum catches a changed word anywhere; format 6's states are still read", "[state]") {
+  Scene scene = loadStateScene(2);
+  Environment& env = *scene.environment;
+  env.step(100);
+  const std::vector<std::byte> saved = env.saveState();
+  env.step(50);
+  const std::vector<std::byte> at150 = env.saveState();
+  constexpr std::size_t kHeader = 40;
+  std::uint32_t version = 0;
+  std::memcpy(&version, saved.data() + 8, 4);
+  CHECK(version == 7);
+  // a bit changed in each of the four lanes' words, and in the bytes past the last whole 32
+  for (const std::size_t at : {kHeader, kHeader + 9, kHeader + 18, kHeader + 31, saved.size() - 1}) {
+    std::vector<std::byte> changed = saved;
+    changed[at] ^= std::byte{0x80};
+    INFO(at);
+    CHECK_THROWS_WITH(env.restoreState(changed), Catch::Contains("corrupted (checksum mismatch)"));
+  }
+  // the same payload as format 6 wrote it, summed byte by byte with FNV-1a: restored as it was
+  std::vector<std::byte> six = saved;
+  const std::uint32_t format6 = 6;
+  std::memcpy(six.data() + 8, &format6, 4);
+  const std::uint64_t sum = fnv1a(six.data() + kHeader, six.size() - kHeader);
+  std::memcpy(six.data() + 32, &sum, 8);
+  env.restoreState(six);
+  env.step(50);
+  CHECK(env.saveState() == at150);
+  // an earlier format is refused, naming the ones read
+  std::vector<std::byte> five = six;
+  const std::uint32_t format5 = 5;
+  std::memcpy(five.data() + 8, &format5, 4);
+  CHECK_THROWS_WITH(env.restoreState(five), Catch::Contains("saved state format 5, this ssx reads formats 6 and 7"));
 }
