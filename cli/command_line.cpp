@@ -82,6 +82,8 @@ CommandLine parseCommandLine(int argc, const char* const* argv, std::ostream& ou
   auto* fast = run_cmd->add_flag("--fast", c.run.fast, "run as fast as possible")->excludes(realtime);
   auto* view = addViewOptions(run_cmd, c.run.view, c.run.view_bind,
                               "serve a live 3D view of the run to web browsers at http://127.0.0.1:PORT/");
+  run_cmd->add_flag("--view-wait", c.run.view_wait, "hold the run after its first step until a page connects to --view")
+      ->needs(view);
   auto* foxglove = run_cmd->add_option("--foxglove", c.run.foxglove,
                                        "serve the run live to Foxglove at ws://127.0.0.1:PORT (default 8765, "
                                        "Foxglove's own; 0: a free port)")

@@ -19,6 +19,7 @@ struct RunArgs {
   double realtime = 1.0;
   int view = -1;                       // --view: the viewer's port (8765 when given bare); -1: no viewer
   std::string view_bind = "127.0.0.1";  // --view-bind: the viewer's address (another needs the printed token)
+  bool view_wait = false;               // --view-wait: hold the run after its first step until a page connects
   int foxglove = -1;                        // --foxglove: the Foxglove server's port (8765 bare); -1: none
   std::string foxglove_bind = "127.0.0.1";  // --foxglove-bind: its address (another needs the printed token)
   bool fast = false;

@@ -45,10 +45,11 @@ inline std::string joined(const std::vector<std::string>& names) {
 // --view: the viewer extension, as <extension plugin="viewer"/> adds it (it listens when the
 // environment starts); with `recording`, playing that recording instead of the run. Attached as an
 // observer: not part of the run's saved states, so that a recording of a run with a view
-// re-simulates without one.
-inline void addViewer(ssx::Environment& env, int port, const std::string& bind, const std::string& recording = {}) {
+// re-simulates without one. `wait`: the run holds after its first step until a page connects.
+inline void addViewer(ssx::Environment& env, int port, const std::string& bind, const std::string& recording = {},
+                      bool wait = false) {
   ssx::Descriptor params("viewer", {"--view", 0});
-  params.set("port", static_cast<std::int64_t>(port)).set("bind", bind);
+  params.set("port", static_cast<std::int64_t>(port)).set("bind", bind).set("wait", wait);
   if (!recording.empty()) params.set("recording", recording);
   env.attachExtension("viewer", env.classLoader().createExtension("viewer", "viewer"), params);
 }

@@ -201,7 +201,7 @@ int commandRun(const RunArgs& args, bool realtime_given) {
   ssx::Environment& env = *scene.environment;
   if (args.view >= 0) {
     try {
-      addViewer(env, args.view, args.view_bind);
+      addViewer(env, args.view, args.view_bind, {}, args.view_wait);
     } catch (const std::exception& e) {
       std::cerr << "ssx: error: --view: " << e.what() << '\n';
       return kExitBadInput;

@@ -44,6 +44,7 @@
 
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <filesystem>
 #include <condition_variable>
@@ -89,6 +90,8 @@ class Viewer final : public SimulationExtension {
       param::real("rate_hz", "30", "Hz", param::positive() & param::atMost(240),
                   "frames sent to the pages per wall-clock second, at most"),
       param::integer("max_clients", "4", param::atLeast(1) & param::atMost(64), "pages connected at once, at most"),
+      param::flag("wait", "false",
+                  "hold the run after its first step until a page connects (ssx run --view-wait)"),
       param::text("recording", "",
                   "play this recording (MCAP) on the page instead of the run, as ssx replay FILE --view does; "
                   "default: none"),
@@ -113,6 +116,7 @@ class Viewer final : public SimulationExtension {
     const int port = static_cast<int>(params.get<std::int64_t>("port"));
     const std::string bind = params.get<std::string>("bind");
     period_ = std::chrono::duration<double>(1.0 / params.get<double>("rate_hz"));
+    wait_ = params.get<bool>("wait");
     if (const std::string file = params.has("recording") ? params.get<std::string>("recording") : ""; !file.empty()) {
       try {
         recording_ = std::make_unique<Recording>(file);
@@ -192,6 +196,12 @@ class Viewer final : public SimulationExtension {
                     " bodies are not the scene's " + std::to_string(names_.size()) + " (a recording of another version?)");
       server_->setHello(sceneJson(env));
       if (recording_) player_ = std::thread([this] { play(); });
+      // --view-wait: paused here until a page says hello (onMessage resumes it)
+      if (wait_ && !recording_ && server_->counts().clients == 0) {
+        waiting_ = true;
+        control_->pause();
+        env.log(LogLevel::Info, "viewer: the run waits for a page at " + url_);
+      }
     }
     if (recording_) return;  // the frames are the recording's
     const TimingRecorder& timing = env.timing();
@@ -228,6 +238,14 @@ class Viewer final : public SimulationExtension {
   void shutdown(Environment& env) override {
     stopPlaying();
     if (!server_) return;
+    if (!recording_) {  // the pages keep the last frame, and say how the run ended
+      char summary[200];
+      std::snprintf(summary, sizeof summary, "t = %.3f s after %lld steps, %lld of them late", toSeconds(env.time()),
+                    static_cast<long long>(env.stepCount()), static_cast<long long>(late_));
+      std::string end = R"({"type":"end","summary":)";
+      appendString(end, summary);
+      server_->farewell(end + "}", std::chrono::milliseconds(500));
+    }
     const viewer::ServerCounts c = server_->counts();  // (with the pages still connected: what they missed)
     server_->stop();
     env.log(LogLevel::Info, "viewer: " + std::to_string(c.frames_published) + " frames published, " +
@@ -255,7 +273,10 @@ class Viewer final : public SimulationExtension {
 
   // a page's message (on a server thread): true when understood
   bool onMessage(const std::string& text) {
-    if (text.find(R"("type":"hello")") != std::string::npos) return true;
+    if (text.find(R"("type":"hello")") != std::string::npos) {
+      if (waiting_.exchange(false)) control_->resume();
+      return true;
+    }
     if (playback_) return onReplayMessage(text);
     // pause, single steps, resume and the real-time factor (Environment::runControl: any thread)
     if (text.find(R"("type":"pause")") != std::string::npos) return control_->pause(), true;
@@ -503,6 +524,8 @@ class Viewer final : public SimulationExtension {
   double last_sim_ = -1;
   std::uint32_t late_ = 0;
   bool begun_ = false;
+  bool wait_ = false;                 // --view-wait: hold the run after its first step until a page says hello
+  std::atomic<bool> waiting_{false};  // (set on the stepping thread, cleared by a page's hello)
   std::uint64_t built_ = 0;  // frames built on the stepping thread, and what they took
   double build_ms_sum_ = 0, build_ms_max_ = 0;
   // what pages asked (under mutex_; nodes_ is fixed once begun): the newest teleoperation command,

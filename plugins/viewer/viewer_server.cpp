@@ -19,6 +19,7 @@ struct Server::Client {
   bool closed = false;  // (under the server's mutex)
   std::uint64_t sent_seq = 0;
   std::uint64_t hello_seq = 0;  // the scene this page has
+  std::uint64_t hello_written = 0;  // ... written to its socket
   std::uint64_t first_seq = 0;  // the newest frame when it connected
   std::uint64_t sent = 0;       // frames sent to it
   std::chrono::duration<double> period{0};  // the least time between two frames the page asked for
@@ -195,6 +196,7 @@ void Server::sendLoop(const std::shared_ptr<Client>& client) {
     if (written <= 0) return;  // the page went away: onClose ends it
     std::lock_guard lock(mutex_);
     if (frame) ++counts_.frames_sent, ++client->sent;
+    if (!frame) client->hello_written = client->hello_seq, changed_.notify_all();
   }
 }
 
@@ -203,6 +205,18 @@ void Server::setHello(std::string hello) {
   hello_ = std::move(hello);
   ++hello_seq_;
   changed_.notify_all();
+}
+
+void Server::farewell(std::string message, std::chrono::milliseconds wait) {
+  std::unique_lock lock(mutex_);
+  hello_ = std::move(message);
+  const std::uint64_t seq = ++hello_seq_;
+  changed_.notify_all();
+  changed_.wait_for(lock, wait, [&] {
+    for (const auto& c : clients_)
+      if (!c->closed && c->hello_written < seq) return false;
+    return true;
+  });
 }
 
 int Server::onData(mg_connection* conn, int opcode, char* data, std::size_t size, void* self) {

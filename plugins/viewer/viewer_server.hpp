@@ -9,6 +9,7 @@
 // pages; messages from a page larger than kMaxMessage bytes, more than kMaxMessagesPerSecond a
 // second, or not understood are dropped and counted.
 #include <atomic>
+#include <chrono>
 #include <condition_variable>
 #include <cstddef>
 #include <cstdint>
@@ -72,6 +73,9 @@ class Server {
   void publish(std::vector<std::uint8_t>& frame);
   /// Replaces the message every page gets first (the scene), and sends it to the pages connected.
   void setHello(std::string hello);
+  /// The last message every page gets (the run's end): sent to the pages connected, waiting up to
+  /// `wait` for them to have it, before stop() closes them.
+  void farewell(std::string message, std::chrono::milliseconds wait);
   /// What was counted so far.
   ServerCounts counts() const;
   /// Stops listening, closes every client and joins their threads.

@@ -11,7 +11,7 @@ const state = {
   details: null,    // the selected robot's details from the simulation (velocities, command, sensors)
   replay: null,     // a recording played: {start, end} (s)
   sliding: false,   // its slider held
-  selected: -1, frames: 0, fpsFrames: 0, fpsSince: performance.now(),
+  selected: -1, hovered: -1, frames: 0, fpsFrames: 0, fpsSince: performance.now(),
   dirty: true,      // something to draw
   pressedAt: -1e9,  // when the pause button was last pressed
 };
@@ -47,8 +47,15 @@ camera.position.set(-12, -12, 9);
 const controls = new THREE.OrbitControls(camera, view);
 controls.target.set(0, 0, 1.5);
 controls.enableKeys = false;  // the keys steer the selected robot
+// the camera stays above the ground: at most level with the point it orbits, which stays above z = 0
+controls.maxPolarAngle = Math.PI / 2 - 0.02;
+controls.minDistance = 0.2;
 controls.update();
-controls.addEventListener("change", () => { state.dirty = true; });
+controls.addEventListener("change", () => {
+  if (controls.target.z < 0) controls.target.z = 0;
+  if (camera.position.z < 0.05) camera.position.z = 0.05;
+  state.dirty = true;
+});
 scene.add(new THREE.HemisphereLight(0xffffff, 0x505050, 0.75));
 const sun = new THREE.DirectionalLight(0xffffff, 0.6);
 sun.position.set(0.35, 0.25, 0.9);
@@ -130,11 +137,13 @@ function buildScene(msg) {
       mesh.applyMatrix(poseMatrix(shape.pose));
       add(mesh);
     }
-    if (shape.kind === "plane" && shape.grid) {
-      // 1 m cells, or 10 m, ... on a larger ground: at most 100 lines each way
+    if (shape.kind === "plane") {
+      // the ground's grid, to judge heights and distances by: 1 m cells, or 10 m, ... on a larger
+      // ground (at most 100 lines each way); darker where the scene asks for it (<ground grid="true">)
       const size = Math.max(shape.size[0], shape.size[1]);
       const cell = 10 ** Math.max(0, Math.ceil(Math.log10(size / 100)));
-      const grid = new THREE.GridHelper(size, Math.max(1, Math.round(size / cell)), 0x555555, 0x777777);
+      const grid = shape.grid ? new THREE.GridHelper(size, Math.max(1, Math.round(size / cell)), 0x555555, 0x777777)
+                              : new THREE.GridHelper(size, Math.max(1, Math.round(size / cell)), 0x7a7a7a, 0x8c8c8c);
       grid.rotateX(Math.PI / 2);
       grid.applyMatrix(poseMatrix(shape.pose));
       grid.position.z += 0.002;
@@ -172,11 +181,18 @@ function buildScene(msg) {
       points.frustumCulled = false;
       add(points);
     }
-    return { parts, points, full: new Int32Array(members[m]), far: new Int32Array(members[m]) };
+    return { parts, points, reach, full: new Int32Array(members[m]), far: new Int32Array(members[m]) };
   });
   // (a robot's joined parts, "robot/wheel", are bodies of their own but not robots; an arm bolted to
   // the world is one robot of moving parts only)
   document.getElementById("robots").textContent = new Set(msg.bodies.map((b) => b.name.split("/")[0])).size;
+  const names = document.getElementById("names");
+  names.replaceChildren(...msg.bodies.filter((b) => !b.name.includes("/")).slice(0, 20000).map((b) => {
+    const option = document.createElement("option");
+    option.value = b.name;
+    return option;
+  }));
+  plotHistory.length = 0;
   state.framed = false;
   state.dirty = true;
   // a recording played (ssx replay --view): a time slider, and nothing to steer
@@ -213,6 +229,8 @@ function applyFrame(buffer) {
   }
   if (!state.framed) frameBodies(n);
   placeBodies(n);
+  placeHighlight();
+  record(view.getFloat32(16, true));
   state.dirty = true;
   document.getElementById("time").textContent = state.time.toFixed(3);
   if (state.replay && !state.sliding) document.getElementById("slider").value = state.time;
@@ -337,14 +355,8 @@ function showSelected() {
 // a click selects the robot under the pointer
 const raycaster = new THREE.Raycaster();
 view.addEventListener("click", (event) => {
-  const pointer = new THREE.Vector2((event.clientX / window.innerWidth) * 2 - 1, -(event.clientY / window.innerHeight) * 2 + 1);
-  raycaster.setFromCamera(pointer, camera);
-  const objects = state.models.flatMap((model) => [...model.parts.map((part) => part.mesh), ...(model.points ? [model.points] : [])]);
-  const hit = raycaster.intersectObjects(objects)[0];
-  if (!hit) return;
-  const model = state.models[hit.object.userData.model];
-  if (hit.object.isPoints) select(model.far[hit.index]);
-  else if (hit.instanceId !== undefined) select(model.full[hit.instanceId]);
+  const i = bodyAt(event);
+  if (i >= 0) select(i);
 });
 
 function select(i) {
@@ -352,7 +364,123 @@ function select(i) {
   state.details = null;
   teleop.sent = null;
   teleop.asked = 0;  // its details asked for at once (then each second)
+  plotHistory.length = 0;
+  placeHighlight();
   showSelected();
+  state.dirty = true;
+}
+
+// the selected robot: a ring around it, as wide as its model, and its name above it
+const ring = new THREE.Mesh(new THREE.TorusGeometry(1, 0.08, 8, 48), new THREE.MeshBasicMaterial({ color: 0xffd34d }));
+ring.visible = false;
+scene.add(ring);
+function placeHighlight() {
+  const i = state.selected, p = state.positions;
+  ring.visible = i >= 0 && !!p && i < state.bodies.length;
+  if (!ring.visible) return;
+  const reach = state.models[state.bodies[i].model].reach;
+  ring.position.set(p[7 * i], p[7 * i + 1], p[7 * i + 2]);
+  ring.scale.setScalar(1.3 * reach);
+}
+const pickLabel = document.getElementById("pick"), hoverLabel = document.getElementById("hover");
+function placeLabel(label, i, text) {
+  const where = i >= 0 && state.drawn ? window.ssxViewer.project(i) : null;
+  label.hidden = !where;
+  if (!where) return;
+  label.textContent = text;
+  label.style.left = `${where[0]}px`;
+  label.style.top = `${where[1]}px`;
+}
+const bodyAt = (event) => {
+  const pointer = new THREE.Vector2((event.clientX / window.innerWidth) * 2 - 1, -(event.clientY / window.innerHeight) * 2 + 1);
+  raycaster.setFromCamera(pointer, camera);
+  const objects = state.models.flatMap((model) => [...model.parts.map((part) => part.mesh), ...(model.points ? [model.points] : [])]);
+  const hit = raycaster.intersectObjects(objects)[0];
+  if (!hit) return -1;
+  const model = state.models[hit.object.userData.model];
+  if (hit.object.isPoints) return model.far[hit.index];
+  return hit.instanceId !== undefined ? model.full[hit.instanceId] : -1;
+};
+// a name under the pointer, looked up at most 10 times a second
+let hoverAt = 0;
+view.addEventListener("pointermove", (event) => {
+  const now = performance.now();
+  if (now - hoverAt < 100 || !state.positions) return;
+  hoverAt = now;
+  state.hovered = bodyAt(event);
+  state.dirty = true;
+});
+view.addEventListener("pointerleave", () => { state.hovered = -1; state.dirty = true; });
+
+// a robot found by name: selected and followed
+document.getElementById("find").addEventListener("change", (event) => {
+  const wanted = event.target.value.trim();
+  if (!wanted) return;
+  let i = state.bodies.findIndex((b) => b.name === wanted);
+  if (i < 0) i = state.bodies.findIndex((b) => b.name.startsWith(wanted));
+  if (i < 0) return;
+  document.getElementById("follow").checked = true;
+  select(i);
+});
+// the view of the first frame again, following nobody
+document.getElementById("reset").addEventListener("click", () => {
+  document.getElementById("follow").checked = false;
+  if (state.positions) frameBodies(state.bodies.length);
+  state.dirty = true;
+});
+
+// the last 20 s (simulated) of the selected robot's height, speed and commanded speed, and of the
+// run's real-time factor, plotted in the panel
+const plotHistory = [];
+function record(rtf) {
+  const i = state.selected, p = state.positions;
+  const last = plotHistory[plotHistory.length - 1];
+  if (last && state.time <= last.t) plotHistory.length = 0;  // (a seek back, a restored state)
+  const entry = { t: state.time, rtf, z: NaN, speed: NaN, commanded: NaN };
+  if (i >= 0 && p) {
+    const k = 7 * i;
+    entry.z = p[k + 2];
+    entry.x = p[k];
+    entry.y = p[k + 1];
+    if (last && last.x !== undefined && state.time > last.t)
+      entry.speed = Math.hypot(p[k] - last.x, p[k + 1] - last.y, p[k + 2] - last.z) / (state.time - last.t);
+    const d = state.details && state.details.body === i ? state.details : null;
+    if (d && d.command && d.command.level === "velocity") entry.commanded = Math.hypot(...d.command.values.slice(0, 3));
+  }
+  plotHistory.push(entry);
+  while (plotHistory.length > 2 && plotHistory[0].t < state.time - 20) plotHistory.shift();
+  drawPlot();
+}
+const plot = document.getElementById("plot");
+const kSeries = [["z", "height m", "#6fd3ff"], ["speed", "speed m/s", "#ffd34d"], ["commanded", "commanded m/s", "#ff8a65"],
+                 ["rtf", "× real time", "#a5e07a"]];
+function drawPlot() {
+  const g = plot.getContext("2d"), w = plot.width, h = plot.height;
+  g.clearRect(0, 0, w, h);
+  if (plotHistory.length < 2) return;
+  const t0 = plotHistory[0].t, t1 = Math.max(plotHistory[plotHistory.length - 1].t, t0 + 1e-6);
+  g.font = "10px system-ui, sans-serif";
+  let legend = 4;
+  for (const [key, name, colour] of kSeries) {
+    const values = plotHistory.map((e) => e[key]).filter(Number.isFinite);
+    if (values.length < 2) continue;
+    const lo = Math.min(0, ...values), hi = Math.max(lo + 1e-3, ...values);
+    g.strokeStyle = colour;
+    g.beginPath();
+    let started = false;
+    for (const e of plotHistory) {
+      if (!Number.isFinite(e[key])) continue;
+      const x = ((e.t - t0) / (t1 - t0)) * (w - 4) + 2, y = h - 14 - ((e[key] - lo) / (hi - lo)) * (h - 20);
+      if (started) g.lineTo(x, y);
+      else g.moveTo(x, y), (started = true);
+    }
+    g.stroke();
+    g.fillStyle = colour;
+    const text = `${name} ${values[values.length - 1].toFixed(2)}`;
+    g.fillText(text, legend, h - 2);
+    legend += g.measureText(text).width + 8;
+  }
+  state.plotted = plotHistory.length;
 }
 
 // teleoperation of the selected robot, or of every robot (the formation): W/S (or the arrows)
@@ -447,11 +575,16 @@ function connect() {
     if (typeof event.data === "string") {
       const msg = JSON.parse(event.data);
       if (msg.type === "scene") buildScene(msg);
+      if (msg.type === "end") state.summary = msg.summary;
     } else if (state.bodies.length > 0) {
       applyFrame(event.data);
     }
   };
-  socket.onclose = () => { status.textContent = "disconnected (the run ended?)"; };
+  // the last frame stays, with what the run said as it ended
+  socket.onclose = () => {
+    state.ended = true;
+    status.textContent = state.summary ? `the run ended: ${state.summary}` : "disconnected (the run ended?)";
+  };
 }
 
 // drawn when something changed (a frame, the view, the window): a page that keeps up draws each
@@ -464,6 +597,9 @@ function animate() {
     renderer.render(scene, camera);
     state.drawn = state.positions;  // what the picture shows now
     state.fpsFrames++;
+    const named = (i) => (i >= 0 && i < state.bodies.length ? state.bodies[i].name : "");
+    placeLabel(pickLabel, state.selected, named(state.selected));
+    placeLabel(hoverLabel, state.hovered !== state.selected ? state.hovered : -1, named(state.hovered));
   }
   if (now - state.fpsSince > 1000) {
     document.getElementById("fps").textContent = Math.round((1000 * state.fpsFrames) / (now - state.fpsSince));
@@ -474,7 +610,7 @@ function animate() {
 
 // for tests and for a look from the browser's console
 window.ssxViewer = {
-  state, camera, controls, select,
+  state, scene, camera, controls, select, plotHistory, ring,
   get renderer() { return renderer; },
   get meshes() { return meshes; },  // the scene's mesh geometries, as the scene message lists them
   // draws now (for a test: pixel() reads this picture in the same task)
