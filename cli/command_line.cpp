@@ -130,9 +130,10 @@ CommandLine parseCommandLine(int argc, const char* const* argv, std::ostream& ou
   run_cmd->add_option("--record-channels", c.run.record_channels,
                       "channels recorded besides the poses, comma-separated: foxglove (/tf and /scene for Foxglove and "
                       "Lichtblick), timing (/ssx/timing, each step's cost), sensors (/ssx/sensors: IMU, pose, range), "
-                      "commands (/ssx/commands), none (default: foxglove for swarms up to 1,000 bodies)")
+                      "commands (/ssx/commands), contacts (/ssx/contacts: pairs, points, impulses), none (default: "
+                      "foxglove for swarms up to 1,000 bodies)")
       ->delimiter(',')
-      ->check(CLI::IsMember({"foxglove", "timing", "sensors", "commands", "none"}))
+      ->check(CLI::IsMember({"foxglove", "timing", "sensors", "commands", "contacts", "none"}))
       ->needs(record);
   run_cmd->add_option("--record-states", c.run.record_states,
                       "simulated seconds between saved states in --record (0: only the first)")

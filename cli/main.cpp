@@ -325,6 +325,7 @@ int commandRun(const RunArgs& args, bool realtime_given) {
         record.timing = has("timing");
         record.sensors = has("sensors");
         record.commands = has("commands");
+        record.contacts = has("contacts");
       }
       record.scene_xml = scene.model->toXml();
       record.scene_label = fs::path(args.scene).filename().string();

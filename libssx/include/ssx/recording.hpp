@@ -84,6 +84,9 @@ struct RecordOptions {
   bool timing = false;   ///< channel `/ssx/timing`: every step's wall-clock cost
   bool sensors = false;  ///< channel `/ssx/sensors`: IMU, pose and range measurements at each sample
   bool commands = false;  ///< channel `/ssx/commands`: each commandable robot's current command at each sample
+  /// channel `/ssx/contacts`: the contacts of the step sampled (pairs, point, normal, impulse);
+  /// turns Environment::recordContacts on
+  bool contacts = false;
 };
 
 /// What a recording wrote (Recorder::finish).

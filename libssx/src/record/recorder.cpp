@@ -45,6 +45,9 @@ struct Job {
   std::string attachment;  // a switch of physics engine: the attachment's name (bytes: its text)
   std::vector<std::byte> bytes;
   std::vector<Extra> extras;
+  // the sensors, commands and contacts at a pose sample, copied on the stepping thread and
+  // written as JSON by the writer (detail::RunSample: the JSON is the costly part)
+  std::unique_ptr<detail::RunSample> sample;
 };
 
 }  // namespace
@@ -63,7 +66,8 @@ struct Recorder::Impl {
   std::vector<const PhysicNode*> nodes;  // the node heading each name's body
   std::vector<RecordedBody> bodies;
   std::uint16_t poses_channel = 0;
-  int tf_channel = -1, timing_channel = -1, sensors_channel = -1, commands_channel = -1;  // -1: not recorded
+  int tf_channel = -1, timing_channel = -1, sensors_channel = -1, commands_channel = -1,
+      contacts_channel = -1;  // -1: not recorded
   std::vector<Extra> extras;                                     // since the last sample
   std::vector<float> tf_positions, tf_orientations;              // the writer thread's
   Nanoseconds first_time = -1, last_time = 0;
@@ -74,6 +78,7 @@ struct Recorder::Impl {
   std::condition_variable changed;
   std::deque<Job> queue;
   std::vector<std::vector<std::byte>> spare;  // buffers the writer is done with
+  std::vector<std::unique_ptr<detail::RunSample>> spare_samples;  // ... and samples
   bool done = false;
   std::exception_ptr error;
   RecordSummary summary;
@@ -166,6 +171,7 @@ void Recorder::Impl::begin() {
   if (options.timing) addJsonChannel(timing_channel, "/ssx/timing", "ssx.StepTiming", detail::kTimingSchema);
   if (options.sensors) addJsonChannel(sensors_channel, "/ssx/sensors", "ssx.Sensors", detail::kSensorsSchema);
   if (options.commands) addJsonChannel(commands_channel, "/ssx/commands", "ssx.Commands", detail::kCommandsSchema);
+  if (options.contacts) addJsonChannel(contacts_channel, "/ssx/contacts", "ssx.Contacts", detail::kContactsSchema);
   next_state = env->time();
   thread = std::thread([this] { loop(); });
 }
@@ -223,16 +229,23 @@ void Recorder::Impl::observe() {
   if (env->stepCount() % period_steps != 0) return;
   Job job;
   job.time = now;
-  if (sensors_channel >= 0) extras.push_back({static_cast<std::uint16_t>(sensors_channel), now, detail::sensorsJson(*env)});
-  if (commands_channel >= 0)
-    extras.push_back({static_cast<std::uint16_t>(commands_channel), now, detail::commandsJson(*env)});
   job.extras.swap(extras);
   {
     std::lock_guard lock(mutex);
+    if ((sensors_channel >= 0 || commands_channel >= 0 || contacts_channel >= 0) && !spare_samples.empty()) {
+      job.sample = std::move(spare_samples.back());
+      spare_samples.pop_back();
+    }
     if (!spare.empty()) {
       job.bytes = std::move(spare.back());
       spare.pop_back();
     }
+  }
+  if (sensors_channel >= 0 || commands_channel >= 0 || contacts_channel >= 0) {
+    if (!job.sample) job.sample = std::make_unique<detail::RunSample>();
+    if (sensors_channel >= 0) job.sample->takeSensors(*env);
+    if (commands_channel >= 0) job.sample->takeCommands(*env);
+    if (contacts_channel >= 0) job.sample->takeContacts(*env);
   }
   detail::encodePoses(nodes, job.bytes);
   if (first_time >= 0 && now <= last_time && !went_back) {
@@ -280,6 +293,14 @@ void Recorder::Impl::loop() {
       } else if (job.state) {
         writer->addAttachment("state/" + std::to_string(job.time), "application/x-ssx-state", job.time, job.bytes);
       } else if (job.time >= 0) {
+        if (job.sample) {
+          auto json = [&](int channel, const std::string& text) {
+            writer->addMessage(static_cast<std::uint16_t>(channel), job.time, std::as_bytes(std::span(text.data(), text.size())));
+          };
+          if (sensors_channel >= 0) json(sensors_channel, job.sample->sensorsJson(*env));
+          if (commands_channel >= 0) json(commands_channel, job.sample->commandsJson(*env));
+          if (contacts_channel >= 0) json(contacts_channel, job.sample->contactsJson(*env));
+        }
         writer->addMessage(poses_channel, job.time, job.bytes);
         if (tf_channel >= 0) {
           detail::decodePoses(job.bytes, &tf_positions, &tf_orientations);
@@ -301,6 +322,7 @@ void Recorder::Impl::loop() {
       ++summary.samples;
     summary.bytes = writer->bytesWritten();
     spare.push_back(std::move(job.bytes));
+    if (job.sample) spare_samples.push_back(std::move(job.sample));
   }
 }
 
@@ -321,6 +343,7 @@ Recorder::Recorder(Environment& env, RecordOptions options) : impl_(std::make_un
   if (m.options.writer_nice < 0 || m.options.writer_nice > 19)
     throw ConfigError({}, "record: writer_nice must be 0 (unchanged) to 19 (a lower priority than the stepping threads)");
   m.writer = std::make_unique<detail::McapWriter>(m.options.file, "ssx", std::string("ssx ") + SSX_VERSION_STRING);
+  if (m.options.contacts) env.recordContacts(true);
   m.switches_seen = env.physicsSwitches().size();  // (made before: the saved states say the engine)
   m.listener = env.addStepListener([&m](const Environment&) { m.observe(); });
   m.listening = true;

@@ -25,6 +25,10 @@ const char* const kCommandsSchema =
     R"j({"title":"ssx.Commands","description":"each commandable robot's current command: its level (position, velocity, attitude, rates, rotors) and values in the column order of Python's set_commands","type":"object",)j"
     R"j("additionalProperties":{"type":"object","properties":{"level":{"type":"string"},"values":{"type":"array","items":{"type":"number"}}}}})j";
 
+const char* const kContactsSchema =
+    R"j({"title":"ssx.Contacts","description":"the contacts of a step: per pair of bodies (or a body and a static artifact), the artifacts, the deepest point (m, world), the normal from b to a and the normal impulse (N s)","type":"object","properties":{"contacts":{"type":"array","items":{"type":"object","properties":{)j"
+    R"j("a":{"type":"string"},"b":{"type":"string"},"position":{"type":"array","items":{"type":"number"}},"normal":{"type":"array","items":{"type":"number"}},"impulse":{"type":"number"}}}}}})j";
+
 std::string runSceneUpdate(const Environment& env, const std::vector<RecordedBody>& bodies) {
   std::vector<SceneShape> shapes;
   auto add = [&](auto& self, const RenderNodeSpec& spec, const std::string& frame, const Pose& parent) -> void {
@@ -121,6 +125,33 @@ std::string RunSample::commandsJson(const Environment& env) const {
     out += ':' + commandJson(command);
   }
   return out + "}";
+}
+
+void RunSample::takeContacts(const Environment& env) { contacts_.assign(env.contacts().begin(), env.contacts().end()); }
+
+std::string RunSample::contactsJson(const Environment& env) const {
+  std::string out = R"({"contacts":[)";
+  for (std::size_t k = 0; k < contacts_.size(); ++k) {
+    const EngineContact& c = contacts_[k];
+    out += k == 0 ? R"({"a":)" : R"(,{"a":)";
+    appendString(out, env.bodyOwner(c.body_a).name());
+    out += R"(,"b":)";
+    appendString(out, env.contactOther(c).name());
+    for (const auto& [name, v] : {std::pair<const char*, const Vec3*>{"position", &c.position}, {"normal", &c.normal}}) {
+      out += ",\"";
+      out += name;
+      out += "\":[";
+      for (int i = 0; i < 3; ++i) {
+        if (i > 0) out += ',';
+        appendNumber(out, (*v)[i]);
+      }
+      out += ']';
+    }
+    out += R"(,"impulse":)";
+    appendNumber(out, c.impulse);
+    out += '}';
+  }
+  return out + "]}";
 }
 
 std::string sensorsJson(const Environment& env) {

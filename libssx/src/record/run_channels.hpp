@@ -4,11 +4,13 @@
 // - /scene (foxglove.SceneUpdate): every artifact's shapes, in the frame of the body it moves with;
 // - /ssx/timing (ssx.StepTiming): one step's wall-clock cost;
 // - /ssx/sensors (ssx.Sensors): each artifact's latest measurements;
-// - /ssx/commands (ssx.Commands): each commandable robot's current command.
+// - /ssx/commands (ssx.Commands): each commandable robot's current command;
+// - /ssx/contacts (ssx.Contacts): the contacts of a step (Environment::recordContacts must be on).
 // Each function reads the environment: call it on the stepping thread (or while it stands).
 
 #include <ssx/command.hpp>
 #include <ssx/measurements.hpp>
+#include <ssx/physic_engine.hpp>
 #include <ssx/recording.hpp>
 #include <ssx/timing.hpp>
 #include <ssx/types.hpp>
@@ -28,6 +30,7 @@ namespace ssx::detail {
 extern const char* const kTimingSchema;
 extern const char* const kSensorsSchema;
 extern const char* const kCommandsSchema;
+extern const char* const kContactsSchema;
 
 /// foxglove.SceneUpdate of a running environment: each render tree in the frame of the recorded
 /// body (`bodies`, as recordedBodies gives them) it moves with, or of the world.
@@ -46,6 +49,11 @@ class RunSample {
   std::string sensorsJson(const Environment& env) const;
   /// /ssx/commands from the commands taken: {"<artifact>": {"level": "attitude", "values": [...]}, ...}.
   std::string commandsJson(const Environment& env) const;
+  /// The contacts of the last step (the environment records them).
+  void takeContacts(const Environment& env);
+  /// /ssx/contacts from the contacts taken: {"contacts": [{"a": artifact, "b": artifact or static
+  /// artifact, "position": [x, y, z], "normal": [x, y, z], "impulse": N s}, ...]}.
+  std::string contactsJson(const Environment& env) const;
 
  private:
   struct Sensor {
@@ -58,6 +66,7 @@ class RunSample {
   std::vector<Sensor> sensors_;
   std::size_t sensor_count_ = 0;
   std::vector<std::pair<std::size_t, Command>> commands_;
+  std::vector<EngineContact> contacts_;
 };
 
 /// /ssx/timing: one step's cost, ms, and the physics engine's contact points in it.

@@ -123,6 +123,25 @@ function poseMatrix(p) {
                                      new THREE.Vector3(1, 1, 1));
 }
 
+// a square grid of `size` m in cells of `cell` m in the plane z = 0, its lines cut into pieces of a
+// few cells: a line that reaches behind the camera is clipped, and software WebGL (SwiftShader)
+// drops such a line whole, so a grid of whole lines lost every line running away from the camera
+function groundGrid(size, cell, colour) {
+  const lines = Math.max(1, Math.round(size / cell)), half = (lines * cell) / 2, piece = 5 * cell, points = [];
+  for (let k = 0; k <= lines; ++k) {
+    const across = -half + k * cell;
+    for (let along = -half; along < half - 1e-9; along += piece) {
+      const to = Math.min(half, along + piece);
+      points.push(along, across, 0, to, across, 0, across, along, 0, across, to, 0);
+    }
+  }
+  const geometry = new THREE.BufferGeometry();
+  geometry.setAttribute("position", new THREE.Float32BufferAttribute(points, 3));
+  const grid = new THREE.LineSegments(geometry, new THREE.LineBasicMaterial({ color: colour }));
+  grid.userData.grid = true;
+  return grid;
+}
+
 const built = [];  // what the last scene message added
 function buildScene(msg) {
   for (const object of built) scene.remove(object);
@@ -134,20 +153,26 @@ function buildScene(msg) {
   for (const shape of msg.world) {
     for (const g of geometries(shape)) {
       const mesh = new THREE.Mesh(g, material(shape));
+      if (shape.kind === "plane") {  // (drawn a little behind its grid's lines, which would flicker into it)
+        mesh.material.polygonOffset = true;
+        mesh.material.polygonOffsetFactor = 2;
+        mesh.material.polygonOffsetUnits = 2;
+      }
       mesh.applyMatrix(poseMatrix(shape.pose));
       add(mesh);
     }
     if (shape.kind === "plane") {
-      // the ground's grid, to judge heights and distances by: 1 m cells, or 10 m, ... on a larger
-      // ground (at most 100 lines each way); darker where the scene asks for it (<ground grid="true">)
+      // the ground's grid, to judge heights and distances by (as the snapshots draw it): 1 m cells
+      // over the middle 100 m, and 10 m cells (or 100 m, ...) over the rest of a larger ground
       const size = Math.max(shape.size[0], shape.size[1]);
-      const cell = 10 ** Math.max(0, Math.ceil(Math.log10(size / 100)));
-      const grid = shape.grid ? new THREE.GridHelper(size, Math.max(1, Math.round(size / cell)), 0x555555, 0x777777)
-                              : new THREE.GridHelper(size, Math.max(1, Math.round(size / cell)), 0x7a7a7a, 0x8c8c8c);
-      grid.rotateX(Math.PI / 2);
-      grid.applyMatrix(poseMatrix(shape.pose));
-      grid.position.z += 0.002;
-      add(grid);
+      const [fine, coarse] = shape.grid ? [0x5f5f5f, 0x4a4a4a] : [0x6a6a6a, 0x555555];
+      const grids = [groundGrid(Math.min(size, 100), 1, fine)];
+      if (size > 100) grids.push(groundGrid(size, Math.max(10, 10 ** Math.ceil(Math.log10(size / 100))), coarse));
+      for (const grid of grids) {
+        grid.applyMatrix(poseMatrix(shape.pose));
+        grid.position.z += 0.002;
+        add(grid);
+      }
     }
   }
   state.bodies = msg.bodies;

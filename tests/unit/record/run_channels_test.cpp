@@ -58,3 +58,26 @@ TEST_CASE("run channels: the scene in each robot's frame, its sensors and its co
   CHECK(timing.rfind(R"({"step":41,"contacts":3,"total_ms":2.5,)", 0) == 0);
   CHECK(count(timing, R"("late_ms":0})") == 1);
 }
+
+TEST_CASE("run channels: the contacts of a step, taken and written later", "[record][foxglove]") {
+  Scene scene = loadSceneFromString(R"(<scene><environment timestep="0.002" seed="1" threads="1"/><type name="b" file="box.xml"/>
+    <ground/><artifact name="crate" type="b" xyz="0 0 0.3"/></scene>)",
+                                    "crate.xml", kArtifacts, testOptions());
+  Environment& env = *scene.environment;
+  env.recordContacts(true);
+  env.step(1000);  // 2 s: it fell and rests on the ground
+  detail::RunSample sample;
+  sample.takeContacts(env);
+  const std::vector<EngineContact> resting = env.contacts();
+  REQUIRE(resting.size() == 1);
+  env.step(1);
+  // written after a further step: what was taken, not what the world has now
+  const std::string json = sample.contactsJson(env);
+  CHECK(json.rfind(R"({"contacts":[{"a":"crate","b":"ground","position":[)", 0) == 0);
+  CHECK(count(json, R"("normal":[0,0,1])") == 1);
+  // the impulse over the step holds the crate up: its weight times the step
+  const auto at = json.find(R"("impulse":)");
+  REQUIRE(at != std::string::npos);
+  CHECK(std::stod(json.substr(at + 10)) == Approx(resting[0].impulse));
+  CHECK(resting[0].impulse > 0);
+}

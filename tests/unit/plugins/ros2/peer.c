@@ -43,7 +43,8 @@
  *                                        success once q0 went 2 W R m ahead (within 15 %) and stood,
  *                                        its joint states showing the wheels at W mid-drive (mean
  *                                        within 10 %)
- *   --vanish-after S                     (with any) ends the process abruptly after S wall seconds
+ *   --vanish-after S                     (with any) ends the process abruptly S wall seconds after the
+ *                                        first odometry came (once connected: discovery can be slow)
  *
  * Exit 0 on success, 1 with a message otherwise. */
 #include "ros2_messages.h"
@@ -317,11 +318,12 @@ int main(int argc, char** argv) {
   int types_checked = 0;
   unsigned seed = 12345;
   const double started = wall();
+  double connected = -1; /* when the first odometry came */
   void* samples[1] = {NULL};
   dds_sample_info_t info[1];
   for (;;) {
     const double now = wall();
-    if (vanish > 0 && now - started > vanish) _exit(0); /* as a crashed controller: no goodbye */
+    if (vanish > 0 && connected > 0 && now - connected > vanish) _exit(0); /* as a crashed controller: no goodbye */
     if (now - started > timeout) {
       if (!bench) fail("timed out");
       break;
@@ -348,6 +350,7 @@ int main(int argc, char** argv) {
           }
           latest_t[i] = t;
           ++odom_messages;
+          if (connected < 0) connected = wall();
           ++per_robot[i];
           last_odom_wall = wall();
           const double x = m->pose.pose.position.x, y = m->pose.pose.position.y, z = m->pose.pose.position.z;

@@ -65,10 +65,20 @@ try:
                         f"connected: the run did not wait for it")
     wait_until(page, "return window.ssxViewer.state.time", lambda v: v is not None and v > 1.5, problems)
 
-    # the ground's grid
-    grids = page.execute_script("return window.ssxViewer.scene.children.filter((c) => c.type === 'GridHelper').length")
-    if grids < 1:
-        problems.append("no grid on the ground")
+    # the ground's grid: drawn, lines both ways (seen from above, away from the robots: a point on a
+    # line along x and one on a line along y are darker than the middle of a cell)
+    grids = page.execute_script("return window.ssxViewer.scene.children.filter((c) => c.userData.grid).length")
+    shades = page.execute_script("""const v = window.ssxViewer;
+      v.controls.target.set(20, 20, 0); v.camera.position.set(20.01, 16, 6); v.controls.update(); v.draw();
+      const at = (x, y) => { const p = new THREE.Vector3(x, y, 0).project(v.camera);
+        return [((p.x + 1) / 2) * window.innerWidth, ((1 - p.y) / 2) * window.innerHeight]; };
+      const darkest = (x, y) => { const [u, w] = at(x, y); let low = 255;
+        for (let i = -1; i <= 1; ++i) for (let j = -1; j <= 1; ++j) low = Math.min(low, v.pixel(u + i, w + j)[1]); return low; };
+      return [darkest(20.5, 20), darkest(20, 20.5), v.pixel(...at(20.5, 20.5))[1]];""")
+    if grids < 1 or not (shades[0] < shades[2] - 10 and shades[1] < shades[2] - 10):
+        problems.append(f"no grid on the ground both ways: {grids} grids, green on a line along x {shades[0]}, "
+                        f"along y {shades[1]}, in a cell {shades[2]}")
+    page.execute_script("document.getElementById('reset').click()")
 
     # a robot by name: selected, followed, ringed, labelled, plotted
     page.execute_script("const f = document.getElementById('find'); f.value = 'quad5';"
