@@ -144,7 +144,7 @@ TEST_CASE("a state restored again continues the same, and another that fails sti
   CHECK(env.stateHash() == hash);
 }
 
-TEST_CASE("format 7's checksum catches a changed word anywhere; format 6's states are still read", "[state]") {
+TEST_CASE("format 7's checksum catches a changed word anywhere, and format 6's states are still read", "[state]") {
   Scene scene = loadStateScene(2);
   Environment& env = *scene.environment;
   env.step(100);
