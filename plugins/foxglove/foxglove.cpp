@@ -190,6 +190,7 @@ class Foxglove final : public SimulationExtension {
     last_sim_ = toSeconds(env.time());
     const auto time = static_cast<std::uint64_t>(std::max<Nanoseconds>(0, env.time()));
     server_->publishTime(time);
+    if (!server_->anyWanted()) return;  // (nobody subscribed: nothing to copy, nothing to write)
 
     std::unique_ptr<Snapshot> s = takeSpare();
     s->time = env.time();
