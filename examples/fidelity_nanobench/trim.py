@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""Makes the trimmed copy of the NanoBench figure-eight flights kept in data/ from the dataset's own
+"""Makes the trimmed copy of the NanoBench flights kept in data/ from the dataset's own
 files (https://github.com/syediu/nanobench-iros2026, commit 0ae7d689, datasets/dataset/): the
 columns the Crazyflie check uses, time from the file's first row, and fewer digits than the
 source's nanometres (positions to 0.1 mm, voltages to 1 mV, angles to 0.01 degree). The
@@ -10,8 +10,30 @@ import csv
 import pathlib
 import sys
 
-FLIGHTS = ["B3_figure8_slow_rep1", "B3_figure8_slow_rep2", "B3_figure8_slow_rep3", "B3_figure8_fast_rep1",
-           "B3_figure8_fast_rep2"]
+FLIGHTS = [
+    "B10_lissajous_slow_rep1",
+    "B2_circle_fast_rep1",
+    "B2_circle_medium_rep1",
+    "B2_circle_slow_rep1",
+    "B3_figure8_fast_rep1",
+    "B3_figure8_fast_rep2",
+    "B3_figure8_slow_rep1",
+    "B3_figure8_slow_rep2",
+    "B3_figure8_slow_rep3",
+    "B5_helix_fast_rep1",
+    "B5_helix_medium_rep1",
+    "B5_helix_slow_rep1",
+    "B6_linear_ramp_rep1",
+    "B7_oval_fast_rep1",
+    "B7_oval_medium_rep1",
+    "B7_oval_slow_rep2",
+    "B8_star_fast_rep1",
+    "B8_star_medium_rep1",
+    "B8_star_slow_rep1",
+    "B9_trefoil_fast_rep1",
+    "B9_trefoil_medium_rep1",
+    "B9_trefoil_slow_rep1",
+]
 # (column in the source, column here, digits after the point)
 COLUMNS = [("px", "px", 4), ("py", "py", 4), ("pz", "pz", 4),
            ("vx", "vx", 3), ("vy", "vy", 3), ("vz", "vz", 3),

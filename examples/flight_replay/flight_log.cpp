@@ -6,16 +6,43 @@
 #include <array>
 #include <cerrno>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <fstream>
+#include <limits>
 #include <sstream>
 
 namespace ssx::flight {
 
 namespace {
 
-constexpr std::array<const char*, 12> kColumns = {"t",    "px",   "py",   "pz",   "roll",       "pitch",
-                                                  "yaw",  "sp_x", "sp_y", "sp_z", "cmd_thrust", "vbat"};
+// A column of Row: its name in the trimmed copies, its name in the dataset's own files, and
+// whether a log must have it.
+struct Column {
+  const char* name;
+  const char* source_name;
+  bool required;
+};
+constexpr std::array<Column, 18> kColumns = {{{"t", "t", true},
+                                              {"px", "px", true},
+                                              {"py", "py", true},
+                                              {"pz", "pz", true},
+                                              {"roll", "roll", true},
+                                              {"pitch", "pitch", true},
+                                              {"yaw", "yaw", true},
+                                              {"sp_x", "sp_ctrltarget_x", true},
+                                              {"sp_y", "sp_ctrltarget_y", true},
+                                              {"sp_z", "sp_ctrltarget_z", true},
+                                              {"cmd_thrust", "pid_controller_cmd_thrust", true},
+                                              {"vbat", "pwr_pm_vbat", true},
+                                              {"vz", "vz", false},
+                                              {"m1", "motor_motor_m1", false},
+                                              {"m2", "motor_motor_m2", false},
+                                              {"m3", "motor_motor_m3", false},
+                                              {"m4", "motor_motor_m4", false},
+                                              {"", "", false}}};  // an end mark
+constexpr std::size_t kUsed = kColumns.size() - 1;
+constexpr std::size_t kAbsent = static_cast<std::size_t>(-1);
 
 std::vector<std::string> split(const std::string& line) {
   std::vector<std::string> out;
@@ -39,30 +66,35 @@ Log readLog(const std::filesystem::path& file) {
   if (!std::getline(in, line)) throw errorAt(file, 1, "empty: a header row (t,px,py,pz,...) comes first");
   if (!line.empty() && line.back() == '\r') line.pop_back();
   const auto header = split(line);
-  std::array<std::size_t, kColumns.size()> at{};
-  for (std::size_t c = 0; c < kColumns.size(); ++c) {
-    const auto it = std::find(header.begin(), header.end(), kColumns[c]);
-    if (it == header.end())
-      throw errorAt(file, 1, std::string("no column '") + kColumns[c] +
-                                 "' in the header (a NanoBench log: t, px, py, pz, roll, pitch, yaw, sp_x, sp_y, sp_z, cmd_thrust, vbat)");
-    at[c] = static_cast<std::size_t>(it - header.begin());
+  std::array<std::size_t, kUsed> at{};
+  for (std::size_t c = 0; c < kUsed; ++c) {
+    auto it = std::find(header.begin(), header.end(), kColumns[c].name);
+    if (it == header.end()) it = std::find(header.begin(), header.end(), kColumns[c].source_name);
+    if (it == header.end() && kColumns[c].required)
+      throw errorAt(file, 1, std::string("no column '") + kColumns[c].name +
+                                 "' in the header (a NanoBench log: t, px, py, pz, roll, pitch, yaw, sp_x, sp_y, sp_z, "
+                                 "cmd_thrust, vbat, as in the trimmed copies or as the dataset names them)");
+    at[c] = it == header.end() ? kAbsent : static_cast<std::size_t>(it - header.begin());
   }
   Log log;
   for (std::size_t number = 2; std::getline(in, line); ++number) {
     if (!line.empty() && line.back() == '\r') line.pop_back();
     if (line.empty()) continue;
     const auto cells = split(line);
-    std::array<double, kColumns.size()> v{};
-    for (std::size_t c = 0; c < kColumns.size(); ++c) {
-      if (at[c] >= cells.size()) throw errorAt(file, number, std::string("no value for '") + kColumns[c] + "'");
+    std::array<double, kUsed> v{};
+    for (std::size_t c = 0; c < kUsed; ++c) {
+      v[c] = std::numeric_limits<double>::quiet_NaN();
+      if (at[c] == kAbsent) continue;
+      if (at[c] >= cells.size()) throw errorAt(file, number, std::string("no value for '") + kColumns[c].name + "'");
       const std::string& cell = cells[at[c]];
       char* end = nullptr;
       errno = 0;
       v[c] = std::strtod(cell.c_str(), &end);
       if (cell.empty() || end != cell.c_str() + cell.size() || errno != 0 || !std::isfinite(v[c]))
-        throw errorAt(file, number, std::string("'") + kColumns[c] + "' is '" + cell + "', not a finite number");
+        throw errorAt(file, number, std::string("'") + kColumns[c].name + "' is '" + cell + "', not a finite number");
     }
-    const Row r{v[0], v[1], v[2], v[3], v[4], v[5], v[6], v[7], v[8], v[9], v[10], v[11]};
+    const Row r{v[0], v[1], v[2],  v[3],  v[4], v[5], v[6], v[7], v[8], v[9], v[10], v[11],
+                v[12], {v[13], v[14], v[15], v[16]}};
     if (!log.rows.empty() && !(r.t > log.rows.back().t))
       throw errorAt(file, number, "t does not increase (" + std::to_string(r.t) + " s after " +
                                       std::to_string(log.rows.back().t) + " s)");
@@ -102,10 +134,49 @@ double cruiseThrustCommand(const Log& log, const Segment& flight, const std::str
     if (std::abs(r.sp_z - cruise) <= 0.01 && r.pz > cruise / 2 && r.cmd_thrust > 0)
       up.push_back(r.cmd_thrust * std::cos(r.roll) * std::cos(r.pitch));
   }
-  if (up.size() < 100)
-    throw Error(label + ": error: fewer than 100 rows (1 s) of flight at cruise altitude (" + std::to_string(cruise) +
-                " m): give the take-off mass with --mass KG");
+  if (up.size() < 100 || up.size() < (flight.last + 1 - flight.first) / 2)
+    throw Error(label + ": error: " + std::to_string(up.size()) + " rows of level flight at cruise altitude (" +
+                std::to_string(cruise) + " m): fewer than 100 (1 s) or than half the flight's; give the take-off mass with --mass KG");
   return median(up, 0, up.size());
+}
+
+MassEstimate identifyMass(const Log& log, const Segment& flight, const std::string& label) {
+  constexpr double kGravity = 9.81, kThrustMax = 0.12;
+  const auto& rows = log.rows;
+  try {
+    const double u = cruiseThrustCommand(log, flight, label);
+    char how[160];
+    std::snprintf(how, sizeof how, "thrust command %.0f in level flight", u);
+    return {4 * kThrustMax * u / 65535.0 / kGravity, how};
+  } catch (const Error&) {
+    // no level flight: the vertical force balance over the whole flight, below
+  }
+  // the propellers' thrust-voltage curve (the firmware's 2.1+ set, as the crazyflie preset's)
+  auto thrust = [](double volts) { return -0.024765 + volts * (0.065238 + volts * (-0.026793 + volts * 0.0067768)); };
+  const double rest = rows[flight.first].pz;
+  constexpr std::size_t kHalf = 10;  // rows either side for the vertical acceleration (0.1 s at 100 Hz)
+  std::vector<double> masses;
+  for (std::size_t i = std::max(flight.first, kHalf); i <= flight.last && i + kHalf < rows.size(); ++i) {
+    const Row& r = rows[i];
+    if (!(r.pz > rest + 0.1) || !std::isfinite(r.vz)) continue;
+    double up = 0;
+    bool motors = true;
+    for (const double pwm : r.motor) {
+      if (!std::isfinite(pwm)) motors = false;
+      if (pwm > 0) up += thrust(pwm / 65535.0 * r.vbat);
+    }
+    const double az = (rows[i + kHalf].vz - rows[i - kHalf].vz) / (rows[i + kHalf].t - rows[i - kHalf].t);
+    if (!motors || !std::isfinite(az) || up <= 0) continue;
+    masses.push_back(up * std::cos(r.roll) * std::cos(r.pitch) / (kGravity + az));
+  }
+  if (masses.size() < 100)
+    throw Error(label + ": error: the take-off mass cannot be found: fewer than 1 s of level flight at cruise "
+                        "altitude, and fewer than 100 rows 0.1 m above the ground with vz and the motors' m1-m4 "
+                        "logged: give it with --mass KG");
+  char how[160];
+  std::snprintf(how, sizeof how, "motors' thrust over %zu airborne rows against g + the vertical acceleration",
+                masses.size());
+  return {median(masses, 0, masses.size()), how};
 }
 
 }  // namespace ssx::flight

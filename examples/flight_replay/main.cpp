@@ -9,10 +9,11 @@
 // last such set-point.
 //
 // Identified from the log, and printed (nothing is fitted to the tracking error):
-// - the take-off mass: the thrust command that holds the vehicle up in level flight at cruise
-//   altitude (the median of the command times the cosine of roll and of pitch), through the
-//   firmware's thrust model (u / 65535 x 0.12 N a motor): m = 4 x 0.12 u / 65535 / g (--mass KG
-//   instead gives it);
+// - the take-off mass (flight_log.hpp, identifyMass): the thrust command that holds the vehicle up
+//   in level flight at cruise altitude through the firmware's thrust model (u / 65535 x 0.12 N a
+//   motor), m = 4 x 0.12 u / 65535 / g; a flight without 1 s of level flight (helix, trefoil, ramp):
+//   the motors' thrust against g plus the vertical acceleration over the whole airborne flight
+//   (--mass KG instead gives it);
 // - the battery voltage the firmware's compensation sees: the median logged voltage in flight;
 // - the vertical offset between the log's tracked point (motion-capture markers) and the
 //   simulated centre of mass: the log's height at rest minus the simulated vehicle's.
@@ -40,8 +41,6 @@
 namespace fs = std::filesystem;
 
 namespace {
-
-constexpr double kGravity = 9.81;
 
 // roll, pitch, yaw (rad; z-y-x) of an orientation
 ssx::Vec3 rollPitchYaw(const ssx::Quat& q) {
@@ -114,12 +113,13 @@ class ArtifactCopy {
 int replay(const Options& o) {
   const ssx::flight::Log log = ssx::flight::readLog(o.log);
   const ssx::flight::Segment flight = ssx::flight::findFlight(log, o.log.string());
-  const double hover = ssx::flight::cruiseThrustCommand(log, flight, o.log.string());
-  const double mass = o.mass > 0 ? o.mass : 4 * 0.12 * hover / 65535.0 / kGravity;
+  const ssx::flight::MassEstimate found =
+      o.mass > 0 ? ssx::flight::MassEstimate{o.mass, "given: --mass"} : ssx::flight::identifyMass(log, flight, o.log.string());
+  const double mass = found.kg;
   const double volts = ssx::flight::median(log.vbat, flight.first, flight.last + 1);
   const auto& start = log.rows[flight.first];
-  std::printf("flight %.2f-%.2f s; thrust command %.0f in level flight: take-off mass %.1f g%s; battery %.3f V\n",
-              start.t, log.rows[flight.last].t, hover, mass * 1e3, o.mass > 0 ? " (given: --mass)" : "", volts);
+  std::printf("flight %.2f-%.2f s; %s: take-off mass %.1f g; battery %.3f V\n", start.t - log.rows.front().t,
+              log.rows[flight.last].t - log.rows.front().t, found.how.c_str(), mass * 1e3, volts);
 
   ArtifactCopy copy(o, mass);
   // the vehicle rests where the log's stands: its centre of mass at rest height, on the log's x, y and yaw
