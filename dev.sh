@@ -109,10 +109,11 @@ case "${1:-}" in
     # for a simulated minute, 70 quadrotors forming a sphere: 22 of the 36 minutes of test time the
     # suite takes under ASan) run in the plain build only; the code they run (ground robots,
     # joints, formations, both engines) runs here in the shorter tests. So do the Crazyflie replay
-    # sweep and the fidelity ablation (174 s and 50 s under ASan): the same replay and flights as the
-    # crazyflie_flight_replay_matches_docs_* and fidelity_eight_matches_readme_* tests run here
+    # sweep and ablation, the replay on Bullet (22 flights) and the fidelity ablation: the same
+    # replay and flights as the crazyflie_flight_replay_matches_docs_ode and
+    # fidelity_eight_matches_readme_* tests run here
     ctest --test-dir build-asan -j "$jobs" --output-on-failure \
-      -E '^install_and_consume$|memory running out while loading|^ground scenarios: (diffusion|aggregation|foraging):|quadrotors (from random starts )?form the sphere|^crazyflie_flight_replay_sweep_matches_docs$|^fidelity_eight_ablation_lines$'
+      -E '^install_and_consume$|memory running out while loading|^ground scenarios: (diffusion|aggregation|foraging):|quadrotors (from random starts )?form the sphere|^crazyflie_flight_replay_(sweep|ablation)_matches_docs$|^crazyflie_flight_replay_matches_docs_bullet$|^fidelity_eight_ablation_lines$'
     tests/fuzz/run.sh build-asan "${FUZZ_SECONDS:-60}"
     cmake -S . -B build-tsan -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DSSX_SANITIZE=thread \
       -DSSX_BUILD_EXAMPLES=OFF -DSSX_WITH_ROS1=OFF -DSSX_WARNINGS_AS_ERRORS="${SSX_WARNINGS_AS_ERRORS:-OFF}" \

@@ -140,16 +140,19 @@ double cruiseThrustCommand(const Log& log, const Segment& flight, const std::str
   return median(up, 0, up.size());
 }
 
-MassEstimate identifyMass(const Log& log, const Segment& flight, const std::string& label) {
+MassEstimate identifyMass(const Log& log, const Segment& flight, const std::string& label, const std::string& method) {
   constexpr double kGravity = 9.81, kThrustMax = 0.12;
   const auto& rows = log.rows;
-  try {
-    const double u = cruiseThrustCommand(log, flight, label);
-    char how[160];
-    std::snprintf(how, sizeof how, "thrust command %.0f in level flight", u);
-    return {4 * kThrustMax * u / 65535.0 / kGravity, how};
-  } catch (const Error&) {
-    // no level flight: the vertical force balance over the whole flight, below
+  if (method != "balance") {
+    try {
+      const double u = cruiseThrustCommand(log, flight, label);
+      char how[160];
+      std::snprintf(how, sizeof how, "thrust command %.0f in level flight", u);
+      return {4 * kThrustMax * u / 65535.0 / kGravity, how};
+    } catch (const Error&) {
+      if (method == "cruise") throw;
+      // no level flight: the vertical force balance over the whole flight, below
+    }
   }
   // the propellers' thrust-voltage curve (the firmware's 2.1+ set, as the crazyflie preset's)
   auto thrust = [](double volts) { return -0.024765 + volts * (0.065238 + volts * (-0.026793 + volts * 0.0067768)); };

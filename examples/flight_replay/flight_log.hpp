@@ -60,7 +60,9 @@ struct MassEstimate {
 ///   cosine of roll and pitch, over g plus the vertical acceleration (the logged vz differentiated
 ///   over 0.2 s). It needs vz and the motors, and 100 such rows.
 /// ssx::Error naming `label` when neither is possible (say --mass KG).
-MassEstimate identifyMass(const Log& log, const Segment& flight, const std::string& label);
+/// `method`: "auto" (as above), "cruise" or "balance" (only that one; an error if it cannot).
+MassEstimate identifyMass(const Log& log, const Segment& flight, const std::string& label,
+                          const std::string& method = "auto");
 
 /// The median of values[first, last).
 double median(const std::vector<double>& values, std::size_t first, std::size_t last);

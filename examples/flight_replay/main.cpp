@@ -18,7 +18,7 @@
 // - the vertical offset between the log's tracked point (motion-capture markers) and the
 //   simulated centre of mass: the log's height at rest minus the simulated vehicle's.
 //
-// usage: ssx_flight_replay LOG.csv --out SIM.csv [--mass KG] [--physics ode|bullet]
+// usage: ssx_flight_replay LOG.csv --out SIM.csv [--mass KG | --mass-from auto|cruise|balance] [--physics ode|bullet]
 //                          [--artifact FILE] [--inertia-scale S] [--driver KEY=VALUE]... [--sensor KEY=VALUE]...
 // --driver and --sensor set the crazyflie's driver and pose-sensor parameters (the sweep over
 // unpublished values: time_constant_up=..., delay=...); --artifact flies another artifact file.
@@ -52,6 +52,7 @@ ssx::Vec3 rollPitchYaw(const ssx::Quat& q) {
 struct Options {
   fs::path log, out, artifact;
   double mass = 0;  // 0: from the log
+  std::string mass_from = "auto";
   double inertia_scale = 1;
   std::string physics;
   std::vector<std::string> driver, sensor;
@@ -114,7 +115,7 @@ int replay(const Options& o) {
   const ssx::flight::Log log = ssx::flight::readLog(o.log);
   const ssx::flight::Segment flight = ssx::flight::findFlight(log, o.log.string());
   const ssx::flight::MassEstimate found =
-      o.mass > 0 ? ssx::flight::MassEstimate{o.mass, "given: --mass"} : ssx::flight::identifyMass(log, flight, o.log.string());
+      o.mass > 0 ? ssx::flight::MassEstimate{o.mass, "given: --mass"} : ssx::flight::identifyMass(log, flight, o.log.string(), o.mass_from);
   const double mass = found.kg;
   const double volts = ssx::flight::median(log.vbat, flight.first, flight.last + 1);
   const auto& start = log.rows[flight.first];
@@ -181,6 +182,9 @@ int main(int argc, char** argv) {
   app.add_option("--out", o.out, "the simulated flight: t,px,py,pz,sp_x,sp_y,sp_z,vx,vy,vz,roll,pitch,yaw")->required();
   app.add_option("--mass", o.mass, "take-off mass, kg (default: from the log's hover thrust)")
       ->check(CLI::Range(0.005, 0.2));
+  app.add_option("--mass-from", o.mass_from,
+                 "how the mass is found: auto (level flight, else the force balance), cruise or balance")
+      ->check(CLI::IsMember({"auto", "cruise", "balance"}));
   app.add_option("--inertia-scale", o.inertia_scale, "the vehicle's inertia times this (a guess's range)")
       ->check(CLI::Range(0.25, 4.0));
   app.add_option("--physics", o.physics, "physics engine")->check(CLI::IsMember({"ode", "bullet"}));
