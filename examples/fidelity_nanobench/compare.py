@@ -179,7 +179,19 @@ ABLATION = [
      ["--driver", "rotor_drag_coefficient=2.0e-6"]),
     ("no rotor drag", ["--driver", "rotor_drag_coefficient=0"]),
     ("motion capture to controller latency 0.02 s", ["--sensor", "delay=0.02"]),
+    ("the logged battery voltage row by row (its sag under load and over the flight)", ["--battery", "log"]),
 ]
+
+
+def motors_saturated(path):
+    """(share of the airborne rows (above 0.3 m) with a motor at full PWM, the battery's 5th and
+    95th percentile there), from a real log."""
+    d = np.genfromtxt(path, delimiter=",", names=True, usecols=("pz", "m1", "m2", "m3", "m4", "vbat"))
+    air = d["pz"] > 0.3
+    if not air.any():
+        return float("nan"), float("nan"), float("nan")
+    top = np.max(np.stack([d[m][air] for m in ("m1", "m2", "m3", "m4")], 1), axis=1)
+    return float(np.mean(top >= 65000)), *np.percentile(d["vbat"][air], [5, 95])
 
 
 def ablation(program, flights, out_dir, extra):
@@ -192,6 +204,15 @@ def ablation(program, flights, out_dir, extra):
         drag = round(float(np.median([r["sim"]["drag"] for r in rows])), 2) or 0.0  # -0.0 is falsy: no "-0.00"
         lines.append(f"| {label} | " + " | ".join(f"{n} of {len(rows)}" for n in counts) +
                      f" | {min(lags):.2f}-{max(lags):.2f} | {drag:.2f} |")
+        if not args:
+            published = rows
+    # the real flights that lag most, and their motors and batteries
+    lines += ["", "| flight (the eight real flights that lag most) | real lag (s) | simulated lag (s) | real motors at full PWM | real battery in flight (V, 5-95 %) |",
+              "|---|---|---|---|---|"]
+    data = flights[0].parent
+    for r in sorted(published, key=lambda r: -r["real"]["lag_s"])[:8]:
+        share, low, high = motors_saturated(data / f"{r['flight']}.csv")
+        lines.append(f"| {r['flight']} | {r['real']['lag_s']:.2f} | {r['sim']['lag_s']:.2f} | {100 * share:.1f} % | {low:.2f}-{high:.2f} |")
     return "\n".join(lines)
 
 

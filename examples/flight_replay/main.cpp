@@ -18,7 +18,8 @@
 // - the vertical offset between the log's tracked point (motion-capture markers) and the
 //   simulated centre of mass: the log's height at rest minus the simulated vehicle's.
 //
-// usage: ssx_flight_replay LOG.csv --out SIM.csv [--mass KG | --mass-from auto|cruise|balance] [--physics ode|bullet]
+// usage: ssx_flight_replay LOG.csv --out SIM.csv [--mass KG | --mass-from auto|cruise|balance]
+//                          [--battery median|log] [--physics ode|bullet]
 //                          [--artifact FILE] [--inertia-scale S] [--driver KEY=VALUE]... [--sensor KEY=VALUE]...
 // --driver and --sensor set the crazyflie's driver and pose-sensor parameters (the sweep over
 // unpublished values: time_constant_up=..., delay=...); --artifact flies another artifact file.
@@ -53,6 +54,7 @@ struct Options {
   fs::path log, out, artifact;
   double mass = 0;  // 0: from the log
   std::string mass_from = "auto";
+  std::string battery = "median";  // or "log": the logged voltage row by row
   double inertia_scale = 1;
   std::string physics;
   std::vector<std::string> driver, sensor;
@@ -123,6 +125,7 @@ int replay(const Options& o) {
               log.rows[flight.last].t - log.rows.front().t, found.how.c_str(), mass * 1e3, volts);
 
   ArtifactCopy copy(o, mass);
+  const double battery_volts = std::clamp(volts, 2.0, 4.35);
   // the vehicle rests where the log's stands: its centre of mass at rest height, on the log's x, y and yaw
   const double rest_z = 0.01;  // the installed crazyflie's box, 0.02 m high
   std::string xml = "<scene><environment timestep=\"0.002\" seed=\"1\"/>";
@@ -131,7 +134,7 @@ int replay(const Options& o) {
   std::snprintf(place, sizeof place,
                 "<type name=\"cf\" file=\"vehicle.xml\"/><ground/><artifact name=\"cf\" type=\"cf\" xyz=\"%.6f %.6f %.6f\" "
                 "rpy=\"0 0 %.6f\"><driver crazyflie_battery_volts=\"%.4f\"/></artifact></scene>",
-                start.px, start.py, rest_z, start.yaw, std::clamp(volts, 2.0, 4.35));
+                start.px, start.py, rest_z, start.yaw, battery_volts);
   xml += place;
   ssx::Scene scene = ssx::loadSceneFromString(xml, o.log.string(), copy.dir());
   for (const auto& w : scene.warnings) std::fprintf(stderr, "%s\n", w.str().c_str());
@@ -159,6 +162,7 @@ int replay(const Options& o) {
     sp.position = ssx::Vec3(r.sp_x, r.sp_y, r.sp_z - z_offset);
     sp.yaw = start.yaw;
     input->setSetpoint(sp);
+    if (o.battery == "log") env.vary(cf, "battery_volts", std::clamp(r.vbat - battery_volts, -2.0, 0.5));
     const ssx::BodyState& s = cf.state();
     const ssx::Vec3 rpy = rollPitchYaw(s.pose.orientation);
     char line[400];
@@ -185,6 +189,10 @@ int main(int argc, char** argv) {
   app.add_option("--mass-from", o.mass_from,
                  "how the mass is found: auto (level flight, else the force balance), cruise or balance")
       ->check(CLI::IsMember({"auto", "cruise", "balance"}));
+  app.add_option("--battery", o.battery,
+                 "the battery voltage the firmware and the motors get: median (the flight's median, held) or log "
+                 "(the logged voltage row by row: its sag under load and over the flight)")
+      ->check(CLI::IsMember({"median", "log"}));
   app.add_option("--inertia-scale", o.inertia_scale, "the vehicle's inertia times this (a guess's range)")
       ->check(CLI::Range(0.25, 4.0));
   app.add_option("--physics", o.physics, "physics engine")->check(CLI::IsMember({"ode", "bullet"}));
