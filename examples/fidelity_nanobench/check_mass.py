@@ -97,6 +97,19 @@ for name, changes in (("B6_linear_ramp_rep1", True), ("B3_figure8_fast_rep2", Fa
         print(f"{name}: the logged voltage row by row moves the flight by up to {worst * 1e3:.2f} mm")
         if (worst > 1e-3) != changes:
             problems.append(f"{name}: --battery log moved it by {worst} m; expected {'a change' if changes else 'none'}")
+# --rotor-factors log: the fast eight on its weak battery, whose motor 1 carried 0.77 of the mean and
+# motor 4 1.2 of it (1 / share each), flies with them
+run = subprocess.run([program, str(data / "B3_figure8_fast_rep2.csv"), "--out", str(work / "factors.csv"),
+                      "--rotor-factors", "log"], capture_output=True, text=True)
+factors = re.search(r"rotor thrust factors ([\d.]+) ([\d.]+) ([\d.]+) ([\d.]+)", run.stdout)
+if run.returncode != 0 or not factors:
+    problems.append(f"--rotor-factors log: {run.stdout} {run.stderr}")
+else:
+    k = [float(x) for x in factors.groups()]
+    flown = np.genfromtxt(work / "factors.csv", delimiter=",", names=True)
+    print(f"B3_figure8_fast_rep2: rotor thrust factors {k}, flown up to {flown['pz'].max():.3f} m")
+    if not (k[0] > 1.2 and k[3] < 0.9 and abs(np.mean([1 / x for x in k]) - 1) < 1e-3) or flown["pz"].max() > 1.5:
+        problems.append(f"--rotor-factors log: factors {k}, highest {flown['pz'].max()} m")
 print("\n".join(problems) if problems else "both ways of finding the mass agree; the dataset's own files are read; "
-      "the logged voltage changes what it should")
+      "the logged voltage and the rotors' factors do what they should")
 sys.exit(1 if problems else 0)

@@ -180,6 +180,7 @@ ABLATION = [
     ("no rotor drag", ["--driver", "rotor_drag_coefficient=0"]),
     ("motion capture to controller latency 0.02 s", ["--sensor", "delay=0.02"]),
     ("the logged battery voltage row by row (its sag under load and over the flight)", ["--battery", "log"]),
+    ("each rotor's thrust factor from the motors' shares in the log", ["--rotor-factors", "log"]),
 ]
 
 

@@ -140,6 +140,38 @@ double cruiseThrustCommand(const Log& log, const Segment& flight, const std::str
   return median(up, 0, up.size());
 }
 
+namespace {
+
+// the propellers' thrust-voltage curve (the firmware's 2.1+ set, as the crazyflie preset's), N
+double propellerThrust(double volts) {
+  return -0.024765 + volts * (0.065238 + volts * (-0.026793 + volts * 0.0067768));
+}
+
+}  // namespace
+
+std::array<double, 4> rotorThrustFactors(const Log& log, const Segment& flight, const std::string& label) {
+  const auto& rows = log.rows;
+  const double rest = rows[flight.first].pz;
+  std::array<double, 4> sum{};
+  std::size_t n = 0;
+  for (std::size_t i = flight.first; i <= flight.last; ++i) {
+    const Row& r = rows[i];
+    if (!(r.pz > rest + 0.1)) continue;
+    bool usable = true;
+    for (const double pwm : r.motor) usable = usable && std::isfinite(pwm) && pwm > 0 && pwm < 65000;
+    if (!usable) continue;
+    for (std::size_t k = 0; k < 4; ++k) sum[k] += propellerThrust(r.motor[k] / 65535.0 * r.vbat);
+    ++n;
+  }
+  if (n < 100)
+    throw Error(label + ": error: the motors' shares cannot be found: fewer than 100 rows 0.1 m above the ground with "
+                        "m1-m4 logged and none at full PWM");
+  const double mean = (sum[0] + sum[1] + sum[2] + sum[3]) / 4;
+  std::array<double, 4> factors{};
+  for (std::size_t k = 0; k < 4; ++k) factors[k] = mean / sum[k];
+  return factors;
+}
+
 MassEstimate identifyMass(const Log& log, const Segment& flight, const std::string& label, const std::string& method) {
   constexpr double kGravity = 9.81, kThrustMax = 0.12;
   const auto& rows = log.rows;
@@ -154,8 +186,6 @@ MassEstimate identifyMass(const Log& log, const Segment& flight, const std::stri
       // no level flight: the vertical force balance over the whole flight, below
     }
   }
-  // the propellers' thrust-voltage curve (the firmware's 2.1+ set, as the crazyflie preset's)
-  auto thrust = [](double volts) { return -0.024765 + volts * (0.065238 + volts * (-0.026793 + volts * 0.0067768)); };
   const double rest = rows[flight.first].pz;
   constexpr std::size_t kHalf = 10;  // rows either side for the vertical acceleration (0.1 s at 100 Hz)
   std::vector<double> masses;
@@ -166,7 +196,7 @@ MassEstimate identifyMass(const Log& log, const Segment& flight, const std::stri
     bool motors = true;
     for (const double pwm : r.motor) {
       if (!std::isfinite(pwm)) motors = false;
-      if (pwm > 0) up += thrust(pwm / 65535.0 * r.vbat);
+      if (pwm > 0) up += propellerThrust(pwm / 65535.0 * r.vbat);
     }
     const double az = (rows[i + kHalf].vz - rows[i - kHalf].vz) / (rows[i + kHalf].t - rows[i - kHalf].t);
     if (!motors || !std::isfinite(az) || up <= 0) continue;

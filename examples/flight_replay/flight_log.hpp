@@ -1,6 +1,7 @@
 #pragma once
 // A real flight's log in NanoBench's format (examples/fidelity_nanobench/data/README.md), read and
 // checked, and what ssx_flight_replay finds in it.
+#include <array>
 #include <cstddef>
 #include <filesystem>
 #include <string>
@@ -63,6 +64,15 @@ struct MassEstimate {
 /// `method`: "auto" (as above), "cruise" or "balance" (only that one; an error if it cannot).
 MassEstimate identifyMass(const Log& log, const Segment& flight, const std::string& label,
                           const std::string& method = "auto");
+
+/// How unevenly the real vehicle's motors carried it, as rotor thrust factors for a symmetric
+/// model: each motor's mean thrust over the airborne rows (0.1 m above the resting height, no motor
+/// at full PWM), from its PWM and the logged voltage through the propellers' curve, as a share s_i
+/// of the four's mean; the factor is 1 / s_i. A rotor that gives 1 / s_i of the model's thrust
+/// needs s_i times the mean command to carry its quarter, as the real one did (whether its
+/// propeller was weaker or the centre of mass sat off its centre). ssx::Error naming `label` without
+/// the motors or 100 such rows.
+std::array<double, 4> rotorThrustFactors(const Log& log, const Segment& flight, const std::string& label);
 
 /// The median of values[first, last).
 double median(const std::vector<double>& values, std::size_t first, std::size_t last);

@@ -19,7 +19,7 @@
 //   simulated centre of mass: the log's height at rest minus the simulated vehicle's.
 //
 // usage: ssx_flight_replay LOG.csv --out SIM.csv [--mass KG | --mass-from auto|cruise|balance]
-//                          [--battery median|log] [--physics ode|bullet]
+//                          [--battery median|log] [--rotor-factors none|log] [--physics ode|bullet]
 //                          [--artifact FILE] [--inertia-scale S] [--driver KEY=VALUE]... [--sensor KEY=VALUE]...
 // --driver and --sensor set the crazyflie's driver and pose-sensor parameters (the sweep over
 // unpublished values: time_constant_up=..., delay=...); --artifact flies another artifact file.
@@ -55,6 +55,7 @@ struct Options {
   double mass = 0;  // 0: from the log
   std::string mass_from = "auto";
   std::string battery = "median";  // or "log": the logged voltage row by row
+  std::string rotor_factors = "none";  // or "log": each rotor's thrust from the motors' shares
   double inertia_scale = 1;
   std::string physics;
   std::vector<std::string> driver, sensor;
@@ -124,7 +125,24 @@ int replay(const Options& o) {
   std::printf("flight %.2f-%.2f s; %s: take-off mass %.1f g; battery %.3f V\n", start.t - log.rows.front().t,
               log.rows[flight.last].t - log.rows.front().t, found.how.c_str(), mass * 1e3, volts);
 
-  ArtifactCopy copy(o, mass);
+  Options options = o;
+  if (o.rotor_factors == "log") {
+    try {
+      const auto k = ssx::flight::rotorThrustFactors(log, flight, o.log.string());
+      char factors[160];
+      std::snprintf(factors, sizeof factors, "%.4f %.4f %.4f %.4f", k[0], k[1], k[2], k[3]);
+      std::printf("rotor thrust factors %s (from the motors' shares)\n", factors);
+      options.driver.push_back(std::string("rotor_thrust_factors=") + factors);
+    } catch (const ssx::Error& e) {
+      // a flight whose motors were never below full PWM in the air (the ramp) has no shares to read:
+      // it flies as the others, and says so
+      std::string what = e.what();
+      const auto at = what.find("error: ");
+      if (at != std::string::npos) what.replace(at, 7, "warning: ");
+      std::fprintf(stderr, "%s; flown with even rotors\n", what.c_str());
+    }
+  }
+  ArtifactCopy copy(options, mass);
   const double battery_volts = std::clamp(volts, 2.0, 4.35);
   // the vehicle rests where the log's stands: its centre of mass at rest height, on the log's x, y and yaw
   const double rest_z = 0.01;  // the installed crazyflie's box, 0.02 m high
@@ -193,6 +211,10 @@ int main(int argc, char** argv) {
                  "the battery voltage the firmware and the motors get: median (the flight's median, held) or log "
                  "(the logged voltage row by row: its sag under load and over the flight)")
       ->check(CLI::IsMember({"median", "log"}));
+  app.add_option("--rotor-factors", o.rotor_factors,
+                 "none (the model's symmetric rotors) or log (each rotor's thrust factor from the motors' shares in the "
+                 "log: rotor_thrust_factors)")
+      ->check(CLI::IsMember({"none", "log"}));
   app.add_option("--inertia-scale", o.inertia_scale, "the vehicle's inertia times this (a guess's range)")
       ->check(CLI::Range(0.25, 4.0));
   app.add_option("--physics", o.physics, "physics engine")->check(CLI::IsMember({"ode", "bullet"}));

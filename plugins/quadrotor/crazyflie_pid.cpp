@@ -175,6 +175,29 @@ double CrazyfliePidController::motorThrust(double command) const {
   return std::max(0.0, curve_.thrust(pwm / 65535.0 * motor_volts_));
 }
 
+std::array<double, 4> CrazyfliePidController::motorThrusts() const {
+  const double battery = filter_.volts();
+  std::array<double, 4> out{};
+  const double highest = std::max({motors_[0], motors_[1], motors_[2], motors_[3]});
+  // the compensation reads the voltage the motors get and no PWM reaches the cap: each motor gives
+  // the thrust asked for (the same numbers as the PWMs below, without inverting the curve)
+  if (motor_volts_ == battery && battery >= 2.0 && highest / 65535.0 * curve_.thrust_max <= curve_.thrust(battery)) {
+    for (std::size_t i = 0; i < 4; ++i) {
+      const double newtons = std::max(motors_[i], 0.0) / 65535.0 * curve_.thrust_max;
+      out[i] = newtons < curve_.thrust_min ? 0.0 : newtons;
+    }
+    return out;
+  }
+  std::array<double, 4> pwm{};
+  for (std::size_t i = 0; i < 4; ++i) pwm[i] = curve_.uncappedPwm(motors_[i], battery);
+  const double excess = std::max(0.0, std::max({pwm[0], pwm[1], pwm[2], pwm[3]}) - 65535.0);
+  for (std::size_t i = 0; i < 4; ++i) {
+    const double capped = std::max(0.0, pwm[i] - excess);
+    out[i] = capped > 0 ? std::max(0.0, curve_.thrust(capped / 65535.0 * motor_volts_)) : 0.0;
+  }
+  return out;
+}
+
 void CrazyfliePidController::resetAll(double yaw_deg) {
   for (int k = 0; k < 3; ++k) pos_[k].reset(), vel_[k].reset(), att_[k].reset(), rate_[k].reset();
   yaw_target_deg_ = yaw_deg;
@@ -238,14 +261,9 @@ void CrazyfliePidController::attitudeLoop(FlightInputs& in) {
   const double yaw = rate_[2].update(rates_desired.z(), gyro.z(), dt);
   // the legacy mixer: half the roll and pitch outputs, truncated as the firmware's integers are
   const double r = std::trunc(roll / 2), p = std::trunc(pitch / 2), y = std::trunc(yaw);
-  double highest = 0;
-  for (std::size_t i = 0; i < 4; ++i) {
-    motors_[i] = thrust_ + signs_[i][0] * r + signs_[i][1] * p + signs_[i][2] * y;
-    highest = std::max(highest, motors_[i]);
-  }
-  // capped: the excess over the ceiling taken from every motor (the differential kept), then floored
-  const double excess = std::max(0.0, highest - 65535.0);
-  for (double& m : motors_) m = std::max(0.0, m - excess);
+  // not capped here: the firmware compensates each motor's command for the battery first and caps the
+  // PWMs (motorThrusts)
+  for (std::size_t i = 0; i < 4; ++i) motors_[i] = thrust_ + signs_[i][0] * r + signs_[i][1] * p + signs_[i][2] * y;
 }
 
 void CrazyfliePidController::step(std::int64_t run, double t, FlightInputs& in, std::span<double> speeds) {
@@ -258,7 +276,8 @@ void CrazyfliePidController::step(std::int64_t run, double t, FlightInputs& in, 
   }
   if (high_level && run % position_every_ == 0) positionLoop(t, in);
   if (run % attitude_every_ == 0) attitudeLoop(in);
-  for (std::size_t i = 0; i < 4 && i < speeds.size(); ++i) speeds[i] = std::sqrt(motorThrust(motors_[i]) / thrust_coefficient_);
+  const std::array<double, 4> thrusts = motorThrusts();
+  for (std::size_t i = 0; i < 4 && i < speeds.size(); ++i) speeds[i] = std::sqrt(thrusts[i] / thrust_coefficient_);
 }
 
 void CrazyfliePidController::saveState(StateWriter& out) const {

@@ -35,6 +35,12 @@ double CrazyflieThrustCurve::pwm(double u, double battery_volts) const {
   return std::min(65535.0, 65535.0 * volts(newtons) / battery_volts);
 }
 
+double CrazyflieThrustCurve::uncappedPwm(double u, double battery_volts) const {
+  const double newtons = std::max(u, 0.0) / 65535.0 * thrust_max;
+  if (newtons < thrust_min || battery_volts < 2.0) return 0;
+  return 65535.0 * volts(newtons) / battery_volts;
+}
+
 double CrazyflieThrustCurve::delivered(double u, double battery_volts) const {
   const double newtons = std::clamp(u, 0.0, 65535.0) / 65535.0 * thrust_max;
   if (newtons < thrust_min || battery_volts < 2.0) return 0;

@@ -31,6 +31,11 @@ struct CrazyflieThrustCurve {
   /// The PWM (0-65535, a real number as the firmware's float) for command `u` (0-65535) at the
   /// filtered battery voltage `battery_volts`: 0 below thrust_min or below 2 V, at most 65535.
   double pwm(double u, double battery_volts) const;
+  /// The PWM the firmware's compensation (motorsCompensateBatteryVoltage) makes of a motor's
+  /// command `u` before the cap: u is not capped at 65535 (the mixer's sums are not) and neither is
+  /// the PWM; 0 below thrust_min or below 2 V. The firmware caps the four PWMs together afterwards
+  /// (powerDistributionCap).
+  double uncappedPwm(double u, double battery_volts) const;
   /// The thrust per motor (N) for command `u` when the motors get the voltage the compensation
   /// reads, `battery_volts`: thrust(pwm(u, V) / 65535 V), which is the thrust asked for up to the
   /// whole battery's, thrust(V); computed so, without inverting the curve.

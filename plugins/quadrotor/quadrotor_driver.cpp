@@ -169,7 +169,7 @@ void QuadrotorDriver::configure(const Descriptor& params, PluginSetup& setup) {
   const auto frame = setup.shared<Airframe>(frame_key, [&] { return Airframe(c, params, a); });
 
   // the vehicle
-  vehicle_.configure(frame->rotor_model, -a.root().poseInBody().position, c.vehicle.battery);
+  vehicle_.configure(frame->rotor_model, -a.root().poseInBody().position, c.vehicle.battery, c.vehicle.thrust_factors);
   frame_ = frame;
   rotor_factors_.fill(1.0);
   wind_offset_.setZero();

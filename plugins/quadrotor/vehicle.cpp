@@ -1,6 +1,8 @@
 #include "vehicle.hpp"
 
+#include <algorithm>
 #include <sstream>
+#include <string>
 
 namespace ssx::quadrotor {
 
@@ -77,6 +79,22 @@ VehicleParams::VehicleParams(const Descriptor& params) : rotor(rotorParams(param
     directions.push_back(d == "1" ? 1 : -1);
   }
   if (params.get<bool>("battery")) battery = batteryParams(params);
+  const auto factors = words(params.get<std::string>("rotor_thrust_factors", ""));
+  if (!factors.empty() && factors.size() != names.size())
+    throw params.errorAt("rotor_thrust_factors", "give one factor per rotor (" + std::to_string(names.size()) +
+                                                     "), got " + std::to_string(factors.size()));
+  for (const auto& f : factors) {
+    std::size_t used = 0;
+    double value = 0;
+    try {
+      value = std::stod(f, &used);
+    } catch (const std::exception&) {
+      used = 0;
+    }
+    if (used != f.size() || !(value >= 0.5 && value <= 1.5))
+      throw params.errorAt("rotor_thrust_factors", "'" + f + "' is not a factor from 0.5 to 1.5");
+    thrust_factors.push_back(value);
+  }
 }
 
 std::vector<Rotor> VehicleParams::rotorsOf(const Descriptor& params, const Artifact& a) const {
@@ -99,10 +117,14 @@ std::vector<Rotor> VehicleParams::rotorsOf(const Descriptor& params, const Artif
   return rotors;
 }
 
-void Vehicle::configure(const RotorModel& at_rest, const Vec3& com_in_root, const std::optional<BatteryParams>& battery) {
+void Vehicle::configure(const RotorModel& at_rest, const Vec3& com_in_root, const std::optional<BatteryParams>& battery,
+                        const std::vector<double>& thrust_factors) {
   rotors_.emplace(at_rest);
   com_in_root_ = com_in_root;
-  gains_.fill(1.0);
+  factors_.fill(1.0);
+  std::copy(thrust_factors.begin(), thrust_factors.end(), factors_.begin());
+  gains_ = factors_;
+  if (!thrust_factors.empty()) rotors_->setThrustGains(std::span(gains_).first(rotors_->size()));
   battery_.reset();
   if (battery) battery_.emplace(*battery);
 }

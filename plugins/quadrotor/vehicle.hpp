@@ -46,6 +46,9 @@ inline constexpr ssx_plugin_param kVehicleParameters[] = {
     param::real("rotor_inertia", "", "kg m^2", param::nonNegative(), "(default: the preset's)"),
     param::text("rotors", "rotor0 rotor1 rotor2 rotor3", "physic node names of the rotors (4 to 8)"),
     param::text("directions", "1 -1 1 -1", "spin of each rotor: 1 counter-clockwise seen from above, -1 clockwise"),
+    param::text("rotor_thrust_factors", "",
+                "each rotor's thrust relative to the model's, one factor (0.5-1.5) per rotor in the order of 'rotors' "
+                "(worn or other propellers, a weak motor; the flight controller is not told; default: all 1)"),
     param::flag("battery", "false",
                 "a battery whose voltage sags with current and charge drawn; thrust at a fixed command follows it "
                 "(the crazyflie's firmware compensates: its thrust holds until the voltage cannot give it)"),
@@ -77,6 +80,7 @@ struct VehicleParams {
   std::vector<std::string> rotor_names;
   std::vector<int> directions;  // 1 or -1 per rotor
   std::optional<BatteryParams> battery;
+  std::vector<double> thrust_factors;  // one per rotor (1: as the model)
   explicit VehicleParams(const Descriptor& params);
   /// The rotors at artifact `a`'s physic nodes, positions relative to the centre of mass.
   std::vector<Rotor> rotorsOf(const Descriptor& params, const Artifact& a) const;
@@ -86,7 +90,9 @@ class Vehicle {
  public:
   /// `at_rest`: the rotors (copied; copies share their constants); `com_in_root`: where the
   /// centre of mass is in the root body's frame.
-  void configure(const RotorModel& at_rest, const Vec3& com_in_root, const std::optional<BatteryParams>& battery);
+  /// `thrust_factors`: one per rotor (empty: all 1), on each rotor's thrust from now on.
+  void configure(const RotorModel& at_rest, const Vec3& com_in_root, const std::optional<BatteryParams>& battery,
+                 const std::vector<double>& thrust_factors = {});
   const RotorModel& rotors() const { return *rotors_; }
   std::size_t rotorCount() const { return rotors_->size(); }
   /// Its rotors' constants from now on (RotorModel::setParams).
@@ -130,7 +136,8 @@ class Vehicle {
   std::optional<RotorModel> rotors_;
   Vec3 com_in_root_ = Vec3::Zero();
   std::optional<Battery> battery_;
-  std::array<double, kMaxRotors> gains_{};  // per rotor thrust gains, handed to the rotor model
+  std::array<double, kMaxRotors> gains_{};    // per rotor thrust gains, handed to the rotor model
+  std::array<double, kMaxRotors> factors_{};  // per rotor thrust factors (rotor_thrust_factors)
 };
 
 template <class GroundGain>
@@ -148,7 +155,7 @@ void Vehicle::updateGains(double dt, GroundGain ground_gain) {
     battery_->step(dt, power);
     battery_gain = battery_->thrustGain();
   }
-  for (std::size_t i = 0; i < rotors.size(); ++i) gains_[i] = battery_gain * ground_gain(i);
+  for (std::size_t i = 0; i < rotors.size(); ++i) gains_[i] = battery_gain * ground_gain(i) * factors_[i];
   rotors_->setThrustGains(std::span(gains_).first(rotors.size()));
 }
 

@@ -116,9 +116,11 @@ TEST_CASE("crazyflie_pid: hover, limits, the yaw frame, no tilt compensation", "
   CHECK(f.desiredAttitude()[2] == Approx(36000 + 1000 * (25 * 1 + 15 * 0.01)));
 }
 
-TEST_CASE("crazyflie_pid: the mixer rolls with the left motors, gives up collective thrust first", "[quadrotor][crazyflie]") {
+TEST_CASE("crazyflie_pid: the mixer rolls with the left motors; the PWMs are capped together after the battery's "
+          "compensation, giving up collective thrust first",
+          "[quadrotor][crazyflie]") {
   CrazyfliePidGains gains;
-  gains.thrust_base = 65000;  // near the ceiling
+  gains.thrust_base = 65000;  // near the command's ceiling
   gains.gyro_cutoff_hz = 0;    // the rates as they are (the filter would take the first sample's edge off)
   Standing in;
   in.pose.position = in.setpoint.position = Vec3(0, 0, 1);
@@ -130,11 +132,28 @@ TEST_CASE("crazyflie_pid: the mixer rolls with the left motors, gives up collect
   CHECK(m[2] == Approx(m[3]));  // left pair alike
   CHECK(m[0] == Approx(m[1]));  // right pair alike
   CHECK(m[3] > m[0]);           // more on the left
-  CHECK(std::max({m[0], m[1], m[2], m[3]}) == 65535);  // capped at the ceiling
-  // the differential survives the cap: half the rate loop's output on each side
+  // the mixer's sums are not capped (the firmware's motorThrustUncapped): half the rate loop's output each side
   const double roll = 250 * (0.5 * 180 / std::numbers::pi) + 500 * (0.5 * 180 / std::numbers::pi) * 0.002;
   CHECK(m[3] - m[0] == Approx(2 * std::trunc(std::min(roll, 32767.0) / 2)));
-  CHECK((m[0] + m[3]) / 2 < 65000);  // the collective given up
+  CHECK(m[3] > 65535);
+  const CrazyflieThrustCurve curve = CrazyflieThrustCurve::propellers21plus();
+  // a full battery (4.2 V) gives a motor more than 0.12 N (thrust(4.2 V) = 0.28 N): every motor as asked
+  auto t = c.motorThrusts();
+  for (std::size_t i = 0; i < 4; ++i) CHECK(t[i] == Approx(m[i] / 65535 * 0.12).epsilon(1e-12));
+  // at 3.0 V the battery gives 0.113 N a motor: the left motors' PWM would pass 65535, and the excess
+  // is taken from all four PWMs
+  c.setBatteryVoltage(3.0);
+  t = c.motorThrusts();
+  const double left = curve.uncappedPwm(m[3], 3.0), right = curve.uncappedPwm(m[0], 3.0);
+  REQUIRE(left > 65535);
+  CHECK(t[3] == Approx(curve.thrust(3.0)).epsilon(1e-12));  // at full PWM
+  CHECK(t[2] == Approx(t[3]));
+  CHECK(t[0] == Approx(curve.thrust((right - (left - 65535)) / 65535 * 3.0)).epsilon(1e-12));
+  CHECK(t[0] < m[0] / 65535 * 0.12);  // the collective given up, the differential kept in PWM
+  // what a command-space cap (65535 before the compensation) cannot do, and NanoBench's flights show
+  // (a motor at full PWM at 3.26 V logged): a command that reaches full PWM above 3.08 V
+  CHECK(curve.uncappedPwm(65535, 3.26) < 65535);
+  CHECK(curve.uncappedPwm(75400, 3.26) > 65535);
 }
 
 TEST_CASE("crazyflie_pid: a saved state continues identically, velocity commands", "[quadrotor][crazyflie]") {

@@ -79,3 +79,43 @@ TEST_CASE("the installed presets: mk_quad writes out the model's defaults, and e
   CHECK(hb.rotor.rotor_radius == 0.1);
   CHECK_FALSE(hb.battery->compensated);
 }
+
+TEST_CASE("rotor_thrust_factors: each rotor's thrust times its factor; their count and range checked",
+          "[quadrotor][parts]") {
+  auto paramsWith = [](const std::string& factors) {
+    Descriptor params("driver");
+    params.setDeclarations(kVehicleParameters);
+    params.set("rotor_thrust_factors", factors);
+    return params;
+  };
+  const VehicleParams vp(paramsWith("0.8 1 1 1.2"));
+  REQUIRE(vp.thrust_factors == std::vector<double>{0.8, 1.0, 1.0, 1.2});
+  CHECK(VehicleParams(paramsWith("")).thrust_factors.empty());
+  CHECK_THROWS_WITH(VehicleParams(paramsWith("0.8 1 1")), Catch::Contains("one factor per rotor (4), got 3"));
+  CHECK_THROWS_WITH(VehicleParams(paramsWith("2 1 1 1")), Catch::Contains("'2' is not a factor from 0.5 to 1.5"));
+  CHECK_THROWS_WITH(VehicleParams(paramsWith("1 1 x 1")), Catch::Contains("'x' is not a factor"));
+
+  const RotorParams rp = RotorParams{};
+  Vehicle vehicle;
+  vehicle.configure(RotorModel(plus(), rp), Vec3::Zero(), std::nullopt, vp.thrust_factors);
+  const double w = 400, t = rp.thrust_coefficient * w * w;  // one rotor's thrust, as the model gives it
+  vehicle.spinAt(std::vector<double>(4, w));
+  Vec3 force, torque;
+  vehicle.rotors().wrench(Vec3::Zero(), Vec3::Zero(), force, torque);
+  CHECK(force.z() == Approx(4.0 * t));  // 0.8 + 1 + 1 + 1.2
+  // rotor 0 (+x) gives 0.8 t and rotor 2 (-x) t: a pitching torque; rotor 1 (+y) t, rotor 3 (-y) 1.2 t
+  CHECK(torque.y() == Approx(0.225 * 0.2 * t));
+  CHECK(torque.x() == Approx(-0.225 * 0.2 * t));
+  CHECK(torque.z() == Approx(rp.moment_constant * 0.4 * t));
+  // with ground effect or a battery the gains are renewed every step: the factors stay in them
+  vehicle.updateGains(0.002, [](std::size_t) { return 1.5; });
+  const auto gains = vehicle.rotors().thrustGains();
+  CHECK(std::vector<double>(gains.begin(), gains.end()) == std::vector<double>{1.5 * 0.8, 1.5, 1.5, 1.5 * 1.2});
+  // without factors, a symmetric vehicle: no torque
+  Vehicle plain;
+  plain.configure(RotorModel(plus(), rp), Vec3::Zero(), std::nullopt);
+  plain.spinAt(std::vector<double>(4, w));
+  plain.rotors().wrench(Vec3::Zero(), Vec3::Zero(), force, torque);
+  CHECK(force.z() == 4 * t);
+  CHECK(torque.norm() == 0);
+}
