@@ -116,7 +116,7 @@ TEST_CASE("crazyflie_pid: hover, limits, the yaw frame, no tilt compensation", "
   CHECK(f.desiredAttitude()[2] == Approx(36000 + 1000 * (25 * 1 + 15 * 0.01)));
 }
 
-TEST_CASE("crazyflie_pid: the mixer rolls with the left motors; the PWMs are capped together after the battery's "
+TEST_CASE("crazyflie_pid: the mixer rolls with the left motors, the PWMs are capped together after the battery's "
           "compensation, giving up collective thrust first",
           "[quadrotor][crazyflie]") {
   CrazyfliePidGains gains;

@@ -80,7 +80,7 @@ TEST_CASE("the installed presets: mk_quad writes out the model's defaults, and e
   CHECK_FALSE(hb.battery->compensated);
 }
 
-TEST_CASE("rotor_thrust_factors: each rotor's thrust times its factor; their count and range checked",
+TEST_CASE("rotor_thrust_factors: each rotor's thrust times its factor, their count and range checked",
           "[quadrotor][parts]") {
   auto paramsWith = [](const std::string& factors) {
     Descriptor params("driver");
