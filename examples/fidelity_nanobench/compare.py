@@ -26,6 +26,7 @@ import pathlib
 import re
 import subprocess
 import sys
+import time
 
 import numpy as np
 
@@ -109,10 +110,22 @@ def takeoff_window(path):
     return float(g["t"][flying[0]]), float(g["t"][i0 - h]), cruise
 
 
+REPLAYED = {"flights": 0, "flight_s": 0.0, "wall_s": 0.0, "longest": (0.0, 0.0)}  # what the replays took
+
+
 def replay(program, log, out, extra):
+    started = time.perf_counter()
     run = subprocess.run([program, str(log), "--out", str(out), *extra], capture_output=True, text=True)
+    wall = time.perf_counter() - started
     if run.returncode != 0:
         sys.exit(f"{program} {log}: {run.stderr.strip()}")
+    span = re.search(r"flight ([\d.]+)-([\d.]+) s", run.stdout)
+    if span:
+        flight = float(span.group(2)) - float(span.group(1))
+        REPLAYED["flights"] += 1
+        REPLAYED["flight_s"] += flight
+        REPLAYED["wall_s"] += wall
+        REPLAYED["longest"] = max(REPLAYED["longest"], (flight, wall))
     return run.stdout
 
 
@@ -332,6 +345,12 @@ def main():
         if a.plots:
             plots(rows, a.data, a.out, a.plots)
     print(text)
+    if REPLAYED["flights"]:
+        longest, wall = REPLAYED["longest"]
+        print(f"replayed {REPLAYED['flights']} flights ({REPLAYED['flight_s']:.0f} s of flight) in "
+              f"{REPLAYED['wall_s']:.1f} s of wall time, the program's start included: "
+              f"{60 * REPLAYED['wall_s'] / REPLAYED['flight_s']:.2f} s per 60 s of flight; the longest "
+              f"({longest:.1f} s) in {wall:.2f} s", file=sys.stderr)
     doc = a.write or a.check
     return put(doc, marker, text, a.write is not None) if doc else 0
 
