@@ -23,7 +23,7 @@ struct Column {
   const char* source_name;
   bool required;
 };
-constexpr std::array<Column, 18> kColumns = {{{"t", "t", true},
+constexpr std::array<Column, 17> kColumns = {{{"t", "t", true},
                                               {"px", "px", true},
                                               {"py", "py", true},
                                               {"pz", "pz", true},
@@ -39,9 +39,8 @@ constexpr std::array<Column, 18> kColumns = {{{"t", "t", true},
                                               {"m1", "motor_motor_m1", false},
                                               {"m2", "motor_motor_m2", false},
                                               {"m3", "motor_motor_m3", false},
-                                              {"m4", "motor_motor_m4", false},
-                                              {"", "", false}}};  // an end mark
-constexpr std::size_t kUsed = kColumns.size() - 1;
+                                              {"m4", "motor_motor_m4", false}}};
+constexpr std::size_t kUsed = kColumns.size();
 constexpr std::size_t kAbsent = static_cast<std::size_t>(-1);
 
 std::vector<std::string> split(const std::string& line) {

@@ -165,16 +165,6 @@ Command CrazyfliePidController::command() const {
   return FlightController::command();
 }
 
-double CrazyfliePidController::motorThrust(double command) const {
-  const double battery = filter_.volts();
-  // the compensation reads the voltage the motors get (a battery held, or settled): the same
-  // numbers as below without inverting the curve (a tenth of a Crazyflie's step)
-  if (motor_volts_ == battery) return curve_.delivered(command, battery);
-  const double pwm = curve_.pwm(command, battery);
-  if (pwm <= 0) return 0;
-  return std::max(0.0, curve_.thrust(pwm / 65535.0 * motor_volts_));
-}
-
 std::array<double, 4> CrazyfliePidController::motorThrusts() const {
   const double battery = filter_.volts();
   std::array<double, 4> out{};

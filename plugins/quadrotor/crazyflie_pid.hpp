@@ -157,9 +157,6 @@ class CrazyfliePidController final : public FlightController {
   /// The four motors' commands after mixing (the firmware's motorThrustUncapped: thrust plus or minus
   /// the roll, pitch and yaw outputs, not capped), in the rotors' order.
   std::array<double, 4> motorCommands() const { return motors_; }
-  /// One motor's thrust (N) for a command, alone: the PWM the compensation makes of it at the voltage
-  /// it sees (at most 65535), given the motor voltage of that PWM of the battery's.
-  double motorThrust(double command) const;
   /// The four motors' thrusts (N) for their commands, as the firmware drives them: each command's PWM
   /// from the compensation, uncapped; then, if the highest is over 65535, the excess taken from every
   /// PWM (powerDistributionCap: the differential kept, the collective given up), floored at 0; each
