@@ -108,7 +108,10 @@ try:
 
     before = page.execute_script(where)
     ActionChains(page).key_down("w").perform()
-    during = wait_simulated(2.0)
+    # held for 2 s of simulated time and until the robot went 1 m (a page starved of the CPU on a loaded
+    # machine may send nothing for a while, and the viewer rightly stops robots 0.5 s after the last message)
+    wait_simulated(2.0)
+    during = wait_for(page, where, lambda w: (w[0] - before[0]) * before[3] + (w[1] - before[1]) * before[4] >= 1.0, 120)
     steering = page.execute_script(panel)
     ActionChains(page).key_up("w").perform()
     if "command (velocity)" not in steering or "commanded " not in steering or "achieved " not in steering:
@@ -131,19 +134,27 @@ try:
         problems.append(f"steered forward at 1 m/s for {held:.2f} s, robot 0 moved {forward:.2f} m along the view")
     if drift > 0.05:
         problems.append(f"robot 0 still moved {drift:.3f} m in a second, 2 s after the key was let go")
-    # the whole formation: every robot forward along the view at once
+    # the whole formation: every robot forward along the view at once. The key is held until every robot
+    # has gone 0.7 m (not for a fixed time: a page starved of the CPU on a loaded machine sends nothing
+    # for a while, and the viewer rightly stops robots 0.5 s after a page's last message). A robot the
+    # command missed would not move: the wait fails after 120 s
     everyone = "return [Array.from(window.ssxViewer.state.positions), window.ssxViewer.state.time]"
+
+    def along_view(now, then):
+        return [(now[0][7 * i] - then[0][7 * i]) * before[3] + (now[0][7 * i + 1] - then[0][7 * i + 1]) * before[4]
+                for i in range(70)]
+
     page.find_element("id", "steer_all").click()
     start = page.execute_script(everyone)
     ActionChains(page).key_down("w").perform()
-    wait_simulated(1.5)
+    reached = wait_for(page, everyone, lambda now: min(along_view(now, start)) >= 0.7, 120)
     ActionChains(page).key_up("w").perform()
     wait_simulated(1.5)
     end = page.execute_script(everyone)
     page.find_element("id", "steer_all").click()
-    moved = [(end[0][7 * i] - start[0][7 * i]) * before[3] + (end[0][7 * i + 1] - start[0][7 * i + 1]) * before[4]
-             for i in range(70)]
-    print(f"the formation steered forward for 1.5 s: robots moved {min(moved):.2f} to {max(moved):.2f} m along the view")
+    moved = along_view(end, start)
+    print(f"the formation steered forward: every robot 0.7 m along the view after {reached[1] - start[1]:.2f} s "
+          f"of simulated time (1 m/s asked); robots moved {min(moved):.2f} to {max(moved):.2f} m in all")
     if min(moved) < 0.7:
         problems.append(f"steering the formation, a robot moved only {min(moved):.2f} m along the view")
     # pause, one step, then on at four times real time, all from the page
