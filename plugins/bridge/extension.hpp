@@ -96,11 +96,14 @@ class BridgeExtension : public SimulationExtension {
       r.tracker = dynamic_cast<SetpointInterface*>(a->driver());
       r.commands = dynamic_cast<CommandInterface*>(a->driver());
       if (r.commands != nullptr && !r.commands->acceptsCommand(CommandLevel::Velocity)) r.commands = nullptr;
+      std::size_t imu_k = a->sensorCount(), ring_k = imu_k, camera_k = imu_k;  // (which sensors they are)
       for (std::size_t k = 0; k < a->sensorCount(); ++k) {
-        if (r.imu == nullptr) r.imu = dynamic_cast<const ImuMeasurement*>(&a->sensor(k).latest());
+        if (r.imu == nullptr && (r.imu = dynamic_cast<const ImuMeasurement*>(&a->sensor(k).latest()))) imu_k = k;
         if (r.range == nullptr) r.range = dynamic_cast<const RangeMeasurement*>(&a->sensor(k).latest());
-        if (r.camera == nullptr) r.camera = dynamic_cast<const CameraMeasurement*>(&a->sensor(k).latest());
-        if (r.proximity == nullptr) r.proximity = dynamic_cast<const ProximityMeasurement*>(&a->sensor(k).latest());
+        if (r.camera == nullptr && (r.camera = dynamic_cast<const CameraMeasurement*>(&a->sensor(k).latest())))
+          camera_k = k;
+        if (r.proximity == nullptr && (r.proximity = dynamic_cast<const ProximityMeasurement*>(&a->sensor(k).latest())))
+          ring_k = k;
         if (r.ground == nullptr) r.ground = dynamic_cast<const GroundMeasurement*>(&a->sensor(k).latest());
         if (r.rab == nullptr) r.rab = dynamic_cast<const RangeBearingMeasurement*>(&a->sensor(k).latest());
       }
@@ -120,7 +123,8 @@ class BridgeExtension : public SimulationExtension {
         t.root_frame = linkName(*a, a->root());
         t.description = describe(*a);
         t.joint_commands = !t.joints.empty();
-        if (r.proximity != nullptr && scan_rate_.period > 0) scanOf(*a, t);
+        if (r.proximity != nullptr && scan_rate_.period > 0) scanOf(t);
+        sensorFrames(*a, t.imu ? imu_k : a->sensorCount(), ring_k, camera_k, t);
         t.ground = r.ground != nullptr && ground_rate_.period > 0;
         t.range_bearing = r.rab != nullptr && rab_rate_.period > 0;
       }

@@ -100,7 +100,9 @@ struct RobotTopics {
   std::string description;           // its URDF: /<name>/robot_description (empty: none)
   bool joint_commands = false;       // takes /<name>/joint_command (its `joints`)
   bool scan = false;                 // publishes /<name>/scan (its proximity ring, where the transport offers it)
-  std::string scan_frame;            // the ring's frame (without the robot's prefix)
+  std::string scan_frame = "scan";   // the ring's frame (without the robot's prefix; on /tf_static with tf)
+  std::string imu_frame = "imu";     // the IMU's frame (likewise)
+  std::string camera_frame = "camera";  // the frame of its images and camera_info (likewise: with tf, the optical frame)
   bool ground = false;               // publishes /<name>/ground (ssx_msgs/Ground; where the transport offers it)
   bool range_bearing = false;        // publishes /<name>/range_bearing (ssx_msgs/RangeBearing; likewise)
 };

@@ -135,12 +135,12 @@ DdsTransport::DdsTransport(int domain, Network network, const std::vector<bridge
       ground_.push_back(r.ground ? writer(&ssx_msgs_msg_dds__Ground__desc, ns + "/ground", Profile::SensorData) : 0);
       rab_.push_back(r.range_bearing ? writer(&ssx_msgs_msg_dds__RangeBearing__desc, ns + "/range_bearing", Profile::Default) : 0);
       scan_frames_.push_back(r.name + "/" + r.scan_frame);
-      camera_frames_.push_back(r.name + "/camera");
+      camera_frames_.push_back(r.name + "/" + r.camera_frame);
       force_.push_back(r.force ? writer(&geometry_msgs_msg_dds__WrenchStamped__desc, ns + "/force", Profile::Default) : 0);
       imu_.push_back(r.imu ? writer(&sensor_msgs_msg_dds__Imu__desc, ns + "/imu", Profile::SensorData) : 0);
       range_.push_back(r.range ? writer(&geometry_msgs_msg_dds__PoseArray__desc, ns + "/range", Profile::Default) : 0);
       odom_frames_.push_back(r.name + "/" + r.root_frame);
-      imu_frames_.push_back(r.name + "/imu");
+      imu_frames_.push_back(r.name + "/" + r.imu_frame);
       if (r.tf && tf_ == 0) tf_ = writer(&tf2_msgs_msg_dds__TFMessage__desc, "/tf", Profile::Tf);
       frames_.push_back({r.name + "/" + r.root_frame});
       for (const std::string& part : r.parts) frames_.back().push_back(r.name + "/" + part);

@@ -4,7 +4,9 @@
  * from the robot's axis at 0.066 / cos(17 deg) m, the others +inf), and /q1/camera_info beside
  * /q1/image (a pinhole: fx = fy = 32 / tan(30 deg), centre 32, 24, for 64 x 48 and 60 degrees),
  * /q0/range_bearing (ssx_msgs/RangeBearing: q2's 4-byte payload from 0.3 m to the left) and
- * /q0/ground (ssx_msgs/Ground: one point, its grey and colour).
+ * /q0/ground (ssx_msgs/Ground: one point, its grey and colour), and /tf_static: every sensor's frame
+ * resolves (q0/scan 3 cm above q0's base where its rays start, q1/camera at its mount, its optical
+ * frame z forward, x right, y down, q1/imu at its body), and each message names its sensor's frame.
  *   sensors_peer TIMEOUT_S            exit 0 when all held */
 #include "ros2_messages.h"
 
@@ -24,6 +26,7 @@ static void check(int ok, const char* what) {
 static dds_entity_t subscribe(dds_entity_t p, const dds_topic_descriptor_t* type, const char* name, int reliable) {
   dds_qos_t* q = dds_create_qos();
   dds_qset_reliability(q, reliable ? DDS_RELIABILITY_RELIABLE : DDS_RELIABILITY_BEST_EFFORT, DDS_SECS(1));
+  if (reliable == 2) dds_qset_durability(q, DDS_DURABILITY_TRANSIENT_LOCAL); /* (tf2's /tf_static) */
   dds_qset_history(q, DDS_HISTORY_KEEP_LAST, 5);
   const dds_entity_t r = dds_create_reader(p, dds_create_topic(p, type, name, NULL, NULL), q, NULL);
   dds_delete_qos(q);
@@ -41,6 +44,51 @@ static int next(dds_entity_t reader, void* out, double timeout) {
   return 0;
 }
 
+/* the transform in `m` to `child` from its parent `parent`, NULL when there is none */
+static const geometry_msgs_msg_dds__TransformStamped_* find(const tf2_msgs_msg_dds__TFMessage_* m, const char* parent,
+                                                            const char* child) {
+  for (uint32_t k = 0; k < m->transforms._length; ++k) {
+    const geometry_msgs_msg_dds__TransformStamped_* t = &m->transforms._buffer[k];
+    if (strcmp(t->child_frame_id, child) == 0 && strcmp(t->header.frame_id, parent) == 0) return t;
+  }
+  return NULL;
+}
+
+/* `v` turned by the transform's rotation */
+static void turn(const geometry_msgs_msg_dds__TransformStamped_* t, const double v[3], double out[3]) {
+  const double x = t->transform.rotation.x, y = t->transform.rotation.y, z = t->transform.rotation.z,
+               w = t->transform.rotation.w;
+  const double c[3] = {y * v[2] - z * v[1], z * v[0] - x * v[2], x * v[1] - y * v[0]}; /* q x v */
+  const double cc[3] = {y * c[2] - z * c[1], z * c[0] - x * c[2], x * c[1] - y * c[0]};
+  for (int i = 0; i < 3; ++i) out[i] = v[i] + 2 * w * c[i] + 2 * cc[i];
+}
+
+static int near3(const double a[3], double x, double y, double z) {
+  return fabs(a[0] - x) < 1e-9 && fabs(a[1] - y) < 1e-9 && fabs(a[2] - z) < 1e-9;
+}
+
+static void checkStaticFrames(const tf2_msgs_msg_dds__TFMessage_* m) {
+  printf("  /tf_static: %u frames\n", m->transforms._length);
+  const geometry_msgs_msg_dds__TransformStamped_* scan = find(m, "q0/base_link", "q0/scan");
+  check(scan && scan->transform.translation.x == 0 && scan->transform.translation.y == 0 &&
+            fabs(scan->transform.translation.z - 0.03) < 1e-12 && scan->transform.rotation.w == 1,
+        "q0/scan: 3 cm above q0/base_link (the rays' height), not turned");
+  const geometry_msgs_msg_dds__TransformStamped_* camera = find(m, "q1/base_link", "q1/camera");
+  check(camera && fabs(camera->transform.translation.x - 0.1) < 1e-12 && camera->transform.rotation.w == 1,
+        "q1/camera: at its mount, 0.1 m ahead of q1/base_link");
+  const geometry_msgs_msg_dds__TransformStamped_* optical = find(m, "q1/camera", "q1/camera_optical");
+  if (optical == NULL) return check(0, "q1/camera_optical in q1/camera");
+  const double ex[3] = {1, 0, 0}, ey[3] = {0, 1, 0}, ez[3] = {0, 0, 1};
+  double x[3], y[3], z[3];
+  turn(optical, ex, x), turn(optical, ey, y), turn(optical, ez, z);
+  printf("  optical axes in q1/camera: x %.3f %.3f %.3f, y %.3f %.3f %.3f, z %.3f %.3f %.3f\n", x[0], x[1], x[2], y[0],
+         y[1], y[2], z[0], z[1], z[2]);
+  check(near3(z, 1, 0, 0) && near3(x, 0, -1, 0) && near3(y, 0, 0, -1),
+        "q1/camera_optical: z forward (the camera's x), x right, y down");
+  const geometry_msgs_msg_dds__TransformStamped_* imu = find(m, "q1/base_link", "q1/imu");
+  check(imu && imu->transform.translation.x == 0 && imu->transform.rotation.w == 1, "q1/imu: at q1's body");
+}
+
 int main(int argc, char** argv) {
   setvbuf(stdout, NULL, _IONBF, 0);
   const double timeout = argc > 1 ? atof(argv[1]) : 30;
@@ -52,6 +100,8 @@ int main(int argc, char** argv) {
   const dds_entity_t image = subscribe(p, &sensor_msgs_msg_dds__Image__desc, "rt/q1/image", 1);
   const dds_entity_t rab = subscribe(p, &ssx_msgs_msg_dds__RangeBearing__desc, "rt/q0/range_bearing", 1);
   const dds_entity_t ground = subscribe(p, &ssx_msgs_msg_dds__Ground__desc, "rt/q0/ground", 0);
+  const dds_entity_t tf_static = subscribe(p, &tf2_msgs_msg_dds__TFMessage__desc, "rt/tf_static", 2);
+  const dds_entity_t imu = subscribe(p, &sensor_msgs_msg_dds__Imu__desc, "rt/q1/imu", 0);
 
   /* (the first scans come before the robot settles on the ground: the 8th is looked at) */
   void* loan[1] = {NULL};
@@ -75,7 +125,7 @@ int main(int argc, char** argv) {
     check(s.ranges._length == 303 && fabs(s.angle_min + 151 * deg) < 1e-6 && fabs(s.angle_increment - deg) < 1e-6,
           "the e-puck's ring on a grid of one degree from -151 degrees (303 slots)");
     check(fabs(s.range_min - 0.036) < 1e-6 && fabs(s.range_max - 0.086) < 1e-6, "range from the ring (3.6 cm) to 8.6 cm");
-    check(strcmp(s.header.frame_id, "q0/base_link") == 0, "in the robot's base frame");
+    check(strcmp(s.header.frame_id, "q0/scan") == 0, "in the ring's frame, q0/scan");
     const int rays[8] = {-17, -46, -90, -151, 151, 90, 46, 17};
     int nan_between = 1;
     for (uint32_t k = 0; k < s.ranges._length; ++k) {
@@ -113,7 +163,8 @@ int main(int argc, char** argv) {
     check(c.p[0] == c.k[0] && c.p[2] == c.k[2] && c.p[10] == 1 && c.r[0] == 1 && c.r[4] == 1 && c.r[8] == 1 &&
               c.d._length == 5 && strcmp(c.distortion_model, "plumb_bob") == 0,
           "P as K, R the identity, no distortion (plumb_bob)");
-    check(strcmp(c.header.frame_id, im.header.frame_id) == 0, "in the image's frame");
+    check(strcmp(c.header.frame_id, im.header.frame_id) == 0 && strcmp(c.header.frame_id, "q1/camera_optical") == 0,
+          "in the image's frame, q1/camera_optical");
   }
   if (got_info) dds_sample_free(&c, &sensor_msgs_msg_dds__CameraInfo__desc, DDS_FREE_CONTENTS);
 
@@ -157,6 +208,16 @@ int main(int argc, char** argv) {
     }
   }
   check(got_ground, "/q0/ground arrives");
+  tf2_msgs_msg_dds__TFMessage_ statics;
+  memset(&statics, 0, sizeof statics);
+  const int got_statics = next(tf_static, &statics, timeout);
+  check(got_statics, "/tf_static arrives (kept for later readers)");
+  if (got_statics) checkStaticFrames(&statics), dds_sample_free(&statics, &tf2_msgs_msg_dds__TFMessage__desc, DDS_FREE_CONTENTS);
+  sensor_msgs_msg_dds__Imu_ reading;
+  memset(&reading, 0, sizeof reading);
+  const int got_imu = next(imu, &reading, timeout);
+  check(got_imu && strcmp(reading.header.frame_id, "q1/imu") == 0, "/q1/imu arrives, in the frame q1/imu");
+  if (got_imu) dds_sample_free(&reading, &sensor_msgs_msg_dds__Imu__desc, DDS_FREE_CONTENTS);
   if (got_image) dds_sample_free(&im, &sensor_msgs_msg_dds__Image__desc, DDS_FREE_CONTENTS);
   dds_delete(p);
   printf("%d check(s) failed\n", failures);
