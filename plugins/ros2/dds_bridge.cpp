@@ -16,11 +16,11 @@
 
 namespace ssx::ros2 {
 
-namespace {
-
-std::runtime_error ddsError(const std::string& what, dds_return_t code) {
+std::runtime_error ddsError(const std::string& what, int code) {
   return std::runtime_error("ros2: " + what + " failed: " + dds_strretcode(code));
 }
+
+namespace {
 
 builtin_interfaces_msg_dds__Time_ stamp(double t) {
   const auto ns = std::llround(std::max(0.0, t) * 1e9);
@@ -529,65 +529,5 @@ std::unique_ptr<bridge::Transport> open(int domain, Network network, const std::
 void close(bridge::Transport& transport) { static_cast<DdsTransport&>(transport).shutdown(); }
 
 int participant(const bridge::Transport& transport) { return static_cast<const DdsTransport&>(transport).participant(); }
-
-namespace {
-rmw_dds_common_msg_dds__Gid_ gidOf(dds_entity_t entity) {
-  dds_guid_t guid{};
-  if (const dds_return_t rc = dds_get_guid(entity, &guid); rc < 0) throw ddsError("reading an entity's GUID", rc);
-  rmw_dds_common_msg_dds__Gid_ gid{};
-  std::copy(std::begin(guid.v), std::end(guid.v), gid.data);
-  return gid;
-}
-// the readers and writers under `entity` (the participant's implicit publisher and subscriber hold them)
-void endpoints(dds_entity_t entity, std::vector<rmw_dds_common_msg_dds__Gid_>& readers,
-               std::vector<rmw_dds_common_msg_dds__Gid_>& writers) {
-  std::vector<dds_entity_t> children(64);
-  dds_return_t n = dds_get_children(entity, children.data(), children.size());
-  if (n > static_cast<dds_return_t>(children.size())) {
-    children.resize(static_cast<std::size_t>(n));
-    n = dds_get_children(entity, children.data(), children.size());
-  }
-  for (dds_return_t k = 0; k < n; ++k) {
-    // (Cyclone 0.10 has no call that names an entity's kind: a writer is what has a publication
-    // status, a reader what has a subscription status; the rest may hold either)
-    const dds_entity_t c = children[static_cast<std::size_t>(k)];
-    dds_publication_matched_status_t w;
-    dds_subscription_matched_status_t r;
-    if (dds_get_publication_matched_status(c, &w) == DDS_RETCODE_OK) writers.push_back(gidOf(c));
-    else if (dds_get_subscription_matched_status(c, &r) == DDS_RETCODE_OK) readers.push_back(gidOf(c));
-    else endpoints(c, readers, writers);
-  }
-}
-}  // namespace
-
-void announce(const bridge::Transport& transport, const std::string& node) {
-  const dds_entity_t p = participant(transport);
-  // rmw_dds_common's QoS for it: reliable, transient local, the last one
-  dds_qos_t* q = dds_create_qos();
-  dds_qset_reliability(q, DDS_RELIABILITY_RELIABLE, DDS_SECS(1));
-  dds_qset_history(q, DDS_HISTORY_KEEP_LAST, 1);
-  dds_qset_durability(q, DDS_DURABILITY_TRANSIENT_LOCAL);
-  const dds_data_representation_id_t xcdr1[] = {DDS_DATA_REPRESENTATION_XCDR1};
-  dds_qset_data_representation(q, 1, xcdr1);
-  const dds_entity_t topic =
-      dds_create_topic(p, &rmw_dds_common_msg_dds__ParticipantEntitiesInfo__desc, "ros_discovery_info", nullptr, nullptr);
-  const dds_entity_t writer = topic < 0 ? topic : dds_create_writer(p, topic, q, nullptr);
-  dds_delete_qos(q);
-  if (writer < 0) throw ddsError("creating the writer of ros_discovery_info", writer);
-  std::vector<rmw_dds_common_msg_dds__Gid_> readers, writers;
-  endpoints(p, readers, writers);
-  rmw_dds_common_msg_dds__NodeEntitiesInfo_ info{};
-  std::snprintf(info.node_namespace, sizeof info.node_namespace, "/");
-  std::snprintf(info.node_name, sizeof info.node_name, "%s", node.c_str());
-  info.reader_gid_seq._buffer = readers.data();
-  info.reader_gid_seq._length = info.reader_gid_seq._maximum = static_cast<uint32_t>(readers.size());
-  info.writer_gid_seq._buffer = writers.data();
-  info.writer_gid_seq._length = info.writer_gid_seq._maximum = static_cast<uint32_t>(writers.size());
-  rmw_dds_common_msg_dds__ParticipantEntitiesInfo_ m{};
-  m.gid = gidOf(p);
-  m.node_entities_info_seq._buffer = &info;
-  m.node_entities_info_seq._length = m.node_entities_info_seq._maximum = 1;
-  if (const dds_return_t rc = dds_write(writer, &m); rc < 0) throw ddsError("writing ros_discovery_info", rc);
-}
 
 }  // namespace ssx::ros2

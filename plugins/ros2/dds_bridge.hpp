@@ -6,6 +6,7 @@
 #include "../bridge/transport.hpp"
 
 #include <memory>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -30,8 +31,14 @@ std::unique_ptr<bridge::Transport> open(int domain, Network network, const std::
 void close(bridge::Transport& transport);
 /// The transport's DDS participant (for the services on the same node), 0 once closed.
 int participant(const bridge::Transport& transport);
+/// An error naming what failed and Cyclone's return code.
+std::runtime_error ddsError(const std::string& what, int code);
 /// Tells ROS 2's graph (ros_discovery_info) that the participant is the node /`node`, with every
-/// reader and writer it has now; kept for ROS tools that start later. Throws std::runtime_error.
-void announce(const bridge::Transport& transport, const std::string& node);
+/// reader and writer it has now; kept for ROS tools that start later. `distro` is the ROS 2
+/// distribution of the tools (humbleDiscovery: which layout). Throws std::runtime_error.
+void announce(const bridge::Transport& transport, const std::string& node, const std::string& distro);
+/// Whether ROS 2 `distro`'s tools read ros_discovery_info in Humble's layout (24-byte ids: Foxy,
+/// Galactic, Humble) rather than Iron's and later ones' (16 bytes).
+bool humbleDiscovery(const std::string& distro);
 
 }  // namespace ssx::ros2

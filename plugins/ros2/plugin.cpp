@@ -39,6 +39,9 @@ inline constexpr ssx_plugin_param kRos2Parameters[] = {
                   "loopback: this machine only (127.0.0.1; discovery by unicast there: a ROS 2 program uses the same "
                   "CYCLONEDDS_URI, see docs); system: Cyclone's choice of interfaces, or $CYCLONEDDS_URI's"),
     param::text("node_name", "ssx", "the ROS 2 node the bridge is to ROS tools (ros2 node list): letters, digits, _"),
+    param::text("ros_distro", "",
+                "the ROS 2 distribution of the tools that are to list the node (ros_discovery_info's layout: humble, "
+                "galactic, foxy: Humble's; iron, jazzy, kilted, rolling and later: Iron's; default: $ROS_DISTRO, else jazzy)"),
     param::flag("services", "true",
                 "serve ROS 2's simulation_interfaces services (/get_entities, /set_entity_state, /step_simulation, "
                 "/reset_simulation, ...), answered between steps"),
@@ -61,6 +64,7 @@ class Ros2Bridge final : public bridge::BridgeExtension {
     if (!valid)
       throw params.errorAt("node_name", "node_name '" + node + "' is not a ROS 2 node name: letters, digits and _, "
                                         "not starting with a digit");
+    (void)distroOf(params);
   }
 
   void init(Environment& env, const Descriptor& params) override {
@@ -70,7 +74,7 @@ class Ros2Bridge final : public bridge::BridgeExtension {
         services_ = std::make_unique<ros2::SimulationServices>(ros2::participant(*dds_), env, "",
                                                                [this] { restarted(); });
       // (last: it lists every reader and writer made)
-      ros2::announce(*dds_, params.get<std::string>("node_name"));
+      ros2::announce(*dds_, params.get<std::string>("node_name"), distroOf(params));
     } catch (const std::exception& e) {
       services_.reset();
       BridgeExtension::shutdown(env);
@@ -105,6 +109,20 @@ class Ros2Bridge final : public bridge::BridgeExtension {
  private:
   bridge::Transport* dds_ = nullptr;  // the transport open() made (the base owns it)
   std::unique_ptr<ros2::SimulationServices> services_;
+  // the parameter, else $ROS_DISTRO, else jazzy: a distribution's name (lower-case letters; one ssx does
+  // not know yet is taken to be as Iron's and later ones)
+  static std::string distroOf(const Descriptor& params) {
+    const char* from_env = std::getenv("ROS_DISTRO");
+    std::string distro = params.get<std::string>("ros_distro", "");
+    if (distro.empty()) distro = from_env != nullptr && *from_env != '\0' ? from_env : "jazzy";
+    const bool valid = distro.size() <= 32 && std::all_of(distro.begin(), distro.end(), [](char c) { return c >= 'a' && c <= 'z'; });
+    if (!valid) {
+      const std::string what = "'" + distro + "' is not a ROS 2 distribution's name (humble, jazzy, ...)";
+      if (!params.get<std::string>("ros_distro", "").empty()) throw params.errorAt("ros_distro", "ros_distro " + what);
+      throw params.error("ROS_DISTRO " + what + ": give ros_distro");
+    }
+    return distro;
+  }
   // the parameter, else $ROS_DOMAIN_ID, else 0; a domain ROS 2 cannot use is an error where it was given
   static int domainOf(const Descriptor& params) {
     const char* from_env = std::getenv("ROS_DOMAIN_ID");
