@@ -26,11 +26,13 @@
 // Replaying (`ssx replay FILE --view`, the parameter `recording`): the page gets the recorded
 // scene with "replay":{"start":S,"end":E} (s) and frames of the recorded poses, played by a thread
 // of the viewer's own on the wall clock (Playback): pause, resume, step (one sample), rate (the
-// speed) and {"type":"seek","time":T} (the page's slider). Nothing is steered; no details.
+// speed) and {"type":"seek","time":T} (the page's slider). Nothing is steered; a selected robot's
+// details are as recorded (replay_details.hpp).
 //
 // Parameters: kParameters below, or `ssx plugins --params viewer`.
 #include "frame.hpp"
 #include "playback.hpp"
+#include "replay_details.hpp"
 #include "scene_shapes.hpp"
 #include "viewer_server.hpp"
 
@@ -125,6 +127,7 @@ class Viewer final : public SimulationExtension {
       }
       if (recording_->times().empty()) throw params.error("viewer: " + file + " holds no pose sample to play");
       playback_ = std::make_unique<viewer::Playback>(recording_->times());
+      replay_details_ = std::make_unique<viewer::ReplayDetails>(*recording_);
     }
     const bool loopback = web::isLoopback(bind);
     const std::string token = web::accessToken(bind);
@@ -288,15 +291,7 @@ class Viewer final : public SimulationExtension {
       control_->setRealtimeFactor(*factor);
       return true;
     }
-    if (text.find(R"("type":"select")") != std::string::npos) {
-      const auto body = jsonNumber(text, "body");
-      std::lock_guard lock(mutex_);
-      if (!body || *body < 0 || *body != std::floor(*body) || *body >= static_cast<double>(nodes_.size())) return false;
-      const int index = static_cast<int>(*body);
-      if (watched_.size() >= kMaxWatched && watched_.count(index) == 0) return false;
-      watched_[index] = std::chrono::steady_clock::now();
-      return true;
-    }
+    if (text.find(R"("type":"select")") != std::string::npos) return watch(text);
     if (text.find(R"("type":"velocity")") == std::string::npos) return false;
     const bool all = text.find(R"("all":true)") != std::string::npos;
     const auto body = all ? std::optional<double>(0) : jsonNumber(text, "body");
@@ -321,13 +316,26 @@ class Viewer final : public SimulationExtension {
   }
 
  private:
+  // a page's {"type":"select","body":I}: its details sent with the frames for 3 s (`locked`: mutex_ is held)
+  bool watch(const std::string& text, bool lock_it = true) {
+    const auto body = jsonNumber(text, "body");
+    std::unique_lock lock(mutex_, std::defer_lock);
+    if (lock_it) lock.lock();
+    if (!body || *body < 0 || *body != std::floor(*body) || *body >= static_cast<double>(nodes_.size())) return false;
+    const int index = static_cast<int>(*body);
+    if (watched_.size() >= kMaxWatched && watched_.count(index) == 0) return false;
+    details_asked_ |= watched_.count(index) == 0;
+    watched_[index] = std::chrono::steady_clock::now();
+    return true;
+  }
+
   // a page's message about the recording played: true when understood
   bool onReplayMessage(const std::string& text) {
     std::lock_guard lock(mutex_);
     if (text.find(R"("type":"pause")") != std::string::npos) return playback_->pause(), true;
     if (text.find(R"("type":"resume")") != std::string::npos) return playback_->resume(), true;
     if (text.find(R"("type":"step")") != std::string::npos) return playback_->stepOnce(), true;
-    if (text.find(R"("type":"select")") != std::string::npos) return true;  // (a recording has no details to show)
+    if (text.find(R"("type":"select")") != std::string::npos) return watch(text, false);
     if (text.find(R"("type":"rate")") != std::string::npos) {
       const auto factor = jsonNumber(text, "factor");
       return factor && playback_->setSpeed(*factor);
@@ -353,8 +361,9 @@ class Viewer final : public SimulationExtension {
     }
     for (;;) {
       std::size_t k = 0;
-      bool paused = false;
+      bool paused = false, asked = false;
       double speed = 1;
+      std::vector<int> watched;
       {
         std::unique_lock lock(mutex_);
         if (playing_cv_.wait_for(lock, period_, [this] { return stop_playing_; })) return;
@@ -362,8 +371,11 @@ class Viewer final : public SimulationExtension {
         playback_->advance(std::chrono::duration<double>(now - last).count());
         last = now;
         k = playback_->sample(), paused = playback_->paused(), speed = playback_->speed();
+        std::erase_if(watched_, [&](const auto& w) { return now - w.second > std::chrono::seconds(3); });
+        for (const auto& w : watched_) watched.push_back(w.first);
+        asked = std::exchange(details_asked_, false);
       }
-      if (k == shown && paused == shown_paused && last - sent < std::chrono::seconds(1)) continue;
+      if (k == shown && paused == shown_paused && !asked && last - sent < std::chrono::seconds(1)) continue;
       shown = k, shown_paused = paused, sent = last;
       const std::vector<float> p = recording_->positions(k), q = recording_->orientations(k);  // (q: w x y z)
       const std::uint32_t n = static_cast<std::uint32_t>(recording_->names().size());
@@ -372,7 +384,16 @@ class Viewer final : public SimulationExtension {
         for (std::size_t a = 0; a < 3; ++a) *f++ = p[3 * i + a];
         *f++ = q[4 * i + 1], *f++ = q[4 * i + 2], *f++ = q[4 * i + 3], *f++ = q[4 * i];
       }
-      viewer::endFrame(play_frame_, n, viewer::trailerJson(speed, paused, {}));
+      // the selected robots as recorded: velocities from the poses, the command and sensors if recorded
+      std::string details;
+      try {
+        for (const int b : watched)
+          details += (details.empty() ? "[" : ",") +
+                     replay_details_->json(k, static_cast<std::size_t>(b), nodes_[static_cast<std::size_t>(b)]->artifact().name());
+      } catch (const std::exception&) {
+        details.clear();  // (a damaged part of the file: the poses go on without details)
+      }
+      viewer::endFrame(play_frame_, n, viewer::trailerJson(speed, paused, details.empty() ? details : details + "]"));
       server_->publish(play_frame_);
     }
   }
@@ -546,6 +567,8 @@ class Viewer final : public SimulationExtension {
   std::mutex mutex_;
   Teleop teleop_;
   std::map<int, std::chrono::steady_clock::time_point> watched_;
+  bool details_asked_ = false;  // a body newly watched: its details at once (a paused replay sends a frame a second)
+  std::unique_ptr<viewer::ReplayDetails> replay_details_;  // a recording's robots as recorded
   std::vector<double> delays_ms_;  // from a command's arrival to the step that used it
   std::uint64_t teleop_stops_ = 0;
   std::string url_;

@@ -39,6 +39,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace ssx {
@@ -173,6 +174,10 @@ class SSX_EXPORT Recording {
   /// (ascending time within a channel). Throws Error naming the channels there are when there is
   /// no such channel.
   std::vector<std::pair<Nanoseconds, std::string>> messages(const std::string& topic) const;
+  /// The last message of channel `topic` logged at or before `time` (log time in ns, its bytes):
+  /// one message read, for a replay that shows what was recorded at a time. Nothing when the
+  /// channel has none that early, or when there is no such channel.
+  std::optional<std::pair<Nanoseconds, std::string>> messageAtOrBefore(const std::string& topic, Nanoseconds time) const;
   /// The message encoding of channel `topic` ("json", "ssx.poses.v1"), or "" when there is none.
   std::string encoding(const std::string& topic) const;
   /// Every channel's topic and message count, in id order.

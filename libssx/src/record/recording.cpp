@@ -8,6 +8,8 @@
 
 #include <algorithm>
 #include <charconv>
+#include <iterator>
+#include <map>
 #include <mutex>
 
 namespace ssx {
@@ -22,6 +24,7 @@ struct Recording::Impl {
   std::uint64_t seed = 0;
   std::vector<std::pair<Nanoseconds, std::span<const std::byte>>> states;
   std::vector<PhysicsSwitch> switches;  // in the file's order (the order made)
+  std::map<int, std::vector<std::size_t>> by_channel;  // messageAtOrBefore's: a channel's messages by time (made at first use)
 };
 
 namespace {
@@ -186,6 +189,29 @@ std::vector<std::pair<Nanoseconds, std::string>> Recording::messages(const std::
       out.emplace_back(msg.log_time, std::string(reinterpret_cast<const char*>(data.data()), data.size()));
     }
   return out;
+}
+
+std::optional<std::pair<Nanoseconds, std::string>> Recording::messageAtOrBefore(const std::string& topic,
+                                                                               Nanoseconds time) const {
+  const detail::McapFile& f = impl_->file;
+  const int channel = f.channelId(topic);
+  if (channel < 0) return std::nullopt;
+  const std::lock_guard lock(impl_->mutex);
+  auto [it, made] = impl_->by_channel.try_emplace(channel);
+  std::vector<std::size_t>& index = it->second;
+  if (made) {
+    for (std::size_t k = 0; k < f.messages.size(); ++k)
+      if (f.messages[k].channel == channel) index.push_back(k);
+    std::stable_sort(index.begin(), index.end(),
+                     [&f](std::size_t a, std::size_t b) { return f.messages[a].log_time < f.messages[b].log_time; });
+  }
+  // the first logged after `time`, then the one before it
+  const auto after = std::upper_bound(index.begin(), index.end(), time,
+                                      [&f](Nanoseconds t, std::size_t k) { return t < f.messages[k].log_time; });
+  if (after == index.begin()) return std::nullopt;
+  const detail::McapFile::Message& msg = f.messages[*std::prev(after)];
+  const std::span<const std::byte> data = f.data(msg);
+  return std::pair{msg.log_time, std::string(reinterpret_cast<const char*>(data.data()), data.size())};
 }
 
 std::string Recording::encoding(const std::string& topic) const {

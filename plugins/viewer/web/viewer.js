@@ -556,11 +556,11 @@ function teleopCommand() {
 function teleopTick(now) {
   const socket = teleop.socket;
   if (!socket || socket.readyState !== 1) return;
-  if (state.replay) return;  // nothing to steer in a recording
   if (state.selected >= 0 && now - teleop.asked >= 1000) {  // the selected robot's details, for 3 s more
     teleop.asked = now;
     socket.send(JSON.stringify({ type: "select", body: state.selected }));
   }
+  if (state.replay) return;  // nothing to steer in a recording (its details are as recorded)
   const all = document.getElementById("steer_all").checked;
   if (state.selected < 0 && !all) return;
   const c = teleopCommand();

@@ -69,3 +69,41 @@ TEST_CASE("recording: an MCAP file that is not an ssx recording is refused, nami
   CHECK_THROWS_WITH(Recording(file), Catch::Contains("foreign.mcap: not an ssx recording: its profile is 'ros2'"));
   CHECK_THROWS_WITH(Recording(fs::current_path() / "missing.mcap"), Catch::Contains("cannot open the recording"));
 }
+
+TEST_CASE("recording: the message of a channel at or before a time is the one messages() has there",
+          "[record][recording]") {
+  const fs::path file = fs::current_path() / "recording_at_or_before.mcap";
+  const std::string xml = R"(<scene><environment timestep="0.002" seed="4"/><type name="q" file="mk_quad.xml"/><ground/>
+    <swarm type="q" count="2" name="q{i}" spacing="1.2" xyz="0 0 0.05"><driver offset="0 0 1"/></swarm></scene>)";
+  {
+    Scene scene = loadSceneFromString(xml, "at.xml", kArtifacts, testOptions());
+    RecordOptions o;
+    o.file = file;
+    o.sensors = true;
+    o.commands = true;
+    o.scene_xml = scene.model->toXml();
+    Recorder recorder(*scene.environment, o);
+    scene.environment->step(250);  // 0.5 s: 13 samples at 25 Hz
+    recorder.finish();
+  }
+  const Recording r(file);
+  const auto all = r.messages("/ssx/sensors");
+  REQUIRE(all.size() >= 10);
+  for (std::size_t k = 0; k < all.size(); ++k) {
+    INFO("message " << k << " at " << all[k].first << " ns");
+    // at its own time, and just before the next one's
+    const auto at = r.messageAtOrBefore("/ssx/sensors", all[k].first);
+    REQUIRE(at);
+    CHECK(at->first == all[k].first);
+    CHECK(at->second == all[k].second);
+    const Nanoseconds before_next = k + 1 < all.size() ? all[k + 1].first - 1 : all[k].first + 1'000'000'000;
+    const auto late = r.messageAtOrBefore("/ssx/sensors", before_next);
+    REQUIRE(late);
+    CHECK(late->second == all[k].second);
+  }
+  CHECK_FALSE(r.messageAtOrBefore("/ssx/sensors", all.front().first - 1));
+  CHECK_FALSE(r.messageAtOrBefore("/no/such/channel", all.back().first));
+  const auto commands = r.messageAtOrBefore("/ssx/commands", all.back().first);
+  REQUIRE(commands);
+  CHECK(commands->second.find("\"q1\"") != std::string::npos);
+}

@@ -225,6 +225,107 @@ def in_browser():
 
 
 in_browser()
+
+# A robot selected in a replay of a run recorded with its sensors and commands: its details come with
+# the frames as the recording has them at the sample shown (the command, the IMU), and the page's
+# panel shows them.
+quads = work / "quads.xml"
+quads.write_text(f"""<scene><environment timestep="0.002" seed="2"/>
+  <type name="q" file="{examples / 'artifacts' / 'mk_quad.xml'}"/><ground/>
+  <swarm type="q" count="3" name="q{{i}}" spacing="1.5" xyz="0 0 0.05"><driver offset="0 0 1"/></swarm></scene>""")
+detailed = work / "quads.mcap"
+made = subprocess.run([ssx, "run", str(quads), "--fast", "--duration", "3", "--record", str(detailed),
+                       "--record-channels", "sensors,commands", "--out", str(work / "out_quads")],
+                      capture_output=True, text=True, timeout=120)
+if made.returncode != 0:
+    sys.exit(f"the recording with sensors was not made:\n{made.stderr[-2000:]}")
+
+
+async def details_of(url):
+    """The details of body 1 with the first frame that has them, paused at 2 s: (frame time, details)."""
+    async with websockets.connect(url.replace("http://", "ws://").rstrip("/") + "/ws", max_size=None) as ws:
+        await ws.send('{"type":"pause"}')
+        await ws.send('{"type":"seek","time":2.0}')
+        await ws.send('{"type":"select","body":1}')
+        deadline = time.monotonic() + 10
+        while time.monotonic() < deadline:
+            message = await asyncio.wait_for(ws.recv(), 10)
+            if not isinstance(message, bytes):
+                continue
+            magic, n, t, rate, late, sample = struct.unpack_from("<IIdfIQ", message)
+            at = 32 + 28 * n
+            (length,) = struct.unpack_from("<I", message, at)
+            trailer = json.loads(message[at + 4:at + 4 + length])
+            for d in trailer.get("details") or []:
+                if d["body"] == 1 and abs(t - 2.0) < 1e-9:
+                    return t, d
+    return None, None
+
+
+replayed = ViewedRun(ssx, None, None, replay=str(detailed))
+try:
+    t, d = asyncio.run(details_of(replayed.url))
+finally:
+    replayed.stop()
+if d is None:
+    problems.append("a robot selected in the replay: no details came with the frames at 2 s")
+else:
+    kinds = [m["kind"] for m in d["sensors"]]
+    print(f"replayed q1's details at {t:.3f} s: command {d['command']}, sensors {kinds}, v {d['v']}")
+    if d["name"] != "q1" or not d["command"] or "imu" not in kinds or len(d["v"]) != 3 or len(d["w"]) != 3:
+        problems.append(f"the replay's details of q1: {d}")
+    if ssx_module:
+        r = ssx_module.Recording(str(detailed))
+        commands = [m for at_s, m in r.channel("/ssx/commands") if at_s <= 2.0 + 1e-9]
+        sensors = [m for at_s, m in r.channel("/ssx/sensors") if at_s <= 2.0 + 1e-9]
+        if d["command"] != commands[-1]["q1"]:
+            problems.append(f"the replay's command of q1 {d['command']}, the recording's {commands[-1]['q1']}")
+        imu = next(m for m in d["sensors"] if m["kind"] == "imu")
+        recorded_imu = next(m for m in sensors[-1]["q1"].values() if m["kind"] == "imu")
+        if imu["accelerometer"] != recorded_imu["accelerometer"]:
+            problems.append(f"the replay's IMU of q1 {imu}, the recording's {recorded_imu}")
+
+
+def panel_in_browser():
+    try:
+        from selenium import webdriver
+        from selenium.webdriver.chrome.options import Options
+        from selenium.webdriver.chrome.service import Service
+    except ImportError:
+        return print("selenium is not installed: the replay's panel in a browser not tried")
+    from viewer_util import chromium_available
+    if not chromium_available():
+        return print("chromium is not installed: the replay's panel in a browser not tried")
+    options = Options()
+    for a in ("--headless=new", "--no-sandbox", "--use-angle=swiftshader", "--enable-unsafe-swiftshader",
+              "--window-size=1024,700", f"--user-data-dir={work}/profile_panel"):
+        options.add_argument(a)
+    page = webdriver.Chrome(service=Service("/usr/bin/chromedriver"), options=options)
+    played = ViewedRun(ssx, None, None, replay=str(detailed))
+    try:
+        page.get(played.url)
+        deadline = time.monotonic() + 60
+        while page.execute_script("return document.getElementById('robots').textContent") != "3":
+            if time.monotonic() > deadline:
+                return problems.append("the replay's page never showed its 3 robots")
+            time.sleep(0.2)
+        page.execute_script("window.ssxViewer.select(1)")
+        deadline, text = time.monotonic() + 20, ""
+        while time.monotonic() < deadline:
+            text = page.execute_script("return document.getElementById('selected').textContent")
+            if "command (" in text and "imu: accelerometer" in text:
+                break
+            time.sleep(0.2)
+        page.save_screenshot(str(work / "replay_panel.png"))
+        print("the replay's panel of q1:\n  " + text.replace("\n", "\n  "))
+        if "command (" not in text or "imu: accelerometer" not in text or "angular velocity" not in text:
+            problems.append(f"the replay's panel of q1 lacks its command, IMU or velocities: {text!r}")
+    finally:
+        page.quit()
+        played.stop()
+
+
+panel_in_browser()
 print("\n".join(problems) if problems else "the recording played on the page as recorded, at its speed, paused, "
-      "stepped and sought")
+      "stepped and sought; a robot's details as recorded")
 sys.exit(1 if problems else 0)
