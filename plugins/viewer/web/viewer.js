@@ -471,6 +471,10 @@ function record(rtf) {
       entry.speed = Math.hypot(p[k] - last.x, p[k + 1] - last.y, p[k + 2] - last.z) / (state.time - last.t);
     const d = state.details && state.details.body === i ? state.details : null;
     if (d && d.command && d.command.level === "velocity") entry.commanded = Math.hypot(...d.command.values.slice(0, 3));
+    // its sensors: the first IMU's specific force and turn rate, the first range sensor's nearest
+    const imu = d && d.sensors.find((m) => m.kind === "imu"), range = d && d.sensors.find((m) => m.kind === "range");
+    if (imu) entry.accel = Math.hypot(...imu.accelerometer), entry.gyro = Math.hypot(...imu.gyroscope);
+    if (range) entry.nearest = range.detections.reduce((n, x) => Math.min(n, x.distance), Infinity);
   }
   plotHistory.push(entry);
   while (plotHistory.length > 2 && plotHistory[0].t < state.time - 20) plotHistory.shift();
@@ -483,17 +487,27 @@ function record(rtf) {
   }
 }
 let plottedAt = 0;
-const plot = document.getElementById("plot");
+const plot = document.getElementById("plot"), sensorPlot = document.getElementById("sensor_plot");
 const kSeries = [["z", "height m", "#6fd3ff"], ["speed", "speed m/s", "#ffd34d"], ["commanded", "commanded m/s", "#ff8a65"],
                  ["rtf", "× real time", "#a5e07a"]];
+const kSensorSeries = [["accel", "|accel| m/s²", "#c792ea"], ["gyro", "|gyro| rad/s", "#f78c6c"],
+                       ["nearest", "nearest m", "#89ddff"]];
 function drawPlot() {
-  const g = plot.getContext("2d"), w = plot.width, h = plot.height;
+  state.plotted = drawSeries(plot, kSeries);
+  // the sensors' plot only for a robot that has some
+  const sensed = plotHistory.some((e) => Number.isFinite(e.accel) || Number.isFinite(e.nearest));
+  sensorPlot.hidden = !sensed;
+  state.sensorPlotted = sensed ? drawSeries(sensorPlot, kSensorSeries) : 0;
+}
+// each series over the last 20 s on `canvas`, scaled to its own range from 0; the samples drawn
+function drawSeries(canvas, series) {
+  const g = canvas.getContext("2d"), w = canvas.width, h = canvas.height;
   g.clearRect(0, 0, w, h);
-  if (plotHistory.length < 2) return;
+  if (plotHistory.length < 2) return 0;
   const t0 = plotHistory[0].t, t1 = Math.max(plotHistory[plotHistory.length - 1].t, t0 + 1e-6);
   g.font = "10px system-ui, sans-serif";
   let legend = 4;
-  for (const [key, name, colour] of kSeries) {
+  for (const [key, name, colour] of series) {
     const values = plotHistory.map((e) => e[key]).filter(Number.isFinite);
     if (values.length < 2) continue;
     const lo = Math.min(0, ...values), hi = Math.max(lo + 1e-3, ...values);
@@ -514,7 +528,7 @@ function drawPlot() {
     g.fillText(text, legend, h - 2);
     legend += g.measureText(text).width + 8;
   }
-  state.plotted = plotHistory.length;
+  return plotHistory.length;
 }
 
 // teleoperation of the selected robot, or of every robot (the formation): W/S (or the arrows)

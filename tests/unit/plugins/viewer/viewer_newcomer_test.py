@@ -7,7 +7,8 @@ The formation runs in real time with --view-wait for 8 simulated seconds:
 - the run holds after its first step until a page connects (it says so; the page's first frames
   are from the start, though it connected seconds later);
 - the ground has its grid; a robot found by name in the list is selected and followed: a ring
-  around it, its name on a label where it is drawn, and the plot of its height and speed drawing;
+  around it, its name on a label where it is drawn, and the plots of its height and speed and of its
+  sensors (IMU, range) drawing;
 - the camera cannot be put under the ground, and "reset view" brings back the first view;
 - in a narrow window (600 px) the panel fits in it;
 - when the run ends the page keeps its last frame and says how the run ended.
@@ -103,6 +104,11 @@ try:
                               "let n = 0; for (let k = 3; k < d.length; k += 4) n += d[k] > 0; return n")
     if plotted < 10 or lit < 200:
         problems.append(f"the plot: {plotted} samples, {lit} pixels drawn")
+    # its sensors' plot (an IMU and a range sensor: |accel|, |gyro|, the nearest robot), below it
+    sensed = "const c = document.getElementById('sensor_plot'), d = c.getContext('2d').getImageData(0, 0, c.width, c.height).data;" \
+             "let n = 0; for (let k = 3; k < d.length; k += 4) n += d[k] > 0; return [c.hidden, window.ssxViewer.state.sensorPlotted || 0, n]"
+    sensors = wait_until(page, sensed, lambda v: not v[0] and v[1] >= 5 and v[2] >= 150, problems, 30)
+    print(f"the sensors' plot: hidden {sensors[0]}, {sensors[1]} samples, {sensors[2]} pixels drawn")
     if screenshot:
         page.save_screenshot(screenshot)
 
