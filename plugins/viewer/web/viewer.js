@@ -27,14 +27,15 @@ const kFullBudget = Number(query.get("full")) > 0 ? Number(query.get("full")) : 
 // #view, where the orbit controls and the clicks are
 const view = document.getElementById("view");
 let renderer = null, smooth = null;
-function makeRenderer(antialias) {
-  if (renderer && smooth === antialias) return;
+function makeRenderer(antialias, shadows) {
+  if (renderer && smooth === antialias) return setShadows(shadows);
   if (renderer) {
     view.removeChild(renderer.domElement);
     renderer.dispose();
   }
   renderer = new THREE.WebGLRenderer({ antialias });
   smooth = antialias;
+  setShadows(shadows);
   renderer.setPixelRatio(window.devicePixelRatio);
   renderer.setSize(window.innerWidth, window.innerHeight);
   view.appendChild(renderer.domElement);
@@ -58,8 +59,37 @@ controls.addEventListener("change", () => {
 });
 scene.add(new THREE.HemisphereLight(0xffffff, 0x505050, 0.75));
 const sun = new THREE.DirectionalLight(0xffffff, 0.6);
-sun.position.set(0.35, 0.25, 0.9);
+const kSunDirection = new THREE.Vector3(0.35, 0.25, 0.9).normalize();
+sun.position.copy(kSunDirection);
 scene.add(sun);
+scene.add(sun.target);
+// Shadows on the ground, their edges filtered (PCF; as the snapshots draw them: a flying robot's
+// height shows in where its shadow falls), up to kSmoothBodies bodies (?shadows=1 or ?shadows=0 to
+// choose): a second drawing of every body and a shadow lookup per pixel, which software WebGL pays
+// for in frame rate (docs/viewer.md). The sun's shadow covers the bodies' box.
+sun.shadow.mapSize.set(1024, 1024);
+sun.shadow.bias = -0.0005;
+function setShadows(on) {
+  renderer.shadowMap.enabled = on;
+  renderer.shadowMap.type = THREE.PCFShadowMap;
+  sun.castShadow = on;
+  state.shadows = on;
+}
+const shadowBox = new THREE.Box3(), shadowCentre = new THREE.Vector3();
+function fitShadow(n) {
+  if (!state.shadows || n === 0) return;
+  const p = state.positions;
+  shadowBox.makeEmpty();
+  for (let i = 0; i < n; ++i) shadowBox.expandByPoint(at.set(p[7 * i], p[7 * i + 1], p[7 * i + 2]));
+  shadowBox.expandByScalar(2);
+  shadowBox.getCenter(shadowCentre);
+  shadowCentre.z = 0;
+  const r = Math.max(5, 0.5 * shadowBox.getSize(at).length() + 2), c = sun.shadow.camera;
+  sun.target.position.copy(shadowCentre);
+  sun.position.copy(shadowCentre).addScaledVector(kSunDirection, 2 * r);
+  c.left = c.bottom = -r, c.right = c.top = r, c.near = 0.1, c.far = 4 * r;
+  c.updateProjectionMatrix();
+}
 window.addEventListener("resize", () => {
   camera.aspect = window.innerWidth / window.innerHeight;
   camera.updateProjectionMatrix();
@@ -153,6 +183,8 @@ function buildScene(msg) {
   for (const shape of msg.world) {
     for (const g of geometries(shape)) {
       const mesh = new THREE.Mesh(g, material(shape));
+      mesh.receiveShadow = true;
+      mesh.castShadow = shape.kind !== "plane";
       if (shape.kind === "plane") {  // (drawn a little behind its grid's lines, which would flicker into it)
         mesh.material.polygonOffset = true;
         mesh.material.polygonOffsetFactor = 2;
@@ -176,8 +208,9 @@ function buildScene(msg) {
     }
   }
   state.bodies = msg.bodies;
-  const aa = query.get("aa");
-  makeRenderer(aa === null ? msg.bodies.length <= kSmoothBodies : aa !== "0");
+  const aa = query.get("aa"), shadows = query.get("shadows");
+  makeRenderer(aa === null ? msg.bodies.length <= kSmoothBodies : aa !== "0",
+               shadows === null ? msg.bodies.length <= kSmoothBodies : shadows !== "0");
   const members = msg.models.map(() => 0);
   msg.bodies.forEach((b) => members[b.model]++);
   const dots = msg.bodies.length > kFullBudget;
@@ -188,6 +221,7 @@ function buildScene(msg) {
       for (const g of geometries(shape)) {
         const mesh = new THREE.InstancedMesh(g, material(shape), Math.max(1, members[m]));
         mesh.instanceMatrix.setUsage(THREE.DynamicDrawUsage);
+        mesh.castShadow = mesh.receiveShadow = true;
         mesh.userData.model = m;
         mesh.frustumCulled = false;
         add(mesh);
@@ -642,6 +676,7 @@ function animate() {
   const now = performance.now();
   if (renderer && state.dirty) {
     state.dirty = false;
+    if (state.positions) fitShadow(state.positions.length / 7);
     renderer.render(scene, camera);
     state.drawn = state.positions;  // what the picture shows now
     state.fpsFrames++;
@@ -672,6 +707,12 @@ window.ssxViewer = {
     const v = new THREE.Vector3(p[k], p[k + 1], p[k + 2]).project(camera);
     if (v.z > 1) return null;
     return [((v.x + 1) / 2) * window.innerWidth, ((1 - v.y) / 2) * window.innerHeight];
+  },
+  // soft shadows on or off (for a test, and from the console): every material made again
+  shadows(on) {
+    setShadows(on);
+    scene.traverse((o) => { if (o.material) o.material.needsUpdate = true; });
+    state.dirty = true;
   },
   // the colour drawn at a point of the page (CSS pixels), as 0-255 RGBA
   pixel(x, y) {

@@ -79,6 +79,20 @@ try:
     if grids < 1 or not (shades[0] < shades[2] - 10 and shades[1] < shades[2] - 10):
         problems.append(f"no grid on the ground both ways: {grids} grids, green on a line along x {shades[0]}, "
                         f"along y {shades[1]}, in a cell {shades[2]}")
+    # soft shadows (70 robots: on by default): seen from above, the ground where pillar0 (at 6.5 0,
+    # 6 m tall) casts its shadow at 3 m up (the sun along 0.35 0.25 0.9: 1.17 m and 0.83 m back) is
+    # darker than when the same picture is drawn without shadows
+    shade = page.execute_script("""const v = window.ssxViewer;
+      v.controls.target.set(5.33, -0.83, 0); v.camera.position.set(5.34, -0.9, 8); v.controls.update();
+      const at = (x, y) => { const p = new THREE.Vector3(x, y, 0).project(v.camera);
+        return [((p.x + 1) / 2) * window.innerWidth, ((1 - p.y) / 2) * window.innerHeight]; };
+      const on = v.state.shadows; v.draw(); const lit = v.pixel(...at(5.33, -0.83))[1];
+      v.shadows(false); v.draw(); const plain = v.pixel(...at(5.33, -0.83))[1];
+      v.shadows(true); return [on, lit, plain];""")
+    print(f"pillar0's shadow on the ground: green {shade[1]} with shadows, {shade[2]} without")
+    if not shade[0] or not shade[1] < shade[2] - 15:
+        problems.append(f"no shadow of pillar0 on the ground: shadows on {shade[0]}, green {shade[1]} with them, "
+                        f"{shade[2]} without")
     page.execute_script("document.getElementById('reset').click()")
 
     # a robot by name: selected, followed, ringed, labelled, plotted
