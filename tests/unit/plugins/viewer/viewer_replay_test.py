@@ -287,35 +287,21 @@ else:
 
 
 def panel_in_browser():
+    from viewer_util import chromium_available, headless_chromium, wait_until
     try:
-        from selenium import webdriver
-        from selenium.webdriver.chrome.options import Options
-        from selenium.webdriver.chrome.service import Service
+        import selenium  # noqa: F401
     except ImportError:
         return print("selenium is not installed: the replay's panel in a browser not tried")
-    from viewer_util import chromium_available
     if not chromium_available():
         return print("chromium is not installed: the replay's panel in a browser not tried")
-    options = Options()
-    for a in ("--headless=new", "--no-sandbox", "--use-angle=swiftshader", "--enable-unsafe-swiftshader",
-              "--window-size=1024,700", f"--user-data-dir={work}/profile_panel"):
-        options.add_argument(a)
-    page = webdriver.Chrome(service=Service("/usr/bin/chromedriver"), options=options)
+    page = headless_chromium(work / "profile_panel")
     played = ViewedRun(ssx, None, None, replay=str(detailed))
     try:
         page.get(played.url)
-        deadline = time.monotonic() + 60
-        while page.execute_script("return document.getElementById('robots').textContent") != "3":
-            if time.monotonic() > deadline:
-                return problems.append("the replay's page never showed its 3 robots")
-            time.sleep(0.2)
+        wait_until(page, "return document.getElementById('robots').textContent", lambda v: v == "3", problems)
         page.execute_script("window.ssxViewer.select(1)")
-        deadline, text = time.monotonic() + 20, ""
-        while time.monotonic() < deadline:
-            text = page.execute_script("return document.getElementById('selected').textContent")
-            if "command (" in text and "imu: accelerometer" in text:
-                break
-            time.sleep(0.2)
+        text = wait_until(page, "return document.getElementById('selected').textContent",
+                          lambda v: "command (" in v and "imu: accelerometer" in v, problems, 20)
         page.save_screenshot(str(work / "replay_panel.png"))
         print("the replay's panel of q1:\n  " + text.replace("\n", "\n  "))
         if "command (" not in text or "imu: accelerometer" not in text or "angular velocity" not in text:
