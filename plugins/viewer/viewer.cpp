@@ -316,7 +316,7 @@ class Viewer final : public SimulationExtension {
   }
 
  private:
-  // a page's {"type":"select","body":I}: its details sent with the frames for 3 s (`locked`: mutex_ is held)
+  // a page's {"type":"select","body":I}: its details sent with the frames for 3 s (`lock_it` false: mutex_ is held)
   bool watch(const std::string& text, bool lock_it = true) {
     const auto body = jsonNumber(text, "body");
     std::unique_lock lock(mutex_, std::defer_lock);
@@ -327,6 +327,14 @@ class Viewer final : public SimulationExtension {
     details_asked_ |= watched_.count(index) == 0;
     watched_[index] = std::chrono::steady_clock::now();
     return true;
+  }
+
+  // the bodies a page selected in the last 3 s, the others forgotten (under mutex_)
+  std::vector<int> stillWatched(std::chrono::steady_clock::time_point now) {
+    std::erase_if(watched_, [&](const auto& w) { return now - w.second > std::chrono::seconds(3); });
+    std::vector<int> bodies;
+    for (const auto& w : watched_) bodies.push_back(w.first);
+    return bodies;
   }
 
   // a page's message about the recording played: true when understood
@@ -371,8 +379,7 @@ class Viewer final : public SimulationExtension {
         playback_->advance(std::chrono::duration<double>(now - last).count());
         last = now;
         k = playback_->sample(), paused = playback_->paused(), speed = playback_->speed();
-        std::erase_if(watched_, [&](const auto& w) { return now - w.second > std::chrono::seconds(3); });
-        for (const auto& w : watched_) watched.push_back(w.first);
+        watched = stillWatched(now);
         asked = std::exchange(details_asked_, false);
       }
       if (k == shown && paused == shown_paused && !asked && last - sent < std::chrono::seconds(1)) continue;
@@ -428,8 +435,7 @@ class Viewer final : public SimulationExtension {
     std::vector<int> bodies;
     {
       std::lock_guard lock(mutex_);
-      std::erase_if(watched_, [&](const auto& w) { return now - w.second > std::chrono::seconds(3); });
-      for (const auto& w : watched_) bodies.push_back(w.first);
+      bodies = stillWatched(now);
     }
     if (bodies.empty()) return {};
     std::string out = "[";
