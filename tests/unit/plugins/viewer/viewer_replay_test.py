@@ -244,10 +244,13 @@ if made.returncode != 0:
 async def details_of(url):
     """The details of body 1 with the first frame that has them, paused at 2 s: (frame time, details)."""
     async with websockets.connect(url.replace("http://", "ws://").rstrip("/") + "/ws", max_size=None) as ws:
+        # (the first frame first: the recording's bodies are known from then on; what comes before,
+        # on a loaded machine, may be dropped)
+        while not isinstance(await asyncio.wait_for(ws.recv(), 30), bytes):
+            pass
         await ws.send('{"type":"pause"}')
         await ws.send('{"type":"seek","time":2.0}')
-        # asked each second, as the page does (the protocol's rule; a selection that comes before the
-        # bodies are known, on a loaded machine, is dropped)
+        # asked each second, as the page does (the protocol's rule)
         deadline, asked = time.monotonic() + 30, 0.0
         while time.monotonic() < deadline:
             if time.monotonic() - asked >= 1.0:
