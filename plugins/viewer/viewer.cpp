@@ -127,6 +127,7 @@ class Viewer final : public SimulationExtension {
       }
       if (recording_->times().empty()) throw params.error("viewer: " + file + " holds no pose sample to play");
       playback_ = std::make_unique<viewer::Playback>(recording_->times());
+      playback_->resume();  // playing at once (here, not in its thread: a pause a page sends before it starts holds)
       replay_details_ = std::make_unique<viewer::ReplayDetails>(*recording_);
     }
     const bool loopback = web::isLoopback(bind);
@@ -363,10 +364,6 @@ class Viewer final : public SimulationExtension {
     auto last = std::chrono::steady_clock::now(), sent = last - std::chrono::hours(1);
     std::size_t shown = static_cast<std::size_t>(-1);
     bool shown_paused = false;
-    {
-      std::lock_guard lock(mutex_);
-      playback_->resume();
-    }
     for (;;) {
       std::size_t k = 0;
       bool paused = false, asked = false;
