@@ -66,10 +66,30 @@ class PyVectorEnvironment {
   std::size_t size() { return envs().size(); }
   std::size_t robots() { return envs().robotNames().size(); }
 
-  void step(std::int64_t n, const py::object& active) {
+  void step(std::int64_t n, const py::object& active, const py::object& level, const py::object& commands,
+            const py::object& states, const py::object& imu) {
     if (n < 0) throw py::value_error("ssx: step(n) needs n >= 0, got " + std::to_string(n));
     InUse use(busy_);
     ssx::VectorEnvironment& v = envs();
+    // commands and readings in the same pass over each copy (VectorEnvironment::step with StepIO)
+    ssx::VectorEnvironment::StepIO io;
+    Doubles rows;
+    py::array_t<double> states_out, imu_out;
+    if (!commands.is_none()) {
+      if (level.is_none()) throw py::value_error("ssx: step(commands=) needs level= too");
+      io.level = commandLevel(py::cast<std::string>(level));
+      rows = commandRows(commands);
+      io.commands = std::span<const double>(rows.data(), static_cast<std::size_t>(rows.size()));
+      io.columns = static_cast<std::size_t>(rows.shape(2));
+    }
+    if (!states.is_none()) {
+      states_out = output(states, ssx::kRobotStateSize, "step(states=)");
+      io.states = std::span<double>(states_out.mutable_data(), static_cast<std::size_t>(states_out.size()));
+    }
+    if (!imu.is_none()) {
+      imu_out = output(imu, 6, "step(imu=)");
+      io.imu = std::span<double>(imu_out.mutable_data(), static_cast<std::size_t>(imu_out.size()));
+    }
     using Flags = py::array_t<std::uint8_t, py::array::c_style | py::array::forcecast>;
     Flags flags;
     if (!active.is_none()) {
@@ -80,8 +100,46 @@ class PyVectorEnvironment {
     }
     const std::span<const std::uint8_t> mask =
         active.is_none() ? std::span<const std::uint8_t>() : std::span<const std::uint8_t>(flags.data(), v.size());
-    py::gil_scoped_release release;
-    v.step(n, mask);
+    try {
+      py::gil_scoped_release release;
+      if (commands.is_none() && states.is_none() && imu.is_none())
+        v.step(n, mask);
+      else
+        v.step(n, mask, io);
+    } catch (const ssx::ConfigError& e) {
+      throw py::value_error(configMessage(e));
+    }
+  }
+
+  static ssx::CommandLevel commandLevel(const std::string& level_name) {
+    const auto level = ssx::commandLevelFromName(level_name);
+    if (!level)
+      throw py::value_error("ssx: unknown command level '" + level_name +
+                            "': position, velocity, attitude, rates, rotors or wheels");
+    return *level;
+  }
+
+  // values as (num_envs, robots, columns) float64 rows (checked: the shape)
+  Doubles commandRows(const py::handle& values) {
+    Doubles a = Doubles::ensure(values);
+    if (!a) throw py::type_error("ssx: values must be an array of numbers");
+    if (a.ndim() != 3 || a.shape(0) != static_cast<py::ssize_t>(size()) ||
+        a.shape(1) != static_cast<py::ssize_t>(robots()))
+      throw py::value_error("ssx: values must have shape (num_envs, robots, columns) = (" + std::to_string(size()) +
+                            ", " + std::to_string(robots()) + ", columns)");
+    return a;
+  }
+
+  void checkCommands(const std::string& level_name, const py::handle& values) {
+    InUse use(busy_);
+    const ssx::CommandLevel level = commandLevel(level_name);
+    const Doubles a = commandRows(values);
+    try {
+      envs().checkCommands(level, std::span<const double>(a.data(), static_cast<std::size_t>(a.size())),
+                           static_cast<std::size_t>(a.shape(2)));
+    } catch (const ssx::ConfigError& e) {
+      throw py::value_error(configMessage(e));
+    }
   }
 
   // an (E, R, cols) float64 array: `out` when given (checked: shape, dtype, C order, writable), else a new one
@@ -157,23 +215,15 @@ class PyVectorEnvironment {
 
   void setCommands(const std::string& level_name, const py::handle& values) {
     InUse use(busy_);
-    const auto level = ssx::commandLevelFromName(level_name);
-    if (!level)
-      throw py::value_error("ssx: unknown command level '" + level_name +
-                            "': position, velocity, attitude, rates, rotors or wheels");
-    const Doubles a = Doubles::ensure(values);
-    if (!a) throw py::type_error("ssx: values must be an array of numbers");
-    if (a.ndim() != 3 || a.shape(0) != static_cast<py::ssize_t>(size()) ||
-        a.shape(1) != static_cast<py::ssize_t>(robots()))
-      throw py::value_error("ssx: values must have shape (num_envs, robots, columns) = (" + std::to_string(size()) +
-                            ", " + std::to_string(robots()) + ", columns)");
+    const ssx::CommandLevel level = commandLevel(level_name);
+    const Doubles a = commandRows(values);
     try {
       // (the drivers take them on the worker threads, where a plugin's log line needs the GIL)
       const std::span<const double> rows(a.data(), static_cast<std::size_t>(a.size()));
       const auto columns = static_cast<std::size_t>(a.shape(2));
       ssx::VectorEnvironment& v = envs();
       py::gil_scoped_release release;
-      v.setCommands(*level, rows, columns);
+      v.setCommands(level, rows, columns);
     } catch (const ssx::ConfigError& e) {
       throw py::value_error(configMessage(e));
     }
@@ -427,7 +477,14 @@ void bindVectorEnvironment(py::module_& m) {
       .def_property_readonly("timestep", &PyVectorEnvironment::timestep, "Physics timestep, s.")
       .def_property_readonly("threads", &PyVectorEnvironment::threads, "Threads stepping the copies.")
       .def("step", &PyVectorEnvironment::step, py::arg("n") = 1, py::arg("active") = py::none(),
-           "Steps every copy n times (GIL released); active: one flag per copy, only those flagged step.")
+           py::arg("level") = py::none(), py::arg("commands") = py::none(), py::arg("states") = py::none(),
+           py::arg("imu") = py::none(),
+           "Steps every copy n times (GIL released); active: one flag per copy, only those flagged step. With "
+           "commands= (and level=, as set_commands), states= and imu= (arrays as robot_states and imu fill), a "
+           "learning step in one pass over each copy: its rows sent, its steps, its readings; the copies not "
+           "flagged active are not sent theirs (checked all the same).")
+      .def("check_commands", &PyVectorEnvironment::checkCommands, py::arg("level"), py::arg("values"),
+           "Checks commands as set_commands does (ValueError naming the copy and robot), sending none.")
       .def("robot_states", &PyVectorEnvironment::robotStates, py::arg("out") = py::none(),
            "(num_envs, robots, 13): x y z, qw qx qy qz, vx vy vz, wx wy wz (world frame); into out= when given.")
       .def("imu", &PyVectorEnvironment::imu, py::arg("out") = py::none(),

@@ -254,8 +254,13 @@ class VectorEnvironment:
     @property
     def threads(self) -> int:
         """Threads stepping the copies."""
-    def step(self, n: int = 1, active: Optional[npt.ArrayLike] = None) -> None:
-        """Steps every copy n times (or only those flagged in active, one flag per copy)."""
+    def step(self, n: int = 1, active: Optional[npt.ArrayLike] = None, level: Optional[str] = None,
+             commands: Optional[npt.ArrayLike] = None, states: Optional[npt.NDArray[np.float64]] = None,
+             imu: Optional[npt.NDArray[np.float64]] = None) -> None:
+        """Steps every copy n times (or only those flagged in active, one flag per copy); with commands= (and
+        level=), states= and imu=, a learning step in one pass over each copy (rows of copies not active not sent)."""
+    def check_commands(self, level: str, values: npt.ArrayLike) -> None:
+        """Checks commands as set_commands does, sending none."""
     def robot_states(self, out: Optional[npt.NDArray[np.float64]] = None) -> npt.NDArray[np.float64]:
         """(num_envs, robots, 13): x y z, qw qx qy qz, vx vy vz, wx wy wz (world frame), into out= when given."""
     def imu(self, out: Optional[npt.NDArray[np.float64]] = None) -> npt.NDArray[np.float64]:

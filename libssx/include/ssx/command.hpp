@@ -113,6 +113,9 @@ class SSX_EXPORT CommandInterface : public SetpointInterface {
   /// What is wrong with this command for this driver (a level it does not take, the wrong number
   /// of rotors, Command::problem()), or an empty string.
   std::string refusal(const Command& command) const;
+  /// refusal() for a driver that takes the command's level or not (`accepts`) and has `rotors`
+  /// rotors: for a caller that asked the driver once (a learning batch's copies of one robot).
+  static std::string refusal(const Command& command, bool accepts, std::size_t rotors);
   /// Switches the driver to this command, held until the next one. Throws std::invalid_argument
   /// with refusal()'s message, leaving the driver as it was, for a command it refuses.
   virtual void setCommand(const Command& command) = 0;

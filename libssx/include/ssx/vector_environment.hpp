@@ -71,6 +71,25 @@ class SSX_EXPORT VectorEnvironment {
   /// in copy i throws StepError "copy i: ..." (the first copy that failed, by index) once every
   /// copy has stopped; the copies that did not fail went on to the end.
   void step(std::int64_t n, std::span<const std::uint8_t> active = {});
+  /// What one learning step gives the copies and reads back (VectorEnvironment::step with it).
+  struct StepIO {
+    CommandLevel level = CommandLevel::Position;  ///< the commands' level
+    std::span<const double> commands;  ///< size() x robots rows of `columns` numbers, as setCommands (empty: none)
+    std::size_t columns = 0;           ///< numbers per row of `commands`
+    std::span<double> states;          ///< robotStates's output after the steps (empty: not read)
+    std::span<double> imu;             ///< imuReadings's output after the steps (empty: not read)
+  };
+  /// A learning step in one pass over each copy, while its memory is at hand (a thousand copies
+  /// do not fit in the caches: passes of their own for commands and readings cost a tenth of a
+  /// Crazyflie's steps): as setCommands, step(n, active), robotStates and imuReadings one after
+  /// another, except that the copies left out by `active` are not sent their rows (they are
+  /// checked all the same); what a copy was sent before a reset, the reset restores over, so a
+  /// copy being reset takes its first command with its first step. Every row and output size is
+  /// checked before any copy changes (ConfigError as setCommands, robotStates, imuReadings).
+  void step(std::int64_t n, std::span<const std::uint8_t> active, const StepIO& io);
+  /// Checks commands as setCommands does (ConfigError "copy i, robot 'name': ..."), sending none:
+  /// for a caller that must know they are taken before it changes anything else.
+  void checkCommands(CommandLevel level, std::span<const double> values, std::size_t columns);
   /// Calls `fn(i)` for every copy i in parallel, on the worker threads (each i once).
   void forEach(const std::function<void(std::size_t)>& fn);
 
@@ -165,6 +184,16 @@ class SSX_EXPORT VectorEnvironment {
   void send(std::size_t r, const Command& command);
   // builds row r's command from `row` into staged_[r]: what is wrong with it ("" when nothing)
   std::string stageCommand(std::size_t r, CommandLevel level, std::span<const double> row);
+  // every row into staged_, checked (ConfigError for the first copy with a problem)
+  void stageCommands(CommandLevel level, std::span<const double> values, std::size_t columns);
+  // copy i's staged rows sent (or set waiting, for robots with a delay)
+  void deliverCommands(std::size_t i);
+  // the robots of copies [begin, end) into `out` (robotStates's layout, from copy `begin`)
+  void readStates(std::size_t begin, std::size_t end, double* out) const;
+  void readImu(std::size_t begin, std::size_t end, double* out) const;
+  // ConfigError unless `out` holds `width` numbers per robot of every copy
+  void checkOutput(std::span<const double> out, std::size_t width, const char* what) const;
+  void checkImus() const;
   // copy i's n steps, with the commands waiting (setCommandDelays) sent when they are due
   void stepCopy(std::size_t i, std::int64_t n);
   std::vector<Scene> scenes_;
@@ -177,6 +206,10 @@ class SSX_EXPORT VectorEnvironment {
   std::vector<CommandInterface*> commands_;
   std::vector<std::vector<int>> bodies_;  // per copy, per robot: its moving bodies
   std::vector<const Sensor*> imus_;       // per copy, per robot: its first IMU sensor, or nullptr
+  // per robot (every copy is the scene of copy 0): the command levels its driver takes (bit
+  // 1 << level) and its rotors, asked once: checking a batch's commands touches no driver
+  std::vector<std::uint8_t> accepts_;
+  std::vector<std::size_t> rotor_counts_;
   std::vector<int> robot_of_body_;        // per body of a copy: its robot, or -1
   // actuation latency (setCommandDelays; all empty until it is first called), per copy per robot:
   // the delay in steps, the steps until the waiting command is sent (-1: none waits), the command

@@ -94,6 +94,14 @@ VectorEnvironment::VectorEnvironment(const std::function<Scene(std::size_t)>& lo
     }
     bodies_.push_back(std::move(bodies));
   }
+  for (std::size_t r = 0; r < robot_names_.size(); ++r) {
+    const CommandInterface* driver = commands_[r];
+    std::uint8_t levels = 0;
+    for (const CommandLevel level : kCommandLevels)
+      if (driver != nullptr && driver->acceptsCommand(level)) levels |= static_cast<std::uint8_t>(1u << static_cast<unsigned>(level));
+    accepts_.push_back(levels);
+    rotor_counts_.push_back(driver != nullptr ? driver->rotorCount() : 0);
+  }
   robot_of_body_.assign(envs_[0]->bodyCount(), -1);
   for (std::size_t r = 0; r < robot_names_.size(); ++r)
     for (const int b : bodies_[r]) robot_of_body_[static_cast<std::size_t>(b)] = static_cast<int>(r);
@@ -169,6 +177,29 @@ void VectorEnvironment::step(std::int64_t n, std::span<const std::uint8_t> activ
   if (n == 0) return;
   forEach([&](std::size_t i) {
     if (active.empty() || active[i] != 0) stepCopy(i, n);
+  });
+}
+
+void VectorEnvironment::step(std::int64_t n, std::span<const std::uint8_t> active, const StepIO& io) {
+  if (n < 0) throw ConfigError({}, "a vector environment steps n >= 0 times, got " + std::to_string(n));
+  if (!active.empty() && active.size() != envs_.size())
+    throw ConfigError({}, "a vector environment of " + std::to_string(envs_.size()) + " copies was given " +
+                              std::to_string(active.size()) + " flags of which copies step");
+  if (!io.states.empty()) checkOutput(io.states, kRobotStateSize, "robotStates");
+  if (!io.imu.empty()) {
+    checkOutput(io.imu, 6, "imuReadings");
+    checkImus();
+  }
+  const bool commanded = !io.commands.empty();
+  if (commanded) stageCommands(io.level, io.commands, io.columns);
+  const std::size_t robots = robot_names_.size();
+  forEach([&](std::size_t i) {
+    if (active.empty() || active[i] != 0) {
+      if (commanded) deliverCommands(i);
+      if (n > 0) stepCopy(i, n);
+    }
+    if (!io.states.empty()) readStates(i, i + 1, io.states.data() + i * robots * kRobotStateSize);
+    if (!io.imu.empty()) readImu(i, i + 1, io.imu.data() + i * robots * 6);
   });
 }
 
@@ -298,27 +329,34 @@ void VectorEnvironment::vary(std::span<const std::size_t> which, std::string_vie
   });
 }
 
-void VectorEnvironment::robotStates(std::span<double> out) const {
+void VectorEnvironment::checkOutput(std::span<const double> out, std::size_t width, const char* what) const {
   const std::size_t robots = robot_names_.size();
-  if (out.size() != envs_.size() * robots * kRobotStateSize)
-    throw ConfigError({}, "robotStates needs " + std::to_string(envs_.size()) + " x " + std::to_string(robots) + " x " +
-                              std::to_string(kRobotStateSize) + " numbers, got " + std::to_string(out.size()));
+  if (out.size() != envs_.size() * robots * width)
+    throw ConfigError({}, std::string(what) + " needs " + std::to_string(envs_.size()) + " x " + std::to_string(robots) +
+                              " x " + std::to_string(width) + " numbers, got " + std::to_string(out.size()));
+}
+
+void VectorEnvironment::readStates(std::size_t begin, std::size_t end, double* out) const {
+  const std::size_t robots = robot_names_.size();
+  for (std::size_t r = begin * robots; r < end * robots; ++r) {
+    const BodyState& s = roots_[r]->state();
+    const Vec3& x = s.pose.position;
+    const Quat& q = s.pose.orientation;
+    const Vec3& v = s.linear_velocity;
+    const Vec3& w = s.angular_velocity;
+    double* p = out + (r - begin * robots) * kRobotStateSize;
+    p[0] = x.x(), p[1] = x.y(), p[2] = x.z();
+    p[3] = q.w(), p[4] = q.x(), p[5] = q.y(), p[6] = q.z();
+    p[7] = v.x(), p[8] = v.y(), p[9] = v.z();
+    p[10] = w.x(), p[11] = w.y(), p[12] = w.z();
+  }
+}
+
+void VectorEnvironment::robotStates(std::span<double> out) const {
+  checkOutput(out, kRobotStateSize, "robotStates");
   // the copies in parallel: each robot's state is a few dependent loads into its own world
-  auto read = [&](std::size_t begin, std::size_t end) {
-    for (std::size_t r = begin * robots; r < end * robots; ++r) {
-      const BodyState& s = roots_[r]->state();
-      const Vec3& x = s.pose.position;
-      const Quat& q = s.pose.orientation;
-      const Vec3& v = s.linear_velocity;
-      const Vec3& w = s.angular_velocity;
-      double* p = out.data() + r * kRobotStateSize;
-      p[0] = x.x(), p[1] = x.y(), p[2] = x.z();
-      p[3] = q.w(), p[4] = q.x(), p[5] = q.y(), p[6] = q.z();
-      p[7] = v.x(), p[8] = v.y(), p[9] = v.z();
-      p[10] = w.x(), p[11] = w.y(), p[12] = w.z();
-    }
-  };
-  forChunks(read);
+  const std::size_t robots = robot_names_.size();
+  forChunks([&](std::size_t begin, std::size_t end) { readStates(begin, end, out.data() + begin * robots * kRobotStateSize); });
 }
 
 void VectorEnvironment::forChunks(const std::function<void(std::size_t, std::size_t)>& fn) const {
@@ -327,21 +365,25 @@ void VectorEnvironment::forChunks(const std::function<void(std::size_t, std::siz
                              chunked);
 }
 
-void VectorEnvironment::imuReadings(std::span<double> out) const {
-  const std::size_t robots = robot_names_.size();
-  if (out.size() != envs_.size() * robots * 6)
-    throw ConfigError({}, "imuReadings needs " + std::to_string(envs_.size()) + " x " + std::to_string(robots) +
-                              " x 6 numbers, got " + std::to_string(out.size()));
-  for (std::size_t r = 0; r < robots; ++r)
+void VectorEnvironment::checkImus() const {
+  for (std::size_t r = 0; r < robot_names_.size(); ++r)
     if (imus_[r] == nullptr)
       throw ConfigError(
           {}, "robot '" + robot_names_[r] + "' has no IMU sensor to read (add <sensor plugin=\"imu\"/> to its type)");
-  double* p = out.data();
-  for (const Sensor* sensor : imus_) {
-    const auto& m = static_cast<const ImuMeasurement&>(sensor->latest());
-    for (int k = 0; k < 3; ++k) p[k] = m.accelerometer[k], p[3 + k] = m.gyroscope[k];
-    p += 6;
+}
+
+void VectorEnvironment::readImu(std::size_t begin, std::size_t end, double* out) const {
+  const std::size_t robots = robot_names_.size();
+  for (std::size_t r = begin * robots; r < end * robots; ++r, out += 6) {
+    const auto& m = static_cast<const ImuMeasurement&>(imus_[r]->latest());
+    for (int k = 0; k < 3; ++k) out[k] = m.accelerometer[k], out[3 + k] = m.gyroscope[k];
   }
+}
+
+void VectorEnvironment::imuReadings(std::span<double> out) const {
+  checkOutput(out, 6, "imuReadings");
+  checkImus();
+  readImu(0, envs_.size(), out.data());
 }
 
 void VectorEnvironment::moveRobots(std::span<const std::size_t> which, std::span<const double> offsets,
@@ -378,56 +420,70 @@ void VectorEnvironment::moveRobots(std::span<const std::size_t> which, std::span
 }
 
 void VectorEnvironment::setCommands(CommandLevel level, std::span<const double> values, std::size_t columns) {
+  stageCommands(level, values, columns);
+  // (the copies in parallel: a robot's driver is far in memory from the next one's; each thread
+  // touches its own)
+  forChunks([&](std::size_t begin, std::size_t end) {
+    for (std::size_t i = begin; i < end; ++i) deliverCommands(i);
+  });
+}
+
+void VectorEnvironment::checkCommands(CommandLevel level, std::span<const double> values, std::size_t columns) {
+  stageCommands(level, values, columns);
+}
+
+void VectorEnvironment::stageCommands(CommandLevel level, std::span<const double> values, std::size_t columns) {
   const std::size_t robots = robot_names_.size();
   const std::size_t rows = envs_.size() * robots;
   if (values.size() != rows * columns)
     throw ConfigError({}, "commands for a vector environment need " + std::to_string(envs_.size()) + " x " +
                               std::to_string(robots) + " rows of " + std::to_string(columns) + " numbers, got " +
                               std::to_string(values.size()) + " numbers");
-  // every row checked before any robot gets one (the copies in parallel: a robot's driver is
-  // far in memory from the next one's; each thread touches its own), the first problem by copy
-  // index reported; the commands built here are what is sent
+  // every row checked before any robot gets one, the first problem by copy index reported; the
+  // commands built here are what is sent
   staged_.resize(rows);
   problems_.resize(envs_.size());
-  auto check = [&](std::size_t begin, std::size_t end) {
+  forChunks([&](std::size_t begin, std::size_t end) {
     for (std::size_t i = begin; i < end; ++i) {
       problems_[i].clear();
       for (std::size_t r = i * robots; r < (i + 1) * robots && problems_[i].empty(); ++r)
         problems_[i] = stageCommand(r, level, values.subspan(r * columns, columns));
     }
-  };
-  forChunks(check);
+  });
   for (const std::string& problem : problems_)
     if (!problem.empty()) throw ConfigError({}, problem);
-  auto deliver = [&](std::size_t begin, std::size_t end) {
-    for (std::size_t r = begin * robots; r < end * robots; ++r) {
-      if (delays_.empty() || delays_[r] == 0) {
-        send(r, staged_[r]);
-        continue;
-      }
-      if (remaining_[r] >= 0) send(r, waiting_[r]);  // overtaken: it takes effect now
-      waiting_[r] = staged_[r];
-      remaining_[r] = delays_[r];
-      copy_waits_[r / robots] = 1;
+}
+
+void VectorEnvironment::deliverCommands(std::size_t i) {
+  const std::size_t robots = robot_names_.size();
+  for (std::size_t r = i * robots; r < (i + 1) * robots; ++r) {
+    if (delays_.empty() || delays_[r] == 0) {
+      send(r, staged_[r]);
+      continue;
     }
-  };
-  forChunks(deliver);
+    if (remaining_[r] >= 0) send(r, waiting_[r]);  // overtaken: it takes effect now
+    waiting_[r] = staged_[r];
+    remaining_[r] = delays_[r];
+    copy_waits_[i] = 1;
+  }
 }
 
 std::string VectorEnvironment::stageCommand(std::size_t r, CommandLevel level, std::span<const double> row) {
   const std::size_t robots = robot_names_.size();
   auto who = [&] { return "copy " + std::to_string(r / robots) + ", robot '" + robot_names_[r % robots] + "'"; };
-  CommandInterface* target = commands_[r];
+  const CommandInterface* target = commands_[r];  // (asked nothing: its answers are kept per robot)
   if (target == nullptr && level != CommandLevel::Position)
     return who() + " takes set-points only, no commands at the " + commandLevelName(level) + " level";
-  const std::size_t rotors = target != nullptr ? target->rotorCount() : 0;
+  const std::size_t robot = r % robots, rotors = rotor_counts_[robot];
   if (!Command::rowSizeFits(level, row.size(), rotors))
     return "a " + std::string(commandLevelName(level)) + " command for " + who() + " has " +
            Command::rowSizes(level, rotors) + " values, got " + std::to_string(row.size());
   for (const double x : row)
     if (!std::isfinite(x)) return "the command for " + who() + " holds a NaN or an infinity";
   staged_[r] = Command::fromRow(level, row);
-  const std::string why = target != nullptr ? target->refusal(staged_[r]) : staged_[r].problem();
+  const bool accepts = ((accepts_[robot] >> static_cast<unsigned>(level)) & 1u) != 0;
+  const std::string why =
+      target != nullptr ? CommandInterface::refusal(staged_[r], accepts, rotors) : staged_[r].problem();
   return why.empty() ? why : who() + ": " + why;
 }
 

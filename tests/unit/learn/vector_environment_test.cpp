@@ -261,3 +261,63 @@ TEST_CASE("vector environment: a command delayed by some steps takes effect then
     CHECK_THROWS_WITH(v.setCommandDelays(second, std::span(delays).first(1)), Contains("need 2 numbers, got 1"));
   }
 }
+
+TEST_CASE("vector environment: a learning step in one pass over each copy is commands, steps and readings in turn",
+          "[learn]") {
+  // two batches of the same copies, one stepped in one pass, the other call by call as a learning
+  // loop did: commands to all, the resets, the steps of the copies not reset, the readings
+  auto load = [](std::size_t) { return crazyflies(2); };
+  const std::size_t copies = 4, robots = 2;
+  for (const int threads : {1, 2}) {
+    VectorEnvironment fused(load, copies, threads), apart(load, copies, 1);
+    fused.step(400);
+    apart.step(400);
+    const std::vector<std::byte> start = fused[0].saveState();
+    // copy 1's robots take commands 3 and 5 steps late (the commands waiting are per copy)
+    const std::array<std::size_t, 1> late{1};
+    const std::array<std::int64_t, 2> delays{3, 5};
+    fused.setCommandDelays(late, delays);
+    apart.setCommandDelays(late, delays);
+    std::vector<double> commands(copies * robots * 4), states(copies * robots * kRobotStateSize),
+        imu(copies * robots * 6), states_apart(states.size()), imu_apart(imu.size());
+    std::uint64_t lcg = 7;
+    auto draw = [&lcg] {
+      lcg = lcg * 6364136223846793005ULL + 1442695040888963407ULL;
+      return static_cast<double>(lcg >> 11) * 0x1p-53 - 0.5;
+    };
+    for (int batch = 0; batch < 30; ++batch) {
+      for (std::size_t k = 0; k < commands.size(); k += 4)  // attitude rows: roll, pitch, yaw rate, thrust
+        commands[k] = 0.2 * draw(), commands[k + 1] = 0.2 * draw(), commands[k + 2] = draw(),
+        commands[k + 3] = 0.3 + 0.05 * draw();
+      // every seventh batch copies 1 and 2 start again, and stay where they are for that batch
+      std::vector<std::uint8_t> active(copies, 1);
+      std::vector<std::size_t> resetting;
+      if (batch % 7 == 6) resetting = {1, 2};
+      const std::vector<std::uint64_t> seeds(resetting.size(), static_cast<std::uint64_t>(batch));
+      for (const std::size_t i : resetting) active[i] = 0;
+      apart.setCommands(CommandLevel::Attitude, commands, 4);
+      apart.reset(resetting, start, seeds);
+      apart.step(10, active);
+      apart.robotStates(states_apart);
+      apart.imuReadings(imu_apart);
+      fused.checkCommands(CommandLevel::Attitude, commands, 4);
+      fused.reset(resetting, start, seeds);
+      fused.step(10, active, {CommandLevel::Attitude, commands, 4, states, imu});
+      CHECK(hashes(fused) == hashes(apart));
+      CHECK(states == states_apart);
+      CHECK(imu == imu_apart);
+    }
+    CHECK(fused[1].stateHash() != fused[3].stateHash());  // (the commands and their delays made a difference)
+    // refused whole before any copy changes: a NaN in the last row, outputs of the wrong size
+    const std::vector<std::uint64_t> before = hashes(fused);
+    commands.back() = std::nan("");
+    CHECK_THROWS_WITH(fused.step(10, {}, {CommandLevel::Attitude, commands, 4, states, imu}),
+                      Contains("copy 3, robot 'cf1'"));
+    commands.back() = 0.3;
+    CHECK_THROWS_WITH(fused.step(10, {}, {CommandLevel::Attitude, commands, 4, std::span(states).first(13), imu}),
+                      Contains("robotStates needs 4 x 2 x 13"));
+    CHECK_THROWS_WITH(fused.step(10, {}, {CommandLevel::Attitude, commands, 4, states, std::span(imu).first(6)}),
+                      Contains("imuReadings needs 4 x 2 x 6"));
+    CHECK(hashes(fused) == before);
+  }
+}
