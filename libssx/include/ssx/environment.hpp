@@ -366,6 +366,13 @@ class SSX_EXPORT Environment {
   void setBodyState(int i, const BodyState& state);
   /// A 64-bit hash (FNV-1a) of every body's pose and velocities, bit for bit, and the time.
   std::uint64_t stateHash() const;
+  /// Appends to `out` the memory the next step reads first: the world's tables, its artifacts,
+  /// plugins and the engine's bodies. For a caller that steps many small environments in turn (a
+  /// learning batch's copies): asking the processor for the next one's while this one steps
+  /// hides the wait for memory (VectorEnvironment does). Valid until the environment is
+  /// restored or changes its artifacts; nothing for an environment of more than 16 artifacts
+  /// (its phases prefetch as they go).
+  void hotMemory(std::vector<MemoryRange>& out) const;
   /// The artifact body `i` belongs to (std::out_of_range for another index).
   const Artifact& bodyOwner(int i) const;
   /// Keeps the contacts of every step from now on (on), or stops (off: the default, since a swarm

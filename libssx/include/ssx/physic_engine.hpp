@@ -146,6 +146,12 @@ class SSX_EXPORT TaskRunner {
   virtual void forEach(std::size_t n, void (*task)(void* context, std::size_t i), void* context) = 0;
 };
 
+/// A block of memory: `bytes` from `address` (Environment::hotMemory).
+struct MemoryRange {
+  const void* address = nullptr;
+  std::size_t bytes = 0;
+};
+
 /// An abstract rigid-body engine. Bodies are created with their centre of mass at the body
 /// origin; the Environment flattens node trees into bodies. Called from one thread at a time
 /// (the thread calling Environment::step), never from the parallel phases; it may use the
@@ -209,6 +215,8 @@ class SSX_EXPORT PhysicEngine {
   virtual void setState(int body, const BodyState& state) = 0;
   /// How many dynamic bodies were added.
   virtual std::size_t bodyCount() const = 0;
+  /// Appends the memory the next step reads first (Environment::hotMemory). Default: nothing.
+  virtual void hotMemory(std::vector<MemoryRange>& out) const { (void)out; }
   /// Contacts generated in the last step.
   virtual std::size_t contactCount() const = 0;
   /// Whether contacts() lists the contacts of each step from now on (off: nothing is kept, and

@@ -177,6 +177,13 @@ class SSX_EXPORT VectorEnvironment {
   // fn(which[k], k) for every k in parallel (every copy, fn(i, i), for `which` empty), the first
   // failure by copy index rethrown as that copy's
   void forEachOf(std::span<const std::size_t> which, const std::function<void(std::size_t, std::size_t)>& fn);
+  // fn(i) for every copy in parallel, each thread taking runs of copies and asking for the next
+  // copy's memory while fn runs (its hot lines); failures as forEachOf
+  void forEachInChunks(const std::function<void(std::size_t)>& fn);
+  // the first failure of the last forEach by copy index, rethrown as that copy's (errors cleared)
+  void rethrowFirst();
+  // copy i's hot lines (Environment::hotMemory), again after it was restored
+  void findHotLines(std::size_t i);
   // fn(begin, end) over the copies [0, size()) in chunks, on the worker threads (the first
   // exception fn throws is rethrown: not by copy index, as forEachOf does)
   void forChunks(const std::function<void(std::size_t, std::size_t)>& fn) const;
@@ -217,6 +224,11 @@ class SSX_EXPORT VectorEnvironment {
   std::vector<Command> waiting_;
   std::vector<std::uint8_t> copy_waits_;  // per copy: a command of one of its robots waits
   std::vector<Command> staged_;           // setCommands's, per copy per robot (kept: no allocation per call)
+  // per copy, the cache lines its next step reads first (Environment::hotMemory), kHotLines a
+  // copy, hot_count_[i] of them used: read in order, with no load waiting on another
+  static constexpr std::size_t kHotLines = 256;
+  std::vector<const char*> hot_lines_;
+  std::vector<std::uint16_t> hot_count_;
   mutable std::vector<std::string> problems_;  // setCommands's and cameraImages's, per copy
   std::unique_ptr<Pool> pool_;
 };

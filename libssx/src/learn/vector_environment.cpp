@@ -84,6 +84,9 @@ VectorEnvironment::VectorEnvironment(const std::function<Scene(std::size_t)>& lo
   }
   pool_ = std::make_unique<Pool>(pool_threads, count);
   forEach([&](std::size_t i) { envs_[i]->start(); });
+  hot_lines_.resize(count * kHotLines);
+  hot_count_.resize(count);
+  forEach([&](std::size_t i) { findHotLines(i); });
   // bodies are numbered at start
   for (const Artifact* artifact : artifacts_) {
     std::vector<int> bodies;
@@ -142,6 +145,25 @@ void VectorEnvironment::forEachOf(std::span<const std::size_t> which,
     body(0, 1);  // one copy (a reset in the middle of a batch): waking the pool would cost more
   else
     pool_->workers.parallelFor(n, 1, body);
+  rethrowFirst();
+}
+
+void VectorEnvironment::findHotLines(std::size_t i) {
+  std::vector<MemoryRange> ranges;
+  envs_[i]->hotMemory(ranges);
+  const char** line = hot_lines_.data() + i * kHotLines;
+  std::size_t count = 0;
+  for (const MemoryRange& range : ranges) {
+    const auto first = reinterpret_cast<std::uintptr_t>(range.address) & ~std::uintptr_t{63};
+    const auto end = reinterpret_cast<std::uintptr_t>(range.address) + range.bytes;
+    for (std::uintptr_t at = first; at < end && count < kHotLines; at += 64)
+      if (count == 0 || line[count - 1] != reinterpret_cast<const char*>(at)) line[count++] = reinterpret_cast<const char*>(at);
+  }
+  hot_count_[i] = static_cast<std::uint16_t>(count);
+}
+
+void VectorEnvironment::rethrowFirst() {
+  std::vector<std::exception_ptr>& errors = pool_->errors;
   const auto first = std::find_if(errors.begin(), errors.end(), [](const auto& e) { return static_cast<bool>(e); });
   if (first == errors.end()) return;
   std::vector<std::exception_ptr> failed;
@@ -175,7 +197,7 @@ void VectorEnvironment::step(std::int64_t n, std::span<const std::uint8_t> activ
     throw ConfigError({}, "a vector environment of " + std::to_string(envs_.size()) + " copies was given " +
                               std::to_string(active.size()) + " flags of which copies step");
   if (n == 0) return;
-  forEach([&](std::size_t i) {
+  forEachInChunks([&](std::size_t i) {
     if (active.empty() || active[i] != 0) stepCopy(i, n);
   });
 }
@@ -193,7 +215,7 @@ void VectorEnvironment::step(std::int64_t n, std::span<const std::uint8_t> activ
   const bool commanded = !io.commands.empty();
   if (commanded) stageCommands(io.level, io.commands, io.columns);
   const std::size_t robots = robot_names_.size();
-  forEach([&](std::size_t i) {
+  forEachInChunks([&](std::size_t i) {
     if (active.empty() || active[i] != 0) {
       if (commanded) deliverCommands(i);
       if (n > 0) stepCopy(i, n);
@@ -201,6 +223,26 @@ void VectorEnvironment::step(std::int64_t n, std::span<const std::uint8_t> activ
     if (!io.states.empty()) readStates(i, i + 1, io.states.data() + i * robots * kRobotStateSize);
     if (!io.imu.empty()) readImu(i, i + 1, io.imu.data() + i * robots * 6);
   });
+}
+
+void VectorEnvironment::forEachInChunks(const std::function<void(std::size_t)>& fn) {
+  std::vector<std::exception_ptr>& errors = pool_->errors;
+  const std::size_t n = envs_.size();
+  auto body = [&](std::size_t begin, std::size_t end) {
+    for (std::size_t i = begin; i < end; ++i) {
+      if (i + 1 < end) {
+        const char* const* line = hot_lines_.data() + (i + 1) * kHotLines;
+        for (std::size_t k = 0; k < hot_count_[i + 1]; ++k) __builtin_prefetch(line[k]);
+      }
+      try {
+        fn(i);
+      } catch (...) {
+        errors[i] = std::current_exception();
+      }
+    }
+  };
+  pool_->workers.parallelFor(n, std::max<std::size_t>(1, n / (pool_->workers.size() * 8)), body);
+  rethrowFirst();
 }
 
 void VectorEnvironment::stepCopy(std::size_t i, std::int64_t n) {
@@ -268,6 +310,7 @@ void VectorEnvironment::reset(std::span<const std::size_t> which, std::span<cons
   forEachOf(which, [&](std::size_t i, std::size_t k) {
     envs_[i]->restoreChecked(state);
     envs_[i]->reseed(seeds[k]);
+    findHotLines(i);
   });
   if (copy_waits_.empty()) return;
   const std::size_t robots = robot_names_.size();

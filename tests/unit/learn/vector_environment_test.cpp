@@ -321,3 +321,36 @@ TEST_CASE("vector environment: a learning step in one pass over each copy is com
     CHECK(hashes(fused) == before);
   }
 }
+
+TEST_CASE("vector environment: a copy's hot memory holds its artifacts, plugins and bodies; a large world lists none",
+          "[learn]") {
+  // what VectorEnvironment asks the processor for, for the next copy while one steps
+  Scene small = crazyflies(2);
+  Environment& env = *small.environment;
+  env.start();
+  std::vector<MemoryRange> ranges;
+  env.hotMemory(ranges);
+  auto holds = [&ranges](const void* p) {
+    return std::any_of(ranges.begin(), ranges.end(), [p](const MemoryRange& r) {
+      const auto* begin = static_cast<const char*>(r.address);
+      return static_cast<const char*>(p) >= begin && static_cast<const char*>(p) < begin + r.bytes;
+    });
+  };
+  for (std::size_t a = 0; a < env.artifactCount(); ++a) {
+    const Artifact& artifact = std::as_const(env).artifact(a);
+    CHECK(holds(&artifact));
+    if (artifact.driver() != nullptr) CHECK(holds(artifact.driver()));
+    for (std::size_t k = 0; k < artifact.sensorCount(); ++k) CHECK(holds(&artifact.sensor(k)));
+  }
+  const std::size_t before = ranges.size();
+  CHECK(before > 10);  // the world's tables and the engine's bodies and geoms besides
+  env.step(10);
+  std::vector<MemoryRange> again;
+  env.hotMemory(again);
+  CHECK(again.size() == before);
+  Scene large = crazyflies(17);
+  large.environment->start();
+  std::vector<MemoryRange> none;
+  large.environment->hotMemory(none);
+  CHECK(none.empty());
+}

@@ -463,6 +463,19 @@ void OdeEngine::logContacts(double h) {
   }
 }
 
+void OdeEngine::hotMemory(std::vector<MemoryRange>& out) const {
+  out.push_back({this, sizeof *this});
+  out.push_back({bodies_.data(), bodies_.size() * sizeof(Body)});
+  for (std::size_t p = 0; p < used_partitions_; ++p) out.push_back({partitions_[p].world, 512});
+  // (ODE's own structs: a body is about 600 bytes, a geom about 200)
+  for (const Body& body : bodies_) {
+    out.push_back({body.id, 640});
+    out.push_back({body.geoms.data(), body.geoms.size() * sizeof(Geom)});
+    for (const Geom& g : body.geoms) out.push_back({g.id, 256});
+  }
+  for (const dGeomID plane : planes_) out.push_back({plane, 256});
+}
+
 void OdeEngine::readStates(std::span<BodyState> out) const {
   for (std::size_t i = 0; i < bodies_.size(); ++i) {
     dBodyID b = bodies_[i].id;

@@ -92,6 +92,7 @@ class OdeEngine final : public PhysicEngine {
   bool isKinematic(int body) const override;
   void setMassScale(int body, double mass_factor, double inertia_factor) override;
   int addStatic(const std::vector<Shape>& shapes, const Pose& pose) override;
+  void hotMemory(std::vector<MemoryRange>& out) const override;
   void setTaskRunner(TaskRunner* runner) override { runner_ = runner; }
   void step(Nanoseconds dt, std::span<const Wrench> wrenches) override;
   void readStates(std::span<BodyState> out) const override;
