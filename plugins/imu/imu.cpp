@@ -12,6 +12,8 @@
 #include <ssx/measurements.hpp>
 #include <ssx/plugin_abi.hpp>
 
+#include "counts.hpp"
+
 #include <cmath>
 #include <cstdio>
 
@@ -75,7 +77,7 @@ struct Channel {
       const double m = scale * (truth[i] + turn_on_bias[i] + bias[i] + white);
       // saturated before the conversion: a crash can read far beyond the range
       const double scaled = std::clamp(m / lsb, -max_count, max_count);
-      const std::int64_t c = std::llround(scaled);
+      const std::int64_t c = roundCounts(scaled);
       counts[static_cast<std::size_t>(i)] = static_cast<std::int32_t>(c);
       out[i] = static_cast<double>(c) * lsb;
     }

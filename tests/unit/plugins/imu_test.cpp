@@ -1,11 +1,15 @@
 // The IMU sensor: noise of its density (sample deviation and Allan deviation), +1 g upwards at rest,
-// and the body's rate on the gyroscope.
+// and the body's rate on the gyroscope; its counts rounded as std::llround does.
 #include <ssx/ssx.hpp>
+
+#include "../../../plugins/imu/counts.hpp"
 
 #include <catch2/catch.hpp>
 
 #include <cmath>
 #include <filesystem>
+#include <limits>
+#include <random>
 #include <vector>
 
 using namespace ssx;
@@ -98,4 +102,24 @@ TEST_CASE("the accelerometer reads +1 g upwards at rest and the gyroscope the bo
   CHECK(imu.accelerometer.z() == Approx(9.81).margin(0.02));
   CHECK(std::abs(imu.accelerometer.x()) < 0.02);
   CHECK(imu.accelerometer_counts[2] == std::llround(imu.accelerometer.z() / imu.accelerometer_lsb));
+}
+
+TEST_CASE("an IMU's counts are rounded as std::llround rounds, halves away from zero", "[imu]") {
+  using ssx::plugins::roundCounts;
+  // the halves and their neighbours one ulp either side, both signs, and numbers spread over the range
+  for (const double whole : {0.0, 1.0, 2.0, 3.0, 1023.0, 8388607.0, 16777215.0}) {
+    const double half = whole + 0.5;
+    for (const double x : {half, std::nextafter(half, 0.0), std::nextafter(half, 1e9), whole, std::nextafter(whole, 1e9)}) {
+      CHECK(roundCounts(x) == std::llround(x));
+      CHECK(roundCounts(-x) == std::llround(-x));
+    }
+  }
+  CHECK(roundCounts(0.49999999999999994) == 0);  // (floor(x + 0.5) would say 1)
+  CHECK(roundCounts(-2.5) == -3);
+  std::mt19937_64 rng(3);
+  std::uniform_real_distribution<double> spread(-16777216.0, 16777216.0);
+  for (int i = 0; i < 100000; ++i) {
+    const double x = spread(rng);
+    REQUIRE(roundCounts(x) == std::llround(x));
+  }
 }
