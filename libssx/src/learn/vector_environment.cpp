@@ -101,7 +101,8 @@ VectorEnvironment::VectorEnvironment(const std::function<Scene(std::size_t)>& lo
     const CommandInterface* driver = commands_[r];
     std::uint8_t levels = 0;
     for (const CommandLevel level : kCommandLevels)
-      if (driver != nullptr && driver->acceptsCommand(level)) levels |= static_cast<std::uint8_t>(1u << static_cast<unsigned>(level));
+      if (driver != nullptr && driver->acceptsCommand(level))
+        levels |= static_cast<std::uint8_t>(1u << static_cast<unsigned>(level));
     accepts_.push_back(levels);
     rotor_counts_.push_back(driver != nullptr ? driver->rotorCount() : 0);
   }
@@ -157,7 +158,8 @@ void VectorEnvironment::findHotLines(std::size_t i) {
     const auto first = reinterpret_cast<std::uintptr_t>(range.address) & ~std::uintptr_t{63};
     const auto end = reinterpret_cast<std::uintptr_t>(range.address) + range.bytes;
     for (std::uintptr_t at = first; at < end && count < kHotLines; at += 64)
-      if (count == 0 || line[count - 1] != reinterpret_cast<const char*>(at)) line[count++] = reinterpret_cast<const char*>(at);
+      if (count == 0 || line[count - 1] != reinterpret_cast<const char*>(at))
+        line[count++] = reinterpret_cast<const char*>(at);
   }
   hot_count_[i] = static_cast<std::uint16_t>(count);
 }
@@ -375,8 +377,9 @@ void VectorEnvironment::vary(std::span<const std::size_t> which, std::string_vie
 void VectorEnvironment::checkOutput(std::span<const double> out, std::size_t width, const char* what) const {
   const std::size_t robots = robot_names_.size();
   if (out.size() != envs_.size() * robots * width)
-    throw ConfigError({}, std::string(what) + " needs " + std::to_string(envs_.size()) + " x " + std::to_string(robots) +
-                              " x " + std::to_string(width) + " numbers, got " + std::to_string(out.size()));
+    throw ConfigError({}, std::string(what) + " needs " + std::to_string(envs_.size()) + " x " +
+                              std::to_string(robots) + " x " + std::to_string(width) + " numbers, got " +
+                              std::to_string(out.size()));
 }
 
 void VectorEnvironment::readStates(std::size_t begin, std::size_t end, double* out) const {
@@ -399,7 +402,9 @@ void VectorEnvironment::robotStates(std::span<double> out) const {
   checkOutput(out, kRobotStateSize, "robotStates");
   // the copies in parallel: each robot's state is a few dependent loads into its own world
   const std::size_t robots = robot_names_.size();
-  forChunks([&](std::size_t begin, std::size_t end) { readStates(begin, end, out.data() + begin * robots * kRobotStateSize); });
+  forChunks([&](std::size_t begin, std::size_t end) {
+    readStates(begin, end, out.data() + begin * robots * kRobotStateSize);
+  });
 }
 
 void VectorEnvironment::forChunks(const std::function<void(std::size_t, std::size_t)>& fn) const {

@@ -237,7 +237,8 @@ std::string CommandInterface::refusal(const Command& command) const {
 }
 
 std::string CommandInterface::refusal(const Command& command, bool accepts, std::size_t rotors) {
-  if (!accepts) return std::string("this driver takes no commands at the ") + commandLevelName(command.level) + " level";
+  if (!accepts)
+    return std::string("this driver takes no commands at the ") + commandLevelName(command.level) + " level";
   if (command.level == CommandLevel::Rotors && command.rotor_speeds.size() != rotors)
     return "a rotors command needs one speed per rotor: " + std::to_string(rotors) + ", got " +
            std::to_string(command.rotor_speeds.size());

@@ -109,7 +109,8 @@ TEST_CASE("an IMU's counts are rounded as std::llround rounds, halves away from 
   // the halves and their neighbours one ulp either side, both signs, and numbers spread over the range
   for (const double whole : {0.0, 1.0, 2.0, 3.0, 1023.0, 8388607.0, 16777215.0}) {
     const double half = whole + 0.5;
-    for (const double x : {half, std::nextafter(half, 0.0), std::nextafter(half, 1e9), whole, std::nextafter(whole, 1e9)}) {
+    for (const double x :
+         {half, std::nextafter(half, 0.0), std::nextafter(half, 1e9), whole, std::nextafter(whole, 1e9)}) {
       CHECK(roundCounts(x) == std::llround(x));
       CHECK(roundCounts(-x) == std::llround(-x));
     }
