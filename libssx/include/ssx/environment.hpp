@@ -333,9 +333,8 @@ class SSX_EXPORT Environment {
   Artifact* findArtifact(std::string_view name);
   /// @copydoc findArtifact(std::string_view)
   const Artifact* findArtifact(std::string_view name) const;
-  /// Artifacts chosen by a parameter: "*" is every artifact with a dynamic root, else names
-  /// separated by spaces, each of an artifact with a physic root. Throws Error naming the first
-  /// name that is not.
+  /// Artifacts chosen by a parameter: "*" is every artifact with a dynamic root, else names separated
+  /// by spaces, each of an artifact with a physic root. Throws Error naming the first name that is not.
   std::vector<Artifact*> selectArtifacts(std::string_view names);
   /// @copydoc selectArtifacts(std::string_view)
   std::vector<const Artifact*> selectArtifacts(std::string_view names) const;
@@ -359,19 +358,14 @@ class SSX_EXPORT Environment {
   const BodyState& bodyState(int i) const;
   /// How many rigid bodies the world has: one per dynamic physic node tree (static trees have none).
   std::size_t bodyCount() const noexcept;
-  /// Sets body `i`'s pose and velocities (centre-of-mass frame, world) between steps: in the
-  /// engine and in the snapshot at once (accelerations are kept). To reset or teleport a robot;
-  /// not allowed from plugins during a step. Throws Error for a static or unknown body, a
-  /// non-finite state or one faster than the speed guards.
+  /// Sets body `i`'s pose and velocities (centre-of-mass frame, world) between steps, in the engine and the
+  /// snapshot (accelerations kept): to reset or teleport a robot, not from plugins during a step. Throws
+  /// Error for a static or unknown body, a non-finite state or one faster than the speed guards.
   void setBodyState(int i, const BodyState& state);
   /// A 64-bit hash (FNV-1a) of every body's pose and velocities, bit for bit, and the time.
   std::uint64_t stateHash() const;
-  /// Appends to `out` the memory the next step reads first: the world's tables, its artifacts,
-  /// plugins and the engine's bodies. For a caller that steps many small environments in turn (a
-  /// learning batch's copies): asking the processor for the next one's while this one steps
-  /// hides the wait for memory (VectorEnvironment does). Valid until the environment is
-  /// restored or changes its artifacts; nothing for an environment of more than 16 artifacts
-  /// (its phases prefetch as they go).
+  /// Appends the memory the next step reads first (tables, artifacts, plugins, bodies), to prefetch while
+  /// another environment steps (VectorEnvironment); until a restore; none past 16 artifacts.
   void hotMemory(std::vector<MemoryRange>& out) const;
   /// The artifact body `i` belongs to (std::out_of_range for another index).
   const Artifact& bodyOwner(int i) const;
@@ -383,9 +377,8 @@ class SSX_EXPORT Environment {
   /// bodies, or a body and the static world, with the normal impulse); empty after restoreState
   /// until the next step. Throws Error when not recording.
   const std::vector<EngineContact>& contacts() const;
-  /// What body_a of `contact` touched: the artifact of body_b, or for a static shape (body_b -1)
-  /// the static artifact it belongs to (the ground, a wall). std::out_of_range for a contact of
-  /// another environment.
+  /// What body_a of `contact` touched: the artifact of body_b, or for a static shape (body_b -1) the
+  /// static artifact it belongs to (the ground, a wall). std::out_of_range for another environment's.
   const Artifact& contactOther(const EngineContact& contact) const;
 
   // --- variations: constants that change between episodes (ssx/variation.hpp) --------------

@@ -148,8 +148,8 @@ class SSX_EXPORT TaskRunner {
 
 /// A block of memory: `bytes` from `address` (Environment::hotMemory).
 struct MemoryRange {
-  const void* address = nullptr;
-  std::size_t bytes = 0;
+  const void* address = nullptr;  ///< where it starts
+  std::size_t bytes = 0;           ///< how long it is
 };
 
 /// An abstract rigid-body engine. Bodies are created with their centre of mass at the body

@@ -322,7 +322,7 @@ TEST_CASE("vector environment: a learning step in one pass over each copy is com
   }
 }
 
-TEST_CASE("vector environment: a copy's hot memory holds its artifacts, plugins and bodies; a large world lists none",
+TEST_CASE("vector environment: a copy's hot memory holds its artifacts, plugins and bodies, a large world lists none",
           "[learn]") {
   // what VectorEnvironment asks the processor for, for the next copy while one steps
   Scene small = crazyflies(2);
