@@ -237,13 +237,14 @@ class GoTo(_Flight):
         return make_box(-10.0, 10.0, shape, np.float32)
 
     def observe(self, states, imu, out):
+        # (written in place: a thousand copies' temporaries cost more than the numbers)
         o = out.reshape(len(states), self.robots, 16)
-        o[..., 0:3] = self.goals[: len(states)] - states[..., 0:3]
-        o[..., 3:6] = states[..., 7:10] * 0.5
+        np.subtract(self.goals[: len(states)], states[..., 0:3], out=o[..., 0:3])
+        np.multiply(states[..., 7:10], 0.5, out=o[..., 3:6])
         q = states[..., 3:7]
-        o[..., 6:10] = np.where(q[..., :1] < 0, -q, q)
-        o[..., 10:13] = imu[..., 3:6] * 0.1
-        o[..., 13:16] = imu[..., 0:3] * 0.1
+        np.multiply(q, np.where(q[..., :1] < 0, -1.0, 1.0), out=o[..., 6:10])
+        np.multiply(imu[..., 3:6], 0.1, out=o[..., 10:13])
+        np.multiply(imu[..., 0:3], 0.1, out=o[..., 13:16])
         np.clip(o, -10.0, 10.0, out=o)
 
     def evaluate(self, states, imu, actions):
@@ -300,6 +301,13 @@ class Formation(_Flight):
         super().bind(num_envs, action_period, states)
         self.centre = self.home.mean(axis=0)
         self.slots = np.repeat(self.home[None], num_envs, axis=0)
+        # the pairs' arrays, component first (numpy's loops then run along rows of R, not of 3), filled
+        # at every step: new ones each step cost more than the numbers in them
+        r = self.robots
+        self._p, self._rel = np.empty((3, num_envs, r)), np.empty((3, num_envs, r, r))
+        self._dist, self._square = np.empty((num_envs, r, r)), np.empty((num_envs, r, r))
+        self._diagonal = np.arange(r)
+        self._first_pair = (np.arange(num_envs * r) * r).reshape(num_envs, r, 1)  # (copy, robot)'s first in a row of rel
 
     def draw(self, ids, rngs):
         u = np.array([rng.random(2 * self.robots + 1) for rng in rngs])  # (k, 2R + 1) in [0, 1)
@@ -319,27 +327,35 @@ class Formation(_Flight):
         return make_box(-1.0, 1.0, (4,) if per_agent else (self.robots, 4), np.float32)
 
     def _pairs(self, states, fresh=False):
-        """(E, R, R) relative positions (j - i) and distances, the diagonal at infinity. observe()
+        """(3, E, R, R) relative positions, [k, e, i, j] robot j's coordinate k less robot i's, and
+        (E, R, R) distances, the diagonal at infinity, in arrays the next call fills again. observe()
         keeps them for the evaluate() that follows it on the same states (a step's two calls)."""
         kept, self._kept_pairs = getattr(self, "_kept_pairs", None), None
         if kept is not None and not fresh:
             return kept
-        p = states[..., 0:3]
-        rel = p[:, None, :, :] - p[:, :, None, :]
-        dist = np.sqrt(np.einsum("...i,...i->...", rel, rel))
-        idx = np.arange(self.robots)
-        dist[:, idx, idx] = np.inf
+        n = len(states)
+        p, rel, dist, square = self._p[:, :n], self._rel[:, :n], self._dist[:n], self._square[:n]
+        np.copyto(p, np.moveaxis(states[..., 0:3], -1, 0))
+        np.subtract(p[:, :, None, :], p[:, :, :, None], out=rel)
+        np.multiply(rel[0], rel[0], out=dist)
+        for k in (1, 2):
+            np.multiply(rel[k], rel[k], out=square)
+            dist += square
+        np.sqrt(dist, out=dist)
+        dist[:, self._diagonal, self._diagonal] = np.inf
         return rel, dist
 
     def observe(self, states, imu, out):
-        o = out.reshape(len(states), self.robots, 15)
-        o[..., 0:3] = self.slots[: len(states)] - states[..., 0:3]
-        o[..., 3:6] = states[..., 7:10] * 0.5
+        n = len(states)
+        o = out.reshape(n, self.robots, 15)
+        np.subtract(self.slots[:n], states[..., 0:3], out=o[..., 0:3])
+        np.multiply(states[..., 7:10], 0.5, out=o[..., 3:6])
         rel, dist = self._pairs(states, fresh=True)
         self._kept_pairs = (rel, dist)  # for evaluate(), on these states
         nearest = np.argsort(dist, axis=-1, kind="stable")[..., : self.neighbours]  # (E, R, 3)
-        picked = np.take_along_axis(rel, nearest[..., None], axis=2)  # (E, R, 3, 3)
-        o[..., 6:15] = picked.reshape(len(states), self.robots, 3 * self.neighbours)
+        nearest += self._first_pair[:n]  # where in rel's rows of one coordinate
+        picked = rel.reshape(3, -1)[:, nearest]  # (3, E, R, 3): coordinate, copy, robot, neighbour
+        o[..., 6:15] = np.moveaxis(picked, 0, -1).reshape(n, self.robots, 3 * self.neighbours)
         np.clip(o, -10.0, 10.0, out=o)
 
     def _agent_rewards(self, states):

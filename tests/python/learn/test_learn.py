@@ -219,6 +219,32 @@ def test_formation_vector_env_counts_collisions():
     env.close()
 
 
+def test_formation_observes_each_robots_slot_velocity_and_nearest_neighbours():
+    # checked robot by robot against the positions read afterwards, while the robots fly close
+    # together (robots pushed towards the middle: neighbours change order, pairs come closer
+    # than the collision distance)
+    env = learn.VectorEnv("formation", num_envs=3, robots=6, threads=2, collision_distance=0.5)
+    env.reset(seed=8)
+    rng = np.random.default_rng(1)
+    collisions = 0
+    for step in range(40):
+        actions = rng.uniform(-1, 1, env.action_space.shape).astype(np.float32)
+        obs, r, term, trunc, infos = env.step(actions)
+        states = env.sim.robot_states()
+        for e in range(3):
+            p = states[e, :, 0:3]
+            apart = np.linalg.norm(p[None, :, :] - p[:, None, :], axis=-1)
+            assert infos["collisions"][e] == (np.count_nonzero(apart < 0.5) - 6) // 2
+            collisions += infos["collisions"][e]
+            for i in range(6):
+                others = [j for j in sorted(range(6), key=lambda j: apart[i, j]) if j != i][:3]
+                expected = np.concatenate([env.task.slots[e, i] - p[i], states[e, i, 7:10] * 0.5] +
+                                          [p[j] - p[i] for j in others])
+                assert np.array_equal(obs[e, i], np.clip(expected, -10, 10).astype(np.float32))
+    assert collisions > 0
+    env.close()
+
+
 def test_a_task_of_ones_own():
     class StayLow(learn.GoTo):
         name = "stay_low"
