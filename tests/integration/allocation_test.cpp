@@ -1,15 +1,19 @@
-// After warm-up a step allocates nothing: counted by replacing the global operator new of this
-// test program. (ODE allocates with malloc inside its own pools; what is counted here is every
-// C++ allocation: the core, the plugins, the worker pool, timing, callbacks.)
+// After warm-up a step allocates nothing, a learning batch's step neither: counted by replacing
+// the global operator new of this test program. (ODE allocates with malloc inside its own pools;
+// what is counted here is every C++ allocation: the core, the plugins, the worker pool, timing,
+// callbacks.)
 #include <ssx/ssx.hpp>
+#include <ssx/vector_environment.hpp>
 
 #include <catch2/catch.hpp>
 
+#include <algorithm>
 #include <atomic>
 #include <cstdlib>
 #include <filesystem>
 #include <new>
 #include <string>
+#include <vector>
 
 namespace {
 std::atomic<long> g_allocations{0};
@@ -81,4 +85,44 @@ TEST_CASE("after warm-up a step allocates nothing: quadrotors, formation, contac
   g_counting = false;
   CHECK(g_allocations.load() == 0);
   CHECK(env.timing().size() == 2000);
+}
+
+TEST_CASE("after warm-up a learning step allocates nothing: commands, steps and readings of copies on 2 threads",
+          "[allocation][learn]") {
+  // ssx.learn's batch step: every copy takes its robots' commands (attitude, or each rotor's
+  // speed), steps 10 times and writes its states and IMU readings, on the worker pool (a copy left
+  // out, as a batch whose copies are being reset leaves them)
+  const bool rotors = GENERATE(false, true);
+  INFO((rotors ? "rotor speeds" : "attitude"));
+  const fs::path artifacts = fs::path(SSX_EXAMPLES_DIR) / "artifacts";
+  auto load = [&artifacts](std::size_t i) {
+    SceneOptions options;
+    options.threads = 1;
+    return loadSceneFromString("<scene><environment timestep=\"0.002\" seed=\"" + std::to_string(5 + i) +
+                                   "\"/><type name=\"cf\" file=\"" + (artifacts / "crazyflie.xml").string() +
+                                   "\"/><ground/><swarm type=\"cf\" count=\"2\" spacing=\"1\" xyz=\"0 0 0.05\">"
+                                   "<driver offset=\"0 0 1\"/></swarm></scene>",
+                               "cf.xml", artifacts, options);
+  };
+  const std::size_t copies = 6, robots = 2;
+  VectorEnvironment v(load, copies, 2);
+  std::vector<double> commands(copies * robots * 4), states(copies * robots * kRobotStateSize),
+      imu(copies * robots * 6);
+  for (std::size_t k = 0; k < commands.size(); k += 4)  // level, about the weight
+    if (rotors)
+      std::fill_n(commands.begin() + static_cast<std::ptrdiff_t>(k), 4, 1770.0);  // rad/s
+    else
+      commands[k + 3] = 0.3;  // N
+  std::vector<std::uint8_t> active(copies, 1);
+  active[2] = 0;
+  const VectorEnvironment::StepIO io{rotors ? CommandLevel::Rotors : CommandLevel::Attitude, commands, 4, states, imu};
+  v.step(400);  // warm-up: take-off
+  for (int batch = 0; batch < 3; ++batch) v.step(10, active, io);
+  const double z = states[2];
+  g_allocations = 0;
+  g_counting = true;
+  for (int batch = 0; batch < 20; ++batch) v.step(10, active, io);
+  g_counting = false;
+  CHECK(g_allocations.load() == 0);
+  CHECK(states[2] != z);  // (the steps were taken and read)
 }

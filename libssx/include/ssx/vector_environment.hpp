@@ -177,16 +177,30 @@ class SSX_EXPORT VectorEnvironment {
   // fn(which[k], k) for every k in parallel (every copy, fn(i, i), for `which` empty), the first
   // failure by copy index rethrown as that copy's
   void forEachOf(std::span<const std::size_t> which, const std::function<void(std::size_t, std::size_t)>& fn);
+  // a callable held by reference, called without allocating (a std::function of a lambda with a
+  // few captures allocates: once per batch step)
+  template <class... Args>
+  class Ref {
+   public:
+    template <class F>
+    Ref(const F& f)  // NOLINT(google-explicit-constructor): lambdas are passed as they are
+        : fn_(&f), call_([](const void* fn, Args... args) { (*static_cast<const F*>(fn))(args...); }) {}
+    void operator()(Args... args) const { call_(fn_, args...); }
+
+   private:
+    const void* fn_;
+    void (*call_)(const void*, Args...);
+  };
   // fn(i) for every copy in parallel, each thread taking runs of copies and asking for the next
   // copy's memory while fn runs (its hot lines); failures as forEachOf
-  void forEachInChunks(const std::function<void(std::size_t)>& fn);
+  void forEachInChunks(Ref<std::size_t> fn);
   // the first failure of the last forEach by copy index, rethrown as that copy's (errors cleared)
   void rethrowFirst();
   // copy i's hot lines (Environment::hotMemory), again after it was restored
   void findHotLines(std::size_t i);
   // fn(begin, end) over the copies [0, size()) in chunks, on the worker threads (the first
   // exception fn throws is rethrown: not by copy index, as forEachOf does)
-  void forChunks(const std::function<void(std::size_t, std::size_t)>& fn) const;
+  void forChunks(Ref<std::size_t, std::size_t> fn) const;
   // the command row r (copy r / robots, robot r % robots) sends now
   void send(std::size_t r, const Command& command);
   // builds row r's command from `row` into staged_[r]: what is wrong with it ("" when nothing)

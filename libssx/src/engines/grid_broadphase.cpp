@@ -25,6 +25,7 @@ void GridBroadphase::build(std::span<const Box> boxes, double cell) {
   if (boxes.size() != small_.size() || cell != cell_) {
     cell_ = cell;
     small_.assign(boxes.size(), 2);  // (neither: the entries are made again below)
+    big_.reserve(boxes.size());
   }
   // the entries of the last build, moved to where their boxes are now: bodies move little from one
   // step to the next, so they are nearly in order and an insertion sort costs about one pass
@@ -62,6 +63,9 @@ void GridBroadphase::build(std::span<const Box> boxes, double cell) {
     entries_[m] = e;
   }
   if (moves > budget) std::sort(entries_.begin(), entries_.end(), before);
+  // at most one band per entry: room for them all once, so that no later step allocates when
+  // bodies spread over more bands than before
+  bands_.reserve(entries_.size());
   for (std::uint32_t k = 0; k < entries_.size();) {
     std::uint32_t end = k + 1;
     while (end < entries_.size() && entries_[end].y == entries_[k].y && entries_[end].z == entries_[k].z) ++end;

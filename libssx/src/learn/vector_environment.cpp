@@ -227,7 +227,7 @@ void VectorEnvironment::step(std::int64_t n, std::span<const std::uint8_t> activ
   });
 }
 
-void VectorEnvironment::forEachInChunks(const std::function<void(std::size_t)>& fn) {
+void VectorEnvironment::forEachInChunks(Ref<std::size_t> fn) {
   std::vector<std::exception_ptr>& errors = pool_->errors;
   const std::size_t n = envs_.size();
   auto body = [&](std::size_t begin, std::size_t end) {
@@ -407,7 +407,7 @@ void VectorEnvironment::robotStates(std::span<double> out) const {
   });
 }
 
-void VectorEnvironment::forChunks(const std::function<void(std::size_t, std::size_t)>& fn) const {
+void VectorEnvironment::forChunks(Ref<std::size_t, std::size_t> fn) const {
   auto chunked = [&fn](std::size_t begin, std::size_t end) { fn(begin, end); };
   pool_->workers.parallelFor(envs_.size(), std::max<std::size_t>(1, envs_.size() / (pool_->workers.size() * 8)),
                              chunked);
@@ -528,7 +528,13 @@ std::string VectorEnvironment::stageCommand(std::size_t r, CommandLevel level, s
            Command::rowSizes(level, rotors) + " values, got " + std::to_string(row.size());
   for (const double x : row)
     if (!std::isfinite(x)) return "the command for " + who() + " holds a NaN or an infinity";
-  staged_[r] = Command::fromRow(level, row);
+  if (level == CommandLevel::Rotors) {  // into the vector staged before: no allocation per step
+    std::vector<double> speeds = std::move(staged_[r].rotor_speeds);
+    speeds.assign(row.begin(), row.end());
+    staged_[r] = Command::rotors(std::move(speeds));
+  } else {
+    staged_[r] = Command::fromRow(level, row);
+  }
   const bool accepts = ((accepts_[robot] >> static_cast<unsigned>(level)) & 1u) != 0;
   const std::string why =
       target != nullptr ? CommandInterface::refusal(staged_[r], accepts, rotors) : staged_[r].problem();
