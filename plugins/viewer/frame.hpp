@@ -3,6 +3,7 @@
 // uint32 magic 0x46585353 ("SSXF"), uint32 N, float64 simulated time (s), float32 real-time factor,
 // uint32 late steps, uint64 step (or sample); N x float32 x, y, z, qx, qy, qz, qw; uint32 L and L
 // bytes of JSON (the trailer).
+#include <chrono>
 #include <cstddef>
 #include <cstdint>
 #include <string>
@@ -36,6 +37,32 @@ struct CommandEcho {
 /// The trailer: {"run":{"factor":F,"paused":B}} with "command":{...} when `echo` has one and
 /// "details":DETAILS (a JSON array) when not empty.
 std::string trailerJson(double factor, bool paused, const std::string& details, const CommandEcho& echo = {});
+
+/// When frames go out, at most one a `period`, to a caller that asks at its own ticks (a run's
+/// steps, a page's sending thread): due on a schedule one period apart, so that ticks of 20 ms
+/// give 30 frames a second at 30 Hz (waiting a whole period after each frame sent gives 25); a
+/// frame sent more than a period late starts the schedule again (no burst after a pause or a
+/// slow stretch).
+class FramePacer {
+ public:
+  using Clock = std::chrono::steady_clock;
+  explicit FramePacer(std::chrono::duration<double> period = {})
+      : period_(std::chrono::duration_cast<Clock::duration>(period)) {}
+  /// Whether a frame is due at `now` (the first always is).
+  bool due(Clock::time_point now) const { return !started_ || now >= next_; }
+  /// When the next frame is due (after a first one).
+  Clock::time_point next() const { return next_; }
+  /// A frame went out at `now`: the next is due a period after this one was.
+  void sent(Clock::time_point now) {
+    next_ = started_ && now - next_ < period_ ? next_ + period_ : now + period_;
+    started_ = true;
+  }
+
+ private:
+  Clock::duration period_;
+  Clock::time_point next_{};
+  bool started_ = false;
+};
 
 /// Appends a number (6 significant digits; 0 for NaN and infinities) or a JSON string.
 void appendNumber(std::string& out, double v);

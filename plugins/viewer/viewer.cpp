@@ -118,6 +118,7 @@ class Viewer final : public SimulationExtension {
     const int port = static_cast<int>(params.get<std::int64_t>("port"));
     const std::string bind = params.get<std::string>("bind");
     period_ = std::chrono::duration<double>(1.0 / params.get<double>("rate_hz"));
+    pacer_ = viewer::FramePacer(period_);
     wait_ = params.get<bool>("wait");
     if (const std::string file = params.has("recording") ? params.get<std::string>("recording") : ""; !file.empty()) {
       try {
@@ -212,7 +213,8 @@ class Viewer final : public SimulationExtension {
     if (timing.size() >= 2 && timing[timing.size() - 2].lateness > 0) ++late_;
     const auto now = std::chrono::steady_clock::now();
     // (and every step of a paused run: the one it was paused after, and each single step)
-    if (now - last_wall_ < period_ && !control_->paused()) return;
+    if (!pacer_.due(now) && !control_->paused()) return;
+    pacer_.sent(now);
     const double wall = std::chrono::duration<double>(now - last_wall_).count();
     const auto build_start = std::chrono::steady_clock::now();
     const double rtf = last_sim_ >= 0 && wall < 60 ? (toSeconds(env.time()) - last_sim_) / wall : 0;
@@ -544,6 +546,7 @@ class Viewer final : public SimulationExtension {
   std::size_t steerable_ = 0;  // bodies with a steer
   std::vector<std::uint8_t> frame_;
   std::chrono::duration<double> period_{};
+  viewer::FramePacer pacer_;  // when the run's next frame goes out
   std::chrono::steady_clock::time_point last_wall_;
   double last_sim_ = -1;
   std::uint32_t late_ = 0;

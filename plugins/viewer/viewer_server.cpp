@@ -2,6 +2,7 @@
 #include "viewer_server.hpp"
 
 #include "../common/web_access.hpp"
+#include "frame.hpp"
 
 #include <civetweb.h>
 
@@ -22,8 +23,7 @@ struct Server::Client {
   std::uint64_t hello_written = 0;  // ... written to its socket
   std::uint64_t first_seq = 0;  // the newest frame when it connected
   std::uint64_t sent = 0;       // frames sent to it
-  std::chrono::duration<double> period{0};  // the least time between two frames the page asked for
-  std::chrono::steady_clock::time_point next_send;
+  viewer::FramePacer pacer;     // at most the frames a second the page asked for (none: all)
   web::MessageRate rate;  // the page's messages in the current second
 };
 
@@ -178,12 +178,12 @@ void Server::sendLoop(const std::shared_ptr<Client>& client) {
         hello = hello_;
       } else {
         const auto now = std::chrono::steady_clock::now();
-        if (now < client->next_send) {  // at the page's rate: the newest frame when its time comes
-          changed_.wait_until(lock, client->next_send,
+        if (!client->pacer.due(now)) {  // at the page's rate: the newest frame when its time comes
+          changed_.wait_until(lock, client->pacer.next(),
                               [&] { return client->closed || stopping_ || hello_seq_ > client->hello_seq; });
           continue;
         }
-        client->next_send = now + std::chrono::duration_cast<std::chrono::steady_clock::duration>(client->period);
+        client->pacer.sent(now);
         client->sent_seq = newest_seq_;
         frame = newest_;
       }
@@ -232,7 +232,7 @@ int Server::onData(mg_connection* conn, int opcode, char* data, std::size_t size
     if (const auto rate = jsonNumber(text, "rate_hz")) {
       take = *rate > 0 && *rate <= 240;
       std::lock_guard lock(s.mutex_);
-      if (take) client->period = std::chrono::duration<double>(1.0 / *rate);
+      if (take) client->pacer = viewer::FramePacer(std::chrono::duration<double>(1.0 / *rate));
     }
   }
   if (take) take = s.on_message_ && s.on_message_(text);

@@ -4,6 +4,7 @@
 
 #include <catch2/catch.hpp>
 
+#include <chrono>
 #include <cstring>
 #include <limits>
 #include <string>
@@ -54,4 +55,28 @@ TEST_CASE("viewer frame trailer: the run's pace, a command's echo once given, th
   text.clear();
   appendNumber(text, std::numeric_limits<double>::infinity());
   CHECK(text == "0");
+}
+
+TEST_CASE("viewer pacing: 30 frames a second from ticks of 20 ms, and no burst after a pause", "[viewer]") {
+  using Clock = FramePacer::Clock;
+  using std::chrono::milliseconds;
+  const Clock::time_point start{std::chrono::hours(5)};
+  FramePacer pacer(std::chrono::duration<double>(1.0 / 30));
+  auto frames_between = [](FramePacer& pacer, Clock::time_point from, int ticks) {  // a tick each 20 ms
+    int sent = 0;
+    for (int k = 0; k < ticks; ++k) {
+      const Clock::time_point now = from + milliseconds(20) * k;
+      if (pacer.due(now)) pacer.sent(now), ++sent;
+    }
+    return sent;
+  };
+  CHECK(pacer.due(start));                         // the first frame at once
+  CHECK(frames_between(pacer, start, 150) == 90);  // 3 s: 30 a second (a period after each frame sent: 25)
+  // a pause of 2 s, then ticks again: one frame at once, then 30 a second, none owed for the pause
+  const Clock::time_point later = start + milliseconds(5000);
+  CHECK(pacer.due(later));
+  CHECK(frames_between(pacer, later, 50) == 30);
+  // no period (a page that asked for no rate): every tick
+  FramePacer every;
+  CHECK(frames_between(every, start, 10) == 10);
 }
