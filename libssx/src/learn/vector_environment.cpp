@@ -193,16 +193,7 @@ void VectorEnvironment::rethrowFirst() {
     }
 }
 
-void VectorEnvironment::step(std::int64_t n, std::span<const std::uint8_t> active) {
-  if (n < 0) throw ConfigError({}, "a vector environment steps n >= 0 times, got " + std::to_string(n));
-  if (!active.empty() && active.size() != envs_.size())
-    throw ConfigError({}, "a vector environment of " + std::to_string(envs_.size()) + " copies was given " +
-                              std::to_string(active.size()) + " flags of which copies step");
-  if (n == 0) return;
-  forEachInChunks([&](std::size_t i) {
-    if (active.empty() || active[i] != 0) stepCopy(i, n);
-  });
-}
+void VectorEnvironment::step(std::int64_t n, std::span<const std::uint8_t> active) { step(n, active, StepIO{}); }
 
 void VectorEnvironment::step(std::int64_t n, std::span<const std::uint8_t> active, const StepIO& io) {
   if (n < 0) throw ConfigError({}, "a vector environment steps n >= 0 times, got " + std::to_string(n));
