@@ -220,9 +220,9 @@ def test_formation_vector_env_counts_collisions():
 
 
 def test_formation_observes_each_robots_slot_velocity_and_nearest_neighbours():
-    # checked robot by robot against the positions read afterwards, while the robots fly close
-    # together (robots pushed towards the middle: neighbours change order, pairs come closer
-    # than the collision distance)
+    # checked robot by robot against the positions read afterwards, the robots flying random
+    # velocity actions (neighbours change order; with a collision distance of 0.5 m some pairs
+    # come closer than it: asserted below)
     env = learn.VectorEnv("formation", num_envs=3, robots=6, threads=2, collision_distance=0.5)
     env.reset(seed=8)
     rng = np.random.default_rng(1)

@@ -62,11 +62,11 @@ TEST_CASE("viewer pacing: 30 frames a second from ticks of 20 ms, and no burst a
   using std::chrono::milliseconds;
   const Clock::time_point start{std::chrono::hours(5)};
   FramePacer pacer(std::chrono::duration<double>(1.0 / 30));
-  auto frames_between = [](FramePacer& pacer, Clock::time_point from, int ticks) {  // a tick each 20 ms
+  auto frames_between = [](FramePacer& paced, Clock::time_point from, int ticks) {  // a tick each 20 ms
     int sent = 0;
     for (int k = 0; k < ticks; ++k) {
       const Clock::time_point now = from + milliseconds(20) * k;
-      if (pacer.due(now)) pacer.sent(now), ++sent;
+      if (paced.due(now)) paced.sent(now), ++sent;
     }
     return sent;
   };
