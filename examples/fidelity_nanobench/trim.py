@@ -43,7 +43,11 @@ COLUMNS = [("px", "px", 4), ("py", "py", 4), ("pz", "pz", 4),
            ("pid_controller_roll", "desired_roll_deg", 2), ("pid_controller_pitch", "desired_pitch_deg", 2),
            ("pid_controller_cmd_thrust", "cmd_thrust", 0),
            ("motor_motor_m1", "m1", 0), ("motor_motor_m2", "m2", 0), ("motor_motor_m3", "m3", 0),
-           ("motor_motor_m4", "m4", 0), ("pwr_pm_vbat", "vbat", 3)]
+           ("motor_motor_m4", "m4", 0), ("pwr_pm_vbat", "vbat", 3),
+           # the onboard estimator (the EKF fed with Vicon's position): what the controller saw
+           ("est_stateEstimate_x", "est_x", 4), ("est_stateEstimate_y", "est_y", 4),
+           ("est_stateEstimate_vx", "est_vx", 3), ("est_stateEstimate_vy", "est_vy", 3),
+           ("att_stateEstimate_roll", "est_roll_deg", 2), ("att_stateEstimate_pitch", "est_pitch_deg", 2)]
 
 
 def main():
