@@ -194,6 +194,10 @@ ABLATION = [
     ("motion capture to controller latency 0.02 s", ["--sensor", "delay=0.02"]),
     ("the logged battery voltage row by row (its sag under load and over the flight)", ["--battery", "log"]),
     ("each rotor's thrust factor from the motors' shares in the log", ["--rotor-factors", "log"]),
+    ("the firmware's Kalman filter between the IMU and motion capture and the loops (crazyflie_estimator)",
+     ["--driver", "crazyflie_estimator=kalman"]),
+    ("the Kalman filter and the rotor drag of 2.0e-6 together", ["--driver", "crazyflie_estimator=kalman",
+                                                                 "--driver", "rotor_drag_coefficient=2.0e-6"]),
 ]
 
 

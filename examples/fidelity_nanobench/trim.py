@@ -47,7 +47,10 @@ COLUMNS = [("px", "px", 4), ("py", "py", 4), ("pz", "pz", 4),
            # the onboard estimator (the EKF fed with Vicon's position): what the controller saw
            ("est_stateEstimate_x", "est_x", 4), ("est_stateEstimate_y", "est_y", 4),
            ("est_stateEstimate_vx", "est_vx", 3), ("est_stateEstimate_vy", "est_vy", 3),
-           ("att_stateEstimate_roll", "est_roll_deg", 2), ("att_stateEstimate_pitch", "est_pitch_deg", 2)]
+           ("att_stateEstimate_roll", "est_roll_deg", 2), ("att_stateEstimate_pitch", "est_pitch_deg", 2),
+           # what the estimator was fed besides Vicon: the IMU (specific force in g, rates in rad/s)
+           ("imu_acc_x", "acc_x_g", 4), ("imu_acc_y", "acc_y_g", 4), ("imu_acc_z", "acc_z_g", 4),
+           ("imu_gyro_x", "gyro_x", 4), ("imu_gyro_y", "gyro_y", 4), ("imu_gyro_z", "gyro_z", 4)]
 
 
 def main():

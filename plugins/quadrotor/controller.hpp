@@ -25,6 +25,10 @@ class FlightInputs {
   /// The body's angular velocity in its own frame, rad/s (the truth: a controller that models its
   /// gyroscope reads the IMU instead, as TeleKybController does).
   virtual Vec3 bodyRates() const = 0;
+  /// When the position source's latest sample was taken (ns); -1 for the truth, new at every run.
+  virtual Nanoseconds positionStamp() const { return -1; }
+  /// The IMU's latest sample, for a controller that estimates its state from it (nullptr: none).
+  virtual const ImuMeasurement* imu() const { return nullptr; }
 };
 
 class FlightController {

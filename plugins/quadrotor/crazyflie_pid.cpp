@@ -35,6 +35,8 @@ Vec3 intoYawFrame(const Vec3& v, double yaw) {
 
 double sign(double v) { return v > 0 ? 1.0 : -1.0; }
 
+constexpr int kGyroBiasSamples = 1024;  // the firmware's gyro bias buffer (sensors_bmi088_bmp3xx.c)
+
 }  // namespace
 
 double Pid::update(double desired, double measured, double dt, bool wrap_degrees) {
@@ -69,7 +71,7 @@ void Pid::load(StateReader& in) {
 
 CrazyfliePidController::CrazyfliePidController(const CrazyfliePidGains& gains, const std::vector<Rotor>& rotors,
                                                const RotorParams& rotor, const CrazyflieThrustCurve& curve)
-    : g_(gains), curve_(curve), thrust_coefficient_(rotor.thrust_coefficient) {
+    : g_(gains), curve_(curve), thrust_coefficient_(rotor.thrust_coefficient), kalman_(gains.kalman_params) {
   if (rotors.size() != 4) throw std::invalid_argument("crazyflie_pid: four rotors, got " + std::to_string(rotors.size()));
   for (std::size_t i = 0; i < 4; ++i) {
     const Rotor& r = rotors[i];
@@ -121,6 +123,8 @@ void CrazyfliePidController::setRuns(std::int64_t attitude_runs, std::int64_t po
   attitude_dt_ = static_cast<double>(attitude_runs) * run_seconds;
   position_dt_ = static_cast<double>(position_runs) * run_seconds;
   filter_ticks_ = std::max(1, static_cast<int>(std::lround(run_seconds * 1000)));
+  run_seconds_ = run_seconds;
+  predict_every_ = std::max<std::int64_t>(1, std::llround(1.0 / (g_.kalman_rate_hz * run_seconds)));
   // the gyro filtered at every run of the driver (the firmware: every 1 ms sample)
   for (LowPass2& f : gyro_filter_) f = g_.gyro_cutoff_hz > 0 ? LowPass2(1.0 / run_seconds, g_.gyro_cutoff_hz) : LowPass2();
 }
@@ -193,11 +197,49 @@ void CrazyfliePidController::resetAll(double yaw_deg) {
   yaw_target_deg_ = yaw_deg;
 }
 
+void CrazyfliePidController::flownState(FlightInputs& in, Pose& pose, Vec3& velocity) const {
+  if (!g_.kalman || !kalman_started_) {
+    in.position(pose, velocity);
+    return;
+  }
+  pose.position = kalman_.position();
+  pose.orientation = kalman_.attitude();
+  velocity = kalman_.velocity();
+}
+
+// The estimator's part of a run, in estimator_kalman.c's order: the IMU's new sample added, the
+// prediction when due, process noise, a new position, then the attitude error moved in.
+void CrazyfliePidController::estimate(std::int64_t run, FlightInputs& in) {
+  Pose measured;
+  Vec3 velocity;
+  in.position(measured, velocity);
+  if (!kalman_started_) {
+    kalman_.reset(measured.position, eulerDegrees(measured.orientation).z() / kDeg);
+    kalman_started_ = true;
+  }
+  if (const ImuMeasurement* imu = in.imu(); imu != nullptr && imu->stamp != imu_stamp_) {
+    if (gyro_bias_samples_ < kGyroBiasSamples) {
+      gyro_bias_sum_ += imu->gyroscope - in.bodyRates();
+      ++gyro_bias_samples_;
+    }
+    kalman_.addImu(imu->accelerometer, imu->gyroscope - gyro_bias_sum_ / gyro_bias_samples_);
+    imu_stamp_ = imu->stamp;
+  }
+  if (run % predict_every_ == 0) kalman_.predict(static_cast<double>(predict_every_) * run_seconds_, thrust_ > 0);
+  kalman_.addProcessNoise(run_seconds_);
+  const Nanoseconds stamp = in.positionStamp();
+  if (stamp < 0 || stamp != position_stamp_) {
+    kalman_.updatePosition(measured.position);
+    position_stamp_ = stamp;
+  }
+  kalman_.finalize();
+}
+
 void CrazyfliePidController::positionLoop(double t, FlightInputs& in) {
   const double dt = position_dt_;
   Pose pose;
   Vec3 velocity;
-  in.position(pose, velocity);
+  flownState(in, pose, velocity);
   const Vec3 euler = eulerDegrees(pose.orientation);
   const double yaw = euler.z() / kDeg;
   if (!yaw_target_set_) yaw_target_deg_ = euler.z(), yaw_target_set_ = true;
@@ -227,7 +269,7 @@ void CrazyfliePidController::attitudeLoop(FlightInputs& in) {
   const double dt = attitude_dt_;
   Pose pose;
   Vec3 velocity;
-  in.position(pose, velocity);
+  flownState(in, pose, velocity);
   const Vec3 euler = eulerDegrees(pose.orientation);
   if (thrust_ <= 0) {  // as the firmware: every loop reset, the heading held where it is
     resetAll(euler.z());
@@ -259,6 +301,7 @@ void CrazyfliePidController::attitudeLoop(FlightInputs& in) {
 void CrazyfliePidController::step(std::int64_t run, double t, FlightInputs& in, std::span<double> speeds) {
   const Vec3 rates = in.bodyRates() * kDeg;
   for (int k = 0; k < 3; ++k) gyro_deg_[k] = gyro_filter_[k].apply(rates[k]);
+  if (g_.kalman) estimate(run, in);
   const bool high_level = level_ == CommandLevel::Position || level_ == CommandLevel::Velocity;
   if (level_ == CommandLevel::Rotors) {  // the loops rest, the motors take the speeds asked for
     for (std::size_t i = 0; i < 4 && i < speeds.size(); ++i) speeds[i] = rotor_command_[i];
@@ -284,6 +327,14 @@ void CrazyfliePidController::saveState(StateWriter& out) const {
   for (int k = 0; k < 3; ++k) out.write(gyro_filter_[k].state(0)), out.write(gyro_filter_[k].state(1)), out.write(gyro_deg_[k]);
   if (level_ == CommandLevel::Rotors)  // (only then: states saved at the other levels read as before)
     for (const double w : rotor_command_) out.write(w);
+  if (g_.kalman) {  // (only with the estimator: states saved without it read as before)
+    out.write(kalman_started_);
+    out.write(imu_stamp_);
+    out.write(position_stamp_);
+    out.write(gyro_bias_sum_);
+    out.write(static_cast<std::int32_t>(gyro_bias_samples_));
+    kalman_.save(out);
+  }
 }
 
 void CrazyfliePidController::loadState(StateReader& in) {
@@ -311,6 +362,18 @@ void CrazyfliePidController::loadState(StateReader& in) {
   }
   if (level_ == CommandLevel::Rotors)
     for (double& w : rotor_command_) in.read(w);
+  if (g_.kalman) {
+    in.read(kalman_started_);
+    in.read(imu_stamp_);
+    in.read(position_stamp_);
+    in.read(gyro_bias_sum_);
+    std::int32_t samples = 0;
+    in.read(samples);
+    if (samples < 0 || samples > kGyroBiasSamples)
+      throw StateError("crazyflie_pid: a saved count of gyroscope bias samples out of range");
+    gyro_bias_samples_ = samples;
+    kalman_.load(in);
+  }
 }
 
 }  // namespace ssx::quadrotor

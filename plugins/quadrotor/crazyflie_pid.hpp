@@ -14,8 +14,12 @@
 // Signs are ssx's (x forward, y left, z up; a positive pitch tilts the thrust towards +x); the
 // firmware's pitch has the other sign, which changes nothing else.
 //
+// Its loops fly on the position source's state, or (crazyflie_estimator="kalman") on the firmware's
+// Kalman filter fed with the IMU and the position source (crazyflie_kalman.hpp).
+//
 // It takes position and velocity commands. The quadrotor driver runs it with controller="crazyflie_pid".
 #include "controller.hpp"
+#include "crazyflie_kalman.hpp"
 #include "crazyflie_thrust.hpp"
 #include "quadrotor_model.hpp"
 
@@ -34,8 +38,14 @@ inline constexpr ssx_plugin_param kControllerChoiceParameters[] = {
                 "crazyflie_pid: position and velocity loops (its period a whole multiple of the driver's)"),
     param::real("crazyflie_attitude_rate_hz", "500", "Hz", param::positive(),
                 "crazyflie_pid: attitude and rate loops (its period a whole multiple of the driver's)"),
+    param::choice(
+        "crazyflie_estimator", "truth", "truth kalman",
+        "crazyflie_pid: the state its loops fly on: truth (the position source's pose and velocity as they come: "
+        "motion capture, else the truth) or kalman (the firmware's extended Kalman filter fed with the IMU and "
+        "the position source's positions, as a Crazyflie flying with motion capture)"),
     param::real("crazyflie_battery_volts", "4.2", "V", param::atLeast(2) & param::atMost(4.35),
-                "crazyflie_pid without battery=\"true\": the battery voltage its thrust compensation sees and its motors get (held constant)"),
+                "crazyflie_pid without battery=\"true\": the battery voltage its thrust compensation sees and its "
+                "motors get (held constant)"),
 };
 
 /// pid.c's element.
@@ -94,6 +104,9 @@ struct CrazyfliePidGains {
   PidGains rate_yaw{120, 16.7, 0, 166.7, 32767};
   double position_rate_hz = 100, attitude_rate_hz = 500;
   double gyro_cutoff_hz = 80;  ///< the gyro's low-pass (0: none)
+  bool kalman = false;         ///< fly on the firmware's Kalman filter's estimate (else on the position source's)
+  CrazyflieKalmanParams kalman_params;
+  double kalman_rate_hz = 100;  ///< the filter's prediction rate
 };
 
 class CrazyfliePidController final : public FlightController {
@@ -114,6 +127,11 @@ class CrazyfliePidController final : public FlightController {
     motor_volts_ = volts;
     filter_.update(volts, filter_ticks_);
   }
+  /// The state the loops fly on (the filter's with `kalman`, else the position source's): position,
+  /// velocity (world) and attitude.
+  void flownState(FlightInputs& in, Pose& pose, Vec3& velocity) const;
+  /// The Kalman filter (with `kalman`).
+  const CrazyflieKalman& estimator() const { return kalman_; }
   /// The voltage the compensation sees.
   double compensationVoltage() const { return filter_.volts(); }
   /// In a driver that runs every `run_seconds`: the attitude loop every `attitude_runs` runs, the
@@ -167,6 +185,7 @@ class CrazyfliePidController final : public FlightController {
   void positionLoop(double t, FlightInputs& in);
   void attitudeLoop(FlightInputs& in);
   void resetAll(double yaw_deg);
+  void estimate(std::int64_t run, FlightInputs& in);
 
   CrazyfliePidGains g_;
   CrazyflieThrustCurve curve_;
@@ -191,6 +210,16 @@ class CrazyfliePidController final : public FlightController {
   double roll_deg_ = 0, pitch_deg_ = 0, yaw_target_deg_ = 0, thrust_ = 0;
   bool yaw_target_set_ = false;
   std::array<double, 4> motors_{};
+  // the estimator (kalman): its filter, the runs between predictions, the latest samples taken
+  CrazyflieKalman kalman_;
+  std::int64_t predict_every_ = 5;
+  double run_seconds_ = 0.002;
+  bool kalman_started_ = false;
+  Nanoseconds imu_stamp_ = -1, position_stamp_ = -2;
+  // the gyroscope's bias, as the firmware measures it at rest before take-off (the mean over 1024
+  // samples): here the mean of the IMU's reading less the true rate over its first 1024 samples
+  Vec3 gyro_bias_sum_ = Vec3::Zero();
+  int gyro_bias_samples_ = 0;
 };
 
 }  // namespace ssx::quadrotor

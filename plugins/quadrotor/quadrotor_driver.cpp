@@ -34,6 +34,7 @@ struct QuadrotorDriver::Config {
         crazyflie_battery(params.get<double>("crazyflie_battery_volts")) {
     crazyflie_gains.position_rate_hz = params.get<double>("crazyflie_position_rate_hz");
     crazyflie_gains.attitude_rate_hz = params.get<double>("crazyflie_attitude_rate_hz");
+    crazyflie_gains.kalman = params.get<std::string>("crazyflie_estimator") == "kalman";
   }
   // the Crazyflie's controller for these rotors, run by a driver of this context (invalid_argument
   // for another frame than an X of four, or rates that do not fit)
@@ -187,8 +188,11 @@ void QuadrotorDriver::configure(const Descriptor& params, PluginSetup& setup) {
   const Sensor* imu = firstSensorOf<ImuMeasurement>(a);
   if (imu == nullptr) throw params.error("a quadrotor needs an IMU: add <sensor plugin=\"imu\"/> to the artifact");
   const PluginContext context{&env, &a, periodSteps(), env.timestep(), {}};
+  imu_ = nullptr;
   if (c.crazyflie_pid) {
     flight_ = c.crazyflie(frame->rotors, context);
+    // its estimator reads the IMU's latest sample in place
+    if (c.crazyflie_gains.kalman) imu_ = static_cast<const ImuMeasurement*>(&imu->latest());
   } else {
     // (the one asked before the start, holding any command given then)
     if (dynamic_cast<TeleKybController*>(flight_.get()) == nullptr) flight_ = std::make_unique<TeleKybController>();

@@ -93,6 +93,8 @@ class QuadrotorDriver final : public Driver,
     const BodyState s = artifact().state();
     return s.pose.orientation.conjugate() * s.angular_velocity;
   }
+  Nanoseconds positionStamp() const override { return have_pose_ ? pose_.stamp : -1; }
+  const ImuMeasurement* imu() const override { return imu_; }
 
   // With thousands of robots a step is bound by memory latency: what every step reads comes
   // first, held in the driver (not behind pointers of its own), so that it spans few cache lines;
@@ -120,6 +122,7 @@ class QuadrotorDriver final : public Driver,
   // the battery varies (battery_volts) with a battery model, or the Crazyflie's held battery
   bool battery_varies_ = false;
   double crazyflie_battery_ = 4.2;  // V, crazyflie_battery_volts
+  const ImuMeasurement* imu_ = nullptr;  // the IMU's latest sample, read in place (a controller's estimator)
 };
 
 }  // namespace ssx::quadrotor

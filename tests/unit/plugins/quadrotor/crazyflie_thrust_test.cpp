@@ -4,6 +4,7 @@
 // command and the filtered voltage give the motors' mean PWM to under 1 % (median over each
 // flight), and the "2.1+ propellers" set fits better than the legacy one.
 #include "crazyflie_thrust.hpp"
+#include "nanobench_flight.hpp"
 
 #include <catch2/catch.hpp>
 
@@ -20,23 +21,6 @@ using ssx::quadrotor::BatteryFilter;
 using ssx::quadrotor::CrazyflieThrustCurve;
 
 namespace {
-
-// a trimmed NanoBench flight: every column by name
-std::map<std::string, std::vector<double>> readFlight(const std::string& name) {
-  std::ifstream in(std::string(SSX_EXAMPLES_DIR) + "/fidelity_nanobench/data/" + name + ".csv");
-  std::string line;
-  std::getline(in, line);
-  std::vector<std::string> header;
-  std::stringstream h(line);
-  for (std::string cell; std::getline(h, cell, ',');) header.push_back(cell);
-  std::map<std::string, std::vector<double>> out;
-  while (std::getline(in, line)) {
-    std::stringstream row(line);
-    std::size_t k = 0;
-    for (std::string cell; std::getline(row, cell, ',') && k < header.size(); ++k) out[header[k]].push_back(std::stod(cell));
-  }
-  return out;
-}
 
 // the median of |mean motor PWM / the model's PWM - 1| over the rows with every motor running and none at the ceiling
 double medianMiss(const std::map<std::string, std::vector<double>>& f, const CrazyflieThrustCurve& curve) {
@@ -77,7 +61,7 @@ TEST_CASE("crazyflie thrust: NanoBench's logged motor PWM from its thrust comman
   for (const char* name : {"B3_figure8_slow_rep1", "B3_figure8_slow_rep2", "B3_figure8_slow_rep3", "B3_figure8_fast_rep1",
                            "B3_figure8_fast_rep2"}) {
     INFO(name);
-    const auto flight = readFlight(name);
+    const auto flight = ssx::test::readNanobenchFlight(name);
     const double plus = medianMiss(flight, CrazyflieThrustCurve::propellers21plus());
     const double legacy = medianMiss(flight, CrazyflieThrustCurve::legacyPropellers());
     std::printf("%s: the motors' mean PWM missed by %.2f %% (median; 2.1+ propellers), %.2f %% (legacy)\n", name,

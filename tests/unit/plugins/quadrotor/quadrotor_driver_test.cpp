@@ -242,3 +242,52 @@ TEST_CASE("a vehicle from a preset file: by name from the artifact path, or by p
   CHECK(std::abs(heightAfter("<driver preset=\"weak\" max_rotor_speed=\"940\"/>") - 2) < 0.02);
   std::filesystem::remove_all(dir);
 }
+
+TEST_CASE("a crazyflie flying on its firmware's Kalman filter: hovers, moves, and its estimate follows the truth",
+          "[quadrotor][flight][crazyflie]") {
+  // the IMU's noise and the motion capture's as installed: the filter between them and the loops
+  Scene s = quadScene("<driver reference=\"external\" crazyflie_estimator=\"kalman\"/>", 1.0, 5, "crazyflie");
+  Environment& env = *s.environment;
+  env.start();
+  Artifact& cf = *env.findArtifact("quad");
+  auto* input = dynamic_cast<SetpointInterface*>(cf.driver());
+  REQUIRE(input != nullptr);
+  Setpoint sp;
+  sp.position = Vec3(0, 0, 1);
+  input->setSetpoint(sp);
+  env.step(1500);
+  INFO("hover error " << (cf.pose().position - sp.position).transpose());
+  CHECK((cf.pose().position - sp.position).norm() < 0.03);
+  sp.position = Vec3(0.5, 0.5, 1.2);
+  input->setSetpoint(sp);
+  env.step(2000);
+  INFO("error " << (cf.pose().position - sp.position).transpose());
+  CHECK((cf.pose().position - sp.position).norm() < 0.03);
+}
+
+TEST_CASE("a crazyflie on its Kalman filter flies bitwise alike on 1 and 2 threads and after a saved state",
+          "[quadrotor][crazyflie][determinism]") {
+  auto scene = [](int threads) {
+    SceneOptions o;
+    o.threads = threads;
+    const std::string xml =
+        "<scene><environment timestep=\"0.002\" seed=\"9\"/><type name=\"q\" file=\"crazyflie.xml\"/><ground/>"
+        "<artifact name=\"a\" type=\"q\" xyz=\"0 0 1\"><driver crazyflie_estimator=\"kalman\" offset=\"0.5 0 "
+        "0\"/></artifact>"
+        "<artifact name=\"b\" type=\"q\" xyz=\"2 0 1\"><driver crazyflie_estimator=\"kalman\" offset=\"0 0.5 "
+        "0\"/></artifact>"
+        "</scene>";
+    return loadSceneFromString(xml, "kalman.xml", kArtifacts, o);
+  };
+  Scene a = scene(1), b = scene(2);
+  a.environment->step(700);
+  b.environment->step(700);
+  const auto saved = a.environment->saveState();
+  a.environment->step(800);
+  b.environment->step(800);
+  Scene c = scene(1);
+  c.environment->restoreState(saved);
+  c.environment->step(800);
+  CHECK(c.environment->stateHash() == a.environment->stateHash());
+  CHECK(b.environment->stateHash() == a.environment->stateHash());
+}
