@@ -115,11 +115,14 @@ case "${1:-}" in
     ctest --test-dir build-asan -j "$jobs" --output-on-failure \
       -E '^install_and_consume$|memory running out while loading|^ground scenarios: (diffusion|aggregation|foraging):|quadrotors (from random starts )?form the sphere|^crazyflie_flight_replay_(sweep|ablation)_matches_docs$|^crazyflie_flight_replay_matches_docs_bullet$|^fidelity_eight_ablation_lines$'
     tests/fuzz/run.sh build-asan "${FUZZ_SECONDS:-60}"
+    # under TSan: the tests of threads, bitwise results across thread counts, the worker pool and
+    # parallel stepping; only the test files that mention them are compiled (a quarter of them)
+    tsan_tests='thread|bitwise|worker pool|parallel'
     cmake -S . -B build-tsan -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DSSX_SANITIZE=thread \
       -DSSX_BUILD_EXAMPLES=OFF -DSSX_WITH_ROS1=OFF -DSSX_WARNINGS_AS_ERRORS="${SSX_WARNINGS_AS_ERRORS:-OFF}" \
-      "${launcher[@]}" "${debug_flags[@]}" >/dev/null
+      -DSSX_TEST_FILES_MATCHING="$tsan_tests" "${launcher[@]}" "${debug_flags[@]}" >/dev/null
     cmake --build build-tsan -j "$jobs" --target ssx_tests
-    ctest --test-dir build-tsan -j "$jobs" --output-on-failure -R 'thread|bitwise|worker pool|parallel'
+    ctest --test-dir build-tsan -j "$jobs" --output-on-failure -R "$tsan_tests"
     ;;
   *)
     sed -n '2,15p' "$0"
