@@ -111,9 +111,11 @@ case "${1:-}" in
     # joints, formations, both engines) runs here in the shorter tests. So do the Crazyflie replay
     # sweep and ablation, the replay on Bullet (22 flights) and the fidelity ablation: the same
     # replay and flights as the crazyflie_flight_replay_matches_docs_ode and
-    # fidelity_eight_matches_readme_* tests run here
+    # fidelity_eight_matches_readme_* tests run here. So do the two other passes over the 22 real
+    # flights (the mass's two methods, the estimator's table: 98 and 33 s under ASan), whose replays
+    # crazyflie_flight_replay_matches_docs_ode runs here too
     ctest --test-dir build-asan -j "$jobs" --output-on-failure \
-      -E '^install_and_consume$|memory running out while loading|^ground scenarios: (diffusion|aggregation|foraging):|quadrotors (from random starts )?form the sphere|^crazyflie_flight_replay_(sweep|ablation)_matches_docs$|^crazyflie_flight_replay_matches_docs_bullet$|^fidelity_eight_ablation_lines$'
+      -E '^install_and_consume$|memory running out while loading|^ground scenarios: (diffusion|aggregation|foraging):|quadrotors (from random starts )?form the sphere|^crazyflie_flight_replay_(sweep|ablation)_matches_docs$|^crazyflie_flight_replay_matches_docs_bullet$|^fidelity_eight_ablation_lines$|^flight_replay_mass_methods_agree$|^nanobench_estimator_matches_docs$'
     tests/fuzz/run.sh build-asan "${FUZZ_SECONDS:-60}"
     # under TSan: the tests of threads, bitwise results across thread counts, the worker pool and
     # parallel stepping; only the test files that mention them are compiled (a quarter of them)
