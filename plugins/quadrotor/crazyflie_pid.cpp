@@ -71,7 +71,10 @@ void Pid::load(StateReader& in) {
 
 CrazyfliePidController::CrazyfliePidController(const CrazyfliePidGains& gains, const std::vector<Rotor>& rotors,
                                                const RotorParams& rotor, const CrazyflieThrustCurve& curve)
-    : g_(gains), curve_(curve), thrust_coefficient_(rotor.thrust_coefficient), kalman_(gains.kalman_params) {
+    : g_(gains),
+      curve_(curve),
+      thrust_coefficient_(rotor.thrust_coefficient),
+      kalman_(gains.kalman ? std::make_unique<CrazyflieKalman>(gains.kalman_params) : nullptr) {
   if (rotors.size() != 4) throw std::invalid_argument("crazyflie_pid: four rotors, got " + std::to_string(rotors.size()));
   for (std::size_t i = 0; i < 4; ++i) {
     const Rotor& r = rotors[i];
@@ -202,9 +205,9 @@ void CrazyfliePidController::flownState(FlightInputs& in, Pose& pose, Vec3& velo
     in.position(pose, velocity);
     return;
   }
-  pose.position = kalman_.position();
-  pose.orientation = kalman_.attitude();
-  velocity = kalman_.velocity();
+  pose.position = kalman_->position();
+  pose.orientation = kalman_->attitude();
+  velocity = kalman_->velocity();
 }
 
 // The estimator's part of a run, in estimator_kalman.c's order: the IMU's new sample added, the
@@ -214,7 +217,7 @@ void CrazyfliePidController::estimate(std::int64_t run, FlightInputs& in) {
   Vec3 velocity;
   in.position(measured, velocity);
   if (!kalman_started_) {
-    kalman_.reset(measured.position, eulerDegrees(measured.orientation).z() / kDeg);
+    kalman_->reset(measured.position, eulerDegrees(measured.orientation).z() / kDeg);
     kalman_started_ = true;
   }
   if (const ImuMeasurement* imu = in.imu(); imu != nullptr && imu->stamp != imu_stamp_) {
@@ -222,17 +225,17 @@ void CrazyfliePidController::estimate(std::int64_t run, FlightInputs& in) {
       gyro_bias_sum_ += imu->gyroscope - in.bodyRates();
       ++gyro_bias_samples_;
     }
-    kalman_.addImu(imu->accelerometer, imu->gyroscope - gyro_bias_sum_ / gyro_bias_samples_);
+    kalman_->addImu(imu->accelerometer, imu->gyroscope - gyro_bias_sum_ / gyro_bias_samples_);
     imu_stamp_ = imu->stamp;
   }
-  if (run % predict_every_ == 0) kalman_.predict(static_cast<double>(predict_every_) * run_seconds_, thrust_ > 0);
-  kalman_.addProcessNoise(run_seconds_);
+  if (run % predict_every_ == 0) kalman_->predict(static_cast<double>(predict_every_) * run_seconds_, thrust_ > 0);
+  kalman_->addProcessNoise(run_seconds_);
   const Nanoseconds stamp = in.positionStamp();
   if (stamp < 0 || stamp != position_stamp_) {
-    kalman_.updatePosition(measured.position);
+    kalman_->updatePosition(measured.position);
     position_stamp_ = stamp;
   }
-  kalman_.finalize();
+  kalman_->finalize();
 }
 
 void CrazyfliePidController::positionLoop(double t, FlightInputs& in) {
@@ -333,7 +336,7 @@ void CrazyfliePidController::saveState(StateWriter& out) const {
     out.write(position_stamp_);
     out.write(gyro_bias_sum_);
     out.write(static_cast<std::int32_t>(gyro_bias_samples_));
-    kalman_.save(out);
+    kalman_->save(out);
   }
 }
 
@@ -372,7 +375,7 @@ void CrazyfliePidController::loadState(StateReader& in) {
     if (samples < 0 || samples > kGyroBiasSamples)
       throw StateError("crazyflie_pid: a saved count of gyroscope bias samples out of range");
     gyro_bias_samples_ = samples;
-    kalman_.load(in);
+    kalman_->load(in);
   }
 }
 

@@ -24,6 +24,7 @@
 #include "quadrotor_model.hpp"
 
 #include <array>
+#include <memory>
 #include <vector>
 
 namespace ssx::quadrotor {
@@ -130,8 +131,8 @@ class CrazyfliePidController final : public FlightController {
   /// The state the loops fly on (the filter's with `kalman`, else the position source's): position,
   /// velocity (world) and attitude.
   void flownState(FlightInputs& in, Pose& pose, Vec3& velocity) const;
-  /// The Kalman filter (with `kalman`).
-  const CrazyflieKalman& estimator() const { return kalman_; }
+  /// The Kalman filter (with `kalman`; nullptr without).
+  const CrazyflieKalman* estimator() const { return kalman_.get(); }
   /// The voltage the compensation sees.
   double compensationVoltage() const { return filter_.volts(); }
   /// In a driver that runs every `run_seconds`: the attitude loop every `attitude_runs` runs, the
@@ -210,8 +211,9 @@ class CrazyfliePidController final : public FlightController {
   double roll_deg_ = 0, pitch_deg_ = 0, yaw_target_deg_ = 0, thrust_ = 0;
   bool yaw_target_set_ = false;
   std::array<double, 4> motors_{};
-  // the estimator (kalman): its filter, the runs between predictions, the latest samples taken
-  CrazyflieKalman kalman_;
+  // the estimator (kalman): its filter (only then: a kilobyte a vehicle), the runs between
+  // predictions, the latest samples taken
+  std::unique_ptr<CrazyflieKalman> kalman_;
   std::int64_t predict_every_ = 5;
   double run_seconds_ = 0.002;
   bool kalman_started_ = false;
