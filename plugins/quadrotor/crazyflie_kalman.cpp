@@ -23,6 +23,16 @@ Mat3 attitudeTurn(const Vec3& d) {
   return a;
 }
 
+// the matrix of v's cross product: crossMatrix(v) w = v x w
+Mat3 crossMatrix(const Vec3& v) {
+  Mat3 m;
+  m << 0, -v.z(), v.y(), v.z(), 0, -v.x(), -v.y(), v.x(), 0;
+  return m;
+}
+
+// a quaternion scaled to unit length as the firmware does (its EPS in the norm)
+Quat unitLength(const Quat& q) { return Quat(q.coeffs() / (q.coeffs().norm() + 1e-6)); }
+
 // the quaternion turned in its own frame by the rotation vector v (rad)
 Quat turned(const Quat& q, const Vec3& v) {
   const double angle = v.norm() + 1e-6;  // the firmware's EPS keeps a zero rotation finite
@@ -70,18 +80,12 @@ void CrazyflieKalman::predict(double dt, bool flying) {
   Mat9 A = Mat9::Identity();
   A.block<3, 3>(X, PX) = R_ * dt;
   // position from the attitude error: R [p]x^T, i.e. -R [p]x
-  Mat3 px;
-  px << 0, -p.z(), p.y(), p.z(), 0, -p.x(), -p.y(), p.x(), 0;
-  A.block<3, 3>(X, D0) = -R_ * px * dt;
+  A.block<3, 3>(X, D0) = -R_ * crossMatrix(p) * dt;
   // body velocity from body velocity (no drag): the gyroscope's cross product
-  Mat3 wx;
-  wx << 0, -gyro.z(), gyro.y(), gyro.z(), 0, -gyro.x(), -gyro.y(), gyro.x(), 0;
-  A.block<3, 3>(PX, PX) = Mat3::Identity() - wx * dt;
+  A.block<3, 3>(PX, PX) = Mat3::Identity() - crossMatrix(gyro) * dt;
   // body velocity from the attitude error: gravity seen in the body frame turning
   const Vec3 g_body = R_.row(2).transpose();  // the world's z in the body frame
-  Mat3 gx;
-  gx << 0, -g_body.z(), g_body.y(), g_body.z(), 0, -g_body.x(), -g_body.y(), g_body.x(), 0;
-  A.block<3, 3>(PX, D0) = -kGravity * gx * dt;
+  A.block<3, 3>(PX, D0) = -kGravity * crossMatrix(g_body) * dt;
   A.block<3, 3>(D0, D0) = attitudeTurn(gyro * dt / 2);
   P_ = A * P_ * A.transpose();
 
@@ -96,7 +100,7 @@ void CrazyflieKalman::predict(double dt, bool flying) {
     const double keep = 1 - p_.attitude_reversion;
     q.coeffs() = keep * q.coeffs() + p_.attitude_reversion * initial_.coeffs();
   }
-  q_ = Quat(q.coeffs() / (q.coeffs().norm() + 1e-6));
+  q_ = unitLength(q);
   updated_ = true;
 }
 
@@ -130,9 +134,8 @@ void CrazyflieKalman::updatePosition(const Vec3& measured) {
 void CrazyflieKalman::finalize() {
   if (!updated_) return;
   const Vec3 v = s_.segment<3>(D0);
-  if ((v.cwiseAbs().maxCoeff() > 0.1e-3) && v.cwiseAbs().maxCoeff() < 10) {
-    q_ = turned(q_, v);
-    q_ = Quat(q_.coeffs() / (q_.coeffs().norm() + 1e-6));
+  if (const double largest = v.cwiseAbs().maxCoeff(); largest > 0.1e-3 && largest < 10) {
+    q_ = unitLength(turned(q_, v));
     Mat9 A = Mat9::Identity();
     A.block<3, 3>(D0, D0) = attitudeTurn(v / 2);
     P_ = A * P_ * A.transpose();
