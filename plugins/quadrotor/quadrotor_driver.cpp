@@ -125,6 +125,10 @@ void QuadrotorDriver::validate(const Descriptor& params, const PluginContext& co
     throw params.errorAt("battery", "this battery is compensated by the flight controller (battery_compensated, the "
                                     "crazyflie's firmware): fly "
                                     "controller=\"crazyflie_pid\" with battery=\"true\"");
+  if (config.crazyflie_gains.kalman && !config.crazyflie_pid)
+    throw params.errorAt("crazyflie_estimator",
+                         "crazyflie_estimator=\"kalman\" is the Crazyflie firmware's filter: fly "
+                         "controller=\"crazyflie_pid\" with it (TeleKyb's controller has none)");
   if (config.crazyflie_pid) {
     // (checked only for this controller: the rates mean nothing to TeleKyb's)
     const double period = toSeconds(context.period());

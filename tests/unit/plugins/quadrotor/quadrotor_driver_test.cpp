@@ -148,8 +148,10 @@ TEST_CASE("the crazyflie flies its firmware's controller: hover, the 1.1 m/s cla
   CHECK(std::abs(cf.pose().position.y() - 1) < 0.03);
 }
 
-TEST_CASE("controller=\"crazyflie_pid\" is refused while loading for a plus frame and for rates the driver cannot keep",
-          "[quadrotor][crazyflie]") {
+TEST_CASE(
+    "controller=\"crazyflie_pid\" is refused while loading for a plus frame and for rates the driver cannot keep, "
+    "and its Kalman filter without it",
+    "[quadrotor][crazyflie]") {
   // the mk_quad is a plus frame
   CHECK_THROWS_WITH(quadScene("<driver controller=\"crazyflie_pid\"/>", 1.0, 1, "mk_quad"),
                     Catch::Contains("error: <driver>") && Catch::Contains("X frame"));
@@ -171,6 +173,9 @@ TEST_CASE("controller=\"crazyflie_pid\" is refused while loading for a plus fram
   const std::string telekyb = "<scene><environment timestep=\"0.02\"/><type name=\"q\" file=\"mk_quad.xml\"/>"
                               "<artifact name=\"q\" type=\"q\" xyz=\"0 0 1\"><driver inner_rate_hz=\"50\"/></artifact></scene>";
   CHECK_NOTHROW(loadSceneFromString(telekyb, "slow.xml", kArtifacts));
+  // the firmware's Kalman filter belongs to its controller
+  CHECK_THROWS_WITH(quadScene("<driver crazyflie_estimator=\"kalman\"/>", 1.0, 1, "mk_quad"),
+                    Catch::Contains("error: <driver>") && Catch::Contains("fly controller=\"crazyflie_pid\" with it"));
 }
 
 TEST_CASE("the crazyflie's 1S battery: its firmware holds the thrust while the voltage sags, until it cannot",
