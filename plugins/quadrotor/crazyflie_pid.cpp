@@ -201,7 +201,7 @@ void CrazyfliePidController::resetAll(double yaw_deg) {
 }
 
 void CrazyfliePidController::flownState(FlightInputs& in, Pose& pose, Vec3& velocity) const {
-  if (!g_.kalman || !kalman_started_) {
+  if (!kalman_) {  // (with the filter, step() has run it before the loops)
     in.position(pose, velocity);
     return;
   }

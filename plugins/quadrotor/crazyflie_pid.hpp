@@ -131,8 +131,6 @@ class CrazyfliePidController final : public FlightController {
   /// The state the loops fly on (the filter's with `kalman`, else the position source's): position,
   /// velocity (world) and attitude.
   void flownState(FlightInputs& in, Pose& pose, Vec3& velocity) const;
-  /// The Kalman filter (with `kalman`; nullptr without).
-  const CrazyflieKalman* estimator() const { return kalman_.get(); }
   /// The voltage the compensation sees.
   double compensationVoltage() const { return filter_.volts(); }
   /// In a driver that runs every `run_seconds`: the attitude loop every `attitude_runs` runs, the
