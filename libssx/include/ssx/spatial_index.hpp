@@ -2,9 +2,10 @@
 /// @file
 /// A uniform-grid index of points for neighbour queries: rebuilt from scratch each time (cells
 /// sorted by key), queried for everything within a radius. Building is O(n log n) in the points,
-/// a query O(columns probed + points scanned). When the points' (x, y) columns fill a good part
-/// of their bounding rectangle (a swarm), a dense table of the rectangle's columns finds a query's
-/// columns of one x as one contiguous run of entries; else a hash table finds each column.
+/// O(n) when they are as many as last time and few changed cells (a swarm from one step to the
+/// next: the last order is sorted again by insertion); a query O(columns probed + points scanned). When the points' (x,
+/// y) columns fill a good part of their bounding rectangle (a swarm), a dense table of the rectangle's columns finds a
+/// query's columns of one x as one contiguous run of entries; else a hash table finds each column.
 
 #include <ssx/export.hpp>
 #include <ssx/types.hpp>
@@ -52,7 +53,9 @@ class SSX_EXPORT SpatialIndex {
     std::uint64_t key;
     std::size_t id;
     Vec3 point;
+    std::uint32_t input;  // its index in rebuild's arguments (orders equal (key, id) pairs)
   };
+  void sortEntries(const std::vector<Vec3>& points, const std::vector<std::size_t>& ids);
   std::uint64_t key(std::int64_t x, std::int64_t y, std::int64_t z) const;
   std::int64_t cell(double v) const;
   template <class Visit>
@@ -66,7 +69,7 @@ class SSX_EXPORT SpatialIndex {
   const Column* findColumn(std::uint64_t column_key) const;
 
   double cell_size_;
-  std::vector<Entry> entries_;  // sorted by (key, id)
+  std::vector<Entry> entries_;   // sorted by (key, id, input)
   std::vector<Column> columns_;  // open-addressing hash table of the non-empty columns (sparse)
   // dense: the columns of cells [x_min, x_min + nx) x [y_min, y_min + ny), x-major as the keys are;
   // column c's entries are [dense_start_[c], dense_start_[c + 1])

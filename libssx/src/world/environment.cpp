@@ -317,7 +317,7 @@ void Environment::start() {
     ghosts_->start(w, *physics_);
     detail::publishSnapshot(w, *physics_, true);
     // (queries enabled before start, by an extension's init, see the first snapshot too)
-    if (neighbors_->enabled()) neighbors_->markStale(w.artifacts);
+    if (neighbors_->enabled()) neighbors_->markStale(w);
     cameras_->bind(w.artifacts, settings_.timestep, settings_.render.background,
                    [this](std::string_view m) { log(LogLevel::Warning, m); });
     cameras_->schedule(settings_.render, 0, *renderer_, w.artifacts);
@@ -447,7 +447,7 @@ void Environment::requireOutsidePhases(const char* what) const {
 
 void Environment::enableNeighborQueries(double cell_size) {
   requireOutsidePhases("enableNeighborQueries");
-  if (neighbors_->enable(cell_size) && world_->state == State::Running) neighbors_->markStale(world_->artifacts);
+  if (neighbors_->enable(cell_size) && world_->state == State::Running) neighbors_->markStale(*world_);
 }
 
 bool Environment::neighborQueriesEnabled() const noexcept { return neighbors_->enabled(); }

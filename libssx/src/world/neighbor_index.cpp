@@ -1,4 +1,5 @@
 #include "world/neighbor_index.hpp"
+#include "world/world.hpp"
 
 namespace ssx::detail {
 
@@ -7,23 +8,30 @@ bool NeighborIndex::enable(double cell_size) {
   // positions do not change while plugins are configured: only a new grid needs building
   const bool is_new = !enabled_ || cell_size < index_.cellSize();
   if (is_new) index_ = SpatialIndex(cell_size);
+  roots_of_ = ~std::size_t{0};
   enabled_ = true;
   return is_new;
 }
 
 void NeighborIndex::rebuild() const {
   // one point per artifact with a dynamic root: its first dynamic root's position
-  points_.clear();
-  ids_.clear();
-  for (const auto& a : *artifacts_) {
-    for (std::size_t r = 0; r < a->rootCount(); ++r) {
-      const PhysicNode& root = a->root(r);
-      if (root.isStatic()) continue;
-      points_.push_back(root.pose().position);
-      ids_.push_back(a->index());
-      break;
+  const World& w = *world_;
+  if (roots_of_ != w.artifacts.size()) {
+    root_nodes_.clear();
+    ids_.clear();
+    for (const auto& a : w.artifacts) {
+      for (std::size_t r = 0; r < a->rootCount(); ++r) {
+        const PhysicNode& root = a->root(r);
+        if (root.isStatic()) continue;
+        root_nodes_.push_back(static_cast<std::uint32_t>(root.nodeIndex()));
+        ids_.push_back(a->index());
+        break;
+      }
     }
+    roots_of_ = w.artifacts.size();
   }
+  points_.resize(root_nodes_.size());
+  for (std::size_t k = 0; k < root_nodes_.size(); ++k) points_[k] = w.nodePose(root_nodes_[k]).position;
   index_.rebuild(points_, ids_);
 }
 

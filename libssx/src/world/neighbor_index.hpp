@@ -6,7 +6,6 @@
 // not change between a snapshot and the next physics step, so the index is the same whoever
 // builds it.
 
-#include <ssx/artifact.hpp>
 #include <ssx/spatial_index.hpp>
 
 #include <atomic>
@@ -16,17 +15,17 @@
 
 namespace ssx::detail {
 
+struct World;
+
 class NeighborIndex {
  public:
-  using Artifacts = std::vector<std::unique_ptr<Artifact>>;
-
   bool enabled() const noexcept { return enabled_; }
   /// Turns queries on with cells of at most `cell_size` m (the smallest asked for wins). Returns
   /// whether the grid is new (and must be rebuilt before the next query).
   bool enable(double cell_size);
   /// The snapshot moved: the artifacts are indexed again at the next query. Not during a query.
-  void markStale(const Artifacts& artifacts) noexcept {
-    artifacts_ = &artifacts;
+  void markStale(const World& world) noexcept {
+    world_ = &world;
     stale_.store(true, std::memory_order_release);
   }
   /// See Environment::neighbors. Throws when queries are off. Any thread, any number at once.
@@ -39,7 +38,12 @@ class NeighborIndex {
   const SpatialIndex& fresh() const;  // rebuilt first when stale
   void rebuild() const;
   bool enabled_ = false;
-  const Artifacts* artifacts_ = nullptr;
+  const World* world_ = nullptr;
+  // the node indexed for each artifact that has a dynamic root (its first), and the artifact's
+  // index: found once for a world's artifacts (they are fixed once it runs), then read from the
+  // world's tables in order, not through each artifact's handles
+  mutable std::vector<std::uint32_t> root_nodes_;
+  mutable std::size_t roots_of_ = ~std::size_t{0};  // how many artifacts root_nodes_ was found for
   mutable std::atomic<bool> stale_{false};
   mutable std::mutex mutex_;  // the one rebuild after a snapshot
   mutable SpatialIndex index_;

@@ -415,12 +415,7 @@ BodyState PhysicNode::state() const {
   return s;
 }
 
-Pose PhysicNode::pose() const {
-  const detail::NodeData& n = world_->nodes[index_];
-  if (n.body < 0 || !world_->started()) return world_->node_setup[index_].pose;
-  const Pose& body = world_->states[static_cast<std::size_t>(n.body)].pose;
-  return n.at_body ? body : body * n.pose_in_body;
-}
+Pose PhysicNode::pose() const { return world_->nodePose(index_); }
 
 void PhysicNode::requireWritable() const {
   if (!detail::PhaseGuard::in_phase || detail::PhaseGuard::writer == artifact_) return;

@@ -31,15 +31,43 @@ std::uint64_t SpatialIndex::key(std::int64_t x, std::int64_t y, std::int64_t z) 
   return (static_cast<std::uint64_t>(x) << 42) | (static_cast<std::uint64_t>(y) << 21) | static_cast<std::uint64_t>(z);
 }
 
-void SpatialIndex::rebuild(const std::vector<Vec3>& points, const std::vector<std::size_t>& ids) {
-  entries_.resize(points.size());
-  for (std::size_t i = 0; i < points.size(); ++i) {
+void SpatialIndex::sortEntries(const std::vector<Vec3>& points, const std::vector<std::size_t>& ids) {
+  auto before = [](const Entry& a, const Entry& b) {
+    if (a.key != b.key) return a.key < b.key;
+    return a.id != b.id ? a.id < b.id : a.input < b.input;
+  };
+  auto entry = [&](std::size_t i) {
     const Vec3& p = points[i];
-    entries_[i] = {key(cell(p.x()), cell(p.y()), cell(p.z())), ids[i], p};
+    return Entry{key(cell(p.x()), cell(p.y()), cell(p.z())), ids[i], p, static_cast<std::uint32_t>(i)};
+  };
+  const std::size_t n = points.size();
+  if (entries_.size() == n && n > 0) {
+    // as many points as last time: the last order, with the new keys, is nearly sorted when the
+    // points moved little (a swarm from one step to the next). Insertion sort finishes it in
+    // O(n + moves); past a budget of moves, a full sort. Both give the one order `before` defines.
+    for (Entry& e : entries_) e = entry(e.input);
+    const std::size_t budget = 8 * n + 1024;
+    std::size_t moves = 0;
+    for (std::size_t i = 1; i < n && moves <= budget; ++i) {
+      if (!before(entries_[i], entries_[i - 1])) continue;
+      const Entry e = entries_[i];
+      std::size_t j = i;
+      for (; j > 0 && before(e, entries_[j - 1]); --j) entries_[j] = entries_[j - 1];
+      entries_[j] = e;
+      moves += i - j;
+    }
+    if (moves <= budget) return;
+  } else {
+    entries_.resize(n);
+    for (std::size_t i = 0; i < n; ++i) entries_[i] = entry(i);
   }
-  std::sort(entries_.begin(), entries_.end(),
-            [](const Entry& a, const Entry& b) { return a.key != b.key ? a.key < b.key : a.id < b.id; });
-  if (entries_.size() >= std::numeric_limits<std::uint32_t>::max()) throw Error("spatial index: too many points");
+  std::sort(entries_.begin(), entries_.end(), before);
+}
+
+void SpatialIndex::rebuild(const std::vector<Vec3>& points, const std::vector<std::size_t>& ids) {
+  if (ids.size() != points.size()) throw Error("spatial index: as many ids as points are needed");
+  if (points.size() >= std::numeric_limits<std::uint32_t>::max()) throw Error("spatial index: too many points");
+  sortEntries(points, ids);
   columns_.clear();
   dense_start_.clear();
   if (entries_.empty()) return;

@@ -259,7 +259,7 @@ void Environment::step() {
   detail::clearUndrivenCommands(w);
   ++w.steps;
   detail::publishSnapshot(w, *physics_, false);
-  if (neighbors_->enabled()) neighbors_->markStale(w.artifacts);
+  if (neighbors_->enabled()) neighbors_->markStale(w);
   if (rays_enabled_) {
     physics_->prepareRayQueries();
     rays_stale_ = false;

@@ -216,6 +216,14 @@ struct World {
   std::vector<WrenchLimit> wrench_limits;
 
   bool started() const noexcept { return !states.empty(); }
+  /// Node `k`'s pose as of the snapshot (before start: as placed): what PhysicNode::pose reads,
+  /// for the core's loops that walk the tables rather than the handles.
+  Pose nodePose(std::size_t k) const {
+    const NodeData& n = nodes[k];
+    if (n.body < 0 || !started()) return node_setup[k].pose;
+    const Pose& body = states[static_cast<std::size_t>(n.body)].pose;
+    return n.at_body ? body : body * n.pose_in_body;
+  }
   ArtifactData& data(const Artifact& a) { return artifact_data[a.index()]; }
   const ArtifactData& data(const Artifact& a) const { return artifact_data[a.index()]; }
   ArtifactModel& model(const Artifact& a) { return models[a.index()]; }

@@ -298,7 +298,7 @@ void Environment::applyState(std::span<const std::byte> payload) {
   w.current_step = steps;
   physics_->recordContacts(w.record_contacts);  // (the last step's contacts are another run's)
   cameras_->invalidate();
-  if (neighbors_->enabled()) neighbors_->markStale(w.artifacts);
+  if (neighbors_->enabled()) neighbors_->markStale(w);
   rays_stale_ = true;
 }
 

@@ -67,3 +67,51 @@ TEST_CASE("the spatial index refuses a non-positive cell size", "[spatial]") {
   CHECK_THROWS(SpatialIndex(0.0));
   CHECK_THROWS(SpatialIndex(-1.0));
 }
+
+namespace {
+// every point's visit order for a query around each point: what a caller that keeps the index's
+// order (forEach) sees
+std::vector<std::size_t> visitOrder(const SpatialIndex& index, const std::vector<Vec3>& points, double radius) {
+  std::vector<std::size_t> order;
+  for (const Vec3& c : points)
+    index.forEach(
+        c, radius,
+        [](void* out, std::size_t id, const Vec3&) { static_cast<std::vector<std::size_t>*>(out)->push_back(id); },
+        &order);
+  return order;
+}
+}  // namespace
+
+TEST_CASE("an index rebuilt from its last order visits exactly as one built afresh", "[spatial]") {
+  // a rebuild with as many points as last time sorts the last order again (insertion, or a full
+  // sort past its budget of moves): the order must be the one a new index makes, moves small or large
+  Random r(5);
+  std::vector<Vec3> points;
+  std::vector<std::size_t> ids;
+  for (int i = 0; i < 2000; ++i) {
+    points.emplace_back(r.uniform(-20, 20), r.uniform(-20, 20), r.uniform(0, 4));
+    ids.push_back(static_cast<std::size_t>(1999 - i) / 2);  // pairs of equal ids: ties in (cell, id)
+  }
+  SpatialIndex kept(1.0);
+  kept.rebuild(points, ids);
+  for (double step : {0.01, 0.2, 5.0, 40.0}) {  // a few points change cells .. nearly all (full sort)
+    for (int round = 0; round < 3; ++round) {
+      for (Vec3& p : points) p += Vec3(r.uniform(-step, step), r.uniform(-step, step), r.uniform(-step, step));
+      kept.rebuild(points, ids);
+      SpatialIndex fresh(1.0);
+      fresh.rebuild(points, ids);
+      REQUIRE(visitOrder(kept, points, 1.5) == visitOrder(fresh, points, 1.5));
+    }
+  }
+  // and with another number of points (the last order does not apply)
+  points.resize(1500);
+  ids.resize(1500);
+  kept.rebuild(points, ids);
+  SpatialIndex fresh(1.0);
+  fresh.rebuild(points, ids);
+  CHECK(visitOrder(kept, points, 1.5) == visitOrder(fresh, points, 1.5));
+  CHECK(kept.size() == 1500);
+  // mismatched arguments are refused
+  ids.pop_back();
+  CHECK_THROWS_WITH(kept.rebuild(points, ids), Catch::Contains("as many ids as points"));
+}
