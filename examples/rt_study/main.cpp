@@ -6,11 +6,13 @@
 // radius grows with sqrt(N) so that the spacing stays about 1.5 m. Prints, last for each N:
 //   n=1000 samples=5000 median_ms=1.23 p95_ms=1.50 p99_ms=1.80 max_ms=4.00 overruns=0 max_late_ms=0
 //     late_steps=0 long_steps=0 began_late=0 physics_ms=0.3 sensors_ms=0.4 drivers_ms=0.5
-//     other_ms=0.03 us_per_robot=1.23
+//     other_ms=0.03 us_per_robot=1.23 heap_mib=17.1 kib_per_robot=17.5
 // (overruns: samples with a late step; max_late_ms: the most any one step ended past its deadline;
 // late_steps, long_steps, began_late: steps, as TimingSummary counts them (late; of those, longer
 // than a step; of the others, begun late after an on-time step); phase medians per sample; other =
-// snapshot, neighbour index and hooks; us_per_robot = the median sample over N)
+// snapshot and hooks (the neighbour index is rebuilt by the first range sensor to ask, in the
+// sensors phase); us_per_robot = the median sample over N; heap_mib = the heap the scene and its
+// started world hold (mallinfo2: the engine's and plugins' included); kib_per_robot = that over N)
 //
 // usage: ssx_rt_study [--n N]... [--samples K] [--threads T] [--physics-hz H] [--tau S] [--csv FILE]
 //                     [--steps-csv FILE] [--physics ode|bullet] [--rt-priority P] [--fast]
@@ -24,6 +26,7 @@
 //                 or CAP_SYS_NICE
 #include <ssx/ssx.hpp>
 
+#include <malloc.h>
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -33,6 +36,12 @@
 #include <vector>
 
 namespace {
+
+// bytes the C heap has handed out and not had back (mmapped blocks included)
+std::size_t heapInUse() {
+  const struct mallinfo2 m = mallinfo2();
+  return m.uordblks + m.hblkhd;
+}
 
 struct Options {
   std::vector<int> sizes;
@@ -132,6 +141,7 @@ int main(int argc, char** argv) {
   }
   for (int n : o.sizes) {
     try {
+      const std::size_t heap_before = heapInUse();
       ssx::SceneOptions options;
       if (!o.physics.empty()) options.physics_engine = o.physics;
       ssx::Scene scene = ssx::loadSceneFromString(sceneFor(n, o), "rt_study.xml",
@@ -145,6 +155,8 @@ int main(int argc, char** argv) {
       const int per_tau = std::max(1, static_cast<int>(std::lround(o.tau / ssx::toSeconds(env.timestep()))));
       run.steps = static_cast<std::int64_t>(o.samples) * per_tau;
       env.start();
+      // what the scene and its world hold on the heap (the engine's and plugins' included), per robot
+      const double heap_mib = static_cast<double>(heapInUse() - std::min(heapInUse(), heap_before)) / 1048576.0;
       const ssx::TimingSummary summary = env.run(run);
       if (!o.steps_csv.empty()) env.timing().writeCsv(o.steps_csv);
       // fold the steps of each tau into one sample
@@ -185,13 +197,15 @@ int main(int argc, char** argv) {
       };
       // per robot and tau of simulated time, from the median step
       const double us_per_robot = pct(50) * 1e3 / n;
-      std::printf("n=%d samples=%zu median_ms=%.3f p95_ms=%.3f p99_ms=%.3f max_ms=%.3f overruns=%lld "
-                  "max_late_ms=%.3f late_steps=%lld long_steps=%lld began_late=%lld physics_ms=%.3f sensors_ms=%.3f "
-                  "drivers_ms=%.3f other_ms=%.3f us_per_robot=%.3f\n",
-                  n, sorted.size(), pct(50), pct(95), pct(99), sorted.back(), static_cast<long long>(overruns),
-                  static_cast<double>(max_late) * 1e-6, static_cast<long long>(summary.overruns),
-                  static_cast<long long>(summary.overruns_long), static_cast<long long>(summary.overruns_began_late),
-                  median(physics), median(sensors), median(drivers), median(other), us_per_robot);
+      std::printf(
+          "n=%d samples=%zu median_ms=%.3f p95_ms=%.3f p99_ms=%.3f max_ms=%.3f overruns=%lld "
+          "max_late_ms=%.3f late_steps=%lld long_steps=%lld began_late=%lld physics_ms=%.3f sensors_ms=%.3f "
+          "drivers_ms=%.3f other_ms=%.3f us_per_robot=%.3f heap_mib=%.1f kib_per_robot=%.1f\n",
+          n, sorted.size(), pct(50), pct(95), pct(99), sorted.back(), static_cast<long long>(overruns),
+          static_cast<double>(max_late) * 1e-6, static_cast<long long>(summary.overruns),
+          static_cast<long long>(summary.overruns_long), static_cast<long long>(summary.overruns_began_late),
+          median(physics), median(sensors), median(drivers), median(other), us_per_robot, heap_mib,
+          heap_mib * 1024.0 / n);
       std::fflush(stdout);
     } catch (const std::exception& e) {
       std::fprintf(stderr, "ssx_rt_study: n=%d: %s\n", n, e.what());

@@ -61,6 +61,15 @@ void prefetchArtifact(const World& world, std::size_t i, std::size_t end, bool s
   const ArtifactData& next = world.artifact_data[i + 1];
   // (the artifact, which sensors and drivers reach their nodes through)
   if (i + 2 < end) prefetch(world.artifacts[i + 2].get(), sizeof(Artifact));
+  // its first node's handle and table row and its first body's snapshot, which every sensor and
+  // driver reading its node's state reaches (in order in their tables, but among a dozen streams
+  // the hardware's prefetcher does not follow them all: 8-12 % of a step at 100,000 robots)
+  if (next.first_node < next.node_end) {
+    prefetch(&world.node_handles[next.first_node]);
+    prefetch(&world.nodes[next.first_node]);
+  }
+  if (next.body_begin < next.body_end)
+    prefetch(&world.states[static_cast<std::size_t>(next.body_begin)], sizeof(BodyState));
   if (sensors) {
     for (std::uint32_t k = next.sensor_begin; k < next.sensor_end; ++k) prefetch(world.sensor_slots[k].sensor, 256);
     return;
