@@ -2,10 +2,10 @@
 /// @file
 /// A uniform-grid index of points for neighbour queries: rebuilt from scratch each time (cells
 /// sorted by key), queried for everything within a radius. Building is O(n log n) in the points,
-/// O(n) when they are as many as last time and few changed cells (a swarm from one step to the
-/// next: the last order is sorted again by insertion); a query O(columns probed + points scanned). When the points' (x,
-/// y) columns fill a good part of their bounding rectangle (a swarm), a dense table of the rectangle's columns finds a
-/// query's columns of one x as one contiguous run of entries; else a hash table finds each column.
+/// O(n + m log m) when they are as many as last time and m of them changed cells (a swarm from
+/// one step to the next: the others keep the last order); a query O(columns probed + points scanned). When the points'
+/// (x, y) columns fill a good part of their bounding rectangle (a swarm), a dense table of the rectangle's columns
+/// finds a query's columns of one x as one contiguous run of entries; else a hash table finds each column.
 
 #include <ssx/export.hpp>
 #include <ssx/types.hpp>
@@ -70,6 +70,7 @@ class SSX_EXPORT SpatialIndex {
 
   double cell_size_;
   std::vector<Entry> entries_;   // sorted by (key, id, input)
+  std::vector<Entry> moved_;     // rebuild's scratch: the entries whose cell or id changed
   std::vector<Column> columns_;  // open-addressing hash table of the non-empty columns (sparse)
   // dense: the columns of cells [x_min, x_min + nx) x [y_min, y_min + ny), x-major as the keys are;
   // column c's entries are [dense_start_[c], dense_start_[c + 1])

@@ -42,25 +42,32 @@ void SpatialIndex::sortEntries(const std::vector<Vec3>& points, const std::vecto
   };
   const std::size_t n = points.size();
   if (entries_.size() == n && n > 0) {
-    // as many points as last time: the last order, with the new keys, is nearly sorted when the
-    // points moved little (a swarm from one step to the next). Insertion sort finishes it in
-    // O(n + moves); past a budget of moves, a full sort. Both give the one order `before` defines.
-    for (Entry& e : entries_) e = entry(e.input);
-    const std::size_t budget = 8 * n + 1024;
-    std::size_t moves = 0;
-    for (std::size_t i = 1; i < n && moves <= budget; ++i) {
-      if (!before(entries_[i], entries_[i - 1])) continue;
-      const Entry e = entries_[i];
-      std::size_t j = i;
-      for (; j > 0 && before(e, entries_[j - 1]); --j) entries_[j] = entries_[j - 1];
-      entries_[j] = e;
-      moves += i - j;
+    // as many points as last time: the entries whose cell and id did not change keep the last
+    // order among themselves; the others (a swarm's few that crossed a cell wall since) are sorted
+    // apart and merged in. O(n + m log m) for m changed; the one order `before` defines either way
+    moved_.clear();
+    std::size_t kept = 0;
+    for (std::size_t k = 0; k < n; ++k) {
+      const Entry e = entry(entries_[k].input);
+      if (e.key == entries_[k].key && e.id == entries_[k].id)
+        entries_[kept++] = e;
+      else
+        moved_.push_back(e);
     }
-    if (moves <= budget) return;
-  } else {
-    entries_.resize(n);
-    for (std::size_t i = 0; i < n; ++i) entries_[i] = entry(i);
+    if (moved_.empty()) return;
+    std::sort(moved_.begin(), moved_.end(), before);
+    // merge from the back, in place: the kept ones fill [0, kept), the moved ones go after
+    std::size_t a = kept, b = moved_.size(), out = n;
+    while (b > 0) {
+      if (a > 0 && before(moved_[b - 1], entries_[a - 1]))
+        entries_[--out] = entries_[--a];
+      else
+        entries_[--out] = moved_[--b];
+    }
+    return;
   }
+  entries_.resize(n);
+  for (std::size_t i = 0; i < n; ++i) entries_[i] = entry(i);
   std::sort(entries_.begin(), entries_.end(), before);
 }
 
