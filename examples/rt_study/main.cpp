@@ -155,8 +155,9 @@ int main(int argc, char** argv) {
       const int per_tau = std::max(1, static_cast<int>(std::lround(o.tau / ssx::toSeconds(env.timestep()))));
       run.steps = static_cast<std::int64_t>(o.samples) * per_tau;
       env.start();
-      // what the scene and its world hold on the heap (the engine's and plugins' included), per robot
-      const double heap_mib = static_cast<double>(heapInUse() - std::min(heapInUse(), heap_before)) / 1048576.0;
+      // what the scene and its world hold on the heap (the engine's and plugins' included)
+      const std::size_t heap_after = heapInUse();
+      const double heap_mib = static_cast<double>(heap_after - std::min(heap_after, heap_before)) / 1048576.0;
       const ssx::TimingSummary summary = env.run(run);
       if (!o.steps_csv.empty()) env.timing().writeCsv(o.steps_csv);
       // fold the steps of each tau into one sample

@@ -1,11 +1,12 @@
 #pragma once
 /// @file
-/// A uniform-grid index of points for neighbour queries: rebuilt from scratch each time (cells
-/// sorted by key), queried for everything within a radius. Building is O(n log n) in the points,
-/// O(n + m log m) when they are as many as last time and m of them changed cells (a swarm from
-/// one step to the next: the others keep the last order); a query O(columns probed + points scanned). When the points'
-/// (x, y) columns fill a good part of their bounding rectangle (a swarm), a dense table of the rectangle's columns
-/// finds a query's columns of one x as one contiguous run of entries; else a hash table finds each column.
+/// A uniform-grid index of points for neighbour queries: its contents replaced whole by each
+/// rebuild (entries sorted by cell key), queried for everything within a radius. Building is
+/// O(n log n) in the points, or O(n + m log m) when they are as many as last time and m of them
+/// changed cells (a swarm from one step to the next: the others keep the last order). A query is
+/// O(columns probed + points scanned). When the points' (x, y) columns fill a good part of their
+/// bounding rectangle (a swarm), a dense table of the rectangle's columns finds a query's columns
+/// of one x as one contiguous run of entries; else a hash table finds each column.
 
 #include <ssx/export.hpp>
 #include <ssx/types.hpp>
