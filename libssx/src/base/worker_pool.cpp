@@ -68,10 +68,20 @@ WorkerPool::~WorkerPool() {
 
 void WorkerPool::work() {
   // take chunks until none are left
+  const std::size_t share = 2 * std::size_t{size()};
   for (;;) {
-    const std::size_t begin = next_.fetch_add(chunk_, std::memory_order_relaxed);
-    if (begin >= n_) break;
-    const std::size_t end = std::min(n_, begin + chunk_);
+    std::size_t begin = 0, end = 0;
+    if (guided_) {
+      begin = next_.load(std::memory_order_relaxed);
+      do {
+        if (begin >= n_) return;
+        end = std::min(n_, begin + std::max(chunk_, (n_ - begin) / share));
+      } while (!next_.compare_exchange_weak(begin, end, std::memory_order_relaxed));
+    } else {
+      begin = next_.fetch_add(chunk_, std::memory_order_relaxed);
+      if (begin >= n_) break;
+      end = std::min(n_, begin + chunk_);
+    }
     try {
       invoke_(ctx_, begin, end);
     } catch (...) {
@@ -101,7 +111,7 @@ void WorkerPool::workerLoop() {
   }
 }
 
-void WorkerPool::run(std::size_t n, std::size_t chunk, Invoke invoke, void* ctx) {
+void WorkerPool::run(std::size_t n, std::size_t chunk, Invoke invoke, void* ctx, bool guided) {
   if (n == 0) return;
   if (n <= chunk || workers_.empty()) {
     // one chunk: waking the workers would cost more than it saves
@@ -110,6 +120,7 @@ void WorkerPool::run(std::size_t n, std::size_t chunk, Invoke invoke, void* ctx)
   }
   n_ = n;
   chunk_ = chunk == 0 ? 1 : chunk;
+  guided_ = guided;
   invoke_ = invoke;
   ctx_ = ctx;
   has_error_.store(false, std::memory_order_relaxed);

@@ -56,10 +56,19 @@ class WorkerPool final : public TaskRunner {
     run(
         n, chunk, [](void* ctx, std::size_t b, std::size_t e) { (*static_cast<F*>(ctx))(b, e); }, &fn);
   }
+  /// As parallelFor, with chunks that shrink as the work runs out (guided scheduling): each takes
+  /// a share of what is left, 1 / (2 x threads) of it, and at least `least`. Large chunks while
+  /// there is much to do, and at the end no thread waits long for another's last chunk: for work
+  /// whose indices cost about the same each and are many (the copies of a vector environment).
+  template <class F>
+  void parallelForGuided(std::size_t n, std::size_t least, F& fn) {
+    run(
+        n, least, [](void* ctx, std::size_t b, std::size_t e) { (*static_cast<F*>(ctx))(b, e); }, &fn, true);
+  }
 
  private:
   using Invoke = void (*)(void*, std::size_t, std::size_t);
-  void run(std::size_t n, std::size_t chunk, Invoke invoke, void* ctx);
+  void run(std::size_t n, std::size_t chunk, Invoke invoke, void* ctx, bool guided = false);
   void work();
   void workerLoop();
 
@@ -73,6 +82,7 @@ class WorkerPool final : public TaskRunner {
   std::atomic<bool> released_{true};
   std::size_t n_ = 0;
   std::size_t chunk_ = 1;
+  bool guided_ = false;  // chunks of a share of what is left, at least chunk_
   Invoke invoke_ = nullptr;
   void* ctx_ = nullptr;
   std::atomic<bool> has_error_{false};

@@ -234,7 +234,9 @@ void VectorEnvironment::forEachInChunks(Ref<std::size_t> fn) {
       }
     }
   };
-  pool_->workers.parallelFor(n, std::max<std::size_t>(1, n / (pool_->workers.size() * 8)), body);
+  // runs of copies that shrink as the batch runs out: no thread waits long at the end for the
+  // other's last run (a run of 64 copies of 1,024 is 0.6 ms of a 6 ms batch)
+  pool_->workers.parallelForGuided(n, 4, body);
   rethrowFirst();
 }
 

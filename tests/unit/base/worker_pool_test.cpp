@@ -2,6 +2,7 @@
 
 #include <catch2/catch.hpp>
 
+#include <algorithm>
 #include <atomic>
 #include <stdexcept>
 #include <vector>
@@ -23,6 +24,49 @@ TEST_CASE("the worker pool covers every index exactly once", "[pool]") {
       }
     }
   }
+}
+
+TEST_CASE("guided chunks cover every index once and shrink to the least asked", "[pool]") {
+  for (unsigned threads : {1u, 2u, 4u}) {
+    WorkerPool pool(threads);
+    for (std::size_t n : {std::size_t{0}, std::size_t{1}, std::size_t{5}, std::size_t{1024}}) {
+      for (int round = 0; round < 50; ++round) {
+        std::vector<std::atomic<int>> hits(n);
+        std::vector<std::size_t> sizes(n + 1, 0);  // by chunk start: its size
+        auto fn = [&](std::size_t b, std::size_t e) {
+          sizes[b] = e - b;
+          for (std::size_t i = b; i < e; ++i) hits[i].fetch_add(1);
+        };
+        pool.parallelForGuided(n, 4, fn);
+        for (std::size_t i = 0; i < n; ++i) REQUIRE(hits[i].load() == 1);
+        if (n < 1024 || threads == 1) continue;
+        // in index order: each chunk a share of what was left (1 / (2 x threads)), at least 4
+        std::size_t at = 0;
+        while (at < n) {
+          const std::size_t want = std::min(n - at, std::max<std::size_t>(4, (n - at) / (2 * threads)));
+          REQUIRE(sizes[at] == want);
+          at += sizes[at];
+        }
+      }
+    }
+  }
+  // the first chunk of 1,024 on 2 threads is a quarter of it, the last at most 4 (what was left)
+  WorkerPool pool(2);
+  std::vector<std::size_t> sizes;
+  std::vector<std::size_t> starts;
+  std::atomic_flag busy = ATOMIC_FLAG_INIT;
+  auto record = [&](std::size_t b, std::size_t e) {
+    while (busy.test_and_set()) {
+    }
+    starts.push_back(b);
+    sizes.push_back(e - b);
+    busy.clear();
+  };
+  pool.parallelForGuided(1024, 4, record);
+  const auto first = std::find(starts.begin(), starts.end(), std::size_t{0}) - starts.begin();
+  CHECK(sizes[static_cast<std::size_t>(first)] == 256);
+  const auto last = std::max_element(starts.begin(), starts.end()) - starts.begin();
+  CHECK(sizes[static_cast<std::size_t>(last)] <= 4);
 }
 
 TEST_CASE("the worker pool rethrows a task's exception after the barrier", "[pool]") {
