@@ -80,7 +80,7 @@ void carryOut(World& world, PhysicEngine& engine, const AttachRequest& r) {
 
 // asked for now: at once between steps, else queued for the next step's physics
 void request(World& world, const AttachRequest& r) {
-  if (!PhaseGuard::in_phase) {
+  if (!PhaseGuard::now.in_phase) {
     carryOut(world, *world.engine, r);
     return;
   }

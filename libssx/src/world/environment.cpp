@@ -440,8 +440,8 @@ void Environment::warnUnusedParameters() const {
 
 void Environment::requireOutsidePhases(const char* what) const {
   // the parallel phases read what these calls change: a call from there would be a data race
-  if (detail::PhaseGuard::in_phase)
-    throw Error(std::string(what) + " is not allowed from a " + detail::PhaseGuard::role +
+  if (detail::PhaseGuard::now.in_phase)
+    throw Error(std::string(what) + " is not allowed from a " + detail::PhaseGuard::now.role +
                 " (the parallel phases): call it from configure, or between steps");
 }
 

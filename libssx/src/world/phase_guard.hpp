@@ -9,27 +9,23 @@ class Artifact;
 namespace ssx::detail {
 
 struct PhaseGuard {
-  static thread_local bool in_phase;           // inside a parallel phase
-  static thread_local const Artifact* writer;  // the artifact whose driver runs, or nullptr
-  static thread_local const char* role;        // "driver", "sensor", "callback" for messages
+  // one thread-local object, not three: in a shared library each thread-local costs a call to
+  // find it, and a guard is set around every plugin call of every step
+  struct State {
+    bool in_phase = false;             // inside a parallel phase
+    const Artifact* writer = nullptr;  // the artifact whose driver runs, or nullptr
+    const char* role = "";             // "driver", "sensor", "callback" for messages
+  };
+  static thread_local State now;
 
-  PhaseGuard(const Artifact* w, const char* r) : saved_in_(in_phase), saved_writer_(writer), saved_role_(role) {
-    in_phase = true;
-    writer = w;
-    role = r;
-  }
-  ~PhaseGuard() {
-    in_phase = saved_in_;
-    writer = saved_writer_;
-    role = saved_role_;
-  }
+  PhaseGuard(const Artifact* w, const char* r) : state_(now), saved_(state_) { state_ = State{true, w, r}; }
+  ~PhaseGuard() { state_ = saved_; }
   PhaseGuard(const PhaseGuard&) = delete;
   PhaseGuard& operator=(const PhaseGuard&) = delete;
 
  private:
-  bool saved_in_;
-  const Artifact* saved_writer_;
-  const char* saved_role_;
+  State& state_;
+  State saved_;
 };
 
 }  // namespace ssx::detail

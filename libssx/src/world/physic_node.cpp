@@ -418,10 +418,10 @@ BodyState PhysicNode::state() const {
 Pose PhysicNode::pose() const { return world_->nodePose(index_); }
 
 void PhysicNode::requireWritable() const {
-  if (!detail::PhaseGuard::in_phase || detail::PhaseGuard::writer == artifact_) return;
-  const Artifact* w = detail::PhaseGuard::writer;
-  std::string who = w != nullptr ? std::string(detail::PhaseGuard::role) + " of artifact '" + w->name() + "'"
-                                 : std::string("a ") + detail::PhaseGuard::role;
+  if (!detail::PhaseGuard::now.in_phase || detail::PhaseGuard::now.writer == artifact_) return;
+  const Artifact* w = detail::PhaseGuard::now.writer;
+  std::string who = w != nullptr ? std::string(detail::PhaseGuard::now.role) + " of artifact '" + w->name() + "'"
+                                 : std::string("a ") + detail::PhaseGuard::now.role;
   throw Error(who + " tried to write to artifact '" + artifact_->name() +
               "': during a step, only an artifact's own driver writes its forces and torques");
 }
@@ -459,7 +459,7 @@ void PhysicNode::addTorque(const Vec3& torque, Frame frame) {
 
 void PhysicNode::setVelocity(const Vec3& linear, const Vec3& angular) {
   Environment& env = world_->env;
-  if (detail::PhaseGuard::in_phase) throw Error("setVelocity is not allowed during a step");
+  if (detail::PhaseGuard::now.in_phase) throw Error("setVelocity is not allowed during a step");
   const PhysicsSettings& ps = env.settings().physics;
   if (!linear.allFinite() || !angular.allFinite() || linear.norm() > ps.max_linear_speed ||
       angular.norm() > ps.max_angular_speed)

@@ -9,7 +9,8 @@
 namespace ssx {
 
 void Environment::enableRayQueries() {
-  if (detail::PhaseGuard::in_phase) throw Error("enableRayQueries is not allowed in the parallel phases: call it from configure");
+  if (detail::PhaseGuard::now.in_phase)
+    throw Error("enableRayQueries is not allowed in the parallel phases: call it from configure");
   rays_enabled_ = true;
   rays_stale_ = true;
 }
@@ -20,7 +21,7 @@ void Environment::castRays(std::span<const Ray> rays, std::span<RayHit> hits, co
   if (rays.size() != hits.size()) throw Error("castRays: one hit per ray");
   if (rays_stale_) {
     // (only ever between steps: after a step's physics the shapes are posed before the sensors run)
-    if (detail::PhaseGuard::in_phase) throw Error("castRays: the shapes were not posed for this step");
+    if (detail::PhaseGuard::now.in_phase) throw Error("castRays: the shapes were not posed for this step");
     physics_->prepareRayQueries();
     rays_stale_ = false;
   }

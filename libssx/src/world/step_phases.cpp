@@ -19,9 +19,7 @@ namespace ssx {
 // defined here, where the phases set them around every plugin call: in the same translation
 // unit the accesses need no call into the dynamic linker's TLS lookup
 namespace detail {
-thread_local bool PhaseGuard::in_phase = false;
-thread_local const Artifact* PhaseGuard::writer = nullptr;
-thread_local const char* PhaseGuard::role = "";
+thread_local PhaseGuard::State PhaseGuard::now;
 }  // namespace detail
 
 namespace {
