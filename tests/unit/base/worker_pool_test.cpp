@@ -26,7 +26,7 @@ TEST_CASE("the worker pool covers every index exactly once", "[pool]") {
   }
 }
 
-TEST_CASE("guided chunks cover every index once and shrink to the least asked", "[pool]") {
+TEST_CASE("the worker pool's guided chunks cover every index once and shrink to the least asked", "[pool]") {
   for (unsigned threads : {1u, 2u, 4u}) {
     WorkerPool pool(threads);
     for (std::size_t n : {std::size_t{0}, std::size_t{1}, std::size_t{5}, std::size_t{1024}}) {
