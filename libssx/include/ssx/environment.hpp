@@ -269,14 +269,15 @@ class SSX_EXPORT Environment {
   /// and extension's own state (their saveState), the step count. A versioned, checksummed
   /// buffer. Starts nothing: the environment must be running (after start() or a step).
   std::vector<std::byte> saveState() const;
+  /// The same into `into`, over what it holds: a buffer kept from the last state saves the
+  /// allocation and the first touch of its memory (a recorder saving every few seconds).
+  void saveState(std::vector<std::byte>& into) const;
   /// Continues from a saved state: the next steps are bitwise those of the run that saved it,
   /// on any number of threads, also in another process that loaded the same scene. Starts the
   /// environment first if it is still being set up. A truncated, corrupted or mismatched buffer
-  /// (another scene, another format) throws StateError and leaves the state as it was.
-  /// Not saved: camera images (drawn again when due) and the outside world of extensions.
+  /// throws StateError and leaves the state as it was. It continues on the engine that saved it
+  /// (switching as switchPhysics does). Not saved: camera images and extensions' outside world.
   void restoreState(std::span<const std::byte> state);
-  /// A saved state names the engine that saved it: restoring it continues on that engine
-  /// (switching to it, as switchPhysics does, when another one is stepping).
   /// The checks restoreState makes before it changes anything (format, size, checksum, the scene
   /// it was saved from), without starting the environment. Throws StateError.
   void checkState(std::span<const std::byte> state) const;
@@ -578,8 +579,7 @@ class SSX_EXPORT Environment {
   bool rays_enabled_ = false;
   mutable bool rays_stale_ = true;  // the engine's shapes are not where the snapshot has the bodies
   std::vector<StaticShape> static_shapes_;
-  std::vector<PhysicsSwitch> switches_;    // made so far
-  std::vector<PhysicsSwitch> scheduled_;   // switchPhysicsAt's, by time (`from` unused)
+  std::vector<PhysicsSwitch> switches_, scheduled_;  // made so far; switchPhysicsAt's, by time (`from` unused)
   TimingRecorder timing_{settings_.timing_samples};
   LogSink log_;
   // step listeners (addStepListener), after the members plugins' inline accessors read

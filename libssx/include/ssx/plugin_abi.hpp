@@ -35,9 +35,9 @@
 
 /// Incremented whenever the manifest layout, the meaning of its fields, the plugin base classes
 /// (Plugin, Driver, Sensor, SimulationExtension: their virtual functions and members) or the
-/// members of the classes whose inline accessors plugins compile in (Artifact) or the structs
-/// handed to them (PluginContext) change.
-#define SSX_PLUGIN_ABI_VERSION 10u
+/// members of the classes whose inline accessors plugins compile in (Artifact, StateWriter) or the
+/// structs handed to them (PluginContext) change.
+#define SSX_PLUGIN_ABI_VERSION 11u
 
 /// @cond
 #define SSX_PLUGIN_STRINGIFY2(x) #x

@@ -15,6 +15,7 @@
 #include <ssx/export.hpp>
 #include <ssx/types.hpp>
 
+#include <algorithm>
 #include <cstddef>
 #include <cstdint>
 #include <cstring>
@@ -32,15 +33,36 @@ class SSX_EXPORT StateError : public Error {
 };
 
 /// Appends values to a byte buffer.
+///
+/// Made on a vector alone, each value is appended to it at once. Environment::saveState makes it
+/// with a start offset instead: it then writes over what the vector already holds from there on
+/// (a buffer kept from the last saved state: no allocation, no page faults), grows it only when
+/// full, and trims it to what was written in finish() or its destructor. Until then the vector may
+/// be longer than size(); the bytes past size() are not part of the state.
 class StateWriter {
  public:
   /// A writer appending to `out`, which must outlive it.
   explicit StateWriter(std::vector<std::byte>& out) : out_(&out) {}
+  /// A writer writing over `out` from byte `from` on (at most its size; the bytes before are
+  /// kept), trimming it to what was written when finished. `out` must outlive it.
+  StateWriter(std::vector<std::byte>& out, std::size_t from) : out_(&out), over_(true) {
+    if (from > out.size()) out.resize(from);
+    at_ = out.data() + from;
+    room_ = out.size() - from;
+  }
+  StateWriter(const StateWriter&) = delete;
+  StateWriter& operator=(const StateWriter&) = delete;
+  ~StateWriter() { finish(); }
 
   /// Appends `size` raw bytes.
   void bytes(const void* data, std::size_t size) {
-    const auto* p = static_cast<const std::byte*>(data);
-    out_->insert(out_->end(), p, p + size);
+    if (size <= room_) {  // (a constant size inlines to a move)
+      std::memcpy(at_, data, size);
+      at_ += size;
+      room_ -= size;
+      return;
+    }
+    grow(data, size);
   }
   /// A trivially copyable value (numbers, enums, bools, arrays and structs of them).
   template <class T>
@@ -70,12 +92,36 @@ class StateWriter {
   }
 
   /// Bytes in the buffer so far (what was there before included).
-  std::size_t size() const noexcept { return out_->size(); }
-  /// The buffer written to.
+  std::size_t size() const noexcept { return out_->size() - room_; }
+  /// The buffer written to (past size(), bytes not written yet while writing over a buffer).
   std::vector<std::byte>& buffer() noexcept { return *out_; }
+  /// Trims the buffer to size() (a writer writing over one; nothing for one appending). Nothing
+  /// may be written after.
+  void finish() noexcept {
+    if (!over_) return;
+    out_->resize(size());  // (shrinking: no allocation)
+    room_ = 0;
+    over_ = false;
+  }
 
  private:
+  void grow(const void* data, std::size_t size) {
+    const auto* p = static_cast<const std::byte*>(data);
+    if (!over_) {
+      out_->insert(out_->end(), p, p + size);
+      return;
+    }
+    const std::size_t written = this->size();
+    out_->resize(std::max(2 * out_->size(), written + size));
+    at_ = out_->data() + written;
+    room_ = out_->size() - written;
+    bytes(data, size);
+  }
+
   std::vector<std::byte>* out_;
+  std::byte* at_ = nullptr;  // writing over: where the next byte goes
+  std::size_t room_ = 0;     // ... and how many fit before the vector's end
+  bool over_ = false;
 };
 
 /// Reads values back in the order they were written; throws StateError when the data ends early.

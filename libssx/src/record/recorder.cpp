@@ -13,8 +13,9 @@
 #include <ssx/version.hpp>
 
 #include <algorithm>
-#include <condition_variable>
+#include <chrono>
 #include <cmath>
+#include <condition_variable>
 #include <cstdio>
 #include <deque>
 #include <exception>
@@ -62,6 +63,7 @@ struct Recorder::Impl {
   bool begun = false;
   std::int64_t period_steps = 1;
   Nanoseconds next_state = 0;
+  std::int64_t states_taken = 0;
   std::vector<std::string> names;
   std::vector<const PhysicNode*> nodes;  // the node heading each name's body
   std::vector<RecordedBody> bodies;
@@ -78,6 +80,7 @@ struct Recorder::Impl {
   std::condition_variable changed;
   std::deque<Job> queue;
   std::vector<std::vector<std::byte>> spare;  // buffers the writer is done with
+  std::vector<std::byte> spare_state;         // ... and the last saved state's (written over by the next)
   std::vector<std::unique_ptr<detail::RunSample>> spare_samples;  // ... and samples
   bool done = false;
   std::exception_ptr error;
@@ -262,7 +265,20 @@ void Recorder::Impl::observe() {
     Job state;
     state.time = now;
     state.state = true;
-    state.bytes = env->saveState();
+    {
+      std::lock_guard lock(mutex);
+      state.bytes.swap(spare_state);
+    }
+    const auto t0 = std::chrono::steady_clock::now();
+    env->saveState(state.bytes);
+    const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+    {
+      std::lock_guard lock(mutex);
+      if (states_taken++ == 0)
+        summary.state_ms_first = ms;
+      else
+        summary.state_ms_max = std::max(summary.state_ms_max, ms);
+    }
     push(std::move(state));
     next_state = options.state_every_s > 0 ? now + toNanoseconds(options.state_every_s)
                                            : std::numeric_limits<Nanoseconds>::max();
@@ -321,7 +337,10 @@ void Recorder::Impl::loop() {
     else if (job.time >= 0 && job.attachment.empty())
       ++summary.samples;
     summary.bytes = writer->bytesWritten();
-    spare.push_back(std::move(job.bytes));
+    if (job.state)
+      spare_state = std::move(job.bytes);  // (kept for the next state: 21 MB at 10,000 quadrotors)
+    else
+      spare.push_back(std::move(job.bytes));
     if (job.sample) spare_samples.push_back(std::move(job.sample));
   }
 }

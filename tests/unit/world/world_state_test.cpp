@@ -177,3 +177,58 @@ TEST_CASE("format 7's checksum catches a changed word anywhere, and format 6's s
   std::memcpy(five.data() + 8, &format5, 4);
   CHECK_THROWS_WITH(env.restoreState(five), Catch::Contains("saved state format 5, this ssx reads formats 6 and 7"));
 }
+
+TEST_CASE("a state saved over a kept buffer is the state saved afresh, whatever the buffer held", "[state]") {
+  Scene scene = loadStateScene(2);
+  Environment& env = *scene.environment;
+  env.step(20);
+  const std::vector<std::byte> fresh = env.saveState();
+  // longer than the state and full of other bytes: written over and trimmed
+  std::vector<std::byte> kept(fresh.size() + 4096, std::byte{0xAB});
+  env.saveState(kept);
+  CHECK(kept == fresh);
+  // shorter (grown while written), and empty
+  std::vector<std::byte> short_one(100, std::byte{0x5C}), empty;
+  env.saveState(short_one);
+  env.saveState(empty);
+  CHECK(short_one == fresh);
+  CHECK(empty == fresh);
+  // the kept buffer, restored, continues as the run did
+  env.step(30);
+  const std::vector<std::byte> at50 = env.saveState();
+  env.restoreState(kept);
+  env.step(30);
+  env.saveState(kept);
+  CHECK(kept == at50);
+}
+
+TEST_CASE("a state writer writing over a buffer keeps what is before its start, grows and trims", "[state]") {
+  std::vector<std::byte> buffer(8, std::byte{7});
+  {
+    StateWriter out(buffer, 3);
+    CHECK(out.size() == 3);
+    out.write(std::uint32_t{0x01020304});  // fits: 3 + 4 of 8
+    CHECK(out.size() == 7);
+    out.write(std::string(50, 'x'));  // does not: grown
+    CHECK(out.size() == 7 + 8 + 50);
+    CHECK(buffer.size() >= out.size());
+  }  // (trimmed when the writer ends)
+  REQUIRE(buffer.size() == 65);
+  CHECK(buffer[0] == std::byte{7});
+  CHECK(buffer[2] == std::byte{7});
+  StateReader in(std::span<const std::byte>(buffer).subspan(3));
+  CHECK(in.get<std::uint32_t>() == 0x01020304u);
+  std::string text;
+  in.read(text);
+  CHECK(text == std::string(50, 'x'));
+  CHECK(in.done());
+  // a start past the end grows the buffer to it; one made on a vector alone appends as before
+  std::vector<std::byte> small(2);
+  StateWriter past(small, 5);
+  CHECK(small.size() == 5);
+  past.finish();
+  StateWriter append(small);
+  append.write(std::uint8_t{9});
+  CHECK(small.size() == 6);
+  CHECK(small[5] == std::byte{9});
+}
