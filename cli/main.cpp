@@ -338,6 +338,7 @@ int commandRun(const RunArgs& args, bool realtime_given) {
   try {
     env.start();
     if (!loaded.empty()) env.restoreState(loaded);
+    if (recorder) recorder->prepare();  // (the first saved state then costs a step what the later ones do)
     for (const std::string& spec : args.switch_physics) {
       const auto [at, engine] = *parseSwitch(spec);
       env.switchPhysicsAt(ssx::toNanoseconds(at), engine);

@@ -1,11 +1,13 @@
 // ssx_bench_record: what recording costs. N quadrotors of the real-time study (ssx_rt_study: tau =
 // 20 ms, 2 threads) fly into a formation in real time, with and without the recorder of --record
 // (25 pose samples per simulated second, a saved state every 10 s), alternated RUNS times. Prints
-// per run the median and p99 step time, the late steps, the samples dropped and how long saved states
-// took on the stepping thread (the first, and the longest of the later ones); then the file's size
-// per robot and simulated second (the poses alone, and with the saved states) and the time to read
-// every pose back (ssx::Recording, every sample decoded):
-//   n=N run=K record=0|1 median_ms=... p99_ms=... late=... dropped=... state_ms_first=... state_ms_max=...
+// per run the median and p99 step time, the late steps (of them: those that took longer than a
+// step, and those that began late after an on-time one; the rest followed a late one), the samples
+// dropped and how long saved states took on the stepping thread (the first, and the longest of the
+// later ones); then the file's size per robot and simulated second (the poses alone, and with the
+// saved states) and the time to read every pose back (ssx::Recording, every sample decoded):
+//   n=N run=K record=0|1 median_ms=... p99_ms=... late=... (long ..., began_late ...) dropped=...
+//       state_ms_first=... state_ms_max=...
 //   n=N bytes_per_robot_s=... (poses) ... (with states) read_s=... samples=... bodies=... floats=...
 // --fast runs unpaced (the stepper then waits for the writer: nothing is dropped). --keep FILE keeps
 // the last recording there (read_numpy.py beside this program times reading it into numpy).
@@ -92,9 +94,10 @@ int main(int argc, char** argv) {
     const ssx::TimingSummary t = env.run(options);
     if (recorder) last = recorder->finish();
     std::printf(
-        "n=%d run=%d record=%d median_ms=%.3f p99_ms=%.3f late=%lld dropped=%lld state_ms_first=%.1f "
-        "state_ms_max=%.1f\n",
+        "n=%d run=%d record=%d median_ms=%.3f p99_ms=%.3f late=%lld (long %lld, began_late %lld) dropped=%lld "
+        "state_ms_first=%.1f state_ms_max=%.1f\n",
         n, run / 2, record ? 1 : 0, t.median_ms, t.p99_ms, static_cast<long long>(t.overruns),
+        static_cast<long long>(t.overruns_long), static_cast<long long>(t.overruns_began_late),
         static_cast<long long>(last.dropped * record), record ? last.state_ms_first : 0.0,
         record ? last.state_ms_max : 0.0);
     std::fflush(stdout);

@@ -366,6 +366,14 @@ Recorder::Recorder(Environment& env, RecordOptions options) : impl_(std::make_un
   m.switches_seen = env.physicsSwitches().size();  // (made before: the saved states say the engine)
   m.listener = env.addStepListener([&m](const Environment&) { m.observe(); });
   m.listening = true;
+  prepare();
+}
+
+void Recorder::prepare() {
+  Impl& m = *impl_;
+  if (m.env->state() != Environment::State::Running || m.states_taken > 0) return;
+  std::lock_guard lock(m.mutex);
+  if (m.spare_state.empty()) m.env->saveState(m.spare_state);
 }
 
 Recorder::~Recorder() {

@@ -298,3 +298,29 @@ TEST_CASE("recorder: a second run recording into the file another is writing is 
   second.environment->step(50);
   CHECK(again.finish().samples == 2);
 }
+
+TEST_CASE("recorder: made on a running environment it sizes its state buffer first and records the world's states",
+          "[record][recorder]") {
+  const fs::path file = fs::current_path() / "recorder_prepared.mcap";
+  Scene scene = loadSceneFromString(kQuads, "quads.xml", kArtifacts, testOptions());
+  Environment& env = *scene.environment;
+  env.step(10);
+  const std::uint64_t before = env.stateHash();
+  Recorder recorder(env, options(file, scene));  // (prepare(): a state saved and kept, not recorded)
+  CHECK(env.stateHash() == before);              // nothing in the world moved
+  recorder.prepare();                            // (again: nothing)
+  std::vector<std::vector<std::byte>> expected;
+  env.step(10);  // the first sample, at 0.04 s: a state
+  expected.push_back(env.saveState());
+  env.step(500);  // 1.04 s
+  expected.push_back(env.saveState());
+  env.step(500);  // 2.04 s
+  expected.push_back(env.saveState());
+  const RecordSummary s = recorder.finish();
+  CHECK(s.states == 3);
+  CHECK(s.state_ms_first > 0);
+  CHECK(s.state_ms_max > 0);
+  const Recording r(file);
+  REQUIRE(r.stateTimes() == std::vector<Nanoseconds>{40'000'000, 1'040'000'000, 2'040'000'000});
+  for (std::size_t k = 0; k < 3; ++k) CHECK(r.stateAtOrBefore(r.stateTimes()[k]) == expected[k]);
+}
