@@ -20,8 +20,11 @@
 #include <deque>
 #include <exception>
 #include <limits>
+#include <memory>
 #include <mutex>
 #include <thread>
+
+#include <zstd.h>
 
 #include <sys/resource.h>
 #include <sys/syscall.h>
@@ -72,6 +75,11 @@ struct Recorder::Impl {
       contacts_channel = -1;  // -1: not recorded
   std::vector<Extra> extras;                                     // since the last sample
   std::vector<float> tf_positions, tf_orientations;              // the writer thread's
+  std::vector<std::byte> packed;                                 // ... (a saved state, compressed)
+  struct FreeZstd {
+    void operator()(ZSTD_CCtx* c) const noexcept { ZSTD_freeCCtx(c); }
+  };
+  std::unique_ptr<ZSTD_CCtx, FreeZstd> zstd;  // ... (made at the first state)
   Nanoseconds first_time = -1, last_time = 0;
   std::size_t switches_seen = 0;  // of the environment's switches of physics engine: those written
   bool went_back = false;  // said once: the time went back (a state restored while recording)
@@ -307,7 +315,21 @@ void Recorder::Impl::loop() {
       if (!job.attachment.empty()) {
         writer->addAttachment(job.attachment, "text/plain", job.time, job.bytes);
       } else if (job.state) {
-        writer->addAttachment("state/" + std::to_string(job.time), "application/x-ssx-state", job.time, job.bytes);
+        // compressed here, off the stepping thread (21.4 MB at 10,000 quadrotors)
+        // (with zstd's checksum: a corrupted frame fails to decompress rather than giving other bytes)
+        if (!zstd) {
+          zstd.reset(ZSTD_createCCtx());
+          if (!zstd) throw Error("cannot compress the saved states of " + options.file.string() + ": out of memory");
+          ZSTD_CCtx_setParameter(zstd.get(), ZSTD_c_compressionLevel, 1);
+          ZSTD_CCtx_setParameter(zstd.get(), ZSTD_c_checksumFlag, 1);
+        }
+        packed.resize(ZSTD_compressBound(job.bytes.size()));
+        const std::size_t size =
+            ZSTD_compress2(zstd.get(), packed.data(), packed.size(), job.bytes.data(), job.bytes.size());
+        if (ZSTD_isError(size))
+          throw Error("cannot compress a saved state for " + options.file.string() + ": " + ZSTD_getErrorName(size));
+        writer->addAttachment("state/" + std::to_string(job.time), "application/x-ssx-state+zstd", job.time,
+                              std::span(packed.data(), size));
       } else if (job.time >= 0) {
         if (job.sample) {
           auto json = [&](int channel, const std::string& text) {

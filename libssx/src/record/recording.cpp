@@ -11,6 +11,9 @@
 #include <iterator>
 #include <map>
 #include <mutex>
+#include <string_view>
+
+#include <zstd.h>
 
 namespace ssx {
 
@@ -22,12 +25,22 @@ struct Recording::Impl {
   std::mutex mutex;                  // file.data() keeps one chunk: one reader at a time
   std::string scene_xml, scene_label, version;
   std::uint64_t seed = 0;
-  std::vector<std::pair<Nanoseconds, std::span<const std::byte>>> states;
+  struct State {
+    Nanoseconds first;  // its time
+    std::span<const std::byte> second;
+    bool zstd;  // compressed (application/x-ssx-state+zstd): by the recorder since 2026-12-07
+  };
+  std::vector<State> states;
   std::vector<PhysicsSwitch> switches;  // in the file's order (the order made)
   std::map<int, std::vector<std::size_t>> by_channel;  // messageAtOrBefore's: a channel's messages by time (made at first use)
 };
 
 namespace {
+
+// a saved state as the recorder writes it: compressed; and the most it may grow when decompressed
+// (a state compresses to 1/2-1/5; the bound keeps a corrupted size from asking for terabytes)
+constexpr std::string_view kStateZstd = "application/x-ssx-state+zstd";
+constexpr unsigned long long kStateMaxRatio = 1024;
 
 [[noreturn]] void notRecording(const std::filesystem::path& file, const std::string& what) {
   throw Error(file.string() + ": not an ssx recording: " + what);
@@ -71,7 +84,14 @@ Recording::Recording(detail::McapFile file) : impl_(std::make_unique<Impl>()) {
     if (a.name == "scene.xml") {
       m.scene_xml.assign(reinterpret_cast<const char*>(a.data.data()), a.data.size());
     } else if (a.name.rfind("state/", 0) == 0) {
-      m.states.emplace_back(a.log_time, a.data);
+      const bool zstd = a.media_type == kStateZstd;
+      if (zstd) {
+        // (checked here, so that a state asked for later cannot ask for more memory than this)
+        const unsigned long long size = ZSTD_getFrameContentSize(a.data.data(), a.data.size());
+        if (size == ZSTD_CONTENTSIZE_ERROR || size == ZSTD_CONTENTSIZE_UNKNOWN || size > kStateMaxRatio * a.data.size())
+          notRecording(path, "its saved state '" + a.name + "' is not a zstd frame of a size it can hold (corrupted)");
+      }
+      m.states.push_back({a.log_time, a.data, zstd});
     } else if (a.name.rfind("physics/", 0) == 0) {
       const std::string text(reinterpret_cast<const char*>(a.data.data()), a.data.size());
       const auto newline = text.find('\n');
@@ -144,7 +164,7 @@ std::vector<Nanoseconds> Recording::stateTimes() const {
 }
 
 std::vector<std::byte> Recording::stateAtOrBefore(Nanoseconds time, Nanoseconds* at) const {
-  const std::pair<Nanoseconds, std::span<const std::byte>>* best = nullptr;
+  const Impl::State* best = nullptr;
   for (const auto& s : impl_->states)
     if (s.first <= time) best = &s;
   if (best == nullptr)
@@ -154,7 +174,13 @@ std::vector<std::byte> Recording::stateAtOrBefore(Nanoseconds time, Nanoseconds*
                                        : "the first is at " + std::to_string(toSeconds(impl_->states.front().first)) + " s") +
                 ")");
   if (at != nullptr) *at = best->first;
-  return {best->second.begin(), best->second.end()};
+  if (!best->zstd) return {best->second.begin(), best->second.end()};
+  std::vector<std::byte> out(ZSTD_getFrameContentSize(best->second.data(), best->second.size()));
+  const std::size_t got = ZSTD_decompress(out.data(), out.size(), best->second.data(), best->second.size());
+  if (ZSTD_isError(got) || got != out.size())
+    throw Error(impl_->file.file.string() + ": the saved state at " + std::to_string(toSeconds(best->first)) +
+                " s does not decompress (corrupted)");
+  return out;
 }
 
 void completeRecording(const std::filesystem::path& damaged, const std::filesystem::path& out) {

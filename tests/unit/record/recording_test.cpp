@@ -1,5 +1,6 @@
 // A recording read back: from one of its saved states, the recorded scene steps again to the same
 // poses, bit for bit; a file that is not a recording says so.
+#include "record/mcap_reader.hpp"
 #include "record/mcap_writer.hpp"
 
 #include <ssx/ssx.hpp>
@@ -8,6 +9,7 @@
 
 #include <catch2/catch.hpp>
 
+#include <algorithm>
 #include <cstring>
 #include <filesystem>
 
@@ -106,4 +108,63 @@ TEST_CASE("recording: the message of a channel at or before a time is the one me
   const auto commands = r.messageAtOrBefore("/ssx/commands", all.back().first);
   REQUIRE(commands);
   CHECK(commands->second.find("\"q1\"") != std::string::npos);
+}
+
+TEST_CASE("recording: saved states are compressed and read back as saved and old uncompressed and corrupted ones too",
+          "[record][recording]") {
+  const fs::path file = fs::current_path() / "recording_states.mcap";
+  const std::string xml = R"(<scene><environment timestep="0.002" seed="4"/><type name="q" file="mk_quad.xml"/>
+    <ground/><swarm type="q" count="3" name="q{i}" spacing="1.2" xyz="0 0 0.05"><driver offset="0 0 1"/></swarm></scene>)";
+  std::vector<std::byte> at_first;
+  {
+    Scene scene = loadSceneFromString(xml, "states.xml", kArtifacts, testOptions());
+    RecordOptions o;
+    o.file = file;
+    o.state_every_s = 1;
+    o.scene_xml = scene.model->toXml();
+    Recorder recorder(*scene.environment, o);
+    scene.environment->step(20);  // the first sample (25 Hz): a state
+    at_first = scene.environment->saveState();
+    scene.environment->step(100);
+    recorder.finish();
+  }
+  detail::McapFile f = detail::readMcap(file);
+  const auto state = std::find_if(f.attachments.begin(), f.attachments.end(),
+                                  [](const auto& a) { return a.name == "state/40000000"; });
+  REQUIRE(state != f.attachments.end());
+  CHECK(state->media_type == "application/x-ssx-state+zstd");
+  CHECK(state->data.size() < at_first.size() / 2);
+  CHECK(Recording(file).stateAtOrBefore(40'000'000) == at_first);
+
+  // as a recording made before states were compressed holds it
+  state->media_type = "application/x-ssx-state";
+  state->data = at_first;
+  const fs::path old = fs::current_path() / "recording_states_old.mcap";
+  detail::rewriteMcap(f, old);
+  CHECK(Recording(old).stateAtOrBefore(40'000'000) == at_first);
+
+  // compressed bytes that do not decompress: refused when asked for; a frame claiming more than
+  // 1,024 times its size: refused when read
+  std::vector<std::byte> broken;
+  {
+    const detail::McapFile g = detail::readMcap(file);
+    const auto s = std::find_if(g.attachments.begin(), g.attachments.end(),
+                                [](const auto& a) { return a.name == "state/40000000"; });
+    broken.assign(s->data.begin(), s->data.end());
+  }
+  for (std::size_t i = broken.size() / 2; i < broken.size() / 2 + 64; ++i) broken[i] ^= std::byte{0x5A};
+  state->media_type = "application/x-ssx-state+zstd";
+  state->data = broken;
+  const fs::path corrupted = fs::current_path() / "recording_states_corrupted.mcap";
+  detail::rewriteMcap(f, corrupted);
+  const Recording r(corrupted);
+  CHECK_THROWS_WITH(r.stateAtOrBefore(40'000'000),
+                    Catch::Contains("the saved state at 0.04") && Catch::Contains("does not decompress (corrupted)"));
+  // a zstd frame header (magic, one segment with an 8-byte content size) saying 1 GiB in 13 bytes
+  std::vector<std::byte> tiny = {std::byte{0x28}, std::byte{0xB5}, std::byte{0x2F}, std::byte{0xFD}, std::byte{0xE0}};
+  for (int k = 0; k < 8; ++k) tiny.push_back(std::byte{static_cast<unsigned char>(k == 3 ? 0x40 : 0)});
+  state->data = tiny;
+  detail::rewriteMcap(f, corrupted);
+  CHECK_THROWS_WITH(Recording(corrupted), Catch::Contains("its saved state 'state/40000000' is not a zstd frame of a "
+                                                          "size it can hold (corrupted)"));
 }
