@@ -95,9 +95,10 @@ struct SSX_EXPORT RecordSummary {
   std::int64_t samples = 0;  ///< pose samples written
   std::int64_t dropped = 0;  ///< pose samples dropped because the writer was behind
   std::int64_t states = 0;   ///< saved states written
-  /// How long the first saved state took on the stepping thread (ms; it sizes the buffer the
-  /// later ones are written into) and the longest of the later ones (the file write is the writer's)
-  double state_ms_first = 0, state_ms_max = 0;
+  /// How long the first saved state took on the stepping thread (ms; written into the buffer
+  /// Recorder::prepare sized, or sizing it when the recorder could not prepare)
+  double state_ms_first = 0;
+  double state_ms_max = 0;   ///< the longest of the later ones (ms; the file write is the writer's)
   std::uint64_t bytes = 0;   ///< size of the file
   std::int64_t bodies = 0;   ///< bodies in each sample
   double simulated_s = 0;    ///< time from the first sample to the last

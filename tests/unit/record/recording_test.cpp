@@ -17,6 +17,19 @@ using namespace ssx;
 using namespace ssx::test;
 namespace fs = std::filesystem;
 
+namespace {
+
+// a recording into `file` with a saved state every second
+RecordOptions everySecond(const fs::path& file, const Scene& scene) {
+  RecordOptions o;
+  o.file = file;
+  o.state_every_s = 1;
+  o.scene_xml = scene.model->toXml();
+  return o;
+}
+
+}  // namespace
+
 TEST_CASE("recording: the recorded scene, restored from a saved state, steps to the recorded poses bit for bit",
           "[record][recording]") {
   const fs::path file = fs::current_path() / "recording_resim.mcap";
@@ -26,11 +39,7 @@ TEST_CASE("recording: the recorded scene, restored from a saved state, steps to 
     <swarm type="box" count="3" name="b{i}" layout="random" min="-1 -1 2" max="1 1 3"/></scene>)";
   {
     Scene scene = loadSceneFromString(xml, "resim.xml", kArtifacts, testOptions());
-    RecordOptions o;
-    o.file = file;
-    o.state_every_s = 1;
-    o.scene_xml = scene.model->toXml();
-    Recorder recorder(*scene.environment, o);
+    Recorder recorder(*scene.environment, everySecond(file, scene));
     scene.environment->step(1500);  // 3 s: take-off, boxes falling and landing
     recorder.finish();
   }
@@ -118,11 +127,7 @@ TEST_CASE("recording: saved states are compressed and read back as saved and old
   std::vector<std::byte> at_first;
   {
     Scene scene = loadSceneFromString(xml, "states.xml", kArtifacts, testOptions());
-    RecordOptions o;
-    o.file = file;
-    o.state_every_s = 1;
-    o.scene_xml = scene.model->toXml();
-    Recorder recorder(*scene.environment, o);
+    Recorder recorder(*scene.environment, everySecond(file, scene));
     scene.environment->step(20);  // the first sample (25 Hz): a state
     at_first = scene.environment->saveState();
     scene.environment->step(100);
