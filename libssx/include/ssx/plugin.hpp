@@ -64,9 +64,7 @@ class SSX_EXPORT Plugin {
   /// Called once when the environment stops, before the engines stop.
   virtual void destroy();
   /// Writes what this plugin keeps between its runs and what it depends on (see ssx/state.hpp),
-  /// for Environment::saveState. Its random stream is saved for it. Default: nothing. Like
-  /// step, it runs on any of the environment's threads, beside other artifacts' plugins saving
-  /// theirs (in shares of artifacts when there are many): it reads only its own plugin's state.
+  /// for Environment::saveState. Its random stream is saved for it. Default: nothing.
   virtual void saveState(StateWriter& out) const;
   /// Reads back what saveState wrote, in the same order, into a plugin configured from the same
   /// scene. Default: nothing.
