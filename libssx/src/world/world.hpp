@@ -166,9 +166,6 @@ struct World {
   std::uint64_t restored_checksum = 0;
   std::size_t restored_size = 0;
   mutable std::size_t state_size_hint = 0;  // the last saved state's size (saveState reserves it)
-  // the plugins' blocks of a saved state after the first share of artifacts, written by the
-  // pool's threads (kept: written over at the next save)
-  mutable std::vector<std::vector<std::byte>> state_parts;
   std::int64_t steps = 0;        // steps taken
   std::int64_t current_step = 0;  // the step being taken
 

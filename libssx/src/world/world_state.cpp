@@ -6,12 +6,11 @@
 // snapshot (body states with accelerations, the velocities before the last step), the command
 // buffers, the joints' motor commands, the run-time joints, the varied constants, every plugin's random stream (the
 // world's plugin table, in order), then one block per plugin (driver first, then sensors, artifact by artifact: what it saved) and one per extension.
-#include "base/worker_pool.hpp"
-#include "engines/state_checks.hpp"
-#include "render/scene_cameras.hpp"
 #include "world/ghosts.hpp"
-#include "world/neighbor_index.hpp"
 #include "world/phases.hpp"
+#include "world/neighbor_index.hpp"
+#include "render/scene_cameras.hpp"
+#include "engines/state_checks.hpp"
 #include "world/world.hpp"
 
 #include <ssx/environment.hpp>
@@ -120,44 +119,6 @@ std::uint64_t Environment::sceneFingerprint() const {
   return h;
 }
 
-namespace {
-
-// every plugin's block, driver first, then sensors, artifact by artifact
-void savePlugins(const detail::World& w, detail::WorkerPool* pool, StateWriter& out) {
-  const auto save = [&w](StateWriter& to, std::size_t begin, std::size_t end) {
-    for (std::size_t i = begin; i < end; ++i) {
-      const auto& a = w.artifact_data[i];
-      if (a.driver != nullptr) writeBlock(to, [&] { a.driver->saveState(to); });
-      for (const auto& s : a.sensors) writeBlock(to, [&] { s.sensor->saveState(to); });
-    }
-  };
-  const std::size_t n = w.artifact_data.size(), parts = pool != nullptr ? pool->size() : 1;
-  if (parts < 2 || n < 64 * parts) {
-    save(out, 0, n);
-    return;
-  }
-  // in shares of artifacts, one per thread, each into a buffer of its own (the first into the
-  // state's): the plugins' blocks are most of a state and reading each plugin's state is bound by
-  // memory latency (15 of 21 MB and 17 of 19 ms at 10,000 quadrotors on one thread); the shares
-  // then follow the first in artifact order, the same bytes as on one thread
-  w.state_parts.resize(parts - 1);
-  auto share = [&](std::size_t b, std::size_t e) {
-    for (std::size_t k = b; k < e; ++k) {
-      const std::size_t from = n * k / parts, to = n * (k + 1) / parts;
-      if (k == 0) {
-        save(out, from, to);
-      } else {
-        StateWriter part(w.state_parts[k - 1], 0);
-        save(part, from, to);
-      }
-    }
-  };
-  pool->parallelFor(parts, 1, share);
-  for (const auto& part : w.state_parts) out.bytes(part.data(), part.size());
-}
-
-}  // namespace
-
 std::vector<std::byte> Environment::saveState() const {
   std::vector<std::byte> buffer;
   saveState(buffer);
@@ -199,7 +160,10 @@ void Environment::saveState(std::vector<std::byte>& buffer) const {
   detail::saveVariations(w, out);
   // the random streams, then each plugin's own state (driver first, then sensors, by artifact)
   for (const Random& r : w.randoms) r.save(out);
-  savePlugins(w, pool_.get(), out);
+  for (const auto& a : w.artifact_data) {
+    if (a.driver != nullptr) writeBlock(out, [&] { a.driver->saveState(out); });
+    for (const auto& s : a.sensors) writeBlock(out, [&] { s.sensor->saveState(out); });
+  }
   for (const auto& e : extensions_)
     if (!e.observer) writeBlock(out, [&] { e.extension->saveState(out); });
   if (!ghosts_->empty()) writeBlock(out, [&] { ghosts_->save(out); });

@@ -232,24 +232,3 @@ TEST_CASE("a state writer writing over a buffer keeps what is before its start, 
   CHECK(small.size() == 6);
   CHECK(small[5] == std::byte{9});
 }
-
-TEST_CASE("a state saved by several threads in shares of artifacts is the one thread's to the byte",
-          "[state][thread]") {
-  const std::string xml = R"(<scene><environment timestep="0.002" seed="8"/><type name="q" file="mk_quad.xml"/><ground/>
-    <swarm type="q" count="200" name="q{i}" spacing="1.2" xyz="0 0 0.05"><driver offset="0 0 1"/></swarm></scene>)";
-  std::vector<std::vector<std::byte>> states;
-  for (const int threads : {1, 2, 3}) {
-    SceneOptions o = ssx::test::testOptions();
-    o.threads = threads;
-    Scene scene = loadSceneFromString(xml, "shares.xml", kArtifacts, o);
-    REQUIRE(scene.environment->threadCount() == static_cast<unsigned>(threads));
-    scene.environment->step(30);
-    states.push_back(scene.environment->saveState());
-    // written again over its own buffer: the same
-    std::vector<std::byte> again = states.back();
-    scene.environment->saveState(again);
-    CHECK(again == states.back());
-  }
-  CHECK(states[1] == states[0]);
-  CHECK(states[2] == states[0]);
-}
