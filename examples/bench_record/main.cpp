@@ -4,11 +4,12 @@
 // per run the median and p99 step time, the late steps (of them: those that took longer than a
 // step, and those that began late after an on-time one; the rest followed a late one), the samples
 // dropped and how long saved states took on the stepping thread (the first, and the longest of the
-// later ones); then the file's size per robot and simulated second (the poses alone, and with the
-// saved states) and the time to read every pose back (ssx::Recording, every sample decoded):
+// later ones); then the file's size per robot and simulated second (all of it, and the saved states
+// before compression) and the time to read every pose back (ssx::Recording, every sample decoded):
 //   n=N run=K record=0|1 median_ms=... p99_ms=... late=... (long ..., began_late ...) dropped=...
 //       state_ms_first=... state_ms_max=...
-//   n=N bytes_per_robot_s=... (poses) ... (with states) read_s=... samples=... bodies=... floats=...
+//   n=N bytes_per_robot_s=... (all, states compressed) states_raw=... read_s=... samples=... bodies=...
+//       floats=...
 // --fast runs unpaced (the stepper then waits for the writer: nothing is dropped). --keep FILE keeps
 // the last recording there (read_numpy.py beside this program times reading it into numpy).
 // --writer-nice K sets the writer thread's nice value (default 19, as RecordOptions has it).
@@ -102,7 +103,7 @@ int main(int argc, char** argv) {
         record ? last.state_ms_max : 0.0);
     std::fflush(stdout);
   }
-  // size: the poses alone (the file less its saved states) and all of it
+  // size: all of it (the saved states compressed in it), and the states' own size before compression
   const auto t0 = std::chrono::steady_clock::now();
   const ssx::Recording r(file);
   std::size_t floats = 0;
@@ -111,9 +112,11 @@ int main(int argc, char** argv) {
   std::uint64_t state_bytes = 0;
   for (const ssx::Nanoseconds at : r.stateTimes()) state_bytes += r.stateAtOrBefore(at).size();
   const double robot_seconds = static_cast<double>(n) * last.simulated_s;
-  std::printf("n=%d bytes_per_robot_s=%.0f (poses) %.0f (with states) read_s=%.2f samples=%zu bodies=%zu floats=%zu\n", n,
-              static_cast<double>(last.bytes - state_bytes) / robot_seconds, static_cast<double>(last.bytes) / robot_seconds,
-              read_s, r.times().size(), r.names().size(), floats);
+  std::printf(
+      "n=%d bytes_per_robot_s=%.0f (all, states compressed) states_raw=%.0f read_s=%.2f samples=%zu bodies=%zu "
+      "floats=%zu\n",
+      n, static_cast<double>(last.bytes) / robot_seconds, static_cast<double>(state_bytes) / robot_seconds, read_s,
+      r.times().size(), r.names().size(), floats);
   if (keep.empty()) {
     fs::remove(file);
   } else {
