@@ -26,8 +26,8 @@ struct Recording::Impl {
   std::string scene_xml, scene_label, version;
   std::uint64_t seed = 0;
   struct State {
-    Nanoseconds first;  // its time
-    std::span<const std::byte> second;
+    Nanoseconds time;
+    std::span<const std::byte> data;
     bool zstd;  // compressed (application/x-ssx-state+zstd): by the recorder since 2026-12-07
   };
   std::vector<State> states;
@@ -100,7 +100,7 @@ Recording::Recording(detail::McapFile file) : impl_(std::make_unique<Impl>()) {
       m.switches.push_back({a.log_time, text.substr(0, newline), text.substr(newline + 1)});
     }
   }
-  std::sort(m.states.begin(), m.states.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+  std::sort(m.states.begin(), m.states.end(), [](const auto& a, const auto& b) { return a.time < b.time; });
   std::stable_sort(m.switches.begin(), m.switches.end(), [](const auto& a, const auto& b) { return a.time < b.time; });
   const int channel = f.channelId("/ssx/poses");
   if (channel < 0) notRecording(path, "it has no /ssx/poses channel");
@@ -159,26 +159,26 @@ std::vector<PhysicsSwitch> Recording::physicsSwitches() const { return impl_->sw
 
 std::vector<Nanoseconds> Recording::stateTimes() const {
   std::vector<Nanoseconds> out;
-  for (const auto& s : impl_->states) out.push_back(s.first);
+  for (const auto& s : impl_->states) out.push_back(s.time);
   return out;
 }
 
 std::vector<std::byte> Recording::stateAtOrBefore(Nanoseconds time, Nanoseconds* at) const {
   const Impl::State* best = nullptr;
   for (const auto& s : impl_->states)
-    if (s.first <= time) best = &s;
+    if (s.time <= time) best = &s;
   if (best == nullptr)
-    throw Error(impl_->file.file.string() + ": no saved state at or before " + std::to_string(toSeconds(time)) +
-                " s (" +
-                (impl_->states.empty() ? std::string("it has none")
-                                       : "the first is at " + std::to_string(toSeconds(impl_->states.front().first)) + " s") +
-                ")");
-  if (at != nullptr) *at = best->first;
-  if (!best->zstd) return {best->second.begin(), best->second.end()};
-  std::vector<std::byte> out(ZSTD_getFrameContentSize(best->second.data(), best->second.size()));
-  const std::size_t got = ZSTD_decompress(out.data(), out.size(), best->second.data(), best->second.size());
+    throw Error(
+        impl_->file.file.string() + ": no saved state at or before " + std::to_string(toSeconds(time)) + " s (" +
+        (impl_->states.empty() ? std::string("it has none")
+                               : "the first is at " + std::to_string(toSeconds(impl_->states.front().time)) + " s") +
+        ")");
+  if (at != nullptr) *at = best->time;
+  if (!best->zstd) return {best->data.begin(), best->data.end()};
+  std::vector<std::byte> out(ZSTD_getFrameContentSize(best->data.data(), best->data.size()));
+  const std::size_t got = ZSTD_decompress(out.data(), out.size(), best->data.data(), best->data.size());
   if (ZSTD_isError(got) || got != out.size())
-    throw Error(impl_->file.file.string() + ": the saved state at " + std::to_string(toSeconds(best->first)) +
+    throw Error(impl_->file.file.string() + ": the saved state at " + std::to_string(toSeconds(best->time)) +
                 " s does not decompress (corrupted)");
   return out;
 }
