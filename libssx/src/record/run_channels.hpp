@@ -16,6 +16,7 @@
 #include <ssx/types.hpp>
 
 #include <cstddef>
+#include <cstdint>
 #include <string>
 #include <utility>
 #include <vector>
@@ -56,15 +57,23 @@ class RunSample {
   std::string contactsJson(const Environment& env) const;
 
  private:
-  struct Sensor {
+  enum class Kind : std::uint8_t { Imu, Pose, Range };
+  // a sensor whose measurements are written, found once: its output is a member of the sensor,
+  // at the same address while the environment runs, and its kind never changes
+  struct Source {
     std::size_t artifact = 0, index = 0;
-    int kind = 0;  // 0 IMU, 1 pose, 2 range
+    Kind kind = Kind::Imu;
+    const Measurement* latest = nullptr;
+  };
+  struct Sensor {
     ImuMeasurement imu;
     PoseMeasurement pose;
     RangeMeasurement range;
   };
-  std::vector<Sensor> sensors_;
-  std::size_t sensor_count_ = 0;
+  std::vector<Source> sources_;
+  const Environment* sources_of_ = nullptr;    // the environment sources_ were found in
+  std::vector<Sensor> sensors_;                // per source, what it measured last (only its kind's member)
+  mutable std::size_t sensors_json_size_ = 0;  // room for the next /ssx/sensors (the last one's, and more)
   std::vector<std::pair<std::size_t, Command>> commands_;
   std::vector<EngineContact> contacts_;
 };

@@ -213,13 +213,13 @@ second = subprocess.run([ssx, "run", str(scene), "--foxglove", run.port, "--dura
 if second.returncode != 2 or "cannot listen" not in second.stderr:
     problems.append(f"a second run on port {run.port}: exit {second.returncode}, {second.stderr[-300:]}")
 status, err = run.stop()
-closing = re.search(r"foxglove: (\d+) messages published, (\d+) sent, (\d+) skipped by slow clients, (\d+) snapshots "
-                    r"replaced, (\d+) requests dropped, (\d+) clients refused", err)
+closing = re.search(r"foxglove: (\d+) messages published, (\d+) sent, (\d+) skipped by slow clients, (\d+) snapshots left "
+                    r"out while its thread was behind, (\d+) requests dropped, (\d+) clients refused", err)
 print(closing.group(0) if closing else "no closing line")
 if not closing:
     problems.append("no closing line with the counts")
 else:
-    published, sent, skipped, replaced, dropped, refused_count = map(int, closing.groups())
+    published, sent, skipped, behind, dropped, refused_count = map(int, closing.groups())
     if skipped == 0 or dropped < 9 + 50 or refused_count < 2:
         problems.append(f"counts: skipped {skipped} (the stalled client: > 0), dropped {dropped} (>= 59), "
                         f"refused {refused_count} (>= 2)")
