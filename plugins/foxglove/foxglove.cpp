@@ -298,7 +298,7 @@ class Foxglove final : public SimulationExtension {
 
   // the extension's thread: each snapshot's JSON, published
   void build() {
-    web::lowerThisThreadsPriority();  // (behind, the newest snapshot replaces the one waiting: counted)
+    web::lowerThisThreadsPriority();  // (behind, the next snapshots are left out until it takes this one: counted)
     for (;;) {
       std::unique_ptr<Snapshot> s;
       {
