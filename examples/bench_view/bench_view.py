@@ -11,7 +11,9 @@ run):
     n=N page_fps_median=... page_fps_min=... (samples over S s)
 With --foxglove the watchers are Foxglove clients instead (`ssx run --foxglove`; python3-websockets
 clients of its protocol subscribed to /tf, /scene, /ssx/timing, /ssx/sensors, /ssx/commands and
-/ssx/run, reading every message): frames_per_page is then the /tf messages each got.
+/ssx/run, reading every message): frames_per_page is then the /tf messages each got, and
+snapshot_ms_mean / snapshot_ms_max what a snapshot for them took the stepping thread (the run's
+closing line).
 
     bench_view.py SSX [--n N]... [--seconds S] [--runs R] [--pages K] [--fps-seconds S] [--foxglove]"""
 import argparse
@@ -174,8 +176,11 @@ def main():
                 out, err = process.communicate()
                 median, p99, late = summary(out + "".join(lines) + err)
                 medians[view].append(median)
+                # the Foxglove extension's closing line: what a snapshot cost the stepping thread
+                taken = re.search(r"a snapshot took ([\d.]+) ms on the stepping thread on average, ([\d.]+) ms at most", err)
                 print(f"n={n} run={run // 2} view={view} median_ms={median:.3f} p99_ms={p99:.3f} late={late} "
-                      f"frames_per_page={'/'.join(map(str, got)) if got else '-'}", flush=True)
+                      f"frames_per_page={'/'.join(map(str, got)) if got else '-'}"
+                      + (f" snapshot_ms_mean={taken.group(1)} snapshot_ms_max={taken.group(2)}" if taken else ""), flush=True)
             print(f"n={n} median_ms without {statistics.median(medians[0]):.3f} with {statistics.median(medians[1]):.3f} "
                   f"({100 * (statistics.median(medians[1]) / statistics.median(medians[0]) - 1):+.1f} %)", flush=True)
             samples = page_fps(a.ssx, scene, work / f"fps{n}", a.fps_seconds) if a.fps_seconds > 0 and not a.foxglove else None

@@ -110,10 +110,20 @@ void RunSample::takeSensors(const Environment& env) {
 }
 
 void RunSample::takeCommands(const Environment& env) {
-  commands_.clear();
-  for (std::size_t i = 0; i < env.artifactCount(); ++i)
-    if (const auto* commandable = dynamic_cast<const CommandInterface*>(env.artifact(i).driver()))
-      commands_.emplace_back(i, commandable->currentCommand());
+  if (commandables_of_ != &env) {  // (drivers, like sensors, stay the same while it runs)
+    commandables_.clear();
+    for (std::size_t i = 0; i < env.artifactCount(); ++i)
+      if (const auto* commandable = dynamic_cast<const CommandInterface*>(env.artifact(i).driver()))
+        commandables_.emplace_back(i, commandable);
+    commandables_of_ = &env;
+    commands_.resize(commandables_.size());
+  }
+  constexpr std::size_t kAhead = 8;
+  for (std::size_t k = 0; k < commandables_.size(); ++k) {
+    if (k + kAhead < commandables_.size()) __builtin_prefetch(commandables_[k + kAhead].second);
+    commands_[k].first = commandables_[k].first;
+    commands_[k].second = commandables_[k].second->currentCommand();
+  }
 }
 
 std::string RunSample::sensorsJson(const Environment& env) const {

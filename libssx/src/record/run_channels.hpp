@@ -74,7 +74,9 @@ class RunSample {
   const Environment* sources_of_ = nullptr;    // the environment sources_ were found in
   std::vector<Sensor> sensors_;                // per source, what it measured last (only its kind's member)
   mutable std::size_t sensors_json_size_ = 0;  // room for the next /ssx/sensors (the last one's, and more)
-  std::vector<std::pair<std::size_t, Command>> commands_;
+  std::vector<std::pair<std::size_t, const CommandInterface*>> commandables_;  // found once, as sources_
+  const Environment* commandables_of_ = nullptr;
+  std::vector<std::pair<std::size_t, Command>> commands_;  // per commandable: its current command
   std::vector<EngineContact> contacts_;
 };
 

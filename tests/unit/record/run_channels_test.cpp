@@ -59,6 +59,36 @@ TEST_CASE("run channels: the scene in each robot's frame, its sensors and its co
   CHECK(count(timing, R"("late_ms":0})") == 1);
 }
 
+TEST_CASE("run channels: a sample taken again after steps holds the new measurements and commands",
+          "[record][foxglove]") {
+  Scene scene = loadSceneFromString(kQuads, "quads.xml", kArtifacts, testOptions());
+  Environment& env = *scene.environment;
+  env.step(10);
+  // one sample taken over and over, as the recorder and the Foxglove server keep theirs: what it
+  // writes is what a fresh one writes at that step (the sensors and drivers it found the first time)
+  detail::RunSample sample;
+  sample.takeSensors(env);
+  sample.takeCommands(env);
+  const std::string first = sample.sensorsJson(env);
+  CHECK(first == detail::sensorsJson(env));
+  for (const double z : {2.0, 3.5}) {
+    env.step(25);
+    for (std::size_t i = 0; i < env.artifactCount(); ++i)
+      if (auto* c = dynamic_cast<CommandInterface*>(env.artifact(i).driver())) {
+        Setpoint p;
+        p.position = Vec3(0, 0, z);
+        c->setCommand(Command::position(p));
+      }
+    sample.takeSensors(env);
+    sample.takeCommands(env);
+    const std::string sensors = sample.sensorsJson(env);
+    CHECK(sensors != first);  // (the stamps moved on)
+    CHECK(sensors == detail::sensorsJson(env));
+    CHECK(sample.commandsJson(env) == detail::commandsJson(env));
+    CHECK(count(sample.commandsJson(env), z == 2.0 ? R"("values":[0,0,2,)" : R"("values":[0,0,3.5,)") == 2);
+  }
+}
+
 TEST_CASE("run channels: the contacts of a step, taken and written later", "[record][foxglove]") {
   Scene scene = loadSceneFromString(R"(<scene><environment timestep="0.002" seed="1" threads="1"/><type name="b" file="box.xml"/>
     <ground/><artifact name="crate" type="b" xyz="0 0 0.3"/></scene>)",
