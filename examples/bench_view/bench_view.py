@@ -15,7 +15,9 @@ clients of its protocol subscribed to /tf, /scene, /ssx/timing, /ssx/sensors, /s
 snapshot_ms_mean / snapshot_ms_max what a snapshot for them took the stepping thread (the run's
 closing line).
 
-    bench_view.py SSX [--n N]... [--seconds S] [--runs R] [--pages K] [--fps-seconds S] [--foxglove]"""
+With --channels LIST they subscribe to those topics only (frames_per_page: messages of the first).
+
+    bench_view.py SSX [--n N]... [--seconds S] [--runs R] [--pages K] [--fps-seconds S] [--foxglove [--channels LIST]]"""
 import argparse
 import asyncio
 import math
@@ -96,22 +98,29 @@ async def pages(url, count, process):
     return got
 
 
-async def foxglove_clients(url, count, process):
-    """`count` Foxglove clients subscribed to the run's fixed channels, reading every message until the
-    run ends; /tf messages each got."""
+async def foxglove_clients(url, count, process, topics=None):
+    """`count` Foxglove clients subscribed to `topics` (None: the run's fixed channels), reading every
+    message until the run ends; the messages each got of the first of them (/tf when all)."""
     import json
     import websockets
     got = [0] * count
 
     async def client(k):
+        counted = None
         try:
             async with websockets.connect(url, subprotocols=["foxglove.websocket.v1"], max_size=None) as ws:
                 async for message in ws:
                     if isinstance(message, str) and json.loads(message).get("op") == "advertise":
-                        wanted = [c for c in json.loads(message)["channels"] if not c["topic"].endswith("/odom")]
+                        channels = json.loads(message)["channels"]
+                        wanted = [c for c in channels if not c["topic"].endswith("/odom")] if topics is None else \
+                            [c for t in topics for c in channels if c["topic"] == t]
+                        if topics is not None and len(wanted) != len(topics):
+                            sys.exit(f"--channels {','.join(topics)}: the run offers "
+                                     f"{', '.join(c['topic'] for c in channels if not c['topic'].endswith('/odom'))}")
+                        counted = wanted[0]["id"]
                         await ws.send(json.dumps({"op": "subscribe", "subscriptions": [
                             {"id": c["id"], "channelId": c["id"]} for c in wanted]}))
-                    elif isinstance(message, bytes) and message[0] == 1 and int.from_bytes(message[1:5], "little") == 1:
+                    elif isinstance(message, bytes) and message[0] == 1 and int.from_bytes(message[1:5], "little") == counted:
                         got[k] += 1
         except (websockets.exceptions.ConnectionClosed, OSError):
             pass
@@ -161,6 +170,8 @@ def main():
     parser.add_argument("--pages", type=int, default=2)
     parser.add_argument("--fps-seconds", type=float, default=10)
     parser.add_argument("--foxglove", action="store_true", help="Foxglove clients instead of the viewer's pages")
+    parser.add_argument("--channels", help="with --foxglove: the topics the clients subscribe to, comma-separated "
+                        "(default: /tf, /scene, /ssx/timing, /ssx/sensors, /ssx/commands, /ssx/run)")
     a = parser.parse_args()
     with tempfile.TemporaryDirectory() as work:
         work = pathlib.Path(work)
@@ -171,8 +182,11 @@ def main():
             for run in range(2 * a.runs):
                 view = run % 2
                 process, url, lines = start(a.ssx, scene, work / f"out{n}_{run}", a.seconds, view, a.foxglove)
-                watch = foxglove_clients if a.foxglove else pages
-                got = asyncio.run(watch(url, a.pages, process)) if view else []
+                topics = a.channels.split(",") if a.channels else None
+                got = []
+                if view:
+                    watched = foxglove_clients(url, a.pages, process, topics) if a.foxglove else pages(url, a.pages, process)
+                    got = asyncio.run(watched)
                 out, err = process.communicate()
                 median, p99, late = summary(out + "".join(lines) + err)
                 medians[view].append(median)
