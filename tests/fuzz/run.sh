@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# Runs every libFuzzer target for a bounded time, starting from the seeds in the repository.
+# Runs every libFuzzer target for a bounded time, two at a time (JOBS), starting from the seeds in
+# the repository.
 #   tests/fuzz/run.sh BUILD_DIR [SECONDS_PER_TARGET]   (default 60)
 # A crash, a sanitizer report, a leak, a timeout (10 s per input) or running out of memory (2 GiB)
 # fails the script; the input is left in BUILD_DIR/fuzz/findings/ and printed as a hint. To keep it
@@ -20,14 +21,35 @@ declare -A seeds=(
   [command_line]="tests/data/fuzz/command_line"
   [recording]="tests/data/fuzz/recording"
 )
-status=0
-for target in scene artifact robot parameter state command_line recording; do
-  corpus=$work/corpus_$target
+# one target: its findings and counts into $work/$target.log, its verdict into $work/$target.status
+fuzz_one() {
+  local target=$1 corpus=$work/corpus_$1
   mkdir -p "$corpus"
   # shellcheck disable=SC2086
-  if ! "$build/bin/ssx_${target}_fuzz" -max_total_time="$seconds" -timeout=10 -rss_limit_mb=2048 \
+  if "$build/bin/ssx_${target}_fuzz" -max_total_time="$seconds" -timeout=10 -rss_limit_mb=2048 \
       -artifact_prefix="$work/findings/${target}_" -print_final_stats=1 "$corpus" ${seeds[$target]} \
       > "$work/$target.log" 2>&1; then
+    echo ok > "$work/$target.status"
+  else
+    echo finding > "$work/$target.status"
+  fi
+}
+# JOBS targets at a time (default 2; each fuzzer runs on one core)
+jobs=${JOBS:-2}
+targets=(scene artifact robot parameter state command_line recording)
+running=0
+for target in "${targets[@]}"; do
+  fuzz_one "$target" &
+  running=$((running + 1))
+  if [ "$running" -ge "$jobs" ]; then
+    wait -n
+    running=$((running - 1))
+  fi
+done
+wait
+status=0
+for target in "${targets[@]}"; do
+  if [ "$(cat "$work/$target.status" 2>/dev/null)" != ok ]; then
     echo "fuzz: $target: FINDING (log: $work/$target.log)"
     grep -E "ERROR|SUMMARY|Test unit written" "$work/$target.log" | head -20
     status=1
