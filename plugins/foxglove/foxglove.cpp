@@ -10,8 +10,10 @@
 // - /ssx/sensors (ssx.Sensors), /ssx/commands (ssx.Commands): every robot's latest measurements and
 //   current command;
 // - /ssx/run (ssx.RunStatus): simulated time, the real-time factor, late steps so far, paused;
-// - /ROBOT/odom (ssx.Odometry), one per robot (up to robot_channels): its pose and velocities in
-//   the world frame.
+// - each robot's own (the first robot_channels robots): /ROBOT/odom (ssx.Odometry: its pose and
+//   velocities in the world frame), /ROBOT/imu (ssx.Imu: its first IMU's reading), /ROBOT/command
+//   (ssx.Command), /ROBOT/sensors (ssx.RobotSensors: its entry of /ssx/sensors) and /ROBOT/metrics
+//   (ssx.Metrics: what its driver and sensors publish as ssx::MetricSource).
 // Messages are stamped with the simulated time, which the server also sends as its time.
 //
 // What the stepping thread does is kept short: at rate_hz per wall-clock second it copies the
@@ -28,8 +30,10 @@
 #include "record/foxglove.hpp"
 #include "record/run_channels.hpp"
 
+#include <ssx/command.hpp>
 #include <ssx/environment.hpp>
 #include <ssx/error.hpp>
+#include <ssx/metrics.hpp>
 #include <ssx/plugin_abi.hpp>
 #include <ssx/recording.hpp>
 
@@ -52,10 +56,26 @@ using detail::appendNumber;
 using detail::appendString;
 
 enum Fixed : std::size_t { kTf, kScene, kTiming, kSensors, kCommands, kRun, kFixedChannels };
+// each robot's own channels, after the fixed ones: channel kFixedChannels + robot * kPerRobot + k
+enum PerRobot : std::size_t { kOdom, kImu, kCommand, kRobotSensors, kMetrics, kPerRobot };
 
 const char* const kRunSchema =
     R"j({"title":"ssx.RunStatus","description":"the run: simulated time (s), real-time factor since the last message, steps late so far (real-time runs), paused","type":"object","properties":{)j"
     R"j("time":{"type":"number"},"step":{"type":"integer"},"realtime_factor":{"type":"number"},"late_steps":{"type":"integer"},"paused":{"type":"boolean"}}})j";
+const char* const kImuSchema =
+    R"j({"title":"ssx.Imu","description":"a robot's first IMU: specific force (m/s^2) and turn rate (rad/s) in the sensor's frame, stamped when measured","type":"object","properties":{)j"
+    R"j("timestamp":{"type":"object","properties":{"sec":{"type":"integer"},"nsec":{"type":"integer"}}},"frame_id":{"type":"string"},)j"
+    R"j("accelerometer":{"type":"object","properties":{"x":{"type":"number"},"y":{"type":"number"},"z":{"type":"number"}}},)j"
+    R"j("gyroscope":{"type":"object","properties":{"x":{"type":"number"},"y":{"type":"number"},"z":{"type":"number"}}}}})j";
+const char* const kCommandSchema =
+    R"j({"title":"ssx.Command","description":"a robot's current command: its level (position, velocity, attitude, rates, rotors, wheels) and values in the column order of Python's set_commands","type":"object",)j"
+    R"j("properties":{"level":{"type":"string"},"values":{"type":"array","items":{"type":"number"}}}})j";
+const char* const kRobotSensorsSchema =
+    R"j({"title":"ssx.RobotSensors","description":"a robot's latest measurements by sensor index, as /ssx/sensors has them","type":"object",)j"
+    R"j("additionalProperties":{"type":"object","properties":{"kind":{"type":"string"},"stamp":{"type":"number"}}}})j";
+const char* const kMetricsSchema =
+    R"j({"title":"ssx.Metrics","description":"the numbers a robot's driver and sensors publish (ssx::MetricSource), by name with their unit; null when there is none now","type":"object",)j"
+    R"j("additionalProperties":{"type":["number","null"]}})j";
 const char* const kOdometrySchema =
     R"j({"title":"ssx.Odometry","description":"a robot's pose (m, quaternion) and velocities (m/s, rad/s) in the world frame","type":"object","properties":{)j"
     R"j("timestamp":{"type":"object","properties":{"sec":{"type":"integer"},"nsec":{"type":"integer"}}},"frame_id":{"type":"string"},"child_frame_id":{"type":"string"},)j"
@@ -73,6 +93,11 @@ struct Snapshot {
   std::vector<std::pair<std::size_t, std::string>> ready;  // (channel, JSON) made on the stepping thread
   bool sensors = false, commands = false;
   detail::RunSample sample;  // the sensors and commands, when wanted
+  // robots' own channels: the sensors of those whose /ROBOT/imu or /ROBOT/sensors is wanted (a
+  // sample per robot, kept with the snapshot), the commands of those whose /ROBOT/command is
+  std::vector<detail::RunSample> robot_samples;
+  std::vector<std::size_t> sensed;
+  std::vector<std::pair<std::size_t, Command>> robot_commands;
 };
 
 void appendXyz(std::string& out, const char* name, double x, double y, double z) {
@@ -85,6 +110,18 @@ void appendXyz(std::string& out, const char* name, double x, double y, double z)
   out += ",\"z\":";
   appendNumber(out, z);
   out += '}';
+}
+
+std::string imuJson(const std::string& frame, const ImuMeasurement& m) {
+  const Nanoseconds stamp = std::max<Nanoseconds>(0, m.stamp);
+  std::string out = R"({"timestamp":{"sec":)" + std::to_string(stamp / 1'000'000'000) + R"(,"nsec":)" +
+                    std::to_string(stamp % 1'000'000'000) + R"(},"frame_id":)";
+  appendString(out, frame);
+  out += ',';
+  appendXyz(out, "accelerometer", m.accelerometer.x(), m.accelerometer.y(), m.accelerometer.z());
+  out += ',';
+  appendXyz(out, "gyroscope", m.gyroscope.x(), m.gyroscope.y(), m.gyroscope.z());
+  return out + "}";
 }
 
 std::string odometryJson(Nanoseconds time, const std::string& name, const BodyState& s) {
@@ -124,8 +161,9 @@ class Foxglove final : public SimulationExtension {
       param::real("rate_hz", "30", "Hz", param::positive() & param::atMost(240),
                   "messages per channel per wall-clock second, at most"),
       param::integer("max_clients", "4", param::atLeast(1) & param::atMost(64), "clients connected at once, at most"),
-      param::integer("robot_channels", "1000", param::atLeast(0) & param::atMost(100000),
-                     "robots that get an odometry channel of their own (the first ones), at most"),
+      param::integer(
+          "robot_channels", "1000", param::atLeast(0) & param::atMost(100000),
+          "robots that get channels of their own (the first ones): odometry, IMU, command, sensors, metrics"),
   };
 
   // before anything is bound: the address is one address
@@ -152,8 +190,13 @@ class Foxglove final : public SimulationExtension {
       bool moves = false;
       for (std::size_t r = 0; r < a.rootCount(); ++r) moves = moves || !a.root(r).isStatic();
       if (!moves) continue;
-      robots_.push_back({i, a.name(), nullptr});
-      channels.push_back({"/" + a.name() + "/odom", "json", "ssx.Odometry", kOdometrySchema, "jsonschema"});
+      robots_.push_back({i, a.name(), nullptr, nullptr, {}});
+      const std::string at = "/" + a.name();
+      channels.push_back({at + "/odom", "json", "ssx.Odometry", kOdometrySchema, "jsonschema"});
+      channels.push_back({at + "/imu", "json", "ssx.Imu", kImuSchema, "jsonschema"});
+      channels.push_back({at + "/command", "json", "ssx.Command", kCommandSchema, "jsonschema"});
+      channels.push_back({at + "/sensors", "json", "ssx.RobotSensors", kRobotSensorsSchema, "jsonschema"});
+      channels.push_back({at + "/metrics", "json", "ssx.Metrics", kMetricsSchema, "jsonschema"});
     }
     try {
       server_ = std::make_unique<foxglove::Server>(bind, static_cast<int>(params.get<std::int64_t>("port")), token,
@@ -177,9 +220,15 @@ class Foxglove final : public SimulationExtension {
         names_.push_back(b.name);
         frames_.push_back({b.node->bodyIndex(), b.node->poseInBody()});
       }
-      for (Robot& r : robots_)
+      for (Robot& r : robots_) {
         for (const RecordedBody& b : bodies_)
           if (b.name == r.name && &b.node->artifact() == &std::as_const(env).artifact(r.artifact)) r.node = b.node;
+        const Artifact& a = std::as_const(env).artifact(r.artifact);
+        r.commandable = dynamic_cast<const CommandInterface*>(a.driver());
+        if (const auto* m = dynamic_cast<const MetricSource*>(a.driver())) r.metrics.push_back(m);
+        for (std::size_t k = 0; k < a.sensorCount(); ++k)
+          if (const auto* m = dynamic_cast<const MetricSource*>(&a.sensor(k))) r.metrics.push_back(m);
+      }
       server_->publish(kScene, static_cast<std::uint64_t>(std::max<Nanoseconds>(0, env.time())),
                        detail::runSceneUpdate(env, bodies_));
     }
@@ -222,9 +271,22 @@ class Foxglove final : public SimulationExtension {
         for (const double v : {q.w(), q.x(), q.y(), q.z()}) *orientation++ = static_cast<float>(v);
       }
     }
-    for (std::size_t r = 0; r < robots_.size(); ++r)
-      if (robots_[r].node != nullptr && server_->wanted(kFixedChannels + r))
-        s->odometry.emplace_back(r, env.bodyState(robots_[r].node->bodyIndex()).attached(robots_[r].node->poseInBody()));
+    s->sensed.clear(), s->robot_commands.clear();
+    for (std::size_t r = 0; r < robots_.size(); ++r) {
+      const Robot& robot = robots_[r];
+      const std::size_t channel = kFixedChannels + r * kPerRobot;
+      if (robot.node != nullptr && server_->wanted(channel + kOdom))
+        s->odometry.emplace_back(r, env.bodyState(robot.node->bodyIndex()).attached(robot.node->poseInBody()));
+      if (server_->wanted(channel + kImu) || server_->wanted(channel + kRobotSensors)) {
+        if (s->robot_samples.size() <= r) s->robot_samples.resize(robots_.size());
+        s->robot_samples[r].takeSensorsOf(env, robot.artifact);
+        s->sensed.push_back(r);
+      }
+      if (robot.commandable != nullptr && server_->wanted(channel + kCommand))
+        s->robot_commands.emplace_back(r, robot.commandable->currentCommand());
+      if (!robot.metrics.empty() && server_->wanted(channel + kMetrics))
+        s->ready.emplace_back(channel + kMetrics, metricsJson(robot));
+    }
     if (server_->wanted(kTiming) && timing.size() > 0)
       s->ready.emplace_back(kTiming, detail::timingJson(timing[timing.size() - 1], env.physics().contactCount()));
     s->sensors = server_->wanted(kSensors);
@@ -278,7 +340,24 @@ class Foxglove final : public SimulationExtension {
     std::size_t artifact;
     std::string name;
     const PhysicNode* node;  // its first body's head, from the first step on
+    const CommandInterface* commandable;       // its driver, when it takes commands (from the first step on)
+    std::vector<const MetricSource*> metrics;  // its driver and sensors that publish metrics
   };
+
+  // /ROBOT/metrics: {"name": value, ...} of its driver's and sensors' metrics (made on the stepping
+  // thread: MetricSource is called there only; a few values)
+  std::string metricsJson(const Robot& robot) {
+    metric_values_.clear();
+    for (const MetricSource* m : robot.metrics) m->metrics(metric_values_);
+    std::string out = "{";
+    for (const Metric& m : metric_values_) {
+      if (out.size() > 1) out += ',';
+      appendString(out, m.name);
+      out += ':';
+      appendNumber(out, m.value);
+    }
+    return out + "}";
+  }
 
   // snapshots are kept for the next ones, never freed while running: one being filled, one
   // waiting and one being written is the most there can be, and a fresh one at 10,000 robots is
@@ -310,7 +389,18 @@ class Foxglove final : public SimulationExtension {
       const auto time = static_cast<std::uint64_t>(std::max<Nanoseconds>(0, s->time));
       if (s->tf) server_->publish(kTf, time, detail::frameTransforms(s->time, names_, s->positions, s->orientations));
       for (const auto& [r, state] : s->odometry)
-        server_->publish(kFixedChannels + r, time, odometryJson(s->time, robots_[r].name, state));
+        server_->publish(kFixedChannels + r * kPerRobot + kOdom, time, odometryJson(s->time, robots_[r].name, state));
+      for (const std::size_t r : s->sensed) {
+        const std::size_t channel = kFixedChannels + r * kPerRobot;
+        const detail::RunSample& sample = s->robot_samples[r];
+        const ImuMeasurement* imu = sample.firstImu();
+        if (imu != nullptr && server_->wanted(channel + kImu))
+          server_->publish(channel + kImu, time, imuJson(robots_[r].name, *imu));
+        if (server_->wanted(channel + kRobotSensors))
+          server_->publish(channel + kRobotSensors, time, sample.artifactSensorsJson(*env_));
+      }
+      for (const auto& [r, command] : s->robot_commands)
+        server_->publish(kFixedChannels + r * kPerRobot + kCommand, time, commandJson(command));
       if (s->sensors) server_->publish(kSensors, time, s->sample.sensorsJson(*env_));
       if (s->commands) server_->publish(kCommands, time, s->sample.commandsJson(*env_));
       for (auto& [channel, json] : s->ready) server_->publish(channel, time, std::move(json));
@@ -345,6 +435,7 @@ class Foxglove final : public SimulationExtension {
   };
   std::vector<Frame> frames_;
   std::vector<Robot> robots_;
+  std::vector<Metric> metric_values_;  // (kept: metricsJson's)
   std::int64_t late_ = 0;
   // the stepping thread and the extension's thread
   std::mutex mutex_;

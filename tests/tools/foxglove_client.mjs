@@ -3,7 +3,8 @@
 // compared with.
 //   node foxglove_client.mjs live URL SECONDS ROBOT
 //     connects, takes the server's information and channels, subscribes to /tf, /scene,
-//     /ssx/timing, /ssx/sensors, /ssx/commands, /ssx/run and /ROBOT/odom, and after SECONDS prints
+//     /ssx/timing, /ssx/sensors, /ssx/commands, /ssx/run and ROBOT's /ROBOT/odom, /ROBOT/imu,
+//     /ROBOT/command, /ROBOT/sensors and /ROBOT/metrics, and after SECONDS prints
 //     as JSON what came: the information, the channels (topic, encoding, schema name, whether the
 //     schema parses), the time messages, and each channel's messages decoded (time, JSON value).
 //   node foxglove_client.mjs tf FILE
@@ -21,7 +22,8 @@ const decoder = new TextDecoder();
 
 if (mode === "live") {
   const [url, seconds, robot] = args;
-  const wanted = ["/tf", "/scene", "/ssx/timing", "/ssx/sensors", "/ssx/commands", "/ssx/run", `/${robot}/odom`];
+  const wanted = ["/tf", "/scene", "/ssx/timing", "/ssx/sensors", "/ssx/commands", "/ssx/run", `/${robot}/odom`,
+                  `/${robot}/imu`, `/${robot}/command`, `/${robot}/sensors`, `/${robot}/metrics`];
   const out = { serverInfo: null, channels: [], times: 0, lastTime: null, messages: {}, statuses: [], badMessages: 0 };
   const client = new FoxgloveClient({ ws: new WebSocket(url, [FoxgloveClient.SUPPORTED_SUBPROTOCOL]) });
   const topics = new Map();  // subscription id -> topic

@@ -9,6 +9,7 @@
 #include <ssx/environment.hpp>
 #include <ssx/measurements.hpp>
 
+#include <algorithm>
 #include <utility>
 
 namespace ssx::detail {
@@ -69,10 +70,17 @@ std::string timingJson(const StepTiming& t, std::size_t contacts) {
   return out + "}";
 }
 
-void RunSample::takeSensors(const Environment& env) {
-  if (sources_of_ != &env) {
+void RunSample::takeSensors(const Environment& env) { take(env, kAllArtifacts); }
+
+void RunSample::takeSensorsOf(const Environment& env, std::size_t artifact) { take(env, artifact); }
+
+void RunSample::take(const Environment& env, std::size_t artifact) {
+  if (sources_of_ != &env || sources_artifact_ != artifact) {
     sources_.clear();
-    for (std::size_t i = 0; i < env.artifactCount(); ++i) {
+    const std::size_t begin = artifact == kAllArtifacts ? 0 : artifact;
+    const std::size_t end =
+        artifact == kAllArtifacts ? env.artifactCount() : std::min(artifact + 1, env.artifactCount());
+    for (std::size_t i = begin; i < end; ++i) {
       const Artifact& a = env.artifact(i);
       for (std::size_t k = 0; k < a.sensorCount(); ++k) {
         const Measurement& m = a.sensor(k).latest();
@@ -85,6 +93,7 @@ void RunSample::takeSensors(const Environment& env) {
       }
     }
     sources_of_ = &env;
+    sources_artifact_ = artifact;
     sensors_.resize(sources_.size());
   }
   // one pass in the order of the sensors, each copied into its kind's member (a range sensor's
@@ -126,31 +135,51 @@ void RunSample::takeCommands(const Environment& env) {
   }
 }
 
+// one artifact's sensors from source k on, as {"0": {measurement}, ...}; k moves past them
+void RunSample::appendArtifact(std::string& out, const Environment& env, std::size_t& k) const {
+  const std::size_t artifact = sources_[k].artifact;
+  out += '{';
+  for (bool first = true; k < sources_.size() && sources_[k].artifact == artifact; ++k, first = false) {
+    const Source& source = sources_[k];
+    const Sensor& s = sensors_[k];
+    const Measurement& m = source.kind == Kind::Imu    ? static_cast<const Measurement&>(s.imu)
+                           : source.kind == Kind::Pose ? static_cast<const Measurement&>(s.pose)
+                                                       : static_cast<const Measurement&>(s.range);
+    if (!first) out += ',';
+    out += '"';
+    out += std::to_string(source.index);
+    out += "\":";
+    appendMeasurementJson(out, m, env);
+  }
+  out += '}';
+}
+
 std::string RunSample::sensorsJson(const Environment& env) const {
   std::string out = "{";
   out.reserve(sensors_json_size_);
   for (std::size_t k = 0; k < sources_.size();) {
-    const std::size_t artifact = sources_[k].artifact;
     if (out.size() > 1) out += ',';
-    appendString(out, env.artifact(artifact).name());
-    out += ":{";
-    for (bool first = true; k < sources_.size() && sources_[k].artifact == artifact; ++k, first = false) {
-      const Source& source = sources_[k];
-      const Sensor& s = sensors_[k];
-      const Measurement& m = source.kind == Kind::Imu    ? static_cast<const Measurement&>(s.imu)
-                             : source.kind == Kind::Pose ? static_cast<const Measurement&>(s.pose)
-                                                         : static_cast<const Measurement&>(s.range);
-      if (!first) out += ',';
-      out += '"';
-      out += std::to_string(source.index);
-      out += "\":";
-      appendMeasurementJson(out, m, env);
-    }
-    out += '}';
+    appendString(out, env.artifact(sources_[k].artifact).name());
+    out += ':';
+    appendArtifact(out, env, k);
   }
   out += '}';
   sensors_json_size_ = out.size() + out.size() / 8;
   return out;
+}
+
+std::string RunSample::artifactSensorsJson(const Environment& env) const {
+  if (sources_.empty()) return "{}";
+  std::string out;
+  std::size_t k = 0;
+  appendArtifact(out, env, k);
+  return out;
+}
+
+const ImuMeasurement* RunSample::firstImu() const {
+  for (std::size_t k = 0; k < sources_.size(); ++k)
+    if (sources_[k].kind == Kind::Imu) return &sensors_[k].imu;
+  return nullptr;
 }
 
 std::string RunSample::commandsJson(const Environment& env) const {

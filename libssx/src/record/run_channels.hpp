@@ -44,10 +44,16 @@ class RunSample {
  public:
   /// Each artifact's latest measurements of the kinds measurementJson writes.
   void takeSensors(const Environment& env);
+  /// The same of artifact `artifact` alone (a robot's own channel).
+  void takeSensorsOf(const Environment& env, std::size_t artifact);
   /// Each commandable robot's current command.
   void takeCommands(const Environment& env);
   /// /ssx/sensors from the sensors taken: {"<artifact>": {"0": {measurement}, ...}, ...}.
   std::string sensorsJson(const Environment& env) const;
+  /// What one artifact's entry in sensorsJson holds, of the sensors taken: {"0": {measurement}, ...}.
+  std::string artifactSensorsJson(const Environment& env) const;
+  /// The first IMU measurement taken, or null.
+  const ImuMeasurement* firstImu() const;
   /// /ssx/commands from the commands taken: {"<artifact>": {"level": "attitude", "values": [...]}, ...}.
   std::string commandsJson(const Environment& env) const;
   /// The contacts of the last step (the environment records them).
@@ -71,7 +77,11 @@ class RunSample {
     RangeMeasurement range;
   };
   std::vector<Source> sources_;
-  const Environment* sources_of_ = nullptr;    // the environment sources_ were found in
+  static constexpr std::size_t kAllArtifacts = ~std::size_t{0};
+  const Environment* sources_of_ = nullptr;       // the environment sources_ were found in ...
+  std::size_t sources_artifact_ = kAllArtifacts;  // ... and of which artifact (kAllArtifacts: every one)
+  void take(const Environment& env, std::size_t artifact);
+  void appendArtifact(std::string& out, const Environment& env, std::size_t& k) const;
   std::vector<Sensor> sensors_;                // per source, what it measured last (only its kind's member)
   mutable std::size_t sensors_json_size_ = 0;  // room for the next /ssx/sensors (the last one's, and more)
   std::vector<std::pair<std::size_t, const CommandInterface*>> commandables_;  // found once, as sources_

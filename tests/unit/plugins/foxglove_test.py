@@ -7,13 +7,16 @@ Runs SCENE in real time with `--foxglove 0` (a free port, read from the line the
 `--record` at every step; tests/tools/foxglove_client.mjs (@foxglove/ws-protocol's FoxgloveClient,
 installed in NPM_DIR by `./dev.sh test`) connects, subscribes and decodes for a few seconds. Then:
 - the server's information offers the `time` capability, and every channel is JSON with a JSON
-  Schema that parses, the recording's topics among them and /ROBOT/odom;
+  Schema that parses, the recording's topics among them and ROBOT's own (odom, imu, command, sensors, metrics);
 - every subscribed channel delivered messages, stamped with simulated time, and time messages came;
 - /scene holds an entity for ROBOT; /ssx/run's time agrees with its stamp, /ssx/timing names steps;
 - every /tf message equals the recording's /tf at the same simulated time (every body, within 1e-6 m:
   both are the simulation's float poses), and /ROBOT/odom's position equals it within 1e-5 m (at
   least 3 of each: a real-time run's recorder drops samples when its writer falls behind, and a
   loaded machine sends fewer messages);
+- ROBOT's own /ROBOT/imu, /ROBOT/command and /ROBOT/sensors equal what /ssx/sensors and
+  /ssx/commands hold for it at the same stamp (at least 3 of each), and /ROBOT/metrics are its
+  driver's numbers;
 - the run's closing line counts what was sent and no client refused.
 Exit status 1 with what differs.
 """
@@ -69,7 +72,8 @@ if "time" not in info.get("capabilities", []):
 topics = {c["topic"]: c for c in got["channels"]}
 for topic, schema in [("/tf", "foxglove.FrameTransforms"), ("/scene", "foxglove.SceneUpdate"), ("/ssx/timing", "ssx.StepTiming"),
                       ("/ssx/sensors", "ssx.Sensors"), ("/ssx/commands", "ssx.Commands"), ("/ssx/run", "ssx.RunStatus"),
-                      (f"/{robot}/odom", "ssx.Odometry")]:
+                      (f"/{robot}/odom", "ssx.Odometry"), (f"/{robot}/imu", "ssx.Imu"), (f"/{robot}/command", "ssx.Command"),
+                      (f"/{robot}/sensors", "ssx.RobotSensors"), (f"/{robot}/metrics", "ssx.Metrics")]:
     c = topics.get(topic)
     if c is None:
         problems.append(f"{topic} is not advertised (channels: {sorted(topics)[:10]}...)")
@@ -131,13 +135,52 @@ if compared < 3 or odometry < 3:
     problems.append(f"only {compared} /tf and {odometry} odometry messages compared with the recording "
                     f"({unmatched} at times the recording dropped)")
 
+# the robot's own channels hold what the swarm's hold for it in the same snapshot (the same stamp):
+# its IMU (the first sensor of kind imu), its command and all its sensors; its metrics are numbers
+swarm_sensors = {int(t): v for t, v in messages.get("/ssx/sensors", [])}
+swarm_commands = {int(t): v for t, v in messages.get("/ssx/commands", [])}
+matched = {"imu": 0, "command": 0, "sensors": 0}
+for stamp, value in messages.get(f"/{robot}/imu", []):
+    entry = swarm_sensors.get(int(stamp), {}).get(robot)
+    if entry is None:
+        continue
+    imu = next(m for _, m in sorted(entry.items(), key=lambda kv: int(kv[0])) if m["kind"] == "imu")
+    ours = [value[f][k] for f in ("accelerometer", "gyroscope") for k in "xyz"]
+    if ours != imu["accelerometer"] + imu["gyroscope"] or abs(value["timestamp"]["sec"] + value["timestamp"]["nsec"] / 1e9 - imu["stamp"]) > 1e-6:
+        problems.append(f"/{robot}/imu at {stamp} ns: {value}, /ssx/sensors has {imu}")
+        break
+    matched["imu"] += 1
+for stamp, value in messages.get(f"/{robot}/command", []):
+    theirs = swarm_commands.get(int(stamp), {}).get(robot)
+    if theirs is None:
+        continue
+    if value != theirs:
+        problems.append(f"/{robot}/command at {stamp} ns: {value}, /ssx/commands has {theirs}")
+        break
+    matched["command"] += 1
+for stamp, value in messages.get(f"/{robot}/sensors", []):
+    theirs = swarm_sensors.get(int(stamp), {}).get(robot)
+    if theirs is None:
+        continue
+    if value != theirs:
+        problems.append(f"/{robot}/sensors at {stamp} ns: {value}, /ssx/sensors has {theirs}")
+        break
+    matched["sensors"] += 1
+if min(matched.values()) < 3:
+    problems.append(f"the robot's own channels matched with the swarm's at the same stamp: {matched} (at least 3 each)")
+metrics = [v for _, v in messages.get(f"/{robot}/metrics", [])]
+if not metrics or not all(isinstance(v, dict) and v and all(x is None or isinstance(x, (int, float)) for x in v.values())
+                          for v in metrics):
+    problems.append(f"/{robot}/metrics: {metrics[:3]} (objects of numbers, the driver's metrics)")
+
 closing = re.search(r"foxglove: (\d+) messages published, (\d+) sent, .* (\d+) clients refused", "".join(lines))
 if not closing or int(closing.group(2)) == 0 or int(closing.group(3)) != 0:
     problems.append("the run's closing line: " + (closing.group(0) if closing else "missing"))
 
 print(f"{len(got['channels'])} channels, {got['times']} time messages, "
       + ", ".join(f"{t} {len(v)}" for t, v in sorted(messages.items()))
-      + f"; {compared} /tf messages equal to the recording's ({unmatched} at times it dropped)")
+      + f"; {compared} /tf messages equal to the recording's ({unmatched} at times it dropped); "
+      f"the robot's own equal to the swarm's: {matched}")
 for p in problems:
     print("error:", p)
 sys.exit(1 if problems else 0)
