@@ -2,8 +2,8 @@
 #include "record/run_channels.hpp"
 
 #include "base/json.hpp"
+#include "base/measurement_json.hpp"
 #include "record/foxglove.hpp"
-#include "robot/measurement_json.hpp"
 
 #include <ssx/command.hpp>
 #include <ssx/environment.hpp>
@@ -77,6 +77,7 @@ void RunSample::takeSensorsOf(const Environment& env, std::size_t artifact) { ta
 void RunSample::take(const Environment& env, std::size_t artifact) {
   if (sources_of_ != &env || sources_artifact_ != artifact) {
     sources_.clear();
+    std::size_t counts[3] = {0, 0, 0};
     const std::size_t begin = artifact == kAllArtifacts ? 0 : artifact;
     const std::size_t end =
         artifact == kAllArtifacts ? env.artifactCount() : std::min(artifact + 1, env.artifactCount());
@@ -84,38 +85,55 @@ void RunSample::take(const Environment& env, std::size_t artifact) {
       const Artifact& a = env.artifact(i);
       for (std::size_t k = 0; k < a.sensorCount(); ++k) {
         const Measurement& m = a.sensor(k).latest();
+        Kind kind = Kind::Imu;
         if (dynamic_cast<const ImuMeasurement*>(&m) != nullptr)
-          sources_.push_back({i, k, Kind::Imu, &m});
+          kind = Kind::Imu;
         else if (dynamic_cast<const PoseMeasurement*>(&m) != nullptr)
-          sources_.push_back({i, k, Kind::Pose, &m});
+          kind = Kind::Pose;
         else if (dynamic_cast<const RangeMeasurement*>(&m) != nullptr)
-          sources_.push_back({i, k, Kind::Range, &m});
+          kind = Kind::Range;
+        else
+          continue;
+        sources_.push_back({i, k, kind, counts[static_cast<int>(kind)]++, &m});
       }
     }
     sources_of_ = &env;
     sources_artifact_ = artifact;
-    sensors_.resize(sources_.size());
+    imus_.resize(counts[0]);
+    poses_.resize(counts[1]);
+    ranges_.resize(counts[2]);
   }
-  // one pass in the order of the sensors, each copied into its kind's member (a range sensor's
+  // one pass in the order of the sensors, each copied into its kind's vector (a range sensor's
   // detections into the vector's room: no allocation once grown); the measurement a few sources
   // ahead fetched while this one is copied (thousands of robots: each is a cache miss)
   constexpr std::size_t kAhead = 8;
   for (std::size_t k = 0; k < sources_.size(); ++k) {
     if (k + kAhead < sources_.size()) __builtin_prefetch(sources_[k + kAhead].latest);
     const Source& source = sources_[k];
-    Sensor& s = sensors_[k];
     switch (source.kind) {
       case Kind::Imu:
-        s.imu = static_cast<const ImuMeasurement&>(*source.latest);
+        imus_[source.slot] = static_cast<const ImuMeasurement&>(*source.latest);
         break;
       case Kind::Pose:
-        s.pose = static_cast<const PoseMeasurement&>(*source.latest);
+        poses_[source.slot] = static_cast<const PoseMeasurement&>(*source.latest);
         break;
       case Kind::Range:
-        s.range = static_cast<const RangeMeasurement&>(*source.latest);
+        ranges_[source.slot] = static_cast<const RangeMeasurement&>(*source.latest);
         break;
     }
   }
+}
+
+const Measurement& RunSample::copyOf(const Source& source) const {
+  switch (source.kind) {
+    case Kind::Imu:
+      return imus_[source.slot];
+    case Kind::Pose:
+      return poses_[source.slot];
+    case Kind::Range:
+      break;
+  }
+  return ranges_[source.slot];
 }
 
 void RunSample::takeCommands(const Environment& env) {
@@ -141,15 +159,11 @@ void RunSample::appendArtifact(std::string& out, const Environment& env, std::si
   out += '{';
   for (bool first = true; k < sources_.size() && sources_[k].artifact == artifact; ++k, first = false) {
     const Source& source = sources_[k];
-    const Sensor& s = sensors_[k];
-    const Measurement& m = source.kind == Kind::Imu    ? static_cast<const Measurement&>(s.imu)
-                           : source.kind == Kind::Pose ? static_cast<const Measurement&>(s.pose)
-                                                       : static_cast<const Measurement&>(s.range);
     if (!first) out += ',';
     out += '"';
     out += std::to_string(source.index);
     out += "\":";
-    appendMeasurementJson(out, m, env);
+    appendMeasurementJson(out, copyOf(source), env);
   }
   out += '}';
 }
@@ -177,8 +191,8 @@ std::string RunSample::artifactSensorsJson(const Environment& env) const {
 }
 
 const ImuMeasurement* RunSample::firstImu() const {
-  for (std::size_t k = 0; k < sources_.size(); ++k)
-    if (sources_[k].kind == Kind::Imu) return &sensors_[k].imu;
+  for (const Source& source : sources_)
+    if (source.kind == Kind::Imu) return &imus_[source.slot];
   return nullptr;
 }
 

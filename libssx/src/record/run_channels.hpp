@@ -69,12 +69,8 @@ class RunSample {
   struct Source {
     std::size_t artifact = 0, index = 0;
     Kind kind = Kind::Imu;
+    std::size_t slot = 0;  // where its copy is in its kind's vector below
     const Measurement* latest = nullptr;
-  };
-  struct Sensor {
-    ImuMeasurement imu;
-    PoseMeasurement pose;
-    RangeMeasurement range;
   };
   std::vector<Source> sources_;
   static constexpr std::size_t kAllArtifacts = ~std::size_t{0};
@@ -82,7 +78,11 @@ class RunSample {
   std::size_t sources_artifact_ = kAllArtifacts;  // ... and of which artifact (kAllArtifacts: every one)
   void take(const Environment& env, std::size_t artifact);
   void appendArtifact(std::string& out, const Environment& env, std::size_t& k) const;
-  std::vector<Sensor> sensors_;                // per source, what it measured last (only its kind's member)
+  // what each source measured last, in its kind's vector (dense: a copy touches only its own)
+  std::vector<ImuMeasurement> imus_;
+  std::vector<PoseMeasurement> poses_;
+  std::vector<RangeMeasurement> ranges_;
+  const Measurement& copyOf(const Source& source) const;
   mutable std::size_t sensors_json_size_ = 0;  // room for the next /ssx/sensors (the last one's, and more)
   std::vector<std::pair<std::size_t, const CommandInterface*>> commandables_;  // found once, as sources_
   const Environment* commandables_of_ = nullptr;

@@ -1,5 +1,5 @@
 // The measurements sensors produce: each one's check that its numbers are finite, and each as JSON.
-#include "robot/measurement_json.hpp"
+#include "base/measurement_json.hpp"
 
 #include <ssx/environment.hpp>
 #include <ssx/measurements.hpp>

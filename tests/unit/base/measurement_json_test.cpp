@@ -1,6 +1,6 @@
-// A measurement's JSON appended in place (robot/measurement_json.hpp): what measurementJson returns,
+// A measurement's JSON appended in place (base/measurement_json.hpp): what measurementJson returns,
 // after whatever the string held, and nothing appended for a kind without JSON.
-#include "robot/measurement_json.hpp"
+#include "base/measurement_json.hpp"
 
 #include <ssx/environment.hpp>
 #include <ssx/measurements.hpp>

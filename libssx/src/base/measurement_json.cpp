@@ -1,5 +1,5 @@
-// A measurement as JSON, appended to a string (robot/measurement_json.hpp).
-#include "robot/measurement_json.hpp"
+// A measurement as JSON, appended to a string (base/measurement_json.hpp).
+#include "base/measurement_json.hpp"
 
 #include "base/json.hpp"
 
