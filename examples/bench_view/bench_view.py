@@ -98,6 +98,9 @@ async def pages(url, count, process):
     return got
 
 
+FIXED = ["/tf", "/scene", "/ssx/timing", "/ssx/sensors", "/ssx/commands", "/ssx/run"]  # the swarm's channels
+
+
 async def foxglove_clients(url, count, process, topics=None):
     """`count` Foxglove clients subscribed to `topics` (None: the run's fixed channels), reading every
     message until the run ends; the messages each got of the first of them (/tf when all)."""
@@ -112,11 +115,10 @@ async def foxglove_clients(url, count, process, topics=None):
                 async for message in ws:
                     if isinstance(message, str) and json.loads(message).get("op") == "advertise":
                         channels = json.loads(message)["channels"]
-                        wanted = [c for c in channels if not c["topic"].endswith("/odom")] if topics is None else \
-                            [c for t in topics for c in channels if c["topic"] == t]
-                        if topics is not None and len(wanted) != len(topics):
-                            sys.exit(f"--channels {','.join(topics)}: the run offers "
-                                     f"{', '.join(c['topic'] for c in channels if not c['topic'].endswith('/odom'))}")
+                        wanted = [c for t in (topics or FIXED) for c in channels if c["topic"] == t]
+                        if len(wanted) != len(topics or FIXED):
+                            sys.exit(f"--channels {','.join(topics or FIXED)}: the run offers "
+                                     f"{', '.join(c['topic'] for c in channels[:20])}, ...")
                         counted = wanted[0]["id"]
                         await ws.send(json.dumps({"op": "subscribe", "subscriptions": [
                             {"id": c["id"], "channelId": c["id"]} for c in wanted]}))
