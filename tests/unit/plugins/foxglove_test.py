@@ -150,22 +150,15 @@ for stamp, value in messages.get(f"/{robot}/imu", []):
         problems.append(f"/{robot}/imu at {stamp} ns: {value}, /ssx/sensors has {imu}")
         break
     matched["imu"] += 1
-for stamp, value in messages.get(f"/{robot}/command", []):
-    theirs = swarm_commands.get(int(stamp), {}).get(robot)
-    if theirs is None:
-        continue
-    if value != theirs:
-        problems.append(f"/{robot}/command at {stamp} ns: {value}, /ssx/commands has {theirs}")
-        break
-    matched["command"] += 1
-for stamp, value in messages.get(f"/{robot}/sensors", []):
-    theirs = swarm_sensors.get(int(stamp), {}).get(robot)
-    if theirs is None:
-        continue
-    if value != theirs:
-        problems.append(f"/{robot}/sensors at {stamp} ns: {value}, /ssx/sensors has {theirs}")
-        break
-    matched["sensors"] += 1
+for own, swarm, by_stamp in (("command", "/ssx/commands", swarm_commands), ("sensors", "/ssx/sensors", swarm_sensors)):
+    for stamp, value in messages.get(f"/{robot}/{own}", []):
+        theirs = by_stamp.get(int(stamp), {}).get(robot)
+        if theirs is None:
+            continue
+        if value != theirs:
+            problems.append(f"/{robot}/{own} at {stamp} ns: {value}, {swarm} has {theirs}")
+            break
+        matched[own] += 1
 if min(matched.values()) < 3:
     problems.append(f"the robot's own channels matched with the swarm's at the same stamp: {matched} (at least 3 each)")
 metrics = [v for _, v in messages.get(f"/{robot}/metrics", [])]
