@@ -55,10 +55,11 @@ struct SSX_EXPORT TimingSummary {
   std::string str() const;
 };
 
-/// Collects StepTiming samples in a ring allocated once, when it is made: recording a step never
-/// allocates, however long the run. When the ring is full the oldest sample is overwritten, so
-/// summaries and CSV cover the newest `capacity()` steps. Not thread-safe; written by the thread
-/// that steps.
+/// Collects StepTiming samples in a ring allocated once, when it is made, and filled as steps are
+/// recorded (its memory is touched then, not when it is made: an environment that takes few steps
+/// does not pay for 16 MiB of zeros): recording a step never allocates, however long the run. When the ring is full the
+/// oldest sample is overwritten, so summaries and CSV cover the newest `capacity()` steps. Not thread-safe; written by
+/// the thread that steps.
 class SSX_EXPORT TimingRecorder {
  public:
   /// 262,144 samples (16 MiB): 4.4 minutes at 1 kHz, 87 minutes at 50 Hz.
@@ -72,7 +73,7 @@ class SSX_EXPORT TimingRecorder {
   /// Samples kept (at most capacity()).
   std::size_t size() const noexcept { return size_; }
   /// Samples the ring holds at most.
-  std::size_t capacity() const noexcept { return ring_.size(); }
+  std::size_t capacity() const noexcept { return ring_.capacity(); }
   /// Samples added since construction or clear(), kept or not: a mark for summary().
   std::int64_t recorded() const noexcept { return recorded_; }
   /// The i-th kept sample, oldest first.
@@ -91,7 +92,7 @@ class SSX_EXPORT TimingRecorder {
   void writeCsv(const std::string& path) const;
 
  private:
-  std::vector<StepTiming> ring_;
+  std::vector<StepTiming> ring_;  ///< reserved for the capacity; grows into it, then wraps
   std::size_t head_ = 0;  ///< where the next sample goes
   std::size_t size_ = 0;
   std::int64_t recorded_ = 0;

@@ -28,16 +28,23 @@ double medianMs(std::vector<Nanoseconds> values) {
 
 }  // namespace
 
-TimingRecorder::TimingRecorder(std::size_t capacity) : ring_(std::max<std::size_t>(2, capacity)) {}
+TimingRecorder::TimingRecorder(std::size_t capacity) { ring_.reserve(std::max<std::size_t>(2, capacity)); }
 
 void TimingRecorder::add(const StepTiming& sample) noexcept {
-  ring_[head_] = sample;
-  head_ = (head_ + 1) % ring_.size();
-  size_ = std::min(size_ + 1, ring_.size());
+  // until the ring is full the next sample goes at its end (head_ is its size): within the room
+  // reserved, so without allocating; then over the oldest. The inline readers' index arithmetic
+  // over ring_.size() holds either way
+  if (ring_.size() < ring_.capacity())
+    ring_.push_back(sample);
+  else
+    ring_[head_] = sample;
+  head_ = (head_ + 1) % ring_.capacity();
+  size_ = std::min(size_ + 1, ring_.capacity());
   ++recorded_;
 }
 
 void TimingRecorder::clear() noexcept {
+  ring_.clear();  // (the room stays)
   head_ = size_ = 0;
   recorded_ = 0;
 }
