@@ -189,27 +189,48 @@ void OdeEngine::collide() {
 }
 
 void OdeEngine::groupContacts() {
-  // where each body steps this substep: a body in contact with others in the home world of the
-  // group's root (world 0 when a pinned body is in it), every other body at home
-  for (const int i : groups_.touched()) {
-    const int r = groups_.rootOf(i);
-    const int target = bodies_[static_cast<std::size_t>(r)].home;
-    if (bodies_[static_cast<std::size_t>(i)].partition != target) {
-      if (bodies_[static_cast<std::size_t>(i)].partition == bodies_[static_cast<std::size_t>(i)].home) away_.push_back(i);
-      moveBody(i, target);
-    }
+  // an articulation lies in one world: the groups its bodies touch are one group
+  const auto first = [this](int ra, int rb) { return firstOf(ra, rb); };
+  const std::size_t touched = groups_.touched().size();
+  for (std::size_t k = 0; k < touched; ++k) {
+    const int i = groups_.touched()[k];
+    if (bodies_[static_cast<std::size_t>(i)].pinned)
+      groups_.unite(i, articulation_[static_cast<std::size_t>(i)], first);
   }
-  // the bodies away from home whose group no longer needs them there go back, lowest first
+  // where each body steps this substep: a body in contact with others in the home world of the
+  // group's root (a pinned body's when there is one), every other body at home; an articulation
+  // moves whole, its joints with it
+  for (const int i : groups_.touched()) {
+    Body& body = bodies_[static_cast<std::size_t>(i)];
+    const int target = bodies_[static_cast<std::size_t>(groups_.rootOf(i))].home;
+    if (body.partition == target) continue;
+    if (body.pinned) {
+      relocate(articulation_[static_cast<std::size_t>(i)], target);
+      continue;
+    }
+    if (target != body.home) listAway(i);
+    moveBody(i, target);
+  }
+  // the bodies away from home whose group no longer needs them there go back, lowest first (an
+  // articulation when none of its bodies is in a group)
   std::sort(away_.begin(), away_.end());
   std::size_t kept = 0;
-  for (const int i : away_) {
+  for (std::size_t k = 0, n = away_.size(); k < n; ++k) {
+    const int i = away_[k];
     Body& body = bodies_[static_cast<std::size_t>(i)];
-    if (body.partition == body.home) continue;
-    if (groups_.grouped(i)) {
+    bool needed = body.partition != body.home && groups_.grouped(i);
+    if (body.pinned && body.partition != body.home)
+      for (const int m : membersOf(articulation_[static_cast<std::size_t>(i)])) needed = needed || groups_.grouped(m);
+    if (needed) {
       away_[kept++] = i;
       continue;
     }
-    moveBody(i, body.home);
+    body.listed = false;
+    if (body.partition == body.home) continue;
+    if (body.pinned)
+      relocate(articulation_[static_cast<std::size_t>(i)], body.home);
+    else
+      moveBody(i, body.home);
   }
   away_.resize(kept);
   groups_.clear();

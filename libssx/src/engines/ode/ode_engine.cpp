@@ -410,19 +410,17 @@ void OdeEngine::step(Nanoseconds dt, std::span<const Wrench> wrenches) {
   if (log) contact_log_.begin();
   seal();
   if (groups_.size() != bodies_.size()) groups_.resize(bodies_.size());
-  if (labels_stale_ || articulation_.size() != bodies_.size()) {
-    labelArticulations(articulation_, bodies_.size(), joints_);
-    labelStaticParents(hangs_from_, articulation_, joints_);
-    labels_stale_ = false;
-  }
+  if (labels_stale_ || articulation_.size() != bodies_.size()) refreshLabels(true);
   for (int k = 0; k < substeps; ++k) {
     // contacts in one space over every world, then the groups they make into one world each
     collide();
     groupContacts();
     for (std::size_t i = 0; i < used_partitions_; ++i) partitions_[i].has_joints = false;
-    partitions_[0].has_joints = live_joints_ > 0;  // (the joined bodies' world: see ode_engine.hpp)
-    if (integrate_free_)
-      for (Body& body : bodies_) body.constrained = body.pinned;
+    if (integrate_free_ || live_joints_ > 0)
+      for (Body& body : bodies_) {
+        body.constrained = body.pinned;
+        if (body.pinned) partitions_[static_cast<std::size_t>(body.partition)].has_joints = true;
+      }
     if (log) feedback_.assign(contacts_.size(), dJointFeedback{});
     for (std::size_t k = 0; k < contacts_.size(); ++k) {
       const dContact& c = contacts_[k];
@@ -568,6 +566,7 @@ void OdeEngine::restoreState(StateReader& in) {
   }
   seal();
   std::vector<Joint> run_time = loadJoints(in);
+  checkJointWorlds(run_time, where);
   ensureThreadData();
   // the joints let go of their bodies, made again once the bodies are
   for (Joint& j : joints_) {
@@ -590,10 +589,11 @@ void OdeEngine::restoreState(StateReader& in) {
       Body& body = bodies_[static_cast<std::size_t>(i)];
       body.partition = static_cast<int>(p);  // (in no order list now: moveBody only appends it)
       moveBody(i, static_cast<int>(p));
-      if (body.home != static_cast<int>(p)) away_.push_back(i);
+      body.listed = body.home != static_cast<int>(p);
+      if (body.listed) away_.push_back(i);
     }
   }
-  recreateJoints();
+  remakeJoints(art_joints_);
   for (std::size_t i = 0; i < bodies_.size(); ++i) writeOdeBits(bodies_[i].id, values.data() + i * kOdeBodyReals);
 }
 

@@ -25,15 +25,18 @@
 // around dWorldQuickStep, which leaves the other islands as they would be. OdeSettings::
 // integrate_free_bodies = false hands every body to ODE (the cross-check of the tests).
 //
-// Joined bodies (addJoint) are pinned to world 0: an ODE joint belongs to one world and cannot
-// follow its bodies into another, and keeps frames (anchors, axes, the hinge's reference rotation)
-// taken when it was set up. So a contact group with a pinned body in it is solved in world 0, and
-// articulated robots step there, one after another, while free bodies still step in parallel. A
-// restored engine makes each joint again with its bodies put back where they were when it was
-// first made, so that ODE computes the same frames to the bit. A joint made between steps (a
-// gripper closing) pins its bodies from then on; once the last joint holding a body is removed it
-// goes back to its home world at the next step, as a body leaving a contact group does. Run-time
-// joints, with their bodies' states when made, are part of the saved state.
+// Joined bodies (addJoint) are pinned: an articulation (the bodies joints join, directly or
+// through others) always lies in one world, its home the home of its lowest body, so that the
+// robots of a swarm of articulated robots step in parallel as free bodies do. An ODE joint belongs
+// to one world and keeps frames (anchors, axes, the hinge's reference rotation) taken when it was
+// made: when a contact group takes an articulation into another world, or it goes back home, its
+// joints are made again there with their bodies put back where they were when each was first made,
+// so that ODE computes the same frames to the bit (restoring a state does the same). The scene's
+// joints are made in world 0, and each articulation goes home at the first step. A joint made
+// between steps (a gripper closing) joins the two articulations in the world of the lower one;
+// once the last joint holding a body is removed it goes back to its home world at the next step,
+// as a body leaving a contact group does. Run-time joints, with their bodies' states when made,
+// are part of the saved state.
 
 #include "engines/contact_groups.hpp"
 #include "engines/contact_log.hpp"
@@ -47,6 +50,7 @@
 #include <map>
 #include <memory>
 #include <mutex>
+#include <span>
 #include <vector>
 
 namespace ssx::detail {
@@ -119,7 +123,7 @@ class OdeEngine final : public PhysicEngine {
     dThreadingImplementationID threading = nullptr;
     unsigned long rand_seed = 0;  // this world's own copy of ODE's process-wide dRand seed
     std::vector<int> order;       // its bodies in creation order (ODE lists them newest first)
-    bool has_joints = false;      // joints in this substep (contacts, or the joints of world 0)
+    bool has_joints = false;      // joints in this substep (contacts, or an articulation's)
   };
   struct Geom {
     dGeomID id;
@@ -132,7 +136,8 @@ class OdeEngine final : public PhysicEngine {
     int partition = 0;
     int home = 0;
     bool kinematic = false;  // moved only by setState (dBodySetKinematic)
-    bool pinned = false;     // joined to another body or the world: always in world 0
+    bool pinned = false;     // joined to another body or the world: in its articulation's world
+    bool listed = false;     // in away_
     dMass mass;   // now (setMassScale)
     dMass added;  // as addBody gave it
     // what stepping it free takes: its inverse inertia and mass as ODE computed them (kinematic:
@@ -155,21 +160,34 @@ class OdeEngine final : public PhysicEngine {
 
   // makes partition p's ODE world, with the settings, unless it has one
   void openWorld(Partition& p);
-  // makes joint j's ODE joint in world 0 from the bodies' current states
+  // makes joint j's ODE joint in its child's world from the bodies' current states
   void createJoint(Joint& joint);
-  // recreates every joint, its bodies put back where they were when it was first made (restore)
-  void recreateJoints();
+  // makes joints_[k] for each k again (in slot order), its bodies put back where they were when
+  // it was first made, then every body they hold back where it is now
+  void remakeJoints(std::span<const int> joints);
+  // moves articulation `root` (articulation_) into world `to`, its joints made again there
+  void relocate(int root, int to);
+  // labels, members and homes from the joints in place; with `list_away`, the bodies away from
+  // home into away_
+  void refreshLabels(bool list_away);
+  void listAway(int body);
+  std::span<const int> membersOf(int root) const {
+    const auto r = static_cast<std::size_t>(root);
+    return {members_.data() + member_offset_[r], members_.data() + member_offset_[r + 1]};
+  }
   void applyMotor(const Joint& joint);
   // the joints made so far are the scene's (at the first step or restore)
   void seal() {
     if (!sealed_) scene_joints_ = joints_.size();
     sealed_ = true;
   }
-  // pins the bodies some joint holds (into world 0) and lets the others go home
-  void repin(bool move);
+  // pins the bodies some joint holds and lets the others go home (refreshLabels)
+  void repin(bool list_away);
   void saveJoints(StateWriter& out) const;
   // reads the run-time joints of a saved state (checked; nothing changed yet)
   std::vector<Joint> loadJoints(StateReader& in) const;
+  // throws StateError unless each joint's two bodies are in one world (`where`: per body)
+  void checkJointWorlds(const std::vector<Joint>& run_time, const std::vector<int>& where) const;
   // the root of a contact group from two roots: a pinned one first, else the lower
   int firstOf(int a, int b) const {
     const bool pa = bodies_[static_cast<std::size_t>(a)].pinned, pb = bodies_[static_cast<std::size_t>(b)].pinned;
@@ -213,6 +231,9 @@ class OdeEngine final : public PhysicEngine {
   std::vector<Joint> joints_;
   std::vector<int> articulation_;  // per body: the lowest body it is joined to (itself when none)
   std::vector<int> hangs_from_;    // per body: the static group its articulation hangs from, or -1
+  // per articulation root: its bodies, ascending, and its joints in place, in slot order, at
+  // members_[member_offset_[r], member_offset_[r + 1]) and likewise in art_joints_
+  std::vector<int> members_, member_offset_, art_joints_, joint_offset_;
   bool labels_stale_ = false;      // joints came or went since articulation_ was computed
   std::size_t scene_joints_ = 0;   // joints_[0, scene_joints_) are the scene's (once sealed_)
   bool sealed_ = false;

@@ -1,5 +1,6 @@
-// The ODE engine's joints: hinge, slider, ball and fixed joints between bodies pinned to world 0
-// (see ode_engine.hpp), their limits and motors; joints made and removed between steps, saved.
+// The ODE engine's joints: hinge, slider, ball and fixed joints between pinned bodies, each
+// articulation in one world (see ode_engine.hpp), their limits and motors; joints made and removed
+// between steps, saved.
 #include "engines/ode/ode_engine.hpp"
 
 #include "engines/articulations.hpp"
@@ -23,13 +24,20 @@ int OdeEngine::addJoint(const EngineJoint& spec) {
     throw Error("ode: the scene's joints come before any step and any run-time joint");
   Joint joint;
   joint.spec = spec;
-  // both bodies in world 0 for good (see ode_engine.hpp), before ODE joins them there
-  for (const int b : {spec.child, spec.parent}) {
-    if (b < 0) continue;
-    Body& body = bodies_[static_cast<std::size_t>(b)];
-    body.pinned = true;
-    body.home = 0;
-    if (body.partition != 0) moveBody(b, 0);
+  for (const int b : {spec.child, spec.parent})
+    if (b >= 0) bodies_[static_cast<std::size_t>(b)].pinned = true;
+  if (!sealed_) {
+    // the scene's joints in world 0 (cheap while the scene is built); each articulation goes home
+    // at the first step (groupContacts)
+    for (const int b : {spec.child, spec.parent})
+      if (b >= 0 && bodies_[static_cast<std::size_t>(b)].partition != 0) moveBody(b, 0);
+  } else if (spec.parent >= 0) {
+    // a joint between steps: both articulations in the world of the lower one, before ODE joins them
+    if (labels_stale_ || articulation_.size() != bodies_.size()) refreshLabels(false);
+    const int a = articulation_[static_cast<std::size_t>(spec.child)];
+    const int b = articulation_[static_cast<std::size_t>(spec.parent)];
+    const int to = bodies_[static_cast<std::size_t>(std::min(a, b))].partition;
+    relocate(std::max(a, b), to);
   }
   joint.child_bits.resize(kOdeBodyReals);
   readOdeBits(bodies_[static_cast<std::size_t>(spec.child)].id, joint.child_bits.data());
@@ -57,23 +65,78 @@ void OdeEngine::removeJoint(int index) {
   labels_stale_ = true;
 }
 
-void OdeEngine::repin(bool move) {
+void OdeEngine::repin(bool list_away) {
   std::vector<char> held(bodies_.size(), 0);
   for (const Joint& j : joints_) {
     if (j.removed) continue;
     held[static_cast<std::size_t>(j.spec.child)] = 1;
     if (j.spec.parent >= 0) held[static_cast<std::size_t>(j.spec.parent)] = 1;
   }
-  for (std::size_t i = 0; i < bodies_.size(); ++i) {
-    Body& body = bodies_[i];
-    body.pinned = held[i] != 0;
-    body.home = body.pinned ? 0 : homeOf(static_cast<int>(i));
-    if (!move) continue;
-    if (body.pinned && body.partition != 0) moveBody(static_cast<int>(i), 0);
-    // let go: home at the next step unless a contact group keeps it (as groupContacts does)
-    if (!body.pinned && body.partition != body.home && std::find(away_.begin(), away_.end(), static_cast<int>(i)) == away_.end())
-      away_.push_back(static_cast<int>(i));
+  for (std::size_t i = 0; i < bodies_.size(); ++i) bodies_[i].pinned = held[i] != 0;
+  refreshLabels(list_away);
+}
+
+void OdeEngine::refreshLabels(bool list_away) {
+  labelArticulations(articulation_, bodies_.size(), joints_);
+  labelStaticParents(hangs_from_, articulation_, joints_);
+  labels_stale_ = false;
+  // each articulation's bodies and joints, by its root (a counting sort: ascending, slot order)
+  const std::size_t n = bodies_.size();
+  member_offset_.assign(n + 1, 0);
+  joint_offset_.assign(n + 1, 0);
+  for (const int r : articulation_) ++member_offset_[static_cast<std::size_t>(r) + 1];
+  for (const Joint& j : joints_)
+    if (!j.removed)
+      ++joint_offset_[static_cast<std::size_t>(articulation_[static_cast<std::size_t>(j.spec.child)]) + 1];
+  for (std::size_t r = 0; r < n; ++r) {
+    member_offset_[r + 1] += member_offset_[r];
+    joint_offset_[r + 1] += joint_offset_[r];
   }
+  members_.resize(n);
+  art_joints_.resize(static_cast<std::size_t>(joint_offset_[n]));
+  std::vector<int> fill(member_offset_.begin(), member_offset_.end() - 1);
+  for (std::size_t i = 0; i < n; ++i)
+    members_[static_cast<std::size_t>(fill[static_cast<std::size_t>(articulation_[i])]++)] = static_cast<int>(i);
+  fill.assign(joint_offset_.begin(), joint_offset_.end() - 1);
+  for (std::size_t k = 0; k < joints_.size(); ++k) {
+    if (joints_[k].removed) continue;
+    const auto r = static_cast<std::size_t>(articulation_[static_cast<std::size_t>(joints_[k].spec.child)]);
+    art_joints_[static_cast<std::size_t>(fill[r]++)] = static_cast<int>(k);
+  }
+  // a pinned body's home is its articulation's; a body away goes home when no group needs it
+  for (std::size_t i = 0; i < n; ++i) {
+    Body& body = bodies_[i];
+    body.home = homeOf(body.pinned ? articulation_[i] : static_cast<int>(i));
+    if (list_away && body.partition != body.home) listAway(static_cast<int>(i));
+  }
+}
+
+void OdeEngine::listAway(int i) {
+  Body& body = bodies_[static_cast<std::size_t>(i)];
+  if (body.listed) return;
+  body.listed = true;
+  away_.push_back(i);
+}
+
+void OdeEngine::relocate(int root, int to) {
+  const std::span<const int> members = membersOf(root);
+  bool there = true;
+  for (const int i : members) there = there && bodies_[static_cast<std::size_t>(i)].partition == to;
+  if (there) return;
+  const auto r = static_cast<std::size_t>(root);
+  const std::span<const int> joints{art_joints_.data() + joint_offset_[r], art_joints_.data() + joint_offset_[r + 1]};
+  // (an ODE joint cannot follow its bodies: it is let go of here and made again there)
+  for (const int k : joints) {
+    dJointDestroy(joints_[static_cast<std::size_t>(k)].id);
+    joints_[static_cast<std::size_t>(k)].id = nullptr;
+  }
+  for (const int i : members) {
+    Body& body = bodies_[static_cast<std::size_t>(i)];
+    if (body.partition == to) continue;
+    if (to != body.home) listAway(i);
+    moveBody(i, to);
+  }
+  remakeJoints(joints);
 }
 
 namespace {
@@ -89,7 +152,8 @@ void setAxisParam(JointSpec::Kind kind, dJointID j, int param, double value) {
 
 void OdeEngine::createJoint(Joint& joint) {
   const EngineJoint& s = joint.spec;
-  const dWorldID world = partitions_[0].world;
+  const dWorldID world =
+      partitions_[static_cast<std::size_t>(bodies_[static_cast<std::size_t>(s.child)].partition)].world;
   // the child is ODE's first body, so that ODE's angle, rate and motor are the child's relative to
   // the parent, as ssx measures them
   const dBodyID child = bodies_[static_cast<std::size_t>(s.child)].id;
@@ -127,17 +191,28 @@ void OdeEngine::createJoint(Joint& joint) {
   joint.id = j;
 }
 
-void OdeEngine::recreateJoints() {
-  // each joint's bodies where they were when it was first made, so that ODE takes the same frames;
-  // the caller then writes every body's saved state
-  for (Joint& joint : joints_) {
-    if (joint.removed) continue;
+void OdeEngine::remakeJoints(std::span<const int> joints) {
+  // where the bodies are now, then each joint made from its bodies' states when first made
+  std::vector<int> held;
+  for (const int k : joints)
+    for (const int b :
+         {joints_[static_cast<std::size_t>(k)].spec.child, joints_[static_cast<std::size_t>(k)].spec.parent})
+      if (b >= 0) held.push_back(b);
+  std::sort(held.begin(), held.end());
+  held.erase(std::unique(held.begin(), held.end()), held.end());
+  std::vector<dReal> now(held.size() * kOdeBodyReals);
+  for (std::size_t h = 0; h < held.size(); ++h)
+    readOdeBits(bodies_[static_cast<std::size_t>(held[h])].id, now.data() + h * kOdeBodyReals);
+  for (const int k : joints) {
+    Joint& joint = joints_[static_cast<std::size_t>(k)];
     writeOdeBits(bodies_[static_cast<std::size_t>(joint.spec.child)].id, joint.child_bits.data());
     if (joint.spec.parent >= 0)
       writeOdeBits(bodies_[static_cast<std::size_t>(joint.spec.parent)].id, joint.parent_bits.data());
     createJoint(joint);
     applyMotor(joint);
   }
+  for (std::size_t h = 0; h < held.size(); ++h)
+    writeOdeBits(bodies_[static_cast<std::size_t>(held[h])].id, now.data() + h * kOdeBodyReals);
 }
 
 void OdeEngine::setJointMotor(int index, double velocity, double max_effort) {
@@ -159,6 +234,16 @@ void OdeEngine::saveJoints(StateWriter& out) const {
     w.bytes(j.child_bits.data(), j.child_bits.size() * sizeof(dReal));
     if (j.spec.parent >= 0) w.bytes(j.parent_bits.data(), j.parent_bits.size() * sizeof(dReal));
   });
+}
+
+void OdeEngine::checkJointWorlds(const std::vector<Joint>& run_time, const std::vector<int>& where) const {
+  for (std::size_t k = 0; k < scene_joints_ + run_time.size(); ++k) {
+    const Joint& j = k < scene_joints_ ? joints_[k] : run_time[k - scene_joints_];
+    if (!j.removed && j.spec.parent >= 0 &&
+        where[static_cast<std::size_t>(j.spec.child)] != where[static_cast<std::size_t>(j.spec.parent)])
+      throw StateError("ode: the saved state puts the two bodies of joint " + std::to_string(k) +
+                       " in different worlds");
+  }
 }
 
 std::vector<OdeEngine::Joint> OdeEngine::loadJoints(StateReader& in) const {
