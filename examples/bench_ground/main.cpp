@@ -5,7 +5,9 @@
 // with N = 100, 1,000 and 10,000 e-pucks packed as there (0.2 m apart) in an arena with room to
 // spread, on 1 and 2 threads, as fast as the machine goes: the median and 95th percentile of the
 // time per 20 ms tick, and per robot. Then the full model (each e-puck five bodies: wheels on hinge
-// motors, casters) on ODE and Bullet: the cost per robot and physics step.
+// motors, casters) on ODE and Bullet: the cost per robot and physics step. Then TurtleBot3 Burgers
+// (full model: four bodies, the chassis four times as long as a wheel), standing in rows 1 m apart,
+// on ODE, 1 and 2 threads: the physics phase per robot and step, 100 to 10,000 robots.
 //
 // usage: ssx_bench_ground [--quick] [--ticks T]
 #include <ssx/ssx.hpp>
@@ -78,6 +80,27 @@ std::string fullScene(int n, const std::string& engine) {
          std::to_string(-packed / 2) + R"( 0"><driver controller="diffusion"/></swarm></scene>)";
 }
 
+std::string burgerScene(int n, int threads) {
+  return R"(<scene><environment timestep="0.002" seed="11" threads=")" + std::to_string(threads) +
+         R"("/><type name="burger" file="turtlebot3_burger.xml"/><ground/><swarm type="burger" count=")" +
+         std::to_string(n) + R"(" name="b{i}" spacing="1"/></scene>)";
+}
+
+// the median physics phase of `ticks` steps after `warmup`, in ms
+double physicsMedian(const std::string& xml, int ticks, int warmup) {
+  ssx::SceneOptions options;
+  ssx::Scene scene = ssx::loadSceneFromString(xml, "bench_ground.xml", kArtifacts, options);
+  ssx::Environment& env = *scene.environment;
+  env.step(warmup);
+  std::vector<double> ms;
+  for (int i = 0; i < ticks; ++i) {
+    env.step();
+    ms.push_back(1e-6 * static_cast<double>(env.timing()[env.timing().size() - 1].physics));
+  }
+  std::sort(ms.begin(), ms.end());
+  return ms[ms.size() / 2];
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -109,6 +132,15 @@ int main(int argc, char** argv) {
     for (const int n : quick ? std::vector<int>{100} : std::vector<int>{100, 1000}) {
       const Timing timing = run(fullScene(n, engine), ticks, 50);
       std::printf("%8d %8s %12.3f %20.2f\n", n, engine, timing.median_ms, 1000.0 * timing.median_ms / n);
+      std::fflush(stdout);
+    }
+  }
+  std::printf("\nTurtleBot3 Burgers, full model (4 bodies), standing 1 m apart, 2 ms steps, ODE: physics phase\n");
+  std::printf("%8s %8s %12s %20s\n", "robots", "threads", "median ms", "us per robot-step");
+  for (const int n : quick ? std::vector<int>{100} : std::vector<int>{100, 1000, 10000}) {
+    for (const int threads : {1, 2}) {
+      const double ms = physicsMedian(burgerScene(n, threads), n >= 10000 ? std::max(10, ticks / 5) : ticks, 5);
+      std::printf("%8d %8d %12.3f %20.2f\n", n, threads, ms, 1000.0 * ms / n);
       std::fflush(stdout);
     }
   }
