@@ -223,15 +223,18 @@ void OdeEngine::groupContacts() {
   for (std::size_t k = 0, n = away_.size(); k < n; ++k) {
     const int i = away_[k];
     Body& body = bodies_[static_cast<std::size_t>(i)];
-    bool needed = body.partition != body.home && groups_.grouped(i);
-    if (body.pinned && body.partition != body.home)
+    if (body.partition == body.home) {  // (a group brought it home, or its articulation went)
+      body.listed = false;
+      continue;
+    }
+    bool needed = groups_.grouped(i);
+    if (body.pinned)
       for (const int m : membersOf(articulation_[static_cast<std::size_t>(i)])) needed = needed || groups_.grouped(m);
     if (needed) {
       away_[kept++] = i;
       continue;
     }
     body.listed = false;
-    if (body.partition == body.home) continue;
     if (body.pinned)
       relocate(articulation_[static_cast<std::size_t>(i)], body.home);
     else

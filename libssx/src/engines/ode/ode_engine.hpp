@@ -175,6 +175,10 @@ class OdeEngine final : public PhysicEngine {
     const auto r = static_cast<std::size_t>(root);
     return {members_.data() + member_offset_[r], members_.data() + member_offset_[r + 1]};
   }
+  std::span<const int> jointsOf(int root) const {
+    const auto r = static_cast<std::size_t>(root);
+    return {art_joints_.data() + joint_offset_[r], art_joints_.data() + joint_offset_[r + 1]};
+  }
   void applyMotor(const Joint& joint);
   // the joints made so far are the scene's (at the first step or restore)
   void seal() {

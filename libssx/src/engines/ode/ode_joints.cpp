@@ -123,8 +123,7 @@ void OdeEngine::relocate(int root, int to) {
   bool there = true;
   for (const int i : members) there = there && bodies_[static_cast<std::size_t>(i)].partition == to;
   if (there) return;
-  const auto r = static_cast<std::size_t>(root);
-  const std::span<const int> joints{art_joints_.data() + joint_offset_[r], art_joints_.data() + joint_offset_[r + 1]};
+  const std::span<const int> joints = jointsOf(root);
   // (an ODE joint cannot follow its bodies: it is let go of here and made again there)
   for (const int k : joints) {
     dJointDestroy(joints_[static_cast<std::size_t>(k)].id);
