@@ -40,6 +40,9 @@ class SSX_EXPORT Artifact {
   const std::string& name() const noexcept { return name_; }
   /// Position in the environment's artifact list; streams and orders derive from it.
   std::size_t index() const noexcept { return index_; }
+  /// Whether it is in the world: false once Environment::despawn took it out (or the scene said
+  /// present="false"), until Environment::spawn puts it back.
+  bool present() const noexcept;
   /// The environment, read-only: what may change it (subscriptions, neighbour queries, camera
   /// requests) is reached from a plugin's configure (PluginSetup) or by the embedding program.
   const Environment& environment() const noexcept { return *env_; }

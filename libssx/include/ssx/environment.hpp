@@ -32,6 +32,7 @@
 #include <ssx/plugin.hpp>
 #include <ssx/pose_stream.hpp>
 #include <ssx/render.hpp>
+#include <ssx/run_control.hpp>
 #include <ssx/spatial_index.hpp>
 #include <ssx/timing.hpp>
 #include <ssx/types.hpp>
@@ -94,53 +95,6 @@ struct EnvironmentSettings {
   PhysicsSettings physics;  ///< the physics engine and its parameters
   RenderSettings render;    ///< the render engine, scene cameras and outputs
   WindSettings wind;        ///< the scene's wind
-};
-
-/// A run steered while it runs, from any thread (a viewer's page, a program's UI): Environment::run
-/// looks at it between steps. Pausing holds the run between two steps (and the stop flag still ends
-/// it); on resuming, real time starts afresh from that moment (no catching up on the pause). A
-/// step asked for while paused is taken at once. A real-time factor set here replaces the run's
-/// from the next step on (real-time runs; a fast run ignores it).
-class SSX_EXPORT RunControl {
- public:
-  /// Holds the run after its current step.
-  void pause();
-  /// Lets a paused run go on.
-  void resume();
-  /// While paused: one more step (or n).
-  void stepOnce(std::int64_t n = 1);
-  /// The real-time factor of real-time runs from the next step on (kMinRealtimeFactor to
-  /// kMaxRealtimeFactor; ConfigError otherwise).
-  void setRealtimeFactor(double factor);
-  /// Whether a pause was asked for.
-  bool paused() const;
-  /// The factor set, or 0 when none was (the run's own applies).
-  double realtimeFactor() const;
-  /// Ends run() between two steps (after the current one), as its stop flag would.
-  void stop();
-  /// Whether stop() was called (run() clears it when it returns).
-  bool stopped() const;
-  /// Work for the stepping thread between two steps (a ROS service call that reads or moves the
-  /// world), from any thread: run() runs the tasks posted, in order, before each step and at once
-  /// while paused; a program stepping with step() calls runPosted(). A task that throws ends run().
-  void post(std::function<void()> task);
-  /// Runs the tasks posted so far, on the calling thread; returns how many ran.
-  std::size_t runPosted();
-
-  /// For Environment::run: waits while paused (returns at once otherwise) until resumed, a step is
-  /// asked for, `stop` is set or a task is posted (run it with runPosted() and wait again); returns
-  /// true when a step may be taken.
-  bool waitWhilePaused(const std::atomic<bool>* stop);
-
- private:
-  friend class Environment;
-  mutable std::mutex mutex_;
-  std::condition_variable changed_;
-  bool paused_ = false;
-  bool stop_ = false;
-  std::int64_t steps_ = 0;
-  double factor_ = 0;
-  std::vector<std::function<void()>> tasks_;
 };
 
 /// How a run is paced.
@@ -397,6 +351,16 @@ class SSX_EXPORT Environment {
   /// The value `name` has now for `artifact` (its neutral value when never varied).
   double variation(const Artifact& artifact, std::string_view name) const;
 
+  // --- artifacts out of the world and back (scene-format.md: present="false") -----------------
+  /// Takes a moving artifact out of the world, before start or between steps: its bodies stay put,
+  /// touch nothing, meet no ray (PhysicEngine::setEnabled); its plugins do not run, neighbour
+  /// queries miss it, Artifact::present() is false; nothing is renumbered. Part of the saved state.
+  /// Error for a static artifact, a ghost, one attached to another, or one out already.
+  void despawn(Artifact& artifact);
+  /// Puts it back between steps, its root frame at `pose` (world), at rest; its plugins go on from
+  /// their state. Error for one in the world, a pose not finite or not of unit length, before start.
+  void spawn(Artifact& artifact, const Pose& pose);
+
   // --- ghosts: real robots inside the simulation --------------------------------------------
 
   /// Makes `artifact` a ghost (before start): a robot whose pose comes from outside, a real one's
@@ -544,7 +508,7 @@ class SSX_EXPORT Environment {
   void checkDeclaredParameters();
   void requireOutsidePhases(const char* what) const;
   std::uint64_t sceneFingerprint() const;
-  void applyState(std::span<const std::byte> payload);
+  void applyState(std::span<const std::byte> payload, std::uint32_t format);
   // restoreState after checkState passed (VectorEnvironment checks a state once for all its copies)
   void restoreChecked(std::span<const std::byte> state);
   friend class VectorEnvironment;
@@ -555,6 +519,7 @@ class SSX_EXPORT Environment {
   void exchangePhysics(const std::string& engine);
   void runScheduledSwitches();
   void requireBetweenSteps(const char* what) const;
+  void checkPresenceChange(const Artifact& artifact, const char* what) const;
   void checkObserver(const SimulationExtension& extension, Descriptor& params, const std::string& name) const;
 
   struct ExtensionSlot {

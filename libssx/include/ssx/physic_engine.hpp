@@ -176,6 +176,13 @@ class SSX_EXPORT PhysicEngine {
   virtual void setKinematic(int body) = 0;
   /// Whether setKinematic made `body` kinematic.
   virtual bool isKinematic(int body) const = 0;
+  /// Takes a body out of the world (false) or puts it back (true), between steps. A body out of
+  /// the world keeps its state as it is (no force, gravity, joint or contact moves it), touches
+  /// nothing and no ray meets it; a joint between two bodies out of the world holds nothing. Put
+  /// back, it moves on from the state it has then (forces applied to it while it was out are
+  /// dropped). Not part of the saved state: the Environment sets it again after restoreState.
+  /// Default: throws Error (an engine that cannot take bodies out of its world).
+  virtual void setEnabled(int body, bool enabled);
   /// Scales a dynamic body's mass and its inertia (about its centre of mass) by these factors,
   /// relative to what addBody gave it ((1, 1): as added), from the next step on; its state stays.
   /// Between steps; a kinematic body ignores it (it has no mass to move).

@@ -98,6 +98,9 @@ struct SSX_EXPORT PlacementModel {
   /// artifacts (a robot in its dock). Otherwise a robot that starts inside another, an obstacle
   /// or the ground is an error, found when the scene is built.
   bool allow_overlap = false;
+  /// `present="false"` (artifacts, swarms): it starts out of the world (Environment::despawn),
+  /// held in reserve until something spawns it (Environment::spawn, ROS 2's /spawn_entity).
+  bool present = true;
   std::string layout = "grid";  ///< grid, random or sphere
   double spacing = 1.0;         ///< grid
   std::int64_t columns = 0;     ///< grid: members per row (parsing fills in ceil(sqrt(count)) when not given)

@@ -32,6 +32,12 @@ class NullRenderEngine final : public RenderEngine {
 }  // namespace
 
 PhysicEngine::~PhysicEngine() = default;
+
+void PhysicEngine::setEnabled(int body, bool enabled) {
+  (void)body;
+  (void)enabled;
+  throw Error("physics engine '" + name() + "' cannot take bodies out of its world (setEnabled)");
+}
 TaskRunner::~TaskRunner() = default;
 RenderEngine::~RenderEngine() = default;
 

@@ -24,14 +24,15 @@ void GridBroadphase::build(std::span<const Box> boxes, double cell) {
   // boxes larger than a cell are tested against all
   if (boxes.size() != small_.size() || cell != cell_) {
     cell_ = cell;
-    small_.assign(boxes.size(), 2);  // (neither: the entries are made again below)
+    small_.assign(boxes.size(), 3);  // (none of them: the entries are made again below)
     big_.reserve(boxes.size());
   }
   // the entries of the last build, moved to where their boxes are now: bodies move little from one
   // step to the next, so they are nearly in order and an insertion sort costs about one pass
   bool same = true;
   for (std::size_t i = 0; i < boxes.size(); ++i) {
-    const std::uint8_t is_small = isBig(boxes[i]) ? 0 : 1;
+    // 1: in the bands, 0: large, 2: off (in neither)
+    const std::uint8_t is_small = boxes[i].off ? 2 : isBig(boxes[i]) ? 0 : 1;
     if (is_small == 0) big_.push_back(static_cast<int>(i));
     same = same && small_[i] == is_small;
     small_[i] = is_small;
@@ -39,7 +40,7 @@ void GridBroadphase::build(std::span<const Box> boxes, double cell) {
   if (!same) {
     entries_.clear();
     for (std::size_t i = 0; i < boxes.size(); ++i)
-      if (small_[i] != 0) entries_.push_back({0, 0, 0, static_cast<int>(i)});
+      if (small_[i] == 1) entries_.push_back({0, 0, 0, static_cast<int>(i)});
   }
   for (Entry& e : entries_) {
     const Box& b = boxes[static_cast<std::size_t>(e.box)];

@@ -23,6 +23,7 @@ class GridBroadphase {
   struct Box {
     Vec3 min, max;
     int owner = -1;  // boxes of one owner >= 0 never pair; two boxes of owner -1 (static) neither
+    bool off = false;  // in no pair and found by no query (a body taken out of the world)
   };
 
   /// Sorts the boxes into bands of `cell` (serial; keeps a view of `boxes` for pairs()). The cell

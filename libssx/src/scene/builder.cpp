@@ -208,6 +208,13 @@ bool SceneBuilder::place(Environment& env, const std::string& name, const Placem
       error(p.ghost_where, std::string("<ghost>: ") + e.what());
     }
   }
+  if (!p.present) {
+    try {
+      env.despawn(a);
+    } catch (const Error& e) {
+      error(p.where, std::string("present=\"false\": ") + e.what());
+    }
+  }
   if (errorCount() != errors_before) return false;  // the class checks assume values of the declared types
   for (std::size_t i = 0; i < a.sensorCount(); ++i)
     validatePlugin(env, &a.sensor(i), a.sensorParameters(i), &a, a.sensor(i).periodSteps(),

@@ -208,6 +208,7 @@ void placement(std::ostringstream& out, const PlacementModel& p) {
       Element e(out, "artifact", 1);
       e("name", p.name)("type", p.type)("xyz", vec(p.xyz))("rpy", vec(p.rpy));
       if (p.allow_overlap) e("allow_overlap", "true");
+      if (!p.present) e("present", "false");
       overrides(out, p, e);
       break;
     }
@@ -220,6 +221,7 @@ void placement(std::ostringstream& out, const PlacementModel& p) {
       if (p.layout == "sphere") e("radius", num(p.radius));
       if (p.random_yaw) e("random_yaw", "true");
       if (p.allow_overlap) e("allow_overlap", "true");
+      if (!p.present) e("present", "false");
       overrides(out, p, e);
       break;
     }

@@ -41,7 +41,8 @@ void SceneBuilder::checkStartOverlaps(const Environment& env, const SceneModel& 
   bool any_dynamic = false;
   for (std::size_t i = 0; i < env.artifactCount(); ++i) {
     const Artifact& a = env.artifact(i);
-    if (env.isGhost(a)) continue;  // moved by a real robot's poses: nothing was placed
+    // moved by a real robot's poses, or out of the world until spawned: nothing was placed
+    if (env.isGhost(a) || !a.present()) continue;
     for (std::size_t n = 0; n < a.nodeCount(); ++n) {
       const PhysicNode& node = a.nodeAt(n);
       const Pose pose = node.pose();

@@ -315,6 +315,7 @@ void Environment::start() {
     renderer_ = createRenderEngine(settings_.render);
     detail::buildBodies(w, *physics_, &static_shapes_);
     ghosts_->start(w, *physics_);
+    detail::applyPresence(w, *physics_, {});
     detail::publishSnapshot(w, *physics_, true);
     // (queries enabled before start, by an extension's init, see the first snapshot too)
     if (neighbors_->enabled()) neighbors_->markStale(w);

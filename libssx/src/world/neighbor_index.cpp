@@ -20,6 +20,7 @@ void NeighborIndex::rebuild() const {
     root_nodes_.clear();
     ids_.clear();
     for (const auto& a : w.artifacts) {
+      if (w.artifact_data[a->index()].absent) continue;  // out of the world
       for (std::size_t r = 0; r < a->rootCount(); ++r) {
         const PhysicNode& root = a->root(r);
         if (root.isStatic()) continue;

@@ -28,6 +28,11 @@ class NeighborIndex {
     world_ = &world;
     stale_.store(true, std::memory_order_release);
   }
+  /// Artifacts left the world or came back: which ones are indexed is worked out again too.
+  void markMembersChanged(const World& world) noexcept {
+    roots_of_ = ~std::size_t{0};
+    markStale(world);
+  }
   /// See Environment::neighbors. Throws when queries are off. Any thread, any number at once.
   void query(const Vec3& point, double radius, std::vector<std::size_t>& out) const;
   void query(const Vec3& point, double radius, std::vector<SpatialIndex::Hit>& out) const;

@@ -7,6 +7,8 @@
 #include <ssx/environment.hpp>
 
 #include <cstddef>
+#include <cstdint>
+#include <span>
 #include <vector>
 
 namespace ssx::detail {
@@ -16,6 +18,10 @@ namespace ssx::detail {
 /// `static_shapes` null, makes the same bodies and joints again in another engine (switching
 /// engines): the body arrays and the snapshot are left as they are.
 void buildBodies(World& world, PhysicEngine& engine, std::vector<Environment::StaticShape>* static_shapes);
+/// Takes the bodies of artifacts out of the engine's world, or puts them back, where their
+/// `absent` flag differs from `was_absent` (per artifact; empty: all were in, as in an engine just
+/// built; presence.cpp).
+void applyPresence(World& world, PhysicEngine& engine, std::span<const std::uint8_t> was_absent);
 /// Makes the engine's joints from the node trees (the end of buildBodies; joints.cpp).
 void buildJoints(World& world, PhysicEngine& engine);
 /// Before a physics step: sets the motors' velocities; returns the wrenches to apply (the drivers',

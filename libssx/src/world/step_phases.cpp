@@ -90,7 +90,7 @@ void runSensors(World& world, std::size_t begin, std::size_t end) {
       const SensorSlot& slot = world.sensor_slots[at];
       std::uint8_t& fresh = world.fresh[slot.plugin];
       fresh = 0;
-      if (a.silent) continue;
+      if (a.silent || a.absent) continue;
       Sensor& sensor = *slot.sensor;
       const std::int64_t period = slot.period_steps;
       if (step % period != 0) continue;
@@ -120,7 +120,7 @@ void runDrivers(World& world, std::size_t begin, std::size_t end) {
   for (std::size_t i = begin; i < end; ++i) {
     prefetchArtifact(world, i, end, false);
     ArtifactData& a = world.artifact_data[i];
-    if (!world.errors[i].plugin.empty()) continue;
+    if (!world.errors[i].plugin.empty() || a.absent) continue;
     // deliver fresh measurements, in the order fixed at start
     const Subscription* current = nullptr;
     try {

@@ -73,6 +73,7 @@ void Environment::exchangePhysics(const std::string& engine) {
   try {
     detail::buildBodies(w, *next, nullptr);
     ghosts_->adopt(*next);
+    detail::applyPresence(w, *next, {});
     for (std::size_t i = 0; i < w.states.size(); ++i) next->setState(static_cast<int>(i), w.states[i]);
     detail::reattach(w, *next);
     detail::applyMassScales(w, *next);

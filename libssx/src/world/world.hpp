@@ -125,6 +125,7 @@ struct ArtifactData {
   std::uint32_t sensor_begin = 0, sensor_end = 0;
   std::uint32_t inbox_begin = 0, inbox_end = 0;
   bool silent = false;             // a lost ghost: its sensors do not measure
+  bool absent = false;             // out of the world (Environment::despawn): no plugin runs
   std::vector<AttachRequest> attach_requests;  // its driver's, until its drivers phase ends
   int body_begin = 0;               // bodies [body_begin, body_end) in the body arrays
   int body_end = 0;

@@ -5,7 +5,8 @@
 // (u64), FNV-1a of the payload (u64); then the payload: step count, the engine's name and its block, the
 // snapshot (body states with accelerations, the velocities before the last step), the command
 // buffers, the joints' motor commands, the run-time joints, the varied constants, every plugin's random stream (the
-// world's plugin table, in order), then one block per plugin (driver first, then sensors, artifact by artifact: what it saved) and one per extension.
+// world's plugin table, in order), then one block per plugin (driver first, then sensors, artifact by artifact: what it
+// saved), one per extension, the ghosts' block, and the artifacts out of the world (their count, then their indices).
 #include "world/ghosts.hpp"
 #include "world/phases.hpp"
 #include "world/neighbor_index.hpp"
@@ -27,9 +28,17 @@ namespace {
 constexpr char kMagic[8] = {'S', 'S', 'X', 'S', 'T', 'A', 'T', 'E'};
 // 4: run-time joints (PhysicNode::attach); 5: the engine's name (states restore on the engine that
 // saved them), the run-time joints' kinds; 6: the varied constants (Environment::vary); 7: the
-// same payload under a faster checksum (stateChecksum; format 6's states are still read)
-constexpr std::uint32_t kFormatVersion = 7;
+// same payload under a faster checksum (stateChecksum; format 6's states are still read); 8: the
+// artifacts out of the world (Environment::despawn; formats 6 and 7 had none)
+constexpr std::uint32_t kFormatVersion = 8;
 constexpr std::size_t kHeaderSize = 8 + 4 + 4 + 8 + 8 + 8;
+
+// the format of a state checkState passed
+std::uint32_t formatOf(std::span<const std::byte> state) {
+  std::uint32_t version = 0;
+  std::memcpy(&version, state.data() + 8, 4);
+  return version;
+}
 
 void writeBody(StateWriter& out, const BodyState& s) {
   out.write(s.pose);
@@ -167,6 +176,11 @@ void Environment::saveState(std::vector<std::byte>& buffer) const {
   for (const auto& e : extensions_)
     if (!e.observer) writeBlock(out, [&] { e.extension->saveState(out); });
   if (!ghosts_->empty()) writeBlock(out, [&] { ghosts_->save(out); });
+  std::uint64_t absent = 0;
+  for (const auto& a : w.artifact_data) absent += a.absent ? 1 : 0;
+  out.write(absent);
+  for (std::size_t i = 0; i < w.artifact_data.size(); ++i)
+    if (w.artifact_data[i].absent) out.write(static_cast<std::uint32_t>(i));
 
   out.finish();
   // the header, now that the payload is known
@@ -194,8 +208,8 @@ void Environment::checkState(std::span<const std::byte> state) const {
   std::memcpy(&fingerprint, state.data() + 16, 8);
   std::memcpy(&payload, state.data() + 24, 8);
   std::memcpy(&checksum, state.data() + 32, 8);
-  if (version != kFormatVersion && version != 6)
-    throw StateError("restoreState: saved state format " + std::to_string(version) + ", this ssx reads formats 6 and " +
+  if (version < 6 || version > kFormatVersion)
+    throw StateError("restoreState: saved state format " + std::to_string(version) + ", this ssx reads formats 6 to " +
                      std::to_string(kFormatVersion));
   if (payload != state.size() - kHeaderSize)
     throw StateError("restoreState: the saved state is " + std::to_string(state.size()) + " bytes, its header says " +
@@ -230,24 +244,24 @@ void Environment::restoreChecked(std::span<const std::byte> state) {
   std::uint64_t checksum = 0;
   std::memcpy(&checksum, state.data() + 32, 8);
   if (checksum == w.restored_checksum && state.size() == w.restored_size) {
-    applyState(state.subspan(kHeaderSize));
+    applyState(state.subspan(kHeaderSize), formatOf(state));
     return;
   }
   const std::vector<std::byte> before = saveState();
   try {
-    applyState(state.subspan(kHeaderSize));
+    applyState(state.subspan(kHeaderSize), formatOf(state));
   } catch (const StateError&) {
-    applyState(std::span<const std::byte>(before).subspan(kHeaderSize));
+    applyState(std::span<const std::byte>(before).subspan(kHeaderSize), kFormatVersion);
     throw;
   } catch (const std::exception& e) {
-    applyState(std::span<const std::byte>(before).subspan(kHeaderSize));
+    applyState(std::span<const std::byte>(before).subspan(kHeaderSize), kFormatVersion);
     throw StateError(std::string("restoreState: ") + e.what());
   }
   w.restored_checksum = checksum;
   w.restored_size = state.size();
 }
 
-void Environment::applyState(std::span<const std::byte> payload) {
+void Environment::applyState(std::span<const std::byte> payload, std::uint32_t format) {
   StateReader in(payload, "saved state");
   const auto steps = in.get<std::int64_t>();
   if (steps < 0) throw StateError("saved state: negative step count (corrupted)");
@@ -300,7 +314,26 @@ void Environment::applyState(std::span<const std::byte> payload) {
     if (!e.observer)
       readBlock(in, "extension '" + e.name + "'", [&](StateReader& block) { e.extension->loadState(block); });
   if (!ghosts_->empty()) readBlock(in, "the ghosts' poses", [&](StateReader& block) { ghosts_->load(block, w); });
+  // the artifacts out of the world (format 8 on; before, every artifact was in), checked whole first
+  std::vector<std::uint8_t> absent(w.artifacts.size(), 0);
+  if (format >= 8) {
+    const std::size_t count = in.count(4);
+    for (std::size_t k = 0; k < count; ++k) {
+      const auto i = in.get<std::uint32_t>();
+      if (i >= w.artifacts.size() || absent[i] != 0 || w.artifacts[i]->rootCount() == 0 ||
+          w.artifacts[i]->root().isStatic() || isGhost(*w.artifacts[i]))
+        throw StateError("saved state: artifact " + std::to_string(i) + " cannot be out of the world here (corrupted)");
+      absent[i] = 1;
+    }
+  }
   if (!in.done()) throw StateError("saved state: " + std::to_string(in.remaining()) + " bytes left over (corrupted)");
+  std::vector<std::uint8_t> was_absent(w.artifacts.size());
+  for (std::size_t i = 0; i < w.artifacts.size(); ++i) {
+    was_absent[i] = w.artifact_data[i].absent ? 1 : 0;
+    w.artifact_data[i].absent = absent[i] != 0;
+  }
+  detail::applyPresence(w, *physics_, was_absent);
+  if (neighbors_->enabled() && was_absent != absent) neighbors_->markMembersChanged(w);
   w.steps = steps;
   w.current_step = steps;
   physics_->recordContacts(w.record_contacts);  // (the last step's contacts are another run's)

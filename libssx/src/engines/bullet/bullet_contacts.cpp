@@ -74,6 +74,7 @@ void BulletEngine::placeGeoms(std::size_t begin, std::size_t end) {
     for (std::size_t k = 0; k < body.geoms.size(); ++k) {
       const Geom& g = body.geoms[k];
       const std::size_t p = first_proxy_[i] + k;
+      boxes_[p].off = !body.enabled;
       const btTransform offset(btQuaternion(g.offset[3], g.offset[4], g.offset[5], g.offset[6]),
                                btVector3(g.offset[0], g.offset[1], g.offset[2]));
       poses_[p].transform = t * offset;
@@ -205,6 +206,7 @@ void BulletEngine::collide(double h) {
       const std::size_t end = std::min(dynamic_proxies_, begin + kGeomsPerPlaneChunk);
       for (std::size_t k = begin; k < end; ++k) {
         const GridBroadphase::Box& box = boxes_[k];
+        if (box.off) continue;
         const Vec3 centre = (box.min + box.max) / 2;
         const Vec3 half = (box.max - box.min) / 2;
         for (std::size_t p = 0; p < planes_.size(); ++p) {
@@ -235,8 +237,12 @@ void BulletEngine::buildIslands() {
     return a >= 0 ? a : bodyOf(m->getBody1());
   };
   // joined bodies are one island, contacts or not
+  // (a joint of bodies out of the world holds nothing: the world takes out whole articulations)
+  const auto holds = [this](const Joint& j) {
+    return !j.removed && bodies_[static_cast<std::size_t>(j.spec.child)]->enabled;
+  };
   for (const Joint& j : joints_) {
-    if (j.removed) continue;
+    if (!holds(j)) continue;
     if (j.spec.parent >= 0)
       groups_.unite(j.spec.child, j.spec.parent);
     else
@@ -278,7 +284,7 @@ void BulletEngine::buildIslands() {
   // the joints of each island, in the order they were added
   joint_order_.clear();
   for (std::size_t k = 0; k < joints_.size(); ++k)
-    if (!joints_[k].removed) joint_order_.emplace_back(find(joints_[k].spec.child), k);
+    if (holds(joints_[k])) joint_order_.emplace_back(find(joints_[k].spec.child), k);
   std::sort(joint_order_.begin(), joint_order_.end());
   island_joints_.clear();
   island = 0;
@@ -290,7 +296,7 @@ void BulletEngine::buildIslands() {
   }
   free_bodies_.clear();
   for (std::size_t i = 0; i < bodies_.size(); ++i)
-    if (!groups_.grouped(static_cast<int>(i))) free_bodies_.push_back(bodies_[i]->rb.get());
+    if (!groups_.grouped(static_cast<int>(i)) && bodies_[i]->enabled) free_bodies_.push_back(bodies_[i]->rb.get());
   groups_.clear();
 }
 

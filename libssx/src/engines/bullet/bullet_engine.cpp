@@ -160,6 +160,14 @@ void BulletEngine::setKinematic(int index) {
 
 bool BulletEngine::isKinematic(int index) const { return bodies_.at(static_cast<std::size_t>(index))->kinematic; }
 
+void BulletEngine::setEnabled(int index, bool enabled) {
+  if (index < 0 || static_cast<std::size_t>(index) >= bodies_.size())
+    throw Error("bullet: setEnabled: no body " + std::to_string(index));
+  Body& body = *bodies_[static_cast<std::size_t>(index)];
+  body.enabled = enabled;
+  body.rb->clearForces();
+}
+
 void BulletEngine::setMassScale(int index, double mass_factor, double inertia_factor) {
   Body& body = *bodies_.at(static_cast<std::size_t>(index));
   if (body.kinematic) return;
@@ -249,6 +257,7 @@ void BulletEngine::step(Nanoseconds dt, std::span<const Wrench> wrenches) {
     for (std::size_t i = 0; i < bodies_.size(); ++i) {
       btRigidBody& rb = *bodies_[i]->rb;
       rb.clearForces();
+      if (!bodies_[i]->enabled) continue;  // out of the world: nothing moves it
       rb.applyCentralForce(toBt(wrenches[i].force));
       rb.applyTorque(toBt(wrenches[i].torque));
       rb.applyGravity();
@@ -262,6 +271,7 @@ void BulletEngine::step(Nanoseconds dt, std::span<const Wrench> wrenches) {
     forEach((bodies_.size() + kBodiesPerChunk - 1) / kBodiesPerChunk, [&](std::size_t c) {
       const std::size_t end = std::min(bodies_.size(), (c + 1) * kBodiesPerChunk);
       for (std::size_t i = c * kBodiesPerChunk; i < end; ++i) {
+        if (!bodies_[i]->enabled) continue;
         btRigidBody& rb = *bodies_[i]->rb;
         btTransform next;
         rb.predictIntegratedTransform(h, next);

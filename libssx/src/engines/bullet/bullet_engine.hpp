@@ -56,6 +56,7 @@ class BulletEngine final : public PhysicEngine {
   int addBody(const MassProperties& mass, const std::vector<Shape>& shapes, const BodyState& state) override;
   void setKinematic(int body) override;
   bool isKinematic(int body) const override;
+  void setEnabled(int body, bool enabled) override;
   void setMassScale(int body, double mass_factor, double inertia_factor) override;
   int addStatic(const std::vector<Shape>& shapes, const Pose& pose) override;
   void setTaskRunner(TaskRunner* runner) override { runner_ = runner; }

@@ -29,6 +29,7 @@ struct BulletEngine::Body {
   Quat principal = Quat::Identity();  // Bullet's body frame in ssx's (the inertia's principal axes)
   bool rotated = false;               // principal is not the identity
   bool kinematic = false;             // moved only by setState (mass 0, CF_KINEMATIC_OBJECT)
+  bool enabled = true;                // in the world (setEnabled): else nothing moves it, its boxes off
   double mass = 0;                    // as added (setMassScale scales these)
   btVector3 inertia{0, 0, 0};         // principal moments, as added
 };

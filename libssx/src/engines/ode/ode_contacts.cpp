@@ -15,6 +15,7 @@ void OdeEngine::placeGeoms(std::size_t begin, std::size_t end) {
   for (std::size_t i = begin; i < end; ++i) {
     const Body& body = bodies_[i];
     if (body.geoms.empty()) continue;
+    for (std::size_t k = 0; k < body.geoms.size(); ++k) boxes_[first_proxy_[i] + k].off = !body.enabled;
     const dReal* p = dBodyGetPosition(body.id);
     const dReal* r = dBodyGetRotation(body.id);
     for (std::size_t k = 0; k < body.geoms.size(); ++k) {
@@ -169,7 +170,7 @@ void OdeEngine::collide() {
       const std::size_t end = std::min(dynamic_proxies_, begin + kGeomsPerPlaneChunk);
       for (std::size_t k = begin; k < end; ++k)
         for (std::size_t p = 0; p < planes_.size(); ++p)
-          if (!aboveOf(boxes_[k], planes_params_[p]))
+          if (!boxes_[k].off && !aboveOf(boxes_[k], planes_params_[p]))
             collidePair(proxy_geoms_[k], planes_[p], chunk.contacts, chunk.scratch);
       return;
     }

@@ -94,6 +94,7 @@ class OdeEngine final : public PhysicEngine {
   int addBody(const MassProperties& mass, const std::vector<Shape>& shapes, const BodyState& state) override;
   void setKinematic(int body) override;
   bool isKinematic(int body) const override;
+  void setEnabled(int body, bool enabled) override;
   void setMassScale(int body, double mass_factor, double inertia_factor) override;
   int addStatic(const std::vector<Shape>& shapes, const Pose& pose) override;
   void hotMemory(std::vector<MemoryRange>& out) const override;
@@ -138,6 +139,7 @@ class OdeEngine final : public PhysicEngine {
     bool kinematic = false;  // moved only by setState (dBodySetKinematic)
     bool pinned = false;     // joined to another body or the world: in its articulation's world
     bool listed = false;     // in away_
+    bool enabled = true;     // in the world (setEnabled): else ODE's body is disabled, its boxes off
     dMass mass;   // now (setMassScale)
     dMass added;  // as addBody gave it
     // what stepping it free takes: its inverse inertia and mass as ODE computed them (kinematic:

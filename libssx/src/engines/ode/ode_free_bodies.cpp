@@ -14,7 +14,10 @@
 #include <ode/odemath.h>
 #include <ode/rotation.h>
 
+#include <ssx/error.hpp>
+
 #include <cstring>
+#include <string>
 
 namespace ssx::detail {
 
@@ -103,24 +106,45 @@ void stepFreeOdeBody(dBodyID b, const dMass& mass, const dReal* inv_inertia, dRe
 // the engine's side of it: which bodies are free, and the partitions' step around ODE's
 
 void OdeEngine::cacheFreeStep(Body& body) {
+  // (a body out of the world stays so in whichever ODE body holds it now: moveBody makes another)
+  if (!body.enabled) dBodyDisable(body.id);
   odeInverseInertia(body.mass, body.kinematic, body.inv_inertia, body.inv_mass);
   body.gyroscopic = dBodyGetGyroscopicMode(body.id) != 0;
   body.plain = odeBodyIsPlain(body.id);
 }
 
+void OdeEngine::setEnabled(int index, bool enabled) {
+  if (index < 0 || static_cast<std::size_t>(index) >= bodies_.size())
+    throw Error("ode: setEnabled: no body " + std::to_string(index));
+  Body& body = bodies_[static_cast<std::size_t>(index)];
+  body.enabled = enabled;
+  if (enabled) {
+    // (what was added to it while it was out is not applied)
+    dBodySetForce(body.id, 0, 0, 0);
+    dBodySetTorque(body.id, 0, 0, 0);
+    dBodyEnable(body.id);
+  }
+  cacheFreeStep(body);
+}
+
 void OdeEngine::stepPartition(Partition& p, double h, std::span<const Wrench> wrenches) {
   if (p.order.empty()) return;
   // ODE clears force accumulators after each step: apply the held wrenches every substep
+  std::size_t out = 0;  // bodies out of the world: nothing moves them
   for (const int i : p.order) {
     const Wrench& w = wrenches[static_cast<std::size_t>(i)];
-    const dBodyID b = bodies_[static_cast<std::size_t>(i)].id;
-    dBodyAddForce(b, w.force.x(), w.force.y(), w.force.z());
-    dBodyAddTorque(b, w.torque.x(), w.torque.y(), w.torque.z());
+    const Body& body = bodies_[static_cast<std::size_t>(i)];
+    if (!body.enabled) {
+      ++out;
+      continue;
+    }
+    dBodyAddForce(body.id, w.force.x(), w.force.y(), w.force.z());
+    dBodyAddTorque(body.id, w.torque.x(), w.torque.y(), w.torque.z());
   }
   // the bodies no constraint holds are stepped here, not by ODE (see ode_engine.hpp)
   std::size_t free = 0;
   for (const int i : p.order) free += isFree(bodies_[static_cast<std::size_t>(i)]) ? 1 : 0;
-  if (free == p.order.size()) {
+  if (free + out == p.order.size()) {
     stepFree(p, h);
     return;
   }

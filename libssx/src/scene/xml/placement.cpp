@@ -32,6 +32,7 @@ void SceneLoader::readPlacements() {
       p.xyz = read<Vec3>(d, "xyz", Vec3::Zero());
       p.rpy = read<Vec3>(d, "rpy", Vec3::Zero());
       p.allow_overlap = read<bool>(d, "allow_overlap", false);
+      p.present = read<bool>(d, "present", true);
       checkUnknown(d, {"driver", "sensor", "ghost"});
       ok = !p.name.empty() && !p.type.empty() && readOverrides(d, p);
     } else if (d.name() == "swarm") {
@@ -165,6 +166,7 @@ bool SceneLoader::readSwarm(const Descriptor& d, PlacementModel& p, std::size_t 
     p.positions = detail::sphereLayout(count, p.radius);
   }
   p.allow_overlap = read<bool>(d, "allow_overlap", false);
+  p.present = read<bool>(d, "present", true);
   p.random_yaw = read<bool>(d, "random_yaw", false);
   if (p.random_yaw) {
     // a stream of its own, apart from the random layout's
